@@ -1,0 +1,148 @@
+//! Choosing the wavelengths a renderer evaluates, and the quadrature weights that go with them.
+
+use crate::error::{ColorError, Result};
+use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
+
+/// A closed wavelength interval in nanometres, validated against the observer data range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WavelengthRange {
+    pub min: f64,
+    pub max: f64,
+}
+
+impl WavelengthRange {
+    /// The visible range the paper renders by default.
+    pub const VISIBLE: WavelengthRange = WavelengthRange { min: 380.0, max: 730.0 };
+    /// The full range of the CIE observer tables.
+    pub const FULL: WavelengthRange = WavelengthRange { min: LAMBDA_MIN, max: LAMBDA_MAX };
+
+    pub fn new(min: f64, max: f64) -> Result<Self> {
+        let bad = |why: &str| Err(ColorError::BadRange { min, max, why: why.into() });
+        if !(min.is_finite() && max.is_finite()) {
+            return bad("bounds must be finite");
+        }
+        if min >= max {
+            return bad("the minimum must be below the maximum");
+        }
+        if min < LAMBDA_MIN || max > LAMBDA_MAX {
+            return bad("spectra has observer data for 360–830 nm only");
+        }
+        Ok(WavelengthRange { min, max })
+    }
+
+    /// Parses `380:730` (also accepts `380-730` and `380..730`).
+    pub fn parse(s: &str) -> Result<Self> {
+        let parts: Vec<&str> = s.splitn(2, [':', '-']).collect();
+        let parts = if parts.len() == 2 { parts } else { s.splitn(2, "..").collect() };
+        let num = |p: &str| p.trim().parse::<f64>().ok();
+        match parts.as_slice() {
+            [a, b] => match (num(a), num(b.trim_start_matches('.'))) {
+                (Some(a), Some(b)) => Self::new(a, b),
+                _ => Err(ColorError::BadRange {
+                    min: f64::NAN,
+                    max: f64::NAN,
+                    why: format!("cannot parse '{s}' as MIN:MAX"),
+                }),
+            },
+            _ => Err(ColorError::BadRange {
+                min: f64::NAN,
+                max: f64::NAN,
+                why: format!("expected MIN:MAX, got '{s}'"),
+            }),
+        }
+    }
+
+    pub fn width(&self) -> f64 {
+        self.max - self.min
+    }
+}
+
+/// Wavelengths with quadrature weights: ∫ f(λ) dλ ≈ Σ f(λᵢ) wᵢ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampledWavelengths {
+    pub lambda: Vec<f64>,
+    pub weight: Vec<f64>,
+}
+
+impl SampledWavelengths {
+    /// N equally spaced samples at the centres of N equal bins (the midpoint rule). This is
+    /// what the real-time renderer uses: deterministic, so there is no noise, and exact for
+    /// integrands that are linear across each bin.
+    pub fn midpoint(range: WavelengthRange, n: usize) -> Result<Self> {
+        if n == 0 {
+            return Err(ColorError::NoSamples);
+        }
+        let d = range.width() / n as f64;
+        Ok(SampledWavelengths {
+            lambda: (0..n).map(|i| range.min + (i as f64 + 0.5) * d).collect(),
+            weight: vec![d; n],
+        })
+    }
+
+    /// One jittered sample in each of N equal bins: `u[i]` in [0, 1) places sample i in its bin.
+    /// Unbiased for any integrand; averaging many frames converges to the exact integral.
+    pub fn stratified(range: WavelengthRange, u: &[f64]) -> Result<Self> {
+        let n = u.len();
+        if n == 0 {
+            return Err(ColorError::NoSamples);
+        }
+        let d = range.width() / n as f64;
+        Ok(SampledWavelengths {
+            lambda: u
+                .iter()
+                .enumerate()
+                .map(|(i, &ui)| range.min + (i as f64 + ui.clamp(0.0, 0.999_999_999)) * d)
+                .collect(),
+            weight: vec![d; n],
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.lambda.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.lambda.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn midpoint_places_bin_centres() {
+        let w = SampledWavelengths::midpoint(WavelengthRange::new(400.0, 700.0).unwrap(), 3).unwrap();
+        assert_eq!(w.lambda, vec![450.0, 550.0, 650.0]);
+        assert_eq!(w.weight, vec![100.0; 3]);
+    }
+
+    #[test]
+    fn midpoint_integrates_linear_exactly() {
+        let r = WavelengthRange::new(380.0, 730.0).unwrap();
+        let w = SampledWavelengths::midpoint(r, 7).unwrap();
+        let sum: f64 = w.lambda.iter().zip(&w.weight).map(|(l, wt)| (2.0 * l + 1.0) * wt).sum();
+        let exact = (730.0f64.powi(2) - 380.0f64.powi(2)) + 350.0;
+        assert!((sum - exact).abs() < 1e-9);
+    }
+
+    #[test]
+    fn stratified_stays_in_bins() {
+        let r = WavelengthRange::new(400.0, 500.0).unwrap();
+        let w = SampledWavelengths::stratified(r, &[0.0, 0.5, 0.999]).unwrap();
+        assert!(w.lambda[0] >= 400.0 && w.lambda[0] < 400.0 + 100.0 / 3.0);
+        assert!(w.lambda[2] < 500.0);
+    }
+
+    #[test]
+    fn rejects_bad_ranges_and_zero_samples() {
+        assert!(WavelengthRange::new(300.0, 700.0).is_err());
+        assert!(WavelengthRange::new(700.0, 400.0).is_err());
+        assert!(WavelengthRange::new(400.0, 900.0).is_err());
+        assert!(WavelengthRange::new(f64::NAN, 700.0).is_err());
+        assert_eq!(SampledWavelengths::midpoint(WavelengthRange::VISIBLE, 0), Err(ColorError::NoSamples));
+        assert_eq!(WavelengthRange::parse("380:730").unwrap(), WavelengthRange::VISIBLE);
+        assert!(WavelengthRange::parse("380").is_err());
+        assert!(WavelengthRange::parse("a:b").is_err());
+    }
+}
