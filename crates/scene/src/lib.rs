@@ -1,14 +1,192 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
+//! The scene description shared by the real-time renderer (`render`) and the ground-truth
+//! path tracer (`truth`): both draw exactly this, so their images can be compared.
+//!
+//! Geometry is flattened to world space at load time (node transforms applied), which is what
+//! both consumers want. Spectral data from glTF `extras` is resolved into
+//! [`color::Spectrum`] values at load time, so errors surface with the file and field named.
+
+use color::Spectrum;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// A fully loaded scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Where the scene came from (a path, or `builtin:NAME`); used in messages.
+    pub source: String,
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+    pub spectral: SpectralSettings,
+    /// Underwater settings (see the underwater issue); `None` for scenes in air.
+    pub water: Option<WaterSettings>,
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// A triangle mesh in world space.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    /// xyz tangent, w handedness (glTF convention); empty when the mesh has no normal map.
+    pub tangents: Vec<Vec4>,
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<u32>,
+    pub material: usize,
+}
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
+/// glTF metallic-roughness material plus spectral additions.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGBA factor.
+    pub base_color: Vec4,
+    pub base_color_texture: Option<TextureRef>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// glTF layout: B = metallic, G = roughness.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    pub normal_texture: Option<TextureRef>,
+    pub normal_scale: f32,
+    /// Linear RGB, already multiplied by `KHR_materials_emissive_strength`.
+    pub emissive: Vec3,
+    pub emissive_texture: Option<TextureRef>,
+    /// Measured reflectance spectra that override the RGB base colour for ground truth.
+    pub spectral: Option<SpectralReflectance>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: String::new(),
+            base_color: Vec4::ONE,
+            base_color_texture: None,
+            metallic: 0.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            spectral: None,
+        }
     }
+}
+
+/// Measured reflectance attached to a material.
+#[derive(Clone, Debug)]
+pub enum SpectralReflectance {
+    /// One spectrum for the whole material (multiplied by nothing: it replaces base colour).
+    Uniform(Spectrum),
+    /// A palette keyed by the 8-bit sRGB texel value of the base-colour texture: a texel
+    /// whose value equals `rgb8` uses `spectrum`; other texels fall back to upsampling.
+    Palette(Vec<PaletteEntry>),
+}
+
+#[derive(Clone, Debug)]
+pub struct PaletteEntry {
+    pub rgb8: [u8; 3],
+    pub spectrum: Spectrum,
+}
+
+/// A texture reference with its UV set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureRef {
+    pub index: usize,
+    pub tex_coord: u32,
+}
+
+/// An RGBA8 image. `srgb` says whether the RGB channels are sRGB-encoded (base colour,
+/// emissive) or linear data (normals, metallic-roughness).
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+    pub srgb: bool,
+}
+
+/// A light's emission: RGB (linear sRGB, the glTF way) and optionally a spectrum.
+///
+/// Convention: when `spectrum` is given it is scaled so that its CIE 1931 luminance equals
+/// the luminance of `rgb × intensity`; RGB rendering then uses the spectrum's own linear
+/// sRGB colour at that luminance. See `docs/scene-format.md`.
+#[derive(Clone, Debug)]
+pub struct Emission {
+    pub rgb: Vec3,
+    pub intensity: f32,
+    pub spectrum: Option<Spectrum>,
+}
+
+#[derive(Clone, Debug)]
+pub enum LightKind {
+    /// Intensity in candela (glTF), at `position`.
+    Point { position: Vec3, range: Option<f32> },
+    /// Cone around `direction` (unit, pointing away from the light).
+    Spot { position: Vec3, direction: Vec3, inner_cone: f32, outer_cone: f32, range: Option<f32> },
+    /// Illuminance in lux arriving along `direction` (unit, pointing away from the light).
+    Directional { direction: Vec3 },
+}
+
+#[derive(Clone, Debug)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    pub emission: Emission,
+}
+
+/// A perspective pinhole camera.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    /// Camera-to-world transform (glTF convention: looks down −Z, +Y up).
+    pub transform: Mat4,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+    pub znear: f32,
+    pub zfar: f32,
+    /// Width / height the scene was authored for; renderers use their own target's aspect.
+    pub aspect: Option<f32>,
+}
+
+impl Camera {
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, yfov: f32) -> Self {
+        Camera {
+            transform: Mat4::look_at_rh(eye, target, up).inverse(),
+            yfov,
+            znear: 0.01,
+            zfar: 1000.0,
+            aspect: None,
+        }
+    }
+
+    pub fn position(&self) -> Vec3 {
+        self.transform.w_axis.truncate()
+    }
+}
+
+/// Spectral rendering defaults carried by the scene (the CLI overrides them).
+#[derive(Clone, Debug, Default)]
+pub struct SpectralSettings {
+    /// Observer name for `color::Observer::by_name`.
+    pub observer: Option<String>,
+    /// Wavelength range in nm.
+    pub range: Option<(f32, f32)>,
+    /// Number of wavelength samples.
+    pub wavelengths: Option<u32>,
+    /// The illuminant whose white is the reference white for XYZ → RGB (default D65).
+    pub white: Option<String>,
+}
+
+/// Underwater settings, validated by the underwater work.
+#[derive(Clone, Debug)]
+pub struct WaterSettings {
+    /// Jerlov type name, e.g. `II`, `3C`, or a blend like `II.5`.
+    pub water_type: String,
+    /// Camera depth below the surface, metres.
+    pub depth: f32,
+    /// Unit direction towards the sun (above water).
+    pub sun_direction: Vec3,
+    /// Metres per scene unit.
+    pub scale: f32,
 }
