@@ -1,3 +1,31 @@
+//! `spectra`: real-time spectral rendering of RGB scenes, with the instruments to prove it.
+//!
+//! Each subcommand lives in its own file under `cmd/`.
+
+mod cmd;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "spectra",
+    version,
+    about = "Real-time spectral rendering of RGB assets, measured against ground truth"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {}
+
 fn main() {
-    println!("Hello, world!");
+    let cli = Cli::parse();
+    let result: anyhow::Result<()> = match cli.command {};
+    if let Err(e) = result {
+        // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
 }
