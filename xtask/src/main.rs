@@ -1,0 +1,184 @@
+//! Developer chores: `cargo xtask setup | demo | test | ci`.
+//!
+//! The README's two commands are `cargo xtask demo` and `cargo xtask test`; CI runs
+//! `cargo xtask ci`. Each installs what it needs on a fresh Debian machine, so nothing has to be
+//! set up by hand: a Vulkan driver (Mesa's software rasteriser lavapipe when there is no GPU
+//! driver) and, for the test oracles, the `colour-science` Python package.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+const VULKAN_PACKAGES: &[&str] = &["mesa-vulkan-drivers", "libvulkan1"];
+const PYTHON_PACKAGES: &[&str] = &["colour-science==0.4.7", "scipy"];
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let task = args.first().map(String::as_str).unwrap_or("help");
+    let rest = &args[args.len().min(1)..];
+    let result = match task {
+        "setup" => setup_vulkan().and_then(|_| setup_python()),
+        "demo" => demo(rest),
+        "test" => test(rest),
+        "ci" => ci(),
+        _ => {
+            eprintln!(
+                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, then test"
+            );
+            return if task == "help" { ExitCode::SUCCESS } else { ExitCode::FAILURE };
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask {task}: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+type Result<T = ()> = std::result::Result<T, String>;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace").to_path_buf()
+}
+
+fn run(cmd: &mut Command) -> Result {
+    eprintln!("$ {}", describe(cmd));
+    let status =
+        cmd.current_dir(root()).status().map_err(|e| format!("cannot start {}: {e}", describe(cmd)))?;
+    if status.success() { Ok(()) } else { Err(format!("`{}` failed ({status})", describe(cmd))) }
+}
+
+fn describe(cmd: &Command) -> String {
+    std::iter::once(cmd.get_program())
+        .chain(cmd.get_args())
+        .map(|s| s.to_string_lossy())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// A Vulkan ICD manifest means some driver (GPU or lavapipe) is installed.
+fn has_vulkan_driver() -> bool {
+    let icd_dirs = ["/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d"];
+    let has_icd =
+        icd_dirs.iter().any(|d| std::fs::read_dir(d).map(|mut r| r.next().is_some()).unwrap_or(false));
+    let has_loader = [
+        "/usr/lib/x86_64-linux-gnu/libvulkan.so.1",
+        "/usr/lib/aarch64-linux-gnu/libvulkan.so.1",
+        "/usr/lib/libvulkan.so.1",
+        "/usr/lib64/libvulkan.so.1",
+    ]
+    .iter()
+    .any(|p| Path::new(p).exists());
+    has_icd && has_loader
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
+}
+
+fn apt_install(packages: &[&str]) -> Result {
+    if Command::new("apt-get").arg("--version").output().is_err() {
+        return Err(format!(
+            "no apt-get on this machine: install {} with your package manager",
+            packages.join(" ")
+        ));
+    }
+    let sudo = !is_root();
+    let mk = |args: &[&str]| {
+        let mut c = if sudo { Command::new("sudo") } else { Command::new("apt-get") };
+        if sudo {
+            c.arg("-n").arg("apt-get");
+        }
+        c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+        c
+    };
+    run(&mut mk(&["update", "-qq"]))?;
+    run(mk(&["install", "-y", "-qq"]).args(packages))
+        .map_err(|e| format!("{e}\n  install them yourself: sudo apt-get install {}", packages.join(" ")))
+}
+
+/// Installs Mesa's Vulkan drivers when no Vulkan driver is present. A machine with a GPU
+/// driver already has an ICD and is left alone.
+fn setup_vulkan() -> Result {
+    if has_vulkan_driver() {
+        return Ok(());
+    }
+    eprintln!(
+        "No Vulkan driver found: installing Mesa's ({}), which includes the software rasteriser lavapipe.",
+        VULKAN_PACKAGES.join(" ")
+    );
+    apt_install(VULKAN_PACKAGES)
+}
+
+fn python() -> String {
+    std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+/// The oracle scripts in tools/ compare against colour-science; install it if missing.
+fn setup_python() -> Result {
+    let ok = Command::new(python())
+        .args(["-c", "import colour, scipy"])
+        .output()
+        .map(|o| o.status.success())
+        .map_err(|e| format!("cannot run {}: {e} (install python3)", python()))?;
+    if ok {
+        return Ok(());
+    }
+    let mut pip = Command::new(python());
+    pip.args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"]).args(PYTHON_PACKAGES);
+    if run(&mut pip).is_err() {
+        apt_install(&["python3-pip"])?;
+        run(&mut pip)?;
+    }
+    Ok(())
+}
+
+fn demo(extra: &[String]) -> Result {
+    setup_vulkan()?;
+    std::fs::create_dir_all(root().join("out")).map_err(|e| format!("cannot create out/: {e}"))?;
+    run(cargo().args(["run", "--release", "--package", "spectra", "--", "demo", "--out", "out"]).args(extra))
+}
+
+/// Every test: the Rust suite, then each `tools/check_*.py` oracle script.
+fn test(extra: &[String]) -> Result {
+    setup_vulkan()?;
+    setup_python()?;
+    run(cargo().args(["test", "--workspace"]).args(extra))?;
+    let mut checks: Vec<PathBuf> = std::fs::read_dir(root().join("tools"))
+        .map_err(|e| format!("cannot list tools/: {e}"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("check_") && n.ends_with(".py"))
+        })
+        .collect();
+    checks.sort();
+    let (mut passed, mut failed) = (0, Vec::new());
+    for check in &checks {
+        match run(Command::new(python()).arg(check)) {
+            Ok(()) => passed += 1,
+            Err(e) => {
+                eprintln!("{e}");
+                failed.push(check.display().to_string());
+            }
+        }
+    }
+    println!("oracle checks: {passed} passed, {} failed", failed.len());
+    if failed.is_empty() { Ok(()) } else { Err(format!("oracle checks failed: {}", failed.join(", "))) }
+}
+
+fn ci() -> Result {
+    run(cargo().args(["fmt", "--all", "--", "--check"]))?;
+    run(cargo().args(["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
+    test(&[])
+}
