@@ -1,14 +1,37 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! `truth`: a CPU spectral path tracer that renders exactly the [`scene::Scene`] the
+//! real-time renderer draws, as ground truth for it.
+//!
+//! - Camera, lights (point, spot with the glTF cone falloff, directional, emissive meshes) and
+//!   the glTF metallic-roughness BRDF follow the glTF specification, as the rasteriser does.
+//! - Reflectances are measured spectra where the material has them, otherwise the same
+//!   Jakob–Hanika upsampling the renderer uses ([`upsample::RgbToSpectrum`]).
+//! - Hero-wavelength sampling (four wavelengths per path), next-event estimation with MIS for
+//!   emissive meshes, Russian roulette, a homogeneous participating medium ([`Medium`]).
+//! - Output is XYZ with the normalisation of [`color::SpectralIntegrator`]: a perfect white lit
+//!   by the scene white has Y = 1, and an RGB (1,1,1) D65 light gives the RGB renderer's values.
+//! - Deterministic for a seed (per-pixel random streams), cancellable, reports progress.
+
+pub mod accel;
+pub mod bsdf;
+pub mod camera;
+pub mod error;
+pub mod integrator;
+pub mod lights;
+pub mod material;
+pub mod medium;
+pub mod render;
+pub mod rng;
+pub mod sampling;
+pub mod spectral;
+pub mod texture;
+pub mod upsample;
+pub mod world;
 
 #[cfg(test)]
-mod tests {
-    use super::*;
+mod testing;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use error::{Result, TruthError};
+pub use medium::{Medium, Phase, Region};
+pub use render::{Settings, XyzImage, render, render_world};
+pub use upsample::RgbToSpectrum;
+pub use world::World;

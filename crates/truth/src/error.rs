@@ -1,0 +1,23 @@
+//! What the path tracer can refuse, each message naming the offending input.
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum TruthError {
+    #[error("samples per pixel must be at least 1 (got 0)")]
+    NoSamples,
+    #[error("image size {0}×{1} is invalid: both sides must be at least 1 pixel")]
+    BadSize(u32, u32),
+    #[error("invalid medium: {0}")]
+    BadMedium(String),
+    #[error("scene '{scene}': {why}")]
+    BadScene { scene: String, why: String },
+    #[error(transparent)]
+    Color(#[from] color::ColorError),
+    #[error("rendering was interrupted")]
+    Cancelled,
+    #[error("writing {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+}
+
+pub type Result<T, E = TruthError> = std::result::Result<T, E>;

@@ -1,0 +1,274 @@
+//! The light transport estimator: unidirectional path tracing with next-event estimation,
+//! multiple importance sampling (power heuristic) between BRDF/phase sampling and emissive
+//! triangles, delta lights by NEE only, Russian roulette, and free-flight sampling in a
+//! homogeneous medium with spectral MIS over the four hero wavelengths.
+
+use crate::bsdf::Brdf;
+use crate::material;
+use crate::medium::{Phase, phase_eval, phase_sample};
+use crate::rng::Sampler;
+use crate::sampling::{Frame, power_heuristic, triangle_barycentrics};
+use crate::spectral::Wavelengths;
+use crate::world::{World, offset};
+use glam::{Vec3, Vec4};
+
+/// Where a path scatters: a surface (BRDF in a shading frame) or a point in the medium.
+enum Vertex {
+    Surface { brdf: Brdf, frame: Frame, ng: Vec3 },
+    Medium { phase: Phase },
+}
+
+impl Vertex {
+    /// (f·|cos| or phase value, pdf of sampling `wi`) for unit world directions; `wo` points
+    /// back along the path.
+    fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec4, f32) {
+        match self {
+            Vertex::Surface { brdf, frame, ng } => {
+                // Reflection only: both directions on the side of the (flipped) geometric normal.
+                if ng.dot(wi) <= 0.0 {
+                    return (Vec4::ZERO, 0.0);
+                }
+                let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
+                (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li))
+            }
+            Vertex::Medium { phase } => {
+                let p = phase_eval(*phase, (-wo).dot(wi));
+                (Vec4::splat(p), p)
+            }
+        }
+    }
+}
+
+pub struct Integrator<'w, 's> {
+    pub world: &'w World<'s>,
+    /// Paths of one scattering vertex only (direct lighting), to compare like for like with
+    /// a rasteriser.
+    pub direct_only: bool,
+    /// Hard cap on scattering events (Russian roulette ends paths long before it in practice).
+    pub max_depth: u32,
+}
+
+#[inline]
+fn mean(v: Vec4) -> f32 {
+    v.element_sum() * 0.25
+}
+
+/// exp(−σt·len) per lane, with 0·∞ = 0 (a transparent lane over an infinite segment).
+#[inline]
+fn beer(sigma_t: Vec4, len: f32) -> Vec4 {
+    Vec4::from_array(sigma_t.to_array().map(|s| if s == 0.0 { 1.0 } else { (-s * len).exp() }))
+}
+
+impl Integrator<'_, '_> {
+    fn transmittance(&self, o: Vec3, d: Vec3, dist: f32, l: Vec4) -> Vec4 {
+        match &self.world.medium {
+            Some(m) => match m.overlap(o, d, dist) {
+                Some((t0, t1)) => beer(m.coefficients(l).1, t1 - t0),
+                None => Vec4::ONE,
+            },
+            None => Vec4::ONE,
+        }
+    }
+
+    /// Light arriving at `p` from every delta light and one emissive-triangle sample, times
+    /// the vertex's scattering function, MIS-weighted against the vertex's own sampling.
+    fn direct(
+        &self,
+        p: Vec3,
+        ng: Option<Vec3>,
+        wo: Vec3,
+        v: &Vertex,
+        wl: &Wavelengths,
+        rng: &mut Sampler,
+    ) -> Vec4 {
+        let w = self.world;
+        let l = wl.0;
+        let origin = |dir: Vec3| ng.map_or(p, |n| offset(p, n, dir));
+        let mut sum = Vec4::ZERO;
+        for light in &w.delta_lights {
+            let Some(s) = light.sample(p) else { continue };
+            let (f, _) = v.eval(wo, s.wi);
+            if f == Vec4::ZERO {
+                continue;
+            }
+            let o = origin(s.wi);
+            let tmax =
+                if s.dist.is_finite() { (s.dist - (o - p).length()) * (1.0 - 1e-5) } else { f32::INFINITY };
+            if w.geometry.occluded(o, s.wi, tmax) {
+                continue;
+            }
+            sum += f * light.spectrum.eval4(l) * s.scale * self.transmittance(o, s.wi, tmax, l);
+        }
+        let (u, u2) = (rng.uniform(), rng.next2());
+        if let Some((tri, pmf)) = w.emitters.sample(u) {
+            let (_, b1, b2) = triangle_barycentrics(u2);
+            let q = w.point_on(tri, b1, b2);
+            let to = q.p - p;
+            let d2 = to.length_squared();
+            let dist = d2.sqrt();
+            if dist > 0.0 {
+                let wi = to / dist;
+                let le = w.emitted(&q, -wi, l);
+                let cos_l = q.ng.dot(wi).abs();
+                if le != Vec4::ZERO && cos_l > 0.0 {
+                    let (f, pdf_v) = v.eval(wo, wi);
+                    if f != Vec4::ZERO {
+                        let pdf_l = pmf / w.areas[tri as usize] * d2 / cos_l;
+                        let o = origin(wi);
+                        let tmax = (q.p - o).length() * (1.0 - 1e-4);
+                        if !w.geometry.occluded(o, wi, tmax) {
+                            let mis = power_heuristic(pdf_l, pdf_v);
+                            sum += f * le * self.transmittance(o, wi, tmax, l) * (mis / pdf_l);
+                        }
+                    }
+                }
+            }
+        }
+        sum
+    }
+
+    /// Radiance arriving at `o` from direction `-d` at the four wavelengths `wl`.
+    pub fn radiance(&self, mut o: Vec3, mut d: Vec3, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
+        let w = self.world;
+        let l = wl.0;
+        // Path throughput for the hero-wavelength MIS (Wilkie et al. 2014): `f` is the product
+        // of each lane's own path contribution, `p` of the pdfs each lane would have sampled the
+        // same decisions with (relative to the hero, which stays at 1). Lane i's estimate is
+        // f_i / mean_j(p_j): the balance heuristic over whole paths, not over single events.
+        let mut f = Vec4::ONE;
+        let mut p = Vec4::ONE;
+        let mut radiance = Vec4::ZERO;
+        // Solid-angle pdf of the direction that produced the current ray; 0 for camera rays
+        // (so emitters hit directly get full weight).
+        let mut prev_pdf = 0.0f32;
+        let mut depth = 0u32;
+        loop {
+            let hit = w.geometry.intersect(o, d, f32::INFINITY);
+            let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+
+            // Free flight through the medium, sampled at the hero wavelength, weighted by the
+            // balance heuristic over all four (the one-sample spectral MIS estimator).
+            if let Some(m) = &w.medium
+                && let Some((t0, t1)) = m.overlap(o, d, t_hit)
+            {
+                let (sigma_s, sigma_t) = m.coefficients(l);
+                let u = rng.uniform();
+                let t = if sigma_t.x > 0.0 { t0 - (1.0 - u).ln() / sigma_t.x } else { f32::INFINITY };
+                if t < t1 {
+                    let tr = beer(sigma_t, t - t0);
+                    let pdf = sigma_t * tr;
+                    if pdf.x <= 0.0 {
+                        break;
+                    }
+                    f *= sigma_s * tr / pdf.x;
+                    p *= pdf / pdf.x;
+                    let pos = o + d * t;
+                    let vtx = Vertex::Medium { phase: m.phase };
+                    if self.direct_only && depth >= 1 {
+                        break;
+                    }
+                    radiance += f / mean(p) * self.direct(pos, None, -d, &vtx, wl, rng);
+                    if depth + 1 >= self.max_depth {
+                        break;
+                    }
+                    let (wi, pdf) = phase_sample(m.phase, d, rng.next2());
+                    // phase/pdf = 1 for exact sampling; beta unchanged.
+                    prev_pdf = pdf;
+                    o = pos;
+                    d = wi;
+                    depth += 1;
+                    if !self.roulette(&mut f, p, depth, rng) {
+                        break;
+                    }
+                    continue;
+                }
+                let tr = beer(sigma_t, t1 - t0);
+                if tr.x <= 0.0 {
+                    break;
+                }
+                f *= tr / tr.x;
+                p *= tr / tr.x;
+            }
+
+            let Some(hit) = hit else {
+                if let Some(env) = &w.environment {
+                    radiance += f / mean(p) * env.eval4(l);
+                }
+                break;
+            };
+            let s = w.surface(&hit);
+            let wo = -d;
+
+            let le = w.emitted(&s, wo, l);
+            if le != Vec4::ZERO {
+                let mis = if prev_pdf > 0.0 {
+                    let pdf_l = w.emitters.pmf[s.tri as usize] / w.areas[s.tri as usize] * hit.t * hit.t
+                        / s.ng.dot(wo).abs().max(1e-12);
+                    power_heuristic(prev_pdf, pdf_l)
+                } else {
+                    1.0
+                };
+                radiance += f / mean(p) * le * mis;
+            }
+            if (self.direct_only && depth >= 1) || depth + 1 > self.max_depth {
+                break;
+            }
+
+            // Two-sided shading: face the normals towards the viewer.
+            let flip = if s.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+            let ng = s.ng * flip;
+            let mat = &w.scene.materials[s.material];
+            let mut ns = material::mapped_normal(mat, &w.scene.textures, s.uv, s.n_vertex * flip, s.tangent);
+            if ns.dot(wo) <= 0.0 {
+                ns = ng;
+            }
+            let base = material::base_reflectance(
+                mat,
+                &w.materials[s.material],
+                &w.scene.textures,
+                w.upsampler,
+                s.uv,
+                l,
+            );
+            let (metallic, roughness) = material::metallic_roughness(mat, &w.scene.textures, s.uv);
+            let brdf = Brdf::new(base, metallic, roughness);
+            let frame = Frame::from_normal(ns);
+            let vtx = Vertex::Surface { brdf, frame, ng };
+
+            radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);
+
+            let Some(bs) = brdf.sample(frame.to_local(wo), rng.uniform(), rng.next2()) else { break };
+            let wi = frame.to_world(bs.wi);
+            if ng.dot(wi) <= 0.0 {
+                break;
+            }
+            // The BRDF pdf is the same for every lane, so it only scales `f`.
+            f *= bs.f * (bs.wi.z / bs.pdf);
+            prev_pdf = bs.pdf;
+            o = offset(s.p, ng, wi);
+            d = wi;
+            depth += 1;
+            if !self.roulette(&mut f, p, depth, rng) {
+                break;
+            }
+        }
+        radiance
+    }
+
+    /// Russian roulette from the fourth vertex on, survival ∝ the largest throughput lane.
+    fn roulette(&self, f: &mut Vec4, p: Vec4, depth: u32, rng: &mut Sampler) -> bool {
+        if depth < 4 || self.direct_only {
+            return true;
+        }
+        let q = (*f / mean(p)).max_element().min(0.95);
+        if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+            return false;
+        }
+        *f /= q;
+        true
+    }
+}
+
+#[cfg(test)]
+#[path = "integrator_tests.rs"]
+mod tests;

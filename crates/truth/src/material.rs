@@ -1,0 +1,176 @@
+//! What a surface point looks like at four wavelengths: glTF material inputs resolved through
+//! textures, measured spectra where the material has them, Jakob–Hanika upsampling otherwise.
+
+use crate::spectral::DenseSpectrum;
+use crate::texture;
+use crate::upsample::{self, RgbToSpectrum};
+use color::WavelengthRange;
+use glam::{Vec2, Vec3, Vec4};
+use scene::{Material, SpectralReflectance, Texture, TextureRef};
+
+/// Per-material data precomputed for the inner loop.
+pub struct PreparedMaterial {
+    uniform: Option<DenseSpectrum>,
+    palette: Vec<([u8; 3], DenseSpectrum)>,
+}
+
+impl PreparedMaterial {
+    pub fn new(m: &Material, range: WavelengthRange) -> Self {
+        match &m.spectral {
+            Some(SpectralReflectance::Uniform(s)) => {
+                PreparedMaterial { uniform: Some(DenseSpectrum::new(s, range)), palette: vec![] }
+            }
+            Some(SpectralReflectance::Palette(p)) => PreparedMaterial {
+                uniform: None,
+                palette: p.iter().map(|e| (e.rgb8, DenseSpectrum::new(&e.spectrum, range))).collect(),
+            },
+            None => PreparedMaterial { uniform: None, palette: vec![] },
+        }
+    }
+}
+
+fn tex<'a>(textures: &'a [Texture], r: &Option<TextureRef>) -> Option<&'a Texture> {
+    r.as_ref().and_then(|r| textures.get(r.index)).filter(|t| t.width > 0 && t.height > 0)
+}
+
+/// Base colour reflectance at four wavelengths.
+///
+/// Measured spectra replace the RGB: `Uniform` everywhere, `Palette` per texel (each of the
+/// four texels of the bilinear footprint contributes its own spectrum, so the filtering
+/// happens in the spectral domain). Everything else is base factor × filtered texture,
+/// upsampled.
+pub fn base_reflectance(
+    m: &Material,
+    pm: &PreparedMaterial,
+    textures: &[Texture],
+    up: &dyn RgbToSpectrum,
+    uv: Vec2,
+    l: Vec4,
+) -> Vec4 {
+    if let Some(u) = &pm.uniform {
+        return u.eval4(l);
+    }
+    let factor = m.base_color.truncate();
+    let t = tex(textures, &m.base_color_texture);
+    if let (false, Some(t)) = (pm.palette.is_empty(), t) {
+        let f = texture::footprint(t, uv);
+        let mut acc = Vec4::ZERO;
+        for (&at, w) in f.texels.iter().zip(f.weights) {
+            if w == 0.0 {
+                continue;
+            }
+            let t8 = texture::texel8(t, at);
+            let s = match pm.palette.iter().find(|(k, _)| *k == [t8[0], t8[1], t8[2]]) {
+                Some((_, s)) => s.eval4(l),
+                None => {
+                    let rgb = texture::texel(t, at).truncate() * factor;
+                    upsample::reflectance(up, rgb.to_array(), l)
+                }
+            };
+            acc += s * w;
+        }
+        return acc;
+    }
+    let rgb = match t {
+        Some(t) => texture::sample(t, uv).truncate() * factor,
+        None => factor,
+    };
+    upsample::reflectance(up, rgb.to_array(), l)
+}
+
+/// (metallic, roughness) with the texture applied (glTF: B = metallic, G = roughness).
+pub fn metallic_roughness(m: &Material, textures: &[Texture], uv: Vec2) -> (f32, f32) {
+    match tex(textures, &m.metallic_roughness_texture) {
+        Some(t) => {
+            let s = texture::sample(t, uv);
+            (m.metallic * s.z, m.roughness * s.y)
+        }
+        None => (m.metallic, m.roughness),
+    }
+}
+
+/// Linear emissive RGB (factor × sRGB-decoded texture).
+pub fn emissive_rgb(m: &Material, textures: &[Texture], uv: Vec2) -> Vec3 {
+    match tex(textures, &m.emissive_texture) {
+        Some(t) => m.emissive * texture::sample(t, uv).truncate(),
+        None => m.emissive,
+    }
+}
+
+/// The shading normal after the normal map; `n` is the interpolated vertex normal and
+/// `tangent` (xyz, w = handedness) the interpolated tangent.
+pub fn mapped_normal(
+    m: &Material,
+    textures: &[Texture],
+    uv: Vec2,
+    n: Vec3,
+    tangent: Option<glam::Vec4>,
+) -> Vec3 {
+    let (Some(t), Some(tan)) = (tex(textures, &m.normal_texture), tangent) else { return n };
+    let s = texture::sample(t, uv);
+    let mut v = Vec3::new(2.0 * s.x - 1.0, 2.0 * s.y - 1.0, 2.0 * s.z - 1.0);
+    v.x *= m.normal_scale;
+    v.y *= m.normal_scale;
+    let f =
+        crate::sampling::Frame::from_normal_tangent(n, tan.truncate(), if tan.w < 0.0 { -1.0 } else { 1.0 });
+    let out = f.to_world(v).normalize_or_zero();
+    if out == Vec3::ZERO { n } else { out }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::upsample::GreyOnly;
+    use color::Spectrum;
+    use scene::PaletteEntry;
+
+    fn l() -> Vec4 {
+        Vec4::new(420.0, 500.0, 580.0, 660.0)
+    }
+
+    #[test]
+    fn uniform_spectrum_replaces_base_colour() {
+        let s = Spectrum::piecewise(vec![380.0, 730.0], vec![0.2, 0.9]).unwrap();
+        let m = Material { spectral: Some(SpectralReflectance::Uniform(s.clone())), ..Default::default() };
+        let pm = PreparedMaterial::new(&m, WavelengthRange::VISIBLE);
+        let r = base_reflectance(&m, &pm, &[], &GreyOnly, Vec2::ZERO, l());
+        for (a, b) in r.to_array().iter().zip(l().to_array()) {
+            assert!((*a as f64 - s.eval(b as f64)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn palette_matches_texels_and_falls_back_to_upsampling() {
+        let t = Texture {
+            name: "p".into(),
+            width: 2,
+            height: 1,
+            rgba8: vec![10, 20, 30, 255, 255, 255, 255, 255],
+            srgb: true,
+        };
+        let m = Material {
+            base_color_texture: Some(TextureRef { index: 0, tex_coord: 0 }),
+            spectral: Some(SpectralReflectance::Palette(vec![PaletteEntry {
+                rgb8: [10, 20, 30],
+                spectrum: Spectrum::Constant(0.3),
+            }])),
+            ..Default::default()
+        };
+        let pm = PreparedMaterial::new(&m, WavelengthRange::VISIBLE);
+        let at =
+            |u: f32| base_reflectance(&m, &pm, std::slice::from_ref(&t), &GreyOnly, Vec2::new(u, 0.5), l());
+        assert!((at(0.25) - Vec4::splat(0.3)).abs().max_element() < 1e-5);
+        assert!((at(0.75) - Vec4::ONE).abs().max_element() < 1e-5);
+        assert!((at(0.5) - Vec4::splat(0.65)).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn flat_normal_map_keeps_the_normal() {
+        let t =
+            Texture { name: "n".into(), width: 1, height: 1, rgba8: vec![128, 128, 255, 255], srgb: false };
+        let m =
+            Material { normal_texture: Some(TextureRef { index: 0, tex_coord: 0 }), ..Default::default() };
+        let n = mapped_normal(&m, &[t], Vec2::ZERO, Vec3::Y, Some(glam::Vec4::new(1.0, 0.0, 0.0, 1.0)));
+        assert!((n - Vec3::Y).length() < 0.01);
+    }
+}

@@ -1,0 +1,217 @@
+//! Homogeneous participating media: per-wavelength absorption and scattering coefficients and
+//! a phase function, filling the whole scene or an axis-aligned box.
+//!
+//! The box is a region of space, not a surface: rays cross its faces without refraction
+//! (index-matched), which is what the underwater model assumes for water around objects.
+
+use crate::error::{Result, TruthError};
+use crate::sampling::Frame;
+use crate::spectral::DenseSpectrum;
+use color::{Spectrum, WavelengthRange};
+use glam::{Vec3, Vec4};
+use std::f32::consts::PI;
+
+/// Where a medium is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Region {
+    /// Everywhere, including around the camera.
+    Everywhere,
+    /// Inside the box `[min, max]` (world units).
+    Box { min: Vec3, max: Vec3 },
+}
+
+/// Angular distribution of scattered light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Phase {
+    Isotropic,
+    /// Henyey–Greenstein with mean cosine `g` in (−1, 1); g > 0 scatters forward.
+    HenyeyGreenstein {
+        g: f32,
+    },
+}
+
+/// A homogeneous medium. Coefficients are per scene unit of length (m⁻¹ when one unit is a
+/// metre), as functions of wavelength in nm.
+#[derive(Clone, Debug)]
+pub struct Medium {
+    pub sigma_a: Spectrum,
+    pub sigma_s: Spectrum,
+    pub phase: Phase,
+    pub region: Region,
+}
+
+impl Medium {
+    /// Checks that the coefficients are finite and non-negative over `range` (1 nm steps) and
+    /// that the phase function and region make sense.
+    pub fn validate(&self, range: WavelengthRange) -> Result<()> {
+        let bad = |s: String| Err(TruthError::BadMedium(s));
+        for (name, s) in [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)] {
+            let n = range.width().ceil() as usize;
+            for i in 0..=n {
+                let l = (range.min + i as f64).min(range.max);
+                let v = s.eval(l);
+                if !v.is_finite() || v < 0.0 {
+                    return bad(format!("{name} is {v} at {l} nm; coefficients must be finite and ≥ 0"));
+                }
+            }
+        }
+        if let Phase::HenyeyGreenstein { g } = self.phase
+            && !(g > -1.0 && g < 1.0)
+        {
+            return bad(format!("Henyey–Greenstein g = {g} must lie strictly between −1 and 1"));
+        }
+        if let Region::Box { min, max } = self.region
+            && (!min.is_finite() || !max.is_finite() || min.cmpgt(max).any())
+        {
+            return bad(format!("box {min}..{max} is empty or not finite"));
+        }
+        Ok(())
+    }
+}
+
+/// A validated medium prepared for the inner loop.
+#[derive(Clone, Debug)]
+pub struct PreparedMedium {
+    sigma_a: DenseSpectrum,
+    sigma_s: DenseSpectrum,
+    pub phase: Phase,
+    pub region: Region,
+}
+
+impl PreparedMedium {
+    pub fn new(m: &Medium, range: WavelengthRange) -> Result<Self> {
+        m.validate(range)?;
+        Ok(PreparedMedium {
+            sigma_a: DenseSpectrum::new(&m.sigma_a, range),
+            sigma_s: DenseSpectrum::new(&m.sigma_s, range),
+            phase: m.phase,
+            region: m.region,
+        })
+    }
+
+    /// (σs, σt) at four wavelengths.
+    #[inline]
+    pub fn coefficients(&self, l: Vec4) -> (Vec4, Vec4) {
+        let s = self.sigma_s.eval4(l);
+        (s, s + self.sigma_a.eval4(l))
+    }
+
+    /// The part `[t0, t1]` of the ray segment `[0, tmax]` inside the medium, if any.
+    pub fn overlap(&self, o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, f32)> {
+        match self.region {
+            Region::Everywhere => Some((0.0, tmax)),
+            Region::Box { min, max } => {
+                let inv = d.recip();
+                let ta = (min - o) * inv;
+                let tb = (max - o) * inv;
+                // NaN (0·∞ on a face-parallel ray) must not widen the interval: max/min ignore it.
+                let t0 = ta.min(tb).max_element().max(0.0);
+                let t1 = ta.max(tb).min_element().min(tmax);
+                (t0 < t1).then_some((t0, t1))
+            }
+        }
+    }
+}
+
+/// Phase function value for the angle between the incoming propagation direction `wi_prop`
+/// (where the light travels) and the outgoing direction `wo`: cosθ = wi_prop·wo.
+pub fn phase_eval(p: Phase, cos_theta: f32) -> f32 {
+    match p {
+        Phase::Isotropic => 1.0 / (4.0 * PI),
+        Phase::HenyeyGreenstein { g } => {
+            let d = 1.0 + g * g - 2.0 * g * cos_theta;
+            (1.0 - g * g) / (4.0 * PI * d * d.max(1e-12).sqrt())
+        }
+    }
+}
+
+/// Samples a new propagation direction given the current one; returns (dir, pdf = phase value).
+pub fn phase_sample(p: Phase, dir: Vec3, u: [f32; 2]) -> (Vec3, f32) {
+    let cos_theta = match p {
+        Phase::Isotropic => 1.0 - 2.0 * u[0],
+        Phase::HenyeyGreenstein { g } if g.abs() < 1e-3 => 1.0 - 2.0 * u[0],
+        Phase::HenyeyGreenstein { g } => {
+            let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u[0]);
+            ((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
+        }
+    };
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u[1];
+    let f = Frame::from_normal(dir);
+    let w = f.to_world(Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta));
+    (w, phase_eval(p, cos_theta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hg_is_normalised_and_has_mean_cosine_g() {
+        for g in [-0.6, 0.0, 0.3, 0.9] {
+            let p = Phase::HenyeyGreenstein { g };
+            let n = 200_000;
+            let (mut norm, mut mean) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                let c = -1.0 + 2.0 * (i as f64 + 0.5) / n as f64;
+                let v = phase_eval(p, c as f32) as f64 * 2.0 * std::f64::consts::PI * 2.0 / n as f64;
+                norm += v;
+                mean += v * c;
+            }
+            assert!((norm - 1.0).abs() < 1e-3, "g={g}: ∫p = {norm}");
+            assert!((mean - g as f64).abs() < 2e-3, "g={g}: mean cos = {mean}");
+        }
+    }
+
+    #[test]
+    fn hg_sampling_matches_its_pdf() {
+        // The sampled cosines must have mean g.
+        let g = 0.7;
+        let p = Phase::HenyeyGreenstein { g };
+        let n = 100_000;
+        let mut m = 0.0f64;
+        for i in 0..n {
+            let (w, pdf) = phase_sample(p, Vec3::Z, [(i as f32 + 0.5) / n as f32, 0.3]);
+            assert!((pdf - phase_eval(p, w.z)).abs() <= 1e-3 * pdf);
+            m += w.z as f64;
+        }
+        assert!((m / n as f64 - g as f64).abs() < 2e-3);
+    }
+
+    #[test]
+    fn validation_rejects_bad_media() {
+        let r = WavelengthRange::VISIBLE;
+        let ok = Medium {
+            sigma_a: Spectrum::Constant(0.1),
+            sigma_s: Spectrum::Constant(0.2),
+            phase: Phase::HenyeyGreenstein { g: 0.5 },
+            region: Region::Everywhere,
+        };
+        assert!(ok.validate(r).is_ok());
+        let neg = Medium { sigma_a: Spectrum::Constant(-0.1), ..ok.clone() };
+        assert!(neg.validate(r).unwrap_err().to_string().contains("sigma_a"));
+        let nan = Medium { sigma_s: Spectrum::Constant(f64::NAN), ..ok.clone() };
+        assert!(nan.validate(r).is_err());
+        let g = Medium { phase: Phase::HenyeyGreenstein { g: 1.0 }, ..ok.clone() };
+        assert!(g.validate(r).is_err());
+        let b = Medium { region: Region::Box { min: Vec3::ONE, max: Vec3::ZERO }, ..ok };
+        assert!(b.validate(r).is_err());
+    }
+
+    #[test]
+    fn box_overlap() {
+        let m = PreparedMedium::new(
+            &Medium {
+                sigma_a: Spectrum::Constant(1.0),
+                sigma_s: Spectrum::Constant(0.0),
+                phase: Phase::Isotropic,
+                region: Region::Box { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) },
+            },
+            WavelengthRange::VISIBLE,
+        )
+        .unwrap();
+        assert_eq!(m.overlap(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, 100.0), Some((4.0, 6.0)));
+        assert_eq!(m.overlap(Vec3::ZERO, Vec3::X, 0.5), Some((0.0, 0.5)));
+        assert_eq!(m.overlap(Vec3::new(-5.0, 3.0, 0.0), Vec3::X, 100.0), None);
+    }
+}

@@ -1,0 +1,58 @@
+//! Small scenes built in code for the tests.
+
+use glam::{Mat4, Vec3};
+use scene::{Camera, Light, Material, Mesh, Scene, SpectralSettings};
+
+pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light>) -> Scene {
+    Scene {
+        source: "test".into(),
+        meshes,
+        materials,
+        textures: vec![],
+        lights,
+        camera: Camera { transform: Mat4::IDENTITY, yfov: 0.8, znear: 0.01, zfar: 100.0, aspect: None },
+        spectral: SpectralSettings::default(),
+        water: None,
+    }
+}
+
+/// An axis-aligned box of half-size `h` around the origin, faces wound (and normals pointing)
+/// inwards, so it is an enclosure seen from inside.
+pub fn inward_box(h: f32, material: usize) -> Mesh {
+    let mut m = Mesh { material, ..Default::default() };
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = -sign * Vec3::from_array(std::array::from_fn(|i| if i == axis { 1.0 } else { 0.0 }));
+            let c = -n * h;
+            let u = Vec3::from_array(std::array::from_fn(|i| if i == (axis + 1) % 3 { h } else { 0.0 }));
+            let v = n.cross(u);
+            let base = m.positions.len() as u32;
+            for p in [c - u - v, c + u - v, c + u + v, c - u + v] {
+                m.positions.push(p);
+                m.normals.push(n);
+            }
+            // Counter-clockwise seen from the side n points to.
+            m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    m
+}
+
+/// A quad with normal `n` (CCW seen from n), centre `c`, half-extent `h`.
+pub fn quad(c: Vec3, n: Vec3, h: f32, material: usize) -> Mesh {
+    let f = crate::sampling::Frame::from_normal(n.normalize());
+    let (u, v) = (f.t * h, f.b * h);
+    Mesh {
+        positions: vec![c - u - v, c + u - v, c + u + v, c - u + v],
+        normals: vec![f.n; 4],
+        uvs: vec![
+            glam::Vec2::new(0.0, 1.0),
+            glam::Vec2::new(1.0, 1.0),
+            glam::Vec2::new(1.0, 0.0),
+            glam::Vec2::ZERO,
+        ],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material,
+        ..Default::default()
+    }
+}
