@@ -7,6 +7,7 @@ pub mod error;
 pub mod illuminant;
 pub mod observer;
 pub mod spectrum;
+pub mod water;
 pub mod wavelengths;
 pub mod xyz;
 

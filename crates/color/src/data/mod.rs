@@ -4,6 +4,8 @@
 pub mod cmf;
 pub mod colorchecker;
 pub mod illuminants;
+pub mod observers_extra;
+pub mod water;
 
 /// A uniformly sampled table of a spectral quantity: `values[i]` is the value at
 /// `start + i * step` nanometres.
