@@ -1,14 +1,23 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! Image comparison for spectra: image I/O (EXR, PNG), per-pixel error metrics (CIEDE2000,
+//! MAE), and ΔE heat maps with a readable colour bar.
+//!
+//! Everything here works on [`Image`], linear sRGB (Rec. 709 primaries, D65 white) pixels, the
+//! type the GPU renderer and the CPU ground-truth tracer both hand to the binary. The metric
+//! maps ([`DiffMaps`]) and heat maps ([`Heatmap`]) are plain values so a report generator can
+//! reuse them without going through files.
+//!
+//! Depends on `color` only.
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+pub mod atomic;
+pub mod diff;
+pub mod error;
+pub mod font;
+pub mod heatmap;
+pub mod image;
+pub mod io;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use diff::{DiffMaps, DiffOptions, DiffSummary};
+pub use error::{CompareError, Result};
+pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
+pub use image::Image;
+pub use io::{ExrPrecision, PngBitDepth, WriteOptions, read_image, write_image};

@@ -18,11 +18,16 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Measure a render against a reference: CIEDE2000 and MAE statistics, optional heat map.
+    Diff(cmd::diff::Args),
+}
 
 fn main() {
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {};
+    let result: anyhow::Result<()> = match cli.command {
+        Command::Diff(a) => cmd::diff::run(a),
+    };
     if let Err(e) = result {
         // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".
         eprintln!("error: {e:#}");

@@ -1,0 +1,376 @@
+//! Reading and writing [`Image`]s: OpenEXR (linear, f16/f32) and PNG (sRGB-encoded, 8/16-bit).
+//!
+//! The format follows the extension (case-insensitive). EXR holds linear values as they are;
+//! PNG holds IEC 61966-2-1 sRGB-encoded values, so reading decodes them to linear and writing
+//! clamps linear values to [0, 1] and encodes them. Writes are atomic ([`crate::atomic`]).
+
+use std::io::Cursor;
+use std::path::Path;
+
+use color::colorspace::{srgb_decode, srgb_encode};
+use exr::prelude::{
+    AnyChannels, Encoding, FlatSamples, Layer, ReadChannels, ReadLayers, SpecificChannels, Vec2,
+    WritableImage, f16,
+};
+
+use crate::atomic::write_atomic;
+use crate::error::{CompareError, Result};
+use crate::image::Image;
+
+/// Sample type of written EXR files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ExrPrecision {
+    /// 32-bit float: exact.
+    #[default]
+    F32,
+    /// 16-bit half float: about 3 significant digits, values above 65504 become infinite.
+    F16,
+}
+
+/// Bit depth of written PNG files.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PngBitDepth {
+    #[default]
+    Eight,
+    Sixteen,
+}
+
+/// Per-format choices for [`write_image`]; the extension picks which one applies.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    pub exr: ExrPrecision,
+    pub png: PngBitDepth,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Exr,
+    Png,
+}
+
+fn format_of(path: &Path) -> Result<Format> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    match ext.as_str() {
+        "exr" => Ok(Format::Exr),
+        "png" => Ok(Format::Png),
+        _ => Err(CompareError::UnsupportedExtension { path: path.into(), ext }),
+    }
+}
+
+/// Reads an EXR or PNG file into linear sRGB.
+///
+/// EXR: the first valid layer at its largest resolution; channels `R`, `G`, `B` are required
+/// (any other channel, e.g. `A`, is ignored); f16, f32 and u32 samples are converted to f32.
+/// The data window is taken as the image (its offset is ignored).
+///
+/// PNG: 8- or 16-bit, grey, grey+alpha, RGB, RGBA or palette; values are sRGB-decoded.
+/// Alpha is dropped, not composited: renders and references are opaque.
+pub fn read_image(path: impl AsRef<Path>) -> Result<Image> {
+    let path = path.as_ref();
+    let format = format_of(path)?;
+    let bytes = std::fs::read(path).map_err(|e| CompareError::io(path, e))?;
+    match format {
+        Format::Exr => read_exr(path, &bytes),
+        Format::Png => read_png(path, &bytes),
+    }
+}
+
+fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
+    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| decode(e.to_string()))?;
+    let layer: Layer<AnyChannels<FlatSamples>> = image.layer_data;
+    let channels = &layer.channel_data.list;
+    let find = |name: &str| channels.iter().find(|c| c.name.eq(name));
+    let (r, g, b) = match (find("R"), find("G"), find("B")) {
+        (Some(r), Some(g), Some(b)) => (r, g, b),
+        found => {
+            let missing: Vec<&str> =
+                [("R", found.0.is_none()), ("G", found.1.is_none()), ("B", found.2.is_none())]
+                    .into_iter()
+                    .filter_map(|(n, m)| m.then_some(n))
+                    .collect();
+            let present: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+            return Err(CompareError::MissingChannels {
+                path: path.into(),
+                missing: missing.join(", "),
+                present: if present.is_empty() { "none".into() } else { present.join(", ") },
+            });
+        }
+    };
+    for c in [r, g, b] {
+        if c.sampling != Vec2(1, 1) {
+            return Err(decode(format!("channel {} is subsampled, which is not supported", c.name)));
+        }
+    }
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let (width, height) = (
+        u32::try_from(w).map_err(|_| decode(format!("width {w} too large")))?,
+        u32::try_from(h).map_err(|_| decode(format!("height {h} too large")))?,
+    );
+    let data = (0..w * h).map(|i| [r, g, b].map(|c| c.sample_data.value_by_flat_index(i).to_f32())).collect();
+    Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+}
+
+fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {
+    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "PNG", reason };
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .map_err(|e| decode(e.to_string()))?;
+    let ct = img.color();
+    let bits_per_channel = ct.bits_per_pixel() / u16::from(ct.channel_count());
+    let (width, height) = (img.width(), img.height());
+    // Lookup tables: decoding is the same few thousand values over and over.
+    let data = if bits_per_channel > 8 {
+        let lut: Vec<f32> = (0..=u16::MAX).map(|v| srgb_decode(f64::from(v) / 65535.0) as f32).collect();
+        img.to_rgb16().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
+    } else {
+        let lut: Vec<f32> = (0..=u8::MAX).map(|v| srgb_decode(f64::from(v) / 255.0) as f32).collect();
+        img.to_rgb8().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
+    };
+    Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+}
+
+/// Writes an image as EXR or PNG (by extension), atomically: on error no file is created
+/// and an existing file at `path` is left untouched.
+///
+/// PNG output needs finite pixels (a NaN has no honest 8-bit encoding); it is an error
+/// naming the first offending pixel. EXR stores NaN and ∞ as they are.
+pub fn write_image(path: impl AsRef<Path>, image: &Image, opts: WriteOptions) -> Result<()> {
+    let path = path.as_ref();
+    let format = format_of(path)?;
+    // The fields are public, so a hand-built image may be inconsistent.
+    image.validate()?;
+    let bytes = match format {
+        Format::Exr => encode_exr(path, image, opts.exr)?,
+        Format::Png => encode_png(path, image, opts.png)?,
+    };
+    write_atomic(path, &bytes)
+}
+
+fn encode_exr(path: &Path, image: &Image, precision: ExrPrecision) -> Result<Vec<u8>> {
+    let w = image.width as usize;
+    let size = (w, image.height as usize);
+    let px = |x: usize, y: usize| image.data[y * w + x];
+    let mut buf = Cursor::new(Vec::new());
+    // ZIP over scan lines: lossless, compact, and readable by every EXR implementation.
+    let res = match precision {
+        ExrPrecision::F32 => {
+            let ch = SpecificChannels::rgb(|Vec2(x, y)| {
+                let p = px(x, y);
+                (p[0], p[1], p[2])
+            });
+            exr::prelude::Image::from_encoded_channels(size, Encoding::SMALL_LOSSLESS, ch)
+                .write()
+                .to_buffered(&mut buf)
+        }
+        ExrPrecision::F16 => {
+            let ch = SpecificChannels::rgb(|Vec2(x, y)| {
+                let p = px(x, y).map(f16::from_f32);
+                (p[0], p[1], p[2])
+            });
+            exr::prelude::Image::from_encoded_channels(size, Encoding::SMALL_LOSSLESS, ch)
+                .write()
+                .to_buffered(&mut buf)
+        }
+    };
+    res.map_err(|e| CompareError::Encode { path: path.into(), format: "OpenEXR", reason: e.to_string() })?;
+    Ok(buf.into_inner())
+}
+
+/// Linear → display-encoded sRGB in [0, 1]: clamp first, as a display would.
+pub fn to_display(v: f32) -> f64 {
+    srgb_encode(f64::from(v).clamp(0.0, 1.0))
+}
+
+fn encode_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<Vec<u8>> {
+    image.check_finite(&path.display().to_string())?;
+    let enc_err = |e: image::ImageError| CompareError::Encode {
+        path: path.into(),
+        format: "PNG",
+        reason: e.to_string(),
+    };
+    let mut buf = Cursor::new(Vec::new());
+    let (w, h) = (image.width, image.height);
+    match depth {
+        PngBitDepth::Eight => {
+            let raw: Vec<u8> =
+                image.data.iter().flat_map(|p| p.map(|v| (to_display(v) * 255.0).round() as u8)).collect();
+            let img = image::RgbImage::from_raw(w, h, raw).expect("length checked by write_image");
+            img.write_to(&mut buf, image::ImageFormat::Png).map_err(enc_err)?;
+        }
+        PngBitDepth::Sixteen => {
+            let raw: Vec<u16> =
+                image.data.iter().flat_map(|p| p.map(|v| (to_display(v) * 65535.0).round() as u16)).collect();
+            let img = image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(w, h, raw)
+                .expect("length checked by write_image");
+            img.write_to(&mut buf, image::ImageFormat::Png).map_err(enc_err)?;
+        }
+    }
+    Ok(buf.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn test_image() -> Image {
+        // HDR and negative values on purpose: EXR must keep them.
+        Image::from_fn(13, 7, |x, y| [x as f32 * 0.37 - 0.5, y as f32 * 1.9, (x * y) as f32 / 91.0 + 1e-4])
+            .unwrap()
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect()
+    }
+
+    #[test]
+    fn exr_f32_round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.EXR");
+        let im = test_image();
+        write_image(&p, &im, WriteOptions::default()).unwrap();
+        assert_eq!(read_image(&p).unwrap(), im);
+    }
+
+    #[test]
+    fn exr_f16_round_trip_within_half_precision() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("h.exr");
+        let im = test_image();
+        write_image(&p, &im, WriteOptions { exr: ExrPrecision::F16, ..Default::default() }).unwrap();
+        let back = read_image(&p).unwrap();
+        for (a, b) in im.data.iter().zip(&back.data) {
+            for k in 0..3 {
+                // f16 has an 11-bit significand: relative error ≤ 2⁻¹¹ (normal range).
+                assert!((a[k] - b[k]).abs() <= a[k].abs() * 4.9e-4 + 6.1e-5, "{a:?} {b:?}");
+            }
+        }
+        // Smaller than the f32 file: it really stored halves.
+        let p32 = dir.path().join("f.exr");
+        write_image(&p32, &im, WriteOptions::default()).unwrap();
+        assert!(std::fs::metadata(&p).unwrap().len() < std::fs::metadata(&p32).unwrap().len());
+    }
+
+    #[test]
+    fn png8_round_trip_on_code_values() {
+        // Linear values that are exactly decoded 8-bit codes must come back unchanged, and
+        // re-encoding them must give the same codes.
+        let codes: Vec<u8> = (0..=255).collect();
+        let im = Image::from_fn(16, 16, |x, y| {
+            let c = codes[(y * 16 + x) as usize];
+            let v = srgb_decode(f64::from(c) / 255.0) as f32;
+            [v, srgb_decode(f64::from(255 - c) / 255.0) as f32, 0.0]
+        })
+        .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("c.png");
+        write_image(&p, &im, WriteOptions::default()).unwrap();
+        let raw = image::open(&p).unwrap();
+        assert_eq!(raw.color(), image::ColorType::Rgb8);
+        let raw = raw.to_rgb8();
+        assert!(raw.pixels().enumerate().all(|(i, px)| px.0 == [i as u8, 255 - i as u8, 0]));
+        assert_eq!(read_image(&p).unwrap(), im);
+    }
+
+    #[test]
+    fn png_clamps_and_16_bit_is_finer() {
+        let im = Image::from_fn(5, 2, |x, _| [x as f32 * 0.3 - 0.2, 0.123_456, 2.0]).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let p8 = dir.path().join("a.png");
+        let p16 = dir.path().join("b.png");
+        write_image(&p8, &im, WriteOptions::default()).unwrap();
+        write_image(&p16, &im, WriteOptions { png: PngBitDepth::Sixteen, ..Default::default() }).unwrap();
+        assert_eq!(image::open(&p16).unwrap().color(), image::ColorType::Rgb16);
+        let (b8, b16) = (read_image(&p8).unwrap(), read_image(&p16).unwrap());
+        assert_eq!(b8.get(0, 0)[0], 0.0);
+        assert_eq!(b16.get(0, 1)[2], 1.0);
+        // Half a code step of slope: 8-bit error ≤ 0.5/255 in encoded terms, 16-bit ≤ 0.5/65535.
+        let e8 = (srgb_encode(f64::from(b8.get(2, 0)[1])) - srgb_encode(0.123_456)).abs();
+        let e16 = (srgb_encode(f64::from(b16.get(2, 0)[1])) - srgb_encode(0.123_456)).abs();
+        assert!(e8 <= 0.5 / 255.0 + 1e-7 && e16 <= 0.5 / 65535.0 + 1e-7, "{e8} {e16}");
+        assert!(e16 < e8);
+    }
+
+    #[test]
+    fn reads_grey_and_rgba_png() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("g.png");
+        image::GrayImage::from_raw(2, 1, vec![0, 188]).unwrap().save(&p).unwrap();
+        let g = read_image(&p).unwrap();
+        let v = srgb_decode(188.0 / 255.0) as f32;
+        assert_eq!(g.data, vec![[0.0; 3], [v; 3]]);
+        let p = dir.path().join("rgba.png");
+        image::RgbaImage::from_raw(1, 1, vec![255, 0, 188, 7]).unwrap().save(&p).unwrap();
+        assert_eq!(read_image(&p).unwrap().data, vec![[1.0, 0.0, v]]);
+    }
+
+    #[test]
+    fn errors_name_the_file_and_the_problem() {
+        let dir = tempfile::tempdir().unwrap();
+        let im = test_image();
+        let e = write_image(dir.path().join("x.tiff"), &im, WriteOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("x.tiff") && e.contains("unsupported") && e.contains("tiff"), "{e}");
+        let e = read_image(dir.path().join("noext")).unwrap_err().to_string();
+        assert!(e.contains("noext") && e.contains("unsupported"), "{e}");
+        let e = read_image(dir.path().join("missing.exr")).unwrap_err().to_string();
+        assert!(e.contains("missing.exr"), "{e}");
+        for name in ["text.png", "text.exr"] {
+            let p = dir.path().join(name);
+            std::fs::write(&p, b"hello, not an image").unwrap();
+            let e = read_image(&p).unwrap_err().to_string();
+            assert!(e.contains(name) && e.contains("not a valid"), "{e}");
+        }
+        // A truncated EXR.
+        let good = dir.path().join("good.exr");
+        write_image(&good, &im, WriteOptions::default()).unwrap();
+        let bytes = std::fs::read(&good).unwrap();
+        let cut = dir.path().join("cut.exr");
+        std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+        let e = read_image(&cut).unwrap_err().to_string();
+        assert!(e.contains("cut.exr"), "{e}");
+    }
+
+    #[test]
+    fn exr_without_rgb_lists_channels() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("lum.exr");
+        let ch = SpecificChannels::build()
+            .with_channel("Y")
+            .with_channel("G")
+            .with_pixel_fn(|Vec2(x, _y)| (x as f32, 0.5f32));
+        exr::prelude::Image::from_channels((3, 2), ch).write().to_file(&p).unwrap();
+        let e = read_image(&p).unwrap_err().to_string();
+        assert!(e.contains("lum.exr") && e.contains("missing channel(s) R, B") && e.contains("G, Y"), "{e}");
+    }
+
+    #[test]
+    fn failed_write_leaves_no_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut im = test_image();
+        im.get_mut(4, 5)[2] = f32::NAN;
+        let p = dir.path().join("nan.png");
+        let e = write_image(&p, &im, WriteOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("nan.png") && e.contains("(4, 5)"), "{e}");
+        assert!(names(dir.path()).is_empty());
+        // An existing file survives a failed overwrite untouched.
+        let good = Image::filled(2, 2, [0.5; 3]).unwrap();
+        write_image(&p, &good, WriteOptions::default()).unwrap();
+        let before = std::fs::read(&p).unwrap();
+        assert!(write_image(&p, &im, WriteOptions::default()).is_err());
+        assert_eq!(std::fs::read(&p).unwrap(), before);
+        assert_eq!(names(dir.path()), vec!["nan.png"]);
+        // Inconsistent hand-built image.
+        let bad = Image { width: 3, height: 3, data: vec![[0.0; 3]; 2] };
+        assert!(write_image(dir.path().join("bad.exr"), &bad, WriteOptions::default()).is_err());
+        assert_eq!(names(dir.path()), vec!["nan.png"]);
+    }
+}

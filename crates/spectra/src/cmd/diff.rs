@@ -1,0 +1,122 @@
+//! `spectra diff REFERENCE TEST`: how far a render is from a reference, in CIEDE2000 and MAE.
+//!
+//! A measurement, not a test: it exits 0 whatever the difference, and non-zero only when it
+//! cannot measure (unreadable file, size mismatch, non-finite pixel, bad option).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use compare::{ColorMap, DiffMaps, DiffOptions, DiffSummary, Heatmap, HeatmapOptions, read_image};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Reference image (.exr linear, or .png sRGB-encoded), e.g. the ground-truth render.
+    reference: PathBuf,
+    /// Image to measure against the reference, same size.
+    test: PathBuf,
+    /// Write a ΔE2000 heat map with a labelled colour bar to this PNG.
+    #[arg(long, value_name = "FILE.png")]
+    heatmap: Option<PathBuf>,
+    /// Top of the heat-map scale in ΔE00 (default: the largest ΔE rounded up to 1/2/2.5/5×10ᵏ).
+    #[arg(long, value_name = "X", requires = "heatmap")]
+    max_de: Option<f64>,
+    /// Heat-map colour map: viridis, magma or inferno.
+    #[arg(long, default_value = "viridis", requires = "heatmap")]
+    colormap: String,
+    /// Luminance Y (image units) of the CIELAB reference white, D65 chromaticity. With 1,
+    /// an image value of (1, 1, 1) is L* = 100.
+    #[arg(long, value_name = "Y", default_value_t = 1.0)]
+    white_y: f64,
+    /// Print the results as JSON (for scripts) instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Write per-pixel values (x, y, ΔE2000, |Δ| linear, |Δ| sRGB) to this CSV file.
+    #[arg(long, value_name = "FILE.csv")]
+    per_pixel_out: Option<PathBuf>,
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    // Check cheap things before reading possibly large images.
+    let colormap = ColorMap::by_name(&args.colormap)?;
+    if let Some(h) = &args.heatmap
+        && !h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        bail!("{}: the heat map is written as PNG; give it a .png name", h.display());
+    }
+    if let Some(m) = args.max_de
+        && !(m.is_finite() && m > 0.0)
+    {
+        bail!("--max-de must be a positive number, got {m}");
+    }
+
+    let reference = read_image(&args.reference).context("reading the reference image")?;
+    let test = read_image(&args.test).context("reading the test image")?;
+    let maps = DiffMaps::compute(&reference, &test, DiffOptions { white_luminance: args.white_y })
+        .with_context(|| format!("comparing {} with {}", args.reference.display(), args.test.display()))?;
+    let summary = maps.summary();
+
+    let heatmap = match &args.heatmap {
+        Some(path) => {
+            let opts = HeatmapOptions { max: args.max_de, colormap, ..Default::default() };
+            let h = Heatmap::of_delta_e(&maps, &opts)?;
+            h.save_png(path).context("writing the heat map")?;
+            Some((path, h.max))
+        }
+        None => None,
+    };
+    if let Some(path) = &args.per_pixel_out {
+        compare::atomic::write_atomic(path, maps.to_csv().as_bytes()).context("writing per-pixel values")?;
+    }
+
+    if args.json {
+        let mut v = serde_json::to_value(summary)?;
+        let o = v.as_object_mut().expect("a struct serialises to an object");
+        o.insert("reference".into(), args.reference.display().to_string().into());
+        o.insert("test".into(), args.test.display().to_string().into());
+        o.insert(
+            "heatmap".into(),
+            match heatmap {
+                Some((p, max)) => serde_json::json!({ "path": p.display().to_string(), "max_delta_e": max }),
+                None => serde_json::Value::Null,
+            },
+        );
+        o.insert("per_pixel_out".into(), args.per_pixel_out.as_ref().map(|p| p.display().to_string()).into());
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        print_table(&args, &summary, heatmap);
+    }
+    Ok(())
+}
+
+fn print_table(args: &Args, s: &DiffSummary, heatmap: Option<(&PathBuf, f64)>) {
+    println!("reference  {}", args.reference.display());
+    println!("test       {}", args.test.display());
+    println!(
+        "size       {}×{} ({} pixels); CIELAB white: D65, Y = {}",
+        s.width,
+        s.height,
+        u64::from(s.width) * u64::from(s.height),
+        s.white_luminance
+    );
+    println!();
+    println!(
+        "{:<22}{:>12}{:>12}{:>12}{:>12}{:>12}",
+        "per-pixel metric", "mean", "median", "p95", "p99", "max"
+    );
+    let row = |name: &str, st: &color::metrics::Stats, prec: usize| {
+        println!(
+            "{name:<22}{:>12.prec$}{:>12.prec$}{:>12.prec$}{:>12.prec$}{:>12.prec$}",
+            st.mean, st.median, st.p95, st.p99, st.max
+        );
+    };
+    row("ΔE2000", &s.delta_e2000, 4);
+    row("MAE linear RGB", &s.mae_linear, 6);
+    row("MAE sRGB-encoded", &s.mae_srgb, 6);
+    if let Some((p, max)) = heatmap {
+        println!();
+        println!("heat map   {} (ΔE00 scale 0 to {max})", p.display());
+    }
+    if let Some(p) = &args.per_pixel_out {
+        println!("per-pixel  {}", p.display());
+    }
+}
