@@ -21,6 +21,9 @@ pub struct Brdf {
     pub base: Vec4,
     pub metallic: f32,
     pub alpha: f32,
+    /// Pure Lambert (base/π), ignoring metallic and roughness: only for comparisons with
+    /// renderers that have no glTF BRDF (Mitsuba's `diffuse`).
+    pub lambert: bool,
 }
 
 /// A sampled direction with its BRDF value and pdf (solid angle).
@@ -33,7 +36,11 @@ pub struct BrdfSample {
 impl Brdf {
     pub fn new(base: Vec4, metallic: f32, roughness: f32) -> Self {
         let r = roughness.clamp(0.0, 1.0);
-        Brdf { base, metallic: metallic.clamp(0.0, 1.0), alpha: (r * r).max(MIN_ALPHA) }
+        Brdf { base, metallic: metallic.clamp(0.0, 1.0), alpha: (r * r).max(MIN_ALPHA), lambert: false }
+    }
+
+    pub fn lambertian(base: Vec4) -> Self {
+        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true }
     }
 
     fn f0(&self) -> Vec4 {
@@ -63,6 +70,9 @@ impl Brdf {
     /// Probability of sampling the specular lobe: its share of the Fresnel-weighted albedo
     /// estimate at normal incidence, averaged over the four wavelengths.
     fn p_spec(&self, n_v: f32) -> f32 {
+        if self.lambert {
+            return 0.0;
+        }
         let f0 = self.f0();
         let fr = f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5);
         let spec = fr.element_sum();
@@ -75,6 +85,9 @@ impl Brdf {
         let (n_v, n_l) = (wo.z, wi.z);
         if n_v <= 0.0 || n_l <= 0.0 {
             return Vec4::ZERO;
+        }
+        if self.lambert {
+            return self.base * FRAC_1_PI;
         }
         let h = (wo + wi).normalize();
         let v_h = wo.dot(h).abs();
@@ -149,6 +162,13 @@ mod tests {
         let f = b.eval(Vec3::Z, Vec3::Z);
         let diffuse = 0.96 * 0.5 / PI;
         assert!(f.x > diffuse && f.x < diffuse + 0.1);
+    }
+
+    #[test]
+    fn lambertian_has_albedo_base() {
+        let b = Brdf::lambertian(Vec4::splat(0.6));
+        assert!((b.eval(dir(0.2, 0.0), dir(1.0, 1.0)) - Vec4::splat(0.6 / PI)).abs().max_element() < 1e-7);
+        assert!((b.pdf(dir(0.2, 0.0), dir(1.0, 1.0)) - 1.0f32.cos() / PI).abs() < 1e-6);
     }
 
     #[test]

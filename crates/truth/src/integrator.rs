@@ -46,6 +46,9 @@ pub struct Integrator<'w, 's> {
     pub direct_only: bool,
     /// Hard cap on scattering events (Russian roulette ends paths long before it in practice).
     pub max_depth: u32,
+    /// Replace the glTF BRDF by Lambert (base/π) everywhere; for comparisons with renderers
+    /// that lack the glTF BRDF.
+    pub lambert: bool,
 }
 
 #[inline]
@@ -231,7 +234,8 @@ impl Integrator<'_, '_> {
                 l,
             );
             let (metallic, roughness) = material::metallic_roughness(mat, &w.scene.textures, s.uv);
-            let brdf = Brdf::new(base, metallic, roughness);
+            let brdf =
+                if self.lambert { Brdf::lambertian(base) } else { Brdf::new(base, metallic, roughness) };
             let frame = Frame::from_normal(ns);
             let vtx = Vertex::Surface { brdf, frame, ng };
 

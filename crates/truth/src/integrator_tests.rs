@@ -76,7 +76,7 @@ fn volume_furnace_returns_the_emission() {
     };
     let range = WavelengthRange::VISIBLE;
     let world = World::new(&scene, &GreyOnly, &d65(), range, Some(&medium)).unwrap().with_environment(&env);
-    let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000 };
+    let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000, lambert: false };
     let sensor = XyzSensor::new(&Observer::cie1931(), &d65(), range);
     for u in [0.05, 0.4, 0.77] {
         let wl = sensor.sample(u);
@@ -106,7 +106,7 @@ fn absorbing_box_follows_beer_lambert() {
     };
     let range = WavelengthRange::VISIBLE;
     let world = World::new(&scene, &GreyOnly, &d65(), range, Some(&medium)).unwrap().with_environment(&d65());
-    let integ = Integrator { world: &world, direct_only: false, max_depth: 10 };
+    let integ = Integrator { world: &world, direct_only: false, max_depth: 10, lambert: false };
     let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.2);
     let (m, se) =
         estimate(20_000, |rng| radiance_any_hero(&integ, Vec3::new(-3.0, 0.0, 0.0), Vec3::X, &wl, rng));
@@ -150,7 +150,7 @@ fn surface_furnace_returns_emission_times_albedo() {
         let scene = scene_with(vec![quad(Vec3::ZERO, Vec3::Y, 0.5, 0)], vec![mat], vec![]);
         let range = WavelengthRange::VISIBLE;
         let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap().with_environment(&env);
-        let integ = Integrator { world: &world, direct_only: false, max_depth: 1000 };
+        let integ = Integrator { world: &world, direct_only: false, max_depth: 1000, lambert: false };
         let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.3);
         let d = Vec3::new(0.4, -1.0, 0.2).normalize();
         let o = -d * 1.5;
@@ -185,11 +185,12 @@ fn point_and_spot_lights_give_closed_form_direct_light() {
             name: "l".into(),
             kind: kind.clone(),
             emission: Emission { rgb: Vec3::ONE, intensity: 5.0, spectrum: Some(d65()) },
+            stands_in_for: None,
         };
         let scene = scene_with(vec![quad(Vec3::ZERO, Vec3::Y, 1.0, 0)], vec![white.clone()], vec![light]);
         let range = WavelengthRange::VISIBLE;
         let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap();
-        let integ = Integrator { world: &world, direct_only: true, max_depth: 10 };
+        let integ = Integrator { world: &world, direct_only: true, max_depth: 10, lambert: false };
         let sensor = XyzSensor::new(&Observer::cie1931(), &d65(), range);
         let wl = sensor.sample(0.6);
         let o = Vec3::new(-1.0, 1.0, 0.5);

@@ -19,6 +19,7 @@ pub mod integrator;
 pub mod lights;
 pub mod material;
 pub mod medium;
+pub mod medium_file;
 pub mod render;
 pub mod rng;
 pub mod sampling;

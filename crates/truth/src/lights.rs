@@ -231,6 +231,7 @@ mod tests {
                 range: None,
             },
             emission: Emission { rgb: Vec3::ONE, intensity: 1.0, spectrum: None },
+            stands_in_for: None,
         };
         let d = DeltaLight::new(&l, DenseSpectrum::from_fn(WavelengthRange::VISIBLE, |_| 1.0));
         let at = |a: f32| {

@@ -31,6 +31,8 @@ pub struct Settings {
     pub medium: Option<Medium>,
     /// Uniform background radiance (see [`World::with_environment`]); none by default.
     pub environment: Option<Spectrum>,
+    /// Lambertian BRDF instead of glTF's (for comparison with Mitsuba's `diffuse`).
+    pub lambert: bool,
 }
 
 impl Settings {
@@ -47,6 +49,7 @@ impl Settings {
             max_depth: 1024,
             medium: None,
             environment: None,
+            lambert: false,
         })
     }
 
@@ -119,7 +122,12 @@ pub fn render_world(
     let (w, h) = (settings.width, settings.height);
     let camera = PinholeCamera::new(&world.scene.camera, w, h);
     let sensor = XyzSensor::new(&settings.observer, &settings.white, settings.range);
-    let integ = Integrator { world, direct_only: settings.direct_only, max_depth: settings.max_depth };
+    let integ = Integrator {
+        world,
+        direct_only: settings.direct_only,
+        max_depth: settings.max_depth,
+        lambert: settings.lambert,
+    };
     let rows_done = AtomicU64::new(0);
     let dropped = AtomicU64::new(0);
     let rows: Vec<Option<Vec<[f32; 3]>>> = (0..h)
@@ -182,6 +190,7 @@ mod tests {
                 name: "p".into(),
                 kind: LightKind::Point { position: Vec3::new(0.3, 0.2, 0.1), range: None },
                 emission: Emission { rgb: Vec3::ONE, intensity: 0.5, spectrum: None },
+                stands_in_for: None,
             }],
         );
         s.camera = Camera::look_at(Vec3::new(0.0, 0.0, 0.9), Vec3::ZERO, Vec3::Y, 1.2);

@@ -34,6 +34,8 @@ pub struct World<'s> {
     pub delta_lights: Vec<DeltaLight>,
     pub emitters: EmitterDistribution,
     pub medium: Option<PreparedMedium>,
+    /// Per material: its measured emission spectrum in tracer units, if it has one.
+    pub emission_spectra: Vec<Option<crate::spectral::DenseSpectrum>>,
     /// Triangle areas (for area-light pdfs).
     pub areas: Vec<f32>,
     /// Uniform radiance arriving from infinity along rays that escape the scene.
@@ -64,8 +66,26 @@ impl<'s> World<'s> {
         }
         let units = EmissionUnits::new(white, range);
         let materials = scene.materials.iter().map(|m| PreparedMaterial::new(m, range)).collect();
-        let delta_lights =
-            scene.lights.iter().map(|l| DeltaLight::new(l, units.light(&l.emission, upsampler))).collect();
+        // Stand-ins approximate emissive meshes for rasterisers; the meshes themselves are
+        // sampled here, so counting the stand-ins too would light the scene twice.
+        let delta_lights = scene
+            .lights
+            .iter()
+            .filter(|l| l.stands_in_for.is_none())
+            .map(|l| DeltaLight::new(l, units.light(&l.emission, upsampler)))
+            .collect();
+        let emission_spectra = scene
+            .materials
+            .iter()
+            .map(|m| {
+                m.emission_spectrum.as_ref().map(|s| {
+                    units.light(
+                        &scene::Emission { rgb: m.emissive, intensity: 1.0, spectrum: Some(s.clone()) },
+                        upsampler,
+                    )
+                })
+            })
+            .collect();
         let areas: Vec<f32> =
             geometry.verts.iter().map(|v| 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()).collect();
         let emitters = EmitterDistribution::new(
@@ -85,6 +105,7 @@ impl<'s> World<'s> {
             delta_lights,
             emitters,
             medium,
+            emission_spectra,
             areas,
             environment: None,
         })
@@ -176,7 +197,15 @@ impl<'s> World<'s> {
             return Vec4::ZERO;
         }
         let rgb = material::emissive_rgb(m, &self.scene.textures, s.uv);
-        self.units.rgb(rgb, self.upsampler, l)
+        match &self.emission_spectra[s.material] {
+            // A measured spectrum, modulated by the emissive texture's luminance.
+            Some(spec) => {
+                let k =
+                    if m.emissive_texture.is_some() { luminance(rgb) / luminance(m.emissive) } else { 1.0 };
+                spec.eval4(l) * k
+            }
+            None => self.units.rgb(rgb, self.upsampler, l),
+        }
     }
 }
 

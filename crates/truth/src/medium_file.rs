@@ -1,0 +1,120 @@
+//! The JSON form of a [`Medium`] (for `spectra truth --medium FILE`):
+//!
+//! ```json
+//! { "sigma_a": 0.05,
+//!   "sigma_s": { "wavelengths": [380, 550, 730], "values": [0.2, 0.1, 0.05] },
+//!   "phase": { "hg": 0.8 },
+//!   "box": { "min": [-1, -1, -1], "max": [1, 1, 1] } }
+//! ```
+//!
+//! Coefficients are per scene unit, as a number (constant) or sampled (nm, linear
+//! interpolation, zero outside). `phase` is `"isotropic"` or `{"hg": g}` (default isotropic);
+//! without `box` the medium fills the scene. Unknown keys are errors, so typos are caught.
+
+use crate::error::{Result, TruthError};
+use crate::medium::{Medium, Phase, Region};
+use color::Spectrum;
+use glam::Vec3;
+use serde_json::Value;
+
+fn bad(origin: &str, why: String) -> TruthError {
+    TruthError::BadMedium(format!("{origin}: {why}"))
+}
+
+fn spectrum(origin: &str, key: &str, v: Option<&Value>) -> Result<Spectrum> {
+    let v = v.ok_or_else(|| bad(origin, format!("missing \"{key}\"")))?;
+    if let Some(x) = v.as_f64() {
+        return Ok(Spectrum::Constant(x));
+    }
+    let nums = |k: &str| -> Result<Vec<f64>> {
+        v.get(k)
+            .and_then(Value::as_array)
+            .ok_or_else(|| {
+                bad(
+                    origin,
+                    format!("\"{key}\" must be a number or {{\"wavelengths\": [..], \"values\": [..]}}"),
+                )
+            })?
+            .iter()
+            .map(|x| x.as_f64().ok_or_else(|| bad(origin, format!("\"{key}.{k}\" holds a non-number {x}"))))
+            .collect()
+    };
+    Spectrum::piecewise(nums("wavelengths")?, nums("values")?)
+        .map_err(|e| bad(origin, format!("\"{key}\": {e}")))
+}
+
+fn vec3(origin: &str, key: &str, v: Option<&Value>) -> Result<Vec3> {
+    let a = v.and_then(Value::as_array).filter(|a| a.len() == 3);
+    let a = a.ok_or_else(|| bad(origin, format!("\"box.{key}\" must be [x, y, z]")))?;
+    let f = |i: usize| a[i].as_f64().ok_or_else(|| bad(origin, format!("\"box.{key}\" must hold numbers")));
+    Ok(Vec3::new(f(0)? as f32, f(1)? as f32, f(2)? as f32))
+}
+
+impl Medium {
+    /// Parses the JSON form; `origin` (a file name) prefixes every error. Values are checked
+    /// by [`Medium::validate`] at render time, against the render's wavelength range.
+    pub fn from_json(text: &str, origin: &str) -> Result<Medium> {
+        let v: Value = serde_json::from_str(text).map_err(|e| bad(origin, format!("not valid JSON: {e}")))?;
+        let obj = v.as_object().ok_or_else(|| bad(origin, "expected a JSON object".into()))?;
+        if let Some(k) = obj.keys().find(|k| !["sigma_a", "sigma_s", "phase", "box"].contains(&k.as_str())) {
+            return Err(bad(origin, format!("unknown key \"{k}\" (known: sigma_a, sigma_s, phase, box)")));
+        }
+        let phase = match obj.get("phase") {
+            None => Phase::Isotropic,
+            Some(Value::String(s)) if s == "isotropic" => Phase::Isotropic,
+            Some(p) => match p.get("hg").and_then(Value::as_f64) {
+                Some(g) => Phase::HenyeyGreenstein { g: g as f32 },
+                None => {
+                    return Err(bad(
+                        origin,
+                        format!("\"phase\" must be \"isotropic\" or {{\"hg\": g}}, got {p}"),
+                    ));
+                }
+            },
+        };
+        let region = match obj.get("box") {
+            None => Region::Everywhere,
+            Some(b) => Region::Box {
+                min: vec3(origin, "min", b.get("min"))?,
+                max: vec3(origin, "max", b.get("max"))?,
+            },
+        };
+        Ok(Medium {
+            sigma_a: spectrum(origin, "sigma_a", obj.get("sigma_a"))?,
+            sigma_s: spectrum(origin, "sigma_s", obj.get("sigma_s"))?,
+            phase,
+            region,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use color::WavelengthRange;
+
+    #[test]
+    fn parses_the_documented_form() {
+        let m = Medium::from_json(
+            r#"{"sigma_a": 0.05, "sigma_s": {"wavelengths": [380, 730], "values": [0.2, 0.1]},
+                "phase": {"hg": 0.8}, "box": {"min": [-1, -1, -1], "max": [1, 2, 3]}}"#,
+            "m.json",
+        )
+        .unwrap();
+        assert_eq!(m.phase, Phase::HenyeyGreenstein { g: 0.8 });
+        assert_eq!(m.region, Region::Box { min: Vec3::splat(-1.0), max: Vec3::new(1.0, 2.0, 3.0) });
+        assert!((m.sigma_s.eval(555.0) - 0.15).abs() < 1e-12);
+        assert!(m.validate(WavelengthRange::VISIBLE).is_ok());
+    }
+
+    #[test]
+    fn errors_name_the_file_and_problem() {
+        let e = |t: &str| Medium::from_json(t, "water.json").unwrap_err().to_string();
+        assert!(e("{").contains("water.json") && e("{").contains("JSON"));
+        assert!(e(r#"{"sigma_s": 1}"#).contains("sigma_a"));
+        assert!(e(r#"{"sigma_a": 1, "sigma_s": 1, "phaze": "isotropic"}"#).contains("phaze"));
+        assert!(e(r#"{"sigma_a": 1, "sigma_s": 1, "phase": {"g": 1}}"#).contains("phase"));
+        let neg = Medium::from_json(r#"{"sigma_a": -1, "sigma_s": 1}"#, "w.json").unwrap();
+        assert!(neg.validate(WavelengthRange::VISIBLE).unwrap_err().to_string().contains("sigma_a"));
+    }
+}
