@@ -7,6 +7,7 @@
 
 use color::Spectrum;
 use glam::{Mat4, Vec2, Vec3, Vec4};
+pub mod water;
 
 /// A fully loaded scene.
 #[derive(Clone, Debug)]
