@@ -5,9 +5,39 @@
 //! both consumers want. Spectral data from glTF `extras` is resolved into
 //! [`color::Spectrum`] values at load time, so errors surface with the file and field named.
 
+mod accessors;
+pub mod builtin;
+mod context;
+pub mod emission;
+mod error;
+mod extras;
+pub mod framing;
+mod gltf_file;
+mod primitive;
+pub mod spectrum_desc;
+pub mod srgb;
+mod tangents;
+mod uri;
+
+use std::path::Path;
+
 use color::Spectrum;
 use glam::{Mat4, Vec2, Vec3, Vec4};
-pub mod water;
+
+pub use builtin::{BUILTIN_NAMES, builtin};
+pub use error::{Result, SceneError};
+pub use gltf_file::{load, load_slice};
+
+/// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
+/// argument ends in `.gltf` or `.glb` (any case), from that file.
+pub fn load_any(name_or_path: &str) -> Result<Scene> {
+    let lower = name_or_path.to_ascii_lowercase();
+    if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+        load(Path::new(name_or_path))
+    } else {
+        builtin(name_or_path)
+    }
+}
 
 /// A fully loaded scene.
 #[derive(Clone, Debug)]
@@ -54,6 +84,9 @@ pub struct Material {
     pub emissive_texture: Option<TextureRef>,
     /// Measured reflectance spectra that override the RGB base colour for ground truth.
     pub spectral: Option<SpectralReflectance>,
+    /// Spectral radiance of the emission, scaled so its luminance equals that of `emissive`
+    /// (same convention as [`Emission`]); `None` = upsample `emissive` as RGB.
+    pub emission_spectrum: Option<Spectrum>,
 }
 
 impl Default for Material {
@@ -70,6 +103,7 @@ impl Default for Material {
             emissive: Vec3::ZERO,
             emissive_texture: None,
             spectral: None,
+            emission_spectrum: None,
         }
     }
 }
@@ -135,6 +169,12 @@ pub struct Light {
     pub name: String,
     pub kind: LightKind,
     pub emission: Emission,
+    /// `Some(i)`: this punctual light is a stand-in for the emissive geometry `meshes[i]` (the
+    /// same lamp), for renderers that cannot light with emissive surfaces. A renderer that
+    /// samples emissive meshes as lights (the path tracer) must skip it, or the lamp would count
+    /// twice; a renderer that only shades punctual lights uses it and draws `meshes[i]` merely
+    /// as a glowing surface. Always `None` for lights loaded from glTF.
+    pub stands_in_for: Option<usize>,
 }
 
 /// A perspective pinhole camera.

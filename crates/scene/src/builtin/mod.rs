@@ -1,0 +1,170 @@
+//! Scenes built into the binary, so demos and tests need no download.
+//!
+//! Every built-in uses measured spectra (ColorChecker reflectances, CIE illuminants) for ground
+//! truth, and gives RGB renderers the colours those spectra actually have under D65, so RGB and
+//! spectral renders describe the same physical scene.
+
+mod colorchecker;
+mod cornell;
+mod metamerism;
+pub(crate) mod shapes;
+
+use color::{Observer, SpectralIntegrator, Spectrum, WavelengthRange};
+use glam::{DVec3, Vec3, Vec4};
+
+use crate::context::Ctx;
+use crate::error::SceneError;
+use crate::{Emission, Material, Scene, SpectralReflectance, SpectralSettings, srgb};
+
+/// Names accepted by [`builtin`].
+pub const BUILTIN_NAMES: &[&str] = &["cornell", "colorchecker", "metamerism"];
+
+/// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
+pub fn builtin(name: &str) -> Result<Scene, SceneError> {
+    let ctx = Ctx::builtin(&name.to_ascii_lowercase());
+    let scene = match name.to_ascii_lowercase().as_str() {
+        "cornell" => cornell::build(&ctx),
+        "colorchecker" => colorchecker::build(&ctx),
+        "metamerism" => metamerism::build(&ctx),
+        _ => {
+            return Err(SceneError::UnknownBuiltin {
+                name: name.to_string(),
+                known: BUILTIN_NAMES.join(", "),
+            });
+        }
+    }?;
+    Ok(scene)
+}
+
+/// An empty scene to fill in, with D65 as the white and the paper's spectral defaults left to
+/// the CLI.
+pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
+    Scene {
+        source: ctx.path.display().to_string(),
+        meshes: Vec::new(),
+        materials: Vec::new(),
+        textures: Vec::new(),
+        lights: Vec::new(),
+        camera,
+        spectral: SpectralSettings { white: Some("D65".into()), ..SpectralSettings::default() },
+        water: None,
+    }
+}
+
+/// Linear sRGB of a reflectance under D65 with the CIE 1931 observer (1 nm, 360–830 nm): the
+/// colour an RGB renderer should give a surface with this measured spectrum.
+pub(crate) fn reflectance_rgb(s: &Spectrum) -> DVec3 {
+    let d65 = color::illuminant::by_name("D65").expect("D65 is tabulated");
+    let integ = SpectralIntegrator::reference(&Observer::cie1931(), &d65, WavelengthRange::FULL)
+        .expect("the full observer range is valid");
+    srgb::xyz_to_linear(integ.integrate(|l| s.eval(l)))
+}
+
+/// A diffuse (roughness 1) material with a measured reflectance and its D65 sRGB colour as
+/// base colour (clipped to the gamut).
+pub(crate) fn measured_material(name: &str, s: &Spectrum) -> Material {
+    let rgb = reflectance_rgb(s).clamp(DVec3::ZERO, DVec3::ONE).as_vec3();
+    Material {
+        name: name.into(),
+        base_color: Vec4::from((rgb, 1.0)),
+        spectral: Some(SpectralReflectance::Uniform(s.clone())),
+        ..Material::default()
+    }
+}
+
+/// A light colour in the glTF sense for a spectral shape: its own linear sRGB chromaticity at
+/// luminance 1 (negative components of out-of-gamut lights clipped), so that `rgb × intensity`
+/// and the scaled spectrum describe the same light as closely as RGB can.
+pub(crate) fn light_emission(
+    ctx: &Ctx,
+    what: &str,
+    shape: &Spectrum,
+    intensity: f32,
+) -> Result<Emission, SceneError> {
+    let xyz = crate::emission::spectrum_xyz(shape);
+    let rgb = srgb::xyz_to_linear(xyz.map(|c| c / xyz[1])).max(DVec3::ZERO).as_vec3();
+    let rgb = rgb / srgb::luminance(rgb) as f32;
+    Emission::new(rgb, intensity, Some(shape)).map_err(|m| ctx.invalid(what, m))
+}
+
+/// The ColorChecker patch spectrum by 0-based chart index.
+pub(crate) fn patch(i: usize) -> Spectrum {
+    Spectrum::from_table(&color::data::colorchecker::SPECTRA[i])
+}
+
+/// Index of a patch by its exact chart name.
+pub(crate) fn patch_index(name: &str) -> usize {
+    color::data::colorchecker::NAMES
+        .iter()
+        .position(|n| *n == name)
+        .unwrap_or_else(|| panic!("no patch {name}"))
+}
+
+/// Unit vector helper for light directions.
+pub(crate) fn dir(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Oracle: colour-science 0.4.7, ColorChecker N Ohta under D65 with the CIE 1931 2° observer,
+    // restricted to the measured 380–780 nm, sRGB-encoded and rounded:
+    //   sd = colour.SDS_COLOURCHECKERS['ColorChecker N Ohta'][name]
+    //   xyz = colour.sd_to_XYZ(sd, cmfs, D65, method='Integration', shape=SpectralShape(380, 780, 1)) / 100
+    //   np.round(np.clip(colour.XYZ_to_sRGB(xyz), 0, 1) * 255)
+    #[test]
+    fn patch_colours_match_colour_science() {
+        let want = [
+            ("dark skin", [116, 79, 63]),
+            ("red", [178, 47, 58]),
+            ("green", [69, 150, 70]),
+            ("white 9.5 (.05 D)", [242, 242, 240]),
+            ("cyan", [0, 137, 167]),
+        ];
+        for (name, rgb8) in want {
+            let got = srgb::linear_to_srgb8(reflectance_rgb(&patch(patch_index(name))));
+            for k in 0..3 {
+                assert!((got[k] as i32 - rgb8[k]).abs() <= 1, "{name}: {got:?} vs colour-science {rgb8:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_builtin_loads_with_lights_camera_and_geometry() {
+        for name in BUILTIN_NAMES {
+            let s = builtin(name).unwrap();
+            assert_eq!(s.source, format!("builtin:{name}"));
+            assert!(!s.lights.is_empty(), "{name} has no lights");
+            assert!(!s.meshes.is_empty(), "{name} has no meshes");
+            let tris: usize = s.meshes.iter().map(|m| m.indices.len() / 3).sum();
+            assert!(tris > 0 && tris < 5_000, "{name}: {tris} triangles");
+            for (i, m) in s.meshes.iter().enumerate() {
+                assert!(m.material < s.materials.len(), "{name} mesh {i}");
+                assert_eq!(m.normals.len(), m.positions.len());
+                assert!(m.uvs.is_empty() || m.uvs.len() == m.positions.len());
+                assert!(m.indices.iter().all(|&i| (i as usize) < m.positions.len()));
+            }
+            for m in &s.materials {
+                for t in
+                    [m.base_color_texture, m.normal_texture, m.emissive_texture, m.metallic_roughness_texture]
+                        .into_iter()
+                        .flatten()
+                {
+                    let tex = &s.textures[t.index];
+                    assert_eq!(tex.rgba8.len(), (tex.width * tex.height * 4) as usize);
+                }
+            }
+            for l in &s.lights {
+                assert!(l.emission.spectrum.is_some(), "{name}: light {} has no spectrum", l.name);
+            }
+            // The camera sees the scene: the bounds' centre is in front of it.
+            let (lo, hi) = s.bounds().unwrap();
+            let v = s.camera.transform.inverse().transform_point3((lo + hi) * 0.5);
+            assert!(v.z < 0.0, "{name}: scene centre behind the camera");
+        }
+        let e = builtin("kitchen").unwrap_err().to_string();
+        assert!(e.contains("kitchen") && e.contains("cornell") && e.contains("metamerism"), "{e}");
+    }
+}

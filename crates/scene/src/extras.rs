@@ -1,0 +1,241 @@
+//! The spectral additions a scene carries in glTF `extras`, parsed strictly: an unknown key is an
+//! error naming it, because a misspelt `reflectence` silently ignored would make ground truth
+//! quietly wrong.
+
+use color::{Observer, Spectrum, WavelengthRange};
+use glam::Vec3;
+use serde_json::{Map, Value};
+
+use crate::context::Ctx;
+use crate::error::SceneError;
+use crate::spectrum_desc;
+use crate::{PaletteEntry, SpectralReflectance, SpectralSettings, WaterSettings};
+
+/// Parses raw `extras` JSON at `at` (e.g. `materials[3]`) into an object, `None` when absent.
+pub(crate) fn object(
+    ctx: &Ctx,
+    at: &str,
+    raw: &gltf::json::Extras,
+) -> Result<Option<Map<String, Value>>, SceneError> {
+    let Some(raw) = raw else { return Ok(None) };
+    let v: Value =
+        serde_json::from_str(raw.get()).map_err(|e| ctx.extras(format!("{at}.extras"), e.to_string()))?;
+    match v {
+        Value::Object(m) => Ok(Some(m)),
+        Value::Null => Ok(None),
+        other => Err(ctx.extras(format!("{at}.extras"), format!("expected an object, got {other}"))),
+    }
+}
+
+fn check_keys(ctx: &Ctx, at: &str, map: &Map<String, Value>, allowed: &[&str]) -> Result<(), SceneError> {
+    match map.keys().find(|k| !allowed.contains(&k.as_str())) {
+        Some(k) => {
+            Err(ctx.extras(format!("{at}.{k}"), format!("unknown key; allowed here: {}", allowed.join(", "))))
+        }
+        None => Ok(()),
+    }
+}
+
+/// Material extras: `reflectance` or `reflectance_palette`, and `emission`.
+#[derive(Default)]
+pub(crate) struct MaterialExtras {
+    pub reflectance: Option<SpectralReflectance>,
+    /// Emission spectral shape, not yet scaled to the emissive colour.
+    pub emission: Option<Spectrum>,
+}
+
+/// Reflectances must be physical: within [0, 1] wherever the observer sees.
+fn check_reflectance(ctx: &Ctx, field: &str, s: &Spectrum) -> Result<(), SceneError> {
+    let (lo, hi) = (color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX);
+    let max = s.max_value(lo, hi);
+    let min = -s.scaled(-1.0).max_value(lo, hi);
+    if min < 0.0 || max > 1.0 {
+        return Err(ctx.extras(
+            field,
+            format!("a reflectance must lie in [0, 1], this one spans {min:.4}–{max:.4} over {lo}–{hi} nm"),
+        ));
+    }
+    Ok(())
+}
+
+pub(crate) fn material(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<MaterialExtras, SceneError> {
+    let at = format!("{at}.extras");
+    check_keys(ctx, &at, map, &["reflectance", "reflectance_palette", "emission"])?;
+    let mut out = MaterialExtras::default();
+    if map.contains_key("reflectance") && map.contains_key("reflectance_palette") {
+        return Err(ctx.extras(&at, "give either reflectance or reflectance_palette, not both"));
+    }
+    if let Some(v) = map.get("reflectance") {
+        let f = format!("{at}.reflectance");
+        let s = spectrum_desc::resolve(ctx, &f, v)?;
+        check_reflectance(ctx, &f, &s)?;
+        out.reflectance = Some(SpectralReflectance::Uniform(s));
+    }
+    if let Some(v) = map.get("reflectance_palette") {
+        let f = format!("{at}.reflectance_palette");
+        let arr = v
+            .as_array()
+            .ok_or_else(|| ctx.extras(&f, "expected an array of {\"rgb8\": [r, g, b], \"spectrum\": ...}"))?;
+        if arr.is_empty() {
+            return Err(ctx.extras(&f, "the palette is empty"));
+        }
+        let mut entries: Vec<PaletteEntry> = Vec::with_capacity(arr.len());
+        for (i, e) in arr.iter().enumerate() {
+            let ef = format!("{f}[{i}]");
+            let m = e
+                .as_object()
+                .ok_or_else(|| ctx.extras(&ef, "expected {\"rgb8\": [r, g, b], \"spectrum\": ...}"))?;
+            check_keys(ctx, &ef, m, &["rgb8", "spectrum"])?;
+            let rgb8 = rgb8(m.get("rgb8")).map_err(|msg| ctx.extras(format!("{ef}.rgb8"), msg))?;
+            if let Some(j) = entries.iter().position(|p| p.rgb8 == rgb8) {
+                return Err(
+                    ctx.extras(format!("{ef}.rgb8"), format!("{rgb8:?} is already used by entry {j}"))
+                );
+            }
+            let sf = format!("{ef}.spectrum");
+            let s = spectrum_desc::resolve(
+                ctx,
+                &sf,
+                m.get("spectrum").ok_or_else(|| ctx.extras(&sf, "missing"))?,
+            )?;
+            check_reflectance(ctx, &sf, &s)?;
+            entries.push(PaletteEntry { rgb8, spectrum: s });
+        }
+        out.reflectance = Some(SpectralReflectance::Palette(entries));
+    }
+    if let Some(v) = map.get("emission") {
+        out.emission = Some(spectrum_desc::resolve(ctx, &format!("{at}.emission"), v)?);
+    }
+    Ok(out)
+}
+
+fn rgb8(v: Option<&Value>) -> Result<[u8; 3], String> {
+    let bad = || "expected three integers 0–255".to_string();
+    let arr = v.and_then(Value::as_array).ok_or_else(bad)?;
+    if arr.len() != 3 {
+        return Err(bad());
+    }
+    let mut out = [0u8; 3];
+    for (o, x) in out.iter_mut().zip(arr) {
+        *o = x.as_u64().filter(|&n| n <= 255).ok_or_else(bad)? as u8;
+    }
+    Ok(out)
+}
+
+/// Light extras: `spectrum` (a shape, scaled later to the light's RGB × intensity).
+pub(crate) fn light(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<Option<Spectrum>, SceneError> {
+    let at = format!("{at}.extras");
+    check_keys(ctx, &at, map, &["spectrum"])?;
+    map.get("spectrum").map(|v| spectrum_desc::resolve(ctx, &format!("{at}.spectrum"), v)).transpose()
+}
+
+/// Scene-level extras (root, asset or scene): `spectra` and `water`.
+#[derive(Default)]
+pub(crate) struct SceneExtras {
+    pub spectral: SpectralSettings,
+    pub water: Option<WaterSettings>,
+}
+
+pub(crate) fn scene(
+    ctx: &Ctx,
+    at: &str,
+    map: &Map<String, Value>,
+    out: &mut SceneExtras,
+) -> Result<(), SceneError> {
+    let at = format!("{at}.extras");
+    check_keys(ctx, &at, map, &["spectra", "water"])?;
+    if let Some(v) = map.get("spectra") {
+        out.spectral = spectra(ctx, &format!("{at}.spectra"), v)?;
+    }
+    if let Some(v) = map.get("water") {
+        out.water = Some(water(ctx, &format!("{at}.water"), v)?);
+    }
+    Ok(())
+}
+
+fn spectra(ctx: &Ctx, at: &str, v: &Value) -> Result<SpectralSettings, SceneError> {
+    let map = v.as_object().ok_or_else(|| ctx.extras(at, "expected an object"))?;
+    check_keys(ctx, at, map, &["observer", "range", "wavelengths", "white"])?;
+    let mut s = SpectralSettings::default();
+    let string = |k: &str| -> Result<Option<String>, SceneError> {
+        map.get(k)
+            .map(|x| {
+                x.as_str()
+                    .map(str::to_string)
+                    .ok_or_else(|| ctx.extras(format!("{at}.{k}"), "expected a string"))
+            })
+            .transpose()
+    };
+    if let Some(o) = string("observer")? {
+        Observer::by_name(&o).map_err(|e| ctx.extras(format!("{at}.observer"), e.to_string()))?;
+        s.observer = Some(o);
+    }
+    if let Some(w) = string("white")? {
+        color::illuminant::by_name(&w).map_err(|e| ctx.extras(format!("{at}.white"), e.to_string()))?;
+        s.white = Some(w);
+    }
+    if let Some(r) = map.get("range") {
+        let f = format!("{at}.range");
+        let pair = r.as_array().filter(|a| a.len() == 2).and_then(|a| Some((a[0].as_f64()?, a[1].as_f64()?)));
+        let (lo, hi) = pair.ok_or_else(|| ctx.extras(&f, "expected [min, max] in nm"))?;
+        WavelengthRange::new(lo, hi).map_err(|e| ctx.extras(&f, e.to_string()))?;
+        s.range = Some((lo as f32, hi as f32));
+    }
+    if let Some(n) = map.get("wavelengths") {
+        let f = format!("{at}.wavelengths");
+        let n = n
+            .as_u64()
+            .filter(|&n| (1..=u32::MAX as u64).contains(&n))
+            .ok_or_else(|| ctx.extras(&f, format!("expected a whole number of samples ≥ 1, got {n}")))?;
+        s.wavelengths = Some(n as u32);
+    }
+    Ok(s)
+}
+
+fn finite(ctx: &Ctx, f: &str, v: &Value) -> Result<f32, SceneError> {
+    v.as_f64()
+        .filter(|x| x.is_finite())
+        .map(|x| x as f32)
+        .ok_or_else(|| ctx.extras(f, format!("expected a number, got {v}")))
+}
+
+fn water(ctx: &Ctx, at: &str, v: &Value) -> Result<WaterSettings, SceneError> {
+    let map = v.as_object().ok_or_else(|| ctx.extras(at, "expected an object"))?;
+    check_keys(ctx, at, map, &["type", "depth", "sun_direction", "scale"])?;
+    let tf = format!("{at}.type");
+    let water_type = map
+        .get("type")
+        .and_then(Value::as_str)
+        .filter(|s| !s.trim().is_empty())
+        .ok_or_else(|| ctx.extras(&tf, "required: a Jerlov water type name such as \"II\" or \"3C\""))?
+        .to_string();
+    let df = format!("{at}.depth");
+    let depth = finite(
+        ctx,
+        &df,
+        map.get("depth").ok_or_else(|| ctx.extras(&df, "required: camera depth in metres"))?,
+    )?;
+    if depth < 0.0 {
+        return Err(ctx.extras(&df, format!("depth below the surface must be ≥ 0 m, got {depth}")));
+    }
+    let sf = format!("{at}.sun_direction");
+    let sun = match map.get("sun_direction") {
+        None => Vec3::Y,
+        Some(d) => {
+            let a =
+                d.as_array().filter(|a| a.len() == 3).ok_or_else(|| ctx.extras(&sf, "expected [x, y, z]"))?;
+            let v = Vec3::new(finite(ctx, &sf, &a[0])?, finite(ctx, &sf, &a[1])?, finite(ctx, &sf, &a[2])?);
+            let n = v.normalize_or_zero();
+            if n.y <= 0.0 {
+                return Err(ctx.extras(&sf, format!("the sun must be above the horizon (+y up), got {v}")));
+            }
+            n
+        }
+    };
+    let cf = format!("{at}.scale");
+    let scale = map.get("scale").map(|s| finite(ctx, &cf, s)).transpose()?.unwrap_or(1.0);
+    if scale <= 0.0 {
+        return Err(ctx.extras(&cf, format!("metres per scene unit must be > 0, got {scale}")));
+    }
+    Ok(WaterSettings { water_type, depth, sun_direction: sun, scale })
+}

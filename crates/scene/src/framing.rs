@@ -1,0 +1,64 @@
+//! Scene bounds and the default camera used when a file has none.
+
+use glam::Vec3;
+
+use crate::{Camera, Mesh, Scene};
+
+/// Vertical field of view of the default camera: 45°, a common "normal lens".
+pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
+
+/// Axis-aligned bounds of all mesh positions, `None` when there are none.
+pub fn bounds(meshes: &[Mesh]) -> Option<(Vec3, Vec3)> {
+    let mut it = meshes.iter().flat_map(|m| m.positions.iter().copied());
+    let first = it.next()?;
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+impl Scene {
+    /// Axis-aligned world bounds of the geometry.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        bounds(&self.meshes)
+    }
+}
+
+impl Camera {
+    /// The default camera: looks down −Z at the centre of `bounds` from far enough along +Z
+    /// that the bounding sphere fits the vertical field of view (with 10% margin), +Y up, 45°.
+    /// Near and far planes enclose the sphere. With no geometry: at the origin looking down −Z.
+    pub fn framing(bounds: Option<(Vec3, Vec3)>) -> Camera {
+        let Some((lo, hi)) = bounds else {
+            return Camera::look_at(Vec3::ZERO, -Vec3::Z, Vec3::Y, DEFAULT_YFOV);
+        };
+        let centre = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1e-3);
+        let dist = 1.1 * radius / (DEFAULT_YFOV * 0.5).sin();
+        let mut cam = Camera::look_at(centre + Vec3::Z * dist, centre, Vec3::Y, DEFAULT_YFOV);
+        cam.znear = ((dist - radius) * 0.5).max(dist * 1e-3);
+        cam.zfar = (dist + radius) * 2.0;
+        cam
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_camera_sees_every_corner() {
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, -3.0), Vec3::new(2.0, 5.0, 1.0));
+        let cam = Camera::framing(Some((lo, hi)));
+        let view = cam.transform.inverse();
+        let half = (cam.yfov * 0.5).tan();
+        for i in 0..8 {
+            let c = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let v = view.transform_point3(c);
+            let depth = -v.z;
+            assert!(depth > cam.znear && depth < cam.zfar, "corner {c} at depth {depth}");
+            assert!(v.y.abs() / depth < half && v.x.abs() / depth < half, "corner {c} outside a square view");
+        }
+    }
+}

@@ -1,0 +1,273 @@
+//! `SpectrumDesc`: the JSON a scene uses to name a spectrum, resolved to a [`Spectrum`].
+//!
+//! Forms (see `docs/scene-format.md`):
+//! - `"D65"`, `"F11"`, `"LED-B3"`, `"3200K"`: a named illuminant ([`color::illuminant::by_name`]);
+//! - `{"blackbody": 3200}`: Planck's law at 3200 K;
+//! - `{"sampled": {"wavelengths": [..], "values": [..]}}`: nm, strictly increasing;
+//! - `{"csv": "path.csv"}`: two columns λ (nm), value; optional header line; `#` comments;
+//!   relative to the glTF file;
+//! - `{"colorchecker": "red"}` or `{"colorchecker": 15}`: a ColorChecker Classic patch by name
+//!   (case-insensitive; a unique prefix such as `"white"` is enough) or 1-based chart index.
+//!
+//! Objects must have exactly one key, so a typo is an error rather than a silently different
+//! spectrum.
+
+use color::Spectrum;
+use color::data::colorchecker;
+use serde_json::Value;
+
+use crate::context::Ctx;
+use crate::error::SceneError;
+
+/// Parses and resolves a SpectrumDesc found at JSON path `field`.
+pub(crate) fn resolve(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
+    let err = |f: &str, m: String| ctx.extras(f, m);
+    match v {
+        Value::String(name) => color::illuminant::by_name(name).map_err(|e| err(field, e.to_string())),
+        Value::Object(map) => {
+            if map.len() != 1 {
+                let keys: Vec<&str> = map.keys().map(String::as_str).collect();
+                return Err(err(
+                    field,
+                    format!(
+                        "a spectrum object needs exactly one of the keys blackbody, sampled, csv, colorchecker; got [{}]",
+                        keys.join(", ")
+                    ),
+                ));
+            }
+            let (key, inner) = map.iter().next().expect("one entry");
+            let sub = format!("{field}.{key}");
+            match key.as_str() {
+                "blackbody" => {
+                    let k = inner
+                        .as_f64()
+                        .ok_or_else(|| err(&sub, format!("expected kelvin as a number, got {inner}")))?;
+                    Spectrum::blackbody(k).map_err(|e| err(&sub, e.to_string()))
+                }
+                "sampled" => sampled(ctx, &sub, inner),
+                "csv" => {
+                    let rel = inner
+                        .as_str()
+                        .ok_or_else(|| err(&sub, format!("expected a file path string, got {inner}")))?;
+                    let file = ctx.resolve(&sub, rel)?;
+                    read_csv(ctx, &sub, &file)
+                }
+                "colorchecker" => {
+                    let i = colorchecker_index(inner).map_err(|m| err(&sub, m))?;
+                    Ok(Spectrum::from_table(&colorchecker::SPECTRA[i]))
+                }
+                other => Err(err(
+                    &sub,
+                    format!(
+                        "unknown spectrum kind '{other}'; expected blackbody, sampled, csv or colorchecker"
+                    ),
+                )),
+            }
+        }
+        other => Err(err(field, format!("expected an illuminant name or a spectrum object, got {other}"))),
+    }
+}
+
+fn numbers(ctx: &Ctx, field: &str, v: Option<&Value>) -> Result<Vec<f64>, SceneError> {
+    let arr = v.and_then(Value::as_array).ok_or_else(|| ctx.extras(field, "expected an array of numbers"))?;
+    arr.iter()
+        .enumerate()
+        .map(|(i, x)| {
+            x.as_f64().filter(|f| f.is_finite()).ok_or_else(|| {
+                ctx.extras(format!("{field}[{i}]"), format!("expected a finite number, got {x}"))
+            })
+        })
+        .collect()
+}
+
+fn sampled(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
+    let map = v
+        .as_object()
+        .ok_or_else(|| ctx.extras(field, "expected {\"wavelengths\": [...], \"values\": [...]}"))?;
+    if let Some(k) = map.keys().find(|k| *k != "wavelengths" && *k != "values") {
+        return Err(ctx.extras(format!("{field}.{k}"), "unknown key; expected wavelengths and values"));
+    }
+    let wf = format!("{field}.wavelengths");
+    let lambda = numbers(ctx, &wf, map.get("wavelengths"))?;
+    let values = numbers(ctx, &format!("{field}.values"), map.get("values"))?;
+    check_increasing(&lambda).map_err(|m| ctx.extras(&wf, m))?;
+    Spectrum::piecewise(lambda, values).map_err(|e| ctx.extras(field, e.to_string()))
+}
+
+fn check_increasing(lambda: &[f64]) -> Result<(), String> {
+    match lambda.windows(2).position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater)) {
+        Some(i) => Err(format!(
+            "wavelengths must increase strictly: [{}] = {} is followed by [{}] = {}",
+            i,
+            lambda[i],
+            i + 1,
+            lambda[i + 1]
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Index (0-based) of a ColorChecker patch given as a name or a 1-based number.
+pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
+    let names = || colorchecker::NAMES.join(", ");
+    if let Some(n) = v.as_u64() {
+        return if (1..=24).contains(&n) {
+            Ok(n as usize - 1)
+        } else {
+            Err(format!("patch number {n} is outside 1–24"))
+        };
+    }
+    let Some(name) = v.as_str() else {
+        return Err(format!("expected a patch name or number 1–24, got {v}"));
+    };
+    let want = name.trim().to_ascii_lowercase();
+    if let Some(i) = colorchecker::NAMES.iter().position(|n| n.eq_ignore_ascii_case(&want)) {
+        return Ok(i);
+    }
+    let hits: Vec<usize> =
+        (0..24).filter(|&i| colorchecker::NAMES[i].to_ascii_lowercase().starts_with(&want)).collect();
+    match hits.as_slice() {
+        [i] if !want.is_empty() => Ok(*i),
+        [] | [_] => Err(format!("unknown ColorChecker patch '{name}'; patches are: {}", names())),
+        many => Err(format!(
+            "'{name}' matches several ColorChecker patches ({}); be more specific",
+            many.iter().map(|&i| colorchecker::NAMES[i]).collect::<Vec<_>>().join(", ")
+        )),
+    }
+}
+
+/// Reads a two-column CSV spectrum; errors carry the line number.
+pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result<Spectrum, SceneError> {
+    let bytes = std::fs::read(file).map_err(|e| ctx.io(file, e))?;
+    let csv_err = |line: u64, message: String| SceneError::Csv {
+        path: ctx.path.clone(),
+        field: field.to_string(),
+        csv: file.to_path_buf(),
+        line,
+        message,
+    };
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(bytes.as_slice());
+    let (mut lambda, mut values, mut lines) = (Vec::new(), Vec::new(), Vec::new());
+    for (n, rec) in rdr.records().enumerate() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            csv_err(line, e.to_string())
+        })?;
+        let line = rec.position().map_or(n as u64 + 1, |p| p.line());
+        if rec.len() == 1 && rec[0].is_empty() {
+            continue;
+        }
+        if rec.len() != 2 {
+            return Err(csv_err(
+                line,
+                format!("expected 2 columns (wavelength in nm, value), found {}", rec.len()),
+            ));
+        }
+        let parse = |s: &str| s.parse::<f64>().ok().filter(|f| f.is_finite());
+        match (parse(&rec[0]), parse(&rec[1])) {
+            (Some(l), Some(v)) => {
+                lambda.push(l);
+                values.push(v);
+                lines.push(line);
+            }
+            // The first row may be a header such as `wavelength,value`.
+            _ if lambda.is_empty() && n == 0 && parse(&rec[0]).is_none() => {}
+            _ => {
+                return Err(csv_err(
+                    line,
+                    format!("cannot read '{}', '{}' as two finite numbers", &rec[0], &rec[1]),
+                ));
+            }
+        }
+    }
+    if lambda.len() < 2 {
+        return Err(csv_err(
+            lines.last().copied().unwrap_or(1),
+            format!("needs at least two rows of data, found {}", lambda.len()),
+        ));
+    }
+    if let Some(i) =
+        lambda.windows(2).position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(csv_err(
+            lines[i + 1],
+            format!("wavelengths must increase strictly: {} follows {}", lambda[i + 1], lambda[i]),
+        ));
+    }
+    Spectrum::piecewise(lambda, values).map_err(|e| csv_err(1, e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn ctx() -> Ctx {
+        Ctx::file(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/x.gltf").as_path())
+    }
+
+    #[test]
+    fn every_form_resolves() {
+        let c = ctx();
+        assert!(resolve(&c, "f", &json!("F11")).is_ok());
+        assert!(matches!(resolve(&c, "f", &json!({"blackbody": 3200})).unwrap(), Spectrum::Blackbody { .. }));
+        let s = resolve(
+            &c,
+            "f",
+            &json!({"sampled": {"wavelengths": [400, 500, 600], "values": [0.1, 0.5, 0.2]}}),
+        )
+        .unwrap();
+        assert_eq!(s.eval(450.0), 0.3);
+        let red = resolve(&c, "f", &json!({"colorchecker": "Red"})).unwrap();
+        assert_eq!(red, resolve(&c, "f", &json!({"colorchecker": 15})).unwrap());
+        assert_eq!(red, Spectrum::from_table(&colorchecker::SPECTRA[14]));
+        let white = resolve(&c, "f", &json!({"colorchecker": "white"})).unwrap();
+        assert_eq!(white, Spectrum::from_table(&colorchecker::SPECTRA[18]));
+        let csv = resolve(&c, "f", &json!({"csv": "spectrum.csv"})).unwrap();
+        assert_eq!(csv.eval(500.0), 0.5);
+    }
+
+    fn msg(v: serde_json::Value) -> String {
+        resolve(&ctx(), "materials[0].extras.reflectance", &v).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn bad_descs_name_the_field() {
+        let e = msg(json!("D42"));
+        assert!(
+            e.contains("materials[0].extras.reflectance") && e.contains("D42") && e.contains("D65"),
+            "{e}"
+        );
+        let e = msg(json!({"sampled": {"wavelengths": [400, 500, 500], "values": [1, 1, 1]}}));
+        assert!(e.contains("sampled.wavelengths") && e.contains("increase strictly"), "{e}");
+        let e = msg(json!({"sampled": {"wavelengths": [400, 500], "values": [1, 1], "scale": 2}}));
+        assert!(e.contains("sampled.scale") && e.contains("unknown key"), "{e}");
+        let e = msg(json!({"blackbody": -5}));
+        assert!(e.contains("blackbody") && e.contains("positive"), "{e}");
+        let e = msg(json!({"colorchecker": 25}));
+        assert!(e.contains("1–24"), "{e}");
+        let e = msg(json!({"colorchecker": "neutral"}));
+        assert!(e.contains("several"), "{e}");
+        let e = msg(json!({"blackbody": 3000, "csv": "a.csv"}));
+        assert!(e.contains("exactly one"), "{e}");
+        let e = msg(json!({"gaussian": 500}));
+        assert!(e.contains("unknown spectrum kind"), "{e}");
+        let e = msg(json!(5));
+        assert!(e.contains("expected an illuminant name"), "{e}");
+    }
+
+    #[test]
+    fn csv_errors_carry_line_numbers() {
+        let e = msg(json!({"csv": "bad_value.csv"}));
+        assert!(e.contains("bad_value.csv: line 4") && e.contains("abc"), "{e}");
+        let e = msg(json!({"csv": "not_increasing.csv"}));
+        assert!(e.contains("line 3") && e.contains("increase strictly"), "{e}");
+        let e = msg(json!({"csv": "missing.csv"}));
+        assert!(e.contains("missing.csv") && e.contains("cannot read"), "{e}");
+    }
+}

@@ -1,0 +1,331 @@
+//! Bad input must give an error naming the file and the place, never a panic.
+
+use std::path::{Path, PathBuf};
+
+use rand::{Rng, SeedableRng};
+use serde_json::{Value, json};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+fn fixture() -> Value {
+    serde_json::from_slice(&std::fs::read(data("textured.gltf")).unwrap()).unwrap()
+}
+
+/// Loads `doc` as if it were `broken.gltf` next to the fixtures, expecting an error.
+fn error_of(doc: &Value) -> String {
+    match scene::load_slice("broken.gltf", doc.to_string().as_bytes(), Some(&data(""))) {
+        Ok(_) => panic!("loaded without error"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn expect(doc: &Value, parts: &[&str]) {
+    let e = error_of(doc);
+    assert!(e.starts_with("broken.gltf"), "error does not name the file: {e}");
+    for p in parts {
+        assert!(e.contains(p), "error lacks '{p}': {e}");
+    }
+}
+
+fn mutate(f: impl FnOnce(&mut Value)) -> Value {
+    let mut d = fixture();
+    f(&mut d);
+    d
+}
+
+#[test]
+fn garbage_and_truncated_files() {
+    let e = scene::load_slice("junk.glb", b"\x00\x01garbage\xff", None).unwrap_err().to_string();
+    assert!(e.contains("junk.glb") && e.contains("not a valid glTF"), "{e}");
+    let glb = std::fs::read(data("textured.glb")).unwrap();
+    for cut in [0, 11, 12, 20, 100, glb.len() / 2, glb.len() - 1] {
+        let e = scene::load_slice("cut.glb", &glb[..cut], None).unwrap_err().to_string();
+        assert!(e.starts_with("cut.glb"), "cut at {cut}: {e}");
+    }
+    let text = std::fs::read(data("textured.gltf")).unwrap();
+    assert!(scene::load_slice("cut.gltf", &text[..text.len() / 2], Some(&data(""))).is_err());
+}
+
+#[test]
+fn missing_files() {
+    expect(&mutate(|d| d["images"][0]["uri"] = json!("nope.png")), &["images[0].uri", "nope.png"]);
+    expect(&mutate(|d| d["buffers"][0]["uri"] = json!("nope.bin")), &["buffers[0].uri", "nope.bin"]);
+    expect(&mutate(|d| d["images"][1]["uri"] = json!("quad.bin")), &["images[1]", "image"]);
+    expect(
+        &mutate(|d| d["buffers"][0]["uri"] = json!("https://example.com/a.bin")),
+        &["buffers[0].uri", "remote"],
+    );
+}
+
+#[test]
+fn unsupported_geometry_and_structure() {
+    expect(
+        &mutate(|d| d["meshes"][0]["primitives"][0]["mode"] = json!(1)),
+        &["meshes[0].primitives[0]", "unsupported primitive mode"],
+    );
+    expect(
+        &mutate(
+            |d| d["cameras"][0] = json!({"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}),
+        ),
+        &["cameras[0]", "orthographic"],
+    );
+    expect(
+        &mutate(|d| d["extensionsRequired"] = json!(["KHR_texture_transform"])),
+        &["extensionsRequired", "KHR_texture_transform"],
+    );
+    expect(
+        &mutate(|d| d["materials"][0]["normalTexture"]["texCoord"] = json!(1)),
+        &["materials[0].normalTexture", "TEXCOORD_1"],
+    );
+    // Wrong indices: caught by validation or by our own checks, named either way.
+    expect(&mutate(|d| d["meshes"][0]["primitives"][0]["indices"] = json!(99)), &["indices"]);
+    expect(&mutate(|d| d["accessors"][0]["count"] = json!(400)), &["POSITION", "accessors[0]", "overrun"]);
+    expect(&mutate(|d| d["accessors"][1]["type"] = json!("VEC2")), &["NORMAL", "accessors[1]"]);
+    expect(&mutate(|d| d["buffers"][0]["byteLength"] = json!(100000)), &["buffers[0]", "byteLength"]);
+    expect(&mutate(|d| d["bufferViews"][0]["byteStride"] = json!(4)), &["byteStride"]);
+    expect(&mutate(|d| d["scenes"] = json!([])), &["scene"]);
+    // An index beyond the vertex count: patch the first index of the quad to 9 and embed the
+    // buffer as a data URI.
+    let mut bin = std::fs::read(data("quad.bin")).unwrap();
+    let doc = fixture();
+    let off = doc["bufferViews"][3]["byteOffset"].as_u64().unwrap() as usize;
+    bin[off..off + 2].copy_from_slice(&9u16.to_le_bytes());
+    use base64::Engine;
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    expect(
+        &mutate(|d| d["buffers"][0]["uri"] = json!(uri)),
+        &["meshes[0].primitives[0].indices", "index 9", "4 vertices"],
+    );
+}
+
+#[test]
+fn bad_extras() {
+    expect(
+        &mutate(|d| d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"]["spectrum"] = json!("D42")),
+        &["KHR_lights_punctual.lights[0].extras.spectrum", "D42", "D65"],
+    );
+    expect(
+        &mutate(|d| {
+            d["extensions"]["KHR_lights_punctual"]["lights"][2]["extras"]["spectrum"]["sampled"]["wavelengths"] =
+                json!([380, 550, 550])
+        }),
+        &["lights[2].extras.spectrum.sampled.wavelengths", "increase strictly"],
+    );
+    expect(
+        &mutate(|d| {
+            d["materials"][0]["extras"]["reflectance_palette"][1]["spectrum"] =
+                json!({"csv": "bad_value.csv"})
+        }),
+        &["bad_value.csv", "line 4", "materials[0].extras.reflectance_palette[1].spectrum.csv"],
+    );
+    expect(
+        &mutate(|d| d["materials"][1]["extras"]["reflectence"] = json!("D65")),
+        &["materials[1].extras.reflectence", "unknown key"],
+    );
+    expect(
+        &mutate(|d| d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"]["colour"] = json!(1)),
+        &["lights[0].extras.colour", "unknown key"],
+    );
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["wavelenghts"] = json!(8)),
+        &["root.extras.spectra.wavelenghts", "unknown key"],
+    );
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["range"] = json!([300, 900])),
+        &["root.extras.spectra.range", "360–830"],
+    );
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("cie2015")),
+        &["spectra.observer", "cie2015"],
+    );
+    expect(&mutate(|d| d["extras"]["spectra"]["wavelengths"] = json!(0)), &["spectra.wavelengths"]);
+    expect(
+        &mutate(|d| d["extras"]["water"] = json!({"type": "I", "depth": 3})),
+        &["scenes[0].extras.water", "root.extras"],
+    );
+    expect(
+        &mutate(|d| d["scenes"][0]["extras"]["water"]["sun_direction"] = json!([0, -1, 0])),
+        &["water.sun_direction", "horizon"],
+    );
+    expect(
+        &mutate(|d| {
+            d["scenes"][0]["extras"]["water"].as_object_mut().unwrap().remove("type").map(|_| ()).unwrap()
+        }),
+        &["water.type", "required"],
+    );
+    expect(
+        &mutate(|d| d["materials"][1]["extras"]["reflectance"] = json!("D65")),
+        &["materials[1].extras.reflectance", "[0, 1]"],
+    );
+    expect(
+        &mutate(|d| d["materials"][1]["extras"]["reflectance_palette"] = json!([])),
+        &["materials[1].extras", "not both"],
+    );
+    expect(
+        &mutate(|d| d["materials"][0]["extras"]["reflectance_palette"][1]["rgb8"] = json!([178, 47, 58])),
+        &["reflectance_palette[1].rgb8", "already used"],
+    );
+    expect(
+        &mutate(|d| d["materials"][0]["extras"]["reflectance_palette"][0]["rgb8"] = json!([1, 2, 300])),
+        &["rgb8", "0–255"],
+    );
+    expect(
+        &mutate(|d| {
+            d["materials"][1]["extras"] =
+                json!({"reflectance_palette": [{"rgb8": [1, 2, 3], "spectrum": {"colorchecker": 1}}]})
+        }),
+        &["materials[1].extras.reflectance_palette", "baseColorTexture"],
+    );
+    expect(
+        &mutate(|d| d["materials"][1]["emissiveFactor"] = json!([0, 0, 0])),
+        &["materials[1].extras.emission", "zero"],
+    );
+    expect(
+        &mutate(|d| d["materials"][1]["extras"] = json!(["not", "an", "object"])),
+        &["materials[1].extras", "object"],
+    );
+}
+
+/// Random damage to a valid GLB and to the JSON of a valid glTF: every outcome must be `Ok` or
+/// `Err`; a panic fails the test. Seeded, so a failure reproduces.
+#[test]
+fn random_damage_never_panics() {
+    let seed = std::env::var("SCENE_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(0x5ce7e);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    // More rounds for a local soak: SCENE_FUZZ_ROUNDS=100000 SCENE_FUZZ_SEED=7 cargo test -p scene --test errors
+    let rounds: usize = std::env::var("SCENE_FUZZ_ROUNDS").ok().and_then(|s| s.parse().ok()).unwrap_or(400);
+    let glb = std::fs::read(data("textured.glb")).unwrap();
+    for _ in 0..rounds {
+        let mut b = glb.clone();
+        for _ in 0..rng.random_range(1..6) {
+            let i = rng.random_range(0..b.len());
+            b[i] = rng.random();
+        }
+        if rng.random_bool(0.2) {
+            b.truncate(rng.random_range(0..b.len()));
+        }
+        let _ = scene::load_slice("fuzz.glb", &b, None);
+    }
+    // Replace numbers in the JSON with hostile ones: wrong indices, zero, negative, huge.
+    let doc = fixture();
+    let mut paths = Vec::new();
+    collect_numbers(&doc, &mut Vec::new(), &mut paths);
+    let hostile = [
+        json!(0),
+        json!(-1),
+        json!(1),
+        json!(3),
+        json!(7),
+        json!(255),
+        json!(65537),
+        json!(4294967295u64),
+        json!(1e30),
+        json!(0.5),
+    ];
+    for _ in 0..rounds {
+        let mut d = doc.clone();
+        for _ in 0..rng.random_range(1..3) {
+            let p = &paths[rng.random_range(0..paths.len())];
+            *pointer_mut(&mut d, p) = hostile[rng.random_range(0..hostile.len())].clone();
+        }
+        let _ = scene::load_slice("fuzz.gltf", d.to_string().as_bytes(), Some(&data("")));
+    }
+    // Replace any value (not only numbers) with one of another shape, or delete an object key.
+    let mut paths = Vec::new();
+    collect_values(&doc, &mut Vec::new(), &mut paths);
+    let shapes = [
+        json!(null),
+        json!("x"),
+        json!({}),
+        json!([]),
+        json!([0]),
+        json!(true),
+        json!("D65"),
+        json!({"csv": "quad.bin"}),
+    ];
+    for _ in 0..rounds {
+        let mut d = doc.clone();
+        for _ in 0..rng.random_range(1..3) {
+            let p = &paths[rng.random_range(0..paths.len())];
+            let (last, parent) = p.split_last().unwrap();
+            match pointer_mut(&mut d, parent) {
+                Value::Object(m) if rng.random_bool(0.5) => {
+                    m.remove(last);
+                }
+                Value::Object(m) => {
+                    m.insert(last.clone(), shapes[rng.random_range(0..shapes.len())].clone());
+                }
+                Value::Array(a) => {
+                    if let Some(x) = last.parse::<usize>().ok().and_then(|i| a.get_mut(i)) {
+                        *x = shapes[rng.random_range(0..shapes.len())].clone();
+                    }
+                }
+                _ => {}
+            }
+        }
+        let _ = scene::load_slice("fuzz.gltf", d.to_string().as_bytes(), Some(&data("")));
+    }
+}
+
+fn collect_values(v: &Value, at: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+    if !at.is_empty() {
+        out.push(at.clone());
+    }
+    match v {
+        Value::Array(a) => a.iter().enumerate().for_each(|(i, x)| {
+            at.push(i.to_string());
+            collect_values(x, at, out);
+            at.pop();
+        }),
+        Value::Object(m) => m.iter().for_each(|(k, x)| {
+            at.push(k.clone());
+            collect_values(x, at, out);
+            at.pop();
+        }),
+        _ => {}
+    }
+}
+
+fn collect_numbers(v: &Value, at: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+    match v {
+        Value::Number(_) => out.push(at.clone()),
+        Value::Array(a) => a.iter().enumerate().for_each(|(i, x)| {
+            at.push(i.to_string());
+            collect_numbers(x, at, out);
+            at.pop();
+        }),
+        Value::Object(m) => m.iter().for_each(|(k, x)| {
+            at.push(k.clone());
+            collect_numbers(x, at, out);
+            at.pop();
+        }),
+        _ => {}
+    }
+}
+
+/// The value at `path`; paths come from the undamaged document, so an earlier edit in the same
+/// round may have removed part of one: then the deepest surviving value is returned.
+fn pointer_mut<'a>(v: &'a mut Value, path: &[String]) -> &'a mut Value {
+    let mut cur = v;
+    for k in path {
+        let has = match &*cur {
+            Value::Array(a) => k.parse::<usize>().is_ok_and(|i| i < a.len()),
+            Value::Object(m) => m.contains_key(k),
+            _ => false,
+        };
+        if !has {
+            break;
+        }
+        cur = match cur {
+            Value::Array(a) => &mut a[k.parse::<usize>().unwrap()],
+            Value::Object(m) => m.get_mut(k).unwrap(),
+            _ => unreachable!(),
+        };
+    }
+    cur
+}

@@ -1,0 +1,141 @@
+//! Loading the hand-written fixtures in `tests/data` (regenerate with `make_fixtures.py`).
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use scene::{LightKind, SpectralReflectance, emission::spectrum_luminance, load, load_any};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    a.abs_diff_eq(b, 1e-5)
+}
+
+fn check_textured(s: &scene::Scene) {
+    assert_eq!(s.meshes.len(), 2);
+    // Quad: scaled ×2 in x, turned 90° about +Y, moved +2 in x: it lies in the plane x = 2
+    // facing +X, spanning z ∈ [-2, 2].
+    let quad = &s.meshes[0];
+    assert!(quad.positions.iter().all(|p| (p.x - 2.0).abs() < 1e-5), "{:?}", quad.positions);
+    assert!(
+        quad.positions.iter().any(|p| (p.z - 2.0).abs() < 1e-5)
+            && quad.positions.iter().any(|p| (p.z + 2.0).abs() < 1e-5)
+    );
+    assert!(quad.normals.iter().all(|n| close(*n, Vec3::X)));
+    // The normal map asked for tangents; the file has none, so MikkTSpace made them: u runs along
+    // local +x, which the node turned to world −z.
+    assert_eq!(quad.tangents.len(), quad.positions.len());
+    for (t, n) in quad.tangents.iter().zip(&quad.normals) {
+        assert!(close(t.truncate(), -Vec3::Z), "tangent {t}");
+        assert!(t.w.abs() == 1.0 && t.truncate().dot(*n).abs() < 1e-5);
+    }
+    assert_eq!(quad.indices.len(), 6);
+    assert_eq!(quad.material, 0);
+    // Triangle without normals: flat normals, +Y after the parent's rotation, no tangents.
+    let tri = &s.meshes[1];
+    assert_eq!((tri.positions.len(), tri.indices.len()), (3, 3));
+    assert!(tri.normals.iter().all(|n| close(*n, Vec3::Y)), "{:?}", tri.normals);
+    assert!(tri.tangents.is_empty() && tri.uvs.is_empty());
+    let g = (tri.positions[1] - tri.positions[0]).cross(tri.positions[2] - tri.positions[0]).normalize();
+    assert!(close(g, Vec3::Y), "winding gives {g}");
+
+    assert_eq!(s.materials.len(), 2);
+    let m = &s.materials[0];
+    assert_eq!((m.metallic, m.roughness, m.normal_scale), (0.25, 0.5, 0.8));
+    assert!(close(m.emissive, Vec3::new(4.0, 2.0, 1.0)), "emissive × strength: {}", m.emissive);
+    let base = &s.textures[m.base_color_texture.unwrap().index];
+    assert!(base.srgb && (base.width, base.height) == (4, 4));
+    assert_eq!(&base.rgba8[..4], &[178, 47, 58, 255]);
+    assert_eq!(&base.rgba8[4..8], &[44, 79, 160, 255]);
+    let normal = &s.textures[m.normal_texture.unwrap().index];
+    assert!(!normal.srgb && (normal.width, normal.height) == (2, 2));
+    assert_eq!(&normal.rgba8[..4], &[128, 128, 255, 255]);
+    assert!(s.textures[m.emissive_texture.unwrap().index].srgb);
+    let Some(SpectralReflectance::Palette(p)) = &m.spectral else { panic!("palette expected") };
+    assert_eq!(p.len(), 2);
+    assert_eq!(p[0].rgb8, [178, 47, 58]);
+    assert_eq!(p[0].spectrum, color::Spectrum::from_table(&color::data::colorchecker::SPECTRA[14]));
+    assert!((p[1].spectrum.eval(380.0) - 0.6).abs() < 1e-9 && (p[1].spectrum.eval(780.0) - 0.1).abs() < 1e-9);
+
+    let plain = &s.materials[1];
+    let Some(SpectralReflectance::Uniform(r)) = &plain.spectral else { panic!("uniform expected") };
+    assert_eq!(*r, color::Spectrum::from_table(&color::data::colorchecker::SPECTRA[19]));
+    let y = spectrum_luminance(plain.emission_spectrum.as_ref().unwrap());
+    assert!((y - 0.2).abs() < 1e-4, "emission luminance {y} should equal that of emissive 0.2 grey");
+
+    assert!(close(s.camera.position(), Vec3::new(0.0, 1.0, 5.0)));
+    assert_eq!(
+        (s.camera.yfov, s.camera.znear, s.camera.zfar, s.camera.aspect),
+        (0.7, 0.05, 100.0, Some(1.5))
+    );
+
+    assert_eq!(s.lights.len(), 3);
+    let l = &s.lights[0];
+    assert_eq!(l.name, "point");
+    assert!(
+        matches!(l.kind, LightKind::Point { position, range: None } if close(position, Vec3::new(0.0, 3.0, 0.0)))
+    );
+    let want = 20.0 * (0.2126 + 0.7152 * 0.9 + 0.0722 * 0.8);
+    let got = spectrum_luminance(l.emission.spectrum.as_ref().unwrap());
+    assert!((got - want).abs() < 1e-3 * want, "{got} vs {want}");
+    let LightKind::Spot { position, direction, inner_cone, outer_cone, range } = s.lights[1].kind else {
+        panic!("spot")
+    };
+    assert!(
+        close(position, Vec3::new(1.0, 2.0, 0.0)) && close(direction, -Vec3::Y),
+        "{position} {direction}"
+    );
+    assert_eq!((inner_cone, outer_cone, range), (0.2, 0.6, Some(10.0)));
+    assert!(matches!(s.lights[2].kind, LightKind::Directional { direction } if close(direction, -Vec3::Z)));
+    assert!(s.lights.iter().all(|l| l.emission.spectrum.is_some() && l.stands_in_for.is_none()));
+
+    assert_eq!(s.spectral.observer.as_deref(), Some("cie1931"));
+    assert_eq!(s.spectral.range, Some((380.0, 730.0)));
+    assert_eq!(s.spectral.wavelengths, Some(16));
+    assert_eq!(s.spectral.white.as_deref(), Some("D65"));
+    let w = s.water.as_ref().unwrap();
+    assert_eq!((w.water_type.as_str(), w.depth, w.scale), ("II", 10.0, 1.0));
+    assert!(close(w.sun_direction, Vec3::Y));
+}
+
+#[test]
+fn loads_textured_gltf_with_external_files_and_data_uri() {
+    let s = load(data("textured.gltf")).unwrap();
+    assert!(s.source.ends_with("textured.gltf"));
+    check_textured(&s);
+}
+
+#[test]
+fn loads_the_same_scene_from_glb() {
+    let s = load(data("textured.glb")).unwrap();
+    check_textured(&s);
+    let g = load(data("textured.gltf")).unwrap();
+    for (a, b) in s.textures.iter().zip(&g.textures) {
+        assert_eq!(a.rgba8, b.rgba8);
+    }
+}
+
+#[test]
+fn load_any_dispatches_on_extension() {
+    assert_eq!(load_any("cornell").unwrap().source, "builtin:cornell");
+    assert_eq!(load_any("Cornell").unwrap().source, "builtin:cornell");
+    assert!(load_any(data("textured.GLB").to_str().unwrap()).is_err(), "no such file (case differs)");
+    assert!(load_any(data("textured.glb").to_str().unwrap()).is_ok());
+    let e = load_any("textured").unwrap_err().to_string();
+    assert!(e.contains("cornell, colorchecker, metamerism") && e.contains(".gltf"), "{e}");
+    let e = load_any("/nonexistent/scene.gltf").unwrap_err().to_string();
+    assert!(e.contains("/nonexistent/scene.gltf") && e.contains("cannot read"), "{e}");
+}
+
+#[test]
+fn default_camera_frames_a_scene_without_one() {
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data("textured.gltf")).unwrap()).unwrap();
+    doc["nodes"][3].as_object_mut().unwrap().remove("camera");
+    let s = scene::load_slice("nocam.gltf", doc.to_string().as_bytes(), Some(&data(""))).unwrap();
+    let (lo, hi) = s.bounds().unwrap();
+    let v = s.camera.transform.inverse().transform_point3((lo + hi) * 0.5);
+    assert!(v.x.abs() < 1e-4 && v.y.abs() < 1e-4 && v.z < 0.0, "centre at {v} in view space");
+}
