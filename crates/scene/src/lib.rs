@@ -18,6 +18,7 @@ pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
 mod uri;
+pub mod water;
 
 use std::path::Path;
 
