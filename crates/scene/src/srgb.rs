@@ -1,31 +1,20 @@
 //! The sRGB colour space (IEC 61966-2-1): the RGB that glTF colours are in.
 //!
 //! Built-in scenes need it to turn measured spectra into the 8-bit texels and linear factors an
-//! RGB renderer sees, and lights need it to give a spectrum its RGB stand-in. The matrices are
-//! derived from the primaries and the D65 chromaticity rather than typed in, so there is one
-//! source of truth (the four xy pairs of the standard).
+//! RGB renderer sees, and lights need it to give a spectrum its RGB stand-in. The matrices and
+//! transfer function are `color::colorspace`'s; this module adds the 8-bit helpers scenes need.
 
+use color::colorspace::{RgbColorSpace, srgb_decode, srgb_encode};
 use glam::{DMat3, DVec3, Vec3};
-
-const PRIMARIES: [[f64; 2]; 3] = [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06]];
-/// D65 as the sRGB standard writes it (4 decimals).
-const WHITE: [f64; 2] = [0.3127, 0.3290];
-
-fn xy_to_xyz([x, y]: [f64; 2]) -> DVec3 {
-    DVec3::new(x / y, 1.0, (1.0 - x - y) / y)
-}
 
 /// Linear sRGB → CIE XYZ (Y of white = 1).
 pub fn rgb_to_xyz_matrix() -> DMat3 {
-    let p = DMat3::from_cols(xy_to_xyz(PRIMARIES[0]), xy_to_xyz(PRIMARIES[1]), xy_to_xyz(PRIMARIES[2]));
-    // Scale each primary so that R = G = B = 1 lands on the white point.
-    let s = p.inverse() * xy_to_xyz(WHITE);
-    DMat3::from_cols(p.x_axis * s.x, p.y_axis * s.y, p.z_axis * s.z)
+    RgbColorSpace::srgb().to_xyz
 }
 
 /// CIE XYZ → linear sRGB.
 pub fn xyz_to_rgb_matrix() -> DMat3 {
-    rgb_to_xyz_matrix().inverse()
+    RgbColorSpace::srgb().from_xyz
 }
 
 /// Linear sRGB of an XYZ triple (may be negative or above 1 for out-of-gamut colours).
@@ -39,14 +28,14 @@ pub fn luminance(rgb: Vec3) -> f64 {
     m.row(1).dot(rgb.as_dvec3())
 }
 
-/// The sRGB transfer function (linear → encoded), for values in [0, 1].
+/// The sRGB transfer function (linear → encoded).
 pub fn encode(c: f64) -> f64 {
-    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    srgb_encode(c)
 }
 
 /// The inverse sRGB transfer function (encoded → linear).
 pub fn decode(c: f64) -> f64 {
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    srgb_decode(c)
 }
 
 /// 8-bit sRGB of a linear colour: clipped to [0, 1] (the gamut of an 8-bit texture), encoded,
