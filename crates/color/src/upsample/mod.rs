@@ -1,0 +1,69 @@
+//! RGB → spectrum upsampling (Jakob & Hanika 2019, "A Low-Dimensional Function Space for
+//! Efficient Spectral Upsampling"), its pbrt-style variants, and the baselines the paper
+//! compares against.
+//!
+//! - [`SigmoidPolynomial`]: the spectral model, scalar `f64` and `f32` 4/8-wide evaluation.
+//! - [`CoeffTable`]: rgb2spec's `.coeff` tables (read, write, `fetch`).
+//! - [`fit_table`] / [`fit_default`]: the fitter; [`refine`]: interpolation-aware refinement.
+//! - [`table`]: the renderer's entry point — a cached, shared table per colour space.
+//! - [`variants`]: unbounded RGB and illuminant spectra (pbrt-v4); [`smits`], [`boxes`]:
+//!   baselines; [`Upsampler`] / [`Method`]: one interface over all three methods.
+//! - [`roundtrip`]: RGB → spectrum → Lab accuracy, as measured for the acceptance figures.
+
+// Numeric kernels index several parallel arrays with one counter, and `!(a > b)` is how the
+// validation code makes NaN fail a check; both lints would make this code harder to read.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod boxes;
+pub mod cache;
+pub mod fit;
+pub mod method;
+pub mod refine;
+pub mod roundtrip;
+pub mod sigmoid;
+pub mod smits;
+pub mod table;
+pub mod throughput;
+pub mod variants;
+
+use std::sync::atomic::AtomicBool;
+
+use indicatif::ProgressBar;
+
+pub use cache::{TABLE_RES, table, table_for};
+pub use fit::{FitOptions, fit_table, fit_table_with};
+pub use method::{Method, Reflectance, Upsampler, upsampler};
+pub use sigmoid::SigmoidPolynomial;
+pub use table::CoeffTable;
+
+use crate::colorspace::RgbColorSpace;
+use crate::error::Result;
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Set by the Ctrl-C handler ([`install_interrupt_handler`]); long fits poll it and stop
+/// without writing anything.
+pub fn interrupt_flag() -> &'static AtomicBool {
+    &INTERRUPTED
+}
+
+/// Installs a Ctrl-C handler that sets [`interrupt_flag`]. Safe to call more than once; if the
+/// program already installed its own handler this does nothing (that handler should set the
+/// flag itself via [`interrupt_flag`]).
+pub fn install_interrupt_handler() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst));
+    });
+}
+
+/// The fit behind the default tables: [`TABLE_RES`]³ nodes on [`fit::spectra_scale`]'s
+/// brightness grid. This is what [`table`] caches and `spectra lut` writes.
+pub fn fit_default(space: &RgbColorSpace, progress: &ProgressBar) -> Result<CoeffTable> {
+    fit_default_res(space, TABLE_RES, progress)
+}
+
+/// [`fit_default`] at another resolution.
+pub fn fit_default_res(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
+    fit_table_with(space, &FitOptions::spectra(res), progress, interrupt_flag())
+}

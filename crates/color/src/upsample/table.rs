@@ -1,0 +1,373 @@
+//! The Jakob–Hanika coefficient table in rgb2spec's `.coeff` file format.
+//!
+//! Layout (little-endian): `"SPEC"`, `u32 res`, `f32 scale[res]`, `f32 data[3][res][res][res][3]`.
+//! `data` is indexed `((l·res + k)·res + j)·res + i`, times 3 coefficients, where `l` is the
+//! largest RGB channel, `k` the brightness index (the largest channel's value is `scale[k]`),
+//! and `i`, `j` the two other channels (`(l+1) % 3` and `(l+2) % 3`) divided by the largest and
+//! multiplied by `res − 1`. Files written here load in rgb2spec, Mitsuba and pbrt, and Mitsuba's
+//! shipped `srgb.coeff` (which appends a trailer after the payload) loads here.
+//!
+//! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
+//! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly. Because
+//! `scale` is stored in the file, a table may use any increasing brightness grid and stay
+//! readable by every rgb2spec-compatible renderer.
+
+use std::io::Write;
+use std::path::Path;
+
+use crate::error::{ColorError, Result};
+use crate::upsample::sigmoid::SigmoidPolynomial;
+
+/// Largest resolution accepted from a file (a 256³ table is already 600 MB).
+pub const MAX_RES: usize = 256;
+
+const MAGIC: &[u8; 4] = b"SPEC";
+
+/// A 3 × res³ table of sigmoid-polynomial coefficients, exactly as in a `.coeff` file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoeffTable {
+    /// Grid points per axis.
+    pub res: usize,
+    /// The largest channel's value at brightness index k, strictly increasing.
+    pub scale: Vec<f32>,
+    /// `3·res³·3` coefficients in rgb2spec order (see the module docs).
+    pub data: Vec<f32>,
+}
+
+/// Why a table was refused, before the file name is attached.
+fn table_err(origin: &str, what: impl std::fmt::Display) -> ColorError {
+    ColorError::Table(format!("{origin}: {what}"))
+}
+
+impl CoeffTable {
+    /// Number of `f32` coefficients for resolution `res`.
+    pub fn data_len(res: usize) -> usize {
+        3 * res * res * res * 3
+    }
+
+    /// Size in bytes of the `.coeff` payload (without any trailer).
+    pub fn file_len(res: usize) -> usize {
+        8 + 4 * res + 4 * Self::data_len(res)
+    }
+
+    /// Index of the first coefficient of node (l, k, j, i) in [`Self::data`].
+    #[inline]
+    pub fn index(&self, l: usize, k: usize, j: usize, i: usize) -> usize {
+        (((l * self.res + k) * self.res + j) * self.res + i) * 3
+    }
+
+    /// The stored coefficients of node (l, k, j, i).
+    #[inline]
+    pub fn node(&self, l: usize, k: usize, j: usize, i: usize) -> [f32; 3] {
+        let o = self.index(l, k, j, i);
+        [self.data[o], self.data[o + 1], self.data[o + 2]]
+    }
+
+    /// Checks the invariants [`Self::fetch`] relies on; `origin` names the table in errors.
+    pub fn validate(&self, origin: &str) -> Result<()> {
+        if self.res < 2 || self.res > MAX_RES {
+            return Err(table_err(origin, format!("resolution {} is outside 2..={MAX_RES}", self.res)));
+        }
+        if self.scale.len() != self.res {
+            return Err(table_err(
+                origin,
+                format!("{} scale entries for resolution {}", self.scale.len(), self.res),
+            ));
+        }
+        if self.data.len() != Self::data_len(self.res) {
+            return Err(table_err(
+                origin,
+                format!("{} coefficients, expected {}", self.data.len(), Self::data_len(self.res)),
+            ));
+        }
+        if let Some(k) = self.scale.iter().position(|s| !(s.is_finite() && (0.0..=1.0).contains(s))) {
+            return Err(table_err(
+                origin,
+                format!("scale[{k}] = {} is not a number in [0, 1]", self.scale[k]),
+            ));
+        }
+        if let Some(k) = self.scale.windows(2).position(|w| !(w[1] > w[0])) {
+            return Err(table_err(
+                origin,
+                format!(
+                    "scale must increase strictly, but scale[{k}] = {} and scale[{}] = {}",
+                    self.scale[k],
+                    k + 1,
+                    self.scale[k + 1]
+                ),
+            ));
+        }
+        if let Some(n) = self.data.iter().position(|v| !v.is_finite()) {
+            let node = n / 3;
+            let (i, j, k, l) = (
+                node % self.res,
+                node / self.res % self.res,
+                node / self.res / self.res % self.res,
+                node / self.res.pow(3),
+            );
+            return Err(table_err(
+                origin,
+                format!(
+                    "coefficient {} of node (l={l}, k={k}, j={j}, i={i}) is {} (not finite)",
+                    n % 3,
+                    self.data[n]
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Parses a `.coeff` payload. `origin` (usually the file name) prefixes every error. Bytes
+    /// after the payload are ignored: Mitsuba appends a trailer to its shipped table.
+    pub fn from_bytes(bytes: &[u8], origin: &str) -> Result<Self> {
+        if bytes.len() < 8 {
+            return Err(table_err(
+                origin,
+                format!("file is truncated: {} bytes, a header needs 8", bytes.len()),
+            ));
+        }
+        if &bytes[..4] != MAGIC {
+            return Err(table_err(
+                origin,
+                format!(
+                    "not an rgb2spec coefficient table (starts with {:?}, expected \"SPEC\")",
+                    String::from_utf8_lossy(&bytes[..4])
+                ),
+            ));
+        }
+        let res = u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize;
+        if !(2..=MAX_RES).contains(&res) {
+            return Err(table_err(origin, format!("resolution {res} is outside 2..={MAX_RES}")));
+        }
+        let need = Self::file_len(res);
+        if bytes.len() < need {
+            return Err(table_err(
+                origin,
+                format!("file is truncated: {} bytes, resolution {res} needs {need}", bytes.len()),
+            ));
+        }
+        let floats = |b: &[u8]| -> Vec<f32> {
+            b.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+        };
+        let scale = floats(&bytes[8..8 + 4 * res]);
+        let data = floats(&bytes[8 + 4 * res..need]);
+        let t = CoeffTable { res, scale, data };
+        t.validate(origin)?;
+        Ok(t)
+    }
+
+    /// Reads a `.coeff` file; errors name the file.
+    pub fn read(path: &Path) -> Result<Self> {
+        let origin = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| table_err(&origin, format!("cannot read: {e}")))?;
+        Self::from_bytes(&bytes, &origin)
+    }
+
+    /// The `.coeff` payload.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(Self::file_len(self.res));
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&(self.res as u32).to_le_bytes());
+        for v in self.scale.iter().chain(&self.data) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out
+    }
+
+    /// Writes a `.coeff` file atomically: a temporary file in the same directory is renamed
+    /// over `path` only once it is complete, so an interrupted write never leaves half a table.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let origin = path.display().to_string();
+        self.validate(&origin)?;
+        write_atomic(path, &self.to_bytes())
+    }
+
+    /// Coefficients for a linear RGB colour with components in [0, 1], exactly as
+    /// `rgb2spec_fetch` computes them. This is the renderer's hot path: it does not validate;
+    /// NaN or negative inputs are clamped to 0 and components above 1 to 1 (use
+    /// [`Self::fetch_checked`] for user input, or the unbounded variant for values above 1).
+    #[inline]
+    pub fn fetch(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
+        let rgb = rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 });
+        let res = self.res;
+        // Largest channel; later channels win ties, as in rgb2spec.
+        let mut l = 0;
+        for c in 1..3 {
+            if rgb[c] >= rgb[l] {
+                l = c;
+            }
+        }
+        let z = rgb[l];
+        let (x, y) = if z > 0.0 {
+            let s = (res - 1) as f32 / z;
+            (rgb[(l + 1) % 3] * s, rgb[(l + 2) % 3] * s)
+        } else {
+            (0.0, 0.0)
+        };
+        let xi = (x as usize).min(res - 2);
+        let yi = (y as usize).min(res - 2);
+        let zi = self.scale.partition_point(|&s| s <= z).clamp(1, res - 1) - 1;
+        let x1 = x - xi as f32;
+        let y1 = y - yi as f32;
+        let z1 = (z - self.scale[zi]) / (self.scale[zi + 1] - self.scale[zi]);
+        let (x0, y0, z0) = (1.0 - x1, 1.0 - y1, 1.0 - z1);
+        let o = self.index(l, zi, yi, xi);
+        let (dx, dy, dz) = (3, 3 * res, 3 * res * res);
+        let d = &self.data;
+        let mut c = [0.0f64; 3];
+        for (m, cm) in c.iter_mut().enumerate() {
+            let o = o + m;
+            let v = ((d[o] * x0 + d[o + dx] * x1) * y0 + (d[o + dy] * x0 + d[o + dy + dx] * x1) * y1) * z0
+                + ((d[o + dz] * x0 + d[o + dz + dx] * x1) * y0
+                    + (d[o + dz + dy] * x0 + d[o + dz + dy + dx] * x1) * y1)
+                    * z1;
+            *cm = v as f64;
+        }
+        SigmoidPolynomial { c }
+    }
+
+    /// [`Self::fetch`] for user input: refuses NaN, infinite, negative and above-1 components.
+    pub fn fetch_checked(&self, rgb: [f64; 3]) -> Result<SigmoidPolynomial> {
+        check_rgb(rgb)?;
+        if rgb.iter().any(|&v| v > 1.0) {
+            return Err(ColorError::Table(format!(
+                "RGB ({}, {}, {}) has a component above 1; a reflectance table covers [0, 1] (use the unbounded variant)",
+                rgb[0], rgb[1], rgb[2]
+            )));
+        }
+        Ok(self.fetch(rgb))
+    }
+
+    /// Bytes of memory the coefficients and scale occupy.
+    pub fn memory_bytes(&self) -> usize {
+        4 * (self.scale.len() + self.data.len())
+    }
+}
+
+/// Refuses NaN, infinite and negative RGB components.
+pub fn check_rgb(rgb: [f64; 3]) -> Result<()> {
+    if rgb.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+        return Err(ColorError::BadRgb(rgb[0], rgb[1], rgb[2]));
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to a temporary file next to `path`, then renames it into place.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let origin = path.display().to_string();
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| {
+        table_err(&origin, format!("cannot create a temporary file in {}: {e}", dir.display()))
+    })?;
+    tmp.write_all(bytes)
+        .and_then(|_| tmp.as_file().sync_all())
+        .map_err(|e| table_err(&origin, format!("cannot write: {e}")))?;
+    tmp.persist(path).map_err(|e| table_err(&origin, format!("cannot rename into place: {}", e.error)))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small table whose coefficients encode their own node, so fetch can be checked exactly.
+    fn synthetic(res: usize) -> CoeffTable {
+        let scale: Vec<f32> = (0..res).map(|k| (k as f32 / (res - 1) as f32).powi(2)).collect();
+        let mut t = CoeffTable { res, scale, data: vec![0.0; CoeffTable::data_len(res)] };
+        for l in 0..3 {
+            for k in 0..res {
+                for j in 0..res {
+                    for i in 0..res {
+                        let o = t.index(l, k, j, i);
+                        t.data[o] = i as f32 + 100.0 * l as f32;
+                        t.data[o + 1] = j as f32;
+                        t.data[o + 2] = k as f32;
+                    }
+                }
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn fetch_interpolates_like_rgb2spec() {
+        let t = synthetic(5);
+        // Green largest (l = 1): x = blue/green·4, y = red/green·4, z located in scale.
+        let c = t.fetch([0.2, 0.5, 0.3]).c;
+        assert!((c[0] - (100.0 + 0.3 / 0.5 * 4.0)).abs() < 1e-5, "{c:?}");
+        assert!((c[1] - 0.2 / 0.5 * 4.0).abs() < 1e-5);
+        // scale = (k/4)²: 0.5 lies between k = 2 (0.25) and k = 3 (0.5625).
+        assert!((c[2] - (2.0 + (0.5 - 0.25) / (0.5625 - 0.25))).abs() < 1e-5);
+        // Ties go to the later channel; black does not divide by zero.
+        assert!((t.fetch([0.7, 0.7, 0.7]).c[0] - 204.0).abs() < 1e-5);
+        assert_eq!(t.fetch([0.0, 0.0, 0.0]).c, [200.0, 0.0, 0.0]);
+        // Hot path clamps instead of failing; the checked path refuses.
+        assert!(t.fetch([f64::NAN, -1.0, 2.0]).c.iter().all(|v| v.is_finite()));
+        assert!(t.fetch_checked([f64::NAN, 0.0, 0.0]).is_err());
+        assert!(t.fetch_checked([-0.1, 0.0, 0.0]).is_err());
+        assert!(t.fetch_checked([1.5, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn bytes_round_trip_and_trailer_is_ignored() {
+        let t = synthetic(4);
+        let mut b = t.to_bytes();
+        assert_eq!(b.len(), CoeffTable::file_len(4));
+        assert_eq!(CoeffTable::from_bytes(&b, "x").unwrap(), t);
+        b.extend_from_slice(&[1, 2, 3, 4, 5]);
+        assert_eq!(CoeffTable::from_bytes(&b, "x").unwrap(), t);
+    }
+
+    #[test]
+    fn file_round_trip_is_atomic_and_named_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.coeff");
+        let t = synthetic(3);
+        t.write(&p).unwrap();
+        assert_eq!(CoeffTable::read(&p).unwrap(), t);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left behind");
+        let e = CoeffTable::read(&dir.path().join("missing.coeff")).unwrap_err().to_string();
+        assert!(e.contains("missing.coeff") && e.contains("cannot read"), "{e}");
+    }
+
+    fn err(bytes: &[u8]) -> String {
+        let e = CoeffTable::from_bytes(bytes, "bad.coeff").unwrap_err();
+        assert!(matches!(e, ColorError::Table(_)));
+        let s = e.to_string();
+        assert!(s.starts_with("bad.coeff: "), "{s}");
+        s
+    }
+
+    #[test]
+    fn malformed_files_are_refused_with_reasons() {
+        let good = synthetic(3).to_bytes();
+        assert!(err(&good[..5]).contains("truncated"));
+        assert!(err(&good[..good.len() - 1]).contains("truncated"));
+        assert!(err(b"").contains("truncated"));
+        let mut b = good.clone();
+        b[..4].copy_from_slice(b"PNG\0");
+        assert!(err(&b).contains("SPEC"));
+        let mut b = good.clone();
+        b[4..8].copy_from_slice(&1u32.to_le_bytes());
+        assert!(err(&b).contains("resolution 1"));
+        let mut b = good.clone();
+        b[4..8].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(err(&b).contains("resolution"));
+        // NaN coefficient: the message names the node.
+        let mut b = good.clone();
+        let off = 8 + 4 * 3 + 4 * (3 * 27 + 5);
+        b[off..off + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+        let s = err(&b);
+        assert!(s.contains("not finite") && s.contains("l=1"), "{s}");
+        // Non-monotonic and out-of-range scale.
+        let mut b = good.clone();
+        b[12..16].copy_from_slice(&0.0f32.to_le_bytes());
+        assert!(err(&b).contains("increase"));
+        let mut b = good;
+        b[16..20].copy_from_slice(&f32::INFINITY.to_le_bytes());
+        assert!(err(&b).contains("scale[2]"));
+    }
+}
