@@ -91,7 +91,7 @@ impl Observer {
 
     /// Picasso triggerfish (*Rhinecanthus aculeatus*), a trichromatic coral-reef fish: visual
     /// pigments with λmax 528 nm (LW), 480 nm (MW) and 413 nm (SW) (Cheney et al. 2013,
-    /// J. Exp. Biol. 216, 3045), each modelled with the Govardovskii et al. 2000 A1 template
+    /// J. Exp. Biol. 216, microspectrophotometry), each modelled with the Govardovskii et al. 2000 A1 template
     /// ([`govardovskii_a1`]). Pigment absorbance only: ocular media filtering and
     /// photoreceptor self-screening are not modelled.
     pub fn triggerfish() -> Self {
