@@ -62,6 +62,7 @@ WH = rows("williamson2022_iop.csv")
 J76 = rows("jerlov1976_kd.csv")
 AW = {float(r["wavelength_nm"]): float(r["aw_per_m"]) for r in rows("williamson2022_aw.csv")}
 WH_KD_BELOW_A = []  # (type, count, first, last): measured a above Jerlov's Kd
+ORACLE = [0]  # cells cross-checked against jerlov's API
 MODIFIED = []  # (type, lambda, quantity, how) for the Solonenko & Mobley table
 
 
@@ -149,6 +150,23 @@ def check(name, lam, a, b, kd, strict=True):
     return bad
 
 
+def oracle_check(source, t, lam, a, b, kd):
+    """Cross-check against jerlov's own API at every wavelength it serves without a flag."""
+    import warnings
+    w = jerlov.water(t, source=source)
+    kdw = jerlov.water(t, source="jerlov1976") if source == "williamson2022" else w
+    n = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for l, av, bv, kv in zip(lam, a, b, kd):
+            if l > 700 or (source == "solonenko2015" and any(m[0] == t and m[1] == l for m in MODIFIED)):
+                continue
+            for got, want in ((av, w.a(l)), (bv, w.b(l)), (kv, kdw.kd(l))):
+                assert abs(got - float(want)) <= 1e-12 * abs(float(want)), (source, t, l, got, want)
+                n += 1
+    return n
+
+
 def arr(v):
     return "&[" + ", ".join(repr(float(x)) for x in v) + "]"
 
@@ -194,6 +212,7 @@ def main():
     for t in TYPES:
         lam, a, b, kd = solonenko(t)
         check(f"SM {t}", lam, a, b, kd)
+        ORACLE[0] += oracle_check("solonenko2015", t, lam, a, b, kd)
         src.append(f"    WaterTable {{ name: {t!r}, lambda: {arr(lam)}, a: {arr(a)}, b: {arr(b)}, kd: {arr(kd)} }},\n".replace("'", '"'))
     src.append("];\n\n")
     src.append("/// Cells of [`SOLONENKO2015`] that are not the published value: (type, nm, quantity, how).\n")
@@ -206,6 +225,7 @@ def main():
     for t in WH_TYPES:
         lam, a, b, kd = williamson(t)
         bad = check(f"WH {t}", lam, a, b, kd, strict=False)
+        ORACLE[0] += oracle_check("williamson2022", t, lam, a, b, kd)
         if bad.size:
             WH_KD_BELOW_A.append((t, bad.size, bad.min(), bad.max()))
         assert wl is None or wl == lam
@@ -220,7 +240,7 @@ def main():
     src.extend(body)
     src.append("];\n")
     OUT.write_text("".join(src))
-    print("wrote", OUT)
+    print("wrote", OUT, f"({ORACLE[0]} cells agree with jerlov.water(...) to 1e-12)")
     for m in MODIFIED:
         print("modified:", m)
 
