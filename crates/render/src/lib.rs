@@ -1,14 +1,47 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! Real-time spectral deferred rendering with wgpu.
+//!
+//! Four passes (plus a shadow map): G-buffer → spectral shading → custom → post. The shading
+//! pass turns each pixel's RGB base colour into a Jakob–Hanika sigmoid spectrum, evaluates it
+//! at N wavelengths against each light's sampled emission and a Lambert + GGX BRDF, and
+//! integrates with precomputed observer×Δλ weights into XYZ and linear sRGB. Three modes run
+//! on the same pipelines and switch per frame: `rgb` (classic, baseline), `naive` (box
+//! upsampling) and `spectral`.
+//!
+//! Conventions (so that `spectral` equals `rgb` for diffuse surfaces under D65-white lights):
+//! lights without a spectrum are upsampled with the "illuminant" variant (`s·ρ(rgb/s)·D65`,
+//! `s = 2·max`), spectral lights are scaled to the luminance of their `rgb × intensity`, the
+//! emission weights give D65 a luminance of 1, and the XYZ → RGB matrix is corrected so that
+//! the sampled D65 maps exactly to the sRGB white.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let scene: scene::Scene = unimplemented!();
+//! let mut r = render::Renderer::new()?;
+//! r.set_scene(&scene)?;
+//! r.resize(64, 64)?;
+//! r.render(&scene.camera, &render::RenderSettings::default())?;
+//! let rgba8 = r.read_ldr()?;
+//! # Ok(()) }
+//! ```
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+pub mod coeff_table;
+pub mod error;
+pub mod gpu;
+pub mod passes;
+mod readback;
+pub mod renderer;
+pub mod scene_gpu;
+pub mod settings;
+mod shader;
+pub mod spectral_data;
+pub mod targets;
+pub mod timing;
+pub mod uniforms;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
-}
+pub use error::{NO_ADAPTER_HELP, RenderError, Result};
+pub use gpu::Gpu;
+pub use passes::custom::CustomShader;
+pub use renderer::Renderer;
+pub use settings::{Mode, RenderSettings, Tonemap};
+pub use spectral_data::SpectralSetup;
+pub use timing::PassTimings;

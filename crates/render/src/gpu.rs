@@ -1,0 +1,56 @@
+//! The GPU connection: instance, adapter, device and queue, shared by the renderer and by a
+//! window that presents its output.
+
+use crate::error::{NO_ADAPTER_HELP, RenderError, Result};
+
+/// An open GPU device. Create it headless with [`Gpu::headless`], or from parts a windowing
+/// layer already made (so the adapter can present to its surface) with [`Gpu::from_adapter`].
+pub struct Gpu {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// Features enabled on `device` that the renderer uses when present.
+    pub features: wgpu::Features,
+}
+
+impl Gpu {
+    /// Opens the default adapter without any window system. Honours `WGPU_BACKEND`
+    /// (`vulkan`, `gl`, …), `WGPU_ADAPTER_NAME` and `WGPU_POWER_PREF`.
+    pub fn headless() -> Result<Self> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let backends = wgpu::Backends::from_env().unwrap_or_default();
+        let adapter =
+            pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None)).map_err(
+                |e| RenderError::NoAdapter { backends: format!("{backends:?}"), reason: e.to_string() },
+            )?;
+        Self::from_adapter(instance, adapter)
+    }
+
+    /// Opens a device on `adapter`, enabling the optional features the renderer can use
+    /// (timestamp queries, filterable f32 textures).
+    pub fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
+        let features = adapter.features() & wanted;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("spectra"),
+            required_features: features,
+            required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
+        Ok(Gpu { instance, adapter, device, queue, features })
+    }
+
+    /// "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)" — for logs and benchmark reports.
+    pub fn describe(&self) -> String {
+        let i = self.adapter.get_info();
+        format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+    }
+
+    /// The text shown when no adapter exists; tests print it when they fail for that reason.
+    pub fn install_help() -> &'static str {
+        NO_ADAPTER_HELP
+    }
+}

@@ -1,0 +1,134 @@
+//! Pass 3 and the custom-shader extension point.
+//!
+//! A [`CustomShader`] is WGSL source that defines three hooks (the default, `custom_hooks.wgsl`,
+//! returns its input unchanged):
+//!
+//! ```wgsl
+//! // Pass 2, spectral & naive modes, once per group of four wavelengths, before integration:
+//! fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32>
+//! // Pass 2, rgb mode, once per pixel:
+//! fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32>
+//! // Pass 3, every mode, once per pixel on the HDR linear-sRGB colour:
+//! fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32>
+//! ```
+//!
+//! Inputs available to the hooks (see `wgsl/custom_api.wgsl` and `wgsl/spectral.wgsl`):
+//! - `ctx: SurfaceContext` — world position, unit normal, unit view direction (camera → pixel),
+//!   distance from the camera, `background` flag, pixel coordinates. Background pixels are
+//!   shaded too (radiance 0 before the hook), so fog or water can add in-scattered light.
+//! - `custom.params` — sixteen floats from [`CustomShader::params`].
+//! - `custom_spectra[group * 4 + s]` — spectrum `s` of [`CustomShader::spectra`] sampled at the
+//!   four wavelengths of `group` (re-sampled by the renderer whenever the wavelengths change).
+//! - `wavelengths[group]` — λ, observer weights, white illuminant; `frame` — matrices, camera,
+//!   mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3.
+//!
+//! Radiance units: the HDR values are linear sRGB where a white diffuse surface under a
+//! 1-lux white directional light at normal incidence is 1/π.
+
+use super::{HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry};
+use crate::error::{RenderError, Result};
+use crate::shader;
+use color::Spectrum;
+
+/// Identity hooks.
+pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
+
+/// User code for the extension point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CustomShader {
+    /// WGSL defining `custom_spectral`, `custom_rgb` and `custom_pixel`.
+    pub source: String,
+    /// Free parameters, `custom.params[i / 4][i % 4]` in WGSL.
+    pub params: [f32; 16],
+    /// Up to four spectra the hooks need per wavelength (absorption, scattering, …).
+    pub spectra: Vec<Spectrum>,
+}
+
+/// Most spectra a custom shader can ask for.
+pub const MAX_CUSTOM_SPECTRA: usize = 4;
+
+impl Default for CustomShader {
+    fn default() -> Self {
+        CustomShader { source: DEFAULT_HOOKS.to_string(), params: [0.0; 16], spectra: Vec::new() }
+    }
+}
+
+impl CustomShader {
+    pub fn new(source: impl Into<String>) -> Self {
+        CustomShader { source: source.into(), ..Default::default() }
+    }
+
+    pub(crate) fn validate(&self) -> Result<()> {
+        if self.spectra.len() > MAX_CUSTOM_SPECTRA {
+            return Err(RenderError::CustomShader(format!(
+                "{} spectra given, at most {MAX_CUSTOM_SPECTRA} are supported",
+                self.spectra.len()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Matches `CustomUniforms` in `wgsl/custom_api.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CustomUniforms {
+    pub params: [f32; 16],
+    pub n_spectra: u32,
+    pub _pad: [u32; 3],
+}
+
+pub struct CustomPass {
+    pub input_layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl CustomPass {
+    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom_source: &str) -> Result<Self> {
+        let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("custom inputs"),
+            entries: &[texture_entry(0), texture_entry(1), depth_entry(2)],
+        });
+        let module = shader::compile(
+            device,
+            "custom",
+            &[
+                shader::COMMON,
+                shader::SPECTRAL,
+                shader::CUSTOM_API,
+                custom_source,
+                include_str!("custom.wgsl"),
+            ],
+        )?;
+        let pipeline = shader::checked(device, "custom pipeline", || {
+            fullscreen_pipeline(
+                device,
+                "custom",
+                &module,
+                &[Some(&shared.frame), Some(&input_layout), Some(&shared.spectral), Some(&shared.custom)],
+                HDR_FORMAT,
+            )
+        })?;
+        Ok(CustomPass { input_layout, pipeline })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        frame: &wgpu::BindGroup,
+        inputs: &wgpu::BindGroup,
+        spectral: &wgpu::BindGroup,
+        custom: &wgpu::BindGroup,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let mut pass = fullscreen_pass(encoder, "custom", target, timestamps);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, frame, &[]);
+        pass.set_bind_group(1, inputs, &[]);
+        pass.set_bind_group(2, spectral, &[]);
+        pass.set_bind_group(3, custom, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

@@ -1,0 +1,172 @@
+// Pass 2: spectral (or RGB) shading of the G-buffer into the HDR target.
+// Prepended: wgsl/common.wgsl, wgsl/spectral.wgsl, wgsl/custom_api.wgsl, then the custom shader.
+
+@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+
+@group(1) @binding(0) var gbuf_base: texture_2d<f32>;
+@group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
+@group(1) @binding(2) var gbuf_emission: texture_2d<f32>;
+@group(1) @binding(3) var gbuf_depth: texture_depth_2d;
+@group(1) @binding(4) var shadow_map: texture_depth_2d;
+@group(1) @binding(5) var shadow_sampler: sampler_comparison;
+
+// Must match MAX_LIGHTS in src/scene_gpu.rs.
+const MAX_LIGHTS: u32 = 32u;
+
+// Fraction of the shadow-casting light that reaches `p` (1 outside the shadow frustum).
+fn shadow_visibility(p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let s = frame.shadow_view_proj * vec4<f32>(p + n * frame.shadow_bias, 1.0);
+    if (s.w <= 0.0) { return 1.0; }
+    let ndc = s.xyz / s.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || ndc.z > 1.0 || ndc.z < 0.0) {
+        return 1.0;
+    }
+    return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, ndc.z);
+}
+
+// Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
+// where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
+// Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
+// costs two fma per light.
+fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+    let light = lights[li];
+    let kind = u32(light.pos_kind.w);
+    var wi: vec3<f32>;
+    var atten = 1.0;
+    if (kind == 0u) {
+        wi = -light.pos_kind.xyz;
+    } else {
+        let d = light.pos_kind.xyz - p;
+        let dist2 = max(dot(d, d), 1e-8);
+        wi = d * inverseSqrt(dist2);
+        atten = 1.0 / dist2;
+        let range = light.dir_range.w;
+        if (range > 0.0) {
+            let r = dist2 / (range * range);
+            let w = clamp(1.0 - r * r, 0.0, 1.0);
+            atten *= w * w;
+        }
+        if (kind == 2u) {
+            let cd = dot(light.dir_range.xyz, -wi);
+            let t = clamp((cd - light.cone.x) * light.cone.y, 0.0, 1.0);
+            atten *= t * t;
+        }
+    }
+    let nl = dot(n, wi);
+    if (nl <= 0.0 || atten <= 0.0) { return vec2<f32>(0.0); }
+    if (li == frame.shadow_light) {
+        atten *= shadow_visibility(p, n);
+    }
+    let h = normalize(wi + v);
+    let nv = max(dot(n, v), 1e-4);
+    let nh = max(dot(n, h), 0.0);
+    let vh = max(dot(v, h), 0.0);
+    let alpha = max(roughness * roughness, 1e-3);
+    let a2 = alpha * alpha;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let dist = a2 / (PI * dd * dd);
+    let vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
+    let dv = dist * vis;
+    let fres = pow(1.0 - vh, 5.0);
+    let f_dielectric = 0.04 + 0.96 * fres;
+    let k = nl * atten;
+    let a = k * ((1.0 - metallic) * (1.0 - f_dielectric) / PI + metallic * dv * (1.0 - fres));
+    let b = k * dv * ((1.0 - metallic) * f_dielectric + metallic * fres);
+    return vec2<f32>(a, b);
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.pos.xy);
+    let depth = textureLoad(gbuf_depth, px, 0);
+    let background = depth >= 1.0;
+    let p = world_from_depth(in.pos.xy, depth, frame);
+    let to_p = p - frame.camera_pos.xyz;
+    var ctx: SurfaceContext;
+    ctx.world_pos = p;
+    ctx.view_dir = normalize(to_p);
+    ctx.distance = select(length(to_p), 0.0, background);
+    ctx.background = background;
+    ctx.pixel = vec2<u32>(px);
+    ctx.normal = vec3<f32>(0.0);
+
+    var base = vec3<f32>(0.0);
+    var emission = vec3<f32>(0.0);
+    var n_lights = 0u;
+    var fa: array<f32, MAX_LIGHTS>;
+    var fb: array<f32, MAX_LIGHTS>;
+    if (!background) {
+        let b = textureLoad(gbuf_base, px, 0);
+        let nr = textureLoad(gbuf_normal, px, 0);
+        base = b.rgb;
+        emission = textureLoad(gbuf_emission, px, 0).rgb;
+        let n = normalize(nr.xyz);
+        ctx.normal = n;
+        n_lights = min(frame.n_lights, MAX_LIGHTS);
+        for (var li = 0u; li < n_lights; li++) {
+            let f = light_factors(li, p, n, -ctx.view_dir, b.a, nr.w);
+            fa[li] = f.x;
+            fb[li] = f.y;
+        }
+    }
+
+    if (frame.mode == MODE_RGB) {
+        var sum_a = vec3<f32>(0.0);
+        var sum_b = vec3<f32>(0.0);
+        for (var li = 0u; li < n_lights; li++) {
+            let e = lights[li].rgb.rgb;
+            sum_a = fma(vec3<f32>(fa[li]), e, sum_a);
+            sum_b = fma(vec3<f32>(fb[li]), e, sum_b);
+        }
+        let rgb = fma(base, sum_a, sum_b) + emission;
+        return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
+    }
+
+    let spectral = frame.mode == MODE_SPECTRAL;
+    let res = frame.table_res;
+    var c_base = vec3<f32>(0.0);
+    var c_em = vec3<f32>(0.0);
+    // Emission uses the "illuminant" variant: s·sigmoid(rgb / s)·white(λ), s = 2·max(rgb),
+    // so that an emissive (1, 1, 1) is exactly the white illuminant.
+    let em_max = max(emission.r, max(emission.g, emission.b));
+    let has_em = em_max > 0.0;
+    let em_scale = 2.0 * em_max;
+    if (spectral && !background) {
+        c_base = fetch_coeffs(base, res);
+        if (has_em) {
+            c_em = fetch_coeffs(emission / em_scale, res);
+        }
+    }
+    let ng = frame.n_groups;
+    var xyz = vec3<f32>(0.0);
+    for (var g = 0u; g < ng; g++) {
+        let wg = wavelengths[g];
+        var rho: vec4<f32>;
+        if (spectral) {
+            rho = sigmoid4(c_base, wg.lambda);
+        } else {
+            rho = box4(base, wg);
+        }
+        var acc_a = vec4<f32>(0.0);
+        var acc_b = vec4<f32>(0.0);
+        for (var li = 0u; li < n_lights; li++) {
+            let e = light_spectra[li * ng + g];
+            acc_a = fma(vec4<f32>(fa[li]), e, acc_a);
+            acc_b = fma(vec4<f32>(fb[li]), e, acc_b);
+        }
+        var radiance = fma(rho, acc_a, acc_b);
+        if (has_em) {
+            var em: vec4<f32>;
+            if (spectral) {
+                em = em_scale * sigmoid4(c_em, wg.lambda);
+            } else {
+                em = box4(emission, wg);
+            }
+            radiance = fma(em, wg.white, radiance);
+        }
+        radiance = custom_spectral(wg.lambda, radiance, g, ctx);
+        xyz += vec3<f32>(dot(radiance, wg.wx), dot(radiance, wg.wy), dot(radiance, wg.wz));
+    }
+    return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
+}

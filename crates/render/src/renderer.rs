@@ -1,0 +1,452 @@
+//! The long-lived renderer: owns the device, pipelines, the uploaded scene and the targets;
+//! [`Renderer::render`] draws one frame with the [`RenderSettings`] given for that frame.
+
+use crate::coeff_table::GpuCoeffTable;
+use crate::error::{RenderError, Result};
+use crate::gpu::Gpu;
+use crate::passes::SharedLayouts;
+use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
+use crate::passes::gbuffer::GBufferPass;
+use crate::passes::post::PostPass;
+use crate::passes::shading::ShadingPass;
+use crate::passes::shadow::{ShadowPass, light_view_proj};
+use crate::readback;
+use crate::scene_gpu::{GpuLight, GpuScene};
+use crate::settings::{Mode, RenderSettings};
+use crate::spectral_data::SpectralSetup;
+use crate::targets::Targets;
+use crate::timing::{PassTimings, Timer};
+use crate::uniforms::{FrameUniforms, NO_SHADOW};
+use color::upsample::CoeffTable;
+use glam::Mat4;
+use std::sync::Arc;
+use wgpu::util::DeviceExt;
+
+/// What the per-wavelength buffers were built for; a change triggers a re-upload.
+#[derive(Clone, Debug, PartialEq)]
+struct SpectralKey {
+    observer: String,
+    range: (u64, u64),
+    n: usize,
+    mode: Mode,
+    scene_generation: u64,
+    custom_generation: u64,
+}
+
+struct SpectralState {
+    key: SpectralKey,
+    setup: SpectralSetup,
+    bind_group: wgpu::BindGroup,
+    custom_bind_group: wgpu::BindGroup,
+    n_lights: u32,
+}
+
+/// Bind groups that reference the size-dependent targets.
+struct TargetBindings {
+    shading: wgpu::BindGroup,
+    custom: wgpu::BindGroup,
+    post: wgpu::BindGroup,
+}
+
+/// A real-time spectral deferred renderer.
+///
+/// Typical use: [`Renderer::new`] once, [`Renderer::set_scene`], [`Renderer::resize`], then
+/// [`Renderer::render`] every frame and either present [`Renderer::output_view`] (rgba8 sRGB)
+/// or read it back with [`Renderer::read_ldr`] / [`Renderer::read_hdr`].
+pub struct Renderer {
+    gpu: Gpu,
+    shared: SharedLayouts,
+    gbuffer: GBufferPass,
+    shadow: ShadowPass,
+    shading: ShadingPass,
+    custom_pass: CustomPass,
+    post: PostPass,
+    table: Arc<CoeffTable>,
+    gpu_table: GpuCoeffTable,
+    frame_buffer: wgpu::Buffer,
+    frame_bind_group: wgpu::BindGroup,
+    custom: CustomShader,
+    custom_generation: u64,
+    scene: Option<GpuScene>,
+    scene_generation: u64,
+    spectral: Option<SpectralState>,
+    targets: Option<(Targets, TargetBindings)>,
+    timer: Option<Timer>,
+}
+
+impl Renderer {
+    /// A headless renderer on the default adapter (honours `WGPU_BACKEND`) with the sRGB
+    /// Jakob–Hanika table from `color::upsample::table` (fitted once per machine, then cached).
+    /// Fails with an install hint when the machine has no adapter at all.
+    pub fn new() -> Result<Self> {
+        let gpu = Gpu::headless()?;
+        Self::with_gpu(gpu, color::upsample::table("srgb")?)
+    }
+
+    /// [`Self::new`] with an explicit coefficient table.
+    pub fn with_table(table: Arc<CoeffTable>) -> Result<Self> {
+        Self::with_gpu(Gpu::headless()?, table)
+    }
+
+    /// A renderer on a device someone else opened (a window that presents the output).
+    pub fn with_gpu(gpu: Gpu, table: Arc<CoeffTable>) -> Result<Self> {
+        let device = &gpu.device;
+        let shared = SharedLayouts::new(device);
+        let custom = CustomShader::default();
+        let gbuffer = GBufferPass::new(device, &shared)?;
+        let shadow = ShadowPass::new(device, &shared)?;
+        let shading = ShadingPass::new(device, &shared, &custom.source)?;
+        let custom_pass = CustomPass::new(device, &shared, &custom.source)?;
+        let post = PostPass::new(device, &shared)?;
+        let gpu_table = GpuCoeffTable::upload(device, &gpu.queue, &table);
+        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniforms"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &shared.frame,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame_buffer.as_entire_binding() }],
+        });
+        let timer =
+            gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Timer::new(device, &gpu.queue));
+        Ok(Renderer {
+            gpu,
+            shared,
+            gbuffer,
+            shadow,
+            shading,
+            custom_pass,
+            post,
+            table,
+            gpu_table,
+            frame_buffer,
+            frame_bind_group,
+            custom,
+            custom_generation: 0,
+            scene: None,
+            scene_generation: 0,
+            spectral: None,
+            targets: None,
+            timer,
+        })
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    pub fn table(&self) -> &Arc<CoeffTable> {
+        &self.table
+    }
+
+    /// Uploads `scene` (geometry, materials, textures, lights), replacing the previous one.
+    pub fn set_scene(&mut self, scene: &scene::Scene) -> Result<()> {
+        self.scene =
+            Some(GpuScene::upload(&self.gpu.device, &self.gpu.queue, &self.gbuffer.material_layout, scene)?);
+        self.scene_generation += 1;
+        Ok(())
+    }
+
+    /// The camera the current scene was authored with.
+    pub fn scene_camera(&self) -> Option<scene::Camera> {
+        self.scene.as_ref().map(|s| s.camera)
+    }
+
+    /// Replaces the custom hooks; recompiles the shading and custom passes. On a compile
+    /// error the previous shader stays in place.
+    pub fn set_custom_shader(&mut self, custom: CustomShader) -> Result<()> {
+        custom.validate()?;
+        let device = &self.gpu.device;
+        let shading = ShadingPass::new(device, &self.shared, &custom.source)?;
+        let custom_pass = CustomPass::new(device, &self.shared, &custom.source)?;
+        self.shading = shading;
+        self.custom_pass = custom_pass;
+        self.custom = custom;
+        self.custom_generation += 1;
+        Ok(())
+    }
+
+    /// Sets the output size (pixels). Cheap when unchanged.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        let max = self.gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(RenderError::Settings(format!(
+                "image size {width}×{height} must be between 1 and {max}"
+            )));
+        }
+        if self.targets.as_ref().is_some_and(|(t, _)| t.width == width && t.height == height) {
+            return Ok(());
+        }
+        let targets = Targets::new(&self.gpu.device, width, height);
+        let bindings = self.target_bindings(&targets);
+        self.targets = Some((targets, bindings));
+        Ok(())
+    }
+
+    pub fn size(&self) -> Option<(u32, u32)> {
+        self.targets.as_ref().map(|(t, _)| (t.width, t.height))
+    }
+
+    /// The display image of the last frame (`Rgba8UnormSrgb`, tone-mapped).
+    pub fn output_view(&self) -> Option<&wgpu::TextureView> {
+        self.targets.as_ref().map(|(t, _)| &t.ldr_view)
+    }
+
+    /// The linear HDR image of the last frame (`Rgba16Float`, after the custom pass, before
+    /// exposure).
+    pub fn hdr_view(&self) -> Option<&wgpu::TextureView> {
+        self.targets.as_ref().map(|(t, _)| &t.hdr_view)
+    }
+
+    /// The per-wavelength data of the last frame (wavelengths, weights, matrix).
+    pub fn spectral_setup(&self) -> Option<&SpectralSetup> {
+        self.spectral.as_ref().map(|s| &s.setup)
+    }
+
+    /// Renders one frame from `camera`. Requires [`Self::set_scene`] and [`Self::resize`].
+    pub fn render(&mut self, camera: &scene::Camera, settings: &RenderSettings) -> Result<()> {
+        settings.validate()?;
+        if self.scene.is_none() {
+            return Err(RenderError::Settings("no scene: call set_scene first".into()));
+        }
+        let Some((targets, _)) = self.targets.as_ref() else {
+            return Err(RenderError::Settings("no render size: call resize first".into()));
+        };
+        let (width, height) = (targets.width, targets.height);
+        self.update_spectral(settings)?;
+        let spectral = self.spectral.as_ref().expect("update_spectral sets it");
+        let scene = self.scene.as_ref().expect("checked above");
+
+        let aspect = width as f32 / height as f32;
+        let view = camera.transform.inverse();
+        let proj = Mat4::perspective_rh(camera.yfov, aspect, camera.znear, camera.zfar);
+        let view_proj = proj * view;
+        let shadow = settings
+            .shadows
+            .then(|| scene.lights.first().and_then(|l| light_view_proj(l, scene.bounds)))
+            .flatten();
+        let m = spectral.setup.xyz_to_rgb;
+        let uniforms = FrameUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            shadow_view_proj: shadow.map(|s| s.0).unwrap_or(Mat4::IDENTITY).to_cols_array_2d(),
+            camera_pos: camera.position().extend(1.0).to_array(),
+            xyz_to_rgb: [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x as f32, c.y as f32, c.z as f32, 0.0]),
+            viewport: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
+            mode: settings.mode.gpu(),
+            n_groups: spectral.setup.groups() as u32,
+            n_lights: spectral.n_lights,
+            shadow_light: if shadow.is_some() { 0 } else { NO_SHADOW },
+            exposure: settings.exposure_ev.exp2(),
+            tonemap: settings.tonemap.gpu(),
+            shadow_bias: shadow.map(|s| s.1).unwrap_or(0.0),
+            table_res: self.gpu_table.res,
+        };
+        self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+
+        let (targets, bindings) = self.targets.as_ref().expect("checked above");
+        let timer = self.timer.as_ref().filter(|_| settings.timestamps);
+        let ts = |i: usize| timer.map(|t| t.writes(i));
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        self.shadow.record(&mut encoder, &self.frame_bind_group, shadow.map(|_| scene), ts(0));
+        let g = &targets.gbuffer_views;
+        self.gbuffer.record(
+            &mut encoder,
+            [&g[0], &g[1], &g[2]],
+            &targets.depth_view,
+            &self.frame_bind_group,
+            scene,
+            ts(1),
+        );
+        self.shading.record(
+            &mut encoder,
+            &targets.hdr_shaded_view,
+            &self.frame_bind_group,
+            &bindings.shading,
+            &spectral.bind_group,
+            &spectral.custom_bind_group,
+            ts(2),
+        );
+        self.custom_pass.record(
+            &mut encoder,
+            &targets.hdr_view,
+            &self.frame_bind_group,
+            &bindings.custom,
+            &spectral.bind_group,
+            &spectral.custom_bind_group,
+            ts(3),
+        );
+        self.post.record(&mut encoder, &targets.ldr_view, &self.frame_bind_group, &bindings.post, ts(4));
+        if let Some(t) = timer {
+            t.resolve(&mut encoder);
+        }
+        let scope = self.gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        self.gpu.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Gpu(e.to_string()));
+        }
+        if let Some(t) = self.timer.as_mut() {
+            t.pending = settings.timestamps;
+        }
+        Ok(())
+    }
+
+    /// GPU time per pass of the last frame rendered with `timestamps: true` (waits for it).
+    /// `None` when the adapter has no timestamp queries or no such frame was rendered.
+    pub fn read_timings(&mut self) -> Result<Option<PassTimings>> {
+        match self.timer.as_mut() {
+            Some(t) if t.pending => t.read(&self.gpu.device).map(Some),
+            _ => Ok(None),
+        }
+    }
+
+    /// The display image as tightly packed RGBA8 (sRGB-encoded) rows.
+    pub fn read_ldr(&self) -> Result<Vec<u8>> {
+        let (t, _) =
+            self.targets.as_ref().ok_or_else(|| RenderError::Settings("nothing rendered yet".into()))?;
+        readback::read_texture(&self.gpu.device, &self.gpu.queue, &t.ldr, 4)
+    }
+
+    /// The linear HDR image (after the custom pass, before exposure) as RGBA f32 pixels.
+    pub fn read_hdr(&self) -> Result<Vec<[f32; 4]>> {
+        let (t, _) =
+            self.targets.as_ref().ok_or_else(|| RenderError::Settings("nothing rendered yet".into()))?;
+        let bytes = readback::read_texture(&self.gpu.device, &self.gpu.queue, &t.hdr, 8)?;
+        Ok(bytes
+            .chunks_exact(8)
+            .map(|p| std::array::from_fn(|c| half::f16::from_le_bytes([p[2 * c], p[2 * c + 1]]).to_f32()))
+            .collect())
+    }
+
+    fn target_bindings(&self, t: &Targets) -> TargetBindings {
+        let device = &self.gpu.device;
+        fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
+        }
+        let g = &t.gbuffer_views;
+        let shading = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shading inputs"),
+            layout: &self.shading.input_layout,
+            entries: &[
+                view(0, &g[0]),
+                view(1, &g[1]),
+                view(2, &g[2]),
+                view(3, &t.depth_view),
+                view(4, &self.shadow.view),
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(&self.shadow.sampler),
+                },
+            ],
+        });
+        let custom = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("custom inputs"),
+            layout: &self.custom_pass.input_layout,
+            entries: &[view(0, &t.hdr_shaded_view), view(1, &g[1]), view(2, &t.depth_view)],
+        });
+        let post = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("post inputs"),
+            layout: &self.post.input_layout,
+            entries: &[view(0, &t.hdr_view)],
+        });
+        TargetBindings { shading, custom, post }
+    }
+
+    /// Rebuilds the per-wavelength buffers when the wavelengths, observer, mode, scene or custom
+    /// spectra changed since the last frame. These are a few KiB: nothing is recompiled.
+    fn update_spectral(&mut self, settings: &RenderSettings) -> Result<()> {
+        let key = SpectralKey {
+            observer: settings.observer.to_ascii_lowercase(),
+            range: (settings.range.min.to_bits(), settings.range.max.to_bits()),
+            n: settings.wavelengths,
+            mode: settings.mode,
+            scene_generation: self.scene_generation,
+            custom_generation: self.custom_generation,
+        };
+        if self.spectral.as_ref().is_some_and(|s| s.key == key) {
+            return Ok(());
+        }
+        let setup = SpectralSetup::new(settings)?;
+        let scene = self.scene.as_ref().expect("render checks the scene first");
+        let device = &self.gpu.device;
+        let groups = setup.gpu_groups();
+        let ng = setup.groups();
+        // Padding lanes repeat the last wavelength; their weights are zero.
+        let padded_lambda: Vec<f64> = groups.iter().flat_map(|g| g.lambda.map(f64::from)).collect();
+
+        let mut lights = Vec::new();
+        let mut light_spectra: Vec<f32> = Vec::new();
+        for light in &scene.lights {
+            lights.push(GpuLight::new(light, setup.light_rgb(&light.emission)));
+            let mut s = setup.light_samples(&light.emission, settings.mode, &self.table);
+            s.resize(ng * 4, 0.0);
+            light_spectra.extend(s.iter().map(|&v| v as f32));
+        }
+        let n_lights = lights.len() as u32;
+        // Storage buffers may not be empty.
+        if lights.is_empty() {
+            lights.push(GpuLight::default());
+        }
+        if light_spectra.is_empty() {
+            light_spectra.resize(4, 0.0);
+        }
+        let storage = |label: &str, bytes: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
+        let light_buf = storage("lights", bytemuck::cast_slice(&lights));
+        let light_spec_buf = storage("light spectra", bytemuck::cast_slice(&light_spectra));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("spectral"),
+            layout: &self.shared.spectral,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wl_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: light_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: light_spec_buf.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&self.gpu_table.view),
+                },
+                wgpu::BindGroupEntry { binding: 4, resource: self.gpu_table.scale.as_entire_binding() },
+            ],
+        });
+
+        // custom_spectra[group * 4 + s] = spectrum s at the group's four wavelengths.
+        let mut custom_spectra = vec![[0f32; 4]; ng * 4];
+        for (s, spectrum) in self.custom.spectra.iter().enumerate() {
+            for g in 0..ng {
+                custom_spectra[g * 4 + s] =
+                    std::array::from_fn(|lane| spectrum.eval(padded_lambda[g * 4 + lane]) as f32);
+            }
+        }
+        let custom_uniforms = CustomUniforms {
+            params: self.custom.params,
+            n_spectra: self.custom.spectra.len() as u32,
+            _pad: [0; 3],
+        };
+        let custom_uniform_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("custom uniforms"),
+            contents: bytemuck::bytes_of(&custom_uniforms),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let custom_spec_buf = storage("custom spectra", bytemuck::cast_slice(&custom_spectra));
+        let custom_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("custom"),
+            layout: &self.shared.custom,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: custom_uniform_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: custom_spec_buf.as_entire_binding() },
+            ],
+        });
+        self.spectral = Some(SpectralState { key, setup, bind_group, custom_bind_group, n_lights });
+        Ok(())
+    }
+}

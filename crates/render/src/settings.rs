@@ -1,0 +1,149 @@
+//! Per-frame render settings: everything a viewer may change between two frames.
+
+use crate::error::{RenderError, Result};
+use color::WavelengthRange;
+
+/// How surfaces and lights are coloured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Mode {
+    /// Classic RGB shading (the baseline every engine uses).
+    Rgb,
+    /// Spectral, with RGB upsampled to box spectra (each band takes one channel).
+    Naive,
+    /// Spectral, with Jakob–Hanika sigmoid upsampling (this project's method).
+    #[default]
+    Spectral,
+}
+
+impl Mode {
+    pub const NAMES: &'static [&'static str] = &["rgb", "naive", "spectral"];
+
+    pub fn parse(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "rgb" => Ok(Mode::Rgb),
+            "naive" | "box" => Ok(Mode::Naive),
+            "spectral" | "jh" => Ok(Mode::Spectral),
+            _ => Err(RenderError::Settings(format!("unknown mode '{s}'; known: rgb, naive, spectral"))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Rgb => "rgb",
+            Mode::Naive => "naive",
+            Mode::Spectral => "spectral",
+        }
+    }
+
+    /// The value of `FrameUniforms::mode`.
+    pub(crate) fn gpu(self) -> u32 {
+        match self {
+            Mode::Rgb => 0,
+            Mode::Naive => 1,
+            Mode::Spectral => 2,
+        }
+    }
+}
+
+/// Tone-mapping operator applied after exposure, before sRGB encoding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Tonemap {
+    /// Clamp to [0, 1]: what the reference-image tests use, so colours are not distorted.
+    #[default]
+    None,
+    /// `c / (1 + c)` per channel.
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve.
+    Aces,
+}
+
+impl Tonemap {
+    pub fn parse(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "none" | "clamp" => Ok(Tonemap::None),
+            "reinhard" => Ok(Tonemap::Reinhard),
+            "aces" => Ok(Tonemap::Aces),
+            _ => Err(RenderError::Settings(format!("unknown tone map '{s}'; known: none, reinhard, aces"))),
+        }
+    }
+
+    pub(crate) fn gpu(self) -> u32 {
+        match self {
+            Tonemap::None => 0,
+            Tonemap::Reinhard => 1,
+            Tonemap::Aces => 2,
+        }
+    }
+}
+
+/// Largest number of wavelengths per pixel.
+pub const MAX_WAVELENGTHS: usize = 256;
+
+/// Settings read at every [`crate::Renderer::render`]. Changing the wavelengths, range or
+/// observer re-uploads a few small buffers; nothing is recompiled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub mode: Mode,
+    /// Number of wavelength samples N (1..=[`MAX_WAVELENGTHS`]), midpoint rule over `range`.
+    pub wavelengths: usize,
+    pub range: WavelengthRange,
+    /// Observer name for `color::Observer::by_name`.
+    pub observer: String,
+    /// Exposure in stops: the HDR colour is multiplied by 2^EV before tone mapping.
+    pub exposure_ev: f32,
+    pub tonemap: Tonemap,
+    /// Render a shadow map for the main light.
+    pub shadows: bool,
+    /// Measure each pass with GPU timestamp queries (when the adapter supports them).
+    pub timestamps: bool,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            mode: Mode::Spectral,
+            wavelengths: 16,
+            range: WavelengthRange::VISIBLE,
+            observer: "cie1931".into(),
+            exposure_ev: 0.0,
+            tonemap: Tonemap::None,
+            shadows: true,
+            timestamps: false,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Refuses values the GPU path cannot honour, naming the value.
+    pub fn validate(&self) -> Result<()> {
+        if self.wavelengths == 0 || self.wavelengths > MAX_WAVELENGTHS {
+            return Err(RenderError::Settings(format!(
+                "the number of wavelengths must be between 1 and {MAX_WAVELENGTHS} (got {})",
+                self.wavelengths
+            )));
+        }
+        WavelengthRange::new(self.range.min, self.range.max)?;
+        if !self.exposure_ev.is_finite() {
+            return Err(RenderError::Settings(format!("exposure must be finite (got {})", self.exposure_ev)));
+        }
+        color::Observer::by_name(&self.observer)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_and_validate() {
+        assert_eq!(Mode::parse("RGB").unwrap(), Mode::Rgb);
+        assert!(Mode::parse("hsv").unwrap_err().to_string().contains("hsv"));
+        assert_eq!(Tonemap::parse("aces").unwrap(), Tonemap::Aces);
+        assert!(RenderSettings::default().validate().is_ok());
+        let bad = RenderSettings { wavelengths: 0, ..Default::default() };
+        assert!(bad.validate().unwrap_err().to_string().contains("got 0"));
+        let bad = RenderSettings { observer: "cat".into(), ..Default::default() };
+        assert!(bad.validate().unwrap_err().to_string().contains("cat"));
+    }
+}

@@ -1,0 +1,69 @@
+//! The size-dependent render targets of one frame.
+
+use crate::passes::{DEPTH_FORMAT, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+
+/// G-buffer, depth, HDR and display targets at one size. Recreated on resize.
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    pub gbuffer: [wgpu::Texture; 3],
+    pub gbuffer_views: [wgpu::TextureView; 3],
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+    /// Shading output (pass 2).
+    pub hdr_shaded: wgpu::Texture,
+    pub hdr_shaded_view: wgpu::TextureView,
+    /// Custom-pass output (pass 3): the linear HDR image EXR output stores.
+    pub hdr: wgpu::Texture,
+    pub hdr_view: wgpu::TextureView,
+    /// Tone-mapped, sRGB-encoded display image (pass 4).
+    pub ldr: wgpu::Texture,
+    pub ldr_view: wgpu::TextureView,
+}
+
+impl Targets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
+            let t = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | extra,
+                view_formats: &[],
+            });
+            let v = t.create_view(&Default::default());
+            (t, v)
+        };
+        let none = wgpu::TextureUsages::empty();
+        let g: [(wgpu::Texture, wgpu::TextureView); 3] = [
+            make("gbuffer base", GBUFFER_FORMATS[0], none),
+            make("gbuffer normal", GBUFFER_FORMATS[1], none),
+            make("gbuffer emission", GBUFFER_FORMATS[2], none),
+        ];
+        let [(g0, v0), (g1, v1), (g2, v2)] = g;
+        let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
+        let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
+        let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
+        let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);
+        Targets {
+            width,
+            height,
+            gbuffer: [g0, g1, g2],
+            gbuffer_views: [v0, v1, v2],
+            depth,
+            depth_view,
+            hdr_shaded,
+            hdr_shaded_view,
+            hdr,
+            hdr_view,
+            ldr,
+            ldr_view,
+        }
+    }
+}

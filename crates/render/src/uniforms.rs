@@ -1,0 +1,33 @@
+//! The per-frame uniform block shared by every pass (`FrameUniforms` in `wgsl/common.wgsl`).
+
+/// Byte-for-byte the WGSL struct; `mat3x3<f32>` columns are padded to 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub shadow_view_proj: [[f32; 4]; 4],
+    pub camera_pos: [f32; 4],
+    pub xyz_to_rgb: [[f32; 4]; 3],
+    pub viewport: [f32; 4],
+    pub mode: u32,
+    pub n_groups: u32,
+    pub n_lights: u32,
+    pub shadow_light: u32,
+    pub exposure: f32,
+    pub tonemap: u32,
+    pub shadow_bias: f32,
+    pub table_res: u32,
+}
+
+/// `shadow_light` value meaning "no light casts shadows".
+pub const NO_SHADOW: u32 = u32::MAX;
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn size_matches_wgsl() {
+        // 3 mat4 (192) + vec4 (16) + mat3x3 (48) + vec4 (16) + 8 scalars (32).
+        assert_eq!(std::mem::size_of::<super::FrameUniforms>(), 304);
+    }
+}

@@ -1,0 +1,53 @@
+// Shared declarations, prepended to every pass's WGSL (naga has no #include).
+// Layout must match `FrameUniforms` in src/uniforms.rs byte for byte.
+
+struct FrameUniforms {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    shadow_view_proj: mat4x4<f32>,
+    // xyz: camera position in world space.
+    camera_pos: vec4<f32>,
+    // Columns of the XYZ → linear-RGB matrix (white-corrected for the sampled wavelengths).
+    xyz_to_rgb: mat3x3<f32>,
+    // width, height, 1/width, 1/height of the render target.
+    viewport: vec4<f32>,
+    // 0 = rgb, 1 = naive, 2 = spectral.
+    mode: u32,
+    // Number of vec4 wavelength groups (N rounded up to a multiple of 4, divided by 4).
+    n_groups: u32,
+    n_lights: u32,
+    // Index of the light that casts shadows, or 0xffffffff for none.
+    shadow_light: u32,
+    // Linear exposure multiplier (2^EV).
+    exposure: f32,
+    // 0 = none, 1 = Reinhard, 2 = ACES fitted.
+    tonemap: u32,
+    shadow_bias: f32,
+    // Resolution of the Jakob–Hanika coefficient table.
+    table_res: u32,
+};
+
+const MODE_RGB: u32 = 0u;
+const MODE_NAIVE: u32 = 1u;
+const MODE_SPECTRAL: u32 = 2u;
+const PI: f32 = 3.14159265358979;
+
+// World position of a pixel from its depth (wgpu depth 0..1, y down in pixel space).
+fn world_from_depth(pixel: vec2<f32>, depth: f32, f: FrameUniforms) -> vec3<f32> {
+    let ndc = vec2<f32>(pixel.x * f.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * f.viewport.w * 2.0);
+    let h = f.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
+    return h.xyz / h.w;
+}
+
+// A triangle that covers the screen; the fullscreen passes draw 3 vertices without buffers.
+struct FullscreenOut {
+    @builtin(position) pos: vec4<f32>,
+};
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    var o: FullscreenOut;
+    o.pos = vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    return o;
+}

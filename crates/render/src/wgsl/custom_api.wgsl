@@ -1,0 +1,33 @@
+// The contract between the renderer and a custom shader (bind group 3, and the context
+// structs passed to the hooks). See src/passes/custom.rs for the documentation.
+
+struct CustomUniforms {
+    // Sixteen free parameters, set with `CustomShader::params`.
+    params: array<vec4<f32>, 4>,
+    // Number of spectra in `custom_spectra` per wavelength group (0..=4).
+    n_spectra: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+@group(3) @binding(0) var<uniform> custom: CustomUniforms;
+// `CustomShader::spectra` resampled at the current wavelengths:
+// custom_spectra[group * 4 + s] holds spectrum s at the group's four wavelengths.
+@group(3) @binding(1) var<storage, read> custom_spectra: array<vec4<f32>>;
+
+// What the hooks know about the point being shaded.
+struct SurfaceContext {
+    // World position of the visible surface (on the far plane for background pixels).
+    world_pos: vec3<f32>,
+    // Unit world normal (zero for background).
+    normal: vec3<f32>,
+    // Unit direction from the camera through the pixel.
+    view_dir: vec3<f32>,
+    // Distance from the camera to `world_pos` in scene units (0 for background).
+    distance: f32,
+    // True where no geometry was drawn.
+    background: bool,
+    // Pixel coordinates.
+    pixel: vec2<u32>,
+};

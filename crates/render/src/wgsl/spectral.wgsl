@@ -1,0 +1,98 @@
+// Per-wavelength data and Jakob–Hanika upsampling, shared by the shading and custom passes
+// (bind group 2). Layouts match src/spectral_data.rs.
+
+// Four wavelengths. Padding lanes (when N is not a multiple of 4) have zero weights.
+struct WavelengthGroup {
+    // Wavelengths in nm.
+    lambda: vec4<f32>,
+    // Observer × Δλ / k weights (SpectralIntegrator::emission): XYZ = Σ L(λ)·w(λ).
+    wx: vec4<f32>,
+    wy: vec4<f32>,
+    wz: vec4<f32>,
+    // The white illuminant (D65 for sRGB) at these wavelengths, for the "illuminant" variant.
+    white: vec4<f32>,
+    // Naive box upsampling: how much of each wavelength's bin lies in the R, G and B band.
+    band_r: vec4<f32>,
+    band_g: vec4<f32>,
+    band_b: vec4<f32>,
+};
+
+// A light. Emission per wavelength lives in `light_spectra[light * n_groups + group]`.
+struct GpuLight {
+    // xyz position (point/spot) or direction the light travels (directional); w = kind
+    // (0 directional, 1 point, 2 spot).
+    pos_kind: vec4<f32>,
+    // xyz spot direction (unit, away from the light); w = range (0 = infinite).
+    dir_range: vec4<f32>,
+    // x = cos(outer cone), y = 1/(cos(inner) - cos(outer)), zw unused.
+    cone: vec4<f32>,
+    // Linear-sRGB emission × intensity, used in rgb mode.
+    rgb: vec4<f32>,
+};
+
+@group(2) @binding(0) var<storage, read> wavelengths: array<WavelengthGroup>;
+@group(2) @binding(1) var<storage, read> lights: array<GpuLight>;
+@group(2) @binding(2) var<storage, read> light_spectra: array<vec4<f32>>;
+// The coefficient table as one 3D texture: x = i, y = j, z = l·res + k; rgb = (c0, c1, c2).
+@group(2) @binding(3) var coeff_table: texture_3d<f32>;
+// The table's non-uniform z axis (values of the largest channel at each k).
+@group(2) @binding(4) var<storage, read> coeff_scale: array<f32>;
+
+// Largest k with scale[k] <= z, clamped to [0, res - 2] (binary search over the z axis).
+fn find_interval(z: f32, res: u32) -> u32 {
+    var lo = 0u;
+    var hi = res - 1u;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (coeff_scale[mid] <= z) { lo = mid; } else { hi = mid; }
+    }
+    return min(lo, res - 2u);
+}
+
+// Jakob–Hanika coefficients of a reflectance in [0, 1]³: manual trilinear interpolation with
+// textureLoad (exact in f32; rgba32float is not filterable everywhere).
+fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
+    let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
+    var l = 0u;
+    if (rgb.y >= rgb[l]) { l = 1u; }
+    if (rgb.z >= rgb[l]) { l = 2u; }
+    let z = rgb[l];
+    let rm1 = f32(res - 1u);
+    // Black: any (x, y) on the z = 0 slice gives the same spectrum; use the corner.
+    let inv = select(0.0, rm1 / z, z > 0.0);
+    let x = rgb[(l + 1u) % 3u] * inv;
+    let y = rgb[(l + 2u) % 3u] * inv;
+    let xi = min(u32(x), res - 2u);
+    let yi = min(u32(y), res - 2u);
+    let zi = find_interval(z, res);
+    let x1 = x - f32(xi);
+    let y1 = y - f32(yi);
+    let z1 = (z - coeff_scale[zi]) / (coeff_scale[zi + 1u] - coeff_scale[zi]);
+    let base = vec3<i32>(i32(xi), i32(yi), i32(l * res + zi));
+    let c000 = textureLoad(coeff_table, base, 0).xyz;
+    let c100 = textureLoad(coeff_table, base + vec3<i32>(1, 0, 0), 0).xyz;
+    let c010 = textureLoad(coeff_table, base + vec3<i32>(0, 1, 0), 0).xyz;
+    let c110 = textureLoad(coeff_table, base + vec3<i32>(1, 1, 0), 0).xyz;
+    let c001 = textureLoad(coeff_table, base + vec3<i32>(0, 0, 1), 0).xyz;
+    let c101 = textureLoad(coeff_table, base + vec3<i32>(1, 0, 1), 0).xyz;
+    let c011 = textureLoad(coeff_table, base + vec3<i32>(0, 1, 1), 0).xyz;
+    let c111 = textureLoad(coeff_table, base + vec3<i32>(1, 1, 1), 0).xyz;
+    let c00 = mix(c000, c100, x1);
+    let c10 = mix(c010, c110, x1);
+    let c01 = mix(c001, c101, x1);
+    let c11 = mix(c011, c111, x1);
+    return mix(mix(c00, c10, y1), mix(c01, c11, y1), z1);
+}
+
+// s(x) = ½ + x / (2·√(1 + x²)) at four wavelengths: 2 fma for the polynomial, then
+// fma + inverseSqrt + mul + fma. x is clamped so that x² stays finite.
+fn sigmoid4(c: vec3<f32>, lambda: vec4<f32>) -> vec4<f32> {
+    let x = clamp(fma(fma(vec4<f32>(c.x), lambda, vec4<f32>(c.y)), lambda, vec4<f32>(c.z)),
+                  vec4<f32>(-1e18), vec4<f32>(1e18));
+    return fma(0.5 * x, inverseSqrt(fma(x, x, vec4<f32>(1.0))), vec4<f32>(0.5));
+}
+
+// Naive box upsampling: each wavelength takes the value of the band it falls in.
+fn box4(rgb: vec3<f32>, g: WavelengthGroup) -> vec4<f32> {
+    return fma(vec4<f32>(rgb.r), g.band_r, fma(vec4<f32>(rgb.g), g.band_g, rgb.b * g.band_b));
+}

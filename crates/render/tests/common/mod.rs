@@ -1,0 +1,247 @@
+//! Shared helpers for the GPU tests: a renderer that FAILS (not skips) without an adapter, a
+//! fitted coefficient table, a test chart scene, an independent CPU shading reference, ΔE
+//! statistics, and images written to `target/test-output/` when a comparison fails.
+
+#![allow(dead_code)]
+
+use color::upsample::CoeffTable;
+use color::{RgbColorSpace, Spectrum};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use render::{RenderError, Renderer};
+use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
+use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
+
+/// The sRGB Jakob–Hanika table the renderer uses (64³, fitted once per machine and cached by
+/// the colour crate).
+pub fn table() -> Arc<CoeffTable> {
+    static T: OnceLock<Arc<CoeffTable>> = OnceLock::new();
+    T.get_or_init(|| color::upsample::table("srgb").expect("the sRGB coefficient table")).clone()
+}
+
+/// A renderer, or a test failure that says what to install.
+pub fn renderer() -> Renderer {
+    match Renderer::with_table(table()) {
+        Ok(r) => r,
+        Err(e @ RenderError::NoAdapter { .. }) => panic!("{e}"),
+        Err(e) => panic!("creating the renderer failed: {e}"),
+    }
+}
+
+pub fn output_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/test-output");
+    std::fs::create_dir_all(&dir).expect("creating target/test-output");
+    dir
+}
+
+/// Layout of the test chart: `cols × rows` unit patches with gaps, in the z = 0 plane,
+/// facing +z, seen by a narrow camera on the +z axis (so every pixel looks almost straight on).
+pub struct Chart {
+    pub colours: Vec<[f32; 3]>,
+    pub cols: usize,
+    pub rows: usize,
+    pub gap: f32,
+}
+
+pub const CAMERA_DISTANCE: f32 = 60.0;
+pub const CAMERA_YFOV: f32 = 0.09;
+
+impl Chart {
+    /// The 24 ColorChecker patches as linear sRGB albedos (their reflectances under D65,
+    /// computed by the colour crate) in chart order.
+    pub fn colorchecker() -> Self {
+        let space = RgbColorSpace::srgb();
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let integ = color::SpectralIntegrator::reference(
+            &color::Observer::cie1931(),
+            &d65,
+            color::WavelengthRange::FULL,
+        )
+        .unwrap();
+        let colours = color::data::colorchecker::SPECTRA
+            .iter()
+            .map(|t| {
+                let s = Spectrum::from_table(t);
+                let rgb = space.xyz_to_rgb(integ.integrate(|l| s.eval(l)));
+                rgb.map(|c| c.clamp(0.0, 1.0) as f32)
+            })
+            .collect();
+        Chart { colours, cols: 6, rows: 4, gap: 0.15 }
+    }
+
+    fn origin(&self, col: usize, row: usize) -> Vec2 {
+        let pitch = 1.0 + self.gap;
+        let w = self.cols as f32 * pitch - self.gap;
+        let h = self.rows as f32 * pitch - self.gap;
+        Vec2::new(-w / 2.0 + col as f32 * pitch, h / 2.0 - row as f32 * pitch - 1.0)
+    }
+
+    /// Index of the patch containing `p` (world x, y) at least `margin` inside its edges.
+    pub fn patch_at(&self, p: Vec2, margin: f32) -> Option<usize> {
+        (0..self.rows * self.cols).find(|&i| {
+            let o = self.origin(i % self.cols, i / self.cols);
+            p.x >= o.x + margin
+                && p.x <= o.x + 1.0 - margin
+                && p.y >= o.y + margin
+                && p.y <= o.y + 1.0 - margin
+        })
+    }
+
+    /// A scene with one quad per patch (material base colour = the patch), lit by `light`.
+    pub fn scene(&self, light: Emission, roughness: f32, metallic: f32) -> Scene {
+        let mut meshes = Vec::new();
+        let mut materials = Vec::new();
+        for (i, c) in self.colours.iter().enumerate() {
+            let o = self.origin(i % self.cols, i / self.cols);
+            let p = |x: f32, y: f32| Vec3::new(o.x + x, o.y + y, 0.0);
+            meshes.push(Mesh {
+                positions: vec![p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)],
+                normals: vec![Vec3::Z; 4],
+                tangents: vec![],
+                uvs: vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)],
+                indices: vec![0, 1, 2, 0, 2, 3],
+                material: i,
+            });
+            materials.push(Material {
+                name: format!("patch {i}"),
+                base_color: Vec4::new(c[0], c[1], c[2], 1.0),
+                roughness,
+                metallic,
+                ..Default::default()
+            });
+        }
+        Scene {
+            source: "test:chart".into(),
+            meshes,
+            materials,
+            textures: vec![],
+            lights: vec![Light {
+                name: "sun".into(),
+                kind: LightKind::Directional { direction: Vec3::NEG_Z },
+                emission: light,
+                stands_in_for: None,
+            }],
+            camera: chart_camera(),
+            spectral: SpectralSettings::default(),
+            water: None,
+        }
+    }
+}
+
+pub fn chart_camera() -> Camera {
+    Camera::look_at(Vec3::new(0.0, 0.0, CAMERA_DISTANCE), Vec3::ZERO, Vec3::Y, CAMERA_YFOV)
+}
+
+/// World (x, y) on the z = 0 plane seen through the centre of pixel (px, py).
+pub fn pixel_to_chart(px: u32, py: u32, w: u32, h: u32) -> (Vec2, Vec3) {
+    let cam = chart_camera();
+    let aspect = w as f32 / h as f32;
+    let inv =
+        (Mat4::perspective_rh(cam.yfov, aspect, cam.znear, cam.zfar) * cam.transform.inverse()).inverse();
+    let ndc = Vec2::new((px as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (py as f32 + 0.5) / h as f32 * 2.0);
+    let a = inv.project_point3(ndc.extend(0.0));
+    let b = inv.project_point3(ndc.extend(1.0));
+    let d = (b - a).normalize();
+    let t = -a.z / d.z;
+    let hit = a + d * t;
+    (hit.truncate(), d)
+}
+
+/// Independent CPU implementation of the renderer's BRDF (glTF metallic-roughness: Lambert +
+/// GGX, height-correlated Smith, Schlick), as (A, B) with radiance = E·(ρ·A + B).
+pub fn brdf_factors(n: Vec3, v: Vec3, wi: Vec3, metallic: f64, roughness: f64) -> (f64, f64) {
+    let nl = n.dot(wi) as f64;
+    if nl <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let h = (wi + v).normalize();
+    let nv = (n.dot(v) as f64).max(1e-4);
+    let nh = (n.dot(h) as f64).max(0.0);
+    let vh = (v.dot(h) as f64).max(0.0);
+    let alpha = (roughness * roughness).max(1e-3);
+    let a2 = alpha * alpha;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let d = a2 / (std::f64::consts::PI * dd * dd);
+    let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+    let fres = (1.0 - vh).powi(5);
+    let fd = 0.04 + 0.96 * fres;
+    let a = nl * ((1.0 - metallic) * (1.0 - fd) / std::f64::consts::PI + metallic * d * vis * (1.0 - fres));
+    let b = nl * d * vis * ((1.0 - metallic) * fd + metallic * fres);
+    (a, b)
+}
+
+/// CIELAB (D65 white) of a linear sRGB colour.
+pub fn lab(rgb: [f64; 3]) -> [f64; 3] {
+    let space = RgbColorSpace::srgb();
+    color::xyz_to_lab(space.rgb_to_xyz(rgb), space.white_xyz())
+}
+
+/// Mean and 99th percentile of a list of ΔE values.
+pub fn stats(mut de: Vec<f64>) -> (f64, f64) {
+    assert!(!de.is_empty(), "no pixels compared");
+    de.sort_by(f64::total_cmp);
+    let mean = de.iter().sum::<f64>() / de.len() as f64;
+    let p99 = de[((de.len() - 1) as f64 * 0.99).round() as usize];
+    (mean, p99)
+}
+
+fn srgb8(v: f64) -> u8 {
+    (color::colorspace::srgb_encode(v.clamp(0.0, 1.0)) * 255.0).round() as u8
+}
+
+/// Writes `actual`, `expected` and a ΔE heatmap (white = ΔE ≥ 5) next to each other.
+pub fn write_failure_images(
+    name: &str,
+    w: u32,
+    h: u32,
+    actual: &[[f64; 3]],
+    expected: &[[f64; 3]],
+    de: &[f64],
+) {
+    let dir = output_dir();
+    let img = |px: &dyn Fn(usize) -> [u8; 3]| {
+        image::RgbImage::from_fn(w, h, |x, y| image::Rgb(px((y * w + x) as usize)))
+    };
+    let _ = img(&|i| actual[i].map(srgb8)).save(dir.join(format!("{name}-actual.png")));
+    let _ = img(&|i| expected[i].map(srgb8)).save(dir.join(format!("{name}-expected.png")));
+    let _ = img(&|i| [(de[i] / 5.0 * 255.0).min(255.0) as u8; 3]).save(dir.join(format!("{name}-diff.png")));
+}
+
+/// Compares two linear-sRGB images over the pixels where `expected` is `Some`; fails with the
+/// statistics and writes images when the mean or 99th-percentile ΔE2000 exceeds the limits.
+pub fn assert_delta_e(
+    name: &str,
+    w: u32,
+    h: u32,
+    actual: &[[f64; 3]],
+    expected: &[Option<[f64; 3]>],
+    max_mean: f64,
+    max_p99: f64,
+) -> (f64, f64) {
+    let de: Vec<f64> = actual
+        .iter()
+        .zip(expected)
+        .map(|(a, e)| e.map(|e| color::ciede2000(lab(*a), lab(e))).unwrap_or(0.0))
+        .collect();
+    let compared: Vec<f64> = de.iter().zip(expected).filter(|(_, e)| e.is_some()).map(|(d, _)| *d).collect();
+    let (mean, p99) = stats(compared);
+    println!("{name}: ΔE2000 mean {mean:.4}, p99 {p99:.4}");
+    if mean > max_mean || p99 > max_p99 {
+        let exp: Vec<[f64; 3]> = expected.iter().map(|e| e.unwrap_or([0.0; 3])).collect();
+        write_failure_images(name, w, h, actual, &exp, &de);
+        panic!(
+            "{name}: ΔE2000 mean {mean:.4} (limit {max_mean}), p99 {p99:.4} (limit {max_p99}); \
+             images in target/test-output/{name}-*.png"
+        );
+    }
+    (mean, p99)
+}
+
+pub fn rgb_of(px: &[f32; 4]) -> [f64; 3] {
+    [px[0] as f64, px[1] as f64, px[2] as f64]
+}
+
+/// A white light (linear sRGB (1, 1, 1)) of `intensity` lux, optionally with a spectrum.
+pub fn white_light(intensity: f32, spectrum: Option<Spectrum>) -> Emission {
+    Emission { rgb: Vec3::ONE, intensity, spectrum }
+}

@@ -1,0 +1,189 @@
+//! Physics checks on lavapipe at small sizes, against independent CPU references:
+//! - rgb mode equals the analytic Lambert + GGX image;
+//! - spectral mode equals the CPU spectral computation (same N, weights and table fetch)
+//!   under F11 to 1e-3, and differs measurably from rgb there;
+//! - spectral reproduces rgb under D65-white lights for diffuse surfaces.
+
+mod common;
+
+use color::upsample::CoeffTable;
+use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spectrum};
+use common::*;
+use glam::{DMat3, DVec3, Vec3};
+use render::{Mode, RenderSettings, Renderer};
+
+const W: u32 = 96;
+const H: u32 = 64;
+/// Keep compared pixels this far (world units, ≈ 1.2 px) inside a patch.
+const MARGIN: f32 = 0.1;
+
+fn settings(mode: Mode, n: usize) -> RenderSettings {
+    RenderSettings { mode, wavelengths: n, shadows: false, ..Default::default() }
+}
+
+fn render_hdr(r: &mut Renderer, s: &RenderSettings) -> Vec<[f64; 3]> {
+    let cam = r.scene_camera().unwrap();
+    r.render(&cam, s).unwrap();
+    r.read_hdr().unwrap().iter().map(rgb_of).collect()
+}
+
+/// Per pixel: the patch seen (with margin) and the (A, B) BRDF factors there.
+fn pixel_geometry(chart: &Chart, roughness: f64, metallic: f64) -> Vec<Option<(usize, f64, f64)>> {
+    let mut out = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let (p, d) = pixel_to_chart(x, y, W, H);
+            out.push(chart.patch_at(p, MARGIN).map(|i| {
+                let (a, b) = brdf_factors(Vec3::Z, -d, Vec3::Z, metallic, roughness);
+                (i, a, b)
+            }));
+        }
+    }
+    out
+}
+
+/// Independent CPU spectral shading of a patch: ρ from the table (the colour crate's fetch),
+/// the light sampled at the midpoint wavelengths, XYZ with the observer×Δλ weights, and the
+/// XYZ → sRGB matrix corrected so that the sampled D65 is the sRGB white.
+struct CpuSpectral {
+    lambda: Vec<f64>,
+    weights: Vec<[f64; 3]>,
+    light: Vec<f64>,
+    to_rgb: DMat3,
+}
+
+impl CpuSpectral {
+    fn new(n: usize, light_spectrum: &Spectrum, luminance: f64) -> Self {
+        let wl = SampledWavelengths::midpoint(color::WavelengthRange::VISIBLE, n).unwrap();
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let integ = SpectralIntegrator::emission(&Observer::cie1931(), &d65, &wl);
+        let raw = light_spectrum.sample(&wl.lambda);
+        let k = luminance / integ.integrate_samples(&raw)[1];
+        let white = integ.integrate_samples(&d65.sample(&wl.lambda));
+        let space = RgbColorSpace::srgb();
+        let t = space.white_xyz();
+        let corr = DMat3::from_diagonal(DVec3::new(t[0] / white[0], t[1] / white[1], t[2] / white[2]));
+        CpuSpectral {
+            lambda: wl.lambda.clone(),
+            weights: integ.weights.clone(),
+            light: raw.iter().map(|v| v * k).collect(),
+            to_rgb: space.from_xyz * corr,
+        }
+    }
+
+    fn shade(&self, table: &CoeffTable, albedo: [f32; 3], a: f64, b: f64) -> [f64; 3] {
+        let poly = table.fetch(albedo.map(f64::from));
+        let mut xyz = DVec3::ZERO;
+        for i in 0..self.lambda.len() {
+            let rho = poly.to_f32_poly_eval(self.lambda[i]);
+            let l = (rho * a + b) * self.light[i];
+            xyz += DVec3::from(self.weights[i]) * l;
+        }
+        (self.to_rgb * xyz).to_array()
+    }
+}
+
+/// Evaluates the sigmoid the way the GPU stores it (coefficients rounded to f32).
+trait F32Eval {
+    fn to_f32_poly_eval(&self, lambda: f64) -> f64;
+}
+
+impl F32Eval for color::upsample::SigmoidPolynomial {
+    fn to_f32_poly_eval(&self, lambda: f64) -> f64 {
+        let c = self.to_f32().map(f64::from);
+        color::upsample::SigmoidPolynomial::new(c[0], c[1], c[2]).eval(lambda)
+    }
+}
+
+#[test]
+fn rgb_mode_matches_analytic_reference() {
+    let chart = Chart::colorchecker();
+    let intensity = 1.5;
+    let mut r = renderer();
+    r.set_scene(&chart.scene(white_light(intensity, None), 0.6, 0.0)).unwrap();
+    r.resize(W, H).unwrap();
+    let actual = render_hdr(&mut r, &settings(Mode::Rgb, 16));
+    let geo = pixel_geometry(&chart, 0.6, 0.0);
+    let expected: Vec<Option<[f64; 3]>> = geo
+        .iter()
+        .enumerate()
+        .map(|(i, g)| match g {
+            Some((patch, a, b)) => Some(chart.colours[*patch].map(|c| (c as f64 * a + b) * intensity as f64)),
+            None => {
+                // Well outside every patch: background, black.
+                let (p, _) = pixel_to_chart(i as u32 % W, i as u32 / W, W, H);
+                chart.patch_at(p, -MARGIN).is_none().then_some([0.0; 3])
+            }
+        })
+        .collect();
+    // Only f16 storage rounding separates the two.
+    assert_delta_e("rgb-analytic", W, H, &actual, &expected, 0.05, 0.15);
+}
+
+#[test]
+fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
+    let chart = Chart::colorchecker();
+    let f11 = color::illuminant::by_name("F11").unwrap();
+    let intensity = 1.5;
+    let mut r = renderer();
+    r.set_scene(&chart.scene(white_light(intensity, Some(f11.clone())), 1.0, 0.0)).unwrap();
+    r.resize(W, H).unwrap();
+    let n = 16;
+    let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
+    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, n));
+    let cpu = CpuSpectral::new(n, &f11, intensity as f64);
+    let table = table();
+    // In rgb mode the F11 light is its own linear-sRGB colour at luminance `intensity`.
+    let dense = SpectralIntegrator::emission(
+        &Observer::cie1931(),
+        &color::illuminant::by_name("D65").unwrap(),
+        &SampledWavelengths::midpoint(color::WavelengthRange::FULL, 470).unwrap(),
+    );
+    let fx = dense.integrate(|l| f11.eval(l));
+    let light_rgb = RgbColorSpace::srgb().xyz_to_rgb(fx.map(|c| c * intensity as f64 / fx[1]));
+
+    let mut worst = 0.0f64;
+    let mut worst_diff = 0.0f64;
+    let mut de = Vec::new();
+    for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
+        let Some((patch, a, b)) = *g else { continue };
+        let albedo = chart.colours[patch];
+        let want = cpu.shade(&table, albedo, a, b);
+        let want_rgb: [f64; 3] = std::array::from_fn(|c| (albedo[c] as f64 * a + b) * light_rgb[c]);
+        for c in 0..3 {
+            worst = worst.max((spectral[i][c] - want[c]).abs());
+            let d_gpu = spectral[i][c] - rgb[i][c];
+            let d_cpu = want[c] - want_rgb[c];
+            worst_diff = worst_diff.max((d_gpu - d_cpu).abs());
+        }
+        de.push(color::ciede2000(lab(spectral[i]), lab(rgb[i])));
+    }
+    let (mean, p99) = stats(de);
+    println!(
+        "F11: |GPU − CPU| max {worst:.2e}, |Δ(spectral − rgb)| max {worst_diff:.2e}, ΔE(spectral, rgb) mean {mean:.3} p99 {p99:.3}"
+    );
+    assert!(worst < 1e-3, "spectral GPU vs CPU differ by {worst}");
+    assert!(worst_diff < 1e-3, "spectral − rgb differs from the CPU's by {worst_diff}");
+    // F11's narrow lines make metamerism visible: the modes must differ clearly.
+    assert!(mean > 1.0, "spectral and rgb under F11 differ by only ΔE {mean}");
+}
+
+#[test]
+fn spectral_reproduces_rgb_under_d65() {
+    let chart = Chart::colorchecker();
+    let d65 = color::illuminant::by_name("D65").unwrap();
+    let mut r = renderer();
+    r.resize(W, H).unwrap();
+    let geo = pixel_geometry(&chart, 1.0, 0.0);
+    for (name, light) in
+        [("rgb-white", white_light(1.5, None)), ("d65-spectrum", white_light(1.5, Some(d65)))]
+    {
+        r.set_scene(&chart.scene(light, 1.0, 0.0)).unwrap();
+        let rgb = render_hdr(&mut r, &settings(Mode::Rgb, 16));
+        let expected: Vec<Option<[f64; 3]>> = geo.iter().zip(&rgb).map(|(g, c)| g.map(|_| *c)).collect();
+        for n in [16, 32] {
+            let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
+            assert_delta_e(&format!("d65-{name}-n{n}"), W, H, &spectral, &expected, 0.2, 0.5);
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! Pipeline behaviour: runtime switching of modes and wavelengths, the custom extension point,
+//! shadows, tone mapping and sRGB output, timestamps, and error reporting.
+
+mod common;
+
+use common::*;
+use glam::{Vec2, Vec3, Vec4};
+use render::{CustomShader, Mode, RenderSettings, Renderer, Tonemap};
+use scene::{Material, Mesh};
+
+const W: u32 = 48;
+const H: u32 = 32;
+
+fn chart_renderer(intensity: f32) -> (Renderer, Chart) {
+    let chart = Chart::colorchecker();
+    let mut r = renderer();
+    r.set_scene(&chart.scene(white_light(intensity, None), 1.0, 0.0)).unwrap();
+    r.resize(W, H).unwrap();
+    (r, chart)
+}
+
+fn hdr(r: &mut Renderer, s: &RenderSettings) -> Vec<[f64; 3]> {
+    let cam = r.scene_camera().unwrap();
+    r.render(&cam, s).unwrap();
+    r.read_hdr().unwrap().iter().map(rgb_of).collect()
+}
+
+fn centre_pixel_of_patch(chart: &Chart, patch: usize) -> usize {
+    (0..W * H)
+        .find(|&i| chart.patch_at(pixel_to_chart(i % W, i / W, W, H).0, 0.3) == Some(patch))
+        .expect("patch visible") as usize
+}
+
+#[test]
+fn modes_wavelengths_and_range_switch_per_frame() {
+    let (mut r, chart) = chart_renderer(1.0);
+    let red = centre_pixel_of_patch(&chart, 14);
+    let base = RenderSettings { shadows: false, ..Default::default() };
+    let mut seen = Vec::new();
+    for s in [
+        RenderSettings { mode: Mode::Rgb, ..base.clone() },
+        RenderSettings { mode: Mode::Spectral, wavelengths: 1, ..base.clone() },
+        RenderSettings { mode: Mode::Spectral, wavelengths: 7, ..base.clone() },
+        RenderSettings { mode: Mode::Spectral, wavelengths: 64, ..base.clone() },
+        RenderSettings { mode: Mode::Naive, wavelengths: 16, ..base.clone() },
+        RenderSettings {
+            mode: Mode::Spectral,
+            wavelengths: 16,
+            range: color::WavelengthRange::new(400.0, 700.0).unwrap(),
+            ..base.clone()
+        },
+    ] {
+        let img = hdr(&mut r, &s);
+        assert!(img.iter().all(|p| p.iter().all(|v| v.is_finite())), "{s:?} produced non-finite pixels");
+        assert_eq!(r.spectral_setup().unwrap().len(), s.wavelengths);
+        seen.push(img[red]);
+    }
+    // N = 1 integrates one wavelength: every colour collapses onto the white's chromaticity,
+    // so the red patch comes out grey.
+    let n1 = seen[1];
+    assert!((n1[0] - n1[1]).abs() < 1e-3 && (n1[1] - n1[2]).abs() < 1e-3, "N=1 red patch {n1:?}");
+    // Everything else keeps the patch red.
+    for (i, p) in seen.iter().enumerate().filter(|(i, _)| *i != 1) {
+        assert!(p[0] > 2.0 * p[1] && p[0] > 2.0 * p[2], "setting {i}: red patch is {p:?}");
+    }
+}
+
+#[test]
+fn custom_hooks_change_the_image_and_bad_code_is_an_error() {
+    let (mut r, chart) = chart_renderer(1.0);
+    let white = centre_pixel_of_patch(&chart, 18);
+    let s = RenderSettings { shadows: false, ..Default::default() };
+    let before = hdr(&mut r, &s)[white];
+
+    // Pass 3 hook scaled by a parameter; pass 2 hook removes everything above 600 nm.
+    let src = r#"
+fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+    return select(radiance, vec4<f32>(0.0), lambda > vec4<f32>(600.0));
+}
+fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> { return radiance; }
+fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {
+    return vec4<f32>(hdr.rgb * custom.params[0].x, hdr.a);
+}
+"#;
+    let mut custom = CustomShader::new(src);
+    custom.params[0] = 0.5;
+    r.set_custom_shader(custom).unwrap();
+    let after = hdr(&mut r, &s)[white];
+    // No long wavelengths: the white patch turns cyan (red drops far more than blue).
+    assert!(after[0] < 0.5 * after[2], "white patch without λ > 600 nm: {after:?} (before {before:?})");
+
+    // In rgb mode only the pass-3 hook applies: exactly half.
+    let rgb_s = RenderSettings { mode: Mode::Rgb, ..s.clone() };
+    let half = hdr(&mut r, &rgb_s)[white];
+    r.set_custom_shader(CustomShader::default()).unwrap();
+    let full = hdr(&mut r, &rgb_s)[white];
+    for c in 0..3 {
+        assert!((half[c] - 0.5 * full[c]).abs() < 2e-3 * full[c].max(1e-3), "{half:?} vs {full:?}");
+    }
+
+    let err = r.set_custom_shader(CustomShader::new("fn custom_pixel( oops")).unwrap_err().to_string();
+    assert!(err.contains("custom shader"), "{err}");
+    // The previous shader is still in place and rendering still works.
+    assert_eq!(hdr(&mut r, &rgb_s)[white], full);
+}
+
+#[test]
+fn occluder_casts_a_shadow_from_the_main_light() {
+    let chart = Chart::colorchecker();
+    let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+    // A light slanted from the upper left, and a small square floating in front of the chart.
+    scene.lights[0].kind =
+        scene::LightKind::Directional { direction: Vec3::new(0.3, -0.3, -1.0).normalize() };
+    let z = 1.5;
+    scene.meshes.push(Mesh {
+        positions: vec![
+            Vec3::new(-1.0, -0.5, z),
+            Vec3::new(0.0, -0.5, z),
+            Vec3::new(0.0, 0.5, z),
+            Vec3::new(-1.0, 0.5, z),
+        ],
+        normals: vec![Vec3::Z; 4],
+        tangents: vec![],
+        uvs: vec![Vec2::ZERO; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: scene.materials.len(),
+    });
+    scene.materials.push(Material { name: "occluder".into(), base_color: Vec4::ZERO, ..Default::default() });
+    let mut r = renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W * 2, H * 2).unwrap();
+    let s = RenderSettings { mode: Mode::Rgb, ..Default::default() };
+    let lit = hdr(&mut r, &RenderSettings { shadows: false, ..s.clone() });
+    let shadowed = hdr(&mut r, &s);
+    // The shadow falls at occluder + 1.5·(0.3, −0.3)/1 → centred near (−0.05, −0.45) on the chart;
+    // the occluder itself hides (−1..0, −0.5..0.5) as seen from the camera (almost straight on).
+    let (w, h) = (W * 2, H * 2);
+    let mut darkened = 0;
+    let mut unchanged_far = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let (p, _) = pixel_to_chart(x, y, w, h);
+            let i = (y * w + x) as usize;
+            let in_shadow = p.x > 0.1 && p.x < 0.35 && p.y > -0.85 && p.y < -0.05;
+            let far = p.x > 1.5 || p.y > 1.2;
+            if in_shadow && chart.patch_at(p, 0.05).is_some() {
+                assert!(shadowed[i][1] < 0.02 * lit[i][1] + 1e-4, "pixel {x},{y} at {p} not in shadow");
+                darkened += 1;
+            }
+            if far && chart.patch_at(p, 0.05).is_some() {
+                assert!(
+                    (shadowed[i][1] - lit[i][1]).abs() < 1e-3 * lit[i][1].max(1e-2),
+                    "pixel {x},{y} at {p} shadowed"
+                );
+                unchanged_far += 1;
+            }
+        }
+    }
+    assert!(darkened > 10 && unchanged_far > 100, "{darkened} shadowed, {unchanged_far} lit pixels checked");
+}
+
+#[test]
+fn post_applies_exposure_tonemap_and_srgb() {
+    let (mut r, _) = chart_renderer(2.0);
+    for (tonemap, ev) in [(Tonemap::None, 0.0f32), (Tonemap::Reinhard, 1.0), (Tonemap::Aces, -0.5)] {
+        let s = RenderSettings { mode: Mode::Rgb, tonemap, exposure_ev: ev, ..Default::default() };
+        let cam = r.scene_camera().unwrap();
+        r.render(&cam, &s).unwrap();
+        let hdr = r.read_hdr().unwrap();
+        let ldr = r.read_ldr().unwrap();
+        let k = ev.exp2() as f64;
+        for (p, q) in hdr.iter().zip(ldr.chunks_exact(4)) {
+            let want = rgb_of(p).map(|c| {
+                let c = (c * k).max(0.0);
+                let t = match tonemap {
+                    Tonemap::None => c,
+                    Tonemap::Reinhard => c / (1.0 + c),
+                    Tonemap::Aces => {
+                        let v = c * 0.6;
+                        (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14)
+                    }
+                };
+                color::colorspace::srgb_encode(t.clamp(0.0, 1.0)) * 255.0
+            });
+            for c in 0..3 {
+                assert!((q[c] as f64 - want[c]).abs() <= 1.0, "{tonemap:?}: {} vs {}", q[c], want[c]);
+            }
+            assert_eq!(q[3], 255);
+        }
+    }
+}
+
+#[test]
+fn timestamps_report_each_pass() {
+    let (mut r, _) = chart_renderer(1.0);
+    if !r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY) {
+        panic!("adapter {} has no timestamp queries", r.gpu().describe());
+    }
+    let cam = r.scene_camera().unwrap();
+    r.render(&cam, &RenderSettings { timestamps: true, ..Default::default() }).unwrap();
+    let t = r.read_timings().unwrap().expect("timings of the frame");
+    assert!(t.ms.iter().all(|&ms| ms >= 0.0 && ms.is_finite()), "{t:?}");
+    assert!(t.get("shading").unwrap() > 0.0, "{t:?}");
+    // Without timestamps requested there is nothing to read.
+    r.render(&cam, &RenderSettings::default()).unwrap();
+    assert_eq!(r.read_timings().unwrap(), None);
+}
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let mut r = renderer();
+    let cam = chart_camera();
+    let e = r.render(&cam, &RenderSettings::default()).unwrap_err().to_string();
+    assert!(e.contains("set_scene"), "{e}");
+    assert!(r.resize(0, 10).unwrap_err().to_string().contains("0×10"));
+    let chart = Chart::colorchecker();
+    let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+    scene.meshes[0].indices.push(99);
+    scene.meshes[0].indices.extend([0, 1]);
+    let e = r.set_scene(&scene).unwrap_err().to_string();
+    assert!(e.contains("test:chart") && e.contains("99"), "{e}");
+    let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+    scene.materials[0].base_color_texture = Some(scene::TextureRef { index: 3, tex_coord: 0 });
+    let e = r.set_scene(&scene).unwrap_err().to_string();
+    assert!(e.contains("texture 3"), "{e}");
+    r.set_scene(&chart.scene(white_light(1.0, None), 1.0, 0.0)).unwrap();
+    r.resize(8, 8).unwrap();
+    let e = r.render(&cam, &RenderSettings { wavelengths: 0, ..Default::default() }).unwrap_err().to_string();
+    assert!(e.contains("got 0"), "{e}");
+}
