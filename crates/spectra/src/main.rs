@@ -21,12 +21,15 @@ struct Cli {
 enum Command {
     /// Measure a render against a reference: CIEDE2000 and MAE statistics, optional heat map.
     Diff(cmd::diff::Args),
+    /// Ground truth: render a scene with the CPU spectral path tracer (or export it for Mitsuba).
+    Truth(cmd::truth::Args),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
         Command::Diff(a) => cmd::diff::run(a),
+        Command::Truth(a) => cmd::truth::run(a),
     };
     if let Err(e) = result {
         // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".

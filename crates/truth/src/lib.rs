@@ -15,6 +15,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod error;
+pub mod export_mitsuba;
 pub mod integrator;
 pub mod lights;
 pub mod material;

@@ -1,0 +1,195 @@
+//! `spectra truth`: the CPU spectral path tracer's ground-truth image of a scene.
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Args as ClapArgs;
+use color::{Observer, RgbColorSpace, WavelengthRange};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+use truth::{Medium, Settings, TruthError, World};
+
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    pub scene: String,
+    /// Samples (paths) per pixel; each path carries four wavelengths.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Direct lighting only (one scattering vertex), to compare like for like with the
+    /// real-time image.
+    #[arg(long)]
+    pub direct_only: bool,
+    /// Random seed; the image depends on it alone (not on threads).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256")]
+    pub size: String,
+    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
+    #[arg(long)]
+    pub range: Option<String>,
+    /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
+    #[arg(long)]
+    pub observer: Option<String>,
+    /// Scene white, the reference of the XYZ normalisation (default: the scene's, else D65).
+    #[arg(long)]
+    pub white: Option<String>,
+    /// Longest path, in scattering events (Russian roulette ends most paths long before).
+    #[arg(long, default_value_t = 1024)]
+    pub max_depth: u32,
+    /// A homogeneous participating medium, as JSON (see `truth::medium_file`).
+    #[arg(long)]
+    pub medium: Option<PathBuf>,
+    /// Lambertian BRDF instead of glTF's (only for comparisons with Mitsuba's `diffuse`).
+    #[arg(long)]
+    pub lambert: bool,
+    /// Write CIE XYZ into the EXR's three channels instead of linear sRGB.
+    #[arg(long)]
+    pub xyz: bool,
+    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+    /// Also (or only, without --out) export the scene for Mitsuba 3 into this new directory.
+    #[arg(long)]
+    pub export_mitsuba: Option<PathBuf>,
+    /// Output image: .exr (linear) or .png (sRGB-encoded, clipped).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) =
+        s.split_once(['x', 'X']).ok_or_else(|| anyhow!("--size '{s}' must look like WIDTHxHEIGHT"))?;
+    match (w.trim().parse::<u32>(), h.trim().parse::<u32>()) {
+        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => bail!("--size '{s}': width and height must be positive integers"),
+    }
+}
+
+fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
+    let (width, height) = parse_size(&a.size)?;
+    let mut s = Settings::new(width, height, a.spp)?;
+    s.seed = a.seed;
+    s.direct_only = a.direct_only;
+    s.max_depth = a.max_depth;
+    s.lambert = a.lambert;
+    s.range = match (&a.range, scene.spectral.range) {
+        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range {r}"))?,
+        (None, Some((lo, hi))) => {
+            WavelengthRange::new(lo as f64, hi as f64).context("the scene's wavelength range")?
+        }
+        (None, None) => WavelengthRange::VISIBLE,
+    };
+    if let Some(o) = a.observer.as_ref().or(scene.spectral.observer.as_ref()) {
+        s.observer = Observer::by_name(o)?;
+    }
+    if let Some(w) = a.white.as_ref().or(scene.spectral.white.as_ref()) {
+        s.white = color::illuminant::by_name(w)?;
+    }
+    if let Some(p) = &a.medium {
+        let text = std::fs::read_to_string(p).with_context(|| format!("reading medium {}", p.display()))?;
+        let m = Medium::from_json(&text, &p.display().to_string())?;
+        m.validate(s.range)?;
+        s.medium = Some(m);
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+pub fn run(a: Args) -> Result<()> {
+    if a.out.is_none() && a.export_mitsuba.is_none() {
+        bail!("nothing to do: give --out FILE (.exr/.png) and/or --export-mitsuba DIR");
+    }
+    if a.spp == 0 {
+        bail!(TruthError::NoSamples);
+    }
+    if let Some(out) = &a.out {
+        let ext = out.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        if ext != "exr" && ext != "png" {
+            bail!("--out {}: use a .exr (linear) or .png (sRGB) file name", out.display());
+        }
+        if a.xyz && ext != "exr" {
+            bail!("--xyz needs an .exr output (PNG is display-encoded sRGB)");
+        }
+    }
+    let scene = scene::load_any(&a.scene).with_context(|| format!("loading scene '{}'", a.scene))?;
+    let st = settings(&a, &scene)?;
+    color::upsample::install_interrupt_handler();
+    let table = match &a.table {
+        Some(p) => std::sync::Arc::new(
+            color::upsample::CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?,
+        ),
+        None => color::upsample::table("srgb").context("loading the sRGB upsampling table")?,
+    };
+    let t0 = Instant::now();
+    let mut world = World::new(&scene, table.as_ref(), &st.white, st.range, st.medium.as_ref())?;
+    if let Some(env) = &st.environment {
+        world = world.with_environment(env);
+    }
+    let prep = t0.elapsed();
+    if let Some(dir) = &a.export_mitsuba {
+        let skipped = truth::export_mitsuba::export(&world, st.width, st.height, dir)
+            .with_context(|| format!("exporting to {}", dir.display()))?;
+        eprintln!("exported {} for Mitsuba to {}", scene.source, dir.display());
+        for s in skipped {
+            eprintln!("  not exported: {s}");
+        }
+    }
+    let Some(out) = &a.out else { return Ok(()) };
+
+    let pb = ProgressBar::new(st.height as u64);
+    if let Ok(style) =
+        ProgressStyle::with_template("truth [{bar:30}] {pos}/{len} rows, {elapsed} (eta {eta})")
+    {
+        pb.set_style(style.progress_chars("=> "));
+    }
+    let t1 = Instant::now();
+    let cancel = color::upsample::interrupt_flag();
+    let img = truth::render_world(&world, &st, cancel, &|rows| pb.set_position(rows));
+    pb.finish_and_clear();
+    let img = match img {
+        Err(TruthError::Cancelled) => bail!("interrupted; nothing written"),
+        r => r?,
+    };
+    let secs = t1.elapsed().as_secs_f64();
+    if cancel.load(Ordering::Relaxed) {
+        bail!("interrupted; nothing written");
+    }
+    let data = if a.xyz { img.xyz.clone() } else { img.to_rgb(&RgbColorSpace::srgb()) };
+    let image = compare::image::Image::new(st.width, st.height, data)?;
+    compare::io::write_image(out, &image, Default::default())
+        .with_context(|| format!("writing {}", out.display()))?;
+    let paths = st.width as f64 * st.height as f64 * st.spp as f64;
+    let y = img.mean()[1];
+    eprintln!(
+        "{}: {} {}×{} at {} spp, {:.0}–{:.0} nm{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
+        out.display(),
+        scene.source,
+        st.width,
+        st.height,
+        st.spp,
+        st.range.min,
+        st.range.max,
+        if st.direct_only { ", direct only" } else { "" },
+        if st.lambert { ", Lambert" } else { "" },
+        secs,
+        prep.as_secs_f64(),
+        paths / secs / 1e6,
+        y,
+        if img.dropped > 0 { format!(", {} non-finite samples dropped", img.dropped) } else { String::new() }
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("64x32").unwrap(), (64, 32));
+        assert!(parse_size("0x3").is_err());
+        assert!(parse_size("64").is_err());
+    }
+}
