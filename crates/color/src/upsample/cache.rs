@@ -55,6 +55,28 @@ pub fn fit_progress(what: &str) -> ProgressBar {
     pb
 }
 
+/// The table cached at `path` if it loads and has resolution `res`; otherwise a fresh
+/// [`crate::upsample::fit_default_res`] fit, written atomically to `path` (a failed write is
+/// not an error: the table is still good, it only costs a refit next time).
+pub fn load_or_fit(path: &std::path::Path, space: &RgbColorSpace, res: usize) -> Result<CoeffTable> {
+    if let Ok(t) = CoeffTable::read(path)
+        && t.res == res
+    {
+        return Ok(t);
+    }
+    let pb = fit_progress(&format!(
+        "fitting the {} spectral table (once; cached in {})",
+        space.name,
+        path.display()
+    ));
+    let t = crate::upsample::fit_default_res(space, res, &pb)?;
+    if let Some(dir) = path.parent() {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    let _ = t.write(path);
+    Ok(t)
+}
+
 static MEMO: Mutex<Option<HashMap<String, Arc<CoeffTable>>>> = Mutex::new(None);
 
 /// The default table of the colour space called `space_name` (see [`RgbColorSpace::by_name`]).
@@ -92,4 +114,24 @@ pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
         m.get_or_insert_with(HashMap::new).insert(space.name.clone(), t.clone());
     }
     Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fits_once_then_loads_and_replaces_corrupt_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sub").join("srgb-8.coeff");
+        let space = RgbColorSpace::srgb();
+        let fitted = load_or_fit(&path, &space, 8).unwrap();
+        assert_eq!(CoeffTable::read(&path).unwrap(), fitted);
+        // A truncated cache file is refitted and replaced, never returned.
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        assert_eq!(load_or_fit(&path, &space, 8).unwrap(), fitted);
+        assert_eq!(std::fs::read(&path).unwrap(), bytes);
+        assert_eq!(std::fs::read_dir(path.parent().unwrap()).unwrap().count(), 1);
+    }
 }

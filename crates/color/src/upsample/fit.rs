@@ -67,20 +67,22 @@ pub struct FitOptions {
     pub tolerance: f64,
     /// Iteration cap per node.
     pub max_iter: usize,
-    /// Largest coefficient magnitude in the normalised variable (rgb2spec uses 200). Only
-    /// unreachable targets (black, the exact white) hit it.
+    /// Largest coefficient magnitude in the normalised variable. rgb2spec clamps at 200, which
+    /// is too tight for dark saturated colours: e.g. sRGB (0, 0.00075, 0) then misses its
+    /// target by ΔE2000 ≈ 13. spectra uses 10⁴, which every node but black (unreachable: a
+    /// sigmoid is never exactly 0) stays inside.
     pub max_coeff: f64,
 }
 
 impl FitOptions {
-    /// rgb2spec's grid ([`rgb2spec_scale`]), for like-for-like comparisons.
+    /// rgb2spec's grid ([`rgb2spec_scale`]) and coefficient clamp, for like-for-like comparisons.
     pub fn new(res: usize) -> Self {
         FitOptions { res, scale: rgb2spec_scale(res), tolerance: 1e-6, max_iter: 40, max_coeff: 200.0 }
     }
 
     /// spectra's default grid ([`spectra_scale`]).
     pub fn spectra(res: usize) -> Self {
-        FitOptions { scale: spectra_scale(res), ..Self::new(res) }
+        FitOptions { scale: spectra_scale(res), max_coeff: 1e4, ..Self::new(res) }
     }
 }
 

@@ -93,3 +93,109 @@ pub fn round_trip_rgb(model: &LabModel, rgb: [f64; 3], f: impl Fn(f64) -> f64) -
     let back = model.space.xyz_to_rgb(crate::lab::lab_to_xyz(lab, model.space.white_xyz()));
     (back, ciede2000(model.target_lab(rgb), lab))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::upsample::variants::{IlluminantSpectrum, UnboundedSpectrum};
+    use crate::upsample::{Method, fit_default};
+    use crate::xyz::SpectralIntegrator;
+    use crate::{Observer, SampledWavelengths, WavelengthRange, xyz_to_lab};
+    use indicatif::ProgressBar;
+    use std::sync::OnceLock;
+
+    /// The shipping sRGB table (64³, spectra grid), fitted once per test binary.
+    fn srgb_table() -> &'static CoeffTable {
+        static T: OnceLock<CoeffTable> = OnceLock::new();
+        T.get_or_init(|| fit_default(&RgbColorSpace::srgb(), &ProgressBar::hidden()).unwrap())
+    }
+
+    #[test]
+    fn table_round_trip_through_interpolation() {
+        let space = RgbColorSpace::srgb();
+        let r = roundtrip_table(srgb_table(), &space, 10_000, 7).unwrap();
+        // Measured: see docs/upsampling.md. Interpolation between nodes dominates these figures.
+        assert!(r.stats.mean < 0.0095, "{:?}", r.stats);
+        assert!(r.stats.p99 < 0.05, "{:?}", r.stats);
+        assert!(r.stats.max < 0.5, "{:?}", r.stats);
+    }
+
+    #[test]
+    fn grid_nodes_are_fitted_exactly() {
+        let space = RgbColorSpace::srgb();
+        let t = srgb_table();
+        let model = LabModel::new(&space).unwrap();
+        let scale: Vec<f64> = t.scale.iter().map(|&s| s as f64).collect();
+        let mut worst: f64 = 0.0;
+        // Every 7th node of every table except black (k = 0), which no reflectance reaches.
+        for l in 0..3 {
+            for k in (1..t.res).step_by(7) {
+                for j in (0..t.res).step_by(7) {
+                    for i in (0..t.res).step_by(7) {
+                        let rgb = crate::upsample::fit::node_rgb(t.res, &scale, l, k, j, i);
+                        let c = t.node(l, k, j, i).map(|v| v as f64);
+                        let de = ciede2000(model.target_lab(rgb), model.lab_of_nm(c));
+                        if de > 1e-3 {
+                            eprintln!("node l{l} k{k} j{j} i{i} rgb {rgb:?} de {de} c {c:?}");
+                        }
+                        worst = worst.max(de);
+                    }
+                }
+            }
+        }
+        assert!(worst < 1e-3, "worst node ΔE2000 {worst}");
+    }
+
+    #[test]
+    fn baselines_are_worse_but_white_is_exact() {
+        let space = RgbColorSpace::srgb();
+        let smits = roundtrip_upsampler(&crate::upsample::method::Smits, &space, 2000, 3).unwrap();
+        let boxes = roundtrip_upsampler(&crate::upsample::method::BoxBasis, &space, 2000, 3).unwrap();
+        let jakob = roundtrip_table(srgb_table(), &space, 2000, 3).unwrap();
+        assert!(jakob.stats.mean * 20.0 < smits.stats.mean, "{:?} vs {:?}", jakob.stats, smits.stats);
+        assert!(jakob.stats.mean * 20.0 < boxes.stats.mean, "{:?} vs {:?}", jakob.stats, boxes.stats);
+        let model = LabModel::new(&space).unwrap();
+        for m in [Method::Box] {
+            let up = crate::upsample::upsampler(m, &space).unwrap();
+            let s = up.reflectance([1.0, 1.0, 1.0]).unwrap();
+            let (_, de) = round_trip_rgb(&model, [1.0; 3], |l| s.eval(l));
+            assert!(de < 1e-9, "{m}: white ΔE {de}");
+        }
+    }
+
+    #[test]
+    fn unbounded_and_illuminant_variants() {
+        let space = RgbColorSpace::srgb();
+        let t = srgb_table();
+        let model = LabModel::new(&space).unwrap();
+        // Unbounded: XYZ scales with the RGB, so compare chromaticity-and-lightness after
+        // dividing both sides by the same factor.
+        let rgb = [2.4, 1.2, 0.3];
+        let u = UnboundedSpectrum::new(t, rgb).unwrap();
+        assert!((u.scale - 4.8).abs() < 1e-12);
+        let xyz = model.xyz_of(|l| u.eval(l) / 4.8);
+        let de = ciede2000(model.target_lab(rgb.map(|v| v / 4.8)), model.lab_of_xyz(xyz));
+        assert!(de < 0.05, "unbounded ΔE {de}");
+        assert!(UnboundedSpectrum::new(t, [f64::NAN, 0.0, 0.0]).is_err());
+        assert!(UnboundedSpectrum::new(t, [0.0, -1.0, 0.0]).is_err());
+        assert_eq!(UnboundedSpectrum::new(t, [0.0; 3]).unwrap().eval(550.0), 0.0);
+        // Illuminant: RGB (1, 1, 1) emits the space's illuminant (D65): its emission XYZ with D65
+        // as the white is the white point with Y = 1.
+        let d65 = space.illuminant();
+        let e = IlluminantSpectrum::new(t, [1.0; 3], d65.clone()).unwrap();
+        let wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470).unwrap();
+        let integ = SpectralIntegrator::emission(&Observer::cie1931(), &d65, &wl);
+        let xyz = integ.integrate(|l| e.eval(l));
+        let white = integ.integrate(|l| d65.eval(l));
+        let de = ciede2000(xyz_to_lab(xyz, white), [100.0, 0.0, 0.0]);
+        assert!(de < 0.01, "illuminant white ΔE {de} ({xyz:?} vs {white:?})");
+    }
+
+    #[test]
+    fn zero_colours_is_an_error() {
+        assert_eq!(
+            roundtrip_table(srgb_table(), &RgbColorSpace::srgb(), 0, 1).unwrap_err(),
+            ColorError::NoSamples
+        );
+    }
+}

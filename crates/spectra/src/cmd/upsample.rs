@@ -1,0 +1,152 @@
+//! `spectra upsample`: turn one RGB reflectance into a spectrum and show how well it round-trips;
+//! `--roundtrip N` measures a method over N random colours; `--bench` measures evaluation speed.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use color::RgbColorSpace;
+use color::upsample::{self, CoeffTable, Method, Reflectance, Upsampler, fit::LabModel, method, roundtrip};
+use serde_json::json;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Linear RGB components in [0, 1] (omit with --roundtrip or --bench).
+    #[arg(num_args = 0..=3, allow_negative_numbers = true)]
+    pub rgb: Vec<f64>,
+    /// Colour space of the RGB: srgb, p3, rec2020, acescg, aces2065-1.
+    #[arg(long, default_value = "srgb")]
+    pub space: String,
+    /// Upsampling method: jakob, smits, box.
+    #[arg(long, default_value = "jakob")]
+    pub method: String,
+    /// Use this `.coeff` table for the jakob method instead of the cached default.
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+    /// Measure the round trip over this many random colours instead of converting one.
+    #[arg(long, value_name = "N")]
+    pub roundtrip: Option<usize>,
+    /// Seed of the random colours for --roundtrip.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Measure evaluation throughput (scalar f64, f32 arrays, f32x4, f32x8).
+    #[arg(long)]
+    pub bench: bool,
+}
+
+fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
+    let m: Method = a.method.parse()?;
+    match (&a.table, m) {
+        (Some(p), Method::Jakob) => {
+            let t = CoeffTable::read(p)?;
+            Ok(Box::new(method::Jakob(Arc::new(t))))
+        }
+        (Some(_), _) => bail!("--table only applies to --method jakob"),
+        _ => {
+            upsample::install_interrupt_handler();
+            Ok(upsample::upsampler(m, space).with_context(|| format!("getting the {} table", space.name))?)
+        }
+    }
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let space = RgbColorSpace::by_name(&a.space)?;
+    if a.bench {
+        return bench(&a, &space);
+    }
+    if let Some(n) = a.roundtrip {
+        if !a.rgb.is_empty() {
+            bail!("--roundtrip measures random colours; do not also give R G B");
+        }
+        let up = upsampler(&a, &space)?;
+        let t0 = Instant::now();
+        let r = roundtrip::roundtrip_upsampler(up.as_ref(), &space, n, a.seed)?;
+        let secs = t0.elapsed().as_secs_f64();
+        if a.json {
+            println!(
+                "{}",
+                json!({"space": space.name, "method": up.method().name(), "table": a.table, "roundtrip": r})
+            );
+        } else {
+            println!(
+                "{} {} round trip, {} random colours (CIE 1931 2°, 1 nm, 360–830 nm, {}): ΔE2000 max {:.4}  p99 {:.4}  p95 {:.4}  mean {:.4}  (worst at RGB {:.4} {:.4} {:.4}; {secs:.2} s)",
+                space.name,
+                up.method(),
+                r.colours,
+                space.illuminant_name,
+                r.stats.max,
+                r.stats.p99,
+                r.stats.p95,
+                r.stats.mean,
+                r.worst_rgb[0],
+                r.worst_rgb[1],
+                r.worst_rgb[2]
+            );
+        }
+        return Ok(());
+    }
+    let [r, g, b] = <[f64; 3]>::try_from(a.rgb.as_slice())
+        .map_err(|_| anyhow::anyhow!("expected three numbers R G B, got {}", a.rgb.len()))?;
+    let rgb = [r, g, b];
+    let up = upsampler(&a, &space)?;
+    let s = up.reflectance(rgb)?;
+    let model = LabModel::new(&space)?;
+    let (back, de) = roundtrip::round_trip_rgb(&model, rgb, |l| s.eval(l));
+    let lambda: Vec<f64> = (0..=94).map(|i| 360.0 + 5.0 * i as f64).collect();
+    let values: Vec<f64> = lambda.iter().map(|&l| s.eval(l)).collect();
+    if a.json {
+        println!(
+            "{}",
+            json!({
+                "space": space.name, "method": up.method().name(), "rgb": rgb, "spectrum": s,
+                "lambda_nm": lambda, "reflectance": values, "roundtrip_rgb": back, "delta_e2000": de,
+            })
+        );
+        return Ok(());
+    }
+    println!("{} RGB ({r}, {g}, {b}) → {} spectrum", space.name, up.method());
+    match s {
+        Reflectance::Jakob(p) => {
+            println!("coefficients (λ in nm): c0 = {:e}  c1 = {:e}  c2 = {:e}", p.c[0], p.c[1], p.c[2])
+        }
+        Reflectance::Smits(sm) => println!("bins (380–720 nm): {:?}", sm.bins),
+        Reflectance::Box(_) => println!(
+            "bands: blue < {} nm ≤ green < {} nm ≤ red",
+            upsample::boxes::BOX_BLUE_GREEN_NM,
+            upsample::boxes::BOX_GREEN_RED_NM
+        ),
+    }
+    println!("  λ nm   reflectance");
+    for (l, v) in lambda.iter().zip(&values) {
+        println!("  {l:5.0}  {v:.6}");
+    }
+    println!(
+        "round trip (CIE 1931 2°, 1 nm, {}): RGB ({:.6}, {:.6}, {:.6}), ΔE2000 {de:.5}",
+        space.illuminant_name, back[0], back[1], back[2]
+    );
+    Ok(())
+}
+
+/// Spectral samples per second for one coefficient set, per evaluation path.
+fn bench(a: &Args, space: &RgbColorSpace) -> Result<()> {
+    let up = upsampler(a, space)?;
+    let Reflectance::Jakob(p) = up.reflectance([0.6, 0.3, 0.1])? else {
+        bail!("--bench measures the sigmoid polynomial; use --method jakob");
+    };
+    let results = upsample::throughput::measure(&p, 4096, 4000);
+    if a.json {
+        let m: serde_json::Map<String, serde_json::Value> =
+            results.iter().map(|(n, r)| (n.to_string(), json!(r))).collect();
+        println!("{}", json!({"samples_per_second": m, "single_thread": true}));
+    } else {
+        println!("sigmoid-polynomial evaluation, one thread, 4096 wavelengths × 4000 repetitions:");
+        for (n, r) in &results {
+            println!("  {n:34} {:8.1} M samples/s", r / 1e6);
+        }
+    }
+    Ok(())
+}
