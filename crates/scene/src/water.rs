@@ -401,6 +401,51 @@ mod tests {
         assert!((up.in_scatter - in_scatter(k.b, k.c, k.kd, 1.0, -1.0, 8.0, 8.0)).abs() < 1e-15);
     }
 
+    /// CIE 1931 chromaticity of a radiance spectrum given at `lambda` (midpoint rule, 5 nm).
+    fn xy(lambda: &[f64], radiance: &[f64]) -> [f64; 2] {
+        use color::{Observer, SampledWavelengths, SpectralIntegrator, WavelengthRange};
+        let wl =
+            SampledWavelengths::midpoint(WavelengthRange::new(380.0, 730.0).unwrap(), lambda.len()).unwrap();
+        assert_eq!(wl.lambda, lambda);
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let xyz = SpectralIntegrator::emission(&Observer::cie1931(), &d65, &wl).integrate_samples(radiance);
+        color::xyz::xyz_to_xy(xyz)
+    }
+
+    #[test]
+    fn colours_are_physically_plausible() {
+        let lambda: Vec<f64> = (0..70).map(|i| 382.5 + 5.0 * i as f64).collect();
+        let e0 = color::illuminant::by_name("D65").unwrap();
+        let white = Spectrum::Constant(1.0);
+        // A white card 0.5 m in front of a diver loses red as the diver descends: x falls
+        // monotonically with depth, and by 20 m in Jerlov II (Kd lowest near 450–500 nm) it is
+        // clearly blue, far from D65's (0.3127, 0.3290).
+        let mut last_x = f64::INFINITY;
+        for z0 in [0.0, 5.0, 10.0, 20.0, 40.0] {
+            let m = WaterMedium::new(WaterType::parse("II").unwrap(), z0, sun(), 1.0).unwrap();
+            let l = m.shade(&lambda, &e0, &white, Vec3::ZERO, Vec3::new(0.0, 0.0, -0.5)).unwrap();
+            let [x, y] = xy(&lambda, &l);
+            assert!(x < last_x, "z0 {z0}: x {x} did not fall below {last_x}");
+            last_x = x;
+            if z0 == 20.0 {
+                eprintln!("white card at 20 m in II, xy (D65): ({x:.4}, {y:.4})");
+                assert!(x < 0.22 && y < 0.29, "white at 20 m: ({x}, {y})");
+            }
+        }
+        // The colour of the water itself (a horizontal ray that hits nothing, 5 m down): blue in
+        // clear oceanic water, yellow-green in turbid coastal water.
+        let water_xy = |t: &str| {
+            let m = WaterMedium::new(WaterType::parse(t).unwrap(), 5.0, sun(), 1.0).unwrap();
+            let terms = m.pixel_terms(&lambda, Vec3::X, f64::INFINITY).unwrap();
+            let l: Vec<f64> = terms.iter().map(|p| p.in_scatter * e0.eval(p.lambda)).collect();
+            xy(&lambda, &l)
+        };
+        let (ocean, coast) = (water_xy("I"), water_xy("9C"));
+        assert!(ocean[0] < 0.25 && ocean[1] < 0.3, "Jerlov I water colour {ocean:?}");
+        assert!(coast[1] > ocean[1] + 0.1 && coast[1] > 0.4, "Jerlov 9C {coast:?} vs I {ocean:?}");
+        eprintln!("water colour xy at 5 m (D65): I {ocean:?}, 9C {coast:?}");
+    }
+
     #[test]
     fn rejects_bad_parameters_with_clear_errors() {
         let t = WaterType::parse("III").unwrap();
