@@ -19,6 +19,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Render a scene with the real-time (wgpu) renderer, headless, to PNG or EXR.
+    Render(cmd::render::RenderArgs),
     /// Measure a render against a reference: CIEDE2000 and MAE statistics, optional heat map.
     Diff(cmd::diff::Args),
     /// Ground truth: render a scene with the CPU spectral path tracer (or export it for Mitsuba).
@@ -28,6 +30,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Render(a) => cmd::render::run(a),
         Command::Diff(a) => cmd::diff::run(a),
         Command::Truth(a) => cmd::truth::run(a),
     };

@@ -1,4 +1,5 @@
 //! Subcommands, one file each.
 
 pub mod diff;
+pub mod render;
 pub mod truth;

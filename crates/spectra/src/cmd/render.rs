@@ -1,0 +1,175 @@
+//! `spectra render`: one frame of the real-time renderer, headless, to PNG (tone-mapped) or
+//! EXR (linear HDR × 2^EV).
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Args;
+use color::WavelengthRange;
+use color::upsample::CoeffTable;
+use render::{Mode, RenderSettings, Renderer, Tonemap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    pub scene: String,
+    /// rgb (classic), naive (box upsampling) or spectral (Jakob–Hanika).
+    #[arg(long, default_value = "spectral")]
+    pub mode: String,
+    /// Number of wavelength samples (default: the scene's, else 16).
+    #[arg(long)]
+    pub wavelengths: Option<usize>,
+    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
+    #[arg(long)]
+    pub range: Option<String>,
+    /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
+    #[arg(long)]
+    pub observer: Option<String>,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
+    pub size: String,
+    /// Exposure in stops (the image is multiplied by 2^EV).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone mapping for PNG output: none, reinhard or aces.
+    #[arg(long, default_value = "none")]
+    pub tonemap: String,
+    /// Disable the main light's shadow map.
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// Jakob–Hanika coefficient table (.coeff). Default: the sRGB 64³ table, fitted once per
+    /// machine and cached (see `spectra lut`, $SPECTRA_CACHE_DIR).
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+    /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Parses `640x480` (also `640X480`, `640*480`).
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) = s
+        .split_once(['x', 'X', '*'])
+        .ok_or_else(|| anyhow!("--size '{s}' must look like WIDTHxHEIGHT, e.g. 640x480"))?;
+    let num = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    match (num(w), num(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--size '{s}': width and height must be positive integers"),
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum OutFormat {
+    Png,
+    Exr,
+}
+
+fn out_format(path: &Path) -> Result<OutFormat> {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("png") => Ok(OutFormat::Png),
+        Some("exr") => Ok(OutFormat::Exr),
+        other => bail!(
+            "--out {}: unknown image extension {}; use .png (tone-mapped) or .exr (linear HDR)",
+            path.display(),
+            other.map(|e| format!("'.{e}'")).unwrap_or_else(|| "(none)".into())
+        ),
+    }
+}
+
+/// Settings from the arguments, falling back to the scene's spectral defaults.
+fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
+    let d = RenderSettings::default();
+    let range = match (&args.range, scene.spectral.range) {
+        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
+        (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
+            .with_context(|| format!("scene {}: spectral range", scene.source))?,
+        (None, None) => d.range,
+    };
+    let wavelengths =
+        args.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
+    let s = RenderSettings {
+        mode: Mode::parse(&args.mode)?,
+        wavelengths,
+        range,
+        observer: args.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer),
+        exposure_ev: args.exposure,
+        tonemap: Tonemap::parse(&args.tonemap)?,
+        shadows: !args.no_shadows,
+        timestamps: false,
+    };
+    s.validate()
+        .map_err(|e| if s.wavelengths == 0 { anyhow!("--wavelengths 0: {e}") } else { anyhow!("{e}") })?;
+    Ok(s)
+}
+
+/// The sRGB table: `--table`, else the colour crate's cached fit (fitted on first use).
+pub fn load_table(explicit: Option<&Path>) -> Result<Arc<CoeffTable>> {
+    match explicit {
+        Some(p) => {
+            Ok(Arc::new(CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?))
+        }
+        None => {
+            color::upsample::install_interrupt_handler();
+            color::upsample::table("srgb").context("the sRGB coefficient table")
+        }
+    }
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let format = out_format(&args.out)?;
+    let (width, height) = parse_size(&args.size)?;
+    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let settings = settings(&args, &scene)?;
+    let table = load_table(args.table.as_deref())?;
+    let mut r = Renderer::with_table(table)?;
+    r.set_scene(&scene)?;
+    r.resize(width, height)?;
+    r.render(&scene.camera, &settings)?;
+    match format {
+        OutFormat::Png => {
+            let rgba = r.read_ldr()?;
+            let img =
+                image::RgbaImage::from_raw(width, height, rgba).context("readback has the wrong size")?;
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut bytes, image::ImageFormat::Png).context("encoding PNG")?;
+            compare::atomic::write_atomic(&args.out, bytes.get_ref())
+                .with_context(|| format!("writing {}", args.out.display()))?;
+        }
+        OutFormat::Exr => {
+            let k = settings.exposure_ev.exp2();
+            let data = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+            let img = compare::image::Image::new(width, height, data)?;
+            compare::io::write_image(&args.out, &img, Default::default())
+                .with_context(|| format!("writing {}", args.out.display()))?;
+        }
+    }
+    eprintln!(
+        "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm, on {}",
+        args.out.display(),
+        scene.source,
+        width,
+        height,
+        settings.mode.name(),
+        settings.wavelengths,
+        settings.range.min,
+        settings.range.max,
+        r.gpu().describe()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_extensions() {
+        assert_eq!(parse_size("64x48").unwrap(), (64, 48));
+        assert!(parse_size("64").unwrap_err().to_string().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x10").is_err());
+        assert_eq!(out_format(Path::new("a.PNG")).unwrap(), OutFormat::Png);
+        assert_eq!(out_format(Path::new("a.exr")).unwrap(), OutFormat::Exr);
+        let e = out_format(Path::new("a.jpg")).unwrap_err().to_string();
+        assert!(e.contains(".jpg") && e.contains(".png"), "{e}");
+    }
+}
