@@ -21,6 +21,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .ok_or_else(|| CompareError::io(path, std::io::Error::other("path has no file name")))?
         .to_string_lossy()
         .into_owned();
+    if !dir.is_dir() {
+        let msg = format!("directory {} does not exist", dir.display());
+        return Err(CompareError::io(path, std::io::Error::new(std::io::ErrorKind::NotFound, msg)));
+    }
     let mut tmp = tempfile::Builder::new()
         .prefix(&format!(".{name}."))
         .suffix(".tmp")
@@ -75,6 +79,6 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("no/such/dir/x.exr");
         let e = write_atomic(&p, b"data").unwrap_err().to_string();
-        assert!(e.contains("x.exr"), "{e}");
+        assert!(e.contains("x.exr") && e.contains("does not exist"), "{e}");
     }
 }

@@ -9,12 +9,10 @@ pub type Result<T> = std::result::Result<T, CompareError>;
 #[derive(Debug, thiserror::Error)]
 pub enum CompareError {
     /// The file could not be opened, read, created or renamed.
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    // The cause is part of the message rather than a `#[source]`, so anyhow's `{:#}` chain
+    // does not print it twice.
+    #[error("{path}: {error}")]
+    Io { path: PathBuf, error: std::io::Error },
     /// The extension is not one we read or write.
     #[error("{path}: unsupported image extension {ext:?} (supported: .exr, .png)")]
     UnsupportedExtension { path: PathBuf, ext: String },
@@ -43,6 +41,6 @@ pub enum CompareError {
 
 impl CompareError {
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        CompareError::Io { path: path.into(), source }
+        CompareError::Io { path: path.into(), error: source }
     }
 }

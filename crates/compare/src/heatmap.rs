@@ -158,7 +158,8 @@ impl Heatmap {
         let labels_w = labels.iter().map(|l| text_width(l, s)).max().unwrap_or(0);
         let canvas_w = (label_x + labels_w).max(bar_x + text_width(&opts.title, s)) + pad;
         let canvas_h = map_h.max(120 * s);
-        let bar_top = pad + th + pad;
+        // Room for the title plus half a label, so the top tick label clears the title.
+        let bar_top = pad + th + pad + th / 2;
         let bar_bottom = canvas_h - pad - th / 2 - 1;
 
         let mut px = vec![BACKGROUND; canvas_w as usize * canvas_h as usize];

@@ -18,14 +18,14 @@ pub struct Args {
     #[arg(long, value_name = "FILE.png")]
     heatmap: Option<PathBuf>,
     /// Top of the heat-map scale in ΔE00 (default: the largest ΔE rounded up to 1/2/2.5/5×10ᵏ).
-    #[arg(long, value_name = "X", requires = "heatmap")]
+    #[arg(long, value_name = "X", requires = "heatmap", allow_negative_numbers = true)]
     max_de: Option<f64>,
     /// Heat-map colour map: viridis, magma or inferno.
     #[arg(long, default_value = "viridis", requires = "heatmap")]
     colormap: String,
     /// Luminance Y (image units) of the CIELAB reference white, D65 chromaticity. With 1,
     /// an image value of (1, 1, 1) is L* = 100.
-    #[arg(long, value_name = "Y", default_value_t = 1.0)]
+    #[arg(long, value_name = "Y", default_value_t = 1.0, allow_negative_numbers = true)]
     white_y: f64,
     /// Print the results as JSON (for scripts) instead of a table.
     #[arg(long)]
