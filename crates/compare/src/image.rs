@@ -49,6 +49,24 @@ impl Image {
         Image::new(width, height, data)
     }
 
+    /// Builds an image from interleaved samples with `channels` per pixel (3 for RGB, 4 for
+    /// RGBA as GPU read-backs deliver them; channels past the third are dropped).
+    pub fn from_interleaved(width: u32, height: u32, samples: &[f32], channels: usize) -> Result<Image> {
+        if channels < 3 {
+            return Err(CompareError::InvalidImage(format!(
+                "{channels} channels per pixel; need at least 3"
+            )));
+        }
+        if samples.len() != width as usize * height as usize * channels {
+            return Err(CompareError::InvalidImage(format!(
+                "{width}×{height} with {channels} channels needs {} samples, got {}",
+                width as usize * height as usize * channels,
+                samples.len()
+            )));
+        }
+        Image::new(width, height, samples.chunks_exact(channels).map(|p| [p[0], p[1], p[2]]).collect())
+    }
+
     /// The pixel at column `x`, row `y` (panics out of range, like slice indexing).
     pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
         self.data[self.index(x, y)]
@@ -103,6 +121,17 @@ mod tests {
         let im = Image::from_fn(3, 2, |x, y| [x as f32, y as f32, 0.0]).unwrap();
         assert_eq!(im.data[4], [1.0, 1.0, 0.0]);
         assert_eq!(im.get(2, 1), [2.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn from_interleaved_rgba() {
+        let s = [1.0, 2.0, 3.0, 9.0, 4.0, 5.0, 6.0, 9.0];
+        assert_eq!(
+            Image::from_interleaved(2, 1, &s, 4).unwrap().data,
+            vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
+        );
+        assert!(Image::from_interleaved(2, 2, &s, 4).is_err());
+        assert!(Image::from_interleaved(4, 1, &s, 2).is_err());
     }
 
     #[test]
