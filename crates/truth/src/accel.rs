@@ -182,6 +182,39 @@ mod tests {
         }
     }
 
+    /// Large triangles (which the builder pre-splits) in a closed box, rays from wall to wall.
+    #[test]
+    fn bvh_agrees_on_large_triangles() {
+        let scene = crate::testing::scene_with(
+            vec![
+                crate::testing::inward_box(1.0, 0),
+                crate::testing::quad(Vec3::new(0.0, 0.99, 0.0), -Vec3::Y, 0.2, 0),
+            ],
+            vec![scene::Material::default()],
+            vec![],
+        );
+        let g = Geometry::new(&scene).unwrap();
+        let mut s = Sampler::new(4, 2);
+        let mut misses = 0;
+        for _ in 0..20000 {
+            let o = Vec3::new(s.uniform(), s.uniform(), s.uniform()) * 1.98 - 0.99;
+            let d = (Vec3::new(s.uniform(), s.uniform(), s.uniform()) - 0.5).normalize();
+            let brute = g
+                .verts
+                .iter()
+                .enumerate()
+                .filter_map(|(i, v)| intersect_triangle(v, o, d, f32::INFINITY).map(|h| (h.0, i)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let got = g.intersect(o, d, f32::INFINITY);
+            match (brute, got) {
+                (Some((t, _)), Some(h)) => assert!((h.t - t).abs() < 1e-5, "{t} vs {}", h.t),
+                (Some(_), None) => misses += 1,
+                other => panic!("mismatch {other:?}"),
+            }
+        }
+        assert_eq!(misses, 0, "BVH missed {misses} of 20000 rays inside a closed box");
+    }
+
     #[test]
     fn bad_indices_are_an_error() {
         let mesh =

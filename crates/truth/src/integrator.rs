@@ -117,9 +117,15 @@ impl Integrator<'_, '_> {
                     let (f, pdf_v) = v.eval(wo, wi);
                     if f != Vec4::ZERO {
                         let pdf_l = pmf / w.areas[tri as usize] * d2 / cos_l;
+                        // Offset both ends off their surfaces: a shadow ray aimed at the exact
+                        // light point would hit the light itself first when it leaves at an
+                        // oblique angle (the origin offset brings it nearer the light's plane).
                         let o = origin(wi);
-                        let tmax = (q.p - o).length() * (1.0 - 1e-4);
-                        if !w.geometry.occluded(o, wi, tmax) {
+                        let end = offset(q.p, q.ng, -wi);
+                        let seg = end - o;
+                        let tmax = seg.length();
+                        let dir = seg / tmax;
+                        if !w.geometry.occluded(o, dir, tmax) {
                             let mis = power_heuristic(pdf_l, pdf_v);
                             sum += f * le * self.transmittance(o, wi, tmax, l) * (mis / pdf_l);
                         }

@@ -214,3 +214,74 @@ fn point_and_spot_lights_give_closed_form_direct_light() {
         assert!((got - want).abs().max_element() <= 2e-3 * want.max_element(), "{kind:?}: {got} vs {want}");
     }
 }
+
+/// The closed-enclosure furnace: every wall of a box emits Le and reflects diffusely with
+/// albedo ρ(λ) (Lambert mode). The radiance field is uniform, L = Le + ρ·L, so everywhere
+/// and in every direction L(λ) = Le(λ)/(1 − ρ(λ)): the geometric series of all bounces, which
+/// checks NEE + MIS on area lights at every vertex and Russian roulette.
+#[test]
+fn emitting_enclosure_sums_all_bounces() {
+    let rho = Spectrum::piecewise(vec![380.0, 550.0, 730.0], vec![0.5, 0.8, 0.3]).unwrap();
+    let wall = Material {
+        emissive: Vec3::splat(0.6),
+        spectral: Some(SpectralReflectance::Uniform(rho.clone())),
+        ..Default::default()
+    };
+    let scene = scene_with(vec![crate::testing::inward_box(1.0, 0)], vec![wall], vec![]);
+    let range = WavelengthRange::VISIBLE;
+    let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap();
+    let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000, lambert: true };
+    let sensor = XyzSensor::new(&Observer::cie1931(), &d65(), range);
+    for u in [0.1, 0.45] {
+        let wl = sensor.sample(u);
+        let le = world.units.rgb(Vec3::splat(0.6), &GreyOnly, wl.0);
+        let want = le / (Vec4::ONE - spectrum_at(&rho, &wl));
+        let (m, se) = estimate(20_000, |rng| {
+            integ.radiance(Vec3::new(0.3, 0.1, -0.2), Vec3::new(-0.5, 0.7, 0.2).normalize(), &wl, rng)
+        });
+        assert_within(m, se, want, &format!("emitting enclosure at λ = {}", wl.0));
+    }
+}
+
+/// Direct light from an area light seen at a grazing angle, against a deterministic
+/// quadrature of ∫ Le·ρ/π·cosθ·cosθ'/r² dA over the lamp. Regression test: shadow rays aimed at
+/// the exact light point once hit the light itself when they left the receiver obliquely.
+#[test]
+fn oblique_area_light_matches_quadrature() {
+    let lamp = Material { emissive: Vec3::splat(5.0), ..Default::default() };
+    let floor = Material {
+        spectral: Some(SpectralReflectance::Uniform(Spectrum::Constant(0.5))),
+        ..Default::default()
+    };
+    let (c, h) = (Vec3::new(0.0, 1.0, 0.0), 0.2);
+    let scene = scene_with(
+        vec![quad(c, -Vec3::Y, h, 0), quad(Vec3::ZERO, Vec3::Y, 10.0, 1)],
+        vec![lamp, floor],
+        vec![],
+    );
+    let range = WavelengthRange::VISIBLE;
+    let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap();
+    let integ = Integrator { world: &world, direct_only: true, max_depth: 10, lambert: true };
+    let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.5);
+    let p = Vec3::new(2.5, 0.0, 0.3);
+    let o = p + Vec3::new(0.3, 0.5, 0.1);
+    let n = 400;
+    let mut e = 0.0f64;
+    for i in 0..n {
+        for j in 0..n {
+            let q = c + Vec3::new(
+                -h + 2.0 * h * (i as f32 + 0.5) / n as f32,
+                0.0,
+                -h + 2.0 * h * (j as f32 + 0.5) / n as f32,
+            );
+            let v = q - p;
+            let r2 = v.length_squared();
+            let cos_r = v.y / r2.sqrt();
+            e += (cos_r * cos_r / r2) as f64 * (2.0 * h as f64 / n as f64).powi(2);
+        }
+    }
+    let le = world.units.rgb(Vec3::splat(5.0), &GreyOnly, wl.0);
+    let want = le * (0.5 / std::f32::consts::PI) * e as f32;
+    let (m, se) = estimate(20_000, |rng| integ.radiance(o, (p - o).normalize(), &wl, rng));
+    assert_within(m, se, want, "oblique area light");
+}
