@@ -67,6 +67,10 @@ pub fn metamer(base: &Spectrum, wiggle: impl Fn(f64) -> f64, lo: f64, hi: f64) -
     Spectrum::piecewise(lambda, values).expect("grid increases")
 }
 
+/// Texels per side of one uniform block of a procedural texture: large enough that filtering
+/// blends palette colours only along block edges, so most texels match a palette entry.
+pub const BLOCK: u32 = 16;
+
 /// An RGBA8 texture from a function of texel position giving a palette colour index.
 fn pattern(name: &str, w: u32, h: u32, colours: &[[u8; 3]], at: impl Fn(u32, u32) -> usize) -> Texture {
     let mut rgba = Vec::with_capacity((w * h * 4) as usize);
@@ -112,22 +116,26 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         &mut s,
         "floor checks (neutral 8 / neutral 6.5)",
         &["neutral 8 (.23 D)", "neutral 6.5 (.44 D)"],
-        8,
-        8,
-        |x, y| ((x + y) % 2) as usize,
+        8 * BLOCK,
+        8 * BLOCK,
+        |x, y| ((x / BLOCK + y / BLOCK) % 2) as usize,
     );
     let stripes = ["red", "orange", "yellow", "green", "blue", "magenta"];
-    let wall =
-        palette_material(&mut s, "wall stripes (six ColorChecker patches)", &stripes, 12, 1, |x, _| {
-            (x / 2) as usize
-        });
+    let wall = palette_material(
+        &mut s,
+        "wall stripes (six ColorChecker patches)",
+        &stripes,
+        6 * BLOCK,
+        BLOCK,
+        |x, _| (x / BLOCK) as usize,
+    );
     let cube = palette_material(
         &mut s,
         "cube checks",
         &["orange", "purplish blue", "yellow green"],
-        6,
-        6,
-        |x, y| ((x / 2 + y / 2) % 3) as usize,
+        3 * BLOCK,
+        3 * BLOCK,
+        |x, y| ((x / BLOCK + y / BLOCK) % 3) as usize,
     );
 
     let grey = patch(patch_index("neutral 6.5 (.44 D)"));
@@ -181,6 +189,19 @@ mod tests {
         SpectralIntegrator::reference(&Observer::cie1931(), &e, WavelengthRange::FULL)
             .unwrap()
             .integrate(|l| s.eval(l))
+    }
+
+    #[test]
+    fn procedural_textures_hold_palette_values() {
+        let s = build(&Ctx::builtin("metamerism")).unwrap();
+        for m in &s.materials {
+            let Some(SpectralReflectance::Palette(p)) = &m.spectral else { continue };
+            let t = &s.textures[m.base_color_texture.unwrap().index];
+            // Every texel is one of the palette's colours, and every colour is used.
+            let texels: Vec<[u8; 3]> = t.rgba8.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect();
+            assert!(texels.iter().all(|x| p.iter().any(|e| e.rgb8 == *x)), "{}", m.name);
+            assert!(p.iter().all(|e| texels.contains(&e.rgb8)), "{}", m.name);
+        }
     }
 
     #[test]
