@@ -98,6 +98,31 @@ impl Observer {
         Self::from_pigments("triggerfish", [528.0, 480.0, 413.0])
     }
 
+    /// Dog, a dichromat: S pigment λmax 429 nm and L pigment λmax 555 nm (Neitz, Geist & Jacobs
+    /// 1989, Vis. Neurosci. 3, 119), Govardovskii A1 template. Two receptors are shown as three
+    /// channels (L, L, S), so under the display convention of [`ObserverKind`] every colour
+    /// falls on the yellow–blue axis, which is what a dichromat can distinguish.
+    pub fn dog() -> Self {
+        Self::from_pigments("dog", [555.0, 555.0, 429.0])
+    }
+
+    /// A human protanope (no L cones): Stockman & Sharpe 2° cone fundamentals as (M, M, S); see
+    /// [`Observer::dog`] for why a receptor is repeated.
+    pub fn protanope() -> Self {
+        Self::from_tables(
+            "protanope",
+            [&ox::STOCKMAN_SHARPE_2_M, &ox::STOCKMAN_SHARPE_2_M, &ox::STOCKMAN_SHARPE_2_S],
+        )
+    }
+
+    /// A human deuteranope (no M cones): Stockman & Sharpe 2° cone fundamentals as (L, L, S).
+    pub fn deuteranope() -> Self {
+        Self::from_tables(
+            "deuteranope",
+            [&ox::STOCKMAN_SHARPE_2_L, &ox::STOCKMAN_SHARPE_2_L, &ox::STOCKMAN_SHARPE_2_S],
+        )
+    }
+
     /// An observer whose three channels are A1 visual pigments with the given λmax (nm,
     /// longest first), sampled from the Govardovskii template at 1 nm over 360–830 nm.
     pub fn from_pigments(name: &str, lambda_max: [f64; 3]) -> Self {
@@ -189,7 +214,10 @@ impl Observer {
         "canon_5d_mark_ii",
         "aces_ricd",
         "lms2",
+        "protanope",
+        "deuteranope",
         "triggerfish",
+        "dog",
     ];
 
     /// Looks an observer up by name (any of [`Self::NAMES`] or a short alias; case-insensitive).
@@ -203,6 +231,9 @@ impl Observer {
             "aces_ricd" | "ricd" => Ok(Self::aces_ricd()),
             "lms2" | "lms" | "stockman_sharpe" => Ok(Self::lms_stockman_sharpe()),
             "triggerfish" | "fish" => Ok(Self::triggerfish()),
+            "dog" => Ok(Self::dog()),
+            "protanope" => Ok(Self::protanope()),
+            "deuteranope" => Ok(Self::deuteranope()),
             _ => Err(ColorError::Unknown {
                 kind: "observer",
                 name: name.into(),
@@ -305,6 +336,25 @@ mod tests {
         let fish = Observer::triggerfish();
         assert_eq!(fish.kind(), ObserverKind::Receptors);
         assert!(fish.bar[0].eval(528.0) > 0.99 && fish.bar[2].eval(413.0) > 0.99);
+    }
+
+    #[test]
+    fn dichromats_see_only_a_yellow_blue_axis() {
+        let d65 = illuminant::by_name("D65").unwrap();
+        for o in [Observer::dog(), Observer::protanope(), Observer::deuteranope()] {
+            assert_eq!(o.kind(), ObserverKind::Receptors);
+            assert_eq!(o.bar[0], o.bar[1], "{}", o.name);
+        }
+        // The dog's L pigment peaks where Neitz et al. measured it.
+        let dog = Observer::dog();
+        assert!(dog.bar[0].eval(555.0) > 0.99 && dog.bar[2].eval(429.0) > 0.99);
+        // A protanope's long-wave channel is the M cone: it sees deep red as much darker
+        // relative to white than a deuteranope does (the classic protan luminance loss).
+        let red = Spectrum::from_table(&colorchecker::SPECTRA[14]);
+        let rel = |o: &Observer| o.response(&red, &d65)[0] / o.white_balance(&d65)[0];
+        let (p, d) = (rel(&Observer::protanope()), rel(&Observer::deuteranope()));
+        eprintln!("red patch / white, long-wave channel: protanope {p:.4}, deuteranope {d:.4}");
+        assert!(p < 0.8 * d);
     }
 
     #[test]
