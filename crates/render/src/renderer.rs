@@ -169,6 +169,29 @@ impl Renderer {
         Ok(())
     }
 
+    /// Changes the custom shader's parameters without recompiling (e.g. every frame from a UI).
+    pub fn set_custom_params(&mut self, params: [f32; 16]) {
+        if self.custom.params != params {
+            self.custom.params = params;
+            self.custom_generation += 1;
+        }
+    }
+
+    /// Changes the custom shader's spectra without recompiling; they are resampled at the
+    /// current wavelengths on the next frame.
+    pub fn set_custom_spectra(&mut self, spectra: Vec<color::Spectrum>) -> Result<()> {
+        let custom = CustomShader { spectra, ..self.custom.clone() };
+        custom.validate()?;
+        self.custom = custom;
+        self.custom_generation += 1;
+        Ok(())
+    }
+
+    /// The custom shader in use.
+    pub fn custom_shader(&self) -> &CustomShader {
+        &self.custom
+    }
+
     /// Sets the output size (pixels). Cheap when unchanged.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         let max = self.gpu.device.limits().max_texture_dimension_2d;

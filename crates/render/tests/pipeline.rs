@@ -89,13 +89,19 @@ fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {
     // No long wavelengths: the white patch turns cyan (red drops far more than blue).
     assert!(after[0] < 0.5 * after[2], "white patch without λ > 600 nm: {after:?} (before {before:?})");
 
-    // In rgb mode only the pass-3 hook applies: exactly half.
+    // In rgb mode only the pass-3 hook applies: exactly half, then a quarter after changing
+    // the parameter without recompiling.
     let rgb_s = RenderSettings { mode: Mode::Rgb, ..s.clone() };
     let half = hdr(&mut r, &rgb_s)[white];
+    let mut params = [0.0; 16];
+    params[0] = 0.25;
+    r.set_custom_params(params);
+    let quarter = hdr(&mut r, &rgb_s)[white];
     r.set_custom_shader(CustomShader::default()).unwrap();
     let full = hdr(&mut r, &rgb_s)[white];
     for c in 0..3 {
         assert!((half[c] - 0.5 * full[c]).abs() < 2e-3 * full[c].max(1e-3), "{half:?} vs {full:?}");
+        assert!((quarter[c] - 0.25 * full[c]).abs() < 2e-3 * full[c].max(1e-3), "{quarter:?} vs {full:?}");
     }
 
     let err = r.set_custom_shader(CustomShader::new("fn custom_pixel( oops")).unwrap_err().to_string();

@@ -4,11 +4,15 @@
 //! emission (illuminant-variant upsampling), call the custom spectral hook and accumulate XYZ
 //! with the observer×Δλ weights; finally XYZ → linear RGB into the HDR target.
 //!
-//! Per wavelength (one lane of a vec4 op each): sigmoid 6 (2 fma polynomial, clamp 2, fma,
-//! inverseSqrt, mul, fma — counted as 6 with the clamp's min/max as 2), 2 fma per light, 1 fma
-//! to combine, 3 dot-product lanes (≈ 3 fma) for XYZ, plus 1 load of λ, 3 of weights and
-//! 1 per light. With one light: ≈ 12 ALU ops and 5 loads per wavelength. The BRDF itself is
-//! evaluated once per light per pixel, not per wavelength.
+//! Per wavelength (one lane of the vec4 ops), for a pixel lit by L lights:
+//! - sigmoid: 2 fma (polynomial) + clamp (max, min) + fma (1 + x²) + inverseSqrt + mul + fma = 7;
+//! - lights: 2 fma per light (ρ-weighted and ρ-independent accumulators);
+//! - combine: 1 fma; XYZ: 3 dot-product lanes (≈ 3 mul-adds);
+//! - loads: λ, 3 weights and 1 emission value per light (storage buffers, shared by all pixels).
+//!
+//! So 11 + 2L ALU ops and 4 + L loads per wavelength (13 and 5 with one light); emissive pixels
+//! add a second sigmoid (+9). The coefficient fetch (8 texel loads, trilinear, binary search over
+//! the z axis) and the BRDF (once per light) are per pixel, not per wavelength.
 
 use super::{HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry};
 use crate::error::Result;

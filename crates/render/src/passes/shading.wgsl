@@ -141,12 +141,13 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let ng = frame.n_groups;
     var xyz = vec3<f32>(0.0);
     for (var g = 0u; g < ng; g++) {
-        let wg = wavelengths[g];
+        // Fields are read one by one so that only what the mode needs is loaded.
+        let lambda = wavelengths[g].lambda;
         var rho: vec4<f32>;
         if (spectral) {
-            rho = sigmoid4(c_base, wg.lambda);
+            rho = sigmoid4(c_base, lambda);
         } else {
-            rho = box4(base, wg);
+            rho = box4(base, g);
         }
         var acc_a = vec4<f32>(0.0);
         var acc_b = vec4<f32>(0.0);
@@ -159,14 +160,18 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         if (has_em) {
             var em: vec4<f32>;
             if (spectral) {
-                em = em_scale * sigmoid4(c_em, wg.lambda);
+                em = em_scale * sigmoid4(c_em, lambda);
             } else {
-                em = box4(emission, wg);
+                em = box4(emission, g);
             }
-            radiance = fma(em, wg.white, radiance);
+            radiance = fma(em, wavelengths[g].white, radiance);
         }
-        radiance = custom_spectral(wg.lambda, radiance, g, ctx);
-        xyz += vec3<f32>(dot(radiance, wg.wx), dot(radiance, wg.wy), dot(radiance, wg.wz));
+        radiance = custom_spectral(lambda, radiance, g, ctx);
+        xyz += vec3<f32>(
+            dot(radiance, wavelengths[g].wx),
+            dot(radiance, wavelengths[g].wy),
+            dot(radiance, wavelengths[g].wz),
+        );
     }
     return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
 }

@@ -11,7 +11,7 @@ struct WavelengthGroup {
     wz: vec4<f32>,
     // The white illuminant (D65 for sRGB) at these wavelengths, for the "illuminant" variant.
     white: vec4<f32>,
-    // Naive box upsampling: how much of each wavelength's bin lies in the R, G and B band.
+    // Naive box upsampling: 1 in the band (R, G or B) that contains the wavelength, else 0.
     band_r: vec4<f32>,
     band_g: vec4<f32>,
     band_b: vec4<f32>,
@@ -93,6 +93,7 @@ fn sigmoid4(c: vec3<f32>, lambda: vec4<f32>) -> vec4<f32> {
 }
 
 // Naive box upsampling: each wavelength takes the value of the band it falls in.
-fn box4(rgb: vec3<f32>, g: WavelengthGroup) -> vec4<f32> {
-    return fma(vec4<f32>(rgb.r), g.band_r, fma(vec4<f32>(rgb.g), g.band_g, rgb.b * g.band_b));
+fn box4(rgb: vec3<f32>, g: u32) -> vec4<f32> {
+    let w = wavelengths[g];
+    return fma(vec4<f32>(rgb.r), w.band_r, fma(vec4<f32>(rgb.g), w.band_g, rgb.b * w.band_b));
 }
