@@ -236,10 +236,10 @@ mod tests {
     use super::*;
 
     fn close_m(a: DMat3, b: [[f64; 3]; 3], tol: f64) {
-        for r in 0..3 {
-            for c in 0..3 {
+        for (r, row) in b.iter().enumerate() {
+            for (c, expected) in row.iter().enumerate() {
                 let v = a.col(c)[r];
-                assert!((v - b[r][c]).abs() < tol, "row {r} col {c}: {v} vs {}", b[r][c]);
+                assert!((v - expected).abs() < tol, "row {r} col {c}: {v} vs {expected}");
             }
         }
     }

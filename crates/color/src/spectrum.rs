@@ -56,7 +56,7 @@ impl Spectrum {
         if lambda.len() < 2 {
             return Err(ColorError::BadSpectrum("needs at least two samples".into()));
         }
-        if let Some(w) = lambda.windows(2).find(|w| !(w[1] > w[0]) || !w[0].is_finite()) {
+        if let Some(w) = lambda.windows(2).find(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[0].is_finite()) {
             return Err(ColorError::BadSpectrum(format!(
                 "wavelengths must increase strictly: {} then {}",
                 w[0], w[1]
@@ -80,7 +80,7 @@ impl Spectrum {
             Spectrum::Constant(c) => *c,
             Spectrum::Blackbody { kelvin, norm } => planck(lambda, *kelvin) * norm,
             Spectrum::Piecewise { lambda: l, values: v } => {
-                if !(lambda >= l[0]) || lambda > l[l.len() - 1] {
+                if lambda.is_nan() || lambda < l[0] || lambda > l[l.len() - 1] {
                     return 0.0;
                 }
                 let i = l.partition_point(|&x| x <= lambda).clamp(1, l.len() - 1);

@@ -26,7 +26,7 @@ impl SampledTable {
     /// inventing values beyond the measurement would be a silent extrapolation.
     pub fn eval(&self, lambda: f64) -> f64 {
         let x = (lambda - self.start) / self.step;
-        if !(x >= 0.0) || x > (self.values.len() - 1) as f64 {
+        if x.is_nan() || x < 0.0 || x > (self.values.len() - 1) as f64 {
             return 0.0;
         }
         let i = (x as usize).min(self.values.len() - 2);
