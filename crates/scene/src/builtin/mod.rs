@@ -145,6 +145,12 @@ mod tests {
                 assert_eq!(m.normals.len(), m.positions.len());
                 assert!(m.uvs.is_empty() || m.uvs.len() == m.positions.len());
                 assert!(m.indices.iter().all(|&i| (i as usize) < m.positions.len()));
+                // Counter-clockwise winding agrees with the shading normals (front faces).
+                for t in m.indices.chunks_exact(3) {
+                    let p = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+                    let n = m.normals[t[0] as usize];
+                    assert!((p[1] - p[0]).cross(p[2] - p[0]).dot(n) > 0.0, "{name} mesh {i} winding");
+                }
             }
             for m in &s.materials {
                 for t in
