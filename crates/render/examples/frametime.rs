@@ -17,8 +17,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("adapter: {}", r.gpu().describe());
     r.set_scene(&scene)?;
     r.resize(w, h)?;
-    for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 4), (Mode::Spectral, 16), (Mode::Spectral, 64)] {
-        let s = RenderSettings { mode, wavelengths: n, timestamps: true, ..Default::default() };
+    let runs = [
+        (Mode::Rgb, 16, true),
+        (Mode::Rgb, 16, false),
+        (Mode::Spectral, 1, true),
+        (Mode::Spectral, 4, true),
+        (Mode::Spectral, 16, true),
+        (Mode::Spectral, 16, false),
+        (Mode::Spectral, 64, true),
+    ];
+    for (mode, n, shadows) in runs {
+        let s = RenderSettings { mode, wavelengths: n, shadows, timestamps: true, ..Default::default() };
         let mut wall = Vec::new();
         let mut gpu = Vec::new();
         for _ in 0..frames {
@@ -43,9 +52,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|(i, p)| format!("{p} {:.1}", med(gpu.iter().map(|t| t.ms[i]).collect())))
             .collect();
         println!(
-            "{:>8} N={:<3} {w}x{h}: median wall {:.1} ms; GPU ms: {}",
+            "{:>8} N={:<3} shadows {:<5} {w}x{h}: median wall {:.1} ms; GPU ms: {}",
             mode.name(),
             n,
+            shadows,
             wall[wall.len() / 2],
             passes.join(", ")
         );
