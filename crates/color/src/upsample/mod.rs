@@ -58,12 +58,18 @@ pub fn install_interrupt_handler() {
 }
 
 /// The fit behind the default tables: [`TABLE_RES`]³ nodes on [`fit::spectra_scale`]'s
-/// brightness grid. This is what [`table`] caches and `spectra lut` writes.
+/// brightness grid, then one sweep of [`refine`] (interpolation-aware). This is what [`table`]
+/// caches and `spectra lut` writes.
 pub fn fit_default(space: &RgbColorSpace, progress: &ProgressBar) -> Result<CoeffTable> {
     fit_default_res(space, TABLE_RES, progress)
 }
 
 /// [`fit_default`] at another resolution.
 pub fn fit_default_res(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
-    fit_table_with(space, &FitOptions::spectra(res), progress, interrupt_flag())
+    let mut t = fit_table_with(space, &FitOptions::spectra(res), progress, interrupt_flag())?;
+    let model = fit::LabModel::new(space)?;
+    progress.set_position(0);
+    progress.set_message(format!("refining the {} table for interpolation", space.name));
+    refine::refine_table(&mut t, &model, &refine::RefineOptions::default(), progress, interrupt_flag())?;
+    Ok(t)
 }

@@ -7,7 +7,7 @@
 //!
 //! This pass re-fits each node that borders a poor cell so that the *interpolated* table is
 //! accurate across all eight cells around it: Gauss–Newton on the Lab residuals of sample
-//! points in those cells (2 × 2 × 2 per cell, plus the node itself), where a sample's
+//! points in those cells ([`RefineOptions::samples_per_axis`]³ per cell, plus the node itself), where a sample's
 //! coefficients are the trilinear blend of its cell's corners and so depend on the node with
 //! the sample's interpolation weight. Nodes are visited in eight parity classes: two nodes of
 //! the same parity never share a cell, so each class updates in parallel and the sweep is an
@@ -34,16 +34,15 @@ pub struct RefineOptions {
     pub threshold: f64,
     /// Gauss–Newton steps per node per sweep.
     pub steps: usize,
+    /// Sample points per axis inside each cell (at (m + ½)/n); 1 = cell centres only.
+    pub samples_per_axis: usize,
 }
 
 impl Default for RefineOptions {
     fn default() -> Self {
-        RefineOptions { sweeps: 2, threshold: 0.03, steps: 2 }
+        RefineOptions { sweeps: 1, threshold: 0.02, steps: 2, samples_per_axis: 1 }
     }
 }
-
-/// Sample offsets inside a cell, along each axis.
-const OFFS: [f64; 2] = [0.25, 0.75];
 
 struct Grid<'a> {
     res: usize,
@@ -102,6 +101,8 @@ pub fn refine_table(
         .map(|c| nm_to_normalised([c[0] as f64, c[1] as f64, c[2] as f64]))
         .collect();
     let ncell = 3 * (res - 1).pow(3);
+    let n_off = opt.samples_per_axis.max(1);
+    let offs: Vec<f64> = (0..n_off).map(|m| (m as f64 + 0.5) / n_off as f64).collect();
     let mut updates = 0;
     progress.set_length((opt.sweeps * 9) as u64);
     for _ in 0..opt.sweeps {
@@ -170,9 +171,9 @@ pub fn refine_table(
                             continue;
                         }
                         let (ci, cj, ck) = (i - di, j - dj, k - dk);
-                        for fz in OFFS {
-                            for fy in OFFS {
-                                for fx in OFFS {
+                        for &fz in &offs {
+                            for &fy in &offs {
+                                for &fx in &offs {
                                     let f = [fx, fy, fz];
                                     let w = weights(f);
                                     let mut rest = [0.0; 3];
@@ -253,9 +254,6 @@ pub fn refine_table(
                 })
                 .collect();
             updates += new.len();
-            if std::env::var_os("SPECTRA_REFINE_DEBUG").is_some() {
-                eprintln!("parity {parity}: {} nodes", new.len());
-            }
             for (n, x) in new {
                 a[n] = x;
             }

@@ -98,25 +98,52 @@ pub fn round_trip_rgb(model: &LabModel, rgb: [f64; 3], f: impl Fn(f64) -> f64) -
 mod tests {
     use super::*;
     use crate::upsample::variants::{IlluminantSpectrum, UnboundedSpectrum};
-    use crate::upsample::{Method, fit_default};
+    use crate::upsample::{FitOptions, Method, fit_table_with};
     use crate::xyz::SpectralIntegrator;
     use crate::{Observer, SampledWavelengths, WavelengthRange, xyz_to_lab};
     use indicatif::ProgressBar;
     use std::sync::OnceLock;
 
-    /// The shipping sRGB table (64³, spectra grid), fitted once per test binary.
+    /// The shipping sRGB table (64³, spectra grid) before refinement, fitted once per test binary
+    /// (refinement at 64³ takes too long for a unit test; it is tested at a lower resolution).
     fn srgb_table() -> &'static CoeffTable {
         static T: OnceLock<CoeffTable> = OnceLock::new();
-        T.get_or_init(|| fit_default(&RgbColorSpace::srgb(), &ProgressBar::hidden()).unwrap())
+        T.get_or_init(|| {
+            let never = std::sync::atomic::AtomicBool::new(false);
+            fit_table_with(&RgbColorSpace::srgb(), &FitOptions::spectra(64), &ProgressBar::hidden(), &never)
+                .unwrap()
+        })
+    }
+
+    #[test]
+    fn refinement_lowers_interpolation_error() {
+        let space = RgbColorSpace::srgb();
+        let never = std::sync::atomic::AtomicBool::new(false);
+        let mut t = fit_table_with(&space, &FitOptions::spectra(20), &ProgressBar::hidden(), &never).unwrap();
+        let before = roundtrip_table(&t, &space, 10_000, 11).unwrap().stats;
+        let model = LabModel::new(&space).unwrap();
+        let opt = crate::upsample::refine::RefineOptions::default();
+        crate::upsample::refine::refine_table(&mut t, &model, &opt, &ProgressBar::hidden(), &never).unwrap();
+        let after = roundtrip_table(&t, &space, 10_000, 11).unwrap().stats;
+        // Measured at res 20 (10⁴ colours, seed 11): mean 0.088 → 0.040, p99 0.45 → 0.27.
+        assert!(after.mean < 0.6 * before.mean, "{before:?} → {after:?}");
+        assert!(after.p99 < 0.7 * before.p99, "{before:?} → {after:?}");
+        let cancelled = std::sync::atomic::AtomicBool::new(true);
+        assert!(
+            crate::upsample::refine::refine_table(&mut t, &model, &opt, &ProgressBar::hidden(), &cancelled)
+                .is_err()
+        );
     }
 
     #[test]
     fn table_round_trip_through_interpolation() {
         let space = RgbColorSpace::srgb();
         let r = roundtrip_table(srgb_table(), &space, 10_000, 7).unwrap();
-        // Measured: see docs/upsampling.md. Interpolation between nodes dominates these figures.
-        assert!(r.stats.mean < 0.0095, "{:?}", r.stats);
-        assert!(r.stats.p99 < 0.05, "{:?}", r.stats);
+        // Measured (unrefined 64³, 10⁴ colours, seed 7): mean 0.0081, p99 0.043, max 0.45.
+        // Interpolation between nodes is all of it (nodes are exact, see below); the shipped,
+        // refined table does better (docs/upsampling.md).
+        assert!(r.stats.mean < 0.009, "{:?}", r.stats);
+        assert!(r.stats.p99 < 0.048, "{:?}", r.stats);
         assert!(r.stats.max < 0.5, "{:?}", r.stats);
     }
 
@@ -155,12 +182,10 @@ mod tests {
         assert!(jakob.stats.mean * 20.0 < smits.stats.mean, "{:?} vs {:?}", jakob.stats, smits.stats);
         assert!(jakob.stats.mean * 20.0 < boxes.stats.mean, "{:?} vs {:?}", jakob.stats, boxes.stats);
         let model = LabModel::new(&space).unwrap();
-        for m in [Method::Box] {
-            let up = crate::upsample::upsampler(m, &space).unwrap();
-            let s = up.reflectance([1.0, 1.0, 1.0]).unwrap();
-            let (_, de) = round_trip_rgb(&model, [1.0; 3], |l| s.eval(l));
-            assert!(de < 1e-9, "{m}: white ΔE {de}");
-        }
+        let up = crate::upsample::upsampler(Method::Box, &space).unwrap();
+        let s = up.reflectance([1.0, 1.0, 1.0]).unwrap();
+        let (_, de) = round_trip_rgb(&model, [1.0; 3], |l| s.eval(l));
+        assert!(de < 1e-9, "box white ΔE {de}");
     }
 
     #[test]

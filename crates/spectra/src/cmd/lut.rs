@@ -21,7 +21,7 @@ pub struct Args {
     /// Reproduce rgb2spec: its double-smoothstep brightness grid and no refinement.
     #[arg(long)]
     pub rgb2spec: bool,
-    /// Skip the interpolation-aware refinement.
+    /// Skip the interpolation-aware refinement (faster; round-trip mean ΔE2000 ≈ 0.008 instead of ≈ 0.005).
     #[arg(long)]
     pub no_refine: bool,
     /// Colours in the round-trip check printed at the end (0 to skip).
