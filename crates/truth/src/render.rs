@@ -15,6 +15,12 @@ use rayon::prelude::*;
 use scene::Scene;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
+/// The s-th point of the R2 sequence shifted by `shift`, in [0, 1)².
+fn r2(shift: [f32; 2], s: u32) -> [f32; 2] {
+    const A: [f64; 2] = [0.754_877_666_246_692_8, 0.569_840_290_998_053_3];
+    std::array::from_fn(|i| ((shift[i] as f64 + s as f64 * A[i]).fract() as f32).min(0.999_999_94))
+}
+
 /// What to render and how.
 #[derive(Clone, Debug)]
 pub struct Settings {
@@ -140,8 +146,12 @@ pub fn render_world(
             for x in 0..w {
                 let mut rng = Sampler::new(settings.seed, y as u64 * w as u64 + x as u64);
                 let mut acc = [0.0f64; 3];
+                // Pixel positions from the R2 rank-1 lattice (Roberts 2018) with a random
+                // per-pixel shift (Cranley–Patterson rotation): well spread over the pixel, and
+                // each sample still uniform, so the estimate stays unbiased.
+                let shift = rng.next2();
                 for s in 0..settings.spp {
-                    let jitter = rng.next2();
+                    let jitter = r2(shift, s);
                     let dir = camera.direction(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
                     // Hero wavelengths stratified over the pixel's samples (one stratum of
                     // 1/spp each, times the four rotations): spiky spectra such as F11 need
