@@ -1,5 +1,9 @@
 //! Subcommands, one file each.
 
+pub mod bench;
 pub mod diff;
+pub mod lut;
 pub mod render;
 pub mod truth;
+pub mod upsample;
+pub mod view;

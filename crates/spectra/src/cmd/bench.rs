@@ -1,0 +1,309 @@
+//! `spectra bench`: frame time of the real-time renderer in RGB mode and in spectral mode at
+//! N = 1, 2, 4, …, 64 wavelengths, with the spectral/RGB ratio and the least-squares cost per
+//! wavelength.
+//!
+//! Each frame is timed twice: GPU time (sum of the per-pass timestamp queries, when the
+//! adapter supports them) and CPU wall time from submission until the frame has finished
+//! (the timestamp read-back, or a device poll, waits for it). Warm-up frames absorb pipeline
+//! and buffer creation. Frames are rendered back to back at a fixed camera; nothing is
+//! presented, so there is no v-sync in the numbers.
+
+pub mod stats;
+
+use crate::cmd::render::{load_table, parse_size};
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Args as ClapArgs;
+use indicatif::{ProgressBar, ProgressStyle};
+use render::{Mode, RenderSettings, Renderer};
+use stats::{LineFit, Summary, fit_line};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    pub scene: String,
+    /// Frame size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720")]
+    pub size: String,
+    /// Measured frames per configuration.
+    #[arg(long, default_value_t = 60)]
+    pub frames: usize,
+    /// Unmeasured frames before each configuration.
+    #[arg(long, default_value_t = 10)]
+    pub warmup: usize,
+    /// Wavelength counts to measure, comma-separated.
+    #[arg(long, default_value = "1,2,4,8,16,32,64")]
+    pub wavelengths: String,
+    /// Also measure naive (box-upsampled) spectral rendering at every N.
+    #[arg(long)]
+    pub naive: bool,
+    /// Write the table as CSV to this file (atomically).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+}
+
+/// Parses `1,2,4` into wavelength counts, each within the renderer's limit.
+pub fn parse_counts(s: &str) -> Result<Vec<usize>> {
+    let mut out = Vec::new();
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let n: usize =
+            part.parse().map_err(|_| anyhow!("--wavelengths '{s}': '{part}' is not a whole number"))?;
+        if n == 0 || n > render::settings::MAX_WAVELENGTHS {
+            bail!("--wavelengths '{s}': {n} is outside 1..={}", render::settings::MAX_WAVELENGTHS);
+        }
+        if !out.contains(&n) {
+            out.push(n);
+        }
+    }
+    if out.is_empty() {
+        bail!("--wavelengths '{s}': give at least one count, e.g. 1,2,4,8");
+    }
+    Ok(out)
+}
+
+/// One measured configuration.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub mode: Mode,
+    /// `None` for RGB (its cost does not depend on N).
+    pub n: Option<usize>,
+    pub gpu: Option<Summary>,
+    pub cpu: Summary,
+}
+
+impl Row {
+    /// The time the comparisons use: GPU when measured, else CPU wall time.
+    pub fn primary(&self) -> f64 {
+        self.gpu.map(|g| g.median).unwrap_or(self.cpu.median)
+    }
+}
+
+/// The least-squares ms-per-wavelength line of one mode's rows.
+pub fn slope(rows: &[Row], mode: Mode) -> Option<LineFit> {
+    let pts: Vec<(f64, f64)> =
+        rows.iter().filter(|r| r.mode == mode).filter_map(|r| Some((r.n? as f64, r.primary()))).collect();
+    fit_line(&pts)
+}
+
+/// The CSV text: one line per configuration, times in milliseconds, empty where not measured.
+pub fn csv(rows: &[Row]) -> String {
+    let rgb = rows.iter().find(|r| r.mode == Mode::Rgb).map(Row::primary);
+    let mut s = String::from(
+        "mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,cpu_median_ms,cpu_p10_ms,cpu_p90_ms,ratio_to_rgb\n",
+    );
+    for r in rows {
+        let g = |f: fn(&Summary) -> f64| r.gpu.as_ref().map(|g| format!("{:.4}", f(g))).unwrap_or_default();
+        let ratio = rgb.map(|b| format!("{:.4}", r.primary() / b)).unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{}",
+            r.mode.name(),
+            r.n.map(|n| n.to_string()).unwrap_or_default(),
+            g(|s| s.median),
+            g(|s| s.p10),
+            g(|s| s.p90),
+            r.cpu.median,
+            r.cpu.p10,
+            r.cpu.p90,
+            ratio
+        );
+    }
+    s
+}
+
+/// The human-readable table plus the per-wavelength fit lines.
+pub fn table(rows: &[Row]) -> String {
+    let rgb = rows.iter().find(|r| r.mode == Mode::Rgb).map(Row::primary);
+    let mut s = format!(
+        "{:<9} {:>3}  {:>9} {:>8} {:>8}  {:>9} {:>8} {:>8}  {:>7}\n",
+        "mode", "N", "GPU med", "p10", "p90", "CPU med", "p10", "p90", "×RGB"
+    );
+    let opt = |v: Option<f64>| v.map(|v| format!("{v:.2}")).unwrap_or_else(|| "–".into());
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{:<9} {:>3}  {:>9} {:>8} {:>8}  {:>9.2} {:>8.2} {:>8.2}  {:>7}",
+            r.mode.name(),
+            r.n.map(|n| n.to_string()).unwrap_or_else(|| "–".into()),
+            opt(r.gpu.map(|g| g.median)),
+            opt(r.gpu.map(|g| g.p10)),
+            opt(r.gpu.map(|g| g.p90)),
+            r.cpu.median,
+            r.cpu.p10,
+            r.cpu.p90,
+            rgb.map(|b| format!("{:.2}", r.primary() / b)).unwrap_or_else(|| "–".into()),
+        );
+    }
+    for mode in [Mode::Spectral, Mode::Naive] {
+        if let Some(f) = slope(rows, mode) {
+            let _ = writeln!(
+                s,
+                "{}: {:.3} ms per wavelength + {:.2} ms (least squares over N, R² = {:.4})",
+                mode.name(),
+                f.slope,
+                f.intercept,
+                f.r2
+            );
+        }
+    }
+    s
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let (width, height) = parse_size(&args.size)?;
+    if args.frames == 0 {
+        bail!("--frames 0: measure at least one frame");
+    }
+    let counts = parse_counts(&args.wavelengths)?;
+    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
+    r.set_scene(&scene)?;
+    r.resize(width, height)?;
+    let has_ts = r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY);
+    eprintln!(
+        "{} {width}×{height} on {}; {} frames after {} warm-up; time: {}",
+        scene.source,
+        r.gpu().describe(),
+        args.frames,
+        args.warmup,
+        if has_ts { "GPU timestamps + CPU wall" } else { "CPU wall only (no timestamp queries)" }
+    );
+
+    let mut configs: Vec<(Mode, Option<usize>)> = vec![(Mode::Rgb, None)];
+    configs.extend(counts.iter().map(|&n| (Mode::Spectral, Some(n))));
+    if args.naive {
+        configs.extend(counts.iter().map(|&n| (Mode::Naive, Some(n))));
+    }
+    let per = (args.warmup + args.frames) as u64;
+    let bar = ProgressBar::new(per * configs.len() as u64).with_style(
+        ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} frames, {eta} left")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    let interrupted = color::upsample::interrupt_flag();
+    color::upsample::install_interrupt_handler();
+    let mut rows = Vec::new();
+    for (mode, n) in configs {
+        bar.set_message(format!("{} N={}", mode.name(), n.map(|n| n.to_string()).unwrap_or("–".into())));
+        let settings = RenderSettings {
+            mode,
+            wavelengths: n.unwrap_or(RenderSettings::default().wavelengths),
+            timestamps: has_ts,
+            ..Default::default()
+        };
+        let mut gpu_ms = Vec::with_capacity(args.frames);
+        let mut cpu_ms = Vec::with_capacity(args.frames);
+        for i in 0..per as usize {
+            if interrupted.load(Ordering::SeqCst) {
+                bar.abandon();
+                bail!("interrupted: nothing written");
+            }
+            let t0 = Instant::now();
+            r.render(&scene.camera, &settings)?;
+            // Reading the timestamps waits for the frame; without them, wait explicitly.
+            let t = r.read_timings()?;
+            if t.is_none() {
+                r.gpu()
+                    .device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+            }
+            let wall = t0.elapsed().as_secs_f64() * 1e3;
+            if i >= args.warmup {
+                cpu_ms.push(wall);
+                if let Some(t) = t {
+                    gpu_ms.push(t.total_ms());
+                }
+            }
+            bar.inc(1);
+        }
+        rows.push(Row {
+            mode,
+            n,
+            gpu: Summary::of(&gpu_ms),
+            cpu: Summary::of(&cpu_ms).context("no frame times")?,
+        });
+    }
+    bar.finish_and_clear();
+    print!("{}", table(&rows));
+    if let Some(path) = &args.csv {
+        compare::atomic::write_atomic(path, csv(&rows).as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    #[test]
+    fn defaults_and_counts() {
+        let a = Cli::try_parse_from(["bench", "cornell"]).unwrap().args;
+        assert_eq!((a.size.as_str(), a.frames, a.warmup), ("1280x720", 60, 10));
+        assert_eq!(parse_counts(&a.wavelengths).unwrap(), vec![1, 2, 4, 8, 16, 32, 64]);
+        assert_eq!(parse_counts(" 4, 4,8 ").unwrap(), vec![4, 8]);
+        assert!(parse_counts("0").unwrap_err().to_string().contains("outside"));
+        assert!(parse_counts("4,x").unwrap_err().to_string().contains("'x'"));
+        assert!(parse_counts(",").unwrap_err().to_string().contains("at least one"));
+        assert!(Cli::try_parse_from(["bench", "cornell", "--frames", "-3"]).is_err());
+    }
+
+    fn summary(m: f64) -> Summary {
+        Summary { median: m, p10: m - 1.0, p90: m + 1.0 }
+    }
+
+    fn rows() -> Vec<Row> {
+        let mut rows = vec![Row { mode: Mode::Rgb, n: None, gpu: Some(summary(20.0)), cpu: summary(25.0) }];
+        for n in [1, 2, 4, 8] {
+            let ms = 20.0 + 2.5 * n as f64;
+            rows.push(Row {
+                mode: Mode::Spectral,
+                n: Some(n),
+                gpu: Some(summary(ms)),
+                cpu: summary(ms + 5.0),
+            });
+        }
+        rows
+    }
+
+    #[test]
+    fn slope_ratio_and_csv() {
+        let rows = rows();
+        let f = slope(&rows, Mode::Spectral).unwrap();
+        assert!((f.slope - 2.5).abs() < 1e-12 && (f.intercept - 20.0).abs() < 1e-12);
+        assert!(slope(&rows, Mode::Naive).is_none());
+        let text = csv(&rows);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 6);
+        assert_eq!(lines[1], "rgb,,20.0000,19.0000,21.0000,25.0000,24.0000,26.0000,1.0000");
+        // N = 8: 40 ms / 20 ms.
+        assert_eq!(lines[5], "spectral,8,40.0000,39.0000,41.0000,45.0000,44.0000,46.0000,2.0000");
+        assert!(table(&rows).contains("spectral: 2.500 ms per wavelength + 20.00 ms"));
+    }
+
+    #[test]
+    fn cpu_time_is_used_without_timestamps() {
+        let mut rows = rows();
+        for r in &mut rows {
+            r.gpu = None;
+        }
+        let lines: Vec<String> = csv(&rows).lines().map(String::from).collect();
+        // 45 ms / 25 ms, and no GPU columns.
+        assert_eq!(lines[5], "spectral,8,,,,45.0000,44.0000,46.0000,1.8000");
+    }
+}

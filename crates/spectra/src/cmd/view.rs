@@ -1,0 +1,142 @@
+//! `spectra view`: an interactive window with live controls (mode, N, range, observer,
+//! exposure, tone map), an orbit/fly camera, a CPU/GPU frame-time readout and screenshots.
+
+use crate::cmd::render::{load_table, parse_size};
+use crate::view::app::{ViewOptions, run as run_window};
+use crate::view::controls::MAX_VIEW_WAVELENGTHS;
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Args as ClapArgs;
+use color::WavelengthRange;
+use render::{Mode, RenderSettings, Tonemap};
+use std::path::PathBuf;
+
+/// What to say when there is nowhere to open a window.
+pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra render`";
+
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    pub scene: String,
+    /// Initial window size WIDTHxHEIGHT (the renderer follows the window).
+    #[arg(long, default_value = "960x640")]
+    pub size: String,
+    /// rgb (classic), naive (box upsampling) or spectral (Jakob–Hanika).
+    #[arg(long, default_value = "spectral")]
+    pub mode: String,
+    /// Number of wavelength samples, 1–64 (default: the scene's, else 16).
+    #[arg(long)]
+    pub wavelengths: Option<usize>,
+    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
+    #[arg(long)]
+    pub range: Option<String>,
+    /// Observer, e.g. cie1931 or cie1964 (default: the scene's, else cie1931).
+    #[arg(long)]
+    pub observer: Option<String>,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone mapping: none, reinhard or aces.
+    #[arg(long, default_value = "none")]
+    pub tonemap: String,
+    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+}
+
+/// The initial settings: arguments first, then the scene's spectral defaults, then the
+/// renderer's. Refuses what the viewer cannot show, naming the argument.
+pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSettings> {
+    let d = RenderSettings::default();
+    let range = match (&args.range, scene.spectral.range) {
+        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
+        (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
+            .with_context(|| format!("scene {}: spectral range", scene.source))?,
+        (None, None) => d.range,
+    };
+    let wavelengths =
+        args.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
+    if !(1..=MAX_VIEW_WAVELENGTHS).contains(&wavelengths) {
+        bail!("--wavelengths {wavelengths}: the viewer shows 1 to {MAX_VIEW_WAVELENGTHS} wavelengths");
+    }
+    let observer = args.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
+    color::Observer::by_name(&observer).with_context(|| format!("--observer '{observer}'"))?;
+    let s = RenderSettings {
+        mode: Mode::parse(&args.mode).context("--mode")?,
+        wavelengths,
+        range,
+        observer,
+        exposure_ev: args.exposure,
+        tonemap: Tonemap::parse(&args.tonemap).context("--tonemap")?,
+        shadows: true,
+        timestamps: true,
+    };
+    s.validate().map_err(|e| anyhow!("{e}"))?;
+    Ok(s)
+}
+
+/// Whether an X11 display is named (the only window system this build of winit speaks).
+fn display_named(display: Option<std::ffi::OsString>) -> bool {
+    display.is_some_and(|d| !d.is_empty())
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let size = parse_size(&args.size)?;
+    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let settings = initial_settings(&args, &scene)?;
+    if !display_named(std::env::var_os("DISPLAY")) {
+        bail!("{NO_DISPLAY}");
+    }
+    // The event loop connects to the X server; a named but unreachable display fails here.
+    let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
+    let table = load_table(args.table.as_deref())?;
+    run_window(event_loop, ViewOptions { scene, settings, size, table })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn parse(argv: &[&str]) -> Result<RenderSettings> {
+        let mut full = vec!["view"];
+        full.extend_from_slice(argv);
+        let args = Cli::try_parse_from(full).map_err(|e| anyhow!("{e}"))?.args;
+        let scene = scene::load_any(&args.scene)?;
+        initial_settings(&args, &scene)
+    }
+
+    #[test]
+    fn arguments_become_settings() {
+        let s = parse(&["cornell", "--mode", "rgb", "--wavelengths", "8", "--range", "400:700"]).unwrap();
+        assert_eq!((s.mode, s.wavelengths, s.range.min, s.range.max), (Mode::Rgb, 8, 400.0, 700.0));
+        let s =
+            parse(&["cornell", "--observer", "cie1964", "--exposure", "-1.5", "--tonemap", "aces"]).unwrap();
+        assert_eq!((s.observer.as_str(), s.exposure_ev, s.tonemap), ("cie1964", -1.5, Tonemap::Aces));
+        assert!(s.timestamps, "the viewer always asks for GPU timings");
+    }
+
+    #[test]
+    fn bad_arguments_are_named() {
+        let e = |argv: &[&str]| format!("{:#}", parse(argv).unwrap_err());
+        assert!(e(&["cornell", "--wavelengths", "65"]).contains("--wavelengths 65"));
+        assert!(e(&["cornell", "--wavelengths", "0"]).contains("1 to 64"));
+        assert!(e(&["cornell", "--mode", "hsv"]).contains("hsv"));
+        assert!(e(&["cornell", "--range", "700:400"]).contains("--range"));
+        assert!(e(&["cornell", "--observer", "cat"]).contains("cat"));
+        assert!(e(&["cornell", "--tonemap", "filmic"]).contains("filmic"));
+        assert!(e(&["no-such-scene"]).contains("no-such-scene"));
+    }
+
+    #[test]
+    fn display_detection() {
+        assert!(!display_named(None));
+        assert!(!display_named(Some("".into())));
+        assert!(display_named(Some(":99".into())));
+    }
+}
