@@ -73,10 +73,32 @@ impl CpuSpectral {
 
     fn shade(&self, table: &CoeffTable, albedo: [f32; 3], a: f64, b: f64) -> [f64; 3] {
         let poly = table.fetch(albedo.map(f64::from));
+        self.shade_with(|l| poly.to_f32_poly_eval(l), a, b)
+    }
+
+    /// Naive mode: the colour crate's box spectrum of the albedo.
+    fn shade_box(&self, albedo: [f32; 3], a: f64, b: f64) -> [f64; 3] {
+        let boxed = color::upsample::boxes::BoxSpectrum { rgb: albedo.map(f64::from) };
+        self.shade_with(|l| boxed.eval(l), a, b)
+    }
+
+    fn shade_with(&self, rho: impl Fn(f64) -> f64, a: f64, b: f64) -> [f64; 3] {
         let mut xyz = DVec3::ZERO;
         for i in 0..self.lambda.len() {
-            let rho = poly.to_f32_poly_eval(self.lambda[i]);
-            let l = (rho * a + b) * self.light[i];
+            let l = (rho(self.lambda[i]) * a + b) * self.light[i];
+            xyz += DVec3::from(self.weights[i]) * l;
+        }
+        (self.to_rgb * xyz).to_array()
+    }
+
+    /// An emitter of linear RGB `e` with the illuminant variant: s·ρ(e/s)(λ)·D65(λ), s = 2·max.
+    fn emitter(&self, table: &CoeffTable, e: [f64; 3]) -> [f64; 3] {
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let s = 2.0 * e[0].max(e[1]).max(e[2]);
+        let poly = table.fetch(e.map(|c| c / s));
+        let mut xyz = DVec3::ZERO;
+        for i in 0..self.lambda.len() {
+            let l = s * poly.to_f32_poly_eval(self.lambda[i]) * d65.eval(self.lambda[i]);
             xyz += DVec3::from(self.weights[i]) * l;
         }
         (self.to_rgb * xyz).to_array()
@@ -130,6 +152,7 @@ fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
     r.resize(W, H).unwrap();
     let n = 16;
     let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
+    let naive = render_hdr(&mut r, &settings(Mode::Naive, n));
     let rgb = render_hdr(&mut r, &settings(Mode::Rgb, n));
     let cpu = CpuSpectral::new(n, &f11, intensity as f64);
     let table = table();
@@ -143,15 +166,18 @@ fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
     let light_rgb = RgbColorSpace::srgb().xyz_to_rgb(fx.map(|c| c * intensity as f64 / fx[1]));
 
     let mut worst = 0.0f64;
+    let mut worst_naive = 0.0f64;
     let mut worst_diff = 0.0f64;
     let mut de = Vec::new();
     for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
         let Some((patch, a, b)) = *g else { continue };
         let albedo = chart.colours[patch];
         let want = cpu.shade(&table, albedo, a, b);
+        let want_naive = cpu.shade_box(albedo, a, b);
         let want_rgb: [f64; 3] = std::array::from_fn(|c| (albedo[c] as f64 * a + b) * light_rgb[c]);
         for c in 0..3 {
             worst = worst.max((spectral[i][c] - want[c]).abs());
+            worst_naive = worst_naive.max((naive[i][c] - want_naive[c]).abs());
             let d_gpu = spectral[i][c] - rgb[i][c];
             let d_cpu = want[c] - want_rgb[c];
             worst_diff = worst_diff.max((d_gpu - d_cpu).abs());
@@ -160,9 +186,11 @@ fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
     }
     let (mean, p99) = stats(de);
     println!(
-        "F11: |GPU − CPU| max {worst:.2e}, |Δ(spectral − rgb)| max {worst_diff:.2e}, ΔE(spectral, rgb) mean {mean:.3} p99 {p99:.3}"
+        "F11: |GPU − CPU| max {worst:.2e} (naive {worst_naive:.2e}), |Δ(spectral − rgb)| max {worst_diff:.2e}, \
+         ΔE(spectral, rgb) mean {mean:.3} p99 {p99:.3}"
     );
     assert!(worst < 1e-3, "spectral GPU vs CPU differ by {worst}");
+    assert!(worst_naive < 1e-3, "naive GPU vs CPU box spectra differ by {worst_naive}");
     assert!(worst_diff < 1e-3, "spectral − rgb differs from the CPU's by {worst_diff}");
     // F11's narrow lines make metamerism visible: the modes must differ clearly.
     assert!(mean > 1.0, "spectral and rgb under F11 differ by only ΔE {mean}");
@@ -186,4 +214,41 @@ fn spectral_reproduces_rgb_under_d65() {
             assert_delta_e(&format!("d65-{name}-n{n}"), W, H, &spectral, &expected, 0.2, 0.5);
         }
     }
+}
+
+#[test]
+fn emissive_surfaces_use_the_illuminant_variant() {
+    // Unlit (no lights) emissive patches: rgb mode shows the emission itself; spectral mode the
+    // illuminant-variant spectrum s·ρ(e/s)·D65 integrated on the CPU; white stays white.
+    let mut chart = Chart::colorchecker();
+    // Kept below 1: the G-buffer and HDR targets are f16 (2^-11 relative), and the tolerance is absolute.
+    let emission: Vec<[f64; 3]> = chart.colours.iter().map(|c| c.map(|v| v as f64 * 0.6)).collect();
+    chart.colours.iter_mut().for_each(|c| *c = [0.0; 3]);
+    let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+    scene.lights.clear();
+    for (m, e) in scene.materials.iter_mut().zip(&emission) {
+        m.emissive = Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32);
+    }
+    let mut r = renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let n = 16;
+    let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
+    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, n));
+    let cpu = CpuSpectral::new(n, &Spectrum::Constant(1.0), 1.0);
+    let table = table();
+    let (mut worst_s, mut worst_r) = (0.0f64, 0.0f64);
+    for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
+        let Some((patch, _, _)) = *g else { continue };
+        let want = cpu.emitter(&table, emission[patch]);
+        for c in 0..3 {
+            worst_s = worst_s.max((spectral[i][c] - want[c]).abs());
+            worst_r = worst_r.max((rgb[i][c] - emission[patch][c]).abs());
+        }
+    }
+    println!("emission: spectral |GPU − CPU| max {worst_s:.2e}, rgb |GPU − e| max {worst_r:.2e}");
+    assert!(worst_s < 1e-3, "spectral emission differs from the CPU by {worst_s}");
+    assert!(worst_r < 1e-3, "rgb emission differs from the material's by {worst_r}");
+    let white = cpu.emitter(&table, [1.0; 3]);
+    assert!(white.iter().all(|&c| (c - 1.0).abs() < 2e-3), "emissive white → {white:?}");
 }
