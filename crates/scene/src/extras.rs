@@ -122,11 +122,28 @@ fn rgb8(v: Option<&Value>) -> Result<[u8; 3], String> {
     Ok(out)
 }
 
-/// Light extras: `spectrum` (a shape, scaled later to the light's RGB × intensity).
-pub(crate) fn light(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<Option<Spectrum>, SceneError> {
+/// Light extras: `spectrum` (a shape, scaled later to the light's RGB × intensity) and
+/// `stands_in_for` (the index of the node whose emissive mesh this light approximates).
+#[derive(Default)]
+pub(crate) struct LightExtras {
+    pub spectrum: Option<Spectrum>,
+    pub stands_in_for_node: Option<usize>,
+}
+
+pub(crate) fn light(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<LightExtras, SceneError> {
     let at = format!("{at}.extras");
-    check_keys(ctx, &at, map, &["spectrum"])?;
-    map.get("spectrum").map(|v| spectrum_desc::resolve(ctx, &format!("{at}.spectrum"), v)).transpose()
+    check_keys(ctx, &at, map, &["spectrum", "stands_in_for"])?;
+    let spectrum =
+        map.get("spectrum").map(|v| spectrum_desc::resolve(ctx, &format!("{at}.spectrum"), v)).transpose()?;
+    let stands_in_for_node = map
+        .get("stands_in_for")
+        .map(|v| {
+            v.as_u64().map(|n| n as usize).ok_or_else(|| {
+                ctx.extras(format!("{at}.stands_in_for"), format!("expected a node index, got {v}"))
+            })
+        })
+        .transpose()?;
+    Ok(LightExtras { spectrum, stands_in_for_node })
 }
 
 /// Scene-level extras (root, asset or scene): `spectra` and `water`.

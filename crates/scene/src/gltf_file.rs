@@ -74,6 +74,9 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
     let mut stack: Vec<(gltf::Node, Mat4)> = gscene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     stack.reverse();
     let mut seen = vec![false; doc.nodes().len()];
+    let mut first_mesh_of_node: HashMap<usize, usize> = HashMap::new();
+    // (index in `lights`, glTF light index, node it stands in for)
+    let mut stand_ins: Vec<(usize, usize, usize)> = Vec::new();
     while let Some((node, parent)) = stack.pop() {
         let at = format!("nodes[{}]", node.index());
         if std::mem::replace(&mut seen[node.index()], true) {
@@ -84,6 +87,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
             return Err(ctx.invalid(at, "transform is not finite"));
         }
         if let Some(mesh) = node.mesh() {
+            first_mesh_of_node.insert(node.index(), meshes.len());
             for prim in mesh.primitives() {
                 let pat = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
                 let mi = match prim.material().index() {
@@ -101,11 +105,29 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
             camera = Some(camera_of(ctx, &cam, world)?);
         }
         if let Some(light) = node.light() {
-            lights.push(light_of(ctx, &light, &node, world)?);
+            let (l, stand_in) = light_of(ctx, &light, &node, world)?;
+            if let Some(n) = stand_in {
+                stand_ins.push((lights.len(), light.index(), n));
+            }
+            lights.push(l);
         }
         for child in node.children().collect::<Vec<_>>().into_iter().rev() {
             stack.push((child, world));
         }
+    }
+    for (li, gl, node) in stand_ins {
+        let f = format!("KHR_lights_punctual.lights[{gl}].extras.stands_in_for");
+        let mesh = *first_mesh_of_node
+            .get(&node)
+            .ok_or_else(|| ctx.extras(&f, format!("node {node} is not a mesh node of the scene")))?;
+        let emits = materials.get(meshes[mesh].material).is_some_and(|m| m.emissive.max_element() > 0.0);
+        if !emits {
+            return Err(ctx.extras(
+                &f,
+                format!("node {node}'s mesh does not emit, so there is nothing to stand in for"),
+            ));
+        }
+        lights[li].stands_in_for = Some(mesh);
     }
     if uses_default {
         materials.push(Material { name: "default".into(), ..Material::default() });
@@ -248,7 +270,7 @@ fn light_of(
     l: &gltf::khr_lights_punctual::Light,
     node: &gltf::Node,
     world: Mat4,
-) -> Result<Light, SceneError> {
+) -> Result<(Light, Option<usize>), SceneError> {
     let at = format!("KHR_lights_punctual.lights[{}]", l.index());
     let position = world.transform_point3(Vec3::ZERO);
     let direction = world.transform_vector3(-Vec3::Z).try_normalize().ok_or_else(|| {
@@ -282,14 +304,15 @@ fn light_of(
     if !(rgb.is_finite() && rgb.min_element() >= 0.0 && intensity.is_finite() && intensity >= 0.0) {
         return Err(ctx.invalid(at, "color and intensity must be finite and non-negative"));
     }
-    let shape = match extras::object(ctx, &at, l.extras())? {
+    let x = match extras::object(ctx, &at, l.extras())? {
         Some(map) => extras::light(ctx, &at, &map)?,
-        None => None,
+        None => extras::LightExtras::default(),
     };
-    let emission = Emission::new(rgb, intensity, shape.as_ref())
+    let emission = Emission::new(rgb, intensity, x.spectrum.as_ref())
         .map_err(|m| ctx.extras(format!("{at}.extras.spectrum"), m))?;
     let name = l.name().or(node.name()).map_or_else(|| format!("light {}", l.index()), str::to_string);
-    Ok(Light { name, kind, emission, stands_in_for: None })
+    // `stands_in_for` holds the node index until the traversal has numbered the meshes.
+    Ok((Light { name, kind, emission, stands_in_for: None }, x.stands_in_for_node))
 }
 
 /// Material and texture conversion, with textures shared between materials and decoded once.

@@ -10,6 +10,7 @@ pub mod builtin;
 mod context;
 pub mod emission;
 mod error;
+pub mod export;
 mod extras;
 pub mod framing;
 mod gltf_file;
@@ -27,6 +28,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 pub use builtin::{BUILTIN_NAMES, builtin};
 pub use error::{Result, SceneError};
+pub use export::write_gltf;
 pub use gltf_file::{load, load_slice};
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
@@ -174,7 +176,8 @@ pub struct Light {
     /// same lamp), for renderers that cannot light with emissive surfaces. A renderer that
     /// samples emissive meshes as lights (the path tracer) must skip it, or the lamp would count
     /// twice; a renderer that only shades punctual lights uses it and draws `meshes[i]` merely
-    /// as a glowing surface. Always `None` for lights loaded from glTF.
+    /// as a glowing surface. In glTF: light `extras.stands_in_for` = the index of the node
+    /// holding the emissive mesh (it resolves to that node's first primitive).
     pub stands_in_for: Option<usize>,
 }
 

@@ -131,6 +131,22 @@ fn bad_extras() {
         &mutate(|d| d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"]["colour"] = json!(1)),
         &["lights[0].extras.colour", "unknown key"],
     );
+    let light0 = |d: &mut Value, v: Value| {
+        d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"]["stands_in_for"] = v
+    };
+    expect(
+        &mutate(|d| light0(d, json!(3))),
+        &["lights[0].extras.stands_in_for", "node 3 is not a mesh node"],
+    );
+    expect(&mutate(|d| light0(d, json!("quad"))), &["lights[0].extras.stands_in_for", "node index"]);
+    expect(
+        &mutate(|d| {
+            light0(d, json!(2));
+            d["materials"][1]["emissiveFactor"] = json!([0, 0, 0]);
+            d["materials"][1]["extras"].as_object_mut().unwrap().remove("emission");
+        }),
+        &["lights[0].extras.stands_in_for", "does not emit"],
+    );
     expect(
         &mutate(|d| d["extras"]["spectra"]["wavelenghts"] = json!(8)),
         &["root.extras.spectra.wavelenghts", "unknown key"],

@@ -130,6 +130,17 @@ fn load_any_dispatches_on_extension() {
 }
 
 #[test]
+fn stand_in_lights_resolve_to_the_mesh_of_their_node() {
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data("textured.gltf")).unwrap()).unwrap();
+    // Node 2 is the triangle, whose material emits; it is the second mesh of the traversal.
+    doc["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"]["stands_in_for"] = serde_json::json!(2);
+    let s = scene::load_slice("standin.gltf", doc.to_string().as_bytes(), Some(&data(""))).unwrap();
+    assert_eq!(s.lights[1].stands_in_for, Some(1));
+    assert_eq!(s.lights[0].stands_in_for, None);
+}
+
+#[test]
 fn default_camera_frames_a_scene_without_one() {
     let mut doc: serde_json::Value =
         serde_json::from_slice(&std::fs::read(data("textured.gltf")).unwrap()).unwrap();

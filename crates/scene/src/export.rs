@@ -1,0 +1,280 @@
+//! Writing a [`Scene`] as a self-contained `.gltf` (buffers and PNG images as data URIs) with
+//! the spectral extras of `docs/scene-format.md`, so built-in scenes can be opened and edited in
+//! other tools and loaded back unchanged.
+//!
+//! Geometry is already in world space, so every mesh gets its own node with no transform.
+//! Spectra are written as `{"sampled": ...}` (blackbodies as `{"blackbody": K}`), which the loader
+//! rescales to the same luminance on the way back.
+
+use std::io::Write;
+use std::path::Path;
+
+use base64::Engine;
+use color::Spectrum;
+use glam::{Quat, Vec3};
+use serde_json::{Value, json};
+
+use crate::error::SceneError;
+use crate::{LightKind, Scene, SpectralReflectance, Texture};
+
+fn spectrum_json(s: &Spectrum) -> Value {
+    match s {
+        Spectrum::Constant(c) => {
+            json!({"sampled": {"wavelengths": [color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX], "values": [c, c]}})
+        }
+        Spectrum::Blackbody { kelvin, .. } => json!({"blackbody": kelvin}),
+        Spectrum::Piecewise { lambda, values } => {
+            json!({"sampled": {"wavelengths": lambda, "values": values}})
+        }
+    }
+}
+
+fn data_uri(mime: &str, bytes: &[u8]) -> String {
+    format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
+}
+
+fn png(t: &Texture) -> Result<Vec<u8>, String> {
+    let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone()).ok_or_else(|| {
+        format!("texture '{}' has {} bytes for {}×{}", t.name, t.rgba8.len(), t.width, t.height)
+    })?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
+}
+
+/// Builds the glTF JSON document for `scene`.
+pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
+    let mut bin: Vec<u8> = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut push =
+        |bytes: &[u8], target: u32, count: usize, ctype: u32, ty: &str, minmax: Option<(Vec3, Vec3)>| {
+            while !bin.len().is_multiple_of(4) {
+                bin.push(0);
+            }
+            views.push(
+                json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": target}),
+            );
+            bin.extend_from_slice(bytes);
+            let mut a =
+                json!({"bufferView": views.len() - 1, "componentType": ctype, "count": count, "type": ty});
+            if let Some((lo, hi)) = minmax {
+                a["min"] = json!(lo.to_array());
+                a["max"] = json!(hi.to_array());
+            }
+            accessors.push(a);
+            accessors.len() - 1
+        };
+    const F32: u32 = 5126;
+    const U32: u32 = 5125;
+    let floats = |v: &mut dyn Iterator<Item = f32>| v.flat_map(f32::to_le_bytes).collect::<Vec<u8>>();
+
+    let mut meshes = Vec::new();
+    let mut nodes = Vec::new();
+    for (i, m) in scene.meshes.iter().enumerate() {
+        if m.positions.is_empty() || m.indices.is_empty() {
+            return Err(format!("mesh {i} is empty"));
+        }
+        let (lo, hi) = crate::framing::bounds(std::slice::from_ref(m)).expect("non-empty");
+        let n = m.positions.len();
+        let mut attrs = serde_json::Map::new();
+        let pos = floats(&mut m.positions.iter().flat_map(|p| p.to_array()));
+        attrs.insert("POSITION".into(), json!(push(&pos, 34962, n, F32, "VEC3", Some((lo, hi)))));
+        let nrm = floats(&mut m.normals.iter().flat_map(|p| p.to_array()));
+        attrs.insert("NORMAL".into(), json!(push(&nrm, 34962, n, F32, "VEC3", None)));
+        if !m.uvs.is_empty() {
+            let uv = floats(&mut m.uvs.iter().flat_map(|p| p.to_array()));
+            attrs.insert("TEXCOORD_0".into(), json!(push(&uv, 34962, n, F32, "VEC2", None)));
+        }
+        if !m.tangents.is_empty() {
+            let t = floats(&mut m.tangents.iter().flat_map(|p| p.to_array()));
+            attrs.insert("TANGENT".into(), json!(push(&t, 34962, n, F32, "VEC4", None)));
+        }
+        let idx: Vec<u8> = m.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let ia = push(&idx, 34963, m.indices.len(), U32, "SCALAR", None);
+        meshes.push(json!({"primitives": [{"attributes": attrs, "indices": ia, "material": m.material}]}));
+        nodes.push(json!({"name": format!("mesh {i}"), "mesh": i}));
+    }
+
+    let mut images = Vec::new();
+    for t in &scene.textures {
+        images.push(json!({"name": t.name, "uri": data_uri("image/png", &png(t)?)}));
+    }
+    let textures: Vec<Value> =
+        (0..scene.textures.len()).map(|i| json!({"source": i, "sampler": 0})).collect();
+    let tex = |r: &crate::TextureRef| json!({"index": r.index, "texCoord": r.tex_coord});
+
+    let mut materials = Vec::new();
+    for m in &scene.materials {
+        let mut pbr = json!({"baseColorFactor": m.base_color.to_array(), "metallicFactor": m.metallic, "roughnessFactor": m.roughness});
+        if let Some(t) = &m.base_color_texture {
+            pbr["baseColorTexture"] = tex(t);
+        }
+        if let Some(t) = &m.metallic_roughness_texture {
+            pbr["metallicRoughnessTexture"] = tex(t);
+        }
+        let mut j = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        if let Some(t) = &m.normal_texture {
+            j["normalTexture"] = tex(t);
+            j["normalTexture"]["scale"] = json!(m.normal_scale);
+        }
+        // glTF caps emissiveFactor at 1; the rest goes into the strength extension.
+        let strength = m.emissive.max_element();
+        if strength > 0.0 {
+            j["emissiveFactor"] = json!((m.emissive / strength.max(1.0)).to_array());
+            if strength > 1.0 {
+                j["extensions"] = json!({"KHR_materials_emissive_strength": {"emissiveStrength": strength}});
+            }
+        }
+        if let Some(t) = &m.emissive_texture {
+            j["emissiveTexture"] = tex(t);
+        }
+        let mut extras = serde_json::Map::new();
+        match &m.spectral {
+            Some(SpectralReflectance::Uniform(s)) => {
+                extras.insert("reflectance".into(), spectrum_json(s));
+            }
+            Some(SpectralReflectance::Palette(p)) => {
+                let entries: Vec<Value> = p
+                    .iter()
+                    .map(|e| json!({"rgb8": e.rgb8, "spectrum": spectrum_json(&e.spectrum)}))
+                    .collect();
+                extras.insert("reflectance_palette".into(), json!(entries));
+            }
+            None => {}
+        }
+        if let Some(s) = &m.emission_spectrum {
+            extras.insert("emission".into(), spectrum_json(s));
+        }
+        if !extras.is_empty() {
+            j["extras"] = Value::Object(extras);
+        }
+        materials.push(j);
+    }
+
+    let mut lights = Vec::new();
+    for (i, l) in scene.lights.iter().enumerate() {
+        let e = &l.emission;
+        let mut j = json!({"name": l.name, "color": e.rgb.to_array(), "intensity": e.intensity});
+        let (pos, dir) = match l.kind {
+            LightKind::Point { position, range } => {
+                j["type"] = json!("point");
+                if let Some(r) = range {
+                    j["range"] = json!(r);
+                }
+                (position, -Vec3::Z)
+            }
+            LightKind::Spot { position, direction, inner_cone, outer_cone, range } => {
+                j["type"] = json!("spot");
+                j["spot"] = json!({"innerConeAngle": inner_cone, "outerConeAngle": outer_cone});
+                if let Some(r) = range {
+                    j["range"] = json!(r);
+                }
+                (position, direction)
+            }
+            LightKind::Directional { direction } => {
+                j["type"] = json!("directional");
+                (Vec3::ZERO, direction)
+            }
+        };
+        let mut extras = serde_json::Map::new();
+        if let Some(s) = &e.spectrum {
+            extras.insert("spectrum".into(), spectrum_json(s));
+        }
+        if let Some(m) = l.stands_in_for {
+            // Mesh i is node i (see above).
+            extras.insert("stands_in_for".into(), json!(m));
+        }
+        if !extras.is_empty() {
+            j["extras"] = Value::Object(extras);
+        }
+        lights.push(j);
+        let rot = Quat::from_rotation_arc(-Vec3::Z, dir.normalize());
+        nodes.push(json!({"name": l.name, "translation": pos.to_array(), "rotation": rot.to_array(),
+            "extensions": {"KHR_lights_punctual": {"light": i}}}));
+    }
+
+    let c = &scene.camera;
+    let (_, rot, pos) = c.transform.to_scale_rotation_translation();
+    let mut persp = json!({"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar});
+    if let Some(a) = c.aspect {
+        persp["aspectRatio"] = json!(a);
+    }
+    nodes.push(
+        json!({"name": "camera", "camera": 0, "translation": pos.to_array(), "rotation": rot.to_array()}),
+    );
+
+    let mut scene_extras = serde_json::Map::new();
+    let sp = &scene.spectral;
+    let mut spectra = serde_json::Map::new();
+    if let Some(o) = &sp.observer {
+        spectra.insert("observer".into(), json!(o));
+    }
+    if let Some((lo, hi)) = sp.range {
+        spectra.insert("range".into(), json!([lo, hi]));
+    }
+    if let Some(n) = sp.wavelengths {
+        spectra.insert("wavelengths".into(), json!(n));
+    }
+    if let Some(w) = &sp.white {
+        spectra.insert("white".into(), json!(w));
+    }
+    if !spectra.is_empty() {
+        scene_extras.insert("spectra".into(), Value::Object(spectra));
+    }
+    if let Some(w) = &scene.water {
+        scene_extras.insert(
+            "water".into(),
+            json!({"type": w.water_type, "depth": w.depth, "sun_direction": w.sun_direction.to_array(), "scale": w.scale}),
+        );
+    }
+
+    let mut doc = json!({
+        "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
+        "scene": 0,
+        "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "cameras": [{"type": "perspective", "perspective": persp}],
+        "extensions": {"KHR_lights_punctual": {"lights": lights}},
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": bin.len(), "uri": data_uri("application/octet-stream", &bin)}],
+    });
+    if !images.is_empty() {
+        doc["images"] = json!(images);
+        doc["textures"] = json!(textures);
+        // Nearest filtering: palette lookups need unblended texels.
+        doc["samplers"] = json!([{"magFilter": 9728, "minFilter": 9728}]);
+    }
+    if !scene_extras.is_empty() {
+        doc["scenes"][0]["extras"] = Value::Object(scene_extras);
+    }
+    Ok(doc)
+}
+
+/// Writes `scene` to `path` as a self-contained `.gltf`. The file appears complete or not at all
+/// (written to a temporary file in the same directory, then renamed).
+pub fn write_gltf(scene: &Scene, path: &Path) -> Result<(), SceneError> {
+    let invalid =
+        |m: String| SceneError::Invalid { path: path.to_path_buf(), at: "export".into(), message: m };
+    let doc = to_gltf_json(scene).map_err(invalid)?;
+    let text = serde_json::to_string_pretty(&doc).map_err(|e| invalid(e.to_string()))?;
+    let io = |e| SceneError::Io { path: path.to_path_buf(), file: path.to_path_buf(), source: e };
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| invalid("the path has no file name".into()))?;
+    let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.write_all(b"\n")?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
+}

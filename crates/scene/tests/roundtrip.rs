@@ -1,0 +1,102 @@
+//! Built-in scenes written as glTF and loaded back must be the same scene: a test of the exporter
+//! and, on larger inputs than the fixtures, of the loader.
+
+use color::Spectrum;
+use scene::{LightKind, Scene, SpectralReflectance, builtin, emission::spectrum_luminance};
+
+fn same_shape(a: &Spectrum, b: &Spectrum) {
+    // The loader rescales spectra to the light's luminance: compare at 10 nm, relative.
+    let (ya, yb) = (spectrum_luminance(a), spectrum_luminance(b));
+    assert!((ya - yb).abs() <= 1e-5 * ya.abs().max(1e-12), "luminance {ya} vs {yb}");
+    for l in (380..=780).step_by(10) {
+        let (x, y) = (a.eval(l as f64), b.eval(l as f64));
+        assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-9), "at {l} nm: {x} vs {y}");
+    }
+}
+
+fn compare(a: &Scene, b: &Scene) {
+    assert_eq!(a.meshes.len(), b.meshes.len());
+    for (m, n) in a.meshes.iter().zip(&b.meshes) {
+        assert_eq!(m.positions, n.positions);
+        assert_eq!(m.uvs, n.uvs);
+        assert_eq!(m.indices, n.indices);
+        assert_eq!(m.material, n.material);
+        for (p, q) in m.normals.iter().zip(&n.normals) {
+            assert!(p.abs_diff_eq(*q, 1e-6));
+        }
+    }
+    assert_eq!(a.materials.len(), b.materials.len());
+    for (m, n) in a.materials.iter().zip(&b.materials) {
+        assert_eq!(m.name, n.name);
+        assert!(m.base_color.abs_diff_eq(n.base_color, 1e-7));
+        assert!(
+            m.emissive.abs_diff_eq(n.emissive, 1e-5 * m.emissive.max_element().max(1.0)),
+            "{} vs {}",
+            m.emissive,
+            n.emissive
+        );
+        assert_eq!((m.metallic, m.roughness), (n.metallic, n.roughness));
+        assert_eq!(m.base_color_texture, n.base_color_texture);
+        match (&m.spectral, &n.spectral) {
+            (Some(SpectralReflectance::Uniform(s)), Some(SpectralReflectance::Uniform(t))) => {
+                assert_eq!(s, t)
+            }
+            (Some(SpectralReflectance::Palette(p)), Some(SpectralReflectance::Palette(q))) => {
+                assert_eq!(p.len(), q.len());
+                for (e, f) in p.iter().zip(q) {
+                    assert_eq!((e.rgb8, &e.spectrum), (f.rgb8, &f.spectrum));
+                }
+            }
+            (None, None) => {}
+            other => panic!("material {}: {other:?}", m.name),
+        }
+        match (&m.emission_spectrum, &n.emission_spectrum) {
+            (Some(s), Some(t)) => same_shape(s, t),
+            (None, None) => {}
+            _ => panic!("emission spectrum lost"),
+        }
+    }
+    assert_eq!(a.textures.len(), b.textures.len());
+    for (t, u) in a.textures.iter().zip(&b.textures) {
+        assert_eq!((t.width, t.height, t.srgb), (u.width, u.height, u.srgb));
+        assert_eq!(t.rgba8, u.rgba8);
+    }
+    assert_eq!(a.lights.len(), b.lights.len());
+    for (l, k) in a.lights.iter().zip(&b.lights) {
+        assert_eq!(l.name, k.name);
+        assert_eq!(l.stands_in_for, k.stands_in_for);
+        same_shape(l.emission.spectrum.as_ref().unwrap(), k.emission.spectrum.as_ref().unwrap());
+        match (&l.kind, &k.kind) {
+            (
+                LightKind::Spot { position: p, direction: d, .. },
+                LightKind::Spot { position: q, direction: e, .. },
+            ) => {
+                assert!(p.abs_diff_eq(*q, 1e-5) && d.abs_diff_eq(*e, 1e-5), "{p} {d} vs {q} {e}");
+            }
+            (LightKind::Directional { direction: d }, LightKind::Directional { direction: e }) => {
+                assert!(d.abs_diff_eq(*e, 1e-5))
+            }
+            (LightKind::Point { position: p, .. }, LightKind::Point { position: q, .. }) => {
+                assert!(p.abs_diff_eq(*q, 1e-5))
+            }
+            other => panic!("light kind changed: {other:?}"),
+        }
+    }
+    assert!(a.camera.transform.abs_diff_eq(b.camera.transform, 1e-5));
+    assert_eq!((a.camera.yfov, a.camera.aspect), (b.camera.yfov, b.camera.aspect));
+    assert_eq!(a.spectral.white, b.spectral.white);
+}
+
+#[test]
+fn builtins_survive_a_gltf_round_trip() {
+    let dir = std::env::temp_dir().join(format!("spectra-scene-roundtrip-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in scene::BUILTIN_NAMES {
+        let a = builtin(name).unwrap();
+        let path = dir.join(format!("{name}.gltf"));
+        scene::write_gltf(&a, &path).unwrap();
+        let b = scene::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        compare(&a, &b);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
