@@ -90,7 +90,7 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
     if let Some(p) = &a.medium {
         let text = std::fs::read_to_string(p).with_context(|| format!("reading medium {}", p.display()))?;
         let m = Medium::from_json(&text, &p.display().to_string())?;
-        m.validate(s.range)?;
+        m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
         s.medium = Some(m);
     }
     s.validate()?;
