@@ -307,11 +307,9 @@ impl Renderer {
         if let Some(t) = timer {
             t.resolve(&mut encoder);
         }
-        let scope = self.gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        self.gpu.queue.submit([encoder.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Gpu(e.to_string()));
-        }
+        crate::shader::checked(&self.gpu.device, "rendering the frame", || {
+            self.gpu.queue.submit([encoder.finish()]);
+        })?;
         if let Some(t) = self.timer.as_mut() {
             t.pending = settings.timestamps;
         }

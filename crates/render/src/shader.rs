@@ -11,23 +11,33 @@ pub(crate) const CUSTOM_API: &str = include_str!("wgsl/custom_api.wgsl");
 /// instead of wgpu's default panic (custom shaders come from users).
 pub(crate) fn compile(device: &wgpu::Device, label: &str, parts: &[&str]) -> Result<wgpu::ShaderModule> {
     let source = parts.join("\n");
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    match pollster::block_on(scope.pop()) {
-        None => Ok(module),
-        Some(e) => Err(RenderError::CustomShader(format!("{label}: {e}"))),
+    checked(device, label, || {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
+    })
+    .map_err(|e| match e {
+        RenderError::Gpu(m) => RenderError::CustomShader(m),
+        other => other,
+    })
+}
+
+/// Runs `f` (pipeline creation) inside validation, internal (shader translation) and
+/// out-of-memory error scopes, so that none of them reaches wgpu's panicking default handler.
+pub(crate) fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
+    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let value = f();
+    let errors = [memory, internal, validation].map(|scope| pollster::block_on(scope.pop()));
+    match errors.into_iter().flatten().next() {
+        None => Ok(value),
+        Some(e) => Err(RenderError::Gpu(format!("{what}: {}", describe(&e)))),
     }
 }
 
-/// Runs `f` (pipeline creation) inside a validation error scope.
-pub(crate) fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T> {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let value = f();
-    match pollster::block_on(scope.pop()) {
-        None => Ok(value),
-        Some(e) => Err(RenderError::Gpu(format!("{what}: {e}"))),
-    }
+/// A wgpu error on one line (its `Display` already lists the causes, over several lines).
+pub(crate) fn describe(e: &wgpu::Error) -> String {
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
