@@ -236,6 +236,7 @@ mod tests {
         );
         for ill in ["F11", "LED-RGB1"] {
             let d = delta_e(&grey, &twin, ill);
+            println!("metamer twins under {ill}: ΔE00 = {d:.2}");
             assert!(d > 10.0, "{ill}: ΔE00 only {d}");
         }
         assert!(
