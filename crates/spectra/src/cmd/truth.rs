@@ -186,6 +186,27 @@ pub fn run(a: Args) -> Result<()> {
 mod tests {
     use super::*;
 
+    fn args(extra: &[&str]) -> Args {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            a: Args,
+        }
+        Cli::parse_from(["truth", "cornell"].iter().chain(extra)).a
+    }
+
+    #[test]
+    fn refuses_bad_requests_before_any_work() {
+        let e = |x: &[&str]| format!("{:#}", run(args(x)).unwrap_err());
+        assert!(e(&[]).contains("nothing to do"));
+        assert!(e(&["--spp", "0", "--out", "x.exr"]).contains("at least 1"));
+        assert!(e(&["--out", "x.bmp"]).contains(".exr"));
+        assert!(e(&["--xyz", "--out", "x.png"]).contains("--xyz"));
+        assert!(e(&["--size", "0x4", "--out", "x.exr"]).contains("positive"));
+        assert!(!std::path::Path::new("x.exr").exists());
+    }
+
     #[test]
     fn sizes() {
         assert_eq!(parse_size("64x32").unwrap(), (64, 32));
