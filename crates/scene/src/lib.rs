@@ -61,10 +61,13 @@ pub struct Scene {
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
+    /// Unit length, one per position; generated (flat) by the loader when a file has none.
     pub normals: Vec<Vec3>,
     /// xyz tangent, w handedness (glTF convention); empty when the mesh has no normal map.
     pub tangents: Vec<Vec4>,
+    /// `TEXCOORD_0`, one per position; empty when the primitive has no texture coordinates.
     pub uvs: Vec<Vec2>,
+    /// Triangle list, counter-clockwise front faces.
     pub indices: Vec<u32>,
     pub material: usize,
 }

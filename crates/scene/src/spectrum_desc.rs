@@ -138,7 +138,8 @@ pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
 
 /// Reads a two-column CSV spectrum; errors carry the line number.
 pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result<Spectrum, SceneError> {
-    let bytes = std::fs::read(file).map_err(|e| ctx.io(file, e))?;
+    let bytes =
+        std::fs::read(file).map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
     let csv_err = |line: u64, message: String| SceneError::Csv {
         path: ctx.path.clone(),
         field: field.to_string(),
@@ -268,6 +269,9 @@ mod tests {
         let e = msg(json!({"csv": "not_increasing.csv"}));
         assert!(e.contains("line 3") && e.contains("increase strictly"), "{e}");
         let e = msg(json!({"csv": "missing.csv"}));
-        assert!(e.contains("missing.csv") && e.contains("cannot read"), "{e}");
+        assert!(
+            e.contains("reflectance.csv") && e.contains("missing.csv") && e.contains("cannot read"),
+            "{e}"
+        );
     }
 }
