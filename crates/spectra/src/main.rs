@@ -20,6 +20,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The paper's claim on one scene: ground truth, rgb, naive and spectral renders, and their errors.
+    Demo(cmd::demo::Args),
     /// Render a scene with the real-time (wgpu) renderer, headless, to PNG or EXR.
     Render(cmd::render::RenderArgs),
     /// Measure a render against a reference: CIEDE2000 and MAE statistics, optional heat map.
@@ -39,6 +41,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
+        Command::Demo(a) => cmd::demo::run(a),
         Command::Render(a) => cmd::render::run(a),
         Command::Diff(a) => cmd::diff::run(a),
         Command::Lut(a) => cmd::lut::run(a),

@@ -1,6 +1,7 @@
 //! Subcommands, one file each.
 
 pub mod bench;
+pub mod demo;
 pub mod diff;
 pub mod lut;
 pub mod render;
