@@ -72,7 +72,7 @@ pub fn run(a: Args) -> Result<()> {
     let reference = read_image(&truth)?;
     let mut rows = Vec::new();
     for mode in modes {
-        let test = read_image(&file(&format!("{mode}.exr")))?;
+        let test = read_image(file(&format!("{mode}.exr")))?;
         let maps = DiffMaps::compute(&reference, &test, DiffOptions::default())?;
         let heat = file(&format!("{mode}-error.png"));
         Heatmap::of_delta_e(&maps, &HeatmapOptions { max: Some(10.0), ..Default::default() })?
