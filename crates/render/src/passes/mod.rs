@@ -10,6 +10,7 @@ pub mod gbuffer;
 pub mod post;
 pub mod shading;
 pub mod shadow;
+pub mod underwater;
 
 /// HDR colour targets (shading output, custom output).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
