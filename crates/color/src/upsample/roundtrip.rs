@@ -58,7 +58,7 @@ pub fn summarise(colours: &[[f64; 3]], de: &[f64]) -> Result<RoundTrip> {
 /// Round trip through `table` exactly as a renderer uses it: trilinear fetch, then evaluate.
 pub fn roundtrip_table(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u64) -> Result<RoundTrip> {
     if n == 0 {
-        return Err(ColorError::NoSamples);
+        return Err(ColorError::Table("a round trip needs at least one colour (got 0)".into()));
     }
     let model = LabModel::new(space)?;
     let colours = random_colours(n, seed);
@@ -75,7 +75,7 @@ pub fn roundtrip_upsampler(
     seed: u64,
 ) -> Result<RoundTrip> {
     if n == 0 {
-        return Err(ColorError::NoSamples);
+        return Err(ColorError::Table("a round trip needs at least one colour (got 0)".into()));
     }
     let model = LabModel::new(space)?;
     let colours = random_colours(n, seed);

@@ -262,6 +262,12 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| {
         table_err(&origin, format!("cannot create a temporary file in {}: {e}", dir.display()))
     })?;
+    // Temporary files are created owner-only; a table is ordinary data, readable by all.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
     tmp.write_all(bytes)
         .and_then(|_| tmp.as_file().sync_all())
         .map_err(|e| table_err(&origin, format!("cannot write: {e}")))?;

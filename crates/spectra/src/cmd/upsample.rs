@@ -36,6 +36,22 @@ pub struct Args {
     /// Measure evaluation throughput (scalar f64, f32 arrays, f32x4, f32x8).
     #[arg(long)]
     pub bench: bool,
+    /// Wavelength range of the printed spectrum, MIN:MAX in nm (within 360–830).
+    #[arg(long, default_value = "360:830")]
+    pub range: String,
+    /// Print the spectrum at this many equally spaced wavelengths (bin midpoints) instead of
+    /// every 5 nm.
+    #[arg(long)]
+    pub samples: Option<usize>,
+}
+
+/// Writes to stdout; a closed pipe (`| head`) ends the output quietly instead of panicking.
+fn emit(text: &str) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => r.context("writing to stdout"),
+    }
 }
 
 fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
@@ -59,6 +75,9 @@ pub fn run(a: Args) -> Result<()> {
         return bench(&a, &space);
     }
     if let Some(n) = a.roundtrip {
+        if n == 0 {
+            bail!("--roundtrip needs at least one colour");
+        }
         if !a.rgb.is_empty() {
             bail!("--roundtrip measures random colours; do not also give R G B");
         }
@@ -96,39 +115,47 @@ pub fn run(a: Args) -> Result<()> {
     let s = up.reflectance(rgb)?;
     let model = LabModel::new(&space)?;
     let (back, de) = roundtrip::round_trip_rgb(&model, rgb, |l| s.eval(l));
-    let lambda: Vec<f64> = (0..=94).map(|i| 360.0 + 5.0 * i as f64).collect();
+    let range = color::WavelengthRange::parse(&a.range).context("--range")?;
+    let lambda: Vec<f64> = match a.samples {
+        Some(n) => color::SampledWavelengths::midpoint(range, n).context("--samples")?.lambda,
+        None => {
+            let steps = (range.width() / 5.0).floor() as usize;
+            (0..=steps).map(|i| range.min + 5.0 * i as f64).collect()
+        }
+    };
     let values: Vec<f64> = lambda.iter().map(|&l| s.eval(l)).collect();
     if a.json {
-        println!(
-            "{}",
-            json!({
-                "space": space.name, "method": up.method().name(), "rgb": rgb, "spectrum": s,
-                "lambda_nm": lambda, "reflectance": values, "roundtrip_rgb": back, "delta_e2000": de,
-            })
-        );
-        return Ok(());
+        let j = json!({
+            "space": space.name, "method": up.method().name(), "rgb": rgb, "spectrum": s,
+            "lambda_nm": lambda, "reflectance": values, "roundtrip_rgb": back, "delta_e2000": de,
+        });
+        return emit(&format!("{j}\n"));
     }
-    println!("{} RGB ({r}, {g}, {b}) → {} spectrum", space.name, up.method());
+    use std::fmt::Write;
+    let mut o = String::new();
+    writeln!(o, "{} RGB ({r}, {g}, {b}) → {} spectrum", space.name, up.method())?;
     match s {
         Reflectance::Jakob(p) => {
-            println!("coefficients (λ in nm): c0 = {:e}  c1 = {:e}  c2 = {:e}", p.c[0], p.c[1], p.c[2])
+            writeln!(o, "coefficients (λ in nm): c0 = {:e}  c1 = {:e}  c2 = {:e}", p.c[0], p.c[1], p.c[2])?
         }
-        Reflectance::Smits(sm) => println!("bins (380–720 nm): {:?}", sm.bins),
-        Reflectance::Box(_) => println!(
+        Reflectance::Smits(sm) => writeln!(o, "bins (380–720 nm): {:?}", sm.bins)?,
+        Reflectance::Box(_) => writeln!(
+            o,
             "bands: blue < {} nm ≤ green < {} nm ≤ red",
             upsample::boxes::BOX_BLUE_GREEN_NM,
             upsample::boxes::BOX_GREEN_RED_NM
-        ),
+        )?,
     }
-    println!("  λ nm   reflectance");
+    writeln!(o, "  λ nm     reflectance")?;
     for (l, v) in lambda.iter().zip(&values) {
-        println!("  {l:5.0}  {v:.6}");
+        writeln!(o, "  {l:7.2}  {v:.6}")?;
     }
-    println!(
+    writeln!(
+        o,
         "round trip (CIE 1931 2°, 1 nm, {}): RGB ({:.6}, {:.6}, {:.6}), ΔE2000 {de:.5}",
         space.illuminant_name, back[0], back[1], back[2]
-    );
-    Ok(())
+    )?;
+    emit(&o)
 }
 
 /// Spectral samples per second for one coefficient set, per evaluation path.
