@@ -8,6 +8,7 @@ mod colorchecker;
 mod cornell;
 mod metamerism;
 pub(crate) mod shapes;
+mod underwater;
 
 use color::{Observer, SpectralIntegrator, Spectrum, WavelengthRange};
 use glam::{DVec3, Vec3, Vec4};
@@ -17,7 +18,7 @@ use crate::error::SceneError;
 use crate::{Emission, Material, Scene, SpectralReflectance, SpectralSettings, srgb};
 
 /// Names accepted by [`builtin`].
-pub const BUILTIN_NAMES: &[&str] = &["cornell", "colorchecker", "metamerism"];
+pub const BUILTIN_NAMES: &[&str] = &["cornell", "colorchecker", "metamerism", "underwater"];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
@@ -26,6 +27,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "cornell" => cornell::build(&ctx),
         "colorchecker" => colorchecker::build(&ctx),
         "metamerism" => metamerism::build(&ctx),
+        "underwater" => underwater::build(&ctx),
         _ => {
             return Err(SceneError::UnknownBuiltin {
                 name: name.to_string(),
