@@ -41,9 +41,57 @@ pub struct RenderArgs {
     /// machine and cached (see `spectra lut`, $SPECTRA_CACHE_DIR).
     #[arg(long)]
     pub table: Option<PathBuf>,
+    /// Render under water: a Jerlov type (I, IA, IB, II, III, 1C … 9C, or a blend such as
+    /// II.5). Default: the scene's own water settings, if it has any.
+    #[arg(long, value_name = "TYPE")]
+    pub water: Option<String>,
+    /// Camera depth below the water surface, metres (default: the scene's, else 10).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub depth: Option<f64>,
     /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// Camera depth used when `--water` is given for a scene without water settings.
+pub const DEFAULT_WATER_DEPTH: f64 = 10.0;
+
+/// The water the camera is in: the scene's `WaterSettings` with `--water`/`--depth` applied on
+/// top, or `None` when neither the scene nor the flags ask for water. Unknown types, negative
+/// or non-finite depths and `--depth` without any water are clear errors.
+pub fn water_medium(
+    scene: &scene::Scene,
+    water: Option<&str>,
+    depth: Option<f64>,
+) -> Result<Option<scene::water::WaterMedium>> {
+    let mut settings = scene.water.clone();
+    if let Some(ty) = water {
+        let base = settings.unwrap_or(scene::WaterSettings {
+            water_type: String::new(),
+            depth: DEFAULT_WATER_DEPTH as f32,
+            sun_direction: glam::Vec3::Y,
+            scale: 1.0,
+        });
+        settings = Some(scene::WaterSettings { water_type: ty.to_string(), ..base });
+    }
+    let Some(mut settings) = settings else {
+        if let Some(d) = depth {
+            bail!("--depth {d}: scene {} has no water; add --water TYPE (e.g. --water II)", scene.source);
+        }
+        return Ok(None);
+    };
+    if let Some(d) = depth {
+        if !(d.is_finite() && d >= 0.0) {
+            bail!("--depth {d}: the camera depth must be a finite number of metres ≥ 0 below the surface");
+        }
+        settings.depth = d as f32;
+    }
+    // The message already includes its cause; anyhow's chain would print it twice.
+    let medium = scene::water::WaterMedium::from_settings(&settings).map_err(|e| match water {
+        Some(w) => anyhow!("--water '{w}': {e}"),
+        None => anyhow!("scene {}: water settings: {e}", scene.source),
+    })?;
+    Ok(Some(medium))
 }
 
 /// Parses `640x480` (also `640X480`, `640*480`).
@@ -120,9 +168,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (width, height) = parse_size(&args.size)?;
     let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
     let settings = settings(&args, &scene)?;
+    let water = water_medium(&scene, args.water.as_deref(), args.depth)?;
     let table = load_table(args.table.as_deref())?;
     let mut r = Renderer::with_table(table)?;
     r.set_scene(&scene)?;
+    if let Some(m) = &water {
+        r.set_custom_shader(render::passes::underwater::shader(m))?;
+    }
     r.resize(width, height)?;
     r.render(&scene.camera, &settings)?;
     match format {
@@ -143,8 +195,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
     }
+    let under = water.as_ref().map_or(String::new(), |m| {
+        let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());
+        format!(", under water {ty} at {} m", m.depth)
+    });
     eprintln!(
-        "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm, on {}",
+        "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
         args.out.display(),
         scene.source,
         width,
@@ -171,5 +227,22 @@ mod tests {
         assert_eq!(out_format(Path::new("a.exr")).unwrap(), OutFormat::Exr);
         let e = out_format(Path::new("a.jpg")).unwrap_err().to_string();
         assert!(e.contains(".jpg") && e.contains(".png"), "{e}");
+    }
+
+    #[test]
+    fn water_flags_override_the_scene_and_reject_bad_input() {
+        let dry = scene::builtin("colorchecker").unwrap();
+        assert!(water_medium(&dry, None, None).unwrap().is_none());
+        let m = water_medium(&dry, Some("3C"), None).unwrap().unwrap();
+        assert_eq!((m.water_type.unwrap().to_string(), m.depth), ("3C".to_string(), DEFAULT_WATER_DEPTH));
+        let e = format!("{:#}", water_medium(&dry, None, Some(5.0)).unwrap_err());
+        assert!(e.contains("--water"), "{e}");
+        let e = format!("{:#}", water_medium(&dry, Some("XIV"), None).unwrap_err());
+        assert!(e.contains("XIV"), "{e}");
+        let e = format!("{:#}", water_medium(&dry, Some("II"), Some(-2.0)).unwrap_err());
+        assert!(e.contains("-2") && e.contains("depth"), "{e}");
+        let wet = scene::builtin("underwater").unwrap();
+        let m = water_medium(&wet, None, Some(20.0)).unwrap().unwrap();
+        assert_eq!((m.water_type.unwrap().to_string(), m.depth), ("IB".to_string(), 20.0));
     }
 }
