@@ -27,6 +27,7 @@ pub mod sampling;
 pub mod spectral;
 pub mod texture;
 pub mod upsample;
+pub mod water;
 pub mod world;
 
 #[cfg(test)]

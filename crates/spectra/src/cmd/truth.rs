@@ -41,6 +41,14 @@ pub struct Args {
     /// A homogeneous participating medium, as JSON (see `truth::medium_file`).
     #[arg(long)]
     pub medium: Option<PathBuf>,
+    /// Render under water: a Jerlov type (I … III, 1C … 9C, blends like II.5); default: the
+    /// scene's water settings, if any. The water becomes a participating medium with a
+    /// forward-peaked phase function (see `truth::water`).
+    #[arg(long, value_name = "TYPE")]
+    pub water: Option<String>,
+    /// Camera depth below the water surface, metres (default: the scene's, else 10).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub depth: Option<f64>,
     /// Lambertian BRDF instead of glTF's (only for comparisons with Mitsuba's `diffuse`).
     #[arg(long)]
     pub lambert: bool,
@@ -92,6 +100,12 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
         let m = Medium::from_json(&text, &p.display().to_string())?;
         m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
         s.medium = Some(m);
+    }
+    if let Some(w) = super::render::water_medium(scene, a.water.as_deref(), a.depth)? {
+        if a.medium.is_some() {
+            bail!("--medium and water (from --water or the scene) cannot be combined: pick one medium");
+        }
+        s.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
     s.validate()?;
     Ok(s)
