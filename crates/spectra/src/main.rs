@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own file under `cmd/`.
 
 mod cmd;
+mod eval;
 mod view;
 
 use clap::{Parser, Subcommand};
@@ -36,6 +37,8 @@ enum Command {
     View(cmd::view::Args),
     /// Frame time of RGB vs spectral rendering at N = 1…64 (median, p10/p90, cost per wavelength).
     Bench(cmd::bench::Args),
+    /// The paper's evaluation: truth vs ours/naive/RGB on a suite, frame time vs N, HTML report.
+    Eval(cmd::eval::Args),
 }
 
 fn main() {
@@ -49,6 +52,7 @@ fn main() {
         Command::Truth(a) => cmd::truth::run(a),
         Command::View(a) => cmd::view::run(a),
         Command::Bench(a) => cmd::bench::run(a),
+        Command::Eval(a) => cmd::eval::run(a),
     };
     if let Err(e) = result {
         // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod demo;
 pub mod diff;
+pub mod eval;
 pub mod lut;
 pub mod render;
 pub mod truth;

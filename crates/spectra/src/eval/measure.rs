@@ -1,0 +1,211 @@
+//! The measurements: ground truth (twice, for the noise floor), the three real-time modes,
+//! their errors against truth (whole image and with an edge mask), frame time against N, and
+//! jittered accumulation against equal spacing.
+
+use anyhow::{Context, Result, bail};
+use color::metrics::Stats;
+use color::{RgbColorSpace, WavelengthRange};
+use compare::{DiffMaps, DiffOptions, Image};
+use render::{Mode, RenderSettings, Renderer};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Error statistics of one image against ground truth.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Errors {
+    pub delta_e2000: Stats,
+    pub mae_linear: Stats,
+    /// ΔE2000 over the pixels outside the edge mask only.
+    pub delta_e2000_masked: Stats,
+    pub mae_linear_masked: Stats,
+}
+
+impl Errors {
+    pub fn of(maps: &DiffMaps, mask: &[bool]) -> Result<Errors> {
+        let keep =
+            |v: &[f64]| -> Vec<f64> { v.iter().zip(mask).filter(|(_, m)| !**m).map(|(x, _)| *x).collect() };
+        let st = |v: &[f64]| Stats::of(v).context("no pixels left to measure (mask covers the whole image)");
+        Ok(Errors {
+            delta_e2000: st(&maps.delta_e2000)?,
+            mae_linear: st(&maps.abs_linear)?,
+            delta_e2000_masked: st(&keep(&maps.delta_e2000))?,
+            mae_linear_masked: st(&keep(&maps.abs_linear))?,
+        })
+    }
+}
+
+/// What a ground-truth render needs besides the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct TruthJob {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub seed: u64,
+    pub range: WavelengthRange,
+}
+
+/// Ground truth of a scene: direct lighting only, linear sRGB.
+pub fn truth(
+    scene: &scene::Scene,
+    table: &color::upsample::CoeffTable,
+    job: TruthJob,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Image> {
+    let (width, height) = (job.width, job.height);
+    let mut st = truth::Settings::new(width, height, job.spp)?;
+    st.seed = job.seed;
+    st.direct_only = true;
+    st.range = job.range;
+    if let Some(w) = &scene.spectral.white {
+        st.white = color::illuminant::by_name(w)?;
+    }
+    let world = truth::World::new(scene, table, &st.white, st.range, None)?;
+    let img = match truth::render_world(&world, &st, cancel, progress) {
+        Err(truth::TruthError::Cancelled) => bail!("interrupted"),
+        r => r?,
+    };
+    if cancel.load(Ordering::Relaxed) {
+        bail!("interrupted");
+    }
+    Ok(Image::new(width, height, img.to_rgb(&RgbColorSpace::srgb()))?)
+}
+
+/// The real-time renderer's linear HDR image of the scene's camera.
+pub fn realtime(r: &mut Renderer, scene: &scene::Scene, settings: &RenderSettings) -> Result<Image> {
+    r.render(&scene.camera, settings)?;
+    let (w, h) = r.size().context("renderer has no size")?;
+    let data = r.read_hdr()?.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    Ok(Image::new(w, h, data)?)
+}
+
+/// Settings for a mode at N over `range`, everything else default (no tone map, shadows on).
+pub fn settings(mode: Mode, n: usize, range: WavelengthRange) -> RenderSettings {
+    RenderSettings { mode, wavelengths: n, range, ..RenderSettings::default() }
+}
+
+/// Pixels near an edge of the ground-truth image: the 3×3 neighbourhood's luminance varies by
+/// more than [`EDGE_CONTRAST`] of its maximum. Depends on truth only, so it removes the same
+/// pixels from every mode (shadow-map and silhouette mismatches, but also texture edges).
+pub fn edge_mask(truth: &Image) -> Vec<bool> {
+    let (w, h) = (truth.width as i64, truth.height as i64);
+    let y: Vec<f32> = truth.data.iter().map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect();
+    let mut mask = vec![false; y.len()];
+    for py in 0..h {
+        for px in 0..w {
+            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (x, yy) = ((px + dx).clamp(0, w - 1), (py + dy).clamp(0, h - 1));
+                    let v = y[(yy * w + x) as usize];
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+            mask[(py * w + px) as usize] = hi - lo > EDGE_CONTRAST * hi.max(0.02);
+        }
+    }
+    mask
+}
+
+/// Relative 3×3 luminance variation above which a pixel is masked.
+pub const EDGE_CONTRAST: f32 = 0.25;
+
+/// Median CPU wall time (ms) of `frames` frames: submit, then wait for the HDR read-back.
+/// Includes the read-back, which is the same for every mode.
+pub fn frame_ms(r: &mut Renderer, scene: &scene::Scene, s: &RenderSettings, frames: usize) -> Result<f64> {
+    for _ in 0..2 {
+        realtime(r, scene, s)?;
+    }
+    let mut t = Vec::with_capacity(frames);
+    for _ in 0..frames {
+        let t0 = Instant::now();
+        r.render(&scene.camera, s)?;
+        r.read_hdr()?;
+        t.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    t.sort_by(f64::total_cmp);
+    Ok(t[t.len() / 2])
+}
+
+/// SplitMix64: a tiny deterministic generator for the jitter offsets (reproducible runs).
+pub struct SplitMix(pub u64);
+
+impl SplitMix {
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Stratified jittered offsets for `frames` frames: frame k's offset lies in [k/K, (k+1)/K).
+pub fn jitter_offsets(frames: usize, seed: u64) -> Vec<f64> {
+    let mut g = SplitMix(seed);
+    (0..frames).map(|k| (k as f64 + g.next_f64()) / frames as f64).collect()
+}
+
+/// The render range that puts N midpoint samples at `range.min + (i + u)·Δ`, Δ = width/N:
+/// the same width shifted by `(u − ½)·Δ`. All samples stay inside `range`; only the range the
+/// renderer is told about moves (it must stay within the observer's 360–830 nm).
+pub fn jittered_range(range: WavelengthRange, n: usize, u: f64) -> Result<WavelengthRange> {
+    let d = (range.max - range.min) / n as f64;
+    let s = (u - 0.5) * d;
+    WavelengthRange::new(range.min + s, range.max + s)
+        .with_context(|| format!("jittered range for N={n}, offset {u:.3} leaves 360–830 nm"))
+}
+
+/// Average of `frames` frames with N wavelengths each at stratified jittered offsets.
+pub fn accumulate(
+    r: &mut Renderer,
+    scene: &scene::Scene,
+    n: usize,
+    range: WavelengthRange,
+    frames: usize,
+    seed: u64,
+) -> Result<Image> {
+    let mut sum: Option<Image> = None;
+    for u in jitter_offsets(frames, seed) {
+        let img = realtime(r, scene, &settings(Mode::Spectral, n, jittered_range(range, n, u)?))?;
+        match &mut sum {
+            None => sum = Some(img),
+            Some(s) => s.data.iter_mut().zip(&img.data).for_each(|(a, b)| (0..3).for_each(|k| a[k] += b[k])),
+        }
+    }
+    let mut s = sum.context("no frames")?;
+    let k = 1.0 / frames as f32;
+    s.data.iter_mut().for_each(|p| p.iter_mut().for_each(|c| *c *= k));
+    Ok(s)
+}
+
+/// ΔE2000/MAE maps of `test` against `reference` (CIELAB white Y = 1).
+pub fn diff(reference: &Image, test: &Image) -> Result<DiffMaps> {
+    Ok(DiffMaps::compute(reference, test, DiffOptions::default())?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_is_stratified_and_samples_stay_inside() {
+        let u = jitter_offsets(8, 3);
+        for (k, v) in u.iter().enumerate() {
+            assert!(*v >= k as f64 / 8.0 && *v < (k + 1) as f64 / 8.0);
+        }
+        let r = WavelengthRange::new(400.0, 730.0).unwrap();
+        let j = jittered_range(r, 6, 0.0).unwrap();
+        // First sample at j.min + Δ/2 = r.min exactly.
+        assert!((j.min + 55.0 / 2.0 - 400.0).abs() < 1e-9);
+        assert!(jittered_range(WavelengthRange::VISIBLE, 2, 0.0).is_err());
+    }
+
+    #[test]
+    fn edge_mask_marks_a_step_only() {
+        let img = Image::from_fn(8, 4, |x, _| if x < 4 { [0.1; 3] } else { [0.9; 3] }).unwrap();
+        let m = edge_mask(&img);
+        assert!(m[3] && m[4] && !m[0] && !m[7]);
+    }
+}

@@ -1,0 +1,302 @@
+//! `spectra eval`: the paper's evaluation in one command.
+//!
+//! For every case of the suite ([`suite`]): a direct-lighting ground truth from the CPU path
+//! tracer (twice, with different seeds, so the report states its own noise floor), the three
+//! real-time modes (`spectral` = ours, `naive`, `rgb`) at the same size and camera, and their
+//! ΔE2000 / MAE against truth, over the whole image and outside an edge mask. Then frame time
+//! against N (paper Fig. 4) and, beyond the paper, stratified jittered wavelengths accumulated
+//! over frames against equal spacing. Everything lands in `--out`: PNGs, heat maps,
+//! `results.json`, `results.csv`, SVG charts and `index.html` ([`report`]).
+
+pub mod measure;
+pub mod plot;
+pub mod report;
+pub mod suite;
+
+use anyhow::{Context, Result};
+use color::WavelengthRange;
+use compare::{Heatmap, HeatmapOptions, Image, WriteOptions};
+use indicatif::{ProgressBar, ProgressStyle};
+use measure::Errors;
+use render::{Mode, Renderer};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// The three real-time modes, in report order, with their report names.
+pub const MODES: &[(Mode, &str)] = &[(Mode::Spectral, "ours"), (Mode::Naive, "naive"), (Mode::Rgb, "rgb")];
+
+/// What a run needs.
+pub struct Config {
+    pub out: PathBuf,
+    pub quick: bool,
+    pub budget: suite::Budget,
+    pub ids: Vec<String>,
+    pub notes: Vec<String>,
+    pub table: Option<PathBuf>,
+}
+
+/// One mode's result in one case.
+#[derive(serde::Serialize)]
+pub struct ModeResult {
+    pub mode: String,
+    pub wavelengths: Option<usize>,
+    pub image: String,
+    pub heatmap: String,
+    pub errors: Errors,
+}
+
+/// One case's results.
+#[derive(serde::Serialize)]
+pub struct CaseResult {
+    pub id: String,
+    pub title: String,
+    pub truth_image: String,
+    /// ΔE2000/MAE between two truth renders with different seeds: differences below this are noise.
+    pub noise_floor: Errors,
+    pub masked_fraction: f64,
+    pub modes: Vec<ModeResult>,
+}
+
+#[derive(serde::Serialize)]
+pub struct FrameTime {
+    pub mode: String,
+    pub wavelengths: Option<usize>,
+    pub median_ms: f64,
+}
+
+#[derive(serde::Serialize)]
+pub struct JitterPoint {
+    /// Wavelengths per pixel summed over the accumulated frames.
+    pub total_wavelengths: usize,
+    pub frames: usize,
+    pub equal_spacing_delta_e: f64,
+    pub jittered_delta_e: f64,
+}
+
+#[derive(serde::Serialize)]
+pub struct Results {
+    pub quick: bool,
+    pub budget: suite::Budget,
+    pub adapter: String,
+    pub machine: String,
+    pub seconds: f64,
+    pub notes: Vec<String>,
+    pub edge_contrast: f32,
+    pub cases: Vec<CaseResult>,
+    pub frame_time_scene: String,
+    pub frame_times: Vec<FrameTime>,
+    pub jitter_scene: String,
+    pub jitter_range: [f64; 2],
+    pub jitter: Vec<JitterPoint>,
+}
+
+fn bar(len: u64, what: &str) -> ProgressBar {
+    let pb = ProgressBar::new(len);
+    if let Ok(st) = ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {msg} ({elapsed})") {
+        pb.set_style(st.progress_chars("=> "));
+    }
+    pb.set_prefix(what.to_string());
+    pb
+}
+
+/// Runs the suite into `cfg.out` (a new or empty-able directory). Ctrl-C stops it with an
+/// error; files already finished stay, `results.json` and `index.html` are written last, so a
+/// directory without them is an interrupted run.
+pub fn run(cfg: Config) -> Result<Results> {
+    let t_start = Instant::now();
+    std::fs::create_dir_all(&cfg.out).with_context(|| format!("creating {}", cfg.out.display()))?;
+    for stale in ["results.json", "index.html", "results.csv"] {
+        let p = cfg.out.join(stale);
+        if p.exists() {
+            std::fs::remove_file(&p).with_context(|| format!("removing stale {}", p.display()))?;
+        }
+    }
+    let table = crate::cmd::render::load_table(cfg.table.as_deref())?;
+    let cancel = color::upsample::interrupt_flag();
+    let check = || -> Result<()> {
+        if cancel.load(Ordering::Relaxed) {
+            anyhow::bail!("interrupted; results.json and index.html not written");
+        }
+        Ok(())
+    };
+    let mut r = Renderer::with_table(table.clone())?;
+    let adapter = r.gpu().describe();
+    let b = &cfg.budget;
+    let job = |seed: u64, range: WavelengthRange| measure::TruthJob {
+        width: b.width,
+        height: b.height,
+        spp: b.truth_spp,
+        seed,
+        range,
+    };
+    let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| suite::case(id)).collect::<Result<_>>()?;
+
+    let mut results = Vec::new();
+    for c in &cases {
+        check()?;
+        let range = scene_range(&c.scene)?;
+        let n = c.scene.spectral.wavelengths.map(|n| n as usize).unwrap_or(16);
+        let pb = bar(2 * b.height as u64, &c.id);
+        pb.set_message("ground truth");
+        let pbr = &pb;
+        let rows = |base: u64| move |k: u64| pbr.set_position(base + k);
+        let t0 = measure::truth(&c.scene, &table, job(1, range), cancel, &rows(0))?;
+        let t1 = measure::truth(&c.scene, &table, job(2, range), cancel, &rows(b.height as u64))?;
+        pb.finish_and_clear();
+        check()?;
+        let mask = measure::edge_mask(&t0);
+        let noise = Errors::of(&measure::diff(&t0, &t1)?, &mask)?;
+        let truth_png = format!("{}_truth.png", c.id);
+        save_png(&cfg.out.join(&truth_png), &t0)?;
+        write_exr(&cfg.out.join(format!("{}_truth.exr", c.id)), &t0)?;
+
+        r.set_scene(&c.scene)?;
+        r.resize(b.width, b.height)?;
+        let mut maps = Vec::new();
+        for (mode, name) in MODES {
+            let img = measure::realtime(&mut r, &c.scene, &measure::settings(*mode, n, range))?;
+            let png = format!("{}_{}.png", c.id, name);
+            save_png(&cfg.out.join(&png), &img)?;
+            maps.push((*mode, *name, png, measure::diff(&t0, &img)?));
+        }
+        // One heat-map scale per case so the three modes are comparable at a glance.
+        let scale = compare::heatmap::nice_ceil(
+            maps.iter().map(|m| m.3.summary().delta_e2000.p99).fold(1.0, f64::max),
+        );
+        let mut modes = Vec::new();
+        for (mode, name, png, m) in maps {
+            let hm = format!("{}_{}_heat.png", c.id, name);
+            Heatmap::of_delta_e(&m, &HeatmapOptions { max: Some(scale), ..Default::default() })?
+                .save_png(cfg.out.join(&hm))?;
+            modes.push(ModeResult {
+                mode: name.into(),
+                wavelengths: (mode != Mode::Rgb).then_some(n),
+                image: png,
+                heatmap: hm,
+                errors: Errors::of(&m, &mask)?,
+            });
+        }
+        eprintln!(
+            "{:<18} ΔE00 mean: ours {:.3}  naive {:.3}  rgb {:.3}  (truth noise {:.3})",
+            c.id,
+            modes[0].errors.delta_e2000.mean,
+            modes[1].errors.delta_e2000.mean,
+            modes[2].errors.delta_e2000.mean,
+            noise.delta_e2000.mean
+        );
+        results.push(CaseResult {
+            id: c.id.clone(),
+            title: c.title.clone(),
+            truth_image: truth_png,
+            noise_floor: noise,
+            masked_fraction: mask.iter().filter(|m| **m).count() as f64 / mask.len() as f64,
+            modes,
+        });
+    }
+
+    // Frame time against N on the first case's scene.
+    let ft_case = cases.first().context("no scenes to evaluate")?;
+    let range = scene_range(&ft_case.scene)?;
+    r.set_scene(&ft_case.scene)?;
+    r.resize(b.bench_width, b.bench_height)?;
+    let pb = bar(1 + 2 * b.bench_counts.len() as u64, "frame time");
+    let mut frame_times = Vec::new();
+    let ms =
+        measure::frame_ms(&mut r, &ft_case.scene, &measure::settings(Mode::Rgb, 1, range), b.bench_frames)?;
+    frame_times.push(FrameTime { mode: "rgb".into(), wavelengths: None, median_ms: ms });
+    pb.inc(1);
+    for &n in &b.bench_counts {
+        for (mode, name) in &MODES[..2] {
+            check()?;
+            let ms = measure::frame_ms(
+                &mut r,
+                &ft_case.scene,
+                &measure::settings(*mode, n, range),
+                b.bench_frames,
+            )?;
+            frame_times.push(FrameTime { mode: (*name).into(), wavelengths: Some(n), median_ms: ms });
+            pb.inc(1);
+        }
+    }
+    pb.finish_and_clear();
+
+    // Jittered accumulation vs equal spacing, on the first case's scene, over a range whose
+    // jittered shifts stay inside the observer's 360–830 nm.
+    let jrange = WavelengthRange::new(400.0, 730.0)?;
+    let pb = bar(2 * b.height as u64, "jitter truth");
+    let jt = measure::truth(&ft_case.scene, &table, job(3, jrange), cancel, &|k| pb.set_position(k))?;
+    pb.finish_and_clear();
+    check()?;
+    r.resize(b.width, b.height)?;
+    let mut jitter = Vec::new();
+    for &k in &b.jitter_frames {
+        check()?;
+        let total = k * b.jitter_per_frame;
+        let eq =
+            measure::realtime(&mut r, &ft_case.scene, &measure::settings(Mode::Spectral, total, jrange))?;
+        let acc = measure::accumulate(&mut r, &ft_case.scene, b.jitter_per_frame, jrange, k, 17)?;
+        jitter.push(JitterPoint {
+            total_wavelengths: total,
+            frames: k,
+            equal_spacing_delta_e: measure::diff(&jt, &eq)?.summary().delta_e2000.mean,
+            jittered_delta_e: measure::diff(&jt, &acc)?.summary().delta_e2000.mean,
+        });
+    }
+
+    let res = Results {
+        quick: cfg.quick,
+        budget: cfg.budget.clone(),
+        adapter,
+        machine: machine(),
+        seconds: t_start.elapsed().as_secs_f64(),
+        notes: cfg.notes.clone(),
+        edge_contrast: measure::EDGE_CONTRAST,
+        cases: results,
+        frame_time_scene: ft_case.id.clone(),
+        frame_times,
+        jitter_scene: ft_case.id.clone(),
+        jitter_range: [jrange.min, jrange.max],
+        jitter,
+    };
+    check()?;
+    report::write_all(&cfg.out, &res)?;
+    Ok(res)
+}
+
+fn scene_range(s: &scene::Scene) -> Result<WavelengthRange> {
+    Ok(match s.spectral.range {
+        Some((a, b)) => WavelengthRange::new(a as f64, b as f64)?,
+        None => WavelengthRange::VISIBLE,
+    })
+}
+
+fn save_png(path: &Path, img: &Image) -> Result<()> {
+    compare::io::write_image(path, img, WriteOptions::default())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn write_exr(path: &Path, img: &Image) -> Result<()> {
+    save_png(path, img)
+}
+
+/// CPU model, core count and memory, from /proc where available.
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0);
+    let mem = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|s| {
+            s.lines().next().and_then(|l| l.split_whitespace().nth(1)).and_then(|k| k.parse::<f64>().ok())
+        })
+        .map(|kb| format!(", {:.0} GiB RAM", kb / 1048576.0))
+        .unwrap_or_default();
+    format!("{cpu}, {cores} threads{mem}, {} {}", std::env::consts::OS, std::env::consts::ARCH)
+}

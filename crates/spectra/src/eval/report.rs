@@ -1,0 +1,304 @@
+//! The report files: `results.json` (every number), `results.csv` (one row per case × mode,
+//! plus frame-time and jitter rows), SVG charts and `index.html`. Each is written atomically.
+
+use super::{MODES, Results};
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
+use std::path::Path;
+
+fn put(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
+    let p = dir.join(name);
+    compare::atomic::write_atomic(&p, bytes).with_context(|| format!("writing {}", p.display()))
+}
+
+/// Writes everything; `index.html` last.
+pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
+    put(dir, "results.csv", csv(r).as_bytes())?;
+    let ids: Vec<String> = r.cases.iter().map(|c| c.id.clone()).collect();
+    let mean = |f: &dyn Fn(&super::ModeResult) -> f64| -> Vec<(&str, Vec<f64>)> {
+        MODES
+            .iter()
+            .enumerate()
+            .map(|(i, (_, name))| (*name, r.cases.iter().map(|c| f(&c.modes[i])).collect()))
+            .collect()
+    };
+    let mut de = mean(&|m| m.errors.delta_e2000.mean);
+    de.push(("truth noise", r.cases.iter().map(|c| c.noise_floor.delta_e2000.mean).collect()));
+    put(
+        dir,
+        "delta_e.svg",
+        super::plot::bars("Mean ΔE2000 against ground truth (lower is better)", "mean ΔE2000", &ids, &de)?
+            .as_bytes(),
+    )?;
+    let mut dem = mean(&|m| m.errors.delta_e2000_masked.mean);
+    dem.push(("truth noise", r.cases.iter().map(|c| c.noise_floor.delta_e2000_masked.mean).collect()));
+    put(
+        dir,
+        "delta_e_masked.svg",
+        super::plot::bars("Mean ΔE2000 outside the edge mask", "mean ΔE2000", &ids, &dem)?.as_bytes(),
+    )?;
+    let mae = mean(&|m| m.errors.mae_linear.mean);
+    put(
+        dir,
+        "mae.svg",
+        super::plot::bars("Mean absolute error, linear sRGB", "MAE", &ids, &mae)?.as_bytes(),
+    )?;
+    let rgb = r.frame_times.iter().find(|f| f.mode == "rgb").map(|f| f.median_ms).unwrap_or(0.0);
+    let nmax = r.frame_times.iter().filter_map(|f| f.wavelengths).max().unwrap_or(1) as f64;
+    let ft_series: Vec<(&str, Vec<(f64, f64)>)> = vec![
+        (
+            "ours (spectral)",
+            r.frame_times
+                .iter()
+                .filter(|f| f.mode == "ours")
+                .map(|f| (f.wavelengths.unwrap_or(1) as f64, f.median_ms))
+                .collect(),
+        ),
+        (
+            "naive",
+            r.frame_times
+                .iter()
+                .filter(|f| f.mode == "naive")
+                .map(|f| (f.wavelengths.unwrap_or(1) as f64, f.median_ms))
+                .collect(),
+        ),
+        ("rgb (independent of N)", vec![(1.0, rgb), (nmax, rgb)]),
+    ];
+    put(
+        dir,
+        "frame_time.svg",
+        super::plot::lines(
+            "Frame time against N (median, CPU wall time incl. read-back)",
+            "wavelengths N",
+            "ms per frame",
+            &ft_series,
+        )?
+        .as_bytes(),
+    )?;
+    let js: Vec<(&str, Vec<(f64, f64)>)> = vec![
+        (
+            "equal spacing, one frame",
+            r.jitter.iter().map(|j| (j.total_wavelengths as f64, j.equal_spacing_delta_e)).collect(),
+        ),
+        (
+            "jittered, accumulated",
+            r.jitter.iter().map(|j| (j.total_wavelengths as f64, j.jittered_delta_e)).collect(),
+        ),
+    ];
+    put(
+        dir,
+        "jitter.svg",
+        super::plot::lines(
+            "Error against total wavelengths: equal spacing vs jittered accumulation",
+            "total wavelengths per pixel",
+            "mean ΔE2000",
+            &js,
+        )?
+        .as_bytes(),
+    )?;
+    put(dir, "results.json", serde_json::to_string_pretty(r)?.as_bytes())?;
+    put(dir, "index.html", html(r).as_bytes())?;
+    Ok(())
+}
+
+/// Every number as CSV sections separated by a blank line.
+pub fn csv(r: &Results) -> String {
+    let mut s = String::from(
+        "case,mode,wavelengths,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
+    );
+    for c in &r.cases {
+        let rows = c.modes.iter().map(|m| (m.mode.as_str(), m.wavelengths, &m.errors));
+        for (mode, n, e) in rows.chain(std::iter::once(("truth_noise", None, &c.noise_floor))) {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{},{},{},{},{},{},{}",
+                c.id,
+                mode,
+                n.map(|n| n.to_string()).unwrap_or_default(),
+                e.delta_e2000.mean,
+                e.delta_e2000.median,
+                e.delta_e2000.p95,
+                e.delta_e2000.max,
+                e.mae_linear.mean,
+                e.delta_e2000_masked.mean,
+                e.mae_linear_masked.mean,
+                c.masked_fraction
+            );
+        }
+    }
+    s.push_str("\nframe_time_mode,wavelengths,median_ms\n");
+    for f in &r.frame_times {
+        let _ = writeln!(
+            s,
+            "{},{},{}",
+            f.mode,
+            f.wavelengths.map(|n| n.to_string()).unwrap_or_default(),
+            f.median_ms
+        );
+    }
+    s.push_str("\njitter_total_wavelengths,frames,equal_spacing_de_mean,jittered_de_mean\n");
+    for j in &r.jitter {
+        let _ = writeln!(
+            s,
+            "{},{},{},{}",
+            j.total_wavelengths, j.frames, j.equal_spacing_delta_e, j.jittered_delta_e
+        );
+    }
+    s
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// The headline table (mean ΔE2000, whole image / masked) as Markdown, for the README.
+pub fn markdown_table(r: &Results) -> String {
+    let mut s = String::from(
+        "| case | ours ΔE00 | naive ΔE00 | rgb ΔE00 | truth noise ΔE00 | ours / naive / rgb, edge-masked |\n|---|---|---|---|---|---|\n",
+    );
+    for c in &r.cases {
+        let m = |i: usize| c.modes[i].errors.delta_e2000.mean;
+        let k = |i: usize| c.modes[i].errors.delta_e2000_masked.mean;
+        let _ = writeln!(
+            s,
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} / {:.3} / {:.3} |",
+            c.id,
+            m(0),
+            m(1),
+            m(2),
+            c.noise_floor.delta_e2000.mean,
+            k(0),
+            k(1),
+            k(2)
+        );
+    }
+    s
+}
+
+fn html(r: &Results) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        r#"<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>spectra evaluation</title>
+<style>body{{font-family:sans-serif;margin:20px;max-width:1360px}}table{{border-collapse:collapse;margin:8px 0}}
+td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}th{{background:#eee}}td:first-child{{text-align:left}}
+.row{{display:flex;gap:8px;flex-wrap:wrap}}figure{{margin:0}}figcaption{{font-size:13px;text-align:center}}
+img.px{{image-rendering:pixelated;width:256px}}img.hm{{height:256px}}.best{{font-weight:bold;color:#060}}</style></head><body>
+<h1>spectra evaluation{q}</h1>
+<p>Ground truth: the CPU spectral path tracer, direct lighting only, {spp} spp, {w}×{h}, same punctual lights as the
+real-time renderer. <b>ours</b> = Jakob–Hanika spectral upsampling, <b>naive</b> = box upsampling, <b>rgb</b> = classic RGB
+shading. Errors are per-pixel CIEDE2000 (CIELAB white Y = 1) and MAE of linear sRGB. The <i>truth noise</i> row is two
+truth renders with different seeds: differences below it are Monte-Carlo noise. The edge mask removes pixels whose 3×3
+neighbourhood in the truth image varies in luminance by more than {ec:.0}% (shadow and silhouette edges where shadow maps and
+ray tracing differ geometrically, but also texture edges); both whole-image and masked numbers are shown.</p>
+<p><b>Machine:</b> {m}<br><b>Adapter:</b> {a}<br><b>Run time:</b> {t:.0} s</p>
+"#,
+        q = if r.quick { " (--quick)" } else { "" },
+        spp = r.budget.truth_spp,
+        w = r.budget.width,
+        h = r.budget.height,
+        ec = r.edge_contrast * 100.0,
+        m = esc(&r.machine),
+        a = esc(&r.adapter),
+        t = r.seconds
+    );
+    for n in &r.notes {
+        let _ = write!(h, "<p><b>Note:</b> {}</p>", esc(n));
+    }
+    h.push_str("<h2>Mean errors</h2><table><tr><th>case</th>");
+    for (_, n) in MODES {
+        let _ = write!(h, "<th>{n} ΔE00</th>");
+    }
+    h.push_str("<th>truth noise ΔE00</th>");
+    for (_, n) in MODES {
+        let _ = write!(h, "<th>{n} ΔE00 masked</th>");
+    }
+    h.push_str("<th>masked px</th>");
+    for (_, n) in MODES {
+        let _ = write!(h, "<th>{n} MAE</th>");
+    }
+    h.push_str("</tr>");
+    for c in &r.cases {
+        let best = (0..3).min_by(|&a, &b| {
+            c.modes[a].errors.delta_e2000.mean.total_cmp(&c.modes[b].errors.delta_e2000.mean)
+        });
+        let _ = write!(h, "<tr><td>{}</td>", esc(&c.id));
+        for (i, m) in c.modes.iter().enumerate() {
+            let cls = if Some(i) == best { " class=\"best\"" } else { "" };
+            let _ = write!(h, "<td{cls}>{:.3}</td>", m.errors.delta_e2000.mean);
+        }
+        let _ = write!(h, "<td>{:.3}</td>", c.noise_floor.delta_e2000.mean);
+        for m in &c.modes {
+            let _ = write!(h, "<td>{:.3}</td>", m.errors.delta_e2000_masked.mean);
+        }
+        let _ = write!(h, "<td>{:.1}%</td>", c.masked_fraction * 100.0);
+        for m in &c.modes {
+            let _ = write!(h, "<td>{:.4}</td>", m.errors.mae_linear.mean);
+        }
+        h.push_str("</tr>");
+    }
+    h.push_str("</table>");
+    h.push_str(r#"<p><img src="delta_e.svg" alt="mean ΔE2000 bar chart"><br><img src="delta_e_masked.svg" alt="masked ΔE2000 bar chart"><br><img src="mae.svg" alt="MAE bar chart"></p>"#);
+    for c in &r.cases {
+        let _ = write!(h, "<h2>{}</h2><p>{}</p><div class=\"row\">", esc(&c.id), esc(&c.title));
+        let _ = write!(
+            h,
+            "<figure><img class=\"px\" src=\"{}\"><figcaption>ground truth</figcaption></figure>",
+            esc(&c.truth_image)
+        );
+        for m in &c.modes {
+            let _ = write!(
+                h,
+                "<figure><img class=\"px\" src=\"{}\"><figcaption>{}{} — ΔE00 {:.3}</figcaption></figure>",
+                esc(&m.image),
+                esc(&m.mode),
+                m.wavelengths.map(|n| format!(" N={n}")).unwrap_or_default(),
+                m.errors.delta_e2000.mean
+            );
+        }
+        h.push_str("</div><div class=\"row\">");
+        for m in &c.modes {
+            let _ = write!(
+                h,
+                "<figure><img class=\"hm\" src=\"{}\"><figcaption>{} ΔE2000 heat map</figcaption></figure>",
+                esc(&m.heatmap),
+                esc(&m.mode)
+            );
+        }
+        h.push_str("</div>");
+    }
+    let _ = write!(
+        h,
+        r#"<h2>Frame time against N (paper Fig. 4)</h2><p>Scene {}, {}×{}, median of {} frames, CPU wall time from submission to finished read-back.</p><img src="frame_time.svg" alt="frame time plot"><table><tr><th>mode</th><th>N</th><th>median ms</th></tr>"#,
+        esc(&r.frame_time_scene),
+        r.budget.bench_width,
+        r.budget.bench_height,
+        r.budget.bench_frames
+    );
+    for f in &r.frame_times {
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{:.2}</td></tr>",
+            f.mode,
+            f.wavelengths.map(|n| n.to_string()).unwrap_or("–".into()),
+            f.median_ms
+        );
+    }
+    let _ = write!(
+        h,
+        r#"</table><h2>Beyond the paper: jittered wavelengths with temporal accumulation</h2><p>Scene {}, range {:.0}–{:.0} nm (truth over the same range). Equal spacing renders all N wavelengths in one frame; jittered renders {} per frame at a stratified random offset and averages the frames.</p><img src="jitter.svg" alt="jitter plot"><table><tr><th>total N</th><th>frames</th><th>equal spacing ΔE00</th><th>jittered ΔE00</th></tr>"#,
+        esc(&r.jitter_scene),
+        r.jitter_range[0],
+        r.jitter_range[1],
+        r.budget.jitter_per_frame
+    );
+    for j in &r.jitter {
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{:.3}</td><td>{:.3}</td></tr>",
+            j.total_wavelengths, j.frames, j.equal_spacing_delta_e, j.jittered_delta_e
+        );
+    }
+    h.push_str("</table><p>All numbers: <a href=\"results.json\">results.json</a>, <a href=\"results.csv\">results.csv</a>.</p></body></html>\n");
+    h
+}
