@@ -1,8 +1,8 @@
 //! Real-time spectral deferred rendering with wgpu.
 //!
-//! Four passes (plus a shadow map): G-buffer → spectral shading → custom → post. The shading
-//! pass turns each pixel's RGB base colour into a Jakob–Hanika sigmoid spectrum, evaluates it
-//! at N wavelengths against each light's sampled emission and a Lambert + GGX BRDF, and
+//! Four passes (plus one shadow map per light): G-buffer → spectral shading → custom → post.
+//! The shading pass turns each pixel's RGB base colour into a Jakob–Hanika sigmoid spectrum,
+//! evaluates it at N wavelengths against each light's sampled emission and a Lambert + GGX BRDF, and
 //! integrates with precomputed observer×Δλ weights into XYZ and linear sRGB. Three modes run
 //! on the same pipelines and switch per frame: `rgb` (classic, baseline), `naive` (box
 //! upsampling) and `spectral`.

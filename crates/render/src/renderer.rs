@@ -9,14 +9,14 @@ use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::post::PostPass;
 use crate::passes::shading::ShadingPass;
-use crate::passes::shadow::{ShadowPass, light_view_proj};
+use crate::passes::shadow::ShadowPass;
 use crate::readback;
 use crate::scene_gpu::{GpuLight, GpuScene};
 use crate::settings::{Mode, RenderSettings};
 use crate::spectral_data::SpectralSetup;
 use crate::targets::Targets;
 use crate::timing::{PassTimings, Timer};
-use crate::uniforms::{FrameUniforms, NO_SHADOW};
+use crate::uniforms::FrameUniforms;
 use color::upsample::CoeffTable;
 use glam::Mat4;
 use std::sync::Arc;
@@ -94,7 +94,7 @@ impl Renderer {
         let shared = SharedLayouts::new(device);
         let custom = CustomShader::default();
         let gbuffer = GBufferPass::new(device, &shared)?;
-        let shadow = ShadowPass::new(device, &shared)?;
+        let shadow = ShadowPass::new(device)?;
         let shading = ShadingPass::new(device, &shared, &custom.source)?;
         let custom_pass = CustomPass::new(device, &shared, &custom.source)?;
         let post = PostPass::new(device, &shared)?;
@@ -242,31 +242,26 @@ impl Renderer {
         self.update_spectral(settings)?;
         let spectral = self.spectral.as_ref().expect("update_spectral sets it");
         let scene = self.scene.as_ref().expect("checked above");
+        self.shadow.update(&self.gpu.queue, scene, settings.shadows);
 
         let aspect = width as f32 / height as f32;
         let view = camera.transform.inverse();
         let proj = Mat4::perspective_rh(camera.yfov, aspect, camera.znear, camera.zfar);
         let view_proj = proj * view;
-        let shadow = settings
-            .shadows
-            .then(|| scene.lights.first().and_then(|l| light_view_proj(l, scene.bounds)))
-            .flatten();
         let m = spectral.setup.xyz_to_rgb;
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            shadow_view_proj: shadow.map(|s| s.0).unwrap_or(Mat4::IDENTITY).to_cols_array_2d(),
             camera_pos: camera.position().extend(1.0).to_array(),
             xyz_to_rgb: [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x as f32, c.y as f32, c.z as f32, 0.0]),
             viewport: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
             mode: settings.mode.gpu(),
             n_groups: spectral.setup.groups() as u32,
             n_lights: spectral.n_lights,
-            shadow_light: if shadow.is_some() { 0 } else { NO_SHADOW },
             exposure: settings.exposure_ev.exp2(),
             tonemap: settings.tonemap.gpu(),
-            shadow_bias: shadow.map(|s| s.1).unwrap_or(0.0),
             table_res: self.gpu_table.res,
+            _pad: [0; 2],
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
 
@@ -275,7 +270,7 @@ impl Renderer {
         let ts = |i: usize| timer.map(|t| t.writes(i));
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        self.shadow.record(&mut encoder, &self.frame_bind_group, shadow.map(|_| scene), ts(0));
+        self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
         self.gbuffer.record(
             &mut encoder,
@@ -362,6 +357,7 @@ impl Renderer {
                     binding: 5,
                     resource: wgpu::BindingResource::Sampler(&self.shadow.sampler),
                 },
+                wgpu::BindGroupEntry { binding: 6, resource: self.shadow.uniforms.as_entire_binding() },
             ],
         });
         let custom = device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -6,28 +6,24 @@
 pub struct FrameUniforms {
     pub view_proj: [[f32; 4]; 4],
     pub inv_view_proj: [[f32; 4]; 4],
-    pub shadow_view_proj: [[f32; 4]; 4],
     pub camera_pos: [f32; 4],
     pub xyz_to_rgb: [[f32; 4]; 3],
     pub viewport: [f32; 4],
     pub mode: u32,
     pub n_groups: u32,
     pub n_lights: u32,
-    pub shadow_light: u32,
     pub exposure: f32,
     pub tonemap: u32,
-    pub shadow_bias: f32,
     pub table_res: u32,
+    /// The WGSL struct's size is rounded up to its 16-byte alignment.
+    pub _pad: [u32; 2],
 }
-
-/// `shadow_light` value meaning "no light casts shadows".
-pub const NO_SHADOW: u32 = u32::MAX;
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn size_matches_wgsl() {
-        // 3 mat4 (192) + vec4 (16) + mat3x3 (48) + vec4 (16) + 8 scalars (32).
-        assert_eq!(std::mem::size_of::<super::FrameUniforms>(), 304);
+        // 2 mat4 (128) + vec4 (16) + mat3x3 (48) + vec4 (16) + 6 scalars (24), rounded to 16.
+        assert_eq!(std::mem::size_of::<super::FrameUniforms>(), 240);
     }
 }

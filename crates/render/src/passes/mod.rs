@@ -1,9 +1,9 @@
 //! The five passes, one file each with its WGSL beside it, plus the bind-group layouts several
 //! passes share.
 //!
-//! Frame order: shadow (depth from the main light) → G-buffer → spectral shading → custom →
-//! post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 = per-wavelength data and the
-//! coefficient table, 3 = the custom shader's parameters.
+//! Frame order: shadow (depth from each shadow-casting light, one layer each) → G-buffer →
+//! spectral shading → custom → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
+//! per-wavelength data and the coefficient table, 3 = the custom shader's parameters.
 
 pub mod custom;
 pub mod gbuffer;

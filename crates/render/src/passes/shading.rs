@@ -12,9 +12,13 @@
 //!
 //! So 11 + 2L ALU ops and 4 + L loads per wavelength (13 and 5 with one light); emissive pixels
 //! add a second sigmoid (+9). The coefficient fetch (8 texel loads, trilinear, binary search over
-//! the z axis) and the BRDF (once per light) are per pixel, not per wavelength.
+//! the z axis), the BRDF and the shadow lookup (once per light: one hardware 2×2 comparison
+//! sample in that light's layer of the shadow-map array) are per pixel, not per wavelength.
 
-use super::{HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry};
+use super::{
+    HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry,
+    uniform_entry,
+};
 use crate::error::Result;
 use crate::shader;
 
@@ -33,13 +37,23 @@ impl ShadingPass {
                 texture_entry(1),
                 texture_entry(2),
                 depth_entry(3),
-                depth_entry(4),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
                 wgpu::BindGroupLayoutEntry {
                     binding: 5,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                     count: None,
                 },
+                uniform_entry(6, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let module = shader::compile(

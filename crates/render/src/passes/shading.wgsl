@@ -7,22 +7,37 @@
 @group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
 @group(1) @binding(2) var gbuf_emission: texture_2d<f32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
-@group(1) @binding(4) var shadow_map: texture_depth_2d;
+@group(1) @binding(4) var shadow_maps: texture_depth_2d_array;
 @group(1) @binding(5) var shadow_sampler: sampler_comparison;
 
 // Must match MAX_LIGHTS in src/scene_gpu.rs.
 const MAX_LIGHTS: u32 = 32u;
+// Must match MAX_SHADOWS in src/passes/shadow.rs.
+const MAX_SHADOWS: u32 = 8u;
+// Value of `layer_of_light` for a light without a shadow map.
+const NO_SHADOW: u32 = 0xffffffffu;
 
-// Fraction of the shadow-casting light that reaches `p` (1 outside the shadow frustum).
-fn shadow_visibility(p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let s = frame.shadow_view_proj * vec4<f32>(p + n * frame.shadow_bias, 1.0);
+// Layout must match `ShadowUniforms` in src/passes/shadow.rs.
+struct ShadowUniforms {
+    view_proj: array<mat4x4<f32>, MAX_SHADOWS>,
+    // x: normal-offset bias in world units.
+    bias: array<vec4<f32>, MAX_SHADOWS>,
+    // Shadow-map layer of light i at [i / 4][i % 4], or NO_SHADOW (8 = MAX_LIGHTS / 4).
+    layer_of_light: array<vec4<u32>, 8>,
+};
+@group(1) @binding(6) var<uniform> shadows: ShadowUniforms;
+
+// Fraction of a light that reaches `p` according to its shadow map `layer` (1 outside the
+// light's frustum): one hardware 2×2 comparison sample.
+fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let s = shadows.view_proj[layer] * vec4<f32>(p + n * shadows.bias[layer].x, 1.0);
     if (s.w <= 0.0) { return 1.0; }
     let ndc = s.xyz / s.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || ndc.z > 1.0 || ndc.z < 0.0) {
         return 1.0;
     }
-    return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, ndc.z);
+    return textureSampleCompareLevel(shadow_maps, shadow_sampler, uv, i32(layer), ndc.z);
 }
 
 // Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
@@ -55,8 +70,9 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
     }
     let nl = dot(n, wi);
     if (nl <= 0.0 || atten <= 0.0) { return vec2<f32>(0.0); }
-    if (li == frame.shadow_light) {
-        atten *= shadow_visibility(p, n);
+    let layer = shadows.layer_of_light[li / 4u][li % 4u];
+    if (layer != NO_SHADOW) {
+        atten *= shadow_visibility(layer, p, n);
     }
     let h = normalize(wi + v);
     let nv = max(dot(n, v), 1e-4);

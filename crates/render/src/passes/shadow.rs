@@ -1,32 +1,77 @@
-//! Shadow map for the main light: depth rendered from the light, sampled with hardware 2×2
-//! comparison filtering in the shading pass.
+//! Shadow maps, one per shadow-casting light: depth rendered from each light into one layer of
+//! a depth texture array, sampled with hardware 2×2 comparison filtering in the shading pass
+//! (one comparison sample per shadowed light per pixel, no per-wavelength work).
 //!
 //! Directional lights get an orthographic frustum around the scene bounds; spot lights a
 //! perspective frustum of their outer cone; point lights a perspective frustum aimed at the
 //! scene's centre (at most 150°: points outside it are treated as lit).
+//!
+//! Lights are given layers in scene order, skipping those without a usable frustum
+//! (degenerate direction); lights beyond [`MAX_SHADOWS`] are **unshadowed**. Stand-in lights
+//! (`Light::stands_in_for`) cast shadows like any other, but their own emissive mesh is left
+//! out of their map: the lamp they approximate does not occlude itself.
 
-use super::{DEPTH_FORMAT, SharedLayouts};
+use super::{DEPTH_FORMAT, uniform_entry};
 use crate::error::Result;
-use crate::scene_gpu::GpuScene;
+use crate::scene_gpu::{GpuScene, MAX_LIGHTS};
 use crate::shader;
 use glam::{Mat4, Vec3};
 use scene::LightKind;
 
 /// Shadow map edge length in texels.
 pub const SHADOW_SIZE: u32 = 1024;
+/// Most lights with a shadow map (layers of the depth array). Must match `MAX_SHADOWS` in
+/// `shading.wgsl`.
+pub const MAX_SHADOWS: usize = 8;
+/// `ShadowUniforms::layer_of_light` value for a light without a shadow map.
+pub const NO_SHADOW: u32 = u32::MAX;
+
+/// Byte-for-byte `ShadowUniforms` in `shading.wgsl`: what the shading pass needs to look a
+/// point up in the maps.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadowUniforms {
+    /// World → clip of each layer's light.
+    pub view_proj: [[[f32; 4]; 4]; MAX_SHADOWS],
+    /// x: normal-offset bias (world units) of each layer; yzw unused (uniform arrays have a
+    /// 16-byte stride).
+    pub bias: [[f32; 4]; MAX_SHADOWS],
+    /// Layer of light `i` at `[i / 4][i % 4]`, or [`NO_SHADOW`].
+    pub layer_of_light: [[u32; 4]; MAX_LIGHTS / 4],
+}
+
+/// One layer to render this frame.
+#[derive(Clone, Copy, Debug)]
+struct Layer {
+    /// Index into `GpuScene::draws` (= `Scene::meshes`) left out of this map.
+    skip_mesh: Option<usize>,
+}
 
 pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
+    /// All layers, for sampling (`texture_depth_2d_array`).
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
+    /// [`ShadowUniforms`] for the shading pass.
+    pub uniforms: wgpu::Buffer,
+    /// One single-layer view per layer, for rendering.
+    layer_views: Vec<wgpu::TextureView>,
+    /// One light view-projection uniform (and its bind group) per layer.
+    layer_buffers: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
+    /// Layers in use since the last [`Self::update`].
+    active: Vec<Layer>,
 }
 
 impl ShadowPass {
-    pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
-        let module = shader::compile(device, "shadow", &[shader::COMMON, include_str!("shadow.wgsl")])?;
+    pub fn new(device: &wgpu::Device) -> Result<Self> {
+        let module = shader::compile(device, "shadow", &[include_str!("shadow.wgsl")])?;
+        let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow light"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow"),
-            bind_group_layouts: &[Some(&shared.frame)],
+            bind_group_layouts: &[Some(&light_layout)],
             immediate_size: 0,
         });
         let pipeline = shader::checked(device, "shadow pipeline", || {
@@ -54,14 +99,56 @@ impl ShadowPass {
             })
         })?;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow map"),
-            size: wgpu::Extent3d { width: SHADOW_SIZE, height: SHADOW_SIZE, depth_or_array_layers: 1 },
+            label: Some("shadow maps"),
+            size: wgpu::Extent3d {
+                width: SHADOW_SIZE,
+                height: SHADOW_SIZE,
+                depth_or_array_layers: MAX_SHADOWS as u32,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: DEPTH_FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("shadow maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let layer_views = (0..MAX_SHADOWS as u32)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("shadow map layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let layer_buffers = (0..MAX_SHADOWS)
+            .map(|_| {
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("shadow light view-projection"),
+                    size: std::mem::size_of::<[[f32; 4]; 4]>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow light"),
+                    layout: &light_layout,
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+                });
+                (buffer, bind_group)
+            })
+            .collect();
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow uniforms"),
+            size: std::mem::size_of::<ShadowUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("shadow"),
@@ -70,38 +157,89 @@ impl ShadowPass {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        Ok(ShadowPass { pipeline, view: texture.create_view(&Default::default()), sampler })
+        Ok(ShadowPass { pipeline, view, sampler, uniforms, layer_views, layer_buffers, active: Vec::new() })
     }
 
-    /// Clears the map to "far" (fully lit), then draws the scene when `scene` is given.
+    /// Chooses the shadowed lights of `scene` (none when `enabled` is false), uploads their
+    /// matrices for the shadow and shading passes.
+    pub fn update(&mut self, queue: &wgpu::Queue, scene: &GpuScene, enabled: bool) {
+        let (uniforms, layers) = assign(&scene.lights, scene.bounds, enabled);
+        for (layer, (buffer, _)) in uniforms.view_proj.iter().zip(&self.layer_buffers).take(layers.len()) {
+            queue.write_buffer(buffer, 0, bytemuck::bytes_of(layer));
+        }
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        self.active = layers;
+    }
+
+    /// Renders every layer chosen by the last [`Self::update`], each cleared to "far" (fully
+    /// lit) first. With no layer in use one empty pass still runs so that the timestamps
+    /// measure something.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &wgpu::BindGroup,
-        scene: Option<&GpuScene>,
+        scene: &GpuScene,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shadow"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
+        let n = self.active.len().max(1);
+        for i in 0..n {
+            // The first pass writes the start timestamp, the last one the end.
+            let ts = timestamps.as_ref().map(|t| wgpu::RenderPassTimestampWrites {
+                query_set: t.query_set,
+                beginning_of_pass_write_index: if i == 0 { t.beginning_of_pass_write_index } else { None },
+                end_of_pass_write_index: if i + 1 == n { t.end_of_pass_write_index } else { None },
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.layer_views[i],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
                 }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        if let Some(scene) = scene {
+                timestamp_writes: ts,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            let Some(layer) = self.active.get(i) else { continue };
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, frame, &[]);
-            scene.draw(&mut pass, false);
+            pass.set_bind_group(0, &self.layer_buffers[i].1, &[]);
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            for (mi, d) in scene.draws.iter().enumerate() {
+                if layer.skip_mesh != Some(mi) {
+                    pass.draw_indexed(d.first_index..d.first_index + d.index_count, d.base_vertex, 0..1);
+                }
+            }
         }
     }
+}
+
+/// Gives the first [`MAX_SHADOWS`] lights that have a frustum a layer each, in scene order.
+fn assign(lights: &[scene::Light], bounds: (Vec3, Vec3), enabled: bool) -> (ShadowUniforms, Vec<Layer>) {
+    let mut u = ShadowUniforms {
+        view_proj: [Mat4::IDENTITY.to_cols_array_2d(); MAX_SHADOWS],
+        bias: [[0.0; 4]; MAX_SHADOWS],
+        layer_of_light: [[NO_SHADOW; 4]; MAX_LIGHTS / 4],
+    };
+    let mut layers = Vec::new();
+    if !enabled {
+        return (u, layers);
+    }
+    for (li, light) in lights.iter().enumerate().take(MAX_LIGHTS) {
+        if layers.len() == MAX_SHADOWS {
+            break;
+        }
+        let Some((view_proj, bias)) = light_view_proj(light, bounds) else { continue };
+        let layer = layers.len();
+        u.view_proj[layer] = view_proj.to_cols_array_2d();
+        u.bias[layer][0] = bias;
+        u.layer_of_light[li / 4][li % 4] = layer as u32;
+        layers.push(Layer { skip_mesh: light.stands_in_for });
+    }
+    (u, layers)
 }
 
 /// View-projection from the light and a normal-offset bias (world units), or `None` when the
@@ -136,5 +274,50 @@ pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Ma
             let view = Mat4::look_at_rh(position, position + d, up_for(d));
             Some((Mat4::perspective_rh(fov, 1.0, far * 1e-3, far) * view, texel * 1.5))
         }
+    }
+}
+
+// `layer_of_light` packs four lights per vec4<u32>.
+const _: () = assert!(MAX_LIGHTS.is_multiple_of(4));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn light(kind: LightKind, stands_in_for: Option<usize>) -> scene::Light {
+        scene::Light {
+            name: "l".into(),
+            kind,
+            emission: scene::Emission { rgb: Vec3::ONE, intensity: 1.0, spectrum: None },
+            stands_in_for,
+        }
+    }
+
+    #[test]
+    fn size_matches_wgsl() {
+        // 8 mat4 (512) + 8 vec4 (128) + MAX_LIGHTS / 4 vec4<u32> (128).
+        assert_eq!(std::mem::size_of::<ShadowUniforms>(), 768);
+    }
+
+    #[test]
+    fn layers_go_to_lights_in_order_up_to_the_maximum() {
+        let bounds = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let sun = LightKind::Directional { direction: Vec3::NEG_Y };
+        let degenerate = LightKind::Directional { direction: Vec3::ZERO };
+        let mut lights = vec![light(degenerate, None), light(sun.clone(), Some(3))];
+        lights.extend((0..MAX_SHADOWS).map(|_| light(sun.clone(), None)));
+        let (u, layers) = assign(&lights, bounds, true);
+        let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
+        assert_eq!(layer(0), NO_SHADOW, "no frustum, no map");
+        assert_eq!(
+            (1..=MAX_SHADOWS).map(layer).collect::<Vec<_>>(),
+            (0..MAX_SHADOWS as u32).collect::<Vec<_>>()
+        );
+        assert_eq!(layer(MAX_SHADOWS + 1), NO_SHADOW, "beyond the maximum");
+        assert_eq!(layers.len(), MAX_SHADOWS);
+        assert_eq!(layers[0].skip_mesh, Some(3), "a stand-in skips its own mesh");
+        assert!(layers[1..].iter().all(|l| l.skip_mesh.is_none()));
+        let (u, layers) = assign(&lights, bounds, false);
+        assert!(layers.is_empty() && u.layer_of_light.iter().flatten().all(|&l| l == NO_SHADOW));
     }
 }

@@ -1,8 +1,9 @@
-// Shadow pass: depth only, rendered from the shadow-casting light. Prepended: wgsl/common.wgsl.
+// Shadow pass: depth only, rendered from one shadow-casting light into one layer of the
+// shadow-map array. Standalone (nothing prepended).
 
-@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+@group(0) @binding(0) var<uniform> light_view_proj: mat4x4<f32>;
 
 @vertex
 fn vs_shadow(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return frame.shadow_view_proj * vec4<f32>(position, 1.0);
+    return light_view_proj * vec4<f32>(position, 1.0);
 }

@@ -4,7 +4,6 @@
 struct FrameUniforms {
     view_proj: mat4x4<f32>,
     inv_view_proj: mat4x4<f32>,
-    shadow_view_proj: mat4x4<f32>,
     // xyz: camera position in world space.
     camera_pos: vec4<f32>,
     // Columns of the XYZ → linear-RGB matrix (white-corrected for the sampled wavelengths).
@@ -16,13 +15,10 @@ struct FrameUniforms {
     // Number of vec4 wavelength groups (N rounded up to a multiple of 4, divided by 4).
     n_groups: u32,
     n_lights: u32,
-    // Index of the light that casts shadows, or 0xffffffff for none.
-    shadow_light: u32,
     // Linear exposure multiplier (2^EV).
     exposure: f32,
     // 0 = none, 1 = Reinhard, 2 = ACES fitted.
     tonemap: u32,
-    shadow_bias: f32,
     // Resolution of the Jakob–Hanika coefficient table.
     table_res: u32,
 };
