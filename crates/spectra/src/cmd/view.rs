@@ -41,6 +41,13 @@ pub struct Args {
     /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
     #[arg(long)]
     pub table: Option<PathBuf>,
+    /// Under water: a Jerlov type (I … III, 1C … 9C, blends like II.5); default: the scene's
+    /// water settings, if any.
+    #[arg(long, value_name = "TYPE")]
+    pub water: Option<String>,
+    /// Camera depth below the water surface, metres (default: the scene's, else 10).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub depth: Option<f64>,
 }
 
 /// The initial settings: arguments first, then the scene's spectral defaults, then the
@@ -83,13 +90,14 @@ pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
     let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
     let settings = initial_settings(&args, &scene)?;
+    let water = super::render::water_medium(&scene, args.water.as_deref(), args.depth)?;
     if !display_named(std::env::var_os("DISPLAY")) {
         bail!("{NO_DISPLAY}");
     }
     // The event loop connects to the X server; a named but unreachable display fails here.
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
     let table = load_table(args.table.as_deref())?;
-    run_window(event_loop, ViewOptions { scene, settings, size, table })
+    run_window(event_loop, ViewOptions { scene, settings, size, table, water })
 }
 
 #[cfg(test)]

@@ -26,6 +26,9 @@ pub struct ViewOptions {
     pub settings: RenderSettings,
     pub size: (u32, u32),
     pub table: Arc<CoeffTable>,
+    /// The water the camera is in (`--water`/`--depth` or the scene's), drawn with the
+    /// underwater hooks.
+    pub water: Option<scene::water::WaterMedium>,
 }
 
 /// Radians of orbit per pixel of drag.
@@ -124,6 +127,9 @@ impl Running {
         let adapter_name = gpu.describe();
         let mut renderer = Renderer::with_gpu(gpu, opts.table.clone())?;
         renderer.set_scene(&opts.scene)?;
+        if let Some(w) = &opts.water {
+            renderer.set_custom_shader(render::passes::underwater::shader(w))?;
+        }
 
         let size = window.inner_size();
         let mut config = surface
