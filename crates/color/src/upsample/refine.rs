@@ -32,6 +32,11 @@ pub struct RefineOptions {
     pub sweeps: usize,
     /// A cell is poor when the ΔE*ab at any of its probe points exceeds this.
     pub threshold: f64,
+    /// Cells whose centre is off by more than this are not refined: their colours are (almost
+    /// always) outside what any reflectance can reach — wide-gamut primaries beyond the
+    /// object-colour solid — and no choice of coefficients helps. Without this cut, P3 and
+    /// Rec.2020 tables spend minutes on hopeless nodes.
+    pub give_up: f64,
     /// Gauss–Newton steps per node per sweep.
     pub steps: usize,
     /// Sample points per axis inside each cell (at (m + ½)/n); 1 = cell centres only.
@@ -40,7 +45,7 @@ pub struct RefineOptions {
 
 impl Default for RefineOptions {
     fn default() -> Self {
-        RefineOptions { sweeps: 1, threshold: 0.02, steps: 2, samples_per_axis: 1 }
+        RefineOptions { sweeps: 1, threshold: 0.02, give_up: 2.0, steps: 2, samples_per_axis: 1 }
     }
 }
 
@@ -121,7 +126,8 @@ pub fn refine_table(
                         ac[m] += wc * a[n][m];
                     }
                 }
-                lab_err(model, model.target_lab(grid.rgb(l, k, j, i, f)), ac) > opt.threshold
+                let e = lab_err(model, model.target_lab(grid.rgb(l, k, j, i, f)), ac);
+                e > opt.threshold && e <= opt.give_up
             })
             .collect();
         progress.inc(1);
