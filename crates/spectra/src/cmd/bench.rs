@@ -155,6 +155,32 @@ pub fn table(rows: &[Row]) -> String {
     s
 }
 
+/// The 1-minute load average (Linux), to flag runs where other processes shared the CPU.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}
+
+/// The load line printed after the table, and whether other processes competed for the CPU:
+/// the load before the run should be well under the core count, and after it (this
+/// benchmark keeps up to every core busy on a CPU driver) under 1.5× the cores.
+pub fn load_report(
+    before: Option<f64>,
+    after: Option<f64>,
+    cores: usize,
+    cpu_device: bool,
+) -> Option<String> {
+    let (b, a) = (before?, after?);
+    let busy = b > 0.5 * cores as f64 || a > 1.5 * cores as f64;
+    let mut s = format!("load average {b:.1} before, {a:.1} after, on {cores} cores");
+    if busy {
+        s += "; other processes were competing for the CPU";
+        if cpu_device {
+            s += ", which runs this adapter: the times are inflated";
+        }
+    }
+    Some(s)
+}
+
 pub fn run(args: Args) -> Result<()> {
     let (width, height) = parse_size(&args.size)?;
     if args.frames == 0 {
@@ -165,6 +191,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
     r.set_scene(&scene)?;
     r.resize(width, height)?;
+    let load_before = load_average();
     let has_ts = r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY);
     eprintln!(
         "{} {width}×{height} on {}; {} frames after {} warm-up; time: {}",
@@ -232,6 +259,11 @@ pub fn run(args: Args) -> Result<()> {
     }
     bar.finish_and_clear();
     print!("{}", table(&rows));
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cpu_device = r.gpu().adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    if let Some(line) = load_report(load_before, load_average(), cores, cpu_device) {
+        println!("{line}");
+    }
     if let Some(path) = &args.csv {
         compare::atomic::write_atomic(path, csv(&rows).as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
@@ -294,6 +326,17 @@ mod tests {
         // N = 8: 40 ms / 20 ms.
         assert_eq!(lines[5], "spectral,8,40.0000,39.0000,41.0000,45.0000,44.0000,46.0000,2.0000");
         assert!(table(&rows).contains("spectral: 2.500 ms per wavelength + 20.00 ms"));
+    }
+
+    #[test]
+    fn load_report_flags_busy_runs() {
+        assert_eq!(load_report(None, Some(1.0), 2, true), None);
+        let quiet = load_report(Some(0.2), Some(2.1), 2, true).unwrap();
+        assert_eq!(quiet, "load average 0.2 before, 2.1 after, on 2 cores");
+        let busy = load_report(Some(4.2), Some(7.3), 2, true).unwrap();
+        assert!(busy.contains("competing") && busy.contains("inflated"), "{busy}");
+        let late = load_report(Some(0.1), Some(3.5), 2, false).unwrap();
+        assert!(late.contains("competing") && !late.contains("inflated"), "{late}");
     }
 
     #[test]

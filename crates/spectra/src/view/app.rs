@@ -114,7 +114,10 @@ impl Running {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
             Box::new(event_loop.owned_display_handle()),
         ));
-        let surface = instance.create_surface(window.clone()).context("creating the window's GPU surface")?;
+        // With no usable backend at all, surface creation is the first thing to fail.
+        let surface = instance.create_surface(window.clone()).map_err(|e| {
+            anyhow!("{} (no backend could create a surface for the window: {e})", render::NO_ADAPTER_HELP)
+        })?;
         let backends = wgpu::Backends::from_env().unwrap_or_default();
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::from_env().unwrap_or_default(),
