@@ -60,7 +60,9 @@ def main():
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        best = r["spectral"][0] <= min(r["naive"][0], r["rgb"][0])
+        # Compared at the table's precision: in turbid water ours and naive agree to 1e-4
+        # (nothing but water is visible) and float noise must not decide the flag.
+        best = round(r["spectral"][0], 2) <= round(min(r["naive"][0], r["rgb"][0]), 2)
         lines.append(
             f"| {r['type']} | {r['depth']} | {r['spectral'][0]:.2f} | {r['naive'][0]:.2f} | {r['rgb'][0]:.2f} | "
             f"{r['spectral'][1]:.4f} | {r['naive'][1]:.4f} | {r['rgb'][1]:.4f} | {'yes' if best else 'no'} |")
@@ -68,7 +70,12 @@ def main():
     mean = lambda m, k: sum(r[m][k] for r in rows) / n
     lines.append(f"| **mean** | | {mean('spectral', 0):.2f} | {mean('naive', 0):.2f} | {mean('rgb', 0):.2f} | "
                  f"{mean('spectral', 1):.4f} | {mean('naive', 1):.4f} | {mean('rgb', 1):.4f} | "
-                 f"{sum(r['spectral'][0] <= min(r['naive'][0], r['rgb'][0]) for r in rows)}/{n} |")
+                 f"{sum(round(r['spectral'][0], 2) <= round(min(r['naive'][0], r['rgb'][0]), 2) for r in rows)}/{n} |")
+    digits = (2, 4)  # the table's precision for ΔE and MAE
+    le = lambda m, k: sum(round(r["spectral"][k], digits[k]) <= round(r[m][k], digits[k]) for r in rows)
+    lines.append("")
+    lines.append(f"ours ≤ rgb: ΔE {le('rgb', 0)}/{n}, MAE {le('rgb', 1)}/{n}; ours ≤ naive: ΔE {le('naive', 0)}/{n}, "
+                 f"MAE {le('naive', 1)}/{n}; ours ΔE ≤ 2: {sum(r['spectral'][0] <= 2 for r in rows)}/{n}")
     text = "\n".join(lines) + "\n"
     text += (f"\n{a.size} px, truth {a.spp} spp, real time N = {a.wavelengths}, scene `underwater`, "
              f"`tools/underwater_table.py --size {a.size} --spp {a.spp} --wavelengths {a.wavelengths}`\n")
