@@ -66,9 +66,14 @@ xdotool mousemove --window "$WIN" 480 240 mousedown 1 mousemove --window "$WIN" 
 sleep 3
 key p                                  # second screenshot, after the orbit
 import -window root "$OUT/screen-3-spectral-orbit.png"
+# Fly forward: hold W for a second and a half.
+xdotool keydown --window "$WIN" w; sleep 1.5; xdotool keyup --window "$WIN" w; sleep 2
+key p                                  # third screenshot, closer to the box
+import -window root "$OUT/screen-4-flown.png"
 kill "$VIEW"; wait "$VIEW" 2>/dev/null || true; VIEW=
 
 n=$(ls "$OUT"/screenshot-*.png 2>/dev/null | wc -l)
-[ "$n" -ge 2 ] || { echo "FAIL: expected 2 screenshots, found $n" >&2; cat "$OUT/view-stderr.txt" >&2; exit 1; }
+[ "$n" -ge 3 ] || { echo "FAIL: expected 3 screenshots, found $n" >&2; cat "$OUT/view-stderr.txt" >&2; exit 1; }
+cmp -s "$OUT/screenshot-2.png" "$OUT/screenshot-3.png" && { echo "FAIL: flying did not change the view" >&2; exit 1; }
 echo "ok: screenshot key wrote: $(tr '\n' ' ' <"$OUT/view-stdout.txt")"
 echo "screens: $(ls "$OUT"/screen-*.png | tr '\n' ' ')"
