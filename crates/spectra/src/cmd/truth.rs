@@ -11,7 +11,7 @@ use truth::{Medium, Settings, TruthError, World};
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
     /// Samples (paths) per pixel; each path carries four wavelengths.
     #[arg(long, default_value_t = 64)]

@@ -15,7 +15,7 @@ pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra rend
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
     /// Initial window size WIDTHxHEIGHT (the renderer follows the window).
     #[arg(long, default_value = "960x640")]
