@@ -301,13 +301,14 @@ pub fn node_rgb(res: usize, scale: &[f64], l: usize, k: usize, j: usize, i: usiz
 }
 
 /// Fits a `res`³ table for `space` with rgb2spec's grid, showing progress on `progress`.
-/// Interrupted by [`crate::upsample::interrupted`] (Ctrl-C once the handler is installed).
+/// Stops early when [`crate::upsample::interrupt_flag`] is set (Ctrl-C once
+/// [`crate::upsample::install_interrupt_handler`] ran).
 pub fn fit_table(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
     fit_table_with(space, &FitOptions::new(res), progress, crate::upsample::interrupt_flag())
 }
 
 /// [`fit_table`] with explicit options and cancellation flag. Returns
-/// [`ColorError::Interrupted`]-style [`ColorError::Table`] when `cancel` becomes true.
+/// a [`ColorError::Table`] ("fit interrupted; nothing was written") when `cancel` becomes true.
 pub fn fit_table_with(
     space: &RgbColorSpace,
     opt: &FitOptions,

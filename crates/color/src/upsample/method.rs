@@ -137,7 +137,7 @@ impl Upsampler for BoxBasis {
 }
 
 /// The upsampler for `method` in `space` (Jakob loads or fits the space's table through
-/// [`crate::upsample::table`]).
+/// [`crate::upsample::table()`]).
 pub fn upsampler(method: Method, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
     Ok(match method {
         Method::Jakob => Box::new(Jakob(crate::upsample::table_for(space)?)),

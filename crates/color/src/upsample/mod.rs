@@ -5,7 +5,7 @@
 //! - [`SigmoidPolynomial`]: the spectral model, scalar `f64` and `f32` 4/8-wide evaluation.
 //! - [`CoeffTable`]: rgb2spec's `.coeff` tables (read, write, `fetch`).
 //! - [`fit_table`] / [`fit_default`]: the fitter; [`refine`]: interpolation-aware refinement.
-//! - [`table`]: the renderer's entry point — a cached, shared table per colour space.
+//! - [`table()`]: the renderer's entry point — a cached, shared table per colour space.
 //! - [`variants`]: unbounded RGB and illuminant spectra (pbrt-v4); [`smits`], [`boxes`]:
 //!   baselines; [`Upsampler`] / [`Method`]: one interface over all three methods.
 //! - [`roundtrip`]: RGB → spectrum → Lab accuracy, as measured for the acceptance figures.
@@ -58,7 +58,7 @@ pub fn install_interrupt_handler() {
 }
 
 /// The fit behind the default tables: [`TABLE_RES`]³ nodes on [`fit::spectra_scale`]'s
-/// brightness grid, then one sweep of [`refine`] (interpolation-aware). This is what [`table`]
+/// brightness grid, then one sweep of [`refine`] (interpolation-aware). This is what [`table()`]
 /// caches and `spectra lut` writes.
 pub fn fit_default(space: &RgbColorSpace, progress: &ProgressBar) -> Result<CoeffTable> {
     fit_default_res(space, TABLE_RES, progress)
