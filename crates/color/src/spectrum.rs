@@ -56,7 +56,10 @@ impl Spectrum {
         if lambda.len() < 2 {
             return Err(ColorError::BadSpectrum("needs at least two samples".into()));
         }
-        if let Some(w) = lambda.windows(2).find(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[0].is_finite()) {
+        if let Some(w) = lambda
+            .windows(2)
+            .find(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[0].is_finite())
+        {
             return Err(ColorError::BadSpectrum(format!(
                 "wavelengths must increase strictly: {} then {}",
                 w[0], w[1]

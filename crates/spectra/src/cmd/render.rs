@@ -34,7 +34,7 @@ pub struct RenderArgs {
     /// Tone mapping for PNG output: none, reinhard or aces.
     #[arg(long, default_value = "none")]
     pub tonemap: String,
-    /// Disable the main light's shadow map.
+    /// Disable shadow maps (otherwise each of the first eight lights casts shadows).
     #[arg(long)]
     pub no_shadows: bool,
     /// Jakob–Hanika coefficient table (.coeff). Default: the sRGB 64³ table, fitted once per

@@ -139,7 +139,7 @@ impl Controls {
                 ui.radio_value(&mut w.tonemap, t, name);
             }
         });
-        ui.checkbox(&mut w.shadows, "shadow map");
+        ui.checkbox(&mut w.shadows, "shadow maps");
         if let Some(e) = &self.error {
             ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
         }
