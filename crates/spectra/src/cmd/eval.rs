@@ -12,7 +12,8 @@ pub struct Args {
     #[arg(long)]
     pub quick: bool,
     /// Cases to run, comma-separated (default: all): metamerism, colorchecker-d65,
-    /// colorchecker-f11, colorchecker-led.
+    /// colorchecker-f11, colorchecker-led; opt-in: underwater-ib, underwater-iii,
+    /// underwater-3c (any Jerlov type as underwater-TYPE).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Override the ground-truth samples per pixel.
@@ -46,7 +47,8 @@ pub fn run(a: Args) -> Result<()> {
         for id in &a.scenes {
             suite::case(id)?;
         }
-        (a.scenes.clone(), Vec::new())
+        let water = a.scenes.iter().any(|s| s.starts_with("underwater-"));
+        (a.scenes.clone(), if water { vec![suite::UNDERWATER_NOTE.to_string()] } else { Vec::new() })
     };
     let out = a.out.clone();
     let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table })?;

@@ -44,6 +44,11 @@ pub struct TruthJob {
     pub range: WavelengthRange,
 }
 
+/// The scene's water as the renderer and the tracer need it, if it has any.
+pub fn water(scene: &scene::Scene) -> Result<Option<scene::water::WaterMedium>> {
+    crate::cmd::render::water_medium(scene, None, None)
+}
+
 /// Ground truth of a scene: direct lighting only, linear sRGB.
 pub fn truth(
     scene: &scene::Scene,
@@ -57,10 +62,15 @@ pub fn truth(
     st.seed = job.seed;
     st.direct_only = true;
     st.range = job.range;
+    if let Some(w) = water(scene)? {
+        // Full transport under water: the real-time model's Kd stands for multiple scattering.
+        st.direct_only = false;
+        st.medium = Some(truth::water::medium(&w, scene.camera.position()));
+    }
     if let Some(w) = &scene.spectral.white {
         st.white = color::illuminant::by_name(w)?;
     }
-    let world = truth::World::new(scene, table, &st.white, st.range, None)?;
+    let world = truth::World::new(scene, table, &st.white, st.range, st.medium.as_ref())?;
     let img = match truth::render_world(&world, &st, cancel, progress) {
         Err(truth::TruthError::Cancelled) => bail!("interrupted"),
         r => r?,
