@@ -30,6 +30,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(|e| CompareError::io(path, e))?;
+    // Temp files are created 0600; an image or report is for everyone who can read the folder.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
+    }
     tmp.write_all(bytes).map_err(|e| CompareError::io(path, e))?;
     tmp.as_file().sync_all().map_err(|e| CompareError::io(path, e))?;
     // On failure `PersistError` hands the temp file back; dropping it deletes it.
