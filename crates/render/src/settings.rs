@@ -98,6 +98,14 @@ pub struct RenderSettings {
     pub shadows: bool,
     /// Measure each pass with GPU timestamp queries (when the adapter supports them).
     pub timestamps: bool,
+    /// Stratified wavelength jitter for frame accumulation: `Some(u)` with u in [0, 1) puts
+    /// sample i at `range.min + (i + u)·Δ` instead of the bin centre. It also switches every
+    /// normalisation (emission weights, the white correction of the XYZ → RGB matrix, the
+    /// scale of spectral lights) from "these N samples" to a dense 1 nm integral over `range`,
+    /// so that each frame is an unbiased estimate of the continuous integral and the average
+    /// of frames at stratified offsets converges to it. `None` (the default) is the midpoint
+    /// rule with per-N normalisation, which makes white exact at every N.
+    pub jitter: Option<f32>,
 }
 
 impl Default for RenderSettings {
@@ -111,6 +119,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::None,
             shadows: true,
             timestamps: false,
+            jitter: None,
         }
     }
 }
@@ -127,6 +136,11 @@ impl RenderSettings {
         WavelengthRange::new(self.range.min, self.range.max)?;
         if !self.exposure_ev.is_finite() {
             return Err(RenderError::Settings(format!("exposure must be finite (got {})", self.exposure_ev)));
+        }
+        if let Some(u) = self.jitter
+            && !(0.0..1.0).contains(&u)
+        {
+            return Err(RenderError::Settings(format!("the wavelength jitter must be in [0, 1) (got {u})")));
         }
         color::Observer::by_name(&self.observer)?;
         Ok(())
@@ -147,5 +161,10 @@ mod tests {
         assert!(bad.validate().unwrap_err().to_string().contains("got 0"));
         let bad = RenderSettings { observer: "cat".into(), ..Default::default() };
         assert!(bad.validate().unwrap_err().to_string().contains("cat"));
+        assert!(RenderSettings { jitter: Some(0.0), ..Default::default() }.validate().is_ok());
+        for u in [1.0, -0.1, f32::NAN] {
+            let bad = RenderSettings { jitter: Some(u), ..Default::default() };
+            assert!(bad.validate().unwrap_err().to_string().contains("jitter"), "{u}");
+        }
     }
 }

@@ -31,7 +31,8 @@ pub struct WavelengthGroup {
 #[derive(Clone, Debug)]
 pub struct SpectralSetup {
     pub wavelengths: SampledWavelengths,
-    /// Emission integrator: XYZ = Σ L(λᵢ)·wᵢ, scaled so that the white illuminant has Y = 1.
+    /// Emission integrator: XYZ = Σ L(λᵢ)·wᵢ, scaled so that the white illuminant has Y = 1
+    /// (over these samples; with jitter, over the dense integral of the render range).
     pub integrator: SpectralIntegrator,
     /// The white illuminant (the colour space's, D65 for sRGB), unnormalised.
     pub white: Spectrum,
@@ -40,11 +41,16 @@ pub struct SpectralSetup {
     /// XYZ → linear RGB, including a diagonal correction (in XYZ) that maps the white
     /// illuminant integrated with these N samples exactly onto the colour space's white. With
     /// it, a white surface under a white light is (1, 1, 1) for every N; without it, small N
-    /// tints everything by the quadrature error of the white.
+    /// tints everything by the quadrature error of the white. With jitter the correction uses
+    /// the dense white instead, so it is the same for every frame (and only the average of
+    /// frames is white).
     pub xyz_to_rgb: DMat3,
     pub space: RgbColorSpace,
     /// Dense (1 nm over the observer range) integrator for converting spectral lights to RGB.
     dense: SpectralIntegrator,
+    /// With jitter: the dense (1 nm midpoint over the render range) emission integrator that
+    /// every normalisation uses instead of the frame's own samples.
+    norm: Option<SpectralIntegrator>,
 }
 
 impl SpectralSetup {
@@ -52,10 +58,41 @@ impl SpectralSetup {
         let observer = Observer::by_name(&settings.observer)?;
         let space = RgbColorSpace::srgb();
         let white = space.illuminant();
-        let wavelengths = SampledWavelengths::midpoint(settings.range, settings.wavelengths)?;
-        let integrator = SpectralIntegrator::emission(&observer, &white, &wavelengths);
+        let (wavelengths, integrator, sampled_white, norm) = match settings.jitter {
+            None => {
+                let wavelengths = SampledWavelengths::midpoint(settings.range, settings.wavelengths)?;
+                let integrator = SpectralIntegrator::emission(&observer, &white, &wavelengths);
+                let sampled_white = integrator.integrate_samples(&white.sample(&wavelengths.lambda));
+                (wavelengths, integrator, sampled_white, None)
+            }
+            Some(u) => {
+                // Normalise with the dense integral over the render range, not these samples:
+                // a ratio of two N-sample estimates is biased, so frame averages would not
+                // converge (see `RenderSettings::jitter`).
+                let n_dense = settings.range.width().round().max(1.0) as usize;
+                let dense_wl = SampledWavelengths::midpoint(settings.range, n_dense)?;
+                let norm = SpectralIntegrator::emission(&observer, &white, &dense_wl);
+                let k: f64 = dense_wl
+                    .lambda
+                    .iter()
+                    .zip(&dense_wl.weight)
+                    .map(|(&l, &dl)| observer.eval(l)[1] * white.eval(l) * dl)
+                    .sum();
+                let k = if k > 0.0 { k } else { 1.0 };
+                let wavelengths =
+                    SampledWavelengths::stratified(settings.range, &vec![u as f64; settings.wavelengths])?;
+                let weights = wavelengths
+                    .lambda
+                    .iter()
+                    .zip(&wavelengths.weight)
+                    .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl / k))
+                    .collect();
+                let integrator = SpectralIntegrator { lambda: wavelengths.lambda.clone(), weights };
+                let dense_white = norm.integrate(|l| white.eval(l));
+                (wavelengths, integrator, dense_white, Some(norm))
+            }
+        };
         let white_samples = white.sample(&wavelengths.lambda);
-        let sampled_white = integrator.integrate_samples(&white_samples);
         let target_white = space.white_xyz();
         let correction = DVec3::from_array(std::array::from_fn(|c| {
             if sampled_white[c] > 1e-12 { target_white[c] / sampled_white[c] } else { 1.0 }
@@ -63,7 +100,7 @@ impl SpectralSetup {
         let xyz_to_rgb = space.from_xyz * DMat3::from_diagonal(correction);
         let dense_wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470)?;
         let dense = SpectralIntegrator::emission(&observer, &white, &dense_wl);
-        Ok(SpectralSetup { wavelengths, integrator, white, white_samples, xyz_to_rgb, space, dense })
+        Ok(SpectralSetup { wavelengths, integrator, white, white_samples, xyz_to_rgb, space, dense, norm })
     }
 
     pub fn len(&self) -> usize {
@@ -114,8 +151,9 @@ impl SpectralSetup {
     /// A light's emission at each wavelength for the spectral modes, in the units the RGB path
     /// uses (so that a white RGB light gives the same Y in every mode).
     ///
-    /// - A spectral light keeps its shape and is scaled so that its Y over these samples equals
-    ///   the luminance of `rgb × intensity` (the scene format's convention).
+    /// - A spectral light keeps its shape and is scaled so that its Y over these samples (with
+    ///   jitter: its dense Y over the render range) equals the luminance of `rgb × intensity`
+    ///   (the scene format's convention).
     /// - An RGB light uses the "illuminant" upsampling: `s·ρ(rgb/s)(λ)·W(λ)` with `s = 2·max(rgb)`
     ///   and W the colour space's white (sigmoid ρ in `Spectral` mode, box ρ in `Naive`).
     pub fn light_samples(&self, e: &Emission, mode: Mode, table: &CoeffTable) -> Vec<f64> {
@@ -123,7 +161,10 @@ impl SpectralSetup {
         let lambda = &self.wavelengths.lambda;
         if let Some(s) = &e.spectrum {
             let samples = s.sample(lambda);
-            let y = self.integrator.integrate_samples(&samples)[1];
+            let y = match &self.norm {
+                None => self.integrator.integrate_samples(&samples)[1],
+                Some(norm) => norm.integrate(|l| s.eval(l))[1],
+            };
             let k = if y > 0.0 { self.luminance(rgb) / y } else { 0.0 };
             return samples.iter().map(|v| v * k).collect();
         }

@@ -144,6 +144,7 @@ fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
         tonemap: Tonemap::parse(&args.tonemap)?,
         shadows: !args.no_shadows,
         timestamps: false,
+        jitter: None,
     };
     s.validate()
         .map_err(|e| if s.wavelengths == 0 { anyhow!("--wavelengths 0: {e}") } else { anyhow!("{e}") })?;

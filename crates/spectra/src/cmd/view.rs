@@ -76,6 +76,7 @@ pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSetti
         tonemap: Tonemap::parse(&args.tonemap).context("--tonemap")?,
         shadows: true,
         timestamps: true,
+        jitter: None,
     };
     s.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(s)
