@@ -25,7 +25,7 @@
 //! Radiance units: the HDR values are linear sRGB where a white diffuse surface under a
 //! 1-lux white directional light at normal incidence is 1/π.
 
-use super::{HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry};
+use super::{HDR_FORMAT, SharedLayouts, depth_entry, draw_fullscreen, fullscreen_pipeline, texture_entry};
 use crate::error::{RenderError, Result};
 use crate::shader;
 use color::Spectrum;
@@ -123,12 +123,13 @@ impl CustomPass {
         custom: &wgpu::BindGroup,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = fullscreen_pass(encoder, "custom", target, timestamps);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(1, inputs, &[]);
-        pass.set_bind_group(2, spectral, &[]);
-        pass.set_bind_group(3, custom, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(
+            encoder,
+            "custom",
+            target,
+            &self.pipeline,
+            &[frame, inputs, spectral, custom],
+            timestamps,
+        );
     }
 }

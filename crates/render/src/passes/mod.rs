@@ -157,6 +157,24 @@ pub(crate) fn fullscreen_pipeline(
     })
 }
 
+/// Records one full-screen triangle into `target` with `groups` bound in order (group i at
+/// index i): the whole of the shading, custom and post passes' recording.
+pub(crate) fn draw_fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    groups: &[&wgpu::BindGroup],
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) {
+    let mut pass = fullscreen_pass(encoder, label, target, timestamps);
+    pass.set_pipeline(pipeline);
+    for (index, group) in groups.iter().enumerate() {
+        pass.set_bind_group(index as u32, *group, &[]);
+    }
+    pass.draw(0..3, 0..1);
+}
+
 /// Begins a render pass that overwrites one colour target, with optional timestamps.
 pub(crate) fn fullscreen_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,

@@ -2,7 +2,7 @@
 //! (by the `Rgba8UnormSrgb` target's store). EXR output skips this pass's result and reads the
 //! linear HDR target instead.
 
-use super::{LDR_FORMAT, SharedLayouts, fullscreen_pass, fullscreen_pipeline, texture_entry};
+use super::{LDR_FORMAT, SharedLayouts, draw_fullscreen, fullscreen_pipeline, texture_entry};
 use crate::error::Result;
 use crate::shader;
 
@@ -38,10 +38,6 @@ impl PostPass {
         inputs: &wgpu::BindGroup,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = fullscreen_pass(encoder, "post", target, timestamps);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(1, inputs, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(encoder, "post", target, &self.pipeline, &[frame, inputs], timestamps);
     }
 }

@@ -16,7 +16,7 @@
 //! sample in that light's layer of the shadow-map array) are per pixel, not per wavelength.
 
 use super::{
-    HDR_FORMAT, SharedLayouts, depth_entry, fullscreen_pass, fullscreen_pipeline, texture_entry,
+    HDR_FORMAT, SharedLayouts, depth_entry, draw_fullscreen, fullscreen_pipeline, texture_entry,
     uniform_entry,
 };
 use crate::error::Result;
@@ -90,12 +90,13 @@ impl ShadingPass {
         custom: &wgpu::BindGroup,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = fullscreen_pass(encoder, "shading", target, timestamps);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(1, inputs, &[]);
-        pass.set_bind_group(2, spectral, &[]);
-        pass.set_bind_group(3, custom, &[]);
-        pass.draw(0..3, 0..1);
+        draw_fullscreen(
+            encoder,
+            "shading",
+            target,
+            &self.pipeline,
+            &[frame, inputs, spectral, custom],
+            timestamps,
+        );
     }
 }
