@@ -18,8 +18,12 @@ impl Gpu {
     /// Opens the default adapter without any window system. Honours `WGPU_BACKEND`
     /// (`vulkan`, `gl`, …), `WGPU_ADAPTER_NAME` and `WGPU_POWER_PREF`.
     pub fn headless() -> Result<Self> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let backends = wgpu::Backends::from_env().unwrap_or_default();
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        // GL cannot run the shading pass (see `from_adapter`), so without an explicit
+        // WGPU_BACKEND a machine lacking Vulkan gets the install hint, not a GLSL error.
+        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+        descriptor.backends = backends;
+        let instance = wgpu::Instance::new(descriptor);
         let adapter =
             pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(&instance, None)).map_err(
                 |e| RenderError::NoAdapter { backends: format!("{backends:?}"), reason: e.to_string() },
@@ -33,6 +37,17 @@ impl Gpu {
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::FLOAT32_FILTERABLE;
         let features = adapter.features() & wanted;
         let info = adapter.get_info();
+        if info.backend == wgpu::Backend::Gl {
+            // naga cannot translate `textureLoad` on depth textures to GLSL.
+            return Err(RenderError::Device {
+                adapter: format!("{} (GL)", info.name),
+                reason: format!(
+                    "the OpenGL backend cannot run spectra's shaders; use Vulkan \
+                     (no GPU: apt-get install mesa-vulkan-drivers libvulkan1){}",
+                    if std::env::var_os("WGPU_BACKEND").is_some() { ", and unset WGPU_BACKEND" } else { "" }
+                ),
+            });
+        }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("spectra"),
             required_features: features,
