@@ -5,6 +5,7 @@ use crate::coeff_table::GpuCoeffTable;
 use crate::error::{RenderError, Result};
 use crate::gpu::Gpu;
 use crate::passes::SharedLayouts;
+use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::post::PostPass;
@@ -47,6 +48,9 @@ struct TargetBindings {
     shading: wgpu::BindGroup,
     custom: wgpu::BindGroup,
     post: wgpu::BindGroup,
+    accumulate: wgpu::BindGroup,
+    /// Post reading the accumulated mean instead of the current frame.
+    post_accumulated: wgpu::BindGroup,
 }
 
 /// A real-time spectral deferred renderer.
@@ -62,6 +66,11 @@ pub struct Renderer {
     shading: ShadingPass,
     custom_pass: CustomPass,
     post: PostPass,
+    accumulate: AccumulatePass,
+    /// Whether frames go through the accumulation pass (off by default).
+    accumulating: bool,
+    /// Frames in the running mean since the last reset (0 = the next frame starts it).
+    accumulated: u32,
     table: Arc<CoeffTable>,
     gpu_table: GpuCoeffTable,
     frame_buffer: wgpu::Buffer,
@@ -99,6 +108,7 @@ impl Renderer {
         let shading = ShadingPass::new(device, &shared, &custom.source)?;
         let custom_pass = CustomPass::new(device, &shared, &custom.source)?;
         let post = PostPass::new(device, &shared)?;
+        let accumulate = AccumulatePass::new(device)?;
         let gpu_table = GpuCoeffTable::upload(device, &gpu.queue, &table);
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
@@ -121,6 +131,9 @@ impl Renderer {
             shading,
             custom_pass,
             post,
+            accumulate,
+            accumulating: false,
+            accumulated: 0,
             table,
             gpu_table,
             frame_buffer,
@@ -207,6 +220,7 @@ impl Renderer {
         let targets = Targets::new(&self.gpu.device, width, height);
         let bindings = self.target_bindings(&targets);
         self.targets = Some((targets, bindings));
+        self.accumulated = 0;
         Ok(())
     }
 
@@ -223,6 +237,36 @@ impl Renderer {
     /// exposure).
     pub fn hdr_view(&self) -> Option<&wgpu::TextureView> {
         self.targets.as_ref().map(|(t, _)| &t.hdr_view)
+    }
+
+    /// Turns temporal accumulation on or off. When on, each [`Self::render`] adds its linear
+    /// HDR image (after the custom pass) to a running mean over the frames since the last
+    /// [`Self::reset_accumulation`] (weight 1/k for the k-th, kept in f32), and post tone-maps
+    /// that mean; [`Self::read_accumulated`] reads it. The renderer cannot tell a new view from a
+    /// new noisy estimate of the same one: the caller resets whenever the camera, scene, size or
+    /// settings change (a resize resets by itself). Pair with `RenderSettings::jitter` at a new
+    /// offset every frame to converge to the dense spectral integral. Off (the default), frames
+    /// render exactly as without this pass. Switching resets the mean.
+    pub fn set_accumulation(&mut self, on: bool) {
+        if self.accumulating != on {
+            self.accumulating = on;
+            self.accumulated = 0;
+        }
+    }
+
+    /// Whether accumulation is on.
+    pub fn accumulation(&self) -> bool {
+        self.accumulating
+    }
+
+    /// Starts a new mean: the next frame rendered with accumulation on replaces it.
+    pub fn reset_accumulation(&mut self) {
+        self.accumulated = 0;
+    }
+
+    /// Frames in the current mean (0 when accumulation is off or was just reset).
+    pub fn accumulated_frames(&self) -> u32 {
+        if self.accumulating { self.accumulated } else { 0 }
     }
 
     /// The per-wavelength data of the last frame (wavelengths, weights, matrix).
@@ -299,7 +343,22 @@ impl Renderer {
             &spectral.custom_bind_group,
             ts(3),
         );
-        self.post.record(&mut encoder, &targets.ldr_view, &self.frame_bind_group, &bindings.post, ts(4));
+        let post_inputs = if self.accumulating {
+            self.accumulated = self.accumulated.saturating_add(1);
+            self.accumulate.set_frame(&self.gpu.queue, self.accumulated);
+            self.accumulate.record(
+                &mut encoder,
+                &targets.accum,
+                &targets.accum_prev,
+                &targets.accum_view,
+                &targets.accum_display_view,
+                &bindings.accumulate,
+            );
+            &bindings.post_accumulated
+        } else {
+            &bindings.post
+        };
+        self.post.record(&mut encoder, &targets.ldr_view, &self.frame_bind_group, post_inputs, ts(4));
         if let Some(t) = timer {
             t.resolve(&mut encoder);
         }
@@ -339,6 +398,27 @@ impl Renderer {
             .collect())
     }
 
+    /// The accumulated mean (see [`Self::set_accumulation`]) as RGBA f32 pixels. An error when
+    /// no frame has been accumulated since the last reset.
+    pub fn read_accumulated(&self) -> Result<Vec<[f32; 4]>> {
+        let (t, _) =
+            self.targets.as_ref().ok_or_else(|| RenderError::Settings("nothing rendered yet".into()))?;
+        if self.accumulated_frames() == 0 {
+            return Err(RenderError::Settings(
+                "no accumulated frame: turn accumulation on and render".into(),
+            ));
+        }
+        let bytes = readback::read_texture(&self.gpu.device, &self.gpu.queue, &t.accum, 16)?;
+        Ok(bytes
+            .chunks_exact(16)
+            .map(|p| {
+                std::array::from_fn(|c| {
+                    f32::from_le_bytes([p[4 * c], p[4 * c + 1], p[4 * c + 2], p[4 * c + 3]])
+                })
+            })
+            .collect())
+    }
+
     fn target_bindings(&self, t: &Targets) -> TargetBindings {
         let device = &self.gpu.device;
         fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
@@ -371,7 +451,21 @@ impl Renderer {
             layout: &self.post.input_layout,
             entries: &[view(0, &t.hdr_view)],
         });
-        TargetBindings { shading, custom, post }
+        let accumulate = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("accumulate inputs"),
+            layout: &self.accumulate.input_layout,
+            entries: &[
+                view(0, &t.hdr_view),
+                view(1, &t.accum_prev_view),
+                wgpu::BindGroupEntry { binding: 2, resource: self.accumulate.uniforms.as_entire_binding() },
+            ],
+        });
+        let post_accumulated = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("post inputs (accumulated)"),
+            layout: &self.post.input_layout,
+            entries: &[view(0, &t.accum_display_view)],
+        });
+        TargetBindings { shading, custom, post, accumulate, post_accumulated }
     }
 
     /// Rebuilds the per-wavelength buffers when the wavelengths, observer, mode, scene or custom

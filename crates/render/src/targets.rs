@@ -1,5 +1,6 @@
 //! The size-dependent render targets of one frame.
 
+use crate::passes::accumulate::ACCUM_FORMAT;
 use crate::passes::{DEPTH_FORMAT, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
 
 /// G-buffer, depth, HDR and display targets at one size. Recreated on resize.
@@ -16,6 +17,15 @@ pub struct Targets {
     /// Custom-pass output (pass 3): the linear HDR image EXR output stores.
     pub hdr: wgpu::Texture,
     pub hdr_view: wgpu::TextureView,
+    /// Running mean of `hdr` over the accumulated frames (f32), and the previous frame's mean
+    /// (copied aside each frame, read by the accumulation pass).
+    pub accum: wgpu::Texture,
+    pub accum_view: wgpu::TextureView,
+    pub accum_prev: wgpu::Texture,
+    pub accum_prev_view: wgpu::TextureView,
+    /// The running mean in the HDR format: post's input while accumulating.
+    pub accum_display: wgpu::Texture,
+    pub accum_display_view: wgpu::TextureView,
     /// Tone-mapped, sRGB-encoded display image (pass 4).
     pub ldr: wgpu::Texture,
     pub ldr_view: wgpu::TextureView,
@@ -50,6 +60,9 @@ impl Targets {
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
+        let (accum, accum_view) = make("accum", ACCUM_FORMAT, none);
+        let (accum_prev, accum_prev_view) = make("accum prev", ACCUM_FORMAT, wgpu::TextureUsages::COPY_DST);
+        let (accum_display, accum_display_view) = make("accum display", HDR_FORMAT, none);
         let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);
         Targets {
             width,
@@ -62,6 +75,12 @@ impl Targets {
             hdr_shaded_view,
             hdr,
             hdr_view,
+            accum,
+            accum_view,
+            accum_prev,
+            accum_prev_view,
+            accum_display,
+            accum_display_view,
             ldr,
             ldr_view,
         }

@@ -2,9 +2,10 @@
 //! passes share.
 //!
 //! Frame order: shadow (depth from each shadow-casting light, one layer each) → G-buffer →
-//! spectral shading → custom → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
+//! spectral shading → custom → (accumulate, only with `Renderer::set_accumulation`) → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
 //! per-wavelength data and the coefficient table, 3 = the custom shader's parameters.
 
+pub mod accumulate;
 pub mod custom;
 pub mod gbuffer;
 pub mod post;

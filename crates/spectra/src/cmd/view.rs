@@ -1,5 +1,6 @@
 //! `spectra view`: an interactive window with live controls (mode, N, range, observer,
-//! exposure, tone map), an orbit/fly camera, a CPU/GPU frame-time readout and screenshots.
+//! exposure, tone map, accumulation at jittered wavelengths), an orbit/fly camera, a CPU/GPU
+//! frame-time readout and screenshots.
 
 use crate::cmd::render::{load_table, parse_size};
 use crate::view::app::{ViewOptions, run as run_window};

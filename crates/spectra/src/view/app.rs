@@ -73,6 +73,8 @@ struct Running {
     adapter: String,
     /// egui textures to free after the next submitted frame.
     pending_free: Vec<egui::TextureId>,
+    /// The camera and settings of the last frame: accumulation restarts when either changes.
+    last_view: Option<(scene::Camera, RenderSettings)>,
 }
 
 impl ApplicationHandler for App {
@@ -181,6 +183,7 @@ impl Running {
             times: FrameTimes::default(),
             adapter: adapter_name,
             pending_free: Vec::new(),
+            last_view: None,
         })
     }
 
@@ -262,6 +265,7 @@ impl Running {
             KeyCode::BracketRight => c.step_wavelengths(1),
             KeyCode::KeyT => c.cycle_tonemap(),
             KeyCode::KeyO => c.cycle_observer(),
+            KeyCode::KeyJ => c.accumulate = !c.accumulate,
             KeyCode::Minus => c.step_exposure(-0.5),
             KeyCode::Equal => c.step_exposure(0.5),
             _ => {}
@@ -330,7 +334,9 @@ impl Running {
         self.controls.commit();
 
         let camera = self.camera.camera();
-        self.renderer.render(&camera, &self.controls.applied)?;
+        let settings = self.accumulation_settings(&camera);
+        self.renderer.render(&camera, &settings)?;
+        self.controls.accumulated_frames = self.renderer.accumulated_frames();
         self.times.gpu = self.renderer.read_timings()?;
 
         if std::mem::take(&mut self.controls.screenshot_requested) {
@@ -400,6 +406,24 @@ impl Running {
         Ok(())
     }
 
+    /// This frame's settings: the applied ones, plus (when accumulating) the next jitter offset
+    /// of the running mean, which restarts whenever the camera or the settings changed. (A
+    /// window resize restarts it inside the renderer.)
+    fn accumulation_settings(&mut self, camera: &scene::Camera) -> RenderSettings {
+        let applied = &self.controls.applied;
+        self.renderer.set_accumulation(self.controls.accumulate);
+        let same = self.last_view.as_ref().is_some_and(|(c, s)| same_camera(c, camera) && s == applied);
+        if !same {
+            self.renderer.reset_accumulation();
+            self.last_view = Some((*camera, applied.clone()));
+        }
+        let jitter = match self.controls.accumulate {
+            true => Some(super::controls::jitter_offset(self.renderer.accumulated_frames())),
+            false => applied.jitter,
+        };
+        RenderSettings { jitter, ..applied.clone() }
+    }
+
     /// Writes the renderer's display image (without the panel) to `screenshot-<n>.png`.
     fn screenshot(&self) -> Result<std::path::PathBuf> {
         let (w, h) = self.renderer.size().context("nothing rendered yet")?;
@@ -413,4 +437,10 @@ impl Running {
             .with_context(|| format!("writing {}", path.display()))?;
         Ok(path)
     }
+}
+
+/// Bit-for-bit the same view (any change, however small, makes the old mean wrong).
+fn same_camera(a: &scene::Camera, b: &scene::Camera) -> bool {
+    a.transform.to_cols_array().map(f32::to_bits) == b.transform.to_cols_array().map(f32::to_bits)
+        && [a.yfov, a.znear, a.zfar].map(f32::to_bits) == [b.yfov, b.znear, b.zfar].map(f32::to_bits)
 }

@@ -17,7 +17,16 @@ const TONEMAPS: [(Tonemap, &str); 3] =
 /// Shortcuts, shown in the panel and printed at start.
 pub const HELP: &str = "left drag: orbit · right drag: look · wheel: zoom · WASD/QE: fly (Shift ×4) · \
 R: reset camera · M or 1/2/3: mode · [ ]: N −/+1 · { }: N ÷/×2 · T: tone map · O: observer · \
-- =: exposure · F12 or P: screenshot · Esc: quit";
+- =: exposure · J: accumulate jittered λ · F12 or P: screenshot · Esc: quit";
+
+/// The wavelength jitter of accumulated frame `k` (0-based since the last reset): the
+/// golden-ratio additive recurrence u_k = frac(½ + k/φ), whose first K values fall one in each
+/// of K strata of [0, 1) up to a small discrepancy for every K, so the running mean is a
+/// stratified estimate whenever the user looks at it (no K fixed in advance).
+pub fn jitter_offset(k: u32) -> f32 {
+    const INV_PHI: f64 = 0.618_033_988_749_894_9;
+    ((0.5 + k as f64 * INV_PHI).fract() as f32).min(1.0 - f32::EPSILON)
+}
 
 /// What the user asked for and what is on screen.
 pub struct Controls {
@@ -31,6 +40,10 @@ pub struct Controls {
     pub status: String,
     pub screenshot_requested: bool,
     pub reset_camera_requested: bool,
+    /// Accumulate frames with jittered wavelengths ([`jitter_offset`]) until the view changes.
+    pub accumulate: bool,
+    /// Frames in the displayed mean (set by the window each frame, shown in the panel).
+    pub accumulated_frames: u32,
 }
 
 /// Timing shown in the panel.
@@ -51,6 +64,8 @@ impl Controls {
             status: String::new(),
             screenshot_requested: false,
             reset_camera_requested: false,
+            accumulate: false,
+            accumulated_frames: 0,
         }
     }
 
@@ -140,6 +155,12 @@ impl Controls {
             }
         });
         ui.checkbox(&mut w.shadows, "shadow maps");
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.accumulate, "accumulate (jittered λ) (J)");
+            if self.accumulate {
+                ui.monospace(format!("{} frames", self.accumulated_frames));
+            }
+        });
         if let Some(e) = &self.error {
             ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
         }
@@ -235,6 +256,23 @@ mod tests {
         c.commit();
         assert!(c.error.is_none());
         assert_eq!((c.applied.range.min, c.applied.range.max, c.applied.wavelengths), (700.0, 780.0, 5));
+    }
+
+    #[test]
+    fn jitter_offsets_are_stratified() {
+        // Every prefix of K offsets puts at most 2 in any of K equal strata and leaves few empty
+        // (the recurrence's three-gap property), and all lie in [0, 1).
+        for k in [1usize, 2, 3, 5, 8, 13, 16, 100] {
+            let mut counts = vec![0; k];
+            for i in 0..k as u32 {
+                let u = jitter_offset(i);
+                assert!((0.0..1.0).contains(&u), "{u}");
+                counts[(u * k as f32) as usize] += 1;
+            }
+            assert!(counts.iter().all(|&c| c <= 2), "K = {k}: {counts:?}");
+            assert!(counts.iter().filter(|&&c| c == 0).count() <= k / 3, "K = {k}: {counts:?}");
+        }
+        assert_eq!(jitter_offset(0), 0.5);
     }
 
     #[test]
