@@ -53,10 +53,10 @@ pub fn sample(tex: &Texture, uv: Vec2) -> Vec4 {
     f.texels.iter().zip(f.weights).map(|(&t, w)| texel(tex, t) * w).sum()
 }
 
-/// IEC 61966-2-1 decoding.
+/// IEC 61966-2-1 decoding: the colour crate's curve, in the tracer's f32.
 #[inline]
 pub fn srgb_decode(v: f32) -> f32 {
-    if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+    color::colorspace::srgb_decode(v as f64) as f32
 }
 
 #[cfg(test)]
