@@ -95,17 +95,9 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
-    let depth = textureLoad(gbuf_depth, px, 0);
-    let background = depth >= 1.0;
-    let p = world_from_depth(in.pos.xy, depth, frame);
-    let to_p = p - frame.camera_pos.xyz;
-    var ctx: SurfaceContext;
-    ctx.world_pos = p;
-    ctx.view_dir = normalize(to_p);
-    ctx.distance = select(length(to_p), 0.0, background);
-    ctx.background = background;
-    ctx.pixel = vec2<u32>(px);
-    ctx.normal = vec3<f32>(0.0);
+    var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
+    let background = ctx.background;
+    let p = ctx.world_pos;
 
     var base = vec3<f32>(0.0);
     var emission = vec3<f32>(0.0);

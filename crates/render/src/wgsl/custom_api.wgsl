@@ -31,3 +31,19 @@ struct SurfaceContext {
     // Pixel coordinates.
     pixel: vec2<u32>,
 };
+
+// The context of the pixel at fragment position `pos` whose G-buffer depth is `depth`, as the
+// shading and custom passes both build it. The normal is left zero for the caller to fill.
+fn surface_context(pos: vec2<f32>, depth: f32, f: FrameUniforms) -> SurfaceContext {
+    let background = depth >= 1.0;
+    let p = world_from_depth(pos, depth, f);
+    let to_p = p - f.camera_pos.xyz;
+    var ctx: SurfaceContext;
+    ctx.world_pos = p;
+    ctx.view_dir = normalize(to_p);
+    ctx.distance = select(length(to_p), 0.0, background);
+    ctx.background = background;
+    ctx.pixel = vec2<u32>(pos);
+    ctx.normal = vec3<f32>(0.0);
+    return ctx;
+}
