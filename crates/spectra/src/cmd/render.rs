@@ -13,10 +13,26 @@ use std::sync::Arc;
 pub struct RenderArgs {
     /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
+    #[command(flatten)]
+    pub look: LookArgs,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
+    pub size: String,
+    /// Disable shadow maps (otherwise each of the first eight lights casts shadows).
+    #[arg(long)]
+    pub no_shadows: bool,
+    /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// What the picture looks like: shared by `spectra render` and `spectra view`.
+#[derive(Args, Debug)]
+pub struct LookArgs {
     /// rgb (classic), naive (box upsampling) or spectral (Jakob–Hanika).
     #[arg(long, default_value = "spectral")]
     pub mode: String,
-    /// Number of wavelength samples (default: the scene's, else 16).
+    /// Number of wavelength samples (default: the scene's, else 16; the viewer shows 1–64).
     #[arg(long)]
     pub wavelengths: Option<usize>,
     /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
@@ -25,18 +41,12 @@ pub struct RenderArgs {
     /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
     #[arg(long)]
     pub observer: Option<String>,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "640x480")]
-    pub size: String,
     /// Exposure in stops (the image is multiplied by 2^EV).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// Tone mapping for PNG output: none, reinhard or aces.
+    /// Tone mapping (PNG output and the window): none, reinhard or aces.
     #[arg(long, default_value = "none")]
     pub tonemap: String,
-    /// Disable shadow maps (otherwise each of the first eight lights casts shadows).
-    #[arg(long)]
-    pub no_shadows: bool,
     /// Jakob–Hanika coefficient table (.coeff). Default: the sRGB 64³ table, fitted once per
     /// machine and cached (see `spectra lut`, $SPECTRA_CACHE_DIR).
     #[arg(long)]
@@ -48,9 +58,24 @@ pub struct RenderArgs {
     /// Camera depth below the water surface, metres (default: the scene's, else 10).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub depth: Option<f64>,
-    /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
-    #[arg(long)]
-    pub out: PathBuf,
+}
+
+impl LookArgs {
+    /// Range, N and observer: the arguments first, then the scene's spectral defaults, then
+    /// the renderer's.
+    pub fn spectral(&self, scene: &scene::Scene) -> Result<(WavelengthRange, usize, String)> {
+        let d = RenderSettings::default();
+        let range = match (&self.range, scene.spectral.range) {
+            (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
+            (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
+                .with_context(|| format!("scene {}: spectral range", scene.source))?,
+            (None, None) => d.range,
+        };
+        let wavelengths =
+            self.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
+        let observer = self.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
+        Ok((range, wavelengths, observer))
+    }
 }
 
 /// Camera depth used when `--water` is given for a scene without water settings.
@@ -126,22 +151,14 @@ fn out_format(path: &Path) -> Result<OutFormat> {
 
 /// Settings from the arguments, falling back to the scene's spectral defaults.
 fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
-    let d = RenderSettings::default();
-    let range = match (&args.range, scene.spectral.range) {
-        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
-        (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
-            .with_context(|| format!("scene {}: spectral range", scene.source))?,
-        (None, None) => d.range,
-    };
-    let wavelengths =
-        args.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
+    let (range, wavelengths, observer) = args.look.spectral(scene)?;
     let s = RenderSettings {
-        mode: Mode::parse(&args.mode)?,
+        mode: Mode::parse(&args.look.mode)?,
         wavelengths,
         range,
-        observer: args.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer),
-        exposure_ev: args.exposure,
-        tonemap: Tonemap::parse(&args.tonemap)?,
+        observer,
+        exposure_ev: args.look.exposure,
+        tonemap: Tonemap::parse(&args.look.tonemap)?,
         shadows: !args.no_shadows,
         timestamps: false,
         jitter: None,
@@ -169,8 +186,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (width, height) = parse_size(&args.size)?;
     let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
     let settings = settings(&args, &scene)?;
-    let water = water_medium(&scene, args.water.as_deref(), args.depth)?;
-    let table = load_table(args.table.as_deref())?;
+    let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
+    let table = load_table(args.look.table.as_deref())?;
     let mut r = Renderer::with_table(table)?;
     r.set_scene(&scene)?;
     if let Some(m) = &water {

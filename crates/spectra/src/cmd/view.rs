@@ -2,14 +2,12 @@
 //! exposure, tone map, accumulation at jittered wavelengths), an orbit/fly camera, a CPU/GPU
 //! frame-time readout and screenshots.
 
-use crate::cmd::render::{load_table, parse_size};
+use crate::cmd::render::{LookArgs, load_table, parse_size};
 use crate::view::app::{ViewOptions, run as run_window};
 use crate::view::controls::MAX_VIEW_WAVELENGTHS;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
-use color::WavelengthRange;
 use render::{Mode, RenderSettings, Tonemap};
-use std::path::PathBuf;
 
 /// What to say when there is nowhere to open a window.
 pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra render`";
@@ -21,60 +19,25 @@ pub struct Args {
     /// Initial window size WIDTHxHEIGHT (the renderer follows the window).
     #[arg(long, default_value = "960x640")]
     pub size: String,
-    /// rgb (classic), naive (box upsampling) or spectral (Jakob–Hanika).
-    #[arg(long, default_value = "spectral")]
-    pub mode: String,
-    /// Number of wavelength samples, 1–64 (default: the scene's, else 16).
-    #[arg(long)]
-    pub wavelengths: Option<usize>,
-    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
-    #[arg(long)]
-    pub range: Option<String>,
-    /// Observer, e.g. cie1931 or cie1964 (default: the scene's, else cie1931).
-    #[arg(long)]
-    pub observer: Option<String>,
-    /// Exposure in stops.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
-    /// Tone mapping: none, reinhard or aces.
-    #[arg(long, default_value = "none")]
-    pub tonemap: String,
-    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
-    #[arg(long)]
-    pub table: Option<PathBuf>,
-    /// Under water: a Jerlov type (I … III, 1C … 9C, blends like II.5); default: the scene's
-    /// water settings, if any.
-    #[arg(long, value_name = "TYPE")]
-    pub water: Option<String>,
-    /// Camera depth below the water surface, metres (default: the scene's, else 10).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
-    pub depth: Option<f64>,
+    #[command(flatten)]
+    pub look: LookArgs,
 }
 
 /// The initial settings: arguments first, then the scene's spectral defaults, then the
 /// renderer's. Refuses what the viewer cannot show, naming the argument.
 pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSettings> {
-    let d = RenderSettings::default();
-    let range = match (&args.range, scene.spectral.range) {
-        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
-        (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
-            .with_context(|| format!("scene {}: spectral range", scene.source))?,
-        (None, None) => d.range,
-    };
-    let wavelengths =
-        args.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
+    let (range, wavelengths, observer) = args.look.spectral(scene)?;
     if !(1..=MAX_VIEW_WAVELENGTHS).contains(&wavelengths) {
         bail!("--wavelengths {wavelengths}: the viewer shows 1 to {MAX_VIEW_WAVELENGTHS} wavelengths");
     }
-    let observer = args.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
     color::Observer::by_name(&observer).with_context(|| format!("--observer '{observer}'"))?;
     let s = RenderSettings {
-        mode: Mode::parse(&args.mode).context("--mode")?,
+        mode: Mode::parse(&args.look.mode).context("--mode")?,
         wavelengths,
         range,
         observer,
-        exposure_ev: args.exposure,
-        tonemap: Tonemap::parse(&args.tonemap).context("--tonemap")?,
+        exposure_ev: args.look.exposure,
+        tonemap: Tonemap::parse(&args.look.tonemap).context("--tonemap")?,
         shadows: true,
         timestamps: true,
         jitter: None,
@@ -92,13 +55,13 @@ pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
     let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
     let settings = initial_settings(&args, &scene)?;
-    let water = super::render::water_medium(&scene, args.water.as_deref(), args.depth)?;
+    let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
     if !display_named(std::env::var_os("DISPLAY")) {
         bail!("{NO_DISPLAY}");
     }
     // The event loop connects to the X server; a named but unreachable display fails here.
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
-    let table = load_table(args.table.as_deref())?;
+    let table = load_table(args.look.table.as_deref())?;
     run_window(event_loop, ViewOptions { scene, settings, size, table, water })
 }
 
