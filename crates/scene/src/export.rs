@@ -225,7 +225,13 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
     if let Some(w) = &scene.water {
         scene_extras.insert(
             "water".into(),
-            json!({"type": w.water_type, "depth": w.depth, "sun_direction": w.sun_direction.to_array(), "scale": w.scale}),
+            json!({
+                "type": w.water_type,
+                "depth": w.depth,
+                "sun_direction": w.sun_direction.to_array(),
+                "scale": w.scale,
+                "sky": w.sky,
+            }),
         );
     }
 

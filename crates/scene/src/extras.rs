@@ -9,7 +9,7 @@ use serde_json::{Map, Value};
 use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::spectrum_desc;
-use crate::{PaletteEntry, SpectralReflectance, SpectralSettings, WaterSettings};
+use crate::{MAX_SKY, PaletteEntry, SpectralReflectance, SpectralSettings, WaterSettings};
 
 /// Parses raw `extras` JSON at `at` (e.g. `materials[3]`) into an object, `None` when absent.
 pub(crate) fn object(
@@ -218,7 +218,7 @@ fn finite(ctx: &Ctx, f: &str, v: &Value) -> Result<f32, SceneError> {
 
 fn water(ctx: &Ctx, at: &str, v: &Value) -> Result<WaterSettings, SceneError> {
     let map = v.as_object().ok_or_else(|| ctx.extras(at, "expected an object"))?;
-    check_keys(ctx, at, map, &["type", "depth", "sun_direction", "scale"])?;
+    check_keys(ctx, at, map, &["type", "depth", "sun_direction", "scale", "sky"])?;
     let tf = format!("{at}.type");
     let water_type = map
         .get("type")
@@ -254,5 +254,13 @@ fn water(ctx: &Ctx, at: &str, v: &Value) -> Result<WaterSettings, SceneError> {
     if scale <= 0.0 {
         return Err(ctx.extras(&cf, format!("metres per scene unit must be > 0, got {scale}")));
     }
-    Ok(WaterSettings { water_type, depth, sun_direction: sun, scale })
+    let kf = format!("{at}.sky");
+    let sky = map.get("sky").map(|s| finite(ctx, &kf, s)).transpose()?.unwrap_or(0.0);
+    if !(0.0..=MAX_SKY).contains(&sky) {
+        return Err(ctx.extras(
+            &kf,
+            format!("sky irradiance as a multiple of the sun's must lie in 0 ..= {MAX_SKY}, got {sky}"),
+        ));
+    }
+    Ok(WaterSettings { water_type, depth, sun_direction: sun, scale, sky })
 }

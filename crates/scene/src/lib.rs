@@ -237,4 +237,13 @@ pub struct WaterSettings {
     pub sun_direction: Vec3,
     /// Metres per scene unit.
     pub scale: f32,
+    /// Diffuse sky light, as a multiple of the sun's: the sky's downwelling irradiance just
+    /// below the surface is `sky` × the sun's there (emission × cosine of its refracted
+    /// direction to the vertical), with the sun's spectrum (a simplification both renderers
+    /// share). 0 = no sky; glTF `extras.water.sky`, 0 ≤ sky ≤ [`MAX_SKY`].
+    pub sky: f32,
 }
+
+/// Largest accepted [`WaterSettings::sky`]: even under overcast skies the diffuse light is a few
+/// times the (weakened) direct sun, not tens of times, so a larger value is a typo.
+pub const MAX_SKY: f32 = 10.0;

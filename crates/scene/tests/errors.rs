@@ -174,6 +174,9 @@ fn bad_extras() {
         }),
         &["water.type", "required"],
     );
+    expect(&mutate(|d| d["scenes"][0]["extras"]["water"]["sky"] = json!(-0.1)), &["water.sky", "0 ..= 10"]);
+    expect(&mutate(|d| d["scenes"][0]["extras"]["water"]["sky"] = json!(10.5)), &["water.sky", "10.5"]);
+    expect(&mutate(|d| d["scenes"][0]["extras"]["water"]["sky"] = json!("blue")), &["water.sky", "number"]);
     expect(
         &mutate(|d| d["materials"][1]["extras"]["reflectance"] = json!("D65")),
         &["materials[1].extras.reflectance", "[0, 1]"],

@@ -96,7 +96,7 @@ fn check_textured(s: &scene::Scene) {
     assert_eq!(s.spectral.wavelengths, Some(16));
     assert_eq!(s.spectral.white.as_deref(), Some("D65"));
     let w = s.water.as_ref().unwrap();
-    assert_eq!((w.water_type.as_str(), w.depth, w.scale), ("II", 10.0, 1.0));
+    assert_eq!((w.water_type.as_str(), w.depth, w.scale, w.sky), ("II", 10.0, 1.0, 0.0));
     assert!(close(w.sun_direction, Vec3::Y));
 }
 

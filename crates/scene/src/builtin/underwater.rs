@@ -116,6 +116,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         depth: DEPTH,
         sun_direction: SUN.normalize(),
         scale: 1.0,
+        sky: 0.0,
     };
     let medium = WaterMedium::from_settings(&settings).map_err(|e| ctx.invalid("water", e.to_string()))?;
     // The sun as it reaches the sea floor: refracted at the surface. Irradiance π lux on a plane

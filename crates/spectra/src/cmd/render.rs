@@ -96,6 +96,7 @@ pub fn water_medium(
             depth: DEFAULT_WATER_DEPTH as f32,
             sun_direction: glam::Vec3::Y,
             scale: 1.0,
+            sky: 0.0,
         });
         settings = Some(scene::WaterSettings { water_type: ty.to_string(), ..base });
     }

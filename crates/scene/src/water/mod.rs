@@ -470,8 +470,13 @@ mod tests {
         assert!(e.contains("a + b"), "{e}");
         let inf = WaterProperties { b: Spectrum::Constant(f64::INFINITY), ..p };
         assert!(WaterMedium::with_properties(inf, 1.0, sun(), 1.0).is_err());
-        let settings =
-            WaterSettings { water_type: "XIV".into(), depth: 3.0, sun_direction: sun(), scale: 1.0 };
+        let settings = WaterSettings {
+            water_type: "XIV".into(),
+            depth: 3.0,
+            sun_direction: sun(),
+            scale: 1.0,
+            sky: 0.0,
+        };
         let e = WaterMedium::from_settings(&settings).unwrap_err().to_string();
         assert!(e.contains("XIV") && e.contains("II.5"), "{e}");
         let m = WaterMedium::new(t, 2.0, sun(), 1.0).unwrap();
@@ -491,6 +496,7 @@ mod tests {
             depth: 4.0,
             sun_direction: Vec3::new(1.0, 1e-6, 0.0),
             scale: 2.0,
+            sky: 0.0,
         };
         let m = WaterMedium::from_settings(&s).unwrap();
         assert_eq!(m.water_type.unwrap().to_string(), "1C.5");
