@@ -153,7 +153,8 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
     }
 
     let mut lights = Vec::new();
-    for (i, l) in scene.lights.iter().enumerate() {
+    // Sky stand-ins are derived from `water.sky`; the loader makes them again.
+    for (i, l) in scene.lights.iter().filter(|l| !crate::sky::is_stand_in(l)).enumerate() {
         let e = &l.emission;
         let mut j = json!({"name": l.name, "color": e.rgb.to_array(), "intensity": e.intensity});
         let (pos, dir) = match l.kind {

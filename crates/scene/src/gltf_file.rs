@@ -133,7 +133,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         materials.push(Material { name: "default".into(), ..Material::default() });
     }
     let camera = camera.unwrap_or_else(|| Camera::framing(crate::framing::bounds(&meshes)));
-    Ok(Scene {
+    let mut scene = Scene {
         source: ctx.path.display().to_string(),
         meshes,
         materials,
@@ -142,7 +142,9 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         camera,
         spectral: sx.spectral,
         water: sx.water,
-    })
+    };
+    crate::sky::sync(&mut scene).map_err(|m| ctx.extras("water.sky", m))?;
+    Ok(scene)
 }
 
 /// Checks what the `gltf` crate assumes without checking (it would panic): the POSITION accessor

@@ -15,6 +15,7 @@ mod extras;
 pub mod framing;
 mod gltf_file;
 mod primitive;
+pub mod sky;
 pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
@@ -181,6 +182,8 @@ pub struct Light {
     /// twice; a renderer that only shades punctual lights uses it and draws `meshes[i]` merely
     /// as a glowing surface. In glTF: light `extras.stands_in_for` = the index of the node
     /// holding the emissive mesh (it resolves to that node's first primitive).
+    /// `Some(`[`sky::SKY_STAND_IN`]`)`: the diffuse sky under water (see [`sky`]), not a mesh;
+    /// derived from `WaterSettings::sky`, never written to files.
     pub stands_in_for: Option<usize>,
 }
 

@@ -85,6 +85,9 @@ fn compare(a: &Scene, b: &Scene) {
     assert!(a.camera.transform.abs_diff_eq(b.camera.transform, 1e-5));
     assert_eq!((a.camera.yfov, a.camera.aspect), (b.camera.yfov, b.camera.aspect));
     assert_eq!(a.spectral.white, b.spectral.white);
+    // Water, including the sky (whose stand-in light is not written but made again on load).
+    let w = |s: &Scene| s.water.as_ref().map(|w| (w.water_type.clone(), w.depth, w.scale, w.sky));
+    assert_eq!(w(a), w(b));
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! `underwater`: a patch of sea floor seen by a diver 1.2 m above it — a sand texture, a
 //! ColorChecker board (the chart at 4× size with its measured palette), a striped textured crate
 //! and two measured-reflectance blocks — lit by the D65 sun refracted through a flat surface.
-//! The scene carries `WaterSettings` (Jerlov IB, camera 10 m deep, metres as scene units), so
+//! The scene carries `WaterSettings` (Jerlov IB, camera 10 m deep, metres as scene units, a
+//! clear maritime sky of [`SKY`] × the sun, hence a second, stand-in light), so
 //! `spectra render underwater` draws it under water without flags; `--water`/`--depth` override.
 //!
 //! Sizes are real-world metres so the water's per-metre coefficients act at the right scale:
@@ -23,8 +24,16 @@ use crate::{
 pub const WATER_TYPE: &str = "IB";
 /// Default camera depth, metres.
 pub const DEPTH: f32 = 10.0;
-/// Direction towards the sun above the water (≈ 37° from the zenith).
+/// Direction towards the sun above the water (≈ 34° from the zenith).
 pub const SUN: Vec3 = Vec3::new(0.45, 0.8, 0.3);
+/// Diffuse sky irradiance just below the surface, as a multiple of the sun's there
+/// (`WaterSettings::sky`). From the clear-sky model SPCTRAL2 (Bird & Riordan 1986, via pvlib)
+/// for this sun (34° from the zenith) over the sea with aerosol optical depth 0.1 at 500 nm (a
+/// typical clear maritime value): sky/sun = 0.160 above the surface in luminance, 0.153 below
+/// it (the uniform sky keeps T̄ = 0.932 of its light through the surface, this sun T = 0.977);
+/// 0.106 for aerosol optical depth 0.05 and 0.252 for 0.2. `python3 tools/sky_ratio.py`
+/// prints the table.
+pub const SKY: f32 = 0.15;
 
 /// Sand: a 64² sRGB texture of grains around a pale sandy colour, from an integer hash so it is
 /// identical on every machine.
@@ -116,7 +125,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         depth: DEPTH,
         sun_direction: SUN.normalize(),
         scale: 1.0,
-        sky: 0.0,
+        sky: SKY,
     };
     let medium = WaterMedium::from_settings(&settings).map_err(|e| ctx.invalid("water", e.to_string()))?;
     // The sun as it reaches the sea floor: refracted at the surface. Irradiance π lux on a plane
@@ -130,6 +139,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         stands_in_for: None,
     });
     s.water = Some(settings);
+    crate::sky::sync(&mut s).map_err(|m| ctx.invalid("water.sky", m))?;
     Ok(s)
 }
 
