@@ -127,7 +127,12 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
                 ..Default::default()
             };
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
-            let wet = render(&mut r, &scene, &settings, underwater::shader(&medium));
+            let wet = render(
+                &mut r,
+                &scene,
+                &settings,
+                underwater::shader_with(&medium, &underwater::Options::paper()),
+            );
             let setup = SpectralSetup::new(&settings).unwrap();
             // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
@@ -176,7 +181,8 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
     let medium = WaterMedium::new(WaterType::parse("3C").unwrap(), 4.0, Vec3::Y, 1.0).unwrap();
     let settings = RenderSettings { mode: Mode::Rgb, shadows: false, ..Default::default() };
     let dry = render(&mut r, &scene, &settings, CustomShader::default());
-    let wet = render(&mut r, &scene, &settings, underwater::shader(&medium));
+    let wet =
+        render(&mut r, &scene, &settings, underwater::shader_with(&medium, &underwater::Options::paper()));
     let e0 = 3.0 * (-light_dir().y as f64);
     let mut worst = 0.0f64;
     for py in 0..H {
@@ -197,4 +203,168 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
         }
     }
     eprintln!("underwater RGB hook vs CPU: worst relative error {worst:.2e}");
+}
+
+/// Ray-marched single scattering (the default model) against the CPU reference
+/// `scene::water::single`: the sun's beam in closed form (the march integrates each segment
+/// exactly and the rays here are unshadowed, so the GPU must be exact up to f32/f16), the
+/// diffuse rest of the paper's term, and a point light's equiangular sum with the same steps
+/// and the same cut, per wavelength, per pixel, with shadow maps on (nothing occludes the
+/// water, so every march sample must come out lit).
+#[test]
+fn single_scattering_matches_cpu_reference_to_1e_3() {
+    use scene::water::single;
+    let mut scene = floor_scene();
+    let lamp = Vec3::new(2.5, 3.0, -7.0);
+    scene.lights.push(Light {
+        name: "lamp".into(),
+        kind: LightKind::Point { position: lamp, range: None },
+        emission: Emission { rgb: Vec3::ONE, intensity: 40.0, spectrum: None },
+        stands_in_for: None,
+    });
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let table = common::table();
+    let options = underwater::Options::default();
+    let steps = options.steps;
+    let g = options.phase_g as f64;
+    let eye = scene.camera.position();
+    let (mut worst, mut n_surface, mut n_down, mut n_up) = (0.0f64, 0, 0, 0);
+    for (ty, depth, scale) in [("IB", 5.0, 1.0), ("3C", 3.0, 0.5)] {
+        let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
+        let c_min = underwater::params_with(&medium, &options)[7] as f64;
+        for lambda in [450.0, 530.0, 610.0] {
+            let settings = RenderSettings {
+                mode: Mode::Spectral,
+                wavelengths: 1,
+                range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
+                shadows: true,
+                ..Default::default()
+            };
+            let dry = render(&mut r, &scene, &settings, CustomShader::default());
+            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
+            let setup = SpectralSetup::new(&settings).unwrap();
+            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+            let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table)[0];
+            let i_lamp = setup.light_samples(&scene.lights[1].emission, Mode::Spectral, &table)[0];
+            let k = medium.coefficients(lambda);
+            let to_sun = -light_dir().as_dvec3();
+            // The lamp in metres from the camera; I/r² in scene units is I·scale²/r² in metres.
+            let lamp_m = (lamp - eye).as_dvec3() * scale;
+            let i_m = i_lamp * scale * scale;
+            for py in 0..H {
+                for px in 0..W {
+                    let Some((dir, hit)) = pixel_ray(&scene.camera, px, py) else { continue };
+                    let w = dir.as_dvec3();
+                    let d = match hit {
+                        Some(t) => t as f64 * scale,
+                        None if w.y > 0.0 => depth / w.y,
+                        None => f64::INFINITY,
+                    };
+                    let scatter = single::diffuse(k.b, k.c, k.kd, &[(to_sun, e_sun)], w, depth, d)
+                        + single::beam(k.b, k.c, g, to_sun, e_sun, w, depth, d)
+                        + single::point_equiangular(k.b, k.c, g, lamp_m, i_m, w, d.min(6.0 / c_min), steps);
+                    let i = (py * W + px) as usize;
+                    let surface = match hit {
+                        Some(_) => {
+                            let t = medium.pixel_terms(&[lambda], dir, d).unwrap()[0];
+                            DVec3::from(common::rgb_of(&dry[i])) * (t.surface_attenuation * t.transmittance)
+                        }
+                        None => DVec3::ZERO,
+                    };
+                    let want = surface + unit * scatter;
+                    let got = common::rgb_of(&wet[i]);
+                    let e = rel_err(got, want.to_array());
+                    assert!(
+                        e <= 1e-3,
+                        "{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py}) dir {dir:?} hit {hit:?}: \
+                         gpu {got:?} cpu {want:?} (relative error {e:.2e})"
+                    );
+                    worst = worst.max(e);
+                    match (hit, dir.y > 0.0) {
+                        (Some(_), _) => n_surface += 1,
+                        (None, false) => n_down += 1,
+                        (None, true) => n_up += 1,
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "single scattering GPU vs CPU: worst relative error {worst:.2e} over {n_surface} surface, \
+         {n_down} downward-background and {n_up} upward-background pixel-wavelengths"
+    );
+    assert!(n_surface > 100 && n_down > 20 && n_up > 100, "{n_surface} {n_down} {n_up}");
+}
+
+/// Shadows in the water: under an opaque roof the sun's beam is blocked along the whole
+/// camera → floor ray, so the march must see it shadowed at every step and the pixel is the
+/// (shadowed) surface term plus the diffuse rest alone — and the beam part that went missing
+/// must be a sizeable share without the roof (or the test would prove nothing).
+#[test]
+fn single_scattering_is_shadowed_under_a_roof() {
+    use scene::water::single;
+    let mut scene = floor_scene();
+    let roof = [
+        Vec3::new(-30.0, 3.5, 10.0),
+        Vec3::new(-30.0, 3.5, -60.0),
+        Vec3::new(30.0, 3.5, -60.0),
+        Vec3::new(30.0, 3.5, 10.0),
+    ];
+    scene.meshes.push(Mesh {
+        positions: roof.to_vec(),
+        normals: vec![Vec3::NEG_Y; 4],
+        tangents: vec![],
+        uvs: vec![Vec2::ZERO; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: 0,
+    });
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let table = common::table();
+    let options = underwater::Options::default();
+    let (depth, lambda) = (6.0, 500.0);
+    let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
+    let settings = RenderSettings {
+        mode: Mode::Spectral,
+        wavelengths: 1,
+        range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
+        shadows: true,
+        ..Default::default()
+    };
+    let dry = render(&mut r, &scene, &settings, CustomShader::default());
+    let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
+    let setup = SpectralSetup::new(&settings).unwrap();
+    let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+    let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table)[0];
+    let k = medium.coefficients(lambda);
+    let to_sun = -light_dir().as_dvec3();
+    let (mut worst, mut n, mut beam_share) = (0.0f64, 0, 0.0f64);
+    for py in 0..H {
+        for px in 0..W {
+            // Floor pixels only: the roof is what upward rays hit.
+            let Some((dir, Some(t))) = pixel_ray(&scene.camera, px, py) else { continue };
+            let w = dir.as_dvec3();
+            let d = t as f64;
+            let i = (py * W + px) as usize;
+            let terms = medium.pixel_terms(&[lambda], dir, d).unwrap()[0];
+            let diffuse = single::diffuse(k.b, k.c, k.kd, &[(to_sun, e_sun)], w, depth, d);
+            let beam = single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
+            let want = DVec3::from(common::rgb_of(&dry[i]))
+                * (terms.surface_attenuation * terms.transmittance)
+                + unit * diffuse;
+            let got = common::rgb_of(&wet[i]);
+            let e = rel_err(got, want.to_array());
+            assert!(e <= 1e-3, "pixel ({px},{py}): gpu {got:?} cpu without the beam {want:?} ({e:.2e})");
+            worst = worst.max(e);
+            beam_share = beam_share.max(beam / (beam + diffuse));
+            n += 1;
+        }
+    }
+    eprintln!(
+        "shadowed single scattering: {n} floor pixels, worst {worst:.2e}; unshadowed beam share up to {beam_share:.2}"
+    );
+    assert!(n > 100 && beam_share > 0.1, "{n} pixels, beam share {beam_share}");
 }

@@ -6,6 +6,12 @@
 @group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
 @group(1) @binding(2) var gbuf_depth: texture_depth_2d;
 
+// Pass 3 has no shadow maps: every light counts as unoccluded here (the custom-shader API's
+// `light_visibility` is only meaningful in the pass-2 hooks).
+fn light_visibility(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    return 1.0;
+}
+
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);

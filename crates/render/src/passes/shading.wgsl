@@ -40,40 +40,25 @@ fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return textureSampleCompareLevel(shadow_maps, shadow_sampler, uv, i32(layer), ndc.z);
 }
 
+// Fraction of light `li` that reaches `p` (offset along `n` against acne; zero for points in
+// a medium): its shadow map, or 1 for a light without one. Part of the custom-shader API.
+fn light_visibility(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let layer = shadows.layer_of_light[li / 4u][li % 4u];
+    if (layer == NO_SHADOW) { return 1.0; }
+    return shadow_visibility(layer, p, n);
+}
+
 // Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
 // where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
 fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
-    let light = lights[li];
-    let kind = u32(light.pos_kind.w);
-    var wi: vec3<f32>;
-    var atten = 1.0;
-    if (kind == 0u) {
-        wi = -light.pos_kind.xyz;
-    } else {
-        let d = light.pos_kind.xyz - p;
-        let dist2 = max(dot(d, d), 1e-8);
-        wi = d * inverseSqrt(dist2);
-        atten = 1.0 / dist2;
-        let range = light.dir_range.w;
-        if (range > 0.0) {
-            let r = dist2 / (range * range);
-            let w = clamp(1.0 - r * r, 0.0, 1.0);
-            atten *= w * w;
-        }
-        if (kind == 2u) {
-            let cd = dot(light.dir_range.xyz, -wi);
-            let t = clamp((cd - light.cone.x) * light.cone.y, 0.0, 1.0);
-            atten *= t * t;
-        }
-    }
+    let inc = light_incidence(li, p);
+    let wi = inc.xyz;
+    var atten = inc.w;
     let nl = dot(n, wi);
     if (nl <= 0.0 || atten <= 0.0) { return vec2<f32>(0.0); }
-    let layer = shadows.layer_of_light[li / 4u][li % 4u];
-    if (layer != NO_SHADOW) {
-        atten *= shadow_visibility(layer, p, n);
-    }
+    atten *= light_visibility(li, p, n);
     let h = normalize(wi + v);
     let nv = max(dot(n, v), 1e-4);
     let nh = max(dot(n, h), 0.0);

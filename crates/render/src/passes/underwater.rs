@@ -1,29 +1,43 @@
-//! Real-time underwater light transport (Monzón, Gutierrez, Akkaynak & Muñoz 2024) as a
-//! [`CustomShader`]: `Renderer::set_custom_shader(underwater::shader(&medium))`.
+//! Real-time underwater light transport (Monzón, Gutierrez, Akkaynak & Muñoz 2024, plus
+//! ray-marched single scattering) as a [`CustomShader`]:
+//! `Renderer::set_custom_shader(underwater::shader(&medium))`.
 //!
 //! The hooks run in pass 2, per wavelength group, on the radiance the surface reflects from
 //! the scene's lights (ρ·E·BRDF·cos), and return
 //!
-//! `L(λ) = L_surface(λ)·e^{−Kd·z_s}·e^{−c·d} + b·E0/(4π·k)·(1 − e^{−k·d})·e^{−Kd·z0}`,
-//! `k = c + Kd·cosθ`,
+//! `L(λ) = L_surface·e^{−Kd·z_s}·e^{−c·d} + L_ms + L_ss`
 //!
 //! with d the camera–surface distance in metres (scene units × `scale`), z_s the surface depth,
 //! z0 the camera depth and cosθ = −ω_y for the view direction ω. Background pixels get only the
-//! in-scattering, up to the water surface when looking up and to infinity otherwise. E0 is the
-//! downwelling irradiance just below the surface, computed in the shader from the scene's
-//! directional lights (emission × cosine to the downward vertical), so it is in exactly the
-//! units of the surface radiance in every mode. `scene::water::WaterMedium::pixel_terms` is the
-//! CPU reference of every factor; `tests/underwater.rs` checks the GPU against it.
+//! in-scattering, up to the water surface when looking up and to infinity otherwise.
+//!
+//! - `L_ms = b/(4π)·[E0·e^{−Kd·z0}·I(c + Kd·cosθ) − Σ_j E_j·μ_j·e^{−c·z0/μ_j}·I(c·(1 − ω_y/μ_j))]`,
+//!   `I(k) = (1 − e^{−k·d})/k`: the paper's isotropic in-scattering of the Kd-attenuated
+//!   downwelling field E0 = Σ_j E_j·μ_j (directional lights j, μ_j the cosine of their direction
+//!   to the downward vertical), minus the unscattered beams inside it, clamped at 0. With
+//!   [`Options::steps`] = 0 the subtraction is off and `L_ss` = 0: exactly the paper's model.
+//! - `L_ss`: single scattering of every directional, point and spot light (the first
+//!   [`SS_LIGHTS`]), Henyey–Greenstein phase [`Options::phase_g`], shadowed through the lights'
+//!   shadow maps. Directional beams reach depth z as E_j·e^{−c·z/μ_j} (the unscattered beam);
+//!   the ray is cut in M equal segments, visibility taken at each midpoint, the exponential
+//!   integrated exactly within each segment (so an unshadowed ray is exact); a ray to infinity
+//!   is marched over the first six optical depths of the clearest wavelength and integrated
+//!   analytically (unshadowed) beyond. Point and spot lights use M equiangular steps (Kulla &
+//!   Fajardo 2012), attenuated by c from the light and to the camera.
+//!
+//! `scene::water` (`in_scatter`, `single`) is the CPU reference of every term;
+//! `tests/underwater.rs` and `tests/underwater_single.rs` check the GPU against it.
 //!
 //! Spectral and naive modes sample b, c and Kd at the frame's wavelengths (the renderer
 //! resamples [`CustomShader::spectra`] whenever N or the range change). The RGB baseline uses
 //! the coefficients at three wavelengths, [`RGB_WAVELENGTHS`], one per channel — what an
-//! RGB renderer without spectral data does.
+//! RGB renderer without spectral data does — and runs the same code.
 //!
 //! Assumptions (shared with the paper): the scene's directional lights are the light field
-//! under the surface (already refracted), all lights are attenuated by Kd over the surface's
-//! depth (no diver's torch), in-scattering is isotropic, and nothing above the surface (sky,
-//! Snell's window) is drawn.
+//! under the surface (already refracted); surfaces are lit by all lights attenuated by Kd over
+//! their depth (a diver's torch is not attenuated by c on its way to the surface); the
+//! diffuse part of the in-scattering is isotropic; nothing above the surface (sky, Snell's
+//! window) is drawn.
 
 use super::custom::CustomShader;
 use scene::water::WaterMedium;
@@ -35,19 +49,70 @@ pub const HOOKS: &str = include_str!("underwater.wgsl");
 /// dominant wavelengths of the sRGB primaries under D65.
 pub const RGB_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 
-/// The custom-shader parameters for `medium`: `[z0, scale, 0, 0]`, then c, Kd and b at
-/// [`RGB_WAVELENGTHS`]. Use with `Renderer::set_custom_params` to move the camera's depth
-/// without recompiling.
+/// Lights that get single scattering (the first ones in the scene); must match the WGSL.
+pub const SS_LIGHTS: usize = 4;
+/// Most march steps; must match the WGSL.
+pub const MAX_STEPS: u32 = 32;
+
+/// Choices of the real-time model beyond the water itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// March steps M for single scattering (≤ [`MAX_STEPS`]); 0 = the paper's model alone.
+    pub steps: u32,
+    /// Henyey–Greenstein asymmetry of the single scattering (default: Petzold's mean cosine,
+    /// the ground truth's phase function).
+    pub phase_g: f32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { steps: 16, phase_g: PETZOLD_G }
+    }
+}
+
+impl Options {
+    /// The paper's model: analytic isotropic in-scattering only.
+    pub fn paper() -> Self {
+        Options { steps: 0, ..Default::default() }
+    }
+
+    /// Checks the values a user can set.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.steps > MAX_STEPS {
+            return Err(format!("underwater march steps must be 0..={MAX_STEPS}, got {}", self.steps));
+        }
+        if !(self.phase_g.is_finite() && self.phase_g.abs() < 1.0) {
+            return Err(format!("phase function g must be in (−1, 1), got {}", self.phase_g));
+        }
+        Ok(())
+    }
+}
+
+/// Mean cosine of Petzold's average-particle phase function (Mobley 1994, *Light and Water*,
+/// §3.8), the g the path-traced water uses too.
+pub const PETZOLD_G: f32 = 0.924;
+
+/// The custom-shader parameters for `medium`: `[z0, scale, steps, g]`, then c, Kd and b at
+/// [`RGB_WAVELENGTHS`] (and the smallest c over 360–830 nm). Use with
+/// `Renderer::set_custom_params` to move the camera's depth without recompiling.
 pub fn params(medium: &WaterMedium) -> [f32; 16] {
+    params_with(medium, &Options::default())
+}
+
+/// [`params`] with explicit [`Options`].
+pub fn params_with(medium: &WaterMedium, options: &Options) -> [f32; 16] {
     let mut p = [0.0f32; 16];
     p[0] = medium.depth as f32;
     p[1] = medium.scale as f32;
+    p[2] = options.steps.min(MAX_STEPS) as f32;
+    p[3] = options.phase_g;
     for (ch, &l) in RGB_WAVELENGTHS.iter().enumerate() {
         let k = medium.coefficients(l);
         p[4 + ch] = k.c as f32;
         p[8 + ch] = k.kd as f32;
         p[12 + ch] = k.b as f32;
     }
+    p[7] = (360..=830).map(|l| medium.coefficients(l as f64).c).fold(f64::INFINITY, f64::min) as f32;
     p
 }
 
@@ -57,9 +122,14 @@ pub fn spectra(medium: &WaterMedium) -> Vec<color::Spectrum> {
     vec![p.b.clone(), p.c.clone(), p.kd.clone()]
 }
 
-/// The underwater custom shader for `medium`.
+/// The underwater custom shader for `medium` with the default [`Options`].
 pub fn shader(medium: &WaterMedium) -> CustomShader {
-    CustomShader { source: HOOKS.to_string(), params: params(medium), spectra: spectra(medium) }
+    shader_with(medium, &Options::default())
+}
+
+/// The underwater custom shader for `medium`.
+pub fn shader_with(medium: &WaterMedium, options: &Options) -> CustomShader {
+    CustomShader { source: HOOKS.to_string(), params: params_with(medium, options), spectra: spectra(medium) }
 }
 
 #[cfg(test)]
@@ -72,13 +142,15 @@ mod tests {
     fn params_hold_depth_scale_and_rgb_coefficients() {
         let m = WaterMedium::new(WaterType::parse("II").unwrap(), 7.5, Vec3::Y, 0.5).unwrap();
         let p = params(&m);
-        assert_eq!((p[0], p[1]), (7.5, 0.5));
+        assert_eq!((p[0], p[1], p[2], p[3]), (7.5, 0.5, 16.0, PETZOLD_G));
+        assert!(p[7] > 0.0 && p[7] <= p[6], "smallest c {} vs c(blue) {}", p[7], p[6]);
         let blue = m.coefficients(464.0);
         assert_eq!((p[6], p[10], p[14]), (blue.c as f32, blue.kd as f32, blue.b as f32));
         // Ocean water attenuates red more than blue, and its downwelling Kd by far (pure-water
         // absorption at 611 nm is ≈ 0.27 /m, in the blue ≈ 0.01 /m).
         assert!(p[4] > p[6] && p[8] > 3.0 * p[10], "{p:?}");
-        let s = shader(&m);
+        let s = shader_with(&m, &Options::paper());
+        assert_eq!(s.params[2], 0.0);
         assert_eq!(s.spectra.len(), 3);
         assert_eq!(s.spectra[2].eval(500.0), m.coefficients(500.0).kd);
     }

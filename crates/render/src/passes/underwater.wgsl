@@ -1,97 +1,211 @@
-// Underwater hooks (Monzón et al. 2024), installed by `underwater::shader`. See
-// src/passes/underwater.rs for the model, the parameter layout and the assumptions; the CPU
-// reference of every formula is `scene::water`.
+// Underwater hooks (Monzón et al. 2024, plus ray-marched single scattering), installed by
+// `underwater::shader`. See src/passes/underwater.rs for the model, the parameter layout and the
+// assumptions; the CPU reference of every formula is `scene::water` (`single` for the march).
 //
-// custom.params[0] = (camera depth z0 m, metres per scene unit, 0, 0)
-// custom.params[1..4] = c, Kd, b at the RGB mode's three wavelengths (xyz)
+// custom.params[0] = (camera depth z0 m, metres per scene unit, march steps M (0 = the paper's
+//                     model alone), Henyey–Greenstein g)
+// custom.params[1] = (c at the RGB mode's three wavelengths, smallest c over the range)
+// custom.params[2].xyz, [3].xyz = Kd, b at the RGB mode's three wavelengths
 // custom_spectra[g * 4 + 0..3] = b, c, Kd at the group's wavelengths
+//
+// All quantities are vec4: four wavelengths in spectral/naive modes, (R, G, B, unused) in rgb
+// mode, so both modes run the same code.
 
 const UW_INV_4PI: f32 = 0.0795774715459476;
 // Must match MAX_LIGHTS in src/scene_gpu.rs.
 const UW_MAX_LIGHTS: u32 = 32u;
+// Lights with single scattering, and march steps: must match underwater.rs.
+const UW_SS_LIGHTS: u32 = 4u;
+const UW_MAX_STEPS: u32 = 32u;
+// A downward or level ray has no end: directional lights are marched (for shadows) over the
+// first UW_CAP optical depths of the clearest wavelength, the rest is integrated unshadowed;
+// point and spot lights are marched over at most that length.
+const UW_CAP: f32 = 6.0;
+
+// Per-pixel, wavelength-independent march, filled once by `uw_prepare` and reused by every
+// wavelength group: for light slot j and step k, weight W = phase × visibility × geometry and
+// optical path s (metres) so that the light's single scattering is b·E·Σ_k W·e^{−c·s}.
+var<private> uw_ready: bool = false;
+var<private> uw_n: u32 = 0u;
+var<private> uw_steps: u32 = 0u;
+var<private> uw_light: array<u32, UW_SS_LIGHTS>;
+// Directional slots: x = q (the beam's optical path grows by c·q per metre along the ray),
+// y = segment length (m), z = tail weight, w = tail path (m). Point/spot slots: all zero.
+var<private> uw_dir: array<vec4<f32>, UW_SS_LIGHTS>;
+var<private> uw_w: array<f32, 128>;
+var<private> uw_s: array<f32, 128>;
+// Path length (m) to the hit or the surface, and whether the ray runs forever.
+var<private> uw_d: f32 = 0.0;
+var<private> uw_infinite: bool = false;
 
 // (1 − e^{−k·d})/k, continuous through k = 0 (where it is d). The series is used where the
 // subtraction would lose f32 digits; its truncation error is below (k·d)³/24·d < 1e-10·d.
-fn uw_path_integral4(k: vec4<f32>, d: f32) -> vec4<f32> {
+fn uw_path_integral(k: vec4<f32>, d: f32) -> vec4<f32> {
     let x = k * d;
     let series = d * (1.0 - 0.5 * x + x * x / 6.0);
     let exact = (1.0 - exp(-x)) / k;
     return select(exact, series, abs(x) < vec4<f32>(1e-3));
 }
 
-fn uw_path_integral3(k: vec3<f32>, d: f32) -> vec3<f32> {
-    let x = k * d;
-    let series = d * (1.0 - 0.5 * x + x * x / 6.0);
-    let exact = (1.0 - exp(-x)) / k;
-    return select(exact, series, abs(x) < vec3<f32>(1e-3));
+// The same over the whole ray: to the hit or surface, or to infinity (k > 0 there).
+fn uw_ray_integral(k: vec4<f32>) -> vec4<f32> {
+    if (uw_infinite) {
+        return 1.0 / k;
+    }
+    return uw_path_integral(k, uw_d);
 }
 
-// Downwelling irradiance just below the surface: every directional light's emission times the
-// cosine of its direction with the downward vertical (point and spot lights do not reach the
-// surface's light field).
-fn uw_e0_spectral(g: u32) -> vec4<f32> {
-    var e = vec4<f32>(0.0);
-    let ng = frame.n_groups;
-    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
-        let l = lights[li].pos_kind;
-        if (u32(l.w) == 0u) {
-            e = fma(vec4<f32>(max(-l.y, 0.0)), light_spectra[li * ng + g], e);
-        }
-    }
-    return e;
+fn uw_hg(g: f32, cos_t: f32) -> f32 {
+    let g2 = g * g;
+    let den = max(1.0 + g2 - 2.0 * g * cos_t, 1e-6);
+    return UW_INV_4PI * (1.0 - g2) / (den * sqrt(den));
 }
 
-fn uw_e0_rgb() -> vec3<f32> {
-    var e = vec3<f32>(0.0);
+// Emission of light `li` at the group's wavelengths, or its linear-sRGB colour in rgb mode.
+fn uw_emission(li: u32, group: u32, rgb: bool) -> vec4<f32> {
+    if (rgb) {
+        return vec4<f32>(lights[li].rgb.rgb, 0.0);
+    }
+    return light_spectra[li * frame.n_groups + group];
+}
+
+fn uw_prepare(ctx: SurfaceContext) {
+    if (uw_ready) { return; }
+    uw_ready = true;
+    let z0 = custom.params[0].x;
+    let scale = custom.params[0].y;
+    let g = custom.params[0].w;
+    let w = ctx.view_dir;
+    uw_infinite = ctx.background && w.y <= 0.0;
+    if (ctx.background) {
+        // Nothing hit: an upward ray ends at the surface, any other runs forever.
+        uw_d = select(0.0, z0 / w.y, w.y > 0.0);
+    } else {
+        uw_d = ctx.distance * scale;
+    }
+    let m = min(u32(custom.params[0].z), UW_MAX_STEPS);
+    uw_steps = m;
+    if (m == 0u) { return; }
+    let fm = f32(m);
+    let cam = frame.camera_pos.xyz;
+    var n = 0u;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        if (n == UW_SS_LIGHTS) { break; }
         let l = lights[li].pos_kind;
         if (u32(l.w) == 0u) {
-            e = fma(vec3<f32>(max(-l.y, 0.0)), lights[li].rgb.rgb, e);
+            // Beam towards the light: its optical path to a point at depth z is c·z/μ.
+            let mu = -l.y;
+            if (mu <= 0.0) { continue; }
+            let q = 1.0 - w.y / mu;
+            let dm = select(uw_d, UW_CAP / custom.params[1].w, uw_infinite);
+            let dt = dm / fm;
+            let p = uw_hg(g, dot(-l.xyz, w));
+            for (var k = 0u; k < m; k++) {
+                let x = cam + w * ((f32(k) + 0.5) * dt / scale);
+                uw_w[n * UW_MAX_STEPS + k] = p * light_visibility(li, x, vec3<f32>(0.0));
+                uw_s[n * UW_MAX_STEPS + k] = z0 / mu + f32(k) * dt * q;
+            }
+            let tail = select(0.0, p, uw_infinite);
+            uw_dir[n] = vec4<f32>(q, dt, tail, z0 / mu + dm * q);
+        } else {
+            // Equiangular steps (Kulla & Fajardo 2012): with t − t0 = h·tan θ the 1/r² of
+            // the light cancels the Jacobian, leaving a smooth integrand in θ.
+            let rel = l.xyz - cam;
+            let t0 = dot(rel, w);
+            let h = max(length(rel - w * t0), 1e-4);
+            // The march ends after UW_CAP optical depths of the clearest wavelength; what
+            // lies beyond is lost (< e^{−6} of the light's scattering there).
+            let cap = UW_CAP / custom.params[1].w;
+            let dm = select(min(uw_d, cap), cap, uw_infinite);
+            let ta = atan2(-t0, h);
+            let tb = atan2(dm / scale - t0, h);
+            let dth = (tb - ta) / fm;
+            for (var k = 0u; k < m; k++) {
+                let th = ta + (f32(k) + 0.5) * dth;
+                let t = t0 + h * tan(th);
+                let r = h / cos(th);
+                let x = cam + w * t;
+                let inc = light_incidence(li, x);
+                let v = light_visibility(li, x, vec3<f32>(0.0));
+                uw_w[n * UW_MAX_STEPS + k] = scale * uw_hg(g, dot(inc.xyz, w)) * v * inc.w * r * r * dth / h;
+                uw_s[n * UW_MAX_STEPS + k] = scale * (r + t);
+            }
+            uw_dir[n] = vec4<f32>(0.0);
+        }
+        uw_light[n] = li;
+        n++;
+    }
+    uw_n = n;
+}
+
+// Single scattering of every marched light, at the wavelengths of `c`.
+fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<f32> {
+    var total = vec4<f32>(0.0);
+    for (var j = 0u; j < uw_n; j++) {
+        var sum = vec4<f32>(0.0);
+        for (var k = 0u; k < uw_steps; k++) {
+            sum = fma(vec4<f32>(uw_w[j * UW_MAX_STEPS + k]), exp(-c * uw_s[j * UW_MAX_STEPS + k]), sum);
+        }
+        let dir = uw_dir[j];
+        if (dir.y > 0.0) {
+            // Directional: each segment's exponential integrated exactly; tail unshadowed.
+            let cq = c * dir.x;
+            sum = sum * uw_path_integral(cq, dir.y);
+            if (dir.z > 0.0) {
+                sum += dir.z * exp(-c * dir.w) / cq;
+            }
+        }
+        total = fma(uw_emission(uw_light[j], group, rgb), sum, total);
+    }
+    return b * total;
+}
+
+// Isotropic in-scattering of the downwelling field E0·e^{−Kd·z} (the paper's L_ms). With
+// single scattering on, the unscattered beams e^{−c·z/μ} it contains are removed, since
+// `uw_single_scatter` counts them with the real phase function.
+fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
+    let z0 = custom.params[0].x;
+    var e0 = vec4<f32>(0.0);
+    var beams = vec4<f32>(0.0);
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        let mu = -l.y;
+        if (u32(l.w) != 0u || mu <= 0.0) { continue; }
+        let e = uw_emission(li, group, rgb) * mu;
+        e0 += e;
+        if (uw_steps > 0u) {
+            beams = fma(e * exp(-c * (z0 / mu)), uw_ray_integral(c * (1.0 - wy / mu)), beams);
         }
     }
-    return e;
+    // k = c + Kd·cosθ with cosθ = −ω_y.
+    let ms = e0 * exp(-kd * z0) * uw_ray_integral(c - kd * wy);
+    return max(b * UW_INV_4PI * (ms - beams), vec4<f32>(0.0));
+}
+
+fn uw_shade(radiance: vec4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> vec4<f32> {
+    uw_prepare(ctx);
+    let wy = ctx.view_dir.y;
+    var l = uw_in_scatter(b, c, kd, group, rgb, wy) + uw_single_scatter(b, c, group, rgb);
+    if (!ctx.background) {
+        let zs = max(custom.params[0].x - uw_d * wy, 0.0);
+        l = fma(radiance, exp(-kd * zs) * exp(-c * uw_d), l);
+    }
+    return l;
 }
 
 fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
-    let z0 = custom.params[0].x;
-    let scale = custom.params[0].y;
     let b = custom_spectra[group * 4u + 0u];
     let c = custom_spectra[group * 4u + 1u];
     let kd = custom_spectra[group * 4u + 2u];
-    let wy = ctx.view_dir.y;
-    // k = c + Kd·cosθ with cosθ = −ω_y.
-    let k = c - kd * wy;
-    let ms = b * uw_e0_spectral(group) * UW_INV_4PI * exp(-kd * z0);
-    if (ctx.background) {
-        // Nothing hit: an upward ray ends at the surface, any other runs forever (k ≥ c > 0).
-        if (wy > 0.0) {
-            return ms * uw_path_integral4(k, z0 / wy);
-        }
-        return ms / k;
-    }
-    let d = ctx.distance * scale;
-    let zs = max(z0 - d * wy, 0.0);
-    return fma(radiance, exp(-kd * zs) * exp(-c * d), ms * uw_path_integral4(k, d));
+    return uw_shade(radiance, b, c, kd, group, false, ctx);
 }
 
 fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> {
-    let z0 = custom.params[0].x;
-    let scale = custom.params[0].y;
-    let c = custom.params[1].xyz;
-    let kd = custom.params[2].xyz;
-    let b = custom.params[3].xyz;
-    let wy = ctx.view_dir.y;
-    let k = c - kd * wy;
-    let ms = b * uw_e0_rgb() * UW_INV_4PI * exp(-kd * z0);
-    if (ctx.background) {
-        if (wy > 0.0) {
-            return ms * uw_path_integral3(k, z0 / wy);
-        }
-        return ms / k;
-    }
-    let d = ctx.distance * scale;
-    let zs = max(z0 - d * wy, 0.0);
-    return fma(radiance, exp(-kd * zs) * exp(-c * d), ms * uw_path_integral3(k, d));
+    // The unused fourth lane gets harmless positive coefficients.
+    let c = vec4<f32>(custom.params[1].xyz, 1.0);
+    let kd = vec4<f32>(custom.params[2].xyz, 1.0);
+    let b = vec4<f32>(custom.params[3].xyz, 1.0);
+    return uw_shade(vec4<f32>(radiance, 0.0), b, c, kd, 0u, true, ctx).rgb;
 }
 
 fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {

@@ -30,6 +30,32 @@ struct GpuLight {
     rgb: vec4<f32>,
 };
 
+// Unit direction from `p` towards light `li` (xyz) and the light's distance falloff at `p`
+// (w): 1 for a directional light; 1/r² × the glTF range window × the spot cone otherwise.
+fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
+    let light = lights[li];
+    let kind = u32(light.pos_kind.w);
+    if (kind == 0u) {
+        return vec4<f32>(-light.pos_kind.xyz, 1.0);
+    }
+    let d = light.pos_kind.xyz - p;
+    let dist2 = max(dot(d, d), 1e-8);
+    let wi = d * inverseSqrt(dist2);
+    var atten = 1.0 / dist2;
+    let range = light.dir_range.w;
+    if (range > 0.0) {
+        let r = dist2 / (range * range);
+        let w = clamp(1.0 - r * r, 0.0, 1.0);
+        atten *= w * w;
+    }
+    if (kind == 2u) {
+        let cd = dot(light.dir_range.xyz, -wi);
+        let t = clamp((cd - light.cone.x) * light.cone.y, 0.0, 1.0);
+        atten *= t * t;
+    }
+    return vec4<f32>(wi, atten);
+}
+
 @group(2) @binding(0) var<storage, read> wavelengths: array<WavelengthGroup>;
 @group(2) @binding(1) var<storage, read> lights: array<GpuLight>;
 @group(2) @binding(2) var<storage, read> light_spectra: array<vec4<f32>>;

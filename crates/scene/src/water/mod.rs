@@ -38,6 +38,9 @@ use thiserror::Error;
 
 use crate::WaterSettings;
 
+mod quadrature;
+pub mod single;
+
 /// Refractive index of sea water used to bend the sun direction (visible band, ≈ 1.34).
 pub const WATER_IOR: f64 = 1.34;
 
@@ -261,35 +264,9 @@ impl WaterMedium {
 
 #[cfg(test)]
 mod tests {
+    use super::quadrature::simpson;
     use super::*;
     use std::f64::consts::PI;
-
-    /// Adaptive Simpson quadrature, written out so the analytic term is checked against an
-    /// independent numerical evaluation of the integral it claims to solve.
-    fn simpson(f: &dyn Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
-        /// One panel [a, b] with f at a, the midpoint and b, and its Simpson estimate `whole`.
-        fn rec(
-            f: &dyn Fn(f64) -> f64,
-            (a, b): (f64, f64),
-            (fa, fm, fb): (f64, f64, f64),
-            whole: f64,
-            tol: f64,
-            depth: u32,
-        ) -> f64 {
-            let m = 0.5 * (a + b);
-            let (flm, frm) = (f(0.5 * (a + m)), f(0.5 * (m + b)));
-            let left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
-            let right = (b - m) / 6.0 * (fm + 4.0 * frm + fb);
-            if depth == 0 || (left + right - whole).abs() <= 15.0 * tol {
-                return left + right + (left + right - whole) / 15.0;
-            }
-            rec(f, (a, m), (fa, flm, fm), left, tol / 2.0, depth - 1)
-                + rec(f, (m, b), (fm, frm, fb), right, tol / 2.0, depth - 1)
-        }
-        let (fa, fb, fm) = (f(a), f(b), f(0.5 * (a + b)));
-        let whole = (b - a) / 6.0 * (fa + 4.0 * fm + fb);
-        rec(f, (a, b), (fa, fm, fb), whole, tol, 50)
-    }
 
     fn single_scatter_numeric(b: f64, c: f64, kd: f64, e0: f64, wy: f64, z0: f64, d: f64) -> f64 {
         let f = |t: f64| b * e0 / (4.0 * PI) * (-kd * (z0 - t * wy)).exp() * (-c * t).exp();

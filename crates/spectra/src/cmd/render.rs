@@ -58,6 +58,14 @@ pub struct LookArgs {
     /// Camera depth below the water surface, metres (default: the scene's, else 10).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub depth: Option<f64>,
+    /// Under water: ray-march steps for single scattering of the scene's lights (0–32; 0 =
+    /// the paper's analytic in-scattering alone).
+    #[arg(long, value_name = "STEPS", default_value_t = render::passes::underwater::Options::default().steps)]
+    pub scatter_steps: u32,
+    /// Under water: Henyey–Greenstein asymmetry g of single scattering (default: Petzold's 0.924).
+    #[arg(long, value_name = "G", allow_negative_numbers = true,
+          default_value_t = render::passes::underwater::Options::default().phase_g)]
+    pub phase_g: f32,
 }
 
 impl LookArgs {
@@ -75,6 +83,13 @@ impl LookArgs {
             self.wavelengths.or(scene.spectral.wavelengths.map(|n| n as usize)).unwrap_or(d.wavelengths);
         let observer = self.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
         Ok((range, wavelengths, observer))
+    }
+
+    /// The underwater model's options from `--scatter-steps` and `--phase-g`.
+    pub fn underwater(&self) -> Result<render::passes::underwater::Options> {
+        let o = render::passes::underwater::Options { steps: self.scatter_steps, phase_g: self.phase_g };
+        o.validate().map_err(|e| anyhow!("--scatter-steps/--phase-g: {e}"))?;
+        Ok(o)
     }
 }
 
@@ -192,7 +207,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let mut r = Renderer::with_table(table)?;
     r.set_scene(&scene)?;
     if let Some(m) = &water {
-        r.set_custom_shader(render::passes::underwater::shader(m))?;
+        r.set_custom_shader(render::passes::underwater::shader_with(m, &args.look.underwater()?))?;
     }
     r.resize(width, height)?;
     r.render(&scene.camera, &settings)?;

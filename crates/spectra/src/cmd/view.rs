@@ -56,13 +56,14 @@ pub fn run(args: Args) -> Result<()> {
     let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
     let settings = initial_settings(&args, &scene)?;
     let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
+    let water_options = args.look.underwater()?;
     if !display_named(std::env::var_os("DISPLAY")) {
         bail!("{NO_DISPLAY}");
     }
     // The event loop connects to the X server; a named but unreachable display fails here.
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
     let table = load_table(args.look.table.as_deref())?;
-    run_window(event_loop, ViewOptions { scene, settings, size, table, water })
+    run_window(event_loop, ViewOptions { scene, settings, size, table, water, water_options })
 }
 
 #[cfg(test)]

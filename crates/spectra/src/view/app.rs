@@ -29,6 +29,8 @@ pub struct ViewOptions {
     /// The water the camera is in (`--water`/`--depth` or the scene's), drawn with the
     /// underwater hooks.
     pub water: Option<scene::water::WaterMedium>,
+    /// The underwater model's choices (`--scatter-steps`, `--phase-g`).
+    pub water_options: render::passes::underwater::Options,
 }
 
 /// Radians of orbit per pixel of drag.
@@ -133,7 +135,7 @@ impl Running {
         let mut renderer = Renderer::with_gpu(gpu, opts.table.clone())?;
         renderer.set_scene(&opts.scene)?;
         if let Some(w) = &opts.water {
-            renderer.set_custom_shader(render::passes::underwater::shader(w))?;
+            renderer.set_custom_shader(render::passes::underwater::shader_with(w, &opts.water_options))?;
         }
 
         let size = window.inner_size();
