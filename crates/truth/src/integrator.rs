@@ -153,7 +153,12 @@ impl Integrator<'_, '_> {
         let mut depth = 0u32;
         loop {
             let hit = w.geometry.intersect(o, d, f32::INFINITY);
-            let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+            let mut t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+            // The water surface, from below, comes before anything above it.
+            let at_surface = w.surface.as_ref().and_then(|s| s.crossing(o, d)).filter(|&t| t <= t_hit);
+            if let Some(t) = at_surface {
+                t_hit = t;
+            }
 
             // Free flight through the medium, sampled at the hero wavelength, weighted by the
             // balance heuristic over all four (the one-sample spectral MIS estimator).
@@ -197,6 +202,31 @@ impl Integrator<'_, '_> {
                 }
                 f *= tr / tr.x;
                 p *= tr / tr.x;
+            }
+
+            if let (Some(t), Some(surf)) = (at_surface, &w.surface) {
+                // Snell's window: the sky refracted in, T·n²·L_air (zero T under TIR).
+                let r = surf.reflectance(d.y);
+                if let Some(sky) = &surf.sky
+                    && r < 1.0
+                {
+                    radiance += f / mean(p) * sky.eval4(l) * ((1.0 - r) * surf.ior * surf.ior);
+                }
+                // The mirror direction with probability R: unbiased for the reflected light
+                // (R/R = 1), always under TIR. A specular vertex: light sampling cannot find
+                // what lies along it, so what it hits gets full MIS weight (prev_pdf = 0).
+                if (self.direct_only && depth >= 1) || depth + 1 > self.max_depth || rng.uniform() >= r {
+                    break;
+                }
+                let pos = o + d * t;
+                o = Vec3::new(pos.x, surf.height - 1e-4 * (1.0 + pos.abs().max_element()), pos.z);
+                d = Vec3::new(d.x, -d.y, d.z);
+                prev_pdf = 0.0;
+                depth += 1;
+                if !self.roulette(&mut f, p, depth, rng) {
+                    break;
+                }
+                continue;
             }
 
             let Some(hit) = hit else {

@@ -73,6 +73,7 @@ fn volume_furnace_returns_the_emission() {
         sigma_s: Spectrum::piecewise(vec![380.0, 500.0, 730.0], vec![6.0, 0.5, 2.0]).unwrap(),
         phase: Phase::HenyeyGreenstein { g: 0.6 },
         region: Region::Box { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) },
+        surface_ior: None,
     };
     let range = WavelengthRange::VISIBLE;
     let world = World::new(&scene, &GreyOnly, &d65(), range, Some(&medium)).unwrap().with_environment(&env);
@@ -103,6 +104,7 @@ fn absorbing_box_follows_beer_lambert() {
         sigma_s: Spectrum::Constant(0.0),
         phase: Phase::Isotropic,
         region: Region::Box { min: Vec3::new(-1.0, -5.0, -5.0), max: Vec3::new(0.5, 5.0, 5.0) },
+        surface_ior: None,
     };
     let range = WavelengthRange::VISIBLE;
     let world = World::new(&scene, &GreyOnly, &d65(), range, Some(&medium)).unwrap().with_environment(&d65());

@@ -28,6 +28,7 @@ pub mod spectral;
 pub mod texture;
 pub mod upsample;
 pub mod water;
+pub mod water_surface;
 pub mod world;
 
 #[cfg(test)]

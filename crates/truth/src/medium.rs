@@ -38,6 +38,11 @@ pub struct Medium {
     pub sigma_s: Spectrum,
     pub phase: Phase,
     pub region: Region,
+    /// `Some(n)`: the top face of the `Region::Box` is a flat water surface, index `n` relative
+    /// to the air above, with the sky above it (see [`crate::water_surface`]); paths reaching
+    /// it from below are Fresnel-reflected or see the sky. `None`: every face is
+    /// index-matched (rays cross it unchanged).
+    pub surface_ior: Option<f32>,
 }
 
 impl Medium {
@@ -64,6 +69,14 @@ impl Medium {
             && (!min.is_finite() || !max.is_finite() || min.cmpgt(max).any())
         {
             return bad(format!("box {min}..{max} is empty or not finite"));
+        }
+        if let Some(n) = self.surface_ior {
+            if !(n.is_finite() && n > 1.0) {
+                return bad(format!("surface index of refraction {n} must be a finite number > 1"));
+            }
+            if self.region == Region::Everywhere {
+                return bad("a water surface needs a box: it is the box's top face".into());
+            }
         }
         Ok(())
     }
@@ -186,6 +199,7 @@ mod tests {
             sigma_s: Spectrum::Constant(0.2),
             phase: Phase::HenyeyGreenstein { g: 0.5 },
             region: Region::Everywhere,
+            surface_ior: None,
         };
         assert!(ok.validate(r).is_ok());
         let neg = Medium { sigma_a: Spectrum::Constant(-0.1), ..ok.clone() };
@@ -194,8 +208,14 @@ mod tests {
         assert!(nan.validate(r).is_err());
         let g = Medium { phase: Phase::HenyeyGreenstein { g: 1.0 }, ..ok.clone() };
         assert!(g.validate(r).is_err());
-        let b = Medium { region: Region::Box { min: Vec3::ONE, max: Vec3::ZERO }, ..ok };
+        let b = Medium { region: Region::Box { min: Vec3::ONE, max: Vec3::ZERO }, ..ok.clone() };
         assert!(b.validate(r).is_err());
+        let no_box = Medium { surface_ior: Some(1.34), ..ok.clone() };
+        assert!(no_box.validate(r).unwrap_err().to_string().contains("box"));
+        let slab = Region::Box { min: Vec3::ZERO, max: Vec3::ONE };
+        let bad_n = Medium { surface_ior: Some(0.9), region: slab, ..ok.clone() };
+        assert!(bad_n.validate(r).unwrap_err().to_string().contains("0.9"));
+        assert!(Medium { surface_ior: Some(1.34), region: slab, ..ok }.validate(r).is_ok());
     }
 
     #[test]
@@ -206,6 +226,7 @@ mod tests {
                 sigma_s: Spectrum::Constant(0.0),
                 phase: Phase::Isotropic,
                 region: Region::Box { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) },
+                surface_ior: None,
             },
             WavelengthRange::VISIBLE,
         )

@@ -84,6 +84,7 @@ impl Medium {
             sigma_s: spectrum(origin, "sigma_s", obj.get("sigma_s"))?,
             phase,
             region,
+            surface_ior: None,
         })
     }
 }

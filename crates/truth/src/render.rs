@@ -250,6 +250,7 @@ mod tests {
                 sigma_s: Spectrum::Constant(0.0),
                 phase: crate::Phase::Isotropic,
                 region: crate::Region::Everywhere,
+                surface_ior: None,
             }),
             ..st
         };

@@ -2,8 +2,13 @@
 //! homogeneous participating medium that the path tracer solves with full multiple scattering.
 //!
 //! Shared with the real-time model: absorption a(λ) and scattering b(λ) of the Jerlov type, the
-//! camera depth, metres per scene unit, the scene's (already refracted) directional sun, a flat
-//! surface with no sky drawn above it, index-matched objects.
+//! camera depth, metres per scene unit, the scene's (already refracted) directional sun, the sky's
+//! downwelling irradiance below the surface (`scene::sky`: `water.sky` × the sun's, the sun's
+//! spectrum), a flat surface, index-matched objects.
+//!
+//! The slab's top face is the water surface ([`crate::water_surface`], n = [`WATER_IOR`]): paths
+//! going up see a uniform sky through Snell's window with exact Fresnel transmission and the n²
+//! radiance law, and are reflected (Fresnel inside the window, totally outside it).
 //!
 //! Different, on purpose (this is what the real-time model approximates):
 //! - the phase function is forward peaked — Henyey–Greenstein with g = [`PETZOLD_G`], the mean
@@ -22,7 +27,7 @@
 
 use crate::medium::{Medium, Phase, Region};
 use glam::Vec3;
-use scene::water::WaterMedium;
+use scene::water::{WATER_IOR, WaterMedium};
 
 /// Mean cosine of Petzold's average-particle phase function.
 pub const PETZOLD_G: f32 = 0.924;
@@ -44,6 +49,7 @@ pub fn medium(water: &WaterMedium, camera: Vec3) -> Medium {
             min: Vec3::new(camera.x - half, camera.y - half, camera.z - half),
             max: Vec3::new(camera.x + half, surface, camera.z + half),
         },
+        surface_ior: Some(WATER_IOR as f32),
     }
 }
 

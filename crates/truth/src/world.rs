@@ -6,7 +6,9 @@ use crate::error::{Result, TruthError};
 use crate::lights::{DeltaLight, EmissionUnits, EmitterDistribution, luminance};
 use crate::material::{self, PreparedMaterial};
 use crate::medium::{Medium, PreparedMedium};
+use crate::spectral::DenseSpectrum;
 use crate::upsample::RgbToSpectrum;
+use crate::water_surface::Surface;
 use color::{Spectrum, WavelengthRange};
 use glam::{Vec2, Vec3, Vec4};
 use scene::Scene;
@@ -40,6 +42,9 @@ pub struct World<'s> {
     pub areas: Vec<f32>,
     /// Uniform radiance arriving from infinity along rays that escape the scene.
     pub environment: Option<crate::spectral::DenseSpectrum>,
+    /// The water surface above the medium, with the sky seen through it (see
+    /// [`crate::water_surface`]); from the medium's `surface_ior` and the scene's sky stand-ins.
+    pub surface: Option<Surface>,
 }
 
 impl<'s> World<'s> {
@@ -95,6 +100,7 @@ impl<'s> World<'s> {
             }),
             geometry.len(),
         );
+        let surface = water_surface(scene, medium, &units, upsampler, range).map_err(bad)?;
         let medium = medium.map(|m| PreparedMedium::new(m, range)).transpose()?;
         Ok(World {
             scene,
@@ -108,6 +114,7 @@ impl<'s> World<'s> {
             emission_spectra,
             areas,
             environment: None,
+            surface,
         })
     }
 
@@ -206,6 +213,42 @@ impl<'s> World<'s> {
             }
             None => self.units.rgb(rgb, self.upsampler, l),
         }
+    }
+}
+
+/// The water surface of `medium`, lit by the sky whose irradiance below the surface the scene's
+/// sky stand-in lights carry (`scene::sky`). A sky with nowhere to be seen from, or a scene
+/// asking for a sky without its stand-ins, is an error rather than a silently dark sky.
+fn water_surface(
+    scene: &Scene,
+    medium: Option<&Medium>,
+    units: &EmissionUnits,
+    upsampler: &dyn RgbToSpectrum,
+    range: WavelengthRange,
+) -> std::result::Result<Option<Surface>, String> {
+    let skies: Vec<DenseSpectrum> = scene
+        .lights
+        .iter()
+        .filter(|l| scene::sky::is_stand_in(l))
+        .map(|l| units.light(&l.emission, upsampler))
+        .collect();
+    if let Some(w) = &scene.water
+        && w.sky > 0.0
+        && skies.is_empty()
+    {
+        return Err(format!(
+            "water.sky = {} but the scene has no sky stand-in light (scene::sky::sync makes it)",
+            w.sky
+        ));
+    }
+    let irradiance = (!skies.is_empty())
+        .then(|| DenseSpectrum::from_fn(range, |l| skies.iter().map(|s| s.eval(l as f32) as f64).sum()));
+    match medium.and_then(|m| Some((m.region, m.surface_ior?))) {
+        Some((region, n)) => Ok(Surface::new(region, n, irradiance)),
+        None if irradiance.is_some() => Err("the scene has a sky under water (water.sky) but no water \
+                                             surface to see it through (a medium from truth::water)"
+            .into()),
+        None => Ok(None),
     }
 }
 
