@@ -36,6 +36,14 @@ fn v3a(v: Vec3) -> Vec3A {
     Vec3A::new(v.x, v.y, v.z)
 }
 
+/// The direction the BVH traverses with: exact zeros become ±1e-30 (sign kept). An exactly
+/// axis-aligned ray has infinite reciprocals, and the traversal then misses flat geometry
+/// (a floor seen straight down); the triangle test still uses the exact direction.
+fn traversal_dir(d: Vec3) -> Vec3A {
+    let f = |c: f32| if c == 0.0 { 1e-30f32.copysign(c) } else { c };
+    Vec3A::new(f(d.x), f(d.y), f(d.z))
+}
+
 /// Möller–Trumbore: (t, b1, b2) if the ray hits within (0, tmax).
 #[inline]
 pub fn intersect_triangle(v: &[Vec3; 3], o: Vec3, d: Vec3, tmax: f32) -> Option<(f32, f32, f32)> {
@@ -109,7 +117,7 @@ impl Geometry {
     /// Closest hit along `o + t·d`, t in (0, tmax).
     pub fn intersect(&self, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let ray = Ray::new(v3a(o), v3a(d), 0.0, tmax);
+        let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
         let mut best: Option<Hit> = None;
         let mut hit = obvhs::ray::RayHit::none();
         bvh.ray_traverse(ray, &mut hit, |r, id| {
@@ -128,7 +136,7 @@ impl Geometry {
     /// Whether anything blocks the open segment `o + t·d`, t in (0, tmax).
     pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
         let Some(bvh) = self.bvh.as_ref() else { return false };
-        let ray = Ray::new(v3a(o), v3a(d), 0.0, tmax);
+        let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
         !bvh.ray_traverse_miss(ray, |r, id| {
             let tri = bvh.primitive_indices[id];
             intersect_triangle(&self.verts[tri as usize], o, d, r.tmax).map_or(f32::INFINITY, |h| h.0)
@@ -213,6 +221,25 @@ mod tests {
             }
         }
         assert_eq!(misses, 0, "BVH missed {misses} of 20000 rays inside a closed box");
+    }
+
+    /// Rays along the axes onto flat quads (zero-thickness bounds): straight down onto a floor
+    /// was a miss before `traversal_dir`.
+    #[test]
+    fn axis_aligned_rays_hit_flat_quads() {
+        for n in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+            let scene = crate::testing::scene_with(
+                vec![crate::testing::quad(-n, n, 1.0, 0)],
+                vec![scene::Material::default()],
+                vec![],
+            );
+            let g = Geometry::new(&scene).unwrap();
+            let o = Vec3::new(0.3, 0.2, 0.1) * (Vec3::ONE - n.abs());
+            let h =
+                g.intersect(o, -n, f32::INFINITY).unwrap_or_else(|| panic!("missed the quad along {}", -n));
+            assert!((h.t - 1.0).abs() < 1e-6, "{}", h.t);
+            assert!(g.occluded(o, -n, 2.0));
+        }
     }
 
     #[test]
