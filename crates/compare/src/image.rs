@@ -88,6 +88,30 @@ impl Image {
         (self.width, self.height)
     }
 
+    /// The image averaged over `n`×`n` pixel blocks (partial blocks at the right and bottom
+    /// edges are dropped). Used to compare against a Monte-Carlo reference whose per-pixel
+    /// noise would otherwise dominate the error: averaging n² pixels cuts the noise by n.
+    pub fn block_mean(&self, n: u32) -> Result<Image> {
+        let (w, h) = (self.width / n.max(1), self.height / n.max(1));
+        if n == 0 || w == 0 || h == 0 {
+            return Err(CompareError::InvalidOption(format!(
+                "block size {n} does not fit a {}×{} image",
+                self.width, self.height
+            )));
+        }
+        let k = 1.0 / (n * n) as f64;
+        Image::from_fn(w, h, |bx, by| {
+            let mut sum = [0.0f64; 3];
+            for y in by * n..(by + 1) * n {
+                for x in bx * n..(bx + 1) * n {
+                    let p = self.get(x, y);
+                    (0..3).for_each(|c| sum[c] += p[c] as f64);
+                }
+            }
+            sum.map(|v| (v * k) as f32)
+        })
+    }
+
     /// The first pixel holding NaN or ±∞, as `(x, y, value)`.
     pub fn first_non_finite(&self) -> Option<(u32, u32, [f32; 3])> {
         let i = self.data.iter().position(|p| p.iter().any(|v| !v.is_finite()))?;
@@ -107,6 +131,18 @@ impl Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block_mean_averages_whole_blocks() {
+        let img = Image::from_fn(5, 4, |x, y| [x as f32, y as f32, (x * y) as f32]).unwrap();
+        let b = img.block_mean(2).unwrap();
+        assert_eq!(b.size(), (2, 2));
+        // Block (1, 1) covers x 2..4, y 2..4: means 2.5, 2.5 and (4 + 6 + 6 + 9) / 4.
+        assert_eq!(b.get(1, 1), [2.5, 2.5, 6.25]);
+        assert_eq!(b.get(0, 0), [0.5, 0.5, 0.25]);
+        assert!(img.block_mean(0).is_err() && img.block_mean(5).is_err());
+        assert_eq!(img.block_mean(1).unwrap(), img);
+    }
 
     #[test]
     fn new_checks_length_and_emptiness() {
