@@ -178,6 +178,17 @@ fn white_floor_under_the_sky_matches_quadrature() {
     let lf = (ed / PI) / (1.0 - k / PI);
     let want = l_air() * (lf * (-a * d).exp()) as f32;
     assert!(k / PI > 0.1, "the TIR term must matter for this test to catch its loss: K/π = {}", k / PI);
+    for j in 0..4 {
+        eprintln!(
+            "white floor, {} nm: path traced {:.4} ± {:.4}, quadrature {:.4} (first bounce alone {:.4}, K/π {:.4})",
+            WL[j],
+            got.0[j],
+            got.1[j],
+            want[j],
+            ed / PI * l_air()[j] as f64 * (-a * d).exp(),
+            k / PI
+        );
+    }
     assert_close(got, want, "white floor under the sky");
 }
 
