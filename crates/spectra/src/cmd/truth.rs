@@ -221,6 +221,23 @@ mod tests {
         assert!(!std::path::Path::new("x.exr").exists());
     }
 
+    /// The underwater scene's truth has the water surface and, from the scene's sky stand-in,
+    /// a sky; `--water` on it changes the type and keeps the sky.
+    #[test]
+    fn underwater_truth_sees_the_sky_through_the_surface() {
+        let scene = scene::builtin("underwater").unwrap();
+        for extra in [&[][..], &["--water", "II"][..]] {
+            let mut a = args(extra);
+            a.scene = "underwater".into();
+            let st = settings(&a, &scene).unwrap();
+            let m = st.medium.as_ref().unwrap();
+            assert_eq!(m.surface_ior, Some(scene::water::WATER_IOR as f32));
+            let w = World::new(&scene, &truth::upsample::GreyOnly, &st.white, st.range, Some(m)).unwrap();
+            let sky = w.surface.as_ref().and_then(|s| s.sky.as_ref()).expect("a sky");
+            assert!(sky.eval(550.0) > 0.0);
+        }
+    }
+
     #[test]
     fn sizes() {
         assert_eq!(parse_size("64x32").unwrap(), (64, 32));
