@@ -177,6 +177,9 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
         }
     }
 
+    if world.surface.is_some() {
+        unsupported.push("water surface (Fresnel, TIR) and the sky seen through it".into());
+    }
     let white = &world.units;
     let doc = json!({
         "source": scene.source,
