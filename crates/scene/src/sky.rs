@@ -9,10 +9,10 @@
 //! - The real-time underwater hooks sum every directional light's emission × cosine into E0 and
 //!   light surfaces with every light, so a light propagating along −Y with irradiance
 //!   `sky·E_sun` adds exactly the sky's E0. What it gets wrong on surfaces: a zenith light
-//!   lights a surface ∝ max(n_y, 0) while a uniform sky gives (1 + n_y)/2 (vertical faces get
-//!   nothing instead of half, and faces turned down stay black); and its shadow map hides the
-//!   whole sky behind any occluder straight above (an object's shadow is hard and complete,
-//!   where the real sky is only partly blocked).
+//!   lights a surface ∝ max(n_y, 0), so a vertical face gets nothing where Snell's window gives
+//!   it ≈ 19 % of the sky's E0 just below the surface, and faces turned down stay black; and its
+//!   shadow map hides the whole sky behind any occluder straight above (an object's shadow is
+//!   hard and complete, where the real sky is only partly blocked).
 //! - The path tracer skips it as a light (it is a stand-in, [`SKY_STAND_IN`]) and instead lights
 //!   the scene through the water surface with a uniform sky whose radiance reproduces that same
 //!   irradiance below the surface (`truth::water_surface`).
