@@ -10,6 +10,9 @@ and a uniform sky keeps the hemispherical mean Tbar (n = 1.34, as scene::water a
 
     sky = (E_sky_above * Tbar) / (E_sun_above * T(theta_sun))
 
+Also prints the irradiance a vertical face receives from that sky just below the surface, as a
+fraction of a horizontal face's (what the real-time zenith stand-in light gets wrong).
+
 Usage: python3 tools/sky_ratio.py [ZENITH_DEG ...]     (needs: pip install pvlib colour-science)
 """
 import sys
@@ -33,6 +36,19 @@ def fresnel_t(mu_air, n=N_WATER):
 def mean_t(n=N_WATER, k=200_000):
     mu = (np.arange(k) + 0.5) / k
     return float(np.sum(fresnel_t(mu, n) * 2.0 * mu) / k)
+
+
+def vertical_fraction(n=N_WATER, k=200_000):
+    """Irradiance on a vertical face just below the surface from a uniform sky seen through
+    Snell's window (radiance L_air*T*n^2 inside it), as a fraction of that on a horizontal face."""
+    th = (np.arange(k) + 0.5) / k * (np.pi / 2)
+    cw = np.cos(th)
+    sin_a = np.minimum(n * np.sin(th), 1.0)
+    t = np.where(n * np.sin(th) < 1.0, fresnel_t(np.sqrt(1.0 - sin_a * sin_a), n), 0.0)
+    dth = np.pi / 2 / k
+    e_h = 2 * np.pi * np.sum(t * cw * np.sin(th)) * dth
+    e_v = 2 * np.sum(t * np.sin(th) ** 2) * dth
+    return e_v / e_h
 
 
 def ratio(zenith_deg, aerosol=0.1, water=1.4, alpha=1.14):
@@ -62,6 +78,7 @@ def ratio(zenith_deg, aerosol=0.1, water=1.4, alpha=1.14):
 def main():
     zs = [float(a) for a in sys.argv[1:]] or [20.0, 34.06, 45.0, 60.0]
     print(f"Tbar(n={N_WATER}) = {mean_t():.6f}")
+    print(f"vertical / horizontal irradiance below the surface (Snell's window) = {vertical_fraction():.4f}")
     print("zenith  aerosol(500nm)  sky/sun above  sky/sun below")
     for z in zs:
         for tau in (0.05, 0.1, 0.2):
