@@ -1,6 +1,7 @@
 //! Frame-time cost of the underwater hooks (not a test): renders the built-in `underwater` scene
-//! with and without water at N = 8, 16, 32 (and rgb) and prints the median wall-clock frame
-//! time and the shading pass's GPU time (where the hooks run) when timestamps are available.
+//! dry, with the paper's model and with the default model (16-step single scattering) at
+//! N = 8, 16, 32 (and rgb) and prints the median wall-clock frame time and the shading pass's
+//! GPU time (where the hooks run) when timestamps are available.
 //!
 //! `cargo run --release -p render --example underwater_frametime -- [WIDTHxHEIGHT] [FRAMES] [TYPE]`
 
@@ -30,9 +31,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     r.resize(w, h)?;
     for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8), (Mode::Spectral, 16), (Mode::Spectral, 32)] {
         let mut line = format!("{:>8} N={n:<3} {w}x{h}:", mode.name());
-        let mut dry_wet = [0.0; 2];
-        for (k, water) in [false, true].into_iter().enumerate() {
-            r.set_custom_shader(if water { underwater::shader(&medium) } else { CustomShader::default() })?;
+        let mut dry_wet = [0.0; 3];
+        let models = [
+            ("dry", None),
+            ("paper", Some(underwater::Options::paper())),
+            ("marched", Some(underwater::Options::default())),
+        ];
+        for (k, (name, model)) in models.into_iter().enumerate() {
+            r.set_custom_shader(match model {
+                Some(o) => underwater::shader_with(&medium, &o),
+                None => CustomShader::default(),
+            })?;
             let s = RenderSettings { mode, wavelengths: n, timestamps: true, ..Default::default() };
             // One warm-up frame uploads the per-wavelength buffers.
             r.render(&scene.camera, &s)?;
@@ -54,9 +63,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 format!(", shading GPU {:.2} ms", median(shading))
             };
-            line += &format!(" {} {:.2} ms{gpu};", if water { "water" } else { "dry" }, dry_wet[k]);
+            line += &format!(" {name} {:.2} ms{gpu};", dry_wet[k]);
         }
-        println!("{line} underwater cost {:+.2} ms", dry_wet[1] - dry_wet[0]);
+        println!(
+            "{line} underwater cost: paper {:+.2} ms, marched {:+.2} ms",
+            dry_wet[1] - dry_wet[0],
+            dry_wet[2] - dry_wet[0]
+        );
     }
     Ok(())
 }

@@ -59,9 +59,14 @@ impl GpuLight {
     pub fn new(light: &scene::Light, rgb: [f64; 3]) -> Self {
         let rgb = [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0];
         match light.kind {
-            LightKind::Directional { direction } => {
-                GpuLight { pos_kind: direction.normalize().extend(0.0).to_array(), rgb, ..Default::default() }
-            }
+            LightKind::Directional { direction } => GpuLight {
+                pos_kind: direction.normalize().extend(0.0).to_array(),
+                // Diffuse sky light under water (scene::sky), drawn as a zenith light: the
+                // underwater hooks scatter it isotropically instead of as a beam.
+                cone: [0.0, 0.0, if scene::sky::is_stand_in(light) { 1.0 } else { 0.0 }, 0.0],
+                rgb,
+                ..Default::default()
+            },
             LightKind::Point { position, range } => GpuLight {
                 pos_kind: position.extend(1.0).to_array(),
                 dir_range: [0.0, 0.0, 0.0, range.unwrap_or(0.0)],

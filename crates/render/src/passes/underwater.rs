@@ -62,15 +62,31 @@ pub struct Options {
     /// Henyey–Greenstein asymmetry of the single scattering (default: Petzold's mean cosine,
     /// the ground truth's phase function).
     pub phase_g: f32,
+    /// Scatter the diffuse field's scalar irradiance E_o = (Kd/a)·E_d (Gershun's law) instead
+    /// of the paper's plane irradiance E_d. Off by default: against the path-traced water it
+    /// overshoots in turbid water (docs/underwater.md).
+    pub scalar_irradiance: bool,
+    /// Remove the unscattered beams from the isotropic term (they are counted by single
+    /// scattering with the real phase function) instead of adding single scattering on top of
+    /// the paper's term.
+    pub split_beams: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { steps: 16, phase_g: PETZOLD_G }
+        Options { steps: 16, phase_g: PETZOLD_G, scalar_irradiance: false, split_beams: false }
     }
 }
 
 impl Options {
+    /// The CPU reference's view of the diffuse term (`scene::water::single::diffuse`).
+    pub fn diffuse_model(&self) -> scene::water::single::DiffuseModel {
+        scene::water::single::DiffuseModel {
+            scalar_irradiance: self.scalar_irradiance,
+            split_beams: self.split_beams && self.steps > 0,
+        }
+    }
+
     /// The paper's model: analytic isotropic in-scattering only.
     pub fn paper() -> Self {
         Options { steps: 0, ..Default::default() }
@@ -112,6 +128,8 @@ pub fn params_with(medium: &WaterMedium, options: &Options) -> [f32; 16] {
         p[8 + ch] = k.kd as f32;
         p[12 + ch] = k.b as f32;
     }
+    p[11] = if options.scalar_irradiance { 1.0 } else { 0.0 };
+    p[15] = if options.split_beams { 1.0 } else { 0.0 };
     p[7] = (360..=830).map(|l| medium.coefficients(l as f64).c).fold(f64::INFINITY, f64::min) as f32;
     p
 }

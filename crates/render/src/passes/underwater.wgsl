@@ -5,7 +5,8 @@
 // custom.params[0] = (camera depth z0 m, metres per scene unit, march steps M (0 = the paper's
 //                     model alone), Henyey–Greenstein g)
 // custom.params[1] = (c at the RGB mode's three wavelengths, smallest c over the range)
-// custom.params[2].xyz, [3].xyz = Kd, b at the RGB mode's three wavelengths
+// custom.params[2] = (Kd at the RGB mode's three wavelengths, 1 = scalar irradiance by Gershun's law)
+// custom.params[3] = (b at the RGB mode's three wavelengths, 1 = take the beams out of L_ms)
 // custom_spectra[g * 4 + 0..3] = b, c, Kd at the group's wavelengths
 //
 // All quantities are vec4: four wavelengths in spectral/naive modes, (R, G, B, unused) in rgb
@@ -93,9 +94,10 @@ fn uw_prepare(ctx: SurfaceContext) {
         if (n == UW_SS_LIGHTS) { break; }
         let l = lights[li].pos_kind;
         if (u32(l.w) == 0u) {
-            // Beam towards the light: its optical path to a point at depth z is c·z/μ.
+            // Beam towards the light: its optical path to a point at depth z is c·z/μ. Sky
+            // stand-ins are diffuse light, left to `uw_in_scatter`.
             let mu = -l.y;
-            if (mu <= 0.0) { continue; }
+            if (mu <= 0.0 || lights[li].cone.z > 0.5) { continue; }
             let q = 1.0 - w.y / mu;
             let dm = select(uw_d, UW_CAP / custom.params[1].w, uw_infinite);
             let dt = dm / fm;
@@ -160,22 +162,33 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
     return b * total;
 }
 
-// Isotropic in-scattering of the downwelling field E0·e^{−Kd·z} (the paper's L_ms). With
-// single scattering on, the unscattered beams e^{−c·z/μ} it contains are removed, since
-// `uw_single_scatter` counts them with the real phase function.
+// Isotropic in-scattering of the downwelling field E0·e^{−Kd·z} (the paper's L_ms, whose
+// source is the plane irradiance). With `custom.params[2].w` = 1 the source is the scalar
+// irradiance instead, from Gershun's law a·E_o = Kd·E_net: E_o = (Kd/a)·E0·e^{−Kd·z}
+// (upwelling light neglected, Kd/a ≥ 1). With `custom.params[3].w` = 1 (and single
+// scattering on) the unscattered sun beams inside the field (scalar irradiance
+// E_j·e^{−c·z/μ_j}, plane E_j·μ_j·e^{−c·z/μ_j}) are taken out, since `uw_single_scatter`
+// counts them with the real phase function; by default single scattering is added on top,
+// as the paper's term stands for light scattered many times. Sky stand-ins are diffuse light
+// and are never taken out.
 fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
     let z0 = custom.params[0].x;
+    let gershun = custom.params[2].w > 0.5;
     var e0 = vec4<f32>(0.0);
     var beams = vec4<f32>(0.0);
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         let l = lights[li].pos_kind;
         let mu = -l.y;
         if (u32(l.w) != 0u || mu <= 0.0) { continue; }
-        let e = uw_emission(li, group, rgb) * mu;
-        e0 += e;
-        if (uw_steps > 0u) {
-            beams = fma(e * exp(-c * (z0 / mu)), uw_ray_integral(c * (1.0 - wy / mu)), beams);
+        let e = uw_emission(li, group, rgb);
+        e0 = fma(e, vec4<f32>(mu), e0);
+        if (uw_steps > 0u && custom.params[3].w > 0.5 && lights[li].cone.z < 0.5) {
+            let scalar = select(e * mu, e, gershun);
+            beams = fma(scalar * exp(-c * (z0 / mu)), uw_ray_integral(c * (1.0 - wy / mu)), beams);
         }
+    }
+    if (gershun) {
+        e0 *= max(kd / max(c - b, vec4<f32>(1e-6)), vec4<f32>(1.0));
     }
     // k = c + Kd·cosθ with cosθ = −ω_y.
     let ms = e0 * exp(-kd * z0) * uw_ray_integral(c - kd * wy);

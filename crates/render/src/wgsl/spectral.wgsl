@@ -24,7 +24,8 @@ struct GpuLight {
     pos_kind: vec4<f32>,
     // xyz spot direction (unit, away from the light); w = range (0 = infinite).
     dir_range: vec4<f32>,
-    // x = cos(outer cone), y = 1/(cos(inner) - cos(outer)), zw unused.
+    // Spot: x = cos(outer cone), y = 1/(cos(inner) - cos(outer)). Directional: z = 1 for a
+    // stand-in for diffuse sky light (scene::sky). w unused.
     cone: vec4<f32>,
     // Linear-sRGB emission × intensity, used in rgb mode.
     rgb: vec4<f32>,

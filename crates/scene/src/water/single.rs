@@ -45,17 +45,50 @@ pub fn beam(b: f64, c: f64, g: f64, to_light: DVec3, e_perp: f64, w: DVec3, z0: 
     b * hg_phase(g, to_light.dot(w)) * e_perp * (-c * z0 / mu).exp() * ray_integral(c * (1.0 - w.y / mu), d)
 }
 
-/// The diffuse rest of the paper's term: isotropic single scattering of
-/// `E0·e^{−Kd·z} − Σ_j E_j·μ_j·e^{−c·z/μ_j}` with `E0 = Σ_j E_j·μ_j`, clamped at 0 (where Kd
-/// exceeds c/μ near the surface the beams alone would be brighter than the measured
-/// downwelling light). `beams` holds (unit direction towards the light, E normal to the beam).
-pub fn diffuse(b: f64, c: f64, kd: f64, beams: &[(DVec3, f64)], w: DVec3, z0: f64, d: f64) -> f64 {
-    let e0: f64 = beams.iter().map(|(l, e)| e * l.y).sum();
-    let total = e0 * (-kd * z0).exp() * ray_integral(c - kd * w.y, d);
-    let unscattered: f64 = beams
-        .iter()
-        .map(|(l, e)| e * l.y * (-c * z0 / l.y).exp() * ray_integral(c * (1.0 - w.y / l.y), d))
-        .sum();
+/// How [`diffuse`] treats the downwelling field.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DiffuseModel {
+    /// Scatter the scalar irradiance `E_o = (Kd/a)·E0·e^{−Kd·z}` (Gershun's law `a·E_o =
+    /// Kd·E_net`, upwelling light neglected, Kd/a ≥ 1) instead of the paper's plane
+    /// irradiance `E0·e^{−Kd·z}`.
+    pub scalar_irradiance: bool,
+    /// Take the unscattered beams out of the field (scalar irradiance `E_j·e^{−c·z/μ_j}`,
+    /// plane `E_j·μ_j·e^{−c·z/μ_j}`): [`beam`] counts them with the real phase function.
+    pub split_beams: bool,
+}
+
+/// Isotropic in-scattering of the downwelling field `E0·e^{−Kd·z}`, `E0 = sky + Σ_j E_j·μ_j`
+/// (plane irradiance just below the surface) — the paper's term for `DiffuseModel::default()`
+/// — optionally as scalar irradiance and without the beams, clamped at 0 (where Kd exceeds
+/// c/μ near the surface the beams alone would be brighter than the measured downwelling
+/// light). `beams` holds (unit direction towards the light, E normal to the beam); `sky` is
+/// the plane irradiance of diffuse light (never taken out).
+#[allow(clippy::too_many_arguments)]
+pub fn diffuse(
+    b: f64,
+    c: f64,
+    kd: f64,
+    model: DiffuseModel,
+    sky: f64,
+    beams: &[(DVec3, f64)],
+    w: DVec3,
+    z0: f64,
+    d: f64,
+) -> f64 {
+    let e0: f64 = sky + beams.iter().map(|(l, e)| e * l.y).sum::<f64>();
+    let gain = if model.scalar_irradiance { (kd / (c - b).max(1e-6)).max(1.0) } else { 1.0 };
+    let total = gain * e0 * (-kd * z0).exp() * ray_integral(c - kd * w.y, d);
+    let unscattered: f64 = if model.split_beams {
+        beams
+            .iter()
+            .map(|(l, e)| {
+                let e = if model.scalar_irradiance { *e } else { e * l.y };
+                e * (-c * z0 / l.y).exp() * ray_integral(c * (1.0 - w.y / l.y), d)
+            })
+            .sum()
+    } else {
+        0.0
+    };
     (b / (4.0 * PI) * (total - unscattered)).max(0.0)
 }
 
@@ -205,6 +238,7 @@ mod tests {
                 for z0 in [2.0, 10.0] {
                     let d = if w.y > 0.0 { z0 / w.y } else { f64::INFINITY };
                     let beams = [(suns()[0], 1.5), (suns()[1], 0.7)];
+                    let model = DiffuseModel { split_beams: true, ..Default::default() };
                     let e0: f64 = beams.iter().map(|(l, e)| e * l.y).sum();
                     let paper = if d.is_finite() {
                         in_scatter(k.b, k.c, k.kd, e0, -w.y, z0, d)
@@ -212,10 +246,12 @@ mod tests {
                         k.b * e0 / (4.0 * PI * (k.c - k.kd * w.y)) * (-k.kd * z0).exp()
                     };
                     // The paper's E0 is plane irradiance: its beam part is E·μ, not E.
-                    let split = diffuse(k.b, k.c, k.kd, &beams, w, z0, d)
+                    let split = diffuse(k.b, k.c, k.kd, model, 0.0, &beams, w, z0, d)
                         + beams.iter().map(|&(l, e)| beam(k.b, k.c, 0.0, l, e * l.y, w, z0, d)).sum::<f64>();
+                    let plain = diffuse(k.b, k.c, k.kd, DiffuseModel::default(), 0.0, &beams, w, z0, d);
+                    assert!((plain - paper).abs() < 1e-12 * paper, "the default model is the paper's term");
                     // Where the clamp is inactive the sum is exact.
-                    if diffuse(k.b, k.c, k.kd, &beams, w, z0, d) > 0.0 {
+                    if diffuse(k.b, k.c, k.kd, model, 0.0, &beams, w, z0, d) > 0.0 {
                         assert!(
                             (split - paper).abs() < 1e-12 * paper,
                             "λ {lambda} w {w} z0 {z0}: {split} vs {paper}"

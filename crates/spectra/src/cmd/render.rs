@@ -66,6 +66,19 @@ pub struct LookArgs {
     #[arg(long, value_name = "G", allow_negative_numbers = true,
           default_value_t = render::passes::underwater::Options::default().phase_g)]
     pub phase_g: f32,
+    /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance,
+    /// no single scattering; same as --scatter-steps 0).
+    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams"])]
+    pub paper_model: bool,
+    /// Under water: scatter the diffuse light's scalar irradiance (Kd/a)·E_d (Gershun's law)
+    /// instead of the paper's plane irradiance E_d.
+    #[arg(long)]
+    pub scalar_irradiance: bool,
+    /// Under water: take the unscattered sun beams out of the isotropic term (single
+    /// scattering counts them with the real phase function) instead of adding single
+    /// scattering on top of the paper's term.
+    #[arg(long)]
+    pub split_beams: bool,
 }
 
 impl LookArgs {
@@ -87,7 +100,16 @@ impl LookArgs {
 
     /// The underwater model's options from `--scatter-steps` and `--phase-g`.
     pub fn underwater(&self) -> Result<render::passes::underwater::Options> {
-        let o = render::passes::underwater::Options { steps: self.scatter_steps, phase_g: self.phase_g };
+        let o = if self.paper_model {
+            render::passes::underwater::Options::paper()
+        } else {
+            render::passes::underwater::Options {
+                steps: self.scatter_steps,
+                phase_g: self.phase_g,
+                scalar_irradiance: self.scalar_irradiance,
+                split_beams: self.split_beams,
+            }
+        };
         o.validate().map_err(|e| anyhow!("--scatter-steps/--phase-g: {e}"))?;
         Ok(o)
     }
