@@ -2,8 +2,9 @@
 # Smoke test of `spectra view` as a user would drive it, under a virtual X server.
 #
 #   tools/view_smoke.sh [OUT_DIR]      (default OUT_DIR: target/view-smoke)
+#   SMOKE_ARGS="underwater --water II --depth 8" tools/view_smoke.sh   (other scene and flags)
 #
-# Starts Xvfb, opens `spectra view cornell`, sends keys with xdotool (mode → rgb, N up, mode →
+# Starts Xvfb, opens `spectra view cornell` (or $SMOKE_ARGS), sends keys with xdotool (mode → rgb, N up, mode →
 # spectral, screenshot key), drags the mouse to orbit, captures the whole screen with
 # ImageMagick's `import`, and checks that the screenshot key wrote a non-empty PNG. Leaves
 # screen-*.png and screenshot-*.png in OUT_DIR for a person to look at.
@@ -16,6 +17,7 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${1:-$ROOT/target/view-smoke}
 BIN=${SPECTRA_BIN:-$ROOT/target/debug/spectra}
 DISPLAY_NUM=${SMOKE_DISPLAY:-:99}
+read -r -a VIEW_ARGS <<<"${SMOKE_ARGS:-cornell}"
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
 for tool in Xvfb xdotool import; do
@@ -42,7 +44,7 @@ fi
 grep -q "no window system" "$OUT/no-display.txt" || { echo "FAIL: $(cat "$OUT/no-display.txt")" >&2; exit 1; }
 echo "ok: without DISPLAY: $(cat "$OUT/no-display.txt")"
 
-(cd "$OUT" && exec "$BIN" view cornell --size 640x480 >"$OUT/view-stdout.txt" 2>"$OUT/view-stderr.txt") &
+(cd "$OUT" && exec "$BIN" view "${VIEW_ARGS[@]}" --size 640x480 >"$OUT/view-stdout.txt" 2>"$OUT/view-stderr.txt") &
 VIEW=$!
 # Wait for the window (the first frames compile pipelines on the CPU driver).
 WIN=

@@ -145,16 +145,26 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
     var total = vec4<f32>(0.0);
     for (var j = 0u; j < uw_n; j++) {
         var sum = vec4<f32>(0.0);
-        for (var k = 0u; k < uw_steps; k++) {
-            sum = fma(vec4<f32>(uw_w[j * UW_MAX_STEPS + k]), exp(-c * uw_s[j * UW_MAX_STEPS + k]), sum);
-        }
         let dir = uw_dir[j];
+        let base = j * UW_MAX_STEPS;
         if (dir.y > 0.0) {
-            // Directional: each segment's exponential integrated exactly; tail unshadowed.
+            // Directional: the optical path grows by dt·q per segment, so the attenuations
+            // form a geometric sequence (two exponentials per group instead of one per step);
+            // each segment's exponential is integrated exactly, the tail unshadowed.
             let cq = c * dir.x;
+            let ratio = exp(-cq * dir.y);
+            var att = exp(-c * uw_s[base]);
+            for (var k = 0u; k < uw_steps; k++) {
+                sum = fma(vec4<f32>(uw_w[base + k]), att, sum);
+                att *= ratio;
+            }
             sum = sum * uw_path_integral(cq, dir.y);
             if (dir.z > 0.0) {
                 sum += dir.z * exp(-c * dir.w) / cq;
+            }
+        } else {
+            for (var k = 0u; k < uw_steps; k++) {
+                sum = fma(vec4<f32>(uw_w[base + k]), exp(-c * uw_s[base + k]), sum);
             }
         }
         total = fma(uw_emission(uw_light[j], group, rgb), sum, total);
