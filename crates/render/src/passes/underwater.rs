@@ -145,9 +145,15 @@ pub fn shader(medium: &WaterMedium) -> CustomShader {
     shader_with(medium, &Options::default())
 }
 
-/// The underwater custom shader for `medium`.
+/// The underwater custom shader for `medium`. Whether it marches is decided here, at compile
+/// time (`options.steps > 0`); the step count itself, like the depth, is a parameter.
 pub fn shader_with(medium: &WaterMedium, options: &Options) -> CustomShader {
-    CustomShader { source: HOOKS.to_string(), params: params_with(medium, options), spectra: spectra(medium) }
+    let source = if options.steps > 0 {
+        HOOKS.to_string()
+    } else {
+        HOOKS.replacen("const UW_MARCH: bool = true;", "const UW_MARCH: bool = false;", 1)
+    };
+    CustomShader { source, params: params_with(medium, options), spectra: spectra(medium) }
 }
 
 #[cfg(test)]
@@ -169,6 +175,11 @@ mod tests {
         assert!(p[4] > p[6] && p[8] > 3.0 * p[10], "{p:?}");
         let s = shader_with(&m, &Options::paper());
         assert_eq!(s.params[2], 0.0);
+        assert!(
+            s.source.contains("const UW_MARCH: bool = false;"),
+            "the paper's model compiles without the march"
+        );
+        assert!(shader(&m).source.contains("const UW_MARCH: bool = true;"));
         assert_eq!(s.spectra.len(), 3);
         assert_eq!(s.spectra[2].eval(500.0), m.coefficients(500.0).kd);
     }

@@ -15,6 +15,10 @@
 const UW_INV_4PI: f32 = 0.0795774715459476;
 // Must match MAX_LIGHTS in src/scene_gpu.rs.
 const UW_MAX_LIGHTS: u32 = 32u;
+// Whether the shader marches at all: `underwater::shader_with` writes `false` here when the
+// steps are 0, so the paper's model compiles without the march (its code and private arrays
+// cost about 2× the hook on a CPU driver even when skipped at run time).
+const UW_MARCH: bool = true;
 // Lights with single scattering, and march steps: must match underwater.rs.
 const UW_SS_LIGHTS: u32 = 4u;
 const UW_MAX_STEPS: u32 = 32u;
@@ -34,6 +38,8 @@ var<private> uw_light: array<u32, UW_SS_LIGHTS>;
 // y = segment length (m), z = tail weight, w = tail path (m). Point/spot slots: all zero.
 var<private> uw_dir: array<vec4<f32>, UW_SS_LIGHTS>;
 var<private> uw_w: array<f32, 128>;
+// Directional slots whose every march sample is lit: their sum has a closed form.
+var<private> uw_lit: array<bool, UW_SS_LIGHTS>;
 var<private> uw_s: array<f32, 128>;
 // Path length (m) to the hit or the surface, and whether the ray runs forever.
 var<private> uw_d: f32 = 0.0;
@@ -86,7 +92,7 @@ fn uw_prepare(ctx: SurfaceContext) {
     }
     let m = min(u32(custom.params[0].z), UW_MAX_STEPS);
     uw_steps = m;
-    if (m == 0u) { return; }
+    if (!UW_MARCH || m == 0u) { return; }
     let fm = f32(m);
     let cam = frame.camera_pos.xyz;
     var n = 0u;
@@ -102,11 +108,15 @@ fn uw_prepare(ctx: SurfaceContext) {
             let dm = select(uw_d, UW_CAP / custom.params[1].w, uw_infinite);
             let dt = dm / fm;
             let p = uw_hg(g, dot(-l.xyz, w));
+            var lit = true;
             for (var k = 0u; k < m; k++) {
                 let x = cam + w * ((f32(k) + 0.5) * dt / scale);
-                uw_w[n * UW_MAX_STEPS + k] = p * light_visibility(li, x, vec3<f32>(0.0));
-                uw_s[n * UW_MAX_STEPS + k] = z0 / mu + f32(k) * dt * q;
+                let v = light_visibility(li, x, vec3<f32>(0.0));
+                lit = lit && v >= 1.0;
+                uw_w[n * UW_MAX_STEPS + k] = p * v;
             }
+            uw_s[n * UW_MAX_STEPS] = z0 / mu;
+            uw_lit[n] = lit;
             let tail = select(0.0, p, uw_infinite);
             uw_dir[n] = vec4<f32>(q, dt, tail, z0 / mu + dm * q);
         } else {
@@ -147,7 +157,11 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
         var sum = vec4<f32>(0.0);
         let dir = uw_dir[j];
         let base = j * UW_MAX_STEPS;
-        if (dir.y > 0.0) {
+        if (dir.y > 0.0 && uw_lit[j]) {
+            // Directional, nothing in the way: the whole ray in closed form.
+            let cq = c * dir.x;
+            sum = uw_w[base] * exp(-c * uw_s[base]) * uw_ray_integral(cq);
+        } else if (dir.y > 0.0) {
             // Directional: the optical path grows by dt·q per segment, so the attenuations
             // form a geometric sequence (two exponentials per group instead of one per step);
             // each segment's exponential is integrated exactly, the tail unshadowed.
@@ -208,7 +222,10 @@ fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: boo
 fn uw_shade(radiance: vec4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> vec4<f32> {
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
-    var l = uw_in_scatter(b, c, kd, group, rgb, wy) + uw_single_scatter(b, c, group, rgb);
+    var l = uw_in_scatter(b, c, kd, group, rgb, wy);
+    if (UW_MARCH) {
+        l += uw_single_scatter(b, c, group, rgb);
+    }
     if (!ctx.background) {
         let zs = max(custom.params[0].x - uw_d * wy, 0.0);
         l = fma(radiance, exp(-kd * zs) * exp(-c * uw_d), l);
