@@ -11,7 +11,7 @@ use color::water::WaterType;
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
 use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
-use scene::water::WaterMedium;
+use scene::water::{WATER_IOR, WaterMedium};
 use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
 
 const W: u32 = 40;
@@ -184,7 +184,8 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
     let dry = render(&mut r, &scene, &settings, CustomShader::default());
     let e_sun = 3.0;
     let to_sun = -light_dir().as_dvec3();
-    for options in [underwater::Options::paper(), underwater::Options::default()] {
+    for options in [underwater::Options::paper(), underwater::Options { surface: true, ..Default::default() }]
+    {
         let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
         let mut worst = 0.0f64;
         for py in 0..H {
@@ -206,17 +207,16 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
                     let scatter = if options.steps == 0 {
                         e_sun * -light_dir().y as f64 * t.in_scatter
                     } else {
-                        single::diffuse(
-                            k.b,
-                            k.c,
-                            k.kd,
-                            options.diffuse_model(),
-                            0.0,
-                            &[(to_sun, e_sun)],
-                            w,
-                            depth,
-                            d,
-                        ) + single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d)
+                        let beams = [(to_sun, e_sun)];
+                        let m = options.diffuse_model();
+                        let surface = if hit.is_none() && w.y > 0.0 {
+                            single::surface_from_below(k.b, k.c, k.kd, m, 0.0, &beams, w, depth, WATER_IOR)
+                        } else {
+                            0.0
+                        };
+                        single::diffuse(k.b, k.c, k.kd, m, 0.0, &beams, w, depth, d)
+                            + single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d)
+                            + surface
                     };
                     dry_rgb[ch] * t.surface_attenuation * t.transmittance + scatter
                 });
@@ -262,13 +262,19 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
     let (mut worst, mut n_surface, mut n_down, mut n_up) = (0.0f64, 0, 0, 0);
     // The default model, and scalar irradiance (Gershun) with other steps and g.
     let configs = [
-        ("IB", 5.0, 1.0, underwater::Options::default()),
+        ("IB", 5.0, 1.0, underwater::Options { surface: true, ..Default::default() }),
         ("3C", 3.0, 0.5, underwater::Options::default()),
         (
             "II",
             4.0,
             1.0,
-            underwater::Options { steps: 24, phase_g: 0.8, scalar_irradiance: true, split_beams: true },
+            underwater::Options {
+                steps: 24,
+                phase_g: 0.8,
+                scalar_irradiance: true,
+                split_beams: true,
+                surface: false,
+            },
         ),
         ("I", 8.0, 1.0, underwater::Options { split_beams: true, ..Default::default() }),
     ];
@@ -317,7 +323,14 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
                         depth,
                         d,
                     ) + single::beam(k.b, k.c, g, to_sun, e_sun, w, depth, d)
-                        + single::point_equiangular(k.b, k.c, g, lamp_m, i_m, w, d.min(6.0 / c_min), steps);
+                        + single::point_equiangular(k.b, k.c, g, lamp_m, i_m, w, d.min(6.0 / c_min), steps)
+                        + if options.surface && hit.is_none() && w.y > 0.0 {
+                            let beams = [(to_sun, e_sun)];
+                            let m = options.diffuse_model();
+                            single::surface_from_below(k.b, k.c, k.kd, m, e_sky, &beams, w, depth, WATER_IOR)
+                        } else {
+                            0.0
+                        };
                     let i = (py * W + px) as usize;
                     let surface = match hit {
                         Some(_) => {

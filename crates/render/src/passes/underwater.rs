@@ -70,17 +70,29 @@ pub struct Options {
     /// scattering with the real phase function) instead of adding single scattering on top of
     /// the paper's term.
     pub split_beams: bool,
+    /// Draw the surface seen from below: the sky through Snell's window, Fresnel reflection and
+    /// total internal reflection of the water below (not of the sea floor or other objects).
+    /// Off by default: without the floor in the reflection it is further from the path-traced
+    /// water than not drawing it (docs/underwater.md).
+    pub surface: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { steps: 16, phase_g: PETZOLD_G, scalar_irradiance: false, split_beams: false }
+        Options {
+            steps: 16,
+            phase_g: PETZOLD_G,
+            scalar_irradiance: false,
+            split_beams: false,
+            surface: false,
+        }
     }
 }
 
 impl Options {
     /// The CPU reference's view of the diffuse term (`scene::water::single::diffuse`).
     pub fn diffuse_model(&self) -> scene::water::single::DiffuseModel {
+        // (the surface seen from below uses the same model for the water it reflects)
         scene::water::single::DiffuseModel {
             scalar_irradiance: self.scalar_irradiance,
             split_beams: self.split_beams && self.steps > 0,
@@ -148,11 +160,20 @@ pub fn shader(medium: &WaterMedium) -> CustomShader {
 /// The underwater custom shader for `medium`. Whether it marches is decided here, at compile
 /// time (`options.steps > 0`); the step count itself, like the depth, is a parameter.
 pub fn shader_with(medium: &WaterMedium, options: &Options) -> CustomShader {
-    let source = if options.steps > 0 {
-        HOOKS.to_string()
-    } else {
-        HOOKS.replacen("const UW_MARCH: bool = true;", "const UW_MARCH: bool = false;", 1)
+    use scene::water::{WATER_IOR, fresnel::mean_transmittance};
+    let mut source = HOOKS.to_string();
+    let mut set = |line: &str, value: String| {
+        let (name, _) = line.split_once('=').expect("a const line");
+        assert!(source.contains(line), "underwater.wgsl lost `{line}`");
+        source = source.replacen(line, &format!("{name}= {value};"), 1);
     };
+    set("const UW_MARCH: bool = true;", (options.steps > 0).to_string());
+    set("const UW_SURFACE: bool = true;", options.surface.to_string());
+    set("const UW_N: f32 = 1.34;", format!("{WATER_IOR:?}"));
+    set(
+        "const UW_SKY_NORM: f32 = 0.34;",
+        format!("{:?}", (1.0 / (std::f64::consts::PI * mean_transmittance(WATER_IOR))) as f32),
+    );
     CustomShader { source, params: params_with(medium, options), spectra: spectra(medium) }
 }
 

@@ -19,6 +19,12 @@ const UW_MAX_LIGHTS: u32 = 32u;
 // steps are 0, so the paper's model compiles without the march (its code and private arrays
 // cost about 2× the hook on a CPU driver even when skipped at run time).
 const UW_MARCH: bool = true;
+// Whether upward rays that reach the surface see it (Snell's window, Fresnel reflection, total
+// internal reflection); `false` for the paper's model. The refractive index and the sky's
+// normalisation 1/(π·T̄) are written by `underwater::shader_with` (scene::water::fresnel).
+const UW_SURFACE: bool = true;
+const UW_N: f32 = 1.34;
+const UW_SKY_NORM: f32 = 0.34;
 // Lights with single scattering, and march steps: must match underwater.rs.
 const UW_SS_LIGHTS: u32 = 4u;
 const UW_MAX_STEPS: u32 = 32u;
@@ -54,12 +60,16 @@ fn uw_path_integral(k: vec4<f32>, d: f32) -> vec4<f32> {
     return select(exact, series, abs(x) < vec4<f32>(1e-3));
 }
 
-// The same over the whole ray: to the hit or surface, or to infinity (k > 0 there).
+// The same over the whole view ray: to the hit or surface, or to infinity (k > 0 there).
 fn uw_ray_integral(k: vec4<f32>) -> vec4<f32> {
-    if (uw_infinite) {
+    return uw_integral_to(k, uw_d, uw_infinite);
+}
+
+fn uw_integral_to(k: vec4<f32>, d: f32, infinite: bool) -> vec4<f32> {
+    if (infinite) {
         return 1.0 / k;
     }
-    return uw_path_integral(k, uw_d);
+    return uw_path_integral(k, d);
 }
 
 fn uw_hg(g: f32, cos_t: f32) -> f32 {
@@ -195,8 +205,8 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
 // counts them with the real phase function; by default single scattering is added on top,
 // as the paper's term stands for light scattered many times. Sky stand-ins are diffuse light
 // and are never taken out.
-fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
-    let z0 = custom.params[0].x;
+// For a ray with vertical component `wy` from depth `z0` over `d` metres (or forever).
+fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32, z0: f32, d: f32, infinite: bool) -> vec4<f32> {
     let gershun = custom.params[2].w > 0.5;
     var e0 = vec4<f32>(0.0);
     var beams = vec4<f32>(0.0);
@@ -208,26 +218,58 @@ fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: boo
         e0 = fma(e, vec4<f32>(mu), e0);
         if (uw_steps > 0u && custom.params[3].w > 0.5 && lights[li].cone.z < 0.5) {
             let scalar = select(e * mu, e, gershun);
-            beams = fma(scalar * exp(-c * (z0 / mu)), uw_ray_integral(c * (1.0 - wy / mu)), beams);
+            beams = fma(scalar * exp(-c * (z0 / mu)), uw_integral_to(c * (1.0 - wy / mu), d, infinite), beams);
         }
     }
     if (gershun) {
         e0 *= max(kd / max(c - b, vec4<f32>(1e-6)), vec4<f32>(1.0));
     }
     // k = c + Kd·cosθ with cosθ = −ω_y.
-    let ms = e0 * exp(-kd * z0) * uw_ray_integral(c - kd * wy);
+    let ms = e0 * exp(-kd * z0) * uw_integral_to(c - kd * wy, d, infinite);
     return max(b * UW_INV_4PI * (ms - beams), vec4<f32>(0.0));
+}
+
+// Unpolarised Fresnel reflectance of the surface for light going up at cosine `cos_w`
+// (scene::water::fresnel::fresnel_reflectance with n_i = UW_N, n_t = 1); 1 outside the window.
+fn uw_fresnel_up(cos_w: f32) -> f32 {
+    let sin_t = UW_N * sqrt(max(1.0 - cos_w * cos_w, 0.0));
+    if (sin_t >= 1.0) { return 1.0; }
+    let cos_t = sqrt(1.0 - sin_t * sin_t);
+    let rs = (UW_N * cos_w - cos_t) / (UW_N * cos_w + cos_t);
+    let rp = (cos_w - UW_N * cos_t) / (cos_w + UW_N * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+// The surface seen from below at the end of an upward view ray (before the path's
+// attenuation): the sky through Snell's window, L_air·T·n² with L_air = E_sky/(π·T̄) from the
+// sky stand-ins' irradiance, plus the reflected water below (the in-scattering of a downward
+// ray from the surface along the mirrored direction; no sea floor, no single scattering).
+fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
+    let r = uw_fresnel_up(wy);
+    var sky = vec4<f32>(0.0);
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        if (u32(l.w) == 0u && lights[li].cone.z > 0.5 && l.y < 0.0) {
+            sky = fma(uw_emission(li, group, rgb), vec4<f32>(-l.y), sky);
+        }
+    }
+    let window = (1.0 - r) * UW_N * UW_N * UW_SKY_NORM * sky;
+    return window + r * uw_in_scatter(b, c, kd, group, rgb, -wy, 0.0, 0.0, true);
 }
 
 fn uw_shade(radiance: vec4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> vec4<f32> {
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
-    var l = uw_in_scatter(b, c, kd, group, rgb, wy);
+    let z0 = custom.params[0].x;
+    var l = uw_in_scatter(b, c, kd, group, rgb, wy, z0, uw_d, uw_infinite);
     if (UW_MARCH) {
         l += uw_single_scatter(b, c, group, rgb);
     }
+    if (UW_SURFACE && ctx.background && wy > 0.0) {
+        l += exp(-c * uw_d) * uw_surface_from_below(b, c, kd, group, rgb, wy);
+    }
     if (!ctx.background) {
-        let zs = max(custom.params[0].x - uw_d * wy, 0.0);
+        let zs = max(z0 - uw_d * wy, 0.0);
         l = fma(radiance, exp(-kd * zs) * exp(-c * uw_d), l);
     }
     return l;

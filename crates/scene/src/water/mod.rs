@@ -38,6 +38,7 @@ use thiserror::Error;
 
 use crate::WaterSettings;
 
+pub mod fresnel;
 mod quadrature;
 pub mod single;
 

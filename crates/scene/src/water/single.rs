@@ -92,6 +92,33 @@ pub fn diffuse(
     (b / (4.0 * PI) * (total - unscattered)).max(0.0)
 }
 
+/// What the camera sees of the flat surface from below along an upward view ray (ω_y > 0)
+/// from depth `z0`, already attenuated over the `z0/ω_y` metres to the surface: inside Snell's
+/// window the sky, uniform above the water with the radiance that gives the plane irradiance
+/// `sky` just below the surface (`L_air = sky/(π·T̄)`, seen as `L_air·T·n²`), plus the
+/// Fresnel-reflected water below; outside the window (total internal reflection) the water
+/// below alone. The water below is the in-scattering [`diffuse`] of a downward ray from the
+/// surface along the mirrored direction, to infinity (no sea floor, no single scattering along
+/// it). `n` is the water's refractive index.
+#[allow(clippy::too_many_arguments)]
+pub fn surface_from_below(
+    b: f64,
+    c: f64,
+    kd: f64,
+    model: DiffuseModel,
+    sky: f64,
+    beams: &[(DVec3, f64)],
+    w: DVec3,
+    z0: f64,
+    n: f64,
+) -> f64 {
+    let r = super::fresnel::fresnel_reflectance(w.y, n, 1.0);
+    let window = (1.0 - r) * n * n * sky / (PI * super::fresnel::mean_transmittance(n));
+    let mirrored = DVec3::new(w.x, -w.y, w.z);
+    let below = diffuse(b, c, kd, model, sky, beams, mirrored, 0.0, f64::INFINITY);
+    (-c * z0 / w.y).exp() * (window + r * below)
+}
+
 /// The integrand of a point light's single scattering at t metres along the ray: light at
 /// `pos` (metres from the camera) with intensity `intensity` (irradiance `I/r²` at r metres).
 #[allow(clippy::too_many_arguments)]

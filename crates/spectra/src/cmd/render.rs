@@ -68,7 +68,7 @@ pub struct LookArgs {
     pub phase_g: f32,
     /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance,
     /// no single scattering; same as --scatter-steps 0).
-    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams"])]
+    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface"])]
     pub paper_model: bool,
     /// Under water: scatter the diffuse light's scalar irradiance (Kd/a)·E_d (Gershun's law)
     /// instead of the paper's plane irradiance E_d.
@@ -79,6 +79,10 @@ pub struct LookArgs {
     /// scattering on top of the paper's term.
     #[arg(long)]
     pub split_beams: bool,
+    /// Under water: draw the surface seen from below (Snell's window with the sky, Fresnel
+    /// reflection and total internal reflection of the water below, not of the sea floor).
+    #[arg(long)]
+    pub water_surface: bool,
 }
 
 impl LookArgs {
@@ -108,6 +112,7 @@ impl LookArgs {
                 phase_g: self.phase_g,
                 scalar_irradiance: self.scalar_irradiance,
                 split_beams: self.split_beams,
+                surface: self.water_surface,
             }
         };
         o.validate().map_err(|e| anyhow!("--scatter-steps/--phase-g: {e}"))?;
