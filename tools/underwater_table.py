@@ -3,7 +3,8 @@
 path-traced ground truth, for every Jerlov type at 2, 10 and 20 m, on the built-in `underwater`
 scene. Modes: ours (spectral, default model: the paper's term + single scattering), ours with
 the paper's model alone (`--paper-model`), ours with the sun beams taken out of the paper's
-term (`--split-beams`), naive and rgb (default model).
+term (`--split-beams`), ours drawing the surface seen from below (`--water-surface`), naive and
+rgb (default model).
 
 Two figures per cell: per pixel, and on BLOCK×BLOCK block means (`spectra diff --block`),
 which cut the path tracer's noise by BLOCK; the truth's own noise floor (two seeds) is
@@ -28,7 +29,8 @@ TYPES = ["I", "IA", "IB", "II", "III", "1C", "3C", "5C", "7C", "9C"]
 DEPTHS = [2, 10, 20]
 # (column, render mode, extra flags)
 MODELS = [("ours", "spectral", []), ("paper", "spectral", ["--paper-model"]),
-          ("split", "spectral", ["--split-beams"]), ("naive", "naive", []), ("rgb", "rgb", [])]
+          ("split", "spectral", ["--split-beams"]), ("surface", "spectral", ["--water-surface"]),
+          ("naive", "naive", []), ("rgb", "rgb", [])]
 
 
 def run(cmd):
