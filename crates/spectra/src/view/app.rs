@@ -7,6 +7,7 @@
 use super::blit::Blit;
 use super::camera::{CameraController, scene_bounds};
 use super::controls::{Controls, FrameTimes, HELP, next_screenshot_path};
+use super::water::WaterControls;
 use anyhow::{Context, Result, anyhow};
 use color::upsample::CoeffTable;
 use render::{Gpu, RenderSettings, Renderer};
@@ -77,6 +78,16 @@ struct Running {
     pending_free: Vec<egui::TextureId>,
     /// The camera and settings of the last frame: accumulation restarts when either changes.
     last_view: Option<(scene::Camera, RenderSettings)>,
+    /// The water panel, when the camera is under water.
+    water: Option<WaterState>,
+}
+
+/// The water the viewer started with and the panel's edits of it.
+struct WaterState {
+    base: scene::water::WaterMedium,
+    wanted: WaterControls,
+    applied: WaterControls,
+    error: Option<String>,
 }
 
 impl ApplicationHandler for App {
@@ -137,6 +148,10 @@ impl Running {
         if let Some(w) = &opts.water {
             renderer.set_custom_shader(render::passes::underwater::shader_with(w, &opts.water_options))?;
         }
+        let water = opts.water.as_ref().map(|w| {
+            let c = WaterControls::new(w, opts.water_options);
+            WaterState { base: w.clone(), wanted: c.clone(), applied: c, error: None }
+        });
 
         let size = window.inner_size();
         let mut config = surface
@@ -186,6 +201,7 @@ impl Running {
             adapter: adapter_name,
             pending_free: Vec::new(),
             last_view: None,
+            water,
         })
     }
 
@@ -315,11 +331,22 @@ impl Running {
         let size = (self.config.width, self.config.height);
         let (times, adapter) = (self.times, self.adapter.clone());
         let controls = &mut self.controls;
+        let water = &mut self.water;
         let mut out = ctx.run_pass(raw, |ctx| {
-            egui::Window::new("spectra")
-                .default_pos([8.0, 8.0])
-                .default_width(300.0)
-                .show(ctx, |ui| controls.ui(ui, &times, &adapter, size));
+            egui::Window::new("spectra").default_pos([8.0, 8.0]).default_width(300.0).vscroll(true).show(
+                ctx,
+                |ui| {
+                    controls.ui(ui, &times, &adapter, size);
+                    if let Some(w) = water {
+                        ui.collapsing("water", |ui| {
+                            w.wanted.ui(ui);
+                            if let Some(e) = &w.error {
+                                ui.colored_label(egui::Color32::from_rgb(255, 110, 90), e);
+                            }
+                        });
+                    }
+                },
+            );
         });
         self.egui_state.handle_platform_output(&self.window, out.platform_output);
         // New glyphs/images go up now, whether or not this frame reaches the screen; frees
@@ -334,6 +361,19 @@ impl Running {
         }
         self.pending_free.extend(out.textures_delta.free.drain());
         self.controls.commit();
+        if let Some(w) = &mut self.water
+            && w.wanted != w.applied
+        {
+            // A refused edit stays in the panel with its reason; the last good water stays on screen.
+            match w.wanted.apply(&w.applied, &w.base, &mut self.renderer) {
+                Ok(()) => {
+                    w.applied = w.wanted.clone();
+                    w.error = None;
+                    self.last_view = None;
+                }
+                Err(e) => w.error = Some(format!("{e:#}")),
+            }
+        }
 
         let camera = self.camera.camera();
         let settings = self.accumulation_settings(&camera);
