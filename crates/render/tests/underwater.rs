@@ -108,6 +108,51 @@ fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
     (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }
 
+/// The worst error of a GPU-vs-CPU comparison and how many pixel-wavelengths of each kind it
+/// covered (surface hits, background looking down, background looking up).
+#[derive(Default)]
+struct Tally {
+    worst: f64,
+    surface: usize,
+    down: usize,
+    up: usize,
+}
+
+impl Tally {
+    /// Checks one pixel to 1e-3 (`what` names it in the failure) and counts it.
+    fn check(
+        &mut self,
+        got: [f64; 3],
+        want: [f64; 3],
+        dir: Vec3,
+        hit: Option<f32>,
+        what: impl Fn() -> String,
+    ) {
+        let e = rel_err(got, want);
+        assert!(
+            e <= 1e-3,
+            "{} dir {dir:?} hit {hit:?}: gpu {got:?} cpu {want:?} (relative error {e:.2e})",
+            what()
+        );
+        self.worst = self.worst.max(e);
+        match (hit, dir.y > 0.0) {
+            (Some(_), _) => self.surface += 1,
+            (None, false) => self.down += 1,
+            (None, true) => self.up += 1,
+        }
+    }
+
+    /// Prints the figures and checks that every branch of the hook was exercised.
+    fn finish(&self, name: &str) {
+        let Tally { worst, surface, down, up } = *self;
+        eprintln!(
+            "{name} GPU vs CPU: worst relative error {worst:.2e} over {surface} surface, {down} \
+             downward-background and {up} upward-background pixel-wavelengths"
+        );
+        assert!(surface > 100 && down > 20 && up > 100, "{surface} {down} {up}");
+    }
+}
+
 #[test]
 fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
     let scene = floor_scene();
@@ -115,7 +160,7 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
     r.set_scene(&scene).unwrap();
     r.resize(W, H).unwrap();
     let table = common::table();
-    let (mut worst, mut n_surface, mut n_down, mut n_up) = (0.0f64, 0, 0, 0);
+    let mut tally = Tally::default();
     for (ty, depth, scale) in [("IB", 5.0, 1.0), ("5C", 12.0, 0.5), ("III", 0.8, 2.0)] {
         let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         for lambda in [430.0, 500.0, 560.0, 640.0] {
@@ -147,29 +192,13 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
                     let dry_rgb = DVec3::from(common::rgb_of(&dry[i]));
                     let want =
                         dry_rgb * (t.surface_attenuation * t.transmittance) + unit * (e0 * t.in_scatter);
-                    let got = common::rgb_of(&wet[i]);
-                    let e = rel_err(got, want.to_array());
-                    assert!(
-                        e <= 1e-3,
-                        "{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py}) dir {dir:?} hit {hit:?}: \
-                         gpu {got:?} cpu {want:?} (relative error {e:.2e})"
-                    );
-                    worst = worst.max(e);
-                    match (hit, dir.y > 0.0) {
-                        (Some(_), _) => n_surface += 1,
-                        (None, false) => n_down += 1,
-                        (None, true) => n_up += 1,
-                    }
+                    let what = || format!("{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
+                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
                 }
             }
         }
     }
-    eprintln!(
-        "underwater GPU vs CPU: worst relative error {worst:.2e} over {n_surface} surface, \
-         {n_down} downward-background and {n_up} upward-background pixel-wavelengths"
-    );
-    // Every branch of the hook was exercised.
-    assert!(n_surface > 100 && n_down > 20 && n_up > 100, "{n_surface} {n_down} {n_up}");
+    tally.finish("underwater");
 }
 
 #[test]
@@ -259,7 +288,7 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
     r.resize(W, H).unwrap();
     let table = common::table();
     let eye = scene.camera.position();
-    let (mut worst, mut n_surface, mut n_down, mut n_up) = (0.0f64, 0, 0, 0);
+    let mut tally = Tally::default();
     // The default model, and scalar irradiance (Gershun) with other steps and g.
     let configs = [
         ("IB", 5.0, 1.0, underwater::Options { surface: true, ..Default::default() }),
@@ -340,28 +369,13 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
                         None => DVec3::ZERO,
                     };
                     let want = surface + unit * scatter;
-                    let got = common::rgb_of(&wet[i]);
-                    let e = rel_err(got, want.to_array());
-                    assert!(
-                        e <= 1e-3,
-                        "{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py}) dir {dir:?} hit {hit:?}: \
-                         gpu {got:?} cpu {want:?} (relative error {e:.2e})"
-                    );
-                    worst = worst.max(e);
-                    match (hit, dir.y > 0.0) {
-                        (Some(_), _) => n_surface += 1,
-                        (None, false) => n_down += 1,
-                        (None, true) => n_up += 1,
-                    }
+                    let what = || format!("{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
+                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
                 }
             }
         }
     }
-    eprintln!(
-        "single scattering GPU vs CPU: worst relative error {worst:.2e} over {n_surface} surface, \
-         {n_down} downward-background and {n_up} upward-background pixel-wavelengths"
-    );
-    assert!(n_surface > 100 && n_down > 20 && n_up > 100, "{n_surface} {n_down} {n_up}");
+    tally.finish("single scattering");
 }
 
 /// Shadows in the water: under an opaque roof the sun's beam is blocked along the whole
