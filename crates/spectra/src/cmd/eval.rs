@@ -11,15 +11,15 @@ pub struct Args {
     /// Small sizes and sample counts (a few minutes on a 2-core CPU; what CI runs).
     #[arg(long)]
     pub quick: bool,
-    /// Cases to run, comma-separated (default: all): metamerism, colorchecker-d65,
-    /// colorchecker-f11, colorchecker-led; opt-in: underwater-ib, underwater-iii,
-    /// underwater-3c (any Jerlov type as underwater-TYPE).
+    /// Cases to run, comma-separated. Default: metamerism, colorchecker-d65, colorchecker-f11,
+    /// colorchecker-led and the underwater scene in Jerlov I (--quick) or I, IB, II, 3C (full);
+    /// any Jerlov type as underwater-TYPE (underwater-iii, underwater-ii.5).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
-    /// Override the ground-truth samples per pixel.
+    /// Override the ground-truth samples per pixel (every case, underwater included).
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Override the image size WIDTHxHEIGHT of the error measurements.
+    /// Override the image size WIDTHxHEIGHT of the error measurements (every case).
     #[arg(long)]
     pub size: Option<String>,
     /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
@@ -32,24 +32,20 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let mut budget = if a.quick { suite::Budget::quick() } else { suite::Budget::full() };
-    if let Some(s) = a.spp {
-        if s == 0 {
-            bail!("--spp must be at least 1");
-        }
-        budget.truth_spp = s;
+    if a.spp == Some(0) {
+        bail!("--spp must be at least 1");
     }
-    if let Some(s) = &a.size {
-        (budget.width, budget.height) = crate::cmd::render::parse_size(s)?;
-    }
-    let (ids, notes) = if a.scenes.is_empty() {
-        suite::default_ids()
+    let size = a.size.as_deref().map(crate::cmd::render::parse_size).transpose()?;
+    budget.override_with(size, a.spp);
+    let ids = if a.scenes.is_empty() {
+        suite::default_ids(&budget)
     } else {
         for id in &a.scenes {
             suite::case(id)?;
         }
-        let water = a.scenes.iter().any(|s| s.starts_with("underwater-"));
-        (a.scenes.clone(), if water { vec![suite::UNDERWATER_NOTE.to_string()] } else { Vec::new() })
+        a.scenes.clone()
     };
+    let notes = suite::notes(&ids);
     let out = a.out.clone();
     let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table })?;
     println!("{}", eval::report::markdown_table(&r));

@@ -52,6 +52,13 @@ pub struct CaseResult {
     pub id: String,
     pub title: String,
     pub truth_image: String,
+    /// Image size and truth samples per pixel of this case (underwater cases have their own).
+    pub width: u32,
+    pub height: u32,
+    pub truth_spp: u32,
+    /// Ground-truth transport: "direct" (direct lighting, the rasteriser's punctual lights) or
+    /// "volumetric" (full path tracing of the water; no edge mask is applied then).
+    pub transport: String,
     /// ΔE2000/MAE between two truth renders with different seeds: differences below this are noise.
     pub noise_floor: Errors,
     pub masked_fraction: f64,
@@ -120,15 +127,11 @@ pub fn run(cfg: Config) -> Result<Results> {
         }
         Ok(())
     };
-    let mut r = Renderer::with_table(table.clone())?;
-    let adapter = r.gpu().describe();
+    let adapter = Renderer::with_table(table.clone())?.gpu().describe();
     let b = &cfg.budget;
-    let job = |seed: u64, range: WavelengthRange| measure::TruthJob {
-        width: b.width,
-        height: b.height,
-        spp: b.truth_spp,
-        seed,
-        range,
+    let job = |c: &suite::Case, seed: u64, range: WavelengthRange| {
+        let (width, height, spp) = b.for_case(c);
+        measure::TruthJob { width, height, spp, seed, range }
     };
     let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| suite::case(id)).collect::<Result<_>>()?;
 
@@ -137,12 +140,13 @@ pub fn run(cfg: Config) -> Result<Results> {
         check()?;
         let range = scene_range(&c.scene)?;
         let n = c.scene.spectral.wavelengths.map(|n| n as usize).unwrap_or(16);
-        let pb = bar(2 * b.height as u64, &c.id);
+        let (width, height, spp) = b.for_case(c);
+        let pb = bar(2 * height as u64, &c.id);
         pb.set_message("ground truth");
         let pbr = &pb;
         let rows = |base: u64| move |k: u64| pbr.set_position(base + k);
-        let t0 = measure::truth(&c.scene, &table, job(1, range), cancel, &rows(0))?;
-        let t1 = measure::truth(&c.scene, &table, job(2, range), cancel, &rows(b.height as u64))?;
+        let t0 = measure::truth(&c.scene, &table, job(c, 1, range), cancel, &rows(0))?;
+        let t1 = measure::truth(&c.scene, &table, job(c, 2, range), cancel, &rows(height as u64))?;
         pb.finish_and_clear();
         check()?;
         // Volumetric truth is too noisy for a luminance-edge mask (it would mask everything).
@@ -153,13 +157,8 @@ pub fn run(cfg: Config) -> Result<Results> {
         save_png(&cfg.out.join(&truth_png), &t0)?;
         write_exr(&cfg.out.join(format!("{}_truth.exr", c.id)), &t0)?;
 
-        // A fresh renderer per case: the underwater cases install custom hooks.
-        let mut r = Renderer::with_table(table.clone())?;
-        r.set_scene(&c.scene)?;
-        if let Some(w) = &water {
-            r.set_custom_shader(render::passes::underwater::shader(w))?;
-        }
-        r.resize(b.width, b.height)?;
+        let mut r = renderer_for(c, &table, water.as_ref())?;
+        r.resize(width, height)?;
         let mut maps = Vec::new();
         for (mode, name) in MODES {
             let img = measure::realtime(&mut r, &c.scene, &measure::settings(*mode, n, range))?;
@@ -196,6 +195,10 @@ pub fn run(cfg: Config) -> Result<Results> {
             id: c.id.clone(),
             title: c.title.clone(),
             truth_image: truth_png,
+            width,
+            height,
+            truth_spp: spp,
+            transport: if water.is_some() { "volumetric" } else { "direct" }.into(),
             noise_floor: noise,
             masked_fraction: mask.iter().filter(|m| **m).count() as f64 / mask.len() as f64,
             modes,
@@ -205,7 +208,7 @@ pub fn run(cfg: Config) -> Result<Results> {
     // Frame time against N on the first case's scene.
     let ft_case = cases.first().context("no scenes to evaluate")?;
     let range = scene_range(&ft_case.scene)?;
-    r.set_scene(&ft_case.scene)?;
+    let mut r = renderer_for(ft_case, &table, measure::water(&ft_case.scene)?.as_ref())?;
     r.resize(b.bench_width, b.bench_height)?;
     let pb = bar(1 + 2 * b.bench_counts.len() as u64, "frame time");
     let mut frame_times = Vec::new();
@@ -231,11 +234,13 @@ pub fn run(cfg: Config) -> Result<Results> {
     // Jittered accumulation vs equal spacing, on the first case's scene and range (jitter
     // moves the samples inside the range; the range itself stays put).
     let jrange = range;
-    let pb = bar(2 * b.height as u64, "jitter truth");
-    let jt = measure::truth(&ft_case.scene, &table, job(3, jrange), cancel, &|k| pb.set_position(k))?;
+    let (jw, jh, _) = b.for_case(ft_case);
+    let pb = bar(jh as u64, "jitter truth");
+    let jt =
+        measure::truth(&ft_case.scene, &table, job(ft_case, 3, jrange), cancel, &|k| pb.set_position(k))?;
     pb.finish_and_clear();
     check()?;
-    r.resize(b.width, b.height)?;
+    r.resize(jw, jh)?;
     let mut jitter = Vec::new();
     for &k in &b.jitter_frames {
         check()?;
@@ -269,6 +274,21 @@ pub fn run(cfg: Config) -> Result<Results> {
     check()?;
     report::write_all(&cfg.out, &res)?;
     Ok(res)
+}
+
+/// A fresh renderer for a case's scene, with the underwater hooks when it has water (they are
+/// per-renderer custom passes, so no case inherits another's).
+fn renderer_for(
+    c: &suite::Case,
+    table: &std::sync::Arc<color::upsample::CoeffTable>,
+    water: Option<&scene::water::WaterMedium>,
+) -> Result<Renderer> {
+    let mut r = Renderer::with_table(table.clone())?;
+    r.set_scene(&c.scene)?;
+    if let Some(w) = water {
+        r.set_custom_shader(render::passes::underwater::shader(w))?;
+    }
+    Ok(r)
 }
 
 fn scene_range(s: &scene::Scene) -> Result<WavelengthRange> {

@@ -3,20 +3,49 @@
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 
+/// Chart size in SVG pixels, and the width of the legend column on its right: the legend sits
+/// beside the plot, never over bars or lines (whatever the data's shape).
+const SIZE: (u32, u32) = (900, 380);
+const LEGEND_W: u32 = 190;
+
+/// How a legend entry is marked.
+#[derive(Clone, Copy)]
+enum Mark {
+    Box,
+    Line,
+}
+
+/// Draws the legend into its own column: one row per series, colour from `Palette99` in order.
+fn legend(area: &DrawingArea<SVGBackend, plotters::coord::Shift>, names: &[&str], mark: Mark) -> Result<()> {
+    for (i, name) in names.iter().enumerate() {
+        let c = Palette99::pick(i).to_rgba();
+        let y = 60 + 22 * i as i32;
+        match mark {
+            Mark::Box => area.draw(&Rectangle::new([(8, y - 6), (20, y + 6)], c.filled())),
+            Mark::Line => area.draw(&PathElement::new(vec![(4, y), (24, y)], c.stroke_width(2))),
+        }
+        .map_err(|e| anyhow!("{e}"))?;
+        area.draw(&Text::new(name.to_string(), (30, y - 7), ("sans-serif", 13)))
+            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
+}
+
 /// Grouped bar chart: one group per case, one bar per series (mean values).
 pub fn bars(title: &str, y_label: &str, groups: &[String], series: &[(&str, Vec<f64>)]) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 380)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-        let ymax = series.iter().flat_map(|(_, v)| v.iter().copied()).fold(0.0, f64::max).max(1e-6) * 1.15;
+        let (plot, side) = root.split_horizontally(SIZE.0 - LEGEND_W);
+        let ymax = series.iter().flat_map(|(_, v)| v.iter().copied()).fold(0.0, f64::max).max(1e-6) * 1.1;
         let n = series.len() as f64;
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(&plot)
             .caption(title, ("sans-serif", 18))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..groups.len() as f64, 0.0..ymax)
+            .build_cartesian_2d(0.0..groups.len().max(1) as f64, 0.0..ymax)
             .map_err(|e| anyhow!("{e}"))?;
         let g = groups.to_vec();
         chart
@@ -30,7 +59,7 @@ pub fn bars(title: &str, y_label: &str, groups: &[String], series: &[(&str, Vec<
             .y_desc(y_label)
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
-        for (si, (name, vals)) in series.iter().enumerate() {
+        for (si, (_, vals)) in series.iter().enumerate() {
             let c = Palette99::pick(si).to_rgba();
             let w = 0.8 / n;
             chart
@@ -38,23 +67,16 @@ pub fn bars(title: &str, y_label: &str, groups: &[String], series: &[(&str, Vec<
                     let x0 = gi as f64 + 0.1 + si as f64 * w;
                     Rectangle::new([(x0, 0.0), (x0 + w * 0.9, *v)], c.filled())
                 }))
-                .map_err(|e| anyhow!("{e}"))?
-                .label(*name)
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], c.filled()));
+                .map_err(|e| anyhow!("{e}"))?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+        legend(&side, &series.iter().map(|s| s.0).collect::<Vec<_>>(), Mark::Box)?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     Ok(svg)
 }
 
-/// Line chart on a log₂ x axis: `series` of (x, y) points.
+/// Line chart on a log x axis with ticks at the data's own x values (N = 1, 2, 4, …), so the
+/// axis reads as the measured configurations rather than a decade grid.
 pub fn lines(
     title: &str,
     x_label: &str,
@@ -63,36 +85,43 @@ pub fn lines(
 ) -> Result<String> {
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 380)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-        let pts = series.iter().flat_map(|(_, v)| v.iter().copied());
-        let (xmax, ymax) = pts.fold((1.0f64, 0.0f64), |(a, b), (x, y)| (a.max(x), b.max(y)));
-        let mut chart = ChartBuilder::on(&root)
+        let (plot, side) = root.split_horizontally(SIZE.0 - LEGEND_W);
+        let mut xs: Vec<f64> =
+            series.iter().flat_map(|(_, v)| v.iter().map(|p| p.0)).filter(|x| *x > 0.0).collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        let (xmin, xmax) = (xs.first().copied().unwrap_or(1.0), xs.last().copied().unwrap_or(1.0));
+        let ymax = series.iter().flat_map(|(_, v)| v.iter().map(|p| p.1)).fold(0.0, f64::max);
+        let mut chart = ChartBuilder::on(&plot)
             .caption(title, ("sans-serif", 18))
             .margin(10)
+            .margin_right(20)
             .x_label_area_size(40)
             .y_label_area_size(60)
-            .build_cartesian_2d((1.0..xmax * 1.2).log_scale(), 0.0..ymax.max(1e-6) * 1.15)
+            .build_cartesian_2d(
+                (xmin / 1.15..xmax * 1.15).log_scale().with_key_points(xs),
+                0.0..ymax.max(1e-6) * 1.1,
+            )
             .map_err(|e| anyhow!("{e}"))?;
-        chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| anyhow!("{e}"))?;
-        for (si, (name, pts)) in series.iter().enumerate() {
+        chart
+            .configure_mesh()
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        for (si, (_, pts)) in series.iter().enumerate() {
             let c = Palette99::pick(si).to_rgba();
             chart
                 .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                .map_err(|e| anyhow!("{e}"))?
-                .label(*name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+                .map_err(|e| anyhow!("{e}"))?;
             chart
                 .draw_series(pts.iter().map(|p| Circle::new(*p, 3, c.filled())))
                 .map_err(|e| anyhow!("{e}"))?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
+        legend(&side, &series.iter().map(|s| s.0).collect::<Vec<_>>(), Mark::Line)?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     Ok(svg)
@@ -106,5 +135,9 @@ mod tests {
         assert!(b.starts_with("<svg") && b.contains("ours"));
         let l = super::lines("t", "N", "ms", &[("rgb", vec![(1.0, 2.0), (4.0, 3.0)])]).unwrap();
         assert!(l.contains("<svg") && l.contains("rgb"));
+        // Ticks at the data's x values only, labelled as integers.
+        let texts: Vec<&str> =
+            l.split("</text>").filter_map(|t| t.rsplit_once('>')).map(|(_, s)| s.trim()).collect();
+        assert!(texts.contains(&"1") && texts.contains(&"4") && !texts.contains(&"3"), "{texts:?}");
     }
 }

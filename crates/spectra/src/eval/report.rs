@@ -30,13 +30,31 @@ pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
         super::plot::bars("Mean ΔE2000 against ground truth (lower is better)", "mean ΔE2000", &ids, &de)?
             .as_bytes(),
     )?;
-    let mut dem = mean(&|m| m.errors.delta_e2000_masked.mean);
-    dem.push(("truth noise", r.cases.iter().map(|c| c.noise_floor.delta_e2000_masked.mean).collect()));
-    put(
-        dir,
-        "delta_e_masked.svg",
-        super::plot::bars("Mean ΔE2000 outside the edge mask", "mean ΔE2000", &ids, &dem)?.as_bytes(),
-    )?;
+    // Masked numbers only for cases that have a mask: a volumetric case's "masked" bars would
+    // repeat its whole-image bars under a title that says otherwise.
+    let masked: Vec<&super::CaseResult> = r.cases.iter().filter(|c| has_mask(c)).collect();
+    let mut dem: Vec<(&str, Vec<f64>)> = MODES
+        .iter()
+        .enumerate()
+        .map(|(i, (_, name))| {
+            (*name, masked.iter().map(|c| c.modes[i].errors.delta_e2000_masked.mean).collect())
+        })
+        .collect();
+    dem.push(("truth noise", masked.iter().map(|c| c.noise_floor.delta_e2000_masked.mean).collect()));
+    let masked_ids: Vec<String> = masked.iter().map(|c| c.id.clone()).collect();
+    if !masked.is_empty() {
+        put(
+            dir,
+            "delta_e_masked.svg",
+            super::plot::bars(
+                "Mean ΔE2000 outside the edge mask (cases with direct-lighting truth)",
+                "mean ΔE2000",
+                &masked_ids,
+                &dem,
+            )?
+            .as_bytes(),
+        )?;
+    }
     let mae = mean(&|m| m.errors.mae_linear.mean);
     put(
         dir,
@@ -104,15 +122,19 @@ pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
 /// Every number as CSV sections separated by a blank line.
 pub fn csv(r: &Results) -> String {
     let mut s = String::from(
-        "case,mode,wavelengths,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
+        "case,transport,width,height,truth_spp,mode,wavelengths,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
     );
     for c in &r.cases {
         let rows = c.modes.iter().map(|m| (m.mode.as_str(), m.wavelengths, &m.errors));
         for (mode, n, e) in rows.chain(std::iter::once(("truth_noise", None, &c.noise_floor))) {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 c.id,
+                c.transport,
+                c.width,
+                c.height,
+                c.truth_spp,
                 mode,
                 n.map(|n| n.to_string()).unwrap_or_default(),
                 e.delta_e2000.mean,
@@ -159,20 +181,33 @@ pub fn markdown_table(r: &Results) -> String {
     for c in &r.cases {
         let m = |i: usize| c.modes[i].errors.delta_e2000.mean;
         let k = |i: usize| c.modes[i].errors.delta_e2000_masked.mean;
+        let masked = if has_mask(c) {
+            format!("{:.3} / {:.3} / {:.3}", k(0), k(1), k(2))
+        } else {
+            "– (volumetric truth, no mask)".into()
+        };
         let _ = writeln!(
             s,
-            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} / {:.3} / {:.3} |",
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {masked} |",
             c.id,
             m(0),
             m(1),
             m(2),
             c.noise_floor.delta_e2000.mean,
-            k(0),
-            k(1),
-            k(2)
         );
     }
     s
+}
+
+/// Whether the case's masked numbers mean anything (volumetric truths get no edge mask).
+fn has_mask(c: &super::CaseResult) -> bool {
+    c.transport != "volumetric"
+}
+
+/// "W×H, S spp" of the cases with the given transport, if any (sizes differ per kind of case).
+fn budget_of(r: &Results, transport: &str) -> Option<String> {
+    let c = r.cases.iter().find(|c| c.transport == transport)?;
+    Some(format!("{} spp, {}×{}", c.truth_spp, c.width, c.height))
 }
 
 fn html(r: &Results) -> String {
@@ -185,8 +220,7 @@ td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}th{{background:#e
 .row{{display:flex;gap:8px;flex-wrap:wrap}}figure{{margin:0}}figcaption{{font-size:13px;text-align:center}}
 img.px{{image-rendering:pixelated;width:256px}}img.hm{{height:256px}}.best{{font-weight:bold;color:#060}}</style></head><body>
 <h1>spectra evaluation{q}</h1>
-<p>Ground truth: the CPU spectral path tracer, direct lighting only, {spp} spp, {w}×{h}, same punctual lights as the
-real-time renderer. <b>ours</b> = Jakob–Hanika spectral upsampling, <b>naive</b> = box upsampling, <b>rgb</b> = classic RGB
+<p>Ground truth: the CPU spectral path tracer{direct}{vol}. <b>ours</b> = Jakob–Hanika spectral upsampling, <b>naive</b> = box upsampling, <b>rgb</b> = classic RGB
 shading. Errors are per-pixel CIEDE2000 (CIELAB white Y = 1) and MAE of linear sRGB. The <i>truth noise</i> row is two
 truth renders with different seeds: differences below it are Monte-Carlo noise. The edge mask removes pixels whose 3×3
 neighbourhood in the truth image varies in luminance by more than {ec:.0}% (shadow and silhouette edges where shadow maps and
@@ -194,9 +228,16 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
 <p><b>Machine:</b> {m}<br><b>Adapter:</b> {a}<br><b>Run time:</b> {t:.0} s</p>
 "#,
         q = if r.quick { " (--quick)" } else { "" },
-        spp = r.budget.truth_spp,
-        w = r.budget.width,
-        h = r.budget.height,
+        direct = budget_of(r, "direct")
+            .map(|b| format!(
+                "; ordinary cases: direct lighting only, {b}, with the same punctual lights as the real-time renderer"
+            ))
+            .unwrap_or_default(),
+        vol = budget_of(r, "volumetric")
+            .map(|b| format!(
+                "; underwater cases: full volumetric path tracing of the water, {b}, no edge mask (see the note)"
+            ))
+            .unwrap_or_default(),
         ec = r.edge_contrast * 100.0,
         m = esc(&r.machine),
         a = esc(&r.adapter),
@@ -229,18 +270,40 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
         }
         let _ = write!(h, "<td>{:.3}</td>", c.noise_floor.delta_e2000.mean);
         for m in &c.modes {
-            let _ = write!(h, "<td>{:.3}</td>", m.errors.delta_e2000_masked.mean);
+            if has_mask(c) {
+                let _ = write!(h, "<td>{:.3}</td>", m.errors.delta_e2000_masked.mean);
+            } else {
+                h.push_str("<td>–</td>");
+            }
         }
-        let _ = write!(h, "<td>{:.1}%</td>", c.masked_fraction * 100.0);
+        if has_mask(c) {
+            let _ = write!(h, "<td>{:.1}%</td>", c.masked_fraction * 100.0);
+        } else {
+            h.push_str("<td>no mask</td>");
+        }
         for m in &c.modes {
             let _ = write!(h, "<td>{:.4}</td>", m.errors.mae_linear.mean);
         }
         h.push_str("</tr>");
     }
     h.push_str("</table>");
-    h.push_str(r#"<p><img src="delta_e.svg" alt="mean ΔE2000 bar chart"><br><img src="delta_e_masked.svg" alt="masked ΔE2000 bar chart"><br><img src="mae.svg" alt="MAE bar chart"></p>"#);
+    h.push_str(r#"<p><img src="delta_e.svg" alt="mean ΔE2000 bar chart"><br>"#);
+    if r.cases.iter().any(has_mask) {
+        h.push_str(r#"<img src="delta_e_masked.svg" alt="masked ΔE2000 bar chart"><br>"#);
+    }
+    h.push_str(r#"<img src="mae.svg" alt="MAE bar chart"></p>"#);
     for c in &r.cases {
-        let _ = write!(h, "<h2>{}</h2><p>{}</p><div class=\"row\">", esc(&c.id), esc(&c.title));
+        let _ = write!(
+            h,
+            "<h2>{}</h2><p>{} — {}×{}, truth {} spp ({}), truth noise ΔE00 {:.3}</p><div class=\"row\">",
+            esc(&c.id),
+            esc(&c.title),
+            c.width,
+            c.height,
+            c.truth_spp,
+            if has_mask(c) { "direct lighting" } else { "volumetric" },
+            c.noise_floor.delta_e2000.mean
+        );
         let _ = write!(
             h,
             "<figure><img class=\"px\" src=\"{}\"><figcaption>ground truth</figcaption></figure>",
@@ -286,7 +349,7 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
     }
     let _ = write!(
         h,
-        r#"</table><h2>Beyond the paper: jittered wavelengths with temporal accumulation</h2><p>Scene {}, range {:.0}–{:.0} nm (truth over the same range). Equal spacing renders all N wavelengths in one frame; jittered renders {} per frame at a stratified random offset and averages the frames.</p><img src="jitter.svg" alt="jitter plot"><table><tr><th>total N</th><th>frames</th><th>equal spacing ΔE00</th><th>jittered ΔE00</th></tr>"#,
+        r#"</table><h2>Beyond the paper: jittered wavelengths with temporal accumulation</h2><p>Scene {}, range {:.0}–{:.0} nm (truth over the same range). Equal spacing renders all N wavelengths in one frame; jittered renders {} per frame at a stratified random offset and averages the frames (each frame normalised by dense integrals, so the mean is unbiased). The viewer does the same live: <code>spectra view</code>, key J / “accumulate (jittered λ)”.</p><img src="jitter.svg" alt="jitter plot"><table><tr><th>total N</th><th>frames</th><th>equal spacing ΔE00</th><th>jittered ΔE00</th></tr>"#,
         esc(&r.jitter_scene),
         r.jitter_range[0],
         r.jitter_range[1],

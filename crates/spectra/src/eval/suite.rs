@@ -23,6 +23,14 @@ pub struct Budget {
     /// Jittered accumulation: wavelengths per frame and the frame counts to accumulate.
     pub jitter_per_frame: usize,
     pub jitter_frames: Vec<usize>,
+    /// Underwater cases have their own size and truth samples: their truth is full volumetric
+    /// transport, several times dearer per sample than direct lighting (≈ 3× more in turbid 3C
+    /// than in clear I), and its noise falls only as 1/√spp, so they trade pixels for samples.
+    pub water_width: u32,
+    pub water_height: u32,
+    pub water_spp: u32,
+    /// Jerlov types of the underwater cases in the default suite.
+    pub water_types: Vec<String>,
 }
 
 impl Budget {
@@ -37,6 +45,12 @@ impl Budget {
             bench_counts: vec![1, 2, 4, 8, 16, 32],
             jitter_per_frame: 6,
             jitter_frames: vec![1, 2, 4, 8],
+            // Clear ocean at the built-in's 10 m: ≈ 7 s per truth render here, truth noise
+            // ≈ 0.6 ΔE00 against mode differences of ≈ 1.2 (docs/evaluation.md).
+            water_width: 128,
+            water_height: 96,
+            water_spp: 1024,
+            water_types: vec!["I".into()],
         }
     }
 
@@ -51,6 +65,31 @@ impl Budget {
             bench_counts: vec![1, 2, 4, 8, 16, 32, 64],
             jitter_per_frame: 6,
             jitter_frames: vec![1, 2, 4, 8, 16],
+            // Four times the quick samples (half the noise) on 1.6× the pixels: the four types
+            // together cost ≈ 12 min of truth here, 3C alone ≈ 5.
+            water_width: 160,
+            water_height: 120,
+            water_spp: 4096,
+            water_types: ["I", "IB", "II", "3C"].iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// Size and truth samples per pixel of a case: the underwater budget for cases with water.
+    pub fn for_case(&self, c: &Case) -> (u32, u32, u32) {
+        if c.scene.water.is_some() {
+            (self.water_width, self.water_height, self.water_spp)
+        } else {
+            (self.width, self.height, self.truth_spp)
+        }
+    }
+
+    /// `--size` / `--spp` overrides: they apply to every case, underwater ones included.
+    pub fn override_with(&mut self, size: Option<(u32, u32)>, spp: Option<u32>) {
+        if let Some((w, h)) = size {
+            (self.width, self.height, self.water_width, self.water_height) = (w, h, w, h);
+        }
+        if let Some(s) = spp {
+            (self.truth_spp, self.water_spp) = (s, s);
         }
     }
 }
@@ -68,21 +107,24 @@ pub struct Case {
 /// Case ids `spectra eval --scenes` accepts.
 pub const CASE_IDS: &[&str] = &["metamerism", "colorchecker-d65", "colorchecker-f11", "colorchecker-led"];
 
-/// Jerlov water types of the underwater cases (clear open ocean, turbid ocean, coastal).
-pub const WATER_TYPES: &[&str] = &["IB", "III", "3C"];
+/// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`).
+pub fn water_id(ty: &str) -> String {
+    format!("underwater-{}", ty.to_ascii_lowercase())
+}
 
-/// The default suite and the notes about how it differs from the paper. The underwater cases
-/// are opt-in (`--scenes underwater-ib,...`): their volumetric truth needs far more samples than
-/// a CI budget allows (1024 spp at 128×96 still leaves a truth noise of ≈3.7 ΔE00).
-pub fn default_ids() -> (Vec<String>, Vec<String>) {
-    let ids: Vec<String> = CASE_IDS.iter().map(|s| s.to_string()).collect();
-    let opt_in =
-        WATER_TYPES.iter().map(|t| format!("underwater-{}", t.to_ascii_lowercase())).collect::<Vec<_>>();
-    let note = format!(
-        "underwater (paper Figs. 1–2) is opt-in, not in this run: --scenes {} (volumetric truth is slow and noisy)",
-        opt_in.join(",")
-    );
-    (ids, vec![note])
+/// The default suite: the direct-lighting cases, then the underwater scene in each of the
+/// budget's water types (paper Figs. 1–2). Other Jerlov types are opt-in (`--scenes underwater-iii`).
+pub fn default_ids(b: &Budget) -> Vec<String> {
+    CASE_IDS.iter().map(|s| s.to_string()).chain(b.water_types.iter().map(|t| water_id(t))).collect()
+}
+
+/// Notes the report carries for a run of `ids`.
+pub fn notes(ids: &[String]) -> Vec<String> {
+    if ids.iter().any(|id| id.starts_with("underwater-")) {
+        vec![UNDERWATER_NOTE.to_string()]
+    } else {
+        Vec::new()
+    }
 }
 
 /// How the underwater cases differ from the others.
@@ -162,5 +204,27 @@ mod tests {
         let x = |e: &Emission| e.xyz()[0] / e.xyz().iter().sum::<f64>();
         assert!(x(b) > x(a) + 0.02, "{} vs {}", x(b), x(a));
         assert!(case("nope").unwrap_err().to_string().contains("colorchecker-f11"));
+    }
+
+    #[test]
+    fn default_suites_include_underwater_with_its_own_budget() {
+        let q = default_ids(&Budget::quick());
+        assert_eq!(q.last().map(String::as_str), Some("underwater-i"));
+        assert!(q.iter().any(|id| id == "metamerism"));
+        let f = default_ids(&Budget::full());
+        for id in ["underwater-i", "underwater-ib", "underwater-ii", "underwater-3c"] {
+            assert!(f.iter().any(|x| x == id), "{id} missing from the full suite");
+        }
+        let b = Budget::quick();
+        let uw = case("underwater-i").unwrap();
+        assert_eq!(uw.scene.water.as_ref().unwrap().water_type, "I");
+        assert_eq!(b.for_case(&uw), (b.water_width, b.water_height, b.water_spp));
+        assert_eq!(b.for_case(&case("metamerism").unwrap()), (b.width, b.height, b.truth_spp));
+        let mut o = Budget::full();
+        o.override_with(Some((64, 48)), Some(256));
+        assert_eq!(o.for_case(&uw), (64, 48, 256));
+        assert_eq!(o.for_case(&case("metamerism").unwrap()), (64, 48, 256));
+        assert_eq!(notes(&q).len(), 1);
+        assert!(notes(&["metamerism".to_string()]).is_empty());
     }
 }
