@@ -159,6 +159,21 @@ pub fn water_medium(
         Some(w) => anyhow!("--water '{w}': {e}"),
         None => anyhow!("scene {}: water settings: {e}", scene.source),
     })?;
+    // Both renderers put the whole scene under a flat surface `depth` above the camera: geometry
+    // above it would be lit and seen as if under water by the rasteriser and as in air by the
+    // path tracer.
+    if let Some((_, hi)) = scene.bounds() {
+        let above = (hi.y - scene.camera.position().y) as f64 * medium.scale;
+        if above > medium.depth + 1e-6 {
+            bail!(
+                "scene {}: its geometry reaches {above:.2} m above the camera, above the water surface {:.2} m \
+                 up; use --depth {:.2} or more (or a larger water scale)",
+                scene.source,
+                medium.depth,
+                above
+            );
+        }
+    }
     Ok(Some(medium))
 }
 
@@ -288,6 +303,14 @@ mod tests {
         assert_eq!(out_format(Path::new("a.exr")).unwrap(), OutFormat::Exr);
         let e = out_format(Path::new("a.jpg")).unwrap_err().to_string();
         assert!(e.contains(".jpg") && e.contains(".png"), "{e}");
+    }
+
+    #[test]
+    fn geometry_above_the_surface_is_refused() {
+        let cornell = scene::builtin("cornell").unwrap();
+        let e = format!("{:#}", water_medium(&cornell, Some("II"), Some(0.0)).unwrap_err());
+        assert!(e.contains("above the water surface") && e.contains("--depth"), "{e}");
+        assert!(water_medium(&cornell, Some("II"), Some(50.0)).unwrap().is_some());
     }
 
     #[test]
