@@ -128,10 +128,12 @@ pub fn notes(ids: &[String]) -> Vec<String> {
 }
 
 /// How the underwater cases differ from the others.
-pub const UNDERWATER_NOTE: &str = "underwater cases: the real-time image is the paper's analytic model (Kd-attenuated \
-sunlight, single isotropic in-scattering), the truth is full volumetric path tracing of the same Jerlov water (not \
-direct-only: the paper's Kd stands for the multiply-scattered downwelling light), so their error includes the model's \
-own approximation, equal for all three modes";
+pub const UNDERWATER_NOTE: &str = "underwater cases: the real-time image is the renderer's default underwater \
+model (render::passes::underwater::shader: the paper's Kd-attenuated in-scattering plus ray-marched single scattering of \
+the scene's lights; the surface itself is not drawn), the truth is full volumetric path tracing of the same Jerlov water \
+with the tracer's sun and sky through a flat surface (not direct-only: the paper's Kd stands for the multiply-scattered \
+downwelling light), so their error includes the real-time model's own approximation, equal for all three modes; no edge \
+mask (volumetric noise would mask everything)";
 
 /// Builds a case by id.
 pub fn case(id: &str) -> Result<Case> {
