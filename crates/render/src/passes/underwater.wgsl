@@ -35,7 +35,9 @@ const UW_CAP: f32 = 6.0;
 
 // Per-pixel, wavelength-independent march, filled once by `uw_prepare` and reused by every
 // wavelength group: for light slot j and step k, weight W = phase × visibility × geometry and
-// optical path s (metres) so that the light's single scattering is b·E·Σ_k W·e^{−c·s}.
+// optical path s (metres) so that the light's single scattering is b·E·Σ_k W·e^{−c·s}. For a
+// directional slot only s at the first step is stored: the later ones follow from q and the
+// segment length in `uw_dir` (see `uw_single_scatter`).
 var<private> uw_ready: bool = false;
 var<private> uw_n: u32 = 0u;
 var<private> uw_steps: u32 = 0u;
