@@ -31,6 +31,7 @@ struct SpectralKey {
     n: usize,
     jitter: Option<u32>,
     mode: Mode,
+    quadrature: color::Quadrature,
     scene_generation: u64,
     custom_generation: u64,
 }
@@ -105,8 +106,8 @@ impl Renderer {
         let custom = CustomShader::default();
         let gbuffer = GBufferPass::new(device, &shared)?;
         let shadow = ShadowPass::new(device)?;
-        let shading = ShadingPass::new(device, &shared, &custom.source)?;
-        let custom_pass = CustomPass::new(device, &shared, &custom.source)?;
+        let shading = ShadingPass::new(device, &shared, &custom.assembled())?;
+        let custom_pass = CustomPass::new(device, &shared, &custom.assembled())?;
         let post = PostPass::new(device, &shared)?;
         let accumulate = AccumulatePass::new(device)?;
         let gpu_table = GpuCoeffTable::upload(device, &gpu.queue, &table);
@@ -174,8 +175,8 @@ impl Renderer {
     pub fn set_custom_shader(&mut self, custom: CustomShader) -> Result<()> {
         custom.validate()?;
         let device = &self.gpu.device;
-        let shading = ShadingPass::new(device, &self.shared, &custom.source)?;
-        let custom_pass = CustomPass::new(device, &self.shared, &custom.source)?;
+        let shading = ShadingPass::new(device, &self.shared, &custom.assembled())?;
+        let custom_pass = CustomPass::new(device, &self.shared, &custom.assembled())?;
         self.shading = shading;
         self.custom_pass = custom_pass;
         self.custom = custom;
@@ -477,6 +478,7 @@ impl Renderer {
             n: settings.wavelengths,
             jitter: settings.jitter.map(f32::to_bits),
             mode: settings.mode,
+            quadrature: settings.quadrature,
             scene_generation: self.scene_generation,
             custom_generation: self.custom_generation,
         };
@@ -492,20 +494,27 @@ impl Renderer {
         let padded_lambda: Vec<f64> = groups.iter().flat_map(|g| g.lambda.map(f64::from)).collect();
 
         let mut lights = Vec::new();
-        let mut light_spectra: Vec<f32> = Vec::new();
+        // light_weights[light · n_groups + group]: the light's node weights (mat3x4 in WGSL).
+        let mut light_weights: Vec<crate::spectral_data::GroupWeights> = Vec::new();
         for light in &scene.lights {
-            lights.push(GpuLight::new(light, setup.light_rgb(&light.emission)));
-            let mut s = setup.light_samples(&light.emission, settings.mode, &self.table);
-            s.resize(ng * 4, 0.0);
-            light_spectra.extend(s.iter().map(|&v| v as f32));
+            let mut gpu = GpuLight::new(light, setup.light_rgb(&light.emission));
+            if settings.mode != Mode::Rgb {
+                let w = setup.light_weights(&light.emission, settings.mode, &self.table)?;
+                let total = SpectralSetup::light_total(&w);
+                gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
+                light_weights.extend(setup.gpu_weights(&w));
+            } else {
+                light_weights.extend(std::iter::repeat_n([[0f32; 4]; 3], ng));
+            }
+            lights.push(gpu);
         }
         let n_lights = lights.len() as u32;
         // Storage buffers may not be empty.
         if lights.is_empty() {
             lights.push(GpuLight::default());
         }
-        if light_spectra.is_empty() {
-            light_spectra.resize(4, 0.0);
+        if light_weights.is_empty() {
+            light_weights.push([[0f32; 4]; 3]);
         }
         let storage = |label: &str, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -516,7 +525,7 @@ impl Renderer {
         };
         let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
         let light_buf = storage("lights", bytemuck::cast_slice(&lights));
-        let light_spec_buf = storage("light spectra", bytemuck::cast_slice(&light_spectra));
+        let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("spectral"),
             layout: &self.shared.spectral,

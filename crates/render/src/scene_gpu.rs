@@ -52,6 +52,9 @@ pub struct GpuLight {
     pub dir_range: [f32; 4],
     pub cone: [f32; 4],
     pub rgb: [f32; 4],
+    /// Spectral modes: XYZ of the light seen by a reflectance of one (the sum of its node
+    /// weights), for the terms that do not depend on the surface's reflectance (specular).
+    pub xyz: [f32; 4],
 }
 
 impl GpuLight {
@@ -80,6 +83,7 @@ impl GpuLight {
                     dir_range: direction.normalize().extend(range.unwrap_or(0.0)).to_array(),
                     cone: [co, 1.0 / (ci - co).max(1e-4), 0.0, 0.0],
                     rgb,
+                    ..Default::default()
                 }
             }
         }

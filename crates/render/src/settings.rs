@@ -1,7 +1,7 @@
 //! Per-frame render settings: everything a viewer may change between two frames.
 
 use crate::error::{RenderError, Result};
-use color::WavelengthRange;
+use color::{Quadrature, WavelengthRange};
 
 /// How surfaces and lights are coloured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -79,13 +79,22 @@ impl Tonemap {
 /// Largest number of wavelengths per pixel.
 pub const MAX_WAVELENGTHS: usize = 256;
 
+/// Narrowest wavelength range a render accepts (nm).
+pub const MIN_RANGE_NM: f64 = 1.0;
+
 /// Settings read at every [`crate::Renderer::render`]. Changing the wavelengths, range or
 /// observer re-uploads a few small buffers; nothing is recompiled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub mode: Mode,
-    /// Number of wavelength samples N (1..=[`MAX_WAVELENGTHS`]), midpoint rule over `range`.
+    /// Number of wavelength nodes N (1..=[`MAX_WAVELENGTHS`]), equally spaced over `range` at
+    /// the centres of N equal bins.
     pub wavelengths: usize,
+    /// How the N node values are integrated against the lights and the observer
+    /// ([`color::quadrature`]): `Prefiltered` (the default) integrates light × observer densely
+    /// against the cardinal functions of the nodes, so line spectra never alias; `Midpoint` is
+    /// the paper's point-sampled sum.
+    pub quadrature: Quadrature,
     pub range: WavelengthRange,
     /// Observer name for `color::Observer::by_name`.
     pub observer: String,
@@ -113,6 +122,7 @@ impl Default for RenderSettings {
         RenderSettings {
             mode: Mode::Spectral,
             wavelengths: 16,
+            quadrature: Quadrature::Prefiltered,
             range: WavelengthRange::VISIBLE,
             observer: "cie1931".into(),
             exposure_ev: 0.0,
@@ -134,6 +144,13 @@ impl RenderSettings {
             )));
         }
         WavelengthRange::new(self.range.min, self.range.max)?;
+        if self.range.width() < MIN_RANGE_NM {
+            return Err(RenderError::Settings(format!(
+                "the wavelength range {}–{} nm is narrower than {MIN_RANGE_NM} nm: nothing visible can be \
+                 integrated over it",
+                self.range.min, self.range.max
+            )));
+        }
         if !self.exposure_ev.is_finite() {
             return Err(RenderError::Settings(format!("exposure must be finite (got {})", self.exposure_ev)));
         }
@@ -162,6 +179,9 @@ mod tests {
         let bad = RenderSettings { observer: "cat".into(), ..Default::default() };
         assert!(bad.validate().unwrap_err().to_string().contains("cat"));
         assert!(RenderSettings { jitter: Some(0.0), ..Default::default() }.validate().is_ok());
+        let narrow =
+            RenderSettings { range: WavelengthRange::new(500.0, 500.0000001).unwrap(), ..Default::default() };
+        assert!(narrow.validate().unwrap_err().to_string().contains("500.0000001"));
         for u in [1.0, -0.1, f32::NAN] {
             let bad = RenderSettings { jitter: Some(u), ..Default::default() };
             assert!(bad.validate().unwrap_err().to_string().contains("jitter"), "{u}");

@@ -1,55 +1,77 @@
 //! Everything per-wavelength the GPU needs, computed once on the CPU whenever the wavelengths,
-//! range, observer or mode change: wavelengths, integration weights, the white illuminant,
-//! naive band masks, each light's emission spectrum and the XYZ → RGB matrix.
+//! range, observer, quadrature or mode change: the node wavelengths, each light's node weights,
+//! the white's node weights, naive band masks and the XYZ → RGB matrix.
 //!
-//! These are small buffers (N ≤ 256 floats each), so changing N or the range at run time only
-//! re-uploads them. The same numbers serve the CPU cross-checks in the tests.
+//! The shader evaluates the reflectance ρ at N nodes and computes, per light l,
+//! `XYZ = Σᵢ ρ(λᵢ)·W_{l,i}` where `W_{l,i}` (a vec3 per node) holds the light's emission, the
+//! observer and the integration rule together ([`color::quadrature`]): point samples × Δλ for
+//! the midpoint rule, or the light × observer integrated densely against the nodes' cardinal
+//! functions for the prefiltered rule. The shader does not know which rule made the weights,
+//! so both cost the same per node.
+//!
+//! These are small buffers (N ≤ 256 × 3 floats per light), so changing N or the range at run
+//! time only re-uploads them. The same numbers serve the CPU cross-checks in the tests.
 
-use crate::error::Result;
+use crate::error::{RenderError, Result};
 use crate::settings::{Mode, RenderSettings};
+use color::quadrature::{NodeQuadrature, Nodes, Quadrature, sum_weights};
 use color::upsample::CoeffTable;
 use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spectrum, WavelengthRange};
 use glam::{DMat3, DVec3};
 use scene::Emission;
 
-/// Four wavelengths and what the shader needs at them. Matches `WavelengthGroup` in
+/// Four node wavelengths and what the shader needs at them. Matches `WavelengthGroup` in
 /// `wgsl/spectral.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct WavelengthGroup {
     pub lambda: [f32; 4],
-    pub wx: [f32; 4],
-    pub wy: [f32; 4],
-    pub wz: [f32; 4],
-    pub white: [f32; 4],
+    /// The white illuminant's node weights for X, Y and Z (what an emissive surface of node
+    /// reflectance ρ is multiplied by: emission uses the "illuminant" upsampling ρ·W(λ)).
+    pub white_x: [f32; 4],
+    pub white_y: [f32; 4],
+    pub white_z: [f32; 4],
     pub band_r: [f32; 4],
     pub band_g: [f32; 4],
     pub band_b: [f32; 4],
+    pub _pad: [f32; 4],
 }
 
-/// The sampled wavelengths with their weights and the matching colour conversion.
+/// One light's node weights for four nodes: column c holds channel c (X, Y, Z). Matches the
+/// `mat3x4<f32>` elements of `light_weights` in `wgsl/spectral.wgsl`.
+pub type GroupWeights = [[f32; 4]; 3];
+
+/// The node wavelengths with the quadrature that goes with them and the matching colour
+/// conversion.
 #[derive(Clone, Debug)]
 pub struct SpectralSetup {
     pub wavelengths: SampledWavelengths,
-    /// Emission integrator: XYZ = Σ L(λᵢ)·wᵢ, scaled so that the white illuminant has Y = 1
-    /// (over these samples; with jitter, over the dense integral of the render range).
+    pub quadrature: Quadrature,
+    /// The point-sampled observer at the nodes, `x̄(λᵢ)·Δλ / k` (k = the white's Y): the
+    /// midpoint rule's weights for a light of radiance 1. Kept for per-wavelength tests; the
+    /// renderer uploads [`Self::light_weights`].
     pub integrator: SpectralIntegrator,
     /// The white illuminant (the colour space's, D65 for sRGB), unnormalised.
     pub white: Spectrum,
-    /// The white illuminant at each wavelength.
+    /// The white illuminant at each node.
     pub white_samples: Vec<f64>,
     /// XYZ → linear RGB, including a diagonal correction (in XYZ) that maps the white
-    /// illuminant integrated with these N samples exactly onto the colour space's white. With
-    /// it, a white surface under a white light is (1, 1, 1) for every N; without it, small N
-    /// tints everything by the quadrature error of the white. With jitter the correction uses
-    /// the dense white instead, so it is the same for every frame (and only the average of
-    /// frames is white).
+    /// illuminant, integrated by this quadrature over the render range, exactly onto the colour
+    /// space's white. With it, a white surface under a white light is (1, 1, 1) for every N;
+    /// without it, small N tints everything by the quadrature error of the white (midpoint) or
+    /// by the part of the white outside the range (both). With jitter the correction uses the
+    /// dense white instead, so it is the same for every frame (and only the average of frames
+    /// is white).
     pub xyz_to_rgb: DMat3,
     pub space: RgbColorSpace,
+    quad: NodeQuadrature,
+    /// The white's Y as every normalisation sees it: this quadrature's, or with jitter the
+    /// dense integral's over the render range.
+    k: f64,
     /// Dense (1 nm over the observer range) integrator for converting spectral lights to RGB.
     dense: SpectralIntegrator,
     /// With jitter: the dense (1 nm midpoint over the render range) emission integrator that
-    /// every normalisation uses instead of the frame's own samples.
+    /// every normalisation uses instead of the frame's own nodes.
     norm: Option<SpectralIntegrator>,
 }
 
@@ -58,40 +80,45 @@ impl SpectralSetup {
         let observer = Observer::by_name(&settings.observer)?;
         let space = RgbColorSpace::srgb();
         let white = space.illuminant();
-        let (wavelengths, integrator, sampled_white, norm) = match settings.jitter {
-            None => {
-                let wavelengths = SampledWavelengths::midpoint(settings.range, settings.wavelengths)?;
-                let integrator = SpectralIntegrator::emission(&observer, &white, &wavelengths);
-                let sampled_white = integrator.integrate_samples(&white.sample(&wavelengths.lambda));
-                (wavelengths, integrator, sampled_white, None)
-            }
-            Some(u) => {
-                // Normalise with the dense integral over the render range, not these samples:
-                // a ratio of two N-sample estimates is biased, so frame averages would not
+        let offset = settings.jitter.map_or(0.5, f64::from);
+        let nodes = Nodes::new(settings.range, settings.wavelengths, offset)?;
+        let quad = NodeQuadrature::new(settings.quadrature, nodes, &observer);
+        let wavelengths = SampledWavelengths {
+            lambda: quad.nodes.lambda.clone(),
+            weight: vec![quad.nodes.spacing; quad.len()],
+        };
+        let quad_white = quad.total(|l| white.eval(l));
+        let (k, sampled_white, norm) = match settings.jitter {
+            None => (quad_white[1], quad_white, None),
+            Some(_) => {
+                // Normalise with the dense integral over the render range, not these nodes:
+                // a ratio of two N-node estimates is biased, so frame averages would not
                 // converge (see `RenderSettings::jitter`).
                 let n_dense = settings.range.width().round().max(1.0) as usize;
                 let dense_wl = SampledWavelengths::midpoint(settings.range, n_dense)?;
                 let norm = SpectralIntegrator::emission(&observer, &white, &dense_wl);
-                let k: f64 = dense_wl
-                    .lambda
-                    .iter()
-                    .zip(&dense_wl.weight)
-                    .map(|(&l, &dl)| observer.eval(l)[1] * white.eval(l) * dl)
-                    .sum();
-                let k = if k > 0.0 { k } else { 1.0 };
-                let wavelengths =
-                    SampledWavelengths::stratified(settings.range, &vec![u as f64; settings.wavelengths])?;
-                let weights = wavelengths
-                    .lambda
-                    .iter()
-                    .zip(&wavelengths.weight)
-                    .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl / k))
-                    .collect();
-                let integrator = SpectralIntegrator { lambda: wavelengths.lambda.clone(), weights };
-                let dense_white = norm.integrate(|l| white.eval(l));
-                (wavelengths, integrator, dense_white, Some(norm))
+                let raw = SpectralIntegrator {
+                    lambda: dense_wl.lambda.clone(),
+                    weights: dense_wl
+                        .lambda
+                        .iter()
+                        .zip(&dense_wl.weight)
+                        .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl))
+                        .collect(),
+                };
+                let dense_white = raw.integrate(|l| white.eval(l));
+                (dense_white[1], dense_white, Some(norm))
             }
         };
+        let k = if k > 0.0 { k } else { 1.0 };
+        let sampled_white = sampled_white.map(|c| c / k);
+        let weights = wavelengths
+            .lambda
+            .iter()
+            .zip(&wavelengths.weight)
+            .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl / k))
+            .collect();
+        let integrator = SpectralIntegrator { lambda: wavelengths.lambda.clone(), weights };
         let white_samples = white.sample(&wavelengths.lambda);
         let target_white = space.white_xyz();
         let correction = DVec3::from_array(std::array::from_fn(|c| {
@@ -100,7 +127,19 @@ impl SpectralSetup {
         let xyz_to_rgb = space.from_xyz * DMat3::from_diagonal(correction);
         let dense_wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470)?;
         let dense = SpectralIntegrator::emission(&observer, &white, &dense_wl);
-        Ok(SpectralSetup { wavelengths, integrator, white, white_samples, xyz_to_rgb, space, dense, norm })
+        Ok(SpectralSetup {
+            wavelengths,
+            quadrature: settings.quadrature,
+            integrator,
+            white,
+            white_samples,
+            xyz_to_rgb,
+            space,
+            quad,
+            k,
+            dense,
+            norm,
+        })
     }
 
     pub fn len(&self) -> usize {
@@ -121,24 +160,35 @@ impl SpectralSetup {
         (self.xyz_to_rgb * DVec3::from_array(xyz)).to_array()
     }
 
+    /// Normalised node weights of an emission spectrum: `XYZ = Σᵢ ρᵢ·Wᵢ` in the units where
+    /// the white illuminant has Y = 1.
+    pub fn weights_of(&self, emission: impl Fn(f64) -> f64) -> Vec<[f64; 3]> {
+        let k = self.k;
+        self.quad.weights(emission).into_iter().map(|w| w.map(|c| c / k)).collect()
+    }
+
+    /// The white illuminant's normalised node weights (for emissive surfaces).
+    pub fn white_weights(&self) -> Vec<[f64; 3]> {
+        self.weights_of(|l| self.white.eval(l))
+    }
+
     /// The GPU layout. Padding lanes repeat the last wavelength with zero weights, so they
     /// add nothing whatever the shader computes there.
     pub fn gpu_groups(&self) -> Vec<WavelengthGroup> {
         let n = self.len();
         let (blue_max, green_max) = naive_band_edges();
+        let white = self.white_weights();
         let mut groups = vec![WavelengthGroup::default(); self.groups()];
-        for i in 0..self.groups() * 4 {
-            let (g, lane) = (i / 4, i % 4);
+        let last = self.wavelengths.lambda[n - 1];
+        for (i, grp_lane) in (0..self.groups() * 4).map(|i| (i, (i / 4, i % 4))) {
+            let (g, lane) = grp_lane;
             let grp = &mut groups[g];
-            let src = i.min(n - 1);
-            let l = self.wavelengths.lambda[src];
+            let l = self.wavelengths.lambda.get(i).copied().unwrap_or(last);
             grp.lambda[lane] = l as f32;
-            if i < n {
-                let w = self.integrator.weights[i];
-                grp.wx[lane] = w[0] as f32;
-                grp.wy[lane] = w[1] as f32;
-                grp.wz[lane] = w[2] as f32;
-                grp.white[lane] = self.white_samples[i] as f32;
+            if let Some(w) = white.get(i) {
+                grp.white_x[lane] = w[0] as f32;
+                grp.white_y[lane] = w[1] as f32;
+                grp.white_z[lane] = w[2] as f32;
                 let band = naive_band(l, blue_max, green_max);
                 grp.band_r[lane] = (band == 0) as u8 as f32;
                 grp.band_g[lane] = (band == 1) as u8 as f32;
@@ -148,40 +198,77 @@ impl SpectralSetup {
         groups
     }
 
-    /// A light's emission at each wavelength for the spectral modes, in the units the RGB path
-    /// uses (so that a white RGB light gives the same Y in every mode).
+    /// A light's emission as a function of wavelength for the spectral modes, in the units the
+    /// RGB path uses (so that a white RGB light gives the same Y in every mode).
     ///
-    /// - A spectral light keeps its shape and is scaled so that its Y over these samples (with
-    ///   jitter: its dense Y over the render range) equals the luminance of `rgb × intensity`
-    ///   (the scene format's convention).
+    /// - A spectral light keeps its shape and is scaled so that its Y under this quadrature
+    ///   (with jitter: its dense Y over the render range) equals the luminance of
+    ///   `rgb × intensity` (the scene format's convention).
     /// - An RGB light uses the "illuminant" upsampling: `s·ρ(rgb/s)(λ)·W(λ)` with `s = 2·max(rgb)`
     ///   and W the colour space's white (sigmoid ρ in `Spectral` mode, box ρ in `Naive`).
-    pub fn light_samples(&self, e: &Emission, mode: Mode, table: &CoeffTable) -> Vec<f64> {
+    pub fn light_spectrum<'a>(
+        &'a self,
+        e: &'a Emission,
+        mode: Mode,
+        table: &CoeffTable,
+    ) -> Result<Box<dyn Fn(f64) -> f64 + 'a>> {
         let rgb = [e.rgb.x as f64, e.rgb.y as f64, e.rgb.z as f64].map(|c| c * e.intensity as f64);
-        let lambda = &self.wavelengths.lambda;
         if let Some(s) = &e.spectrum {
-            let samples = s.sample(lambda);
             let y = match &self.norm {
-                None => self.integrator.integrate_samples(&samples)[1],
+                None => self.quad.total(|l| s.eval(l))[1] / self.k,
                 Some(norm) => norm.integrate(|l| s.eval(l))[1],
             };
-            let k = if y > 0.0 { self.luminance(rgb) / y } else { 0.0 };
-            return samples.iter().map(|v| v * k).collect();
+            let want = self.luminance(rgb);
+            if y.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) && want > 0.0 {
+                let r = self.quad.nodes.range;
+                return Err(RenderError::Settings(format!(
+                    "a light's emission spectrum has no luminance inside the render range {}–{} nm \
+                     (it is zero or outside it there); widen --range or fix the spectrum",
+                    r.min, r.max
+                )));
+            }
+            let k = if y > 0.0 { want / y } else { 0.0 };
+            return Ok(Box::new(move |l| s.eval(l) * k));
         }
+        let white = &self.white;
         match mode {
             Mode::Naive => {
                 let (blue_max, green_max) = naive_band_edges();
-                lambda
-                    .iter()
-                    .zip(&self.white_samples)
-                    .map(|(&l, w)| rgb[naive_band(l, blue_max, green_max)] * w)
-                    .collect()
+                Ok(Box::new(move |l| rgb[naive_band(l, blue_max, green_max)] * white.eval(l)))
             }
             _ => {
                 let (scale, poly) = illuminant_coeffs(rgb, table);
-                lambda.iter().zip(&self.white_samples).map(|(&l, w)| scale * poly.eval(l) * w).collect()
+                Ok(Box::new(move |l| scale * poly.eval(l) * white.eval(l)))
             }
         }
+    }
+
+    /// A light's emission at each node (see [`Self::light_spectrum`]).
+    pub fn light_samples(&self, e: &Emission, mode: Mode, table: &CoeffTable) -> Result<Vec<f64>> {
+        let f = self.light_spectrum(e, mode, table)?;
+        Ok(self.wavelengths.lambda.iter().map(|&l| f(l)).collect())
+    }
+
+    /// A light's normalised node weights (see [`Self::weights_of`]).
+    pub fn light_weights(&self, e: &Emission, mode: Mode, table: &CoeffTable) -> Result<Vec<[f64; 3]>> {
+        Ok(self.weights_of(self.light_spectrum(e, mode, table)?))
+    }
+
+    /// The GPU layout of node weights: one [`GroupWeights`] per group, padding lanes zero.
+    pub fn gpu_weights(&self, weights: &[[f64; 3]]) -> Vec<GroupWeights> {
+        let mut out = vec![[[0f32; 4]; 3]; self.groups()];
+        for (i, w) in weights.iter().enumerate() {
+            for c in 0..3 {
+                out[i / 4][c][i % 4] = w[c] as f32;
+            }
+        }
+        out
+    }
+
+    /// XYZ of a light seen by a reflectance of one (Σᵢ Wᵢ): what its ρ-independent terms
+    /// (specular reflection) integrate to.
+    pub fn light_total(weights: &[[f64; 3]]) -> [f64; 3] {
+        sum_weights(weights)
     }
 
     /// A light's linear-sRGB emission for the RGB mode: its RGB, or for a spectral light the

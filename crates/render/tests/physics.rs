@@ -6,6 +6,7 @@
 
 mod common;
 
+use color::quadrature::{NodeQuadrature, Nodes, Quadrature, integrate_nodes, sum_weights};
 use color::upsample::CoeffTable;
 use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spectrum};
 use common::*;
@@ -19,6 +20,10 @@ const MARGIN: f32 = 0.1;
 
 fn settings(mode: Mode, n: usize) -> RenderSettings {
     RenderSettings { mode, wavelengths: n, shadows: false, ..Default::default() }
+}
+
+fn settings_q(mode: Mode, n: usize, quadrature: Quadrature) -> RenderSettings {
+    RenderSettings { quadrature, ..settings(mode, n) }
 }
 
 fn render_hdr(r: &mut Renderer, s: &RenderSettings) -> Vec<[f64; 3]> {
@@ -42,31 +47,40 @@ fn pixel_geometry(chart: &Chart, roughness: f64, metallic: f64) -> Vec<Option<(u
     out
 }
 
-/// Independent CPU spectral shading of a patch: ρ from the table (the colour crate's fetch),
-/// the light sampled at the midpoint wavelengths, XYZ with the observer×Δλ weights, and the
-/// XYZ → sRGB matrix corrected so that the sampled D65 is the sRGB white.
+/// Independent CPU spectral shading of a patch: ρ from the table (the colour crate's fetch) at
+/// the nodes, the light's node weights from `color::quadrature` (midpoint or prefiltered),
+/// scaled to the requested luminance, and the XYZ → sRGB matrix corrected so that the white
+/// D65 as the same quadrature integrates it is the sRGB white.
 struct CpuSpectral {
     lambda: Vec<f64>,
-    weights: Vec<[f64; 3]>,
-    light: Vec<f64>,
+    /// The light's normalised node weights.
+    light: Vec<[f64; 3]>,
+    /// D65's normalised node weights (for emission).
+    white: Vec<[f64; 3]>,
     to_rgb: DMat3,
 }
 
 impl CpuSpectral {
-    fn new(n: usize, light_spectrum: &Spectrum, luminance: f64) -> Self {
-        let wl = SampledWavelengths::midpoint(color::WavelengthRange::VISIBLE, n).unwrap();
+    fn new(n: usize, rule: Quadrature, light_spectrum: &Spectrum, luminance: f64) -> Self {
+        let nodes = Nodes::new(color::WavelengthRange::VISIBLE, n, 0.5).unwrap();
+        let quad = NodeQuadrature::new(rule, nodes, &Observer::cie1931());
         let d65 = color::illuminant::by_name("D65").unwrap();
-        let integ = SpectralIntegrator::emission(&Observer::cie1931(), &d65, &wl);
-        let raw = light_spectrum.sample(&wl.lambda);
-        let k = luminance / integ.integrate_samples(&raw)[1];
-        let white = integ.integrate_samples(&d65.sample(&wl.lambda));
+        let white_raw = quad.weights(|l| d65.eval(l));
+        let white_xyz = sum_weights(&white_raw);
+        let k = white_xyz[1];
+        let raw = quad.weights(|l| light_spectrum.eval(l));
+        let scale = luminance / sum_weights(&raw)[1];
         let space = RgbColorSpace::srgb();
         let t = space.white_xyz();
-        let corr = DMat3::from_diagonal(DVec3::new(t[0] / white[0], t[1] / white[1], t[2] / white[2]));
+        let corr = DMat3::from_diagonal(DVec3::new(
+            t[0] * k / white_xyz[0],
+            t[1] * k / white_xyz[1],
+            t[2] * k / white_xyz[2],
+        ));
         CpuSpectral {
-            lambda: wl.lambda.clone(),
-            weights: integ.weights.clone(),
-            light: raw.iter().map(|v| v * k).collect(),
+            lambda: quad.nodes.lambda.clone(),
+            light: raw.iter().map(|w| w.map(|c| c * scale)).collect(),
+            white: white_raw.iter().map(|w| w.map(|c| c / k)).collect(),
             to_rgb: space.from_xyz * corr,
         }
     }
@@ -83,25 +97,16 @@ impl CpuSpectral {
     }
 
     fn shade_with(&self, rho: impl Fn(f64) -> f64, a: f64, b: f64) -> [f64; 3] {
-        let mut xyz = DVec3::ZERO;
-        for i in 0..self.lambda.len() {
-            let l = (rho(self.lambda[i]) * a + b) * self.light[i];
-            xyz += DVec3::from(self.weights[i]) * l;
-        }
-        (self.to_rgb * xyz).to_array()
+        let values: Vec<f64> = self.lambda.iter().map(|&l| rho(l) * a + b).collect();
+        (self.to_rgb * DVec3::from(integrate_nodes(&self.light, &values))).to_array()
     }
 
     /// An emitter of linear RGB `e` with the illuminant variant: s·ρ(e/s)(λ)·D65(λ), s = 2·max.
     fn emitter(&self, table: &CoeffTable, e: [f64; 3]) -> [f64; 3] {
-        let d65 = color::illuminant::by_name("D65").unwrap();
         let s = 2.0 * e[0].max(e[1]).max(e[2]);
         let poly = table.fetch(e.map(|c| c / s));
-        let mut xyz = DVec3::ZERO;
-        for i in 0..self.lambda.len() {
-            let l = s * poly.to_f32_poly_eval(self.lambda[i]) * d65.eval(self.lambda[i]);
-            xyz += DVec3::from(self.weights[i]) * l;
-        }
-        (self.to_rgb * xyz).to_array()
+        let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
+        (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
     }
 }
 
@@ -150,12 +155,7 @@ fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
     let mut r = renderer();
     r.set_scene(&chart.scene(white_light(intensity, Some(f11.clone())), 1.0, 0.0)).unwrap();
     r.resize(W, H).unwrap();
-    let n = 16;
-    let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
-    let naive = render_hdr(&mut r, &settings(Mode::Naive, n));
-    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, n));
-    let cpu = CpuSpectral::new(n, &f11, intensity as f64);
-    let table = table();
+    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, 16));
     // In rgb mode the F11 light is its own linear-sRGB colour at luminance `intensity`.
     let dense = SpectralIntegrator::emission(
         &Observer::cie1931(),
@@ -164,36 +164,42 @@ fn spectral_matches_cpu_under_f11_and_differs_from_rgb() {
     );
     let fx = dense.integrate(|l| f11.eval(l));
     let light_rgb = RgbColorSpace::srgb().xyz_to_rgb(fx.map(|c| c * intensity as f64 / fx[1]));
-
-    let mut worst = 0.0f64;
-    let mut worst_naive = 0.0f64;
-    let mut worst_diff = 0.0f64;
-    let mut de = Vec::new();
-    for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
-        let Some((patch, a, b)) = *g else { continue };
-        let albedo = chart.colours[patch];
-        let want = cpu.shade(&table, albedo, a, b);
-        let want_naive = cpu.shade_box(albedo, a, b);
-        let want_rgb: [f64; 3] = std::array::from_fn(|c| (albedo[c] as f64 * a + b) * light_rgb[c]);
-        for c in 0..3 {
-            worst = worst.max((spectral[i][c] - want[c]).abs());
-            worst_naive = worst_naive.max((naive[i][c] - want_naive[c]).abs());
-            let d_gpu = spectral[i][c] - rgb[i][c];
-            let d_cpu = want[c] - want_rgb[c];
-            worst_diff = worst_diff.max((d_gpu - d_cpu).abs());
+    let table = table();
+    for (rule, n) in [(Quadrature::Midpoint, 16), (Quadrature::Prefiltered, 16), (Quadrature::Prefiltered, 7)]
+    {
+        let spectral = render_hdr(&mut r, &settings_q(Mode::Spectral, n, rule));
+        let naive = render_hdr(&mut r, &settings_q(Mode::Naive, n, rule));
+        let cpu = CpuSpectral::new(n, rule, &f11, intensity as f64);
+        let mut worst = 0.0f64;
+        let mut worst_naive = 0.0f64;
+        let mut worst_diff = 0.0f64;
+        let mut de = Vec::new();
+        for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
+            let Some((patch, a, b)) = *g else { continue };
+            let albedo = chart.colours[patch];
+            let want = cpu.shade(&table, albedo, a, b);
+            let want_naive = cpu.shade_box(albedo, a, b);
+            let want_rgb: [f64; 3] = std::array::from_fn(|c| (albedo[c] as f64 * a + b) * light_rgb[c]);
+            for c in 0..3 {
+                worst = worst.max((spectral[i][c] - want[c]).abs());
+                worst_naive = worst_naive.max((naive[i][c] - want_naive[c]).abs());
+                let d_gpu = spectral[i][c] - rgb[i][c];
+                let d_cpu = want[c] - want_rgb[c];
+                worst_diff = worst_diff.max((d_gpu - d_cpu).abs());
+            }
+            de.push(color::ciede2000(lab(spectral[i]), lab(rgb[i])));
         }
-        de.push(color::ciede2000(lab(spectral[i]), lab(rgb[i])));
+        let (mean, p99) = stats(de);
+        println!(
+            "F11 {rule} N={n}: |GPU − CPU| max {worst:.2e} (naive {worst_naive:.2e}), |Δ(spectral − rgb)| max \
+             {worst_diff:.2e}, ΔE(spectral, rgb) mean {mean:.3} p99 {p99:.3}"
+        );
+        assert!(worst < 1e-3, "{rule} N={n}: spectral GPU vs CPU differ by {worst}");
+        assert!(worst_naive < 1e-3, "{rule} N={n}: naive GPU vs CPU box spectra differ by {worst_naive}");
+        assert!(worst_diff < 1e-3, "{rule} N={n}: spectral − rgb differs from the CPU's by {worst_diff}");
+        // F11's narrow lines make metamerism visible: the modes must differ clearly.
+        assert!(mean > 1.0, "{rule} N={n}: spectral and rgb under F11 differ by only ΔE {mean}");
     }
-    let (mean, p99) = stats(de);
-    println!(
-        "F11: |GPU − CPU| max {worst:.2e} (naive {worst_naive:.2e}), |Δ(spectral − rgb)| max {worst_diff:.2e}, \
-         ΔE(spectral, rgb) mean {mean:.3} p99 {p99:.3}"
-    );
-    assert!(worst < 1e-3, "spectral GPU vs CPU differ by {worst}");
-    assert!(worst_naive < 1e-3, "naive GPU vs CPU box spectra differ by {worst_naive}");
-    assert!(worst_diff < 1e-3, "spectral − rgb differs from the CPU's by {worst_diff}");
-    // F11's narrow lines make metamerism visible: the modes must differ clearly.
-    assert!(mean > 1.0, "spectral and rgb under F11 differ by only ΔE {mean}");
 }
 
 #[test]
@@ -209,9 +215,11 @@ fn spectral_reproduces_rgb_under_d65() {
         r.set_scene(&chart.scene(light, 1.0, 0.0)).unwrap();
         let rgb = render_hdr(&mut r, &settings(Mode::Rgb, 16));
         let expected: Vec<Option<[f64; 3]>> = geo.iter().zip(&rgb).map(|(g, c)| g.map(|_| *c)).collect();
-        for n in [16, 32] {
-            let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
-            assert_delta_e(&format!("d65-{name}-n{n}"), W, H, &spectral, &expected, 0.2, 0.5);
+        for rule in Quadrature::ALL {
+            for n in [16, 32] {
+                let spectral = render_hdr(&mut r, &settings_q(Mode::Spectral, n, rule));
+                assert_delta_e(&format!("d65-{name}-{rule}-n{n}"), W, H, &spectral, &expected, 0.2, 0.5);
+            }
         }
     }
 }
@@ -232,23 +240,27 @@ fn emissive_surfaces_use_the_illuminant_variant() {
     let mut r = renderer();
     r.set_scene(&scene).unwrap();
     r.resize(W, H).unwrap();
-    let n = 16;
-    let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n));
-    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, n));
-    let cpu = CpuSpectral::new(n, &Spectrum::Constant(1.0), 1.0);
+    let rgb = render_hdr(&mut r, &settings(Mode::Rgb, 16));
     let table = table();
-    let (mut worst_s, mut worst_r) = (0.0f64, 0.0f64);
-    for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
-        let Some((patch, _, _)) = *g else { continue };
-        let want = cpu.emitter(&table, emission[patch]);
-        for c in 0..3 {
-            worst_s = worst_s.max((spectral[i][c] - want[c]).abs());
-            worst_r = worst_r.max((rgb[i][c] - emission[patch][c]).abs());
+    for (rule, n) in [(Quadrature::Midpoint, 16), (Quadrature::Prefiltered, 16), (Quadrature::Prefiltered, 5)]
+    {
+        let spectral = render_hdr(&mut r, &settings_q(Mode::Spectral, n, rule));
+        let cpu = CpuSpectral::new(n, rule, &Spectrum::Constant(1.0), 1.0);
+        let (mut worst_s, mut worst_r) = (0.0f64, 0.0f64);
+        for (i, g) in pixel_geometry(&chart, 1.0, 0.0).iter().enumerate() {
+            let Some((patch, _, _)) = *g else { continue };
+            let want = cpu.emitter(&table, emission[patch]);
+            for c in 0..3 {
+                worst_s = worst_s.max((spectral[i][c] - want[c]).abs());
+                worst_r = worst_r.max((rgb[i][c] - emission[patch][c]).abs());
+            }
         }
+        println!(
+            "emission {rule} N={n}: spectral |GPU − CPU| max {worst_s:.2e}, rgb |GPU − e| max {worst_r:.2e}"
+        );
+        assert!(worst_s < 1e-3, "{rule} N={n}: spectral emission differs from the CPU by {worst_s}");
+        assert!(worst_r < 1e-3, "rgb emission differs from the material's by {worst_r}");
+        let white = cpu.emitter(&table, [1.0; 3]);
+        assert!(white.iter().all(|&c| (c - 1.0).abs() < 2e-3), "{rule} N={n}: emissive white → {white:?}");
     }
-    println!("emission: spectral |GPU − CPU| max {worst_s:.2e}, rgb |GPU − e| max {worst_r:.2e}");
-    assert!(worst_s < 1e-3, "spectral emission differs from the CPU by {worst_s}");
-    assert!(worst_r < 1e-3, "rgb emission differs from the material's by {worst_r}");
-    let white = cpu.emitter(&table, [1.0; 3]);
-    assert!(white.iter().all(|&c| (c - 1.0).abs() < 2e-3), "emissive white → {white:?}");
 }

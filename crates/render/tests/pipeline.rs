@@ -74,8 +74,8 @@ fn custom_hooks_change_the_image_and_bad_code_is_an_error() {
 
     // Pass 3 hook scaled by a parameter; pass 2 hook removes everything above 600 nm.
     let src = r#"
-fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
-    return select(radiance, vec4<f32>(0.0), lambda > vec4<f32>(600.0));
+fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
+    return s3_scale(radiance, select(vec4<f32>(1.0), vec4<f32>(0.0), lambda > vec4<f32>(600.0)));
 }
 fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> { return radiance; }
 fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {

@@ -6,8 +6,8 @@
 
 mod common;
 
-use color::WavelengthRange;
 use color::water::WaterType;
+use color::{Quadrature, WavelengthRange};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
 use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
@@ -166,6 +166,7 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
         for lambda in [430.0, 500.0, 560.0, 640.0] {
             let settings = RenderSettings {
                 mode: Mode::Spectral,
+                quadrature: Quadrature::Midpoint,
                 wavelengths: 1,
                 range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
                 shadows: false,
@@ -181,7 +182,7 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
             let setup = SpectralSetup::new(&settings).unwrap();
             // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-            let e0 = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table)[0]
+            let e0 = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0]
                 * (-light_dir().y as f64);
             for py in 0..H {
                 for px in 0..W {
@@ -315,6 +316,7 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
         for lambda in [450.0, 530.0, 610.0] {
             let settings = RenderSettings {
                 mode: Mode::Spectral,
+                quadrature: Quadrature::Midpoint,
                 wavelengths: 1,
                 range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
                 shadows: true,
@@ -324,9 +326,9 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
             let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
             let setup = SpectralSetup::new(&settings).unwrap();
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-            let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table)[0];
-            let i_lamp = setup.light_samples(&scene.lights[1].emission, Mode::Spectral, &table)[0];
-            let e_sky = setup.light_samples(&scene.lights[2].emission, Mode::Spectral, &table)[0];
+            let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
+            let i_lamp = setup.light_samples(&scene.lights[1].emission, Mode::Spectral, &table).unwrap()[0];
+            let e_sky = setup.light_samples(&scene.lights[2].emission, Mode::Spectral, &table).unwrap()[0];
             let k = medium.coefficients(lambda);
             let to_sun = -light_dir().as_dvec3();
             // The lamp in metres from the camera; I/r² in scene units is I·scale²/r² in metres.
@@ -409,6 +411,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
     let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
     let settings = RenderSettings {
         mode: Mode::Spectral,
+        quadrature: Quadrature::Midpoint,
         wavelengths: 1,
         range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
         shadows: true,
@@ -418,7 +421,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
     let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
     let setup = SpectralSetup::new(&settings).unwrap();
     let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-    let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table)[0];
+    let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
     let k = medium.coefficients(lambda);
     let to_sun = -light_dir().as_dvec3();
     let (mut worst, mut n, mut beam_share) = (0.0f64, 0, 0.0f64);
@@ -458,4 +461,51 @@ fn single_scattering_is_shadowed_under_a_roof() {
     );
     // Ignoring the shadow would add the beam: at 2 % it is 20× the tolerance.
     assert!(n > 100 && beam_share > 0.02, "{n} pixels, beam share {beam_share}");
+}
+
+#[test]
+fn prefiltered_weights_pass_through_the_hook_node_by_node() {
+    // Under the prefiltered rule the hook sees weighted radiance: in-scattered light must be
+    // Σᵢ W_sun,i·μ·ms(λᵢ) with the sun's prefiltered node weights (F11 lines included) and the
+    // water's factors at the nodes. Checked on background pixels (nothing but water), N = 8.
+    let mut scene = floor_scene();
+    // The floor moved behind the camera: every pixel sees water only.
+    scene.meshes[0].positions.iter_mut().for_each(|p| p.z += 100.0);
+    scene.lights[0].emission.spectrum = Some(color::illuminant::by_name("F11").unwrap());
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let table = common::table();
+    let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), 6.0, Vec3::Y, 1.0).unwrap();
+    let settings = RenderSettings {
+        mode: Mode::Spectral,
+        quadrature: Quadrature::Prefiltered,
+        wavelengths: 8,
+        shadows: false,
+        ..Default::default()
+    };
+    let wet =
+        render(&mut r, &scene, &settings, underwater::shader_with(&medium, &underwater::Options::paper()));
+    let setup = SpectralSetup::new(&settings).unwrap();
+    let w = setup.light_weights(&scene.lights[0].emission, Mode::Spectral, &table).unwrap();
+    let mu = -light_dir().y as f64;
+    let (mut worst, mut count) = (0.0f64, 0);
+    for py in 0..H {
+        for px in 0..W {
+            let Some((dir, _)) = pixel_ray(&scene.camera, px, py) else { continue };
+            let terms = medium.pixel_terms(&setup.wavelengths.lambda, dir, f64::INFINITY).unwrap();
+            let mut xyz = DVec3::ZERO;
+            for (wi, t) in w.iter().zip(&terms) {
+                xyz += DVec3::from(*wi) * (mu * t.in_scatter);
+            }
+            let want = (setup.xyz_to_rgb * xyz).to_array();
+            let got = common::rgb_of(&wet[(py * W + px) as usize]);
+            let e = rel_err(got, want);
+            assert!(e <= 1e-3, "pixel ({px},{py}) dir {dir:?}: gpu {got:?} cpu {want:?} ({e:.2e})");
+            worst = worst.max(e);
+            count += 1;
+        }
+    }
+    eprintln!("prefiltered hook GPU vs CPU: worst relative error {worst:.2e} over {count} pixels");
+    assert!(count > 500, "{count}");
 }

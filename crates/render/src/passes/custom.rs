@@ -1,11 +1,12 @@
 //! Pass 3 and the custom-shader extension point.
 //!
-//! A [`CustomShader`] is WGSL source that defines three hooks (the default, `custom_hooks.wgsl`,
-//! returns its input unchanged):
+//! A [`CustomShader`] is WGSL source that defines any of three hooks (each one it leaves out is
+//! the identity from `custom_hooks.wgsl`):
 //!
 //! ```wgsl
-//! // Pass 2, spectral & naive modes, once per group of four wavelengths, before integration:
-//! fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32>
+//! // Pass 2, spectral & naive modes, once per group of four node wavelengths, before
+//! // integration; radiance[c] is channel c's (X, Y, Z) weighted node radiance:
+//! fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32>
 //! // Pass 2, rgb mode, once per pixel:
 //! fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32>
 //! // Pass 3, every mode, once per pixel on the HDR linear-sRGB colour:
@@ -19,8 +20,16 @@
 //! - `custom.params` — sixteen floats from [`CustomShader::params`].
 //! - `custom_spectra[group * 4 + s]` — spectrum `s` of [`CustomShader::spectra`] sampled at the
 //!   four wavelengths of `group` (re-sampled by the renderer whenever the wavelengths change).
-//! - `wavelengths[group]` — λ, observer weights, white illuminant; `frame` — matrices, camera,
-//!   mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3.
+//! - `wavelengths[group]` — node λ and the white's node weights; `light_w(li, group,
+//!   frame.n_groups)` — a light's node weights; `s3_scale`, `s3_xyz` for weighted radiance;
+//!   `frame` — matrices, camera, mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3.
+//!
+//! Weighted radiance: the renderer integrates `XYZ = Σ_nodes ρ(λᵢ)·W_{l,i}` with node weights
+//! W that carry the light, the observer and the quadrature rule ([`color::quadrature`]). A
+//! spectral hook therefore sees, per channel, the node radiance already multiplied by its
+//! weight; a smooth wavelength-dependent factor multiplies it node by node, and light added
+//! along a ray is a light's weights times a smooth factor. Under the prefiltered rule a light's
+//! lines are then integrated exactly even through the hook.
 //!
 //! Radiance units: the HDR values are linear sRGB where a white diffuse surface under a
 //! 1-lux white directional light at normal incidence is 1/π.
@@ -33,10 +42,13 @@ use color::Spectrum;
 /// Identity hooks.
 pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
 
+/// The three hook names, in the order `custom_hooks.wgsl` defines them.
+const HOOKS: [&str; 3] = ["custom_spectral", "custom_rgb", "custom_pixel"];
+
 /// User code for the extension point.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CustomShader {
-    /// WGSL defining `custom_spectral`, `custom_rgb` and `custom_pixel`.
+    /// WGSL defining any of `custom_spectral`, `custom_rgb` and `custom_pixel`.
     pub source: String,
     /// Free parameters, `custom.params[i / 4][i % 4]` in WGSL.
     pub params: [f32; 16],
@@ -49,13 +61,33 @@ pub const MAX_CUSTOM_SPECTRA: usize = 4;
 
 impl Default for CustomShader {
     fn default() -> Self {
-        CustomShader { source: DEFAULT_HOOKS.to_string(), params: [0.0; 16], spectra: Vec::new() }
+        CustomShader { source: String::new(), params: [0.0; 16], spectra: Vec::new() }
     }
 }
 
 impl CustomShader {
     pub fn new(source: impl Into<String>) -> Self {
         CustomShader { source: source.into(), ..Default::default() }
+    }
+
+    /// Whether the source defines the hook `name`.
+    pub fn defines(&self, name: &str) -> bool {
+        defines(&self.source, name)
+    }
+
+    /// The source as the passes compile it: the user's code, the identity definition of each
+    /// hook it leaves out, and `CUSTOM_SPECTRAL` (whether the spectral hook is the user's: the
+    /// shading loop skips the hook, and carries the specular term outside the nodes, when not).
+    pub fn assembled(&self) -> String {
+        let mut out = self.source.clone();
+        for name in HOOKS {
+            if !self.defines(name) {
+                out.push('\n');
+                out.push_str(default_hook(name));
+            }
+        }
+        out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {};\n", self.defines("custom_spectral")));
+        out
     }
 
     pub(crate) fn validate(&self) -> Result<()> {
@@ -67,6 +99,19 @@ impl CustomShader {
         }
         Ok(())
     }
+}
+
+/// `fn NAME` followed by optional white space and `(`.
+fn defines(source: &str, name: &str) -> bool {
+    let pat = format!("fn {name}");
+    source.match_indices(&pat).any(|(i, _)| source[i + pat.len()..].trim_start().starts_with('('))
+}
+
+/// The identity definition of hook `name` from `custom_hooks.wgsl`.
+fn default_hook(name: &str) -> &'static str {
+    let start = DEFAULT_HOOKS.find(&format!("fn {name}(")).expect("custom_hooks.wgsl defines every hook");
+    let len = DEFAULT_HOOKS[start..].find("\n}").expect("hooks end with a closing brace") + 2;
+    &DEFAULT_HOOKS[start..start + len]
 }
 
 /// Matches `CustomUniforms` in `wgsl/custom_api.wgsl`.

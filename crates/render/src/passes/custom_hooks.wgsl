@@ -1,9 +1,15 @@
-// Default custom hooks: identity. `CustomShader::new(source)` replaces this file's content.
-// A custom shader must define these three functions (it may declare helpers too).
+// Default custom hooks: identity. A custom shader defines any of these three functions (it
+// may declare helpers too); the renderer adds this file's definition of each one it leaves out
+// (`CustomShader::assembled`).
 
-// Pass 2, spectral and naive modes: radiance at four wavelengths (`lambda`, nm) of the
-// wavelength group `group`, before integration to XYZ. Return the radiance to integrate.
-fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+// Pass 2, spectral and naive modes, once per group of four node wavelengths (`lambda`, nm),
+// before integration. `radiance[c]` is the light leaving the surface towards the camera at
+// the four nodes, in weighted form for channel c (X, Y, Z): XYZ = Σ over groups and lanes of
+// `radiance[c]`. A factor that depends on wavelength (a transmittance, say) multiplies every
+// column (`s3_scale`); light added along the ray is a light's node weights (`light_w`) or the
+// white's (`white_weights`) times its factor. Return the radiance to integrate. Defining this
+// hook makes the shading loop carry the specular term through the nodes (a few fma per light).
+fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
     return radiance;
 }
 

@@ -131,10 +131,20 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             c_em = fetch_coeffs(emission / em_scale, res);
         }
     }
+    if (background && !CUSTOM_SPECTRAL) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
     let ng = frame.n_groups;
     var xyz = vec3<f32>(0.0);
+    // Terms that do not depend on the reflectance (specular) need no nodes: each light's XYZ
+    // once. With a spectral hook they go through the nodes, where the hook can change them.
+    if (!CUSTOM_SPECTRAL) {
+        for (var li = 0u; li < n_lights; li++) {
+            xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
+        }
+    }
+    let zero = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     for (var g = 0u; g < ng; g++) {
-        // Fields are read one by one so that only what the mode needs is loaded.
         let lambda = wavelengths[g].lambda;
         var rho: vec4<f32>;
         if (spectral) {
@@ -142,29 +152,36 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         } else {
             rho = box4(base, g);
         }
-        var acc_a = vec4<f32>(0.0);
-        var acc_b = vec4<f32>(0.0);
+        // Σ_l a_l·W_l (and Σ_l b_l·W_l for a hook): three fma per light and group.
+        var acc_a = zero;
+        var acc_b = zero;
         for (var li = 0u; li < n_lights; li++) {
-            let e = light_spectra[li * ng + g];
-            acc_a = fma(vec4<f32>(fa[li]), e, acc_a);
-            acc_b = fma(vec4<f32>(fb[li]), e, acc_b);
+            let w = light_w(li, g, ng);
+            acc_a += w * fa[li];
+            if (CUSTOM_SPECTRAL) {
+                acc_b += w * fb[li];
+            }
         }
-        var radiance = fma(rho, acc_a, acc_b);
+        var em = vec4<f32>(0.0);
         if (has_em) {
-            var em: vec4<f32>;
             if (spectral) {
                 em = em_scale * sigmoid4(c_em, lambda);
             } else {
                 em = box4(emission, g);
             }
-            radiance = fma(em, wavelengths[g].white, radiance);
         }
-        radiance = custom_spectral(lambda, radiance, g, ctx);
-        xyz += vec3<f32>(
-            dot(radiance, wavelengths[g].wx),
-            dot(radiance, wavelengths[g].wy),
-            dot(radiance, wavelengths[g].wz),
-        );
+        if (CUSTOM_SPECTRAL) {
+            var radiance = s3_scale(acc_a, rho) + acc_b;
+            if (has_em) {
+                radiance += s3_scale(white_weights(g), em);
+            }
+            xyz += s3_xyz(custom_spectral(lambda, radiance, g, ctx));
+        } else {
+            xyz += rho * acc_a;
+            if (has_em) {
+                xyz += em * white_weights(g);
+            }
+        }
     }
     return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
 }

@@ -9,8 +9,11 @@
 // custom.params[3] = (b at the RGB mode's three wavelengths, 1 = take the beams out of L_ms)
 // custom_spectra[g * 4 + 0..3] = b, c, Kd at the group's wavelengths
 //
-// All quantities are vec4: four wavelengths in spectral/naive modes, (R, G, B, unused) in rgb
-// mode, so both modes run the same code.
+// Water coefficients are vec4: four node wavelengths in spectral/naive modes, (R, G, B, unused)
+// in rgb mode, so both modes run the same code. Light is in weighted form (mat3x4, see
+// custom_hooks.wgsl): in spectral/naive modes column c holds channel c's node weights, so the
+// light's lines are integrated by the renderer's quadrature and the water's smooth factors
+// multiply node by node; in rgb mode column 0 holds (R, G, B, 0) and the others are zero.
 
 const UW_INV_4PI: f32 = 0.0795774715459476;
 // Must match MAX_LIGHTS in src/scene_gpu.rs.
@@ -80,13 +83,16 @@ fn uw_hg(g: f32, cos_t: f32) -> f32 {
     return UW_INV_4PI * (1.0 - g2) / (den * sqrt(den));
 }
 
-// Emission of light `li` at the group's wavelengths, or its linear-sRGB colour in rgb mode.
-fn uw_emission(li: u32, group: u32, rgb: bool) -> vec4<f32> {
+// Light `li` in weighted form: its node weights for the group, or in rgb mode its linear-sRGB
+// colour in column 0.
+fn uw_emission(li: u32, group: u32, rgb: bool) -> mat3x4<f32> {
     if (rgb) {
-        return vec4<f32>(lights[li].rgb.rgb, 0.0);
+        return mat3x4<f32>(vec4<f32>(lights[li].rgb.rgb, 0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     }
-    return light_spectra[li * frame.n_groups + group];
+    return light_w(li, group, frame.n_groups);
 }
+
+const UW_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
 
 fn uw_prepare(ctx: SurfaceContext) {
     if (uw_ready) { return; }
@@ -163,8 +169,8 @@ fn uw_prepare(ctx: SurfaceContext) {
 }
 
 // Single scattering of every marched light, at the wavelengths of `c`.
-fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<f32> {
-    var total = vec4<f32>(0.0);
+fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> mat3x4<f32> {
+    var total = UW_ZERO;
     for (var j = 0u; j < uw_n; j++) {
         var sum = vec4<f32>(0.0);
         let dir = uw_dir[j];
@@ -193,9 +199,9 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
                 sum = fma(vec4<f32>(uw_w[base + k]), exp(-c * uw_s[base + k]), sum);
             }
         }
-        total = fma(uw_emission(uw_light[j], group, rgb), sum, total);
+        total += s3_scale(uw_emission(uw_light[j], group, rgb), b * sum);
     }
-    return b * total;
+    return total;
 }
 
 // Isotropic in-scattering of the downwelling field E0·e^{−Kd·z} (the paper's L_ms, whose
@@ -208,27 +214,30 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> vec4<
 // as the paper's term stands for light scattered many times. Sky stand-ins are diffuse light
 // and are never taken out.
 // For a ray with vertical component `wy` from depth `z0` over `d` metres (or forever).
-fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32, z0: f32, d: f32, infinite: bool) -> vec4<f32> {
+fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32, z0: f32, d: f32, infinite: bool) -> mat3x4<f32> {
     let gershun = custom.params[2].w > 0.5;
-    var e0 = vec4<f32>(0.0);
-    var beams = vec4<f32>(0.0);
+    let split = uw_steps > 0u && custom.params[3].w > 0.5;
+    // k = c + Kd·cosθ with cosθ = −ω_y: the field's decay along the ray, the same for every
+    // light; Gershun's factor likewise.
+    var field = b * UW_INV_4PI * exp(-kd * z0) * uw_integral_to(c - kd * wy, d, infinite);
+    if (gershun) {
+        field *= max(kd / max(c - b, vec4<f32>(1e-6)), vec4<f32>(1.0));
+    }
+    var total = UW_ZERO;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         let l = lights[li].pos_kind;
         let mu = -l.y;
         if (u32(l.w) != 0u || mu <= 0.0) { continue; }
-        let e = uw_emission(li, group, rgb);
-        e0 = fma(e, vec4<f32>(mu), e0);
-        if (uw_steps > 0u && custom.params[3].w > 0.5 && lights[li].cone.z < 0.5) {
-            let scalar = select(e * mu, e, gershun);
-            beams = fma(scalar * exp(-c * (z0 / mu)), uw_integral_to(c * (1.0 - wy / mu), d, infinite), beams);
+        var f = field * mu;
+        if (split && lights[li].cone.z < 0.5) {
+            let scalar = select(mu, 1.0, gershun);
+            let beam = scalar * exp(-c * (z0 / mu)) * uw_integral_to(c * (1.0 - wy / mu), d, infinite);
+            // Per light (not over the sum of lights): a beam larger than its field is clamped.
+            f = max(f - b * UW_INV_4PI * beam, vec4<f32>(0.0));
         }
+        total += s3_scale(uw_emission(li, group, rgb), f);
     }
-    if (gershun) {
-        e0 *= max(kd / max(c - b, vec4<f32>(1e-6)), vec4<f32>(1.0));
-    }
-    // k = c + Kd·cosθ with cosθ = −ω_y.
-    let ms = e0 * exp(-kd * z0) * uw_integral_to(c - kd * wy, d, infinite);
-    return max(b * UW_INV_4PI * (ms - beams), vec4<f32>(0.0));
+    return total;
 }
 
 // Unpolarised Fresnel reflectance of the surface for light going up at cosine `cos_w`
@@ -246,20 +255,20 @@ fn uw_fresnel_up(cos_w: f32) -> f32 {
 // attenuation): the sky through Snell's window, L_air·T·n² with L_air = E_sky/(π·T̄) from the
 // sky stand-ins' irradiance, plus the reflected water below (the in-scattering of a downward
 // ray from the surface along the mirrored direction; no sea floor, no single scattering).
-fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
+fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f32> {
     let r = uw_fresnel_up(wy);
-    var sky = vec4<f32>(0.0);
+    var sky = UW_ZERO;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         let l = lights[li].pos_kind;
         if (u32(l.w) == 0u && lights[li].cone.z > 0.5 && l.y < 0.0) {
-            sky = fma(uw_emission(li, group, rgb), vec4<f32>(-l.y), sky);
+            sky += uw_emission(li, group, rgb) * (-l.y);
         }
     }
-    let window = (1.0 - r) * UW_N * UW_N * UW_SKY_NORM * sky;
-    return window + r * uw_in_scatter(b, c, kd, group, rgb, -wy, 0.0, 0.0, true);
+    let window = sky * ((1.0 - r) * UW_N * UW_N * UW_SKY_NORM);
+    return window + uw_in_scatter(b, c, kd, group, rgb, -wy, 0.0, 0.0, true) * r;
 }
 
-fn uw_shade(radiance: vec4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> vec4<f32> {
+fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
     let z0 = custom.params[0].x;
@@ -268,16 +277,16 @@ fn uw_shade(radiance: vec4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, grou
         l += uw_single_scatter(b, c, group, rgb);
     }
     if (UW_SURFACE && ctx.background && wy > 0.0) {
-        l += exp(-c * uw_d) * uw_surface_from_below(b, c, kd, group, rgb, wy);
+        l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy), exp(-c * uw_d));
     }
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
-        l = fma(radiance, exp(-kd * zs) * exp(-c * uw_d), l);
+        l += s3_scale(radiance, exp(-kd * zs) * exp(-c * uw_d));
     }
     return l;
 }
 
-fn custom_spectral(lambda: vec4<f32>, radiance: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
     let b = custom_spectra[group * 4u + 0u];
     let c = custom_spectra[group * 4u + 1u];
     let kd = custom_spectra[group * 4u + 2u];
@@ -289,7 +298,8 @@ fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> {
     let c = vec4<f32>(custom.params[1].xyz, 1.0);
     let kd = vec4<f32>(custom.params[2].xyz, 1.0);
     let b = vec4<f32>(custom.params[3].xyz, 1.0);
-    return uw_shade(vec4<f32>(radiance, 0.0), b, c, kd, 0u, true, ctx).rgb;
+    let r = mat3x4<f32>(vec4<f32>(radiance, 0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    return uw_shade(r, b, c, kd, 0u, true, ctx)[0].rgb;
 }
 
 fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {

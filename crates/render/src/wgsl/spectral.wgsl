@@ -1,23 +1,22 @@
 // Per-wavelength data and Jakob–Hanika upsampling, shared by the shading and custom passes
 // (bind group 2). Layouts match src/spectral_data.rs.
 
-// Four wavelengths. Padding lanes (when N is not a multiple of 4) have zero weights.
+// Four node wavelengths. Padding lanes (when N is not a multiple of 4) have zero weights.
 struct WavelengthGroup {
-    // Wavelengths in nm.
+    // Node wavelengths in nm.
     lambda: vec4<f32>,
-    // Observer × Δλ / k weights (SpectralIntegrator::emission): XYZ = Σ L(λ)·w(λ).
-    wx: vec4<f32>,
-    wy: vec4<f32>,
-    wz: vec4<f32>,
-    // The white illuminant (D65 for sRGB) at these wavelengths, for the "illuminant" variant.
-    white: vec4<f32>,
+    // The white illuminant's node weights for X, Y, Z (see `white_weights`).
+    white_x: vec4<f32>,
+    white_y: vec4<f32>,
+    white_z: vec4<f32>,
     // Naive box upsampling: 1 in the band (R, G or B) that contains the wavelength, else 0.
     band_r: vec4<f32>,
     band_g: vec4<f32>,
     band_b: vec4<f32>,
+    _pad: vec4<f32>,
 };
 
-// A light. Emission per wavelength lives in `light_spectra[light * n_groups + group]`.
+// A light. Its node weights live in `light_weights[light * n_groups + group]`.
 struct GpuLight {
     // xyz position (point/spot) or direction the light travels (directional); w = kind
     // (0 directional, 1 point, 2 spot).
@@ -29,6 +28,9 @@ struct GpuLight {
     cone: vec4<f32>,
     // Linear-sRGB emission × intensity, used in rgb mode.
     rgb: vec4<f32>,
+    // Spectral modes: XYZ of the light seen by a reflectance of one (Σ of its node weights),
+    // for the terms that do not depend on the reflectance (specular). w unused.
+    xyz: vec4<f32>,
 };
 
 // Unit direction from `p` towards light `li` (xyz) and the light's distance falloff at `p`
@@ -59,7 +61,13 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
 
 @group(2) @binding(0) var<storage, read> wavelengths: array<WavelengthGroup>;
 @group(2) @binding(1) var<storage, read> lights: array<GpuLight>;
-@group(2) @binding(2) var<storage, read> light_spectra: array<vec4<f32>>;
+// Node weights of each light (src/spectral_data.rs, color::quadrature): column c of
+// `light_weights[li * n_groups + g]` holds, for the group's four nodes, what the node's
+// reflectance is multiplied by to give channel c (X, Y, Z) of the light reflected there, so
+// that XYZ = Σ_g ρ_g · light_weights[li * n_groups + g] (a vec4 × mat3x4 product). The
+// weights carry the light's spectrum, the observer and the quadrature rule (midpoint or
+// prefiltered) together: the shader does not know which rule made them.
+@group(2) @binding(2) var<storage, read> light_weights: array<mat3x4<f32>>;
 // The coefficient table as one 3D texture: x = i, y = j, z = l·res + k; rgb = (c0, c1, c2).
 @group(2) @binding(3) var coeff_table: texture_3d<f32>;
 // The table's non-uniform z axis (values of the largest channel at each k).
@@ -123,4 +131,27 @@ fn sigmoid4(c: vec3<f32>, lambda: vec4<f32>) -> vec4<f32> {
 fn box4(rgb: vec3<f32>, g: u32) -> vec4<f32> {
     let w = wavelengths[g];
     return fma(vec4<f32>(rgb.r), w.band_r, fma(vec4<f32>(rgb.g), w.band_g, rgb.b * w.band_b));
+}
+
+// The weights of light `li` for group `g` (see `light_weights`).
+fn light_w(li: u32, g: u32, n_groups: u32) -> mat3x4<f32> {
+    return light_weights[li * n_groups + g];
+}
+
+// The white illuminant's node weights for group `g`: emission uses the "illuminant"
+// upsampling ρ(λ)·W(λ), so an emissive surface is its node reflectance times these.
+fn white_weights(g: u32) -> mat3x4<f32> {
+    let w = wavelengths[g];
+    return mat3x4<f32>(w.white_x, w.white_y, w.white_z);
+}
+
+// Node radiance in weighted form: `m[c]` holds channel c's weighted node values, so a
+// wavelength-dependent factor f (transmittance, scattering) multiplies each column.
+fn s3_scale(m: mat3x4<f32>, f: vec4<f32>) -> mat3x4<f32> {
+    return mat3x4<f32>(m[0] * f, m[1] * f, m[2] * f);
+}
+
+// XYZ of weighted node radiance: the sum of each column's lanes.
+fn s3_xyz(m: mat3x4<f32>) -> vec3<f32> {
+    return vec4<f32>(1.0) * m;
 }

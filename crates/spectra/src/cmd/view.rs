@@ -41,6 +41,7 @@ pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSetti
         shadows: true,
         timestamps: true,
         jitter: None,
+        quadrature: args.look.quadrature,
     };
     s.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(s)
