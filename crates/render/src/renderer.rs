@@ -184,6 +184,20 @@ impl Renderer {
         Ok(())
     }
 
+    /// Benchmarking: replaces pass 2 with the minimal single-light RGB shader
+    /// (`passes/shading_reference.wgsl`: light 0, Lambert + GGX, no shadows, hooks or emission)
+    /// so that its GPU time can be compared with the real pass's; `false` restores the real
+    /// pass with the current custom hooks. Not for images: the reference ignores the mode.
+    pub fn set_reference_shading(&mut self, on: bool) -> Result<()> {
+        let device = &self.gpu.device;
+        self.shading = if on {
+            ShadingPass::reference(device, &self.shared)?
+        } else {
+            ShadingPass::new(device, &self.shared, &self.custom.assembled())?
+        };
+        Ok(())
+    }
+
     /// Changes the custom shader's parameters without recompiling (e.g. every frame from a UI).
     pub fn set_custom_params(&mut self, params: [f32; 16]) {
         if self.custom.params != params {
@@ -333,6 +347,7 @@ impl Renderer {
             &bindings.shading,
             &spectral.bind_group,
             &spectral.custom_bind_group,
+            settings.mode == Mode::Rgb,
             ts(2),
         );
         self.custom_pass.record(

@@ -319,3 +319,48 @@ fn naive_band(lambda: f64, blue_max: f64, green_max: f64) -> usize {
         0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use color::quadrature::dense_integral;
+    use glam::Vec3;
+
+    fn table() -> std::sync::Arc<CoeffTable> {
+        color::upsample::table("srgb").expect("the sRGB table")
+    }
+
+    #[test]
+    fn a_light_outside_the_range_is_an_error_naming_the_range() {
+        let setup = SpectralSetup::new(&RenderSettings::default()).unwrap();
+        let ir = Spectrum::piecewise(vec![790.0, 800.0, 810.0], vec![0.0, 1.0, 0.0]).unwrap();
+        let e = Emission { rgb: Vec3::ONE, intensity: 2.0, spectrum: Some(ir) };
+        let err = setup.light_weights(&e, Mode::Spectral, &table()).unwrap_err().to_string();
+        assert!(err.contains("380–730"), "{err}");
+        // A dark light with the same spectrum is not an error: there is nothing to scale.
+        let dark = Emission { intensity: 0.0, ..e };
+        assert!(setup.light_weights(&dark, Mode::Spectral, &table()).is_ok());
+    }
+
+    #[test]
+    fn prefiltered_light_weights_carry_the_dense_integral_at_every_n() {
+        let f11 = color::illuminant::by_name("F11").unwrap();
+        let e = Emission { rgb: Vec3::ONE, intensity: 1.0, spectrum: Some(f11.clone()) };
+        let obs = color::Observer::cie1931();
+        let dense = dense_integral(WavelengthRange::VISIBLE, &obs, |l| f11.eval(l));
+        for n in [1, 3, 4, 8, 16, 17, 64] {
+            let s = RenderSettings { wavelengths: n, ..Default::default() };
+            let setup = SpectralSetup::new(&s).unwrap();
+            let total =
+                SpectralSetup::light_total(&setup.light_weights(&e, Mode::Spectral, &table()).unwrap());
+            // Y is the light's luminance (1); X/Y and Z/Y are the dense integral's.
+            assert!((total[1] - 1.0).abs() < 1e-9, "N={n}: Y {}", total[1]);
+            for c in [0, 2] {
+                let want = dense[c] / dense[1];
+                assert!((total[c] - want).abs() < 1e-6 * want, "N={n} channel {c}: {} vs {want}", total[c]);
+            }
+            let groups = setup.gpu_weights(&setup.light_weights(&e, Mode::Spectral, &table()).unwrap());
+            assert_eq!(groups.len(), n.div_ceil(4));
+        }
+    }
+}

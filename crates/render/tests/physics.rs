@@ -264,3 +264,54 @@ fn emissive_surfaces_use_the_illuminant_variant() {
         assert!(white.iter().all(|&c| (c - 1.0).abs() < 2e-3), "{rule} N={n}: emissive white → {white:?}");
     }
 }
+
+#[test]
+fn white_under_f11_keeps_its_white_point_at_every_n() {
+    // Equal-energy check: a white Lambertian surface under F11 must have the chromaticity of
+    // the dense integral (0.25 nm, same table spectrum, same white correction) at any N with
+    // the prefiltered rule; the midpoint rule misses it by far at some N (printed).
+    let mut chart = Chart::colorchecker();
+    chart.colours.iter_mut().for_each(|c| *c = [1.0; 3]);
+    let f11 = color::illuminant::by_name("F11").unwrap();
+    let mut r = renderer();
+    r.set_scene(&chart.scene(white_light(0.8, Some(f11.clone())), 1.0, 0.0)).unwrap();
+    r.resize(W, H).unwrap();
+    let table = table();
+    let obs = Observer::cie1931();
+    let range = color::WavelengthRange::VISIBLE;
+    let poly = table.fetch([1.0; 3]);
+    let d65 = color::illuminant::by_name("D65").unwrap();
+    let space = RgbColorSpace::srgb();
+    // What the renderer's white correction does to XYZ, from dense integrals.
+    let white = color::quadrature::dense_integral(range, &obs, |l| d65.eval(l));
+    let target = space.white_xyz();
+    let xyz = color::quadrature::dense_integral(range, &obs, |l| poly.to_f32_poly_eval(l) * f11.eval(l));
+    let want = color::xyz::xyz_to_xy(std::array::from_fn(|c| xyz[c] * target[c] * white[1] / white[c]));
+    let geo = pixel_geometry(&chart, 1.0, 0.0);
+    for rule in Quadrature::ALL {
+        let mut worst = 0.0f64;
+        for n in [4, 8, 16, 32] {
+            let img = render_hdr(&mut r, &settings_q(Mode::Spectral, n, rule));
+            let mut sum = [0.0f64; 3];
+            for (p, g) in img.iter().zip(&geo) {
+                if g.is_some() {
+                    let x = space.rgb_to_xyz(*p);
+                    (0..3).for_each(|c| sum[c] += x[c]);
+                }
+            }
+            let xy = color::xyz::xyz_to_xy(sum);
+            let e = (xy[0] - want[0]).abs().max((xy[1] - want[1]).abs());
+            println!(
+                "white under F11, {rule} N={n}: xy ({:.5}, {:.5}) vs dense ({:.5}, {:.5}): {e:.1e}",
+                xy[0], xy[1], want[0], want[1]
+            );
+            if rule == Quadrature::Prefiltered {
+                assert!(e < 1e-4, "prefiltered N={n}: white point off by {e:.2e}");
+            }
+            worst = worst.max(e);
+        }
+        if rule == Quadrature::Midpoint {
+            assert!(worst > 1e-3, "the midpoint rule should miss F11's white at some N (worst {worst:.1e})");
+        }
+    }
+}

@@ -126,6 +126,18 @@ pub(crate) fn fullscreen_pipeline(
     layouts: &[Option<&wgpu::BindGroupLayout>],
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    fullscreen_pipeline_entry(device, label, module, layouts, format, "fs_main")
+}
+
+/// [`fullscreen_pipeline`] with the fragment entry point `entry`.
+pub(crate) fn fullscreen_pipeline_entry(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    format: wgpu::TextureFormat,
+    entry: &str,
+) -> wgpu::RenderPipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: layouts,
@@ -145,7 +157,7 @@ pub(crate) fn fullscreen_pipeline(
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
                 format,

@@ -77,6 +77,45 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
     return vec2<f32>(a, b);
 }
 
+// What the G-buffer holds for one pixel.
+struct GSurface {
+    base: vec3<f32>,
+    emission: vec3<f32>,
+    normal: vec3<f32>,
+    metallic: f32,
+    roughness: f32,
+};
+
+fn load_surface(px: vec2<i32>) -> GSurface {
+    let b = textureLoad(gbuf_base, px, 0);
+    let nr = textureLoad(gbuf_normal, px, 0);
+    return GSurface(b.rgb, textureLoad(gbuf_emission, px, 0).rgb, normalize(nr.xyz), b.a, nr.w);
+}
+
+// RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
+// own), so that RGB pays only for what RGB needs.
+@fragment
+fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(in.pos.xy);
+    var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
+    var rgb = vec3<f32>(0.0);
+    if (!ctx.background) {
+        let s = load_surface(px);
+        ctx.normal = s.normal;
+        var sum_a = vec3<f32>(0.0);
+        var sum_b = vec3<f32>(0.0);
+        for (var li = 0u; li < min(frame.n_lights, MAX_LIGHTS); li++) {
+            let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness);
+            let e = lights[li].rgb.rgb;
+            sum_a = fma(vec3<f32>(f.x), e, sum_a);
+            sum_b = fma(vec3<f32>(f.y), e, sum_b);
+        }
+        rgb = fma(s.base, sum_a, sum_b) + s.emission;
+    }
+    return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
+}
+
+// Spectral and naive modes.
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
@@ -87,33 +126,20 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     var base = vec3<f32>(0.0);
     var emission = vec3<f32>(0.0);
     var n_lights = 0u;
+    // The spectral loop reads each light's factors once per wavelength group.
     var fa: array<f32, MAX_LIGHTS>;
     var fb: array<f32, MAX_LIGHTS>;
     if (!background) {
-        let b = textureLoad(gbuf_base, px, 0);
-        let nr = textureLoad(gbuf_normal, px, 0);
-        base = b.rgb;
-        emission = textureLoad(gbuf_emission, px, 0).rgb;
-        let n = normalize(nr.xyz);
-        ctx.normal = n;
+        let s = load_surface(px);
+        base = s.base;
+        emission = s.emission;
+        ctx.normal = s.normal;
         n_lights = min(frame.n_lights, MAX_LIGHTS);
         for (var li = 0u; li < n_lights; li++) {
-            let f = light_factors(li, p, n, -ctx.view_dir, b.a, nr.w);
+            let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness);
             fa[li] = f.x;
             fb[li] = f.y;
         }
-    }
-
-    if (frame.mode == MODE_RGB) {
-        var sum_a = vec3<f32>(0.0);
-        var sum_b = vec3<f32>(0.0);
-        for (var li = 0u; li < n_lights; li++) {
-            let e = lights[li].rgb.rgb;
-            sum_a = fma(vec3<f32>(fa[li]), e, sum_a);
-            sum_b = fma(vec3<f32>(fb[li]), e, sum_b);
-        }
-        let rgb = fma(base, sum_a, sum_b) + emission;
-        return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
     }
 
     let spectral = frame.mode == MODE_SPECTRAL;

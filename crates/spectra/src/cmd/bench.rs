@@ -7,12 +7,18 @@
 //! (the timestamp read-back, or a device poll, waits for it). Warm-up frames absorb pipeline
 //! and buffer creation. Frames are rendered back to back at a fixed camera; nothing is
 //! presented, so there is no v-sync in the numbers.
+//!
+//! The spectral rows run once per `--quadrature` (the rules differ only in the weights uploaded,
+//! so their cost should be the same; the benchmark shows it). `--reference` adds a row that
+//! replaces the shading pass by a minimal single-light Lambert + GGX shader, the floor an RGB
+//! deferred pass cannot go below, and prints the RGB shading pass against it.
 
 pub mod stats;
 
 use crate::cmd::render::{load_table, parse_size};
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
+use color::Quadrature;
 use indicatif::{ProgressBar, ProgressStyle};
 use render::{Mode, RenderSettings, Renderer};
 use stats::{LineFit, Summary, fit_line};
@@ -46,6 +52,29 @@ pub struct Args {
     /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
     #[arg(long)]
     pub table: Option<PathBuf>,
+    /// Quadrature rules to measure the spectral rows with, comma-separated (midpoint,
+    /// prefiltered).
+    #[arg(long, default_value = "prefiltered")]
+    pub quadrature: String,
+    /// Also time the minimal reference shading pass (one light, Lambert + GGX, RGB) and print
+    /// the RGB shading pass against it.
+    #[arg(long)]
+    pub reference: bool,
+}
+
+/// Parses `midpoint,prefiltered` into rules.
+pub fn parse_rules(s: &str) -> Result<Vec<Quadrature>> {
+    let mut out = Vec::new();
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let q = Quadrature::parse(part).map_err(|e| anyhow!("--quadrature '{s}': {e}"))?;
+        if !out.contains(&q) {
+            out.push(q);
+        }
+    }
+    if out.is_empty() {
+        bail!("--quadrature '{s}': give at least one of midpoint, prefiltered");
+    }
+    Ok(out)
 }
 
 /// Parses `1,2,4` into wavelength counts, each within the renderer's limit.
@@ -71,43 +100,67 @@ pub fn parse_counts(s: &str) -> Result<Vec<usize>> {
 #[derive(Clone, Debug)]
 pub struct Row {
     pub mode: Mode,
+    /// The spectral rows' rule; `None` for RGB.
+    pub quadrature: Option<Quadrature>,
+    /// The minimal reference shading pass instead of the real one (RGB mode).
+    pub reference: bool,
     /// `None` for RGB (its cost does not depend on N).
     pub n: Option<usize>,
     pub gpu: Option<Summary>,
+    /// GPU time of the shading pass alone.
+    pub shading: Option<Summary>,
     pub cpu: Summary,
 }
 
 impl Row {
+    /// `rgb`, `reference`, or the spectral mode with its rule (`spectral/prefiltered`).
+    pub fn name(&self) -> String {
+        match (self.reference, self.quadrature) {
+            (true, _) => "reference".into(),
+            (false, Some(q)) => format!("{}/{}", self.mode.name(), q.name()),
+            (false, None) => self.mode.name().into(),
+        }
+    }
+
     /// The time the comparisons use: GPU when measured, else CPU wall time.
     pub fn primary(&self) -> f64 {
         self.gpu.map(|g| g.median).unwrap_or(self.cpu.median)
     }
 }
 
-/// The least-squares ms-per-wavelength line of one mode's rows.
-pub fn slope(rows: &[Row], mode: Mode) -> Option<LineFit> {
-    let pts: Vec<(f64, f64)> =
-        rows.iter().filter(|r| r.mode == mode).filter_map(|r| Some((r.n? as f64, r.primary()))).collect();
+/// The least-squares ms-per-wavelength line of one mode's rows under one rule.
+pub fn slope(rows: &[Row], mode: Mode, rule: Quadrature) -> Option<LineFit> {
+    let pts: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.mode == mode && r.quadrature == Some(rule))
+        .filter_map(|r| Some((r.n? as f64, r.primary())))
+        .collect();
     fit_line(&pts)
+}
+
+/// The baseline the ratios divide by: the real RGB row.
+fn rgb_row(rows: &[Row]) -> Option<&Row> {
+    rows.iter().find(|r| r.mode == Mode::Rgb && !r.reference)
 }
 
 /// The CSV text: one line per configuration, times in milliseconds, empty where not measured.
 pub fn csv(rows: &[Row]) -> String {
-    let rgb = rows.iter().find(|r| r.mode == Mode::Rgb).map(Row::primary);
+    let rgb = rgb_row(rows).map(Row::primary);
     let mut s = String::from(
-        "mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,cpu_median_ms,cpu_p10_ms,cpu_p90_ms,ratio_to_rgb\n",
+        "mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,shading_gpu_median_ms,cpu_median_ms,cpu_p10_ms,cpu_p90_ms,ratio_to_rgb\n",
     );
     for r in rows {
         let g = |f: fn(&Summary) -> f64| r.gpu.as_ref().map(|g| format!("{:.4}", f(g))).unwrap_or_default();
         let ratio = rgb.map(|b| format!("{:.4}", r.primary() / b)).unwrap_or_default();
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{:.4},{:.4},{:.4},{}",
-            r.mode.name(),
+            "{},{},{},{},{},{},{:.4},{:.4},{:.4},{}",
+            r.name(),
             r.n.map(|n| n.to_string()).unwrap_or_default(),
             g(|s| s.median),
             g(|s| s.p10),
             g(|s| s.p90),
+            r.shading.map(|s| format!("{:.4}", s.median)).unwrap_or_default(),
             r.cpu.median,
             r.cpu.p10,
             r.cpu.p90,
@@ -119,21 +172,22 @@ pub fn csv(rows: &[Row]) -> String {
 
 /// The human-readable table plus the per-wavelength fit lines.
 pub fn table(rows: &[Row]) -> String {
-    let rgb = rows.iter().find(|r| r.mode == Mode::Rgb).map(Row::primary);
+    let rgb = rgb_row(rows).map(Row::primary);
     let mut s = format!(
-        "{:<9} {:>3}  {:>9} {:>8} {:>8}  {:>9} {:>8} {:>8}  {:>7}\n",
-        "mode", "N", "GPU med", "p10", "p90", "CPU med", "p10", "p90", "×RGB"
+        "{:<21} {:>3}  {:>9} {:>8} {:>8} {:>9}  {:>9} {:>8} {:>8}  {:>7}\n",
+        "mode", "N", "GPU med", "p10", "p90", "shading", "CPU med", "p10", "p90", "×RGB"
     );
     let opt = |v: Option<f64>| v.map(|v| format!("{v:.2}")).unwrap_or_else(|| "–".into());
     for r in rows {
         let _ = writeln!(
             s,
-            "{:<9} {:>3}  {:>9} {:>8} {:>8}  {:>9.2} {:>8.2} {:>8.2}  {:>7}",
-            r.mode.name(),
+            "{:<21} {:>3}  {:>9} {:>8} {:>8} {:>9}  {:>9.2} {:>8.2} {:>8.2}  {:>7}",
+            r.name(),
             r.n.map(|n| n.to_string()).unwrap_or_else(|| "–".into()),
             opt(r.gpu.map(|g| g.median)),
             opt(r.gpu.map(|g| g.p10)),
             opt(r.gpu.map(|g| g.p90)),
+            opt(r.shading.map(|g| g.median)),
             r.cpu.median,
             r.cpu.p10,
             r.cpu.p90,
@@ -141,16 +195,37 @@ pub fn table(rows: &[Row]) -> String {
         );
     }
     for mode in [Mode::Spectral, Mode::Naive] {
-        if let Some(f) = slope(rows, mode) {
-            let _ = writeln!(
-                s,
-                "{}: {:.3} ms per wavelength + {:.2} ms (least squares over N, R² = {:.4})",
-                mode.name(),
-                f.slope,
-                f.intercept,
-                f.r2
-            );
+        for rule in Quadrature::ALL {
+            if let Some(f) = slope(rows, mode, rule) {
+                let _ = writeln!(
+                    s,
+                    "{}/{}: {:.3} ms per wavelength + {:.2} ms (least squares over N, R² = {:.4})",
+                    mode.name(),
+                    rule.name(),
+                    f.slope,
+                    f.intercept,
+                    f.r2
+                );
+            }
         }
+    }
+    // The rules upload different weights to the same shader: their cost should match.
+    for n in rows.iter().filter_map(|r| r.n) {
+        let at =
+            |q| rows.iter().find(|r| r.mode == Mode::Spectral && r.n == Some(n) && r.quadrature == Some(q));
+        if let (Some(m), Some(p)) = (at(Quadrature::Midpoint), at(Quadrature::Prefiltered))
+            && !s.contains(&format!("N = {n}: prefiltered"))
+        {
+            let _ = writeln!(s, "N = {n}: prefiltered / midpoint = {:.3}", p.primary() / m.primary());
+        }
+    }
+    let shading = |r: Option<&Row>| r.and_then(|r| r.shading).map(|s| s.median);
+    if let (Some(real), Some(floor)) = (shading(rgb_row(rows)), shading(rows.iter().find(|r| r.reference))) {
+        let _ = writeln!(
+            s,
+            "RGB shading pass {real:.2} ms vs the minimal reference {floor:.2} ms: {:.2}×",
+            real / floor
+        );
     }
     s
 }
@@ -202,10 +277,18 @@ pub fn run(args: Args) -> Result<()> {
         if has_ts { "GPU timestamps + CPU wall" } else { "CPU wall only (no timestamp queries)" }
     );
 
-    let mut configs: Vec<(Mode, Option<usize>)> = vec![(Mode::Rgb, None)];
-    configs.extend(counts.iter().map(|&n| (Mode::Spectral, Some(n))));
-    if args.naive {
-        configs.extend(counts.iter().map(|&n| (Mode::Naive, Some(n))));
+    let rules = parse_rules(&args.quadrature)?;
+    // (mode, rule, reference, N)
+    let mut configs: Vec<(Mode, Option<Quadrature>, bool, Option<usize>)> =
+        vec![(Mode::Rgb, None, false, None)];
+    if args.reference {
+        configs.push((Mode::Rgb, None, true, None));
+    }
+    for &q in &rules {
+        configs.extend(counts.iter().map(|&n| (Mode::Spectral, Some(q), false, Some(n))));
+        if args.naive {
+            configs.extend(counts.iter().map(|&n| (Mode::Naive, Some(q), false, Some(n))));
+        }
     }
     let per = (args.warmup + args.frames) as u64;
     let bar = ProgressBar::new(per * configs.len() as u64).with_style(
@@ -216,15 +299,18 @@ pub fn run(args: Args) -> Result<()> {
     let interrupted = color::upsample::interrupt_flag();
     color::upsample::install_interrupt_handler();
     let mut rows = Vec::new();
-    for (mode, n) in configs {
+    for (mode, quadrature, reference, n) in configs {
         bar.set_message(format!("{} N={}", mode.name(), n.map(|n| n.to_string()).unwrap_or("–".into())));
         let settings = RenderSettings {
             mode,
             wavelengths: n.unwrap_or(RenderSettings::default().wavelengths),
+            quadrature: quadrature.unwrap_or_default(),
             timestamps: has_ts,
             ..Default::default()
         };
+        r.set_reference_shading(reference)?;
         let mut gpu_ms = Vec::with_capacity(args.frames);
+        let mut shading_ms = Vec::with_capacity(args.frames);
         let mut cpu_ms = Vec::with_capacity(args.frames);
         for i in 0..per as usize {
             if interrupted.load(Ordering::SeqCst) {
@@ -246,18 +332,23 @@ pub fn run(args: Args) -> Result<()> {
                 cpu_ms.push(wall);
                 if let Some(t) = t {
                     gpu_ms.push(t.total_ms());
+                    shading_ms.extend(t.get("shading"));
                 }
             }
             bar.inc(1);
         }
         rows.push(Row {
             mode,
+            quadrature,
+            reference,
             n,
             gpu: Summary::of(&gpu_ms),
+            shading: Summary::of(&shading_ms),
             cpu: Summary::of(&cpu_ms).context("no frame times")?,
         });
     }
     bar.finish_and_clear();
+    r.set_reference_shading(false)?;
     print!("{}", table(&rows));
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let cpu_device = r.gpu().adapter.get_info().device_type == wgpu::DeviceType::Cpu;
@@ -300,15 +391,18 @@ mod tests {
     }
 
     fn rows() -> Vec<Row> {
-        let mut rows = vec![Row { mode: Mode::Rgb, n: None, gpu: Some(summary(20.0)), cpu: summary(25.0) }];
+        let row = |mode, quadrature, n: Option<usize>, ms: f64| Row {
+            mode,
+            quadrature,
+            reference: false,
+            n,
+            gpu: Some(summary(ms)),
+            shading: Some(summary(ms / 2.0)),
+            cpu: summary(ms + 5.0),
+        };
+        let mut rows = vec![row(Mode::Rgb, None, None, 20.0)];
         for n in [1, 2, 4, 8] {
-            let ms = 20.0 + 2.5 * n as f64;
-            rows.push(Row {
-                mode: Mode::Spectral,
-                n: Some(n),
-                gpu: Some(summary(ms)),
-                cpu: summary(ms + 5.0),
-            });
+            rows.push(row(Mode::Spectral, Some(Quadrature::Prefiltered), Some(n), 20.0 + 2.5 * n as f64));
         }
         rows
     }
@@ -316,16 +410,22 @@ mod tests {
     #[test]
     fn slope_ratio_and_csv() {
         let rows = rows();
-        let f = slope(&rows, Mode::Spectral).unwrap();
+        let f = slope(&rows, Mode::Spectral, Quadrature::Prefiltered).unwrap();
         assert!((f.slope - 2.5).abs() < 1e-12 && (f.intercept - 20.0).abs() < 1e-12);
-        assert!(slope(&rows, Mode::Naive).is_none());
+        assert!(slope(&rows, Mode::Naive, Quadrature::Prefiltered).is_none());
+        assert!(slope(&rows, Mode::Spectral, Quadrature::Midpoint).is_none());
         let text = csv(&rows);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 6);
-        assert_eq!(lines[1], "rgb,,20.0000,19.0000,21.0000,25.0000,24.0000,26.0000,1.0000");
+        assert_eq!(lines[1], "rgb,,20.0000,19.0000,21.0000,10.0000,25.0000,24.0000,26.0000,1.0000");
         // N = 8: 40 ms / 20 ms.
-        assert_eq!(lines[5], "spectral,8,40.0000,39.0000,41.0000,45.0000,44.0000,46.0000,2.0000");
-        assert!(table(&rows).contains("spectral: 2.500 ms per wavelength + 20.00 ms"));
+        assert_eq!(
+            lines[5],
+            "spectral/prefiltered,8,40.0000,39.0000,41.0000,20.0000,45.0000,44.0000,46.0000,2.0000"
+        );
+        assert!(table(&rows).contains("spectral/prefiltered: 2.500 ms per wavelength + 20.00 ms"));
+        assert_eq!(parse_rules(" midpoint,prefiltered,midpoint").unwrap(), Quadrature::ALL.to_vec());
+        assert!(parse_rules("gauss").unwrap_err().to_string().contains("gauss"));
     }
 
     #[test]
@@ -344,9 +444,10 @@ mod tests {
         let mut rows = rows();
         for r in &mut rows {
             r.gpu = None;
+            r.shading = None;
         }
         let lines: Vec<String> = csv(&rows).lines().map(String::from).collect();
         // 45 ms / 25 ms, and no GPU columns.
-        assert_eq!(lines[5], "spectral,8,,,,45.0000,44.0000,46.0000,1.8000");
+        assert_eq!(lines[5], "spectral/prefiltered,8,,,,,45.0000,44.0000,46.0000,1.8000");
     }
 }
