@@ -282,6 +282,7 @@ impl Running {
             KeyCode::BracketLeft => c.step_wavelengths(-1),
             KeyCode::BracketRight => c.step_wavelengths(1),
             KeyCode::KeyT => c.cycle_tonemap(),
+            KeyCode::KeyI => c.cycle_quadrature(),
             KeyCode::KeyO => c.cycle_observer(),
             KeyCode::KeyJ => c.accumulate = !c.accumulate,
             KeyCode::Minus => c.step_exposure(-0.5),

@@ -16,7 +16,7 @@ const TONEMAPS: [(Tonemap, &str); 3] =
 
 /// Shortcuts, shown in the panel and printed at start.
 pub const HELP: &str = "left drag: orbit · right drag: look · wheel: zoom · WASD/QE: fly (Shift ×4) · \
-R: reset camera · M or 1/2/3: mode · [ ]: N −/+1 · { }: N ÷/×2 · T: tone map · O: observer · \
+R: reset camera · M or 1/2/3: mode · [ ]: N −/+1 · { }: N ÷/×2 · I: quadrature · T: tone map · O: observer · \
 - =: exposure · J: accumulate jittered λ · F12 or P: screenshot · Esc: quit";
 
 /// The wavelength jitter of accumulated frame `k` (0-based since the last reset): the
@@ -105,6 +105,13 @@ impl Controls {
         self.wanted.wavelengths = if up { n * 2 } else { n / 2 }.clamp(1, MAX_VIEW_WAVELENGTHS);
     }
 
+    /// Switches between the prefiltered and the midpoint quadrature.
+    pub fn cycle_quadrature(&mut self) {
+        let all = color::Quadrature::ALL;
+        let i = all.iter().position(|q| *q == self.wanted.quadrature).unwrap_or(0);
+        self.wanted.quadrature = all[(i + 1) % all.len()];
+    }
+
     pub fn cycle_tonemap(&mut self) {
         let i = TONEMAPS.iter().position(|t| t.0 == self.wanted.tonemap).unwrap_or(0);
         self.wanted.tonemap = TONEMAPS[(i + 1) % TONEMAPS.len()].0;
@@ -131,6 +138,12 @@ impl Controls {
             }
         });
         ui.add(egui::Slider::new(&mut w.wavelengths, 1..=MAX_VIEW_WAVELENGTHS).text("N wavelengths"));
+        ui.horizontal(|ui| {
+            ui.label("quadrature (I)");
+            for q in color::Quadrature::ALL {
+                ui.radio_value(&mut w.quadrature, q, q.name());
+            }
+        });
         let (mut lo, mut hi) = (w.range.min, w.range.max);
         ui.horizontal(|ui| {
             ui.label("range nm");
@@ -221,6 +234,11 @@ mod tests {
         assert_eq!(c.wanted.wavelengths, MAX_VIEW_WAVELENGTHS);
         c.step_exposure(100.0);
         assert_eq!(c.wanted.exposure_ev, 16.0);
+        assert_eq!(c.wanted.quadrature, color::Quadrature::Prefiltered);
+        c.cycle_quadrature();
+        assert_eq!(c.wanted.quadrature, color::Quadrature::Midpoint);
+        c.cycle_quadrature();
+        assert_eq!(c.wanted.quadrature, color::Quadrature::Prefiltered);
     }
 
     #[test]
