@@ -2,7 +2,7 @@
 //! directory with an HTML report. See `crate::eval` and docs/evaluation.md.
 
 use crate::eval::{self, Config, suite};
-use anyhow::{Result, bail};
+use anyhow::{Result, anyhow, bail};
 use clap::Args as ClapArgs;
 use std::path::PathBuf;
 
@@ -22,6 +22,12 @@ pub struct Args {
     /// Override the image size WIDTHxHEIGHT of the error measurements (every case).
     #[arg(long)]
     pub size: Option<String>,
+    /// Wavelength counts N of the error sweep (ours and naive, midpoint and prefiltered
+    /// quadrature, every case), comma-separated, each in 1..=256. Default: 4,8,16 (--quick) or
+    /// 4,8,16,32,64. The error-vs-frame-time chart uses the N that are also timed
+    /// (1,2,4,8,16,32 with --quick, up to 64 in the full run).
+    #[arg(long, value_name = "N,N,...")]
+    pub sweep: Option<String>,
     /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
     #[arg(long)]
     pub table: Option<PathBuf>,
@@ -37,6 +43,9 @@ pub fn run(a: Args) -> Result<()> {
     }
     let size = a.size.as_deref().map(crate::cmd::render::parse_size).transpose()?;
     budget.override_with(size, a.spp);
+    if let Some(s) = &a.sweep {
+        budget.sweep_counts = parse_sweep(s)?;
+    }
     let ids = if a.scenes.is_empty() {
         suite::default_ids(&budget)
     } else {
@@ -49,6 +58,44 @@ pub fn run(a: Args) -> Result<()> {
     let out = a.out.clone();
     let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table })?;
     println!("{}", eval::report::markdown_table(&r));
+    println!("{}", eval::report::markdown_sweep(&r));
     println!("report: {}  ({:.0} s)", out.join("index.html").display(), r.seconds);
     Ok(())
+}
+
+/// `--sweep 4,8,16`: distinct counts in 1..=MAX_WAVELENGTHS, ascending (the charts draw lines
+/// through them in order), or an error naming the bad value.
+pub fn parse_sweep(s: &str) -> Result<Vec<usize>> {
+    let max = render::settings::MAX_WAVELENGTHS;
+    let mut out = Vec::new();
+    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let n: usize = part.parse().map_err(|_| anyhow!("--sweep '{s}': '{part}' is not a whole number"))?;
+        if n == 0 || n > max {
+            bail!("--sweep '{s}': {n} is outside 1..={max}");
+        }
+        if !out.contains(&n) {
+            out.push(n);
+        }
+    }
+    if out.is_empty() {
+        bail!("--sweep '{s}': give at least one count, e.g. 4,8,16");
+    }
+    out.sort_unstable();
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_sweep;
+
+    #[test]
+    fn sweep_list_is_validated_sorted_and_deduplicated() {
+        assert_eq!(parse_sweep("16, 4,8,4").unwrap(), vec![4, 8, 16]);
+        assert_eq!(parse_sweep("256").unwrap(), vec![256]);
+        let e = parse_sweep("4,257").unwrap_err().to_string();
+        assert!(e.contains("257") && e.contains("1..=256"), "{e}");
+        assert!(parse_sweep("0").unwrap_err().to_string().contains("outside"));
+        assert!(parse_sweep("4,x").unwrap_err().to_string().contains("'x'"));
+        assert!(parse_sweep(" , ").unwrap_err().to_string().contains("at least one"));
+    }
 }

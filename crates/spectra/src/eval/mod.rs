@@ -3,10 +3,12 @@
 //! For every case of the suite ([`suite`]): a direct-lighting ground truth from the CPU path
 //! tracer (twice, with different seeds, so the report states its own noise floor), the three
 //! real-time modes (`spectral` = ours, `naive`, `rgb`) at the same size and camera, and their
-//! ΔE2000 / MAE against truth, over the whole image and outside an edge mask. Then frame time
-//! against N (paper Fig. 4) and, beyond the paper, stratified jittered wavelengths accumulated
-//! over frames against equal spacing. Everything lands in `--out`: PNGs, heat maps,
-//! `results.json`, `results.csv`, SVG charts and `index.html` ([`report`]).
+//! ΔE2000 / MAE against truth, over the whole image and outside an edge mask, plus a sweep of
+//! ours and naive over N in both quadratures against the same truth. Then frame time against N
+//! (paper Fig. 4), the error-vs-frame-time curve that a user picks N from and, beyond the
+//! paper, stratified jittered wavelengths accumulated over frames against equal spacing.
+//! Everything lands in `--out`: PNGs, heat maps, `results.json`, `results.csv`, SVG charts and
+//! `index.html` ([`report`]).
 
 pub mod measure;
 pub mod plot;
@@ -14,17 +16,25 @@ pub mod report;
 pub mod suite;
 
 use anyhow::{Context, Result};
-use color::WavelengthRange;
+use color::{Quadrature, WavelengthRange};
 use compare::{Heatmap, HeatmapOptions, Image, WriteOptions};
 use indicatif::{ProgressBar, ProgressStyle};
 use measure::Errors;
-use render::{Mode, Renderer};
+use render::{Mode, RenderSettings, Renderer};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 /// The three real-time modes, in report order, with their report names.
 pub const MODES: &[(Mode, &str)] = &[(Mode::Spectral, "ours"), (Mode::Naive, "naive"), (Mode::Rgb, "rgb")];
+
+/// The modes whose result depends on N and on the quadrature: the first two of [`MODES`].
+pub const SPECTRAL_MODES: &[(Mode, &str)] = &[(Mode::Spectral, "ours"), (Mode::Naive, "naive")];
+
+/// The headline modes' quadrature: the renderer's default, i.e. what a user gets.
+pub fn headline_quadrature() -> Quadrature {
+    RenderSettings::default().quadrature
+}
 
 /// What a run needs.
 pub struct Config {
@@ -41,6 +51,8 @@ pub struct Config {
 pub struct ModeResult {
     pub mode: String,
     pub wavelengths: Option<usize>,
+    /// `None` for rgb, which has no wavelength nodes.
+    pub quadrature: Option<String>,
     pub image: String,
     pub heatmap: String,
     pub errors: Errors,
@@ -63,12 +75,49 @@ pub struct CaseResult {
     pub noise_floor: Errors,
     pub masked_fraction: f64,
     pub modes: Vec<ModeResult>,
+    /// Ours and naive at every N of the sweep in both quadratures, against the same truth as
+    /// `modes` (seed 1).
+    pub sweep: Vec<SweepPoint>,
+}
+
+/// One (mode, quadrature, N) of the sweep: its errors against the case's truth. Only the means
+/// are kept; the sweep writes no images.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SweepPoint {
+    pub mode: String,
+    pub quadrature: String,
+    pub wavelengths: usize,
+    pub delta_e2000_mean: f64,
+    /// Outside the edge mask; equal to the whole-image mean for volumetric cases (no mask).
+    pub delta_e2000_masked_mean: f64,
+    pub mae_linear_mean: f64,
+}
+
+impl CaseResult {
+    /// The sweep's point for a mode, quadrature and N, if it was measured.
+    pub fn sweep_point(&self, mode: &str, quadrature: &str, n: usize) -> Option<&SweepPoint> {
+        self.sweep.iter().find(|p| p.mode == mode && p.quadrature == quadrature && p.wavelengths == n)
+    }
+}
+
+/// A point of the error-vs-frame-time curve: the frame time of a configuration on the
+/// frame-time scene beside its mean error in that scene's case.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TradeoffPoint {
+    pub mode: String,
+    /// `None` for rgb.
+    pub quadrature: Option<String>,
+    pub wavelengths: Option<usize>,
+    pub median_ms: f64,
+    pub delta_e2000_mean: f64,
 }
 
 #[derive(serde::Serialize)]
 pub struct FrameTime {
     pub mode: String,
     pub wavelengths: Option<usize>,
+    /// `None` for rgb.
+    pub quadrature: Option<String>,
     pub median_ms: f64,
 }
 
@@ -93,8 +142,12 @@ pub struct Results {
     pub cases: Vec<CaseResult>,
     pub frame_time_scene: String,
     pub frame_times: Vec<FrameTime>,
+    /// Frame time (at the frame-time size) against mean ΔE2000 (at the case's size) of the
+    /// frame-time scene's case, for N both swept and timed, plus rgb.
+    pub tradeoff: Vec<TradeoffPoint>,
     pub jitter_scene: String,
     pub jitter_range: [f64; 2],
+    pub jitter_quadrature: String,
     pub jitter: Vec<JitterPoint>,
 }
 
@@ -178,19 +231,22 @@ pub fn run(cfg: Config) -> Result<Results> {
             modes.push(ModeResult {
                 mode: name.into(),
                 wavelengths: (mode != Mode::Rgb).then_some(n),
+                quadrature: (mode != Mode::Rgb).then(|| headline_quadrature().name().to_string()),
                 image: png,
                 heatmap: hm,
                 errors: Errors::of(&m, &mask)?,
             });
         }
         eprintln!(
-            "{:<18} ΔE00 mean: ours {:.3}  naive {:.3}  rgb {:.3}  (truth noise {:.3})",
+            "{:<18} ΔE00 mean at N = {n}, {}: ours {:.3}  naive {:.3}  rgb {:.3}  (truth noise {:.3})",
             c.id,
+            headline_quadrature(),
             modes[0].errors.delta_e2000.mean,
             modes[1].errors.delta_e2000.mean,
             modes[2].errors.delta_e2000.mean,
             noise.delta_e2000.mean
         );
+        let sweep = sweep(&mut r, c, &t0, &mask, range, &b.sweep_counts, &check)?;
         results.push(CaseResult {
             id: c.id.clone(),
             title: c.title.clone(),
@@ -202,6 +258,7 @@ pub fn run(cfg: Config) -> Result<Results> {
             noise_floor: noise,
             masked_fraction: mask.iter().filter(|m| **m).count() as f64 / mask.len() as f64,
             modes,
+            sweep,
         });
     }
 
@@ -210,26 +267,31 @@ pub fn run(cfg: Config) -> Result<Results> {
     let range = scene_range(&ft_case.scene)?;
     let mut r = renderer_for(ft_case, &table, measure::water(&ft_case.scene)?.as_ref())?;
     r.resize(b.bench_width, b.bench_height)?;
-    let pb = bar(1 + 2 * b.bench_counts.len() as u64, "frame time");
+    let configs = (SPECTRAL_MODES.len() * Quadrature::ALL.len() * b.bench_counts.len()) as u64;
+    let pb = bar(1 + configs, "frame time");
     let mut frame_times = Vec::new();
     let ms =
         measure::frame_ms(&mut r, &ft_case.scene, &measure::settings(Mode::Rgb, 1, range), b.bench_frames)?;
-    frame_times.push(FrameTime { mode: "rgb".into(), wavelengths: None, median_ms: ms });
+    frame_times.push(FrameTime { mode: "rgb".into(), wavelengths: None, quadrature: None, median_ms: ms });
     pb.inc(1);
     for &n in &b.bench_counts {
-        for (mode, name) in &MODES[..2] {
-            check()?;
-            let ms = measure::frame_ms(
-                &mut r,
-                &ft_case.scene,
-                &measure::settings(*mode, n, range),
-                b.bench_frames,
-            )?;
-            frame_times.push(FrameTime { mode: (*name).into(), wavelengths: Some(n), median_ms: ms });
-            pb.inc(1);
+        for (mode, name) in SPECTRAL_MODES {
+            for q in Quadrature::ALL {
+                check()?;
+                let s = RenderSettings { quadrature: q, ..measure::settings(*mode, n, range) };
+                let ms = measure::frame_ms(&mut r, &ft_case.scene, &s, b.bench_frames)?;
+                frame_times.push(FrameTime {
+                    mode: (*name).into(),
+                    wavelengths: Some(n),
+                    quadrature: Some(q.name().into()),
+                    median_ms: ms,
+                });
+                pb.inc(1);
+            }
         }
     }
     pb.finish_and_clear();
+    let tradeoff = tradeoff(&results[0], &frame_times);
 
     // Jittered accumulation vs equal spacing, on the first case's scene and range (jitter
     // moves the samples inside the range; the range itself stays put).
@@ -267,13 +329,73 @@ pub fn run(cfg: Config) -> Result<Results> {
         cases: results,
         frame_time_scene: ft_case.id.clone(),
         frame_times,
+        tradeoff,
         jitter_scene: ft_case.id.clone(),
         jitter_range: [jrange.min, jrange.max],
+        jitter_quadrature: headline_quadrature().name().into(),
         jitter,
     };
     check()?;
     report::write_all(&cfg.out, &res)?;
     Ok(res)
+}
+
+/// Ours and naive at every N of `counts` in both quadratures, against the case's truth `t0`
+/// (the renderer is already at the case's size).
+fn sweep(
+    r: &mut Renderer,
+    c: &suite::Case,
+    t0: &Image,
+    mask: &[bool],
+    range: WavelengthRange,
+    counts: &[usize],
+    check: &dyn Fn() -> Result<()>,
+) -> Result<Vec<SweepPoint>> {
+    let pb = bar((SPECTRAL_MODES.len() * Quadrature::ALL.len() * counts.len()) as u64, &c.id);
+    pb.set_message("N sweep");
+    let mut out = Vec::new();
+    for (mode, name) in SPECTRAL_MODES {
+        for q in Quadrature::ALL {
+            for &n in counts {
+                check()?;
+                let s = RenderSettings { quadrature: q, ..measure::settings(*mode, n, range) };
+                let img = measure::realtime(r, &c.scene, &s)?;
+                let e = Errors::of(&measure::diff(t0, &img)?, mask)?;
+                out.push(SweepPoint {
+                    mode: (*name).into(),
+                    quadrature: q.name().into(),
+                    wavelengths: n,
+                    delta_e2000_mean: e.delta_e2000.mean,
+                    delta_e2000_masked_mean: e.delta_e2000_masked.mean,
+                    mae_linear_mean: e.mae_linear.mean,
+                });
+                pb.inc(1);
+            }
+        }
+    }
+    pb.finish_and_clear();
+    Ok(out)
+}
+
+/// Pairs each timed configuration with the error the sweep measured for it in `case`; N values
+/// that were timed but not swept (or the reverse) have no point. rgb's error is the headline's.
+pub fn tradeoff(case: &CaseResult, frame_times: &[FrameTime]) -> Vec<TradeoffPoint> {
+    frame_times
+        .iter()
+        .filter_map(|f| {
+            let de = match (&f.quadrature, f.wavelengths) {
+                (Some(q), Some(n)) => case.sweep_point(&f.mode, q, n)?.delta_e2000_mean,
+                _ => case.modes.iter().find(|m| m.mode == f.mode)?.errors.delta_e2000.mean,
+            };
+            Some(TradeoffPoint {
+                mode: f.mode.clone(),
+                quadrature: f.quadrature.clone(),
+                wavelengths: f.wavelengths,
+                median_ms: f.median_ms,
+                delta_e2000_mean: de,
+            })
+        })
+        .collect()
 }
 
 /// A fresh renderer for a case's scene, with the underwater hooks when it has water (they are
@@ -326,4 +448,85 @@ fn machine() -> String {
         .map(|kb| format!(", {:.0} GiB RAM", kb / 1048576.0))
         .unwrap_or_default();
     format!("{cpu}, {cores} threads{mem}, {} {}", std::env::consts::OS, std::env::consts::ARCH)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn errors(de: f64) -> Errors {
+        let st = color::metrics::Stats::of(&[de]).unwrap();
+        Errors { delta_e2000: st, mae_linear: st, delta_e2000_masked: st, mae_linear_masked: st }
+    }
+
+    fn point(mode: &str, q: &str, n: usize, de: f64) -> SweepPoint {
+        SweepPoint {
+            mode: mode.into(),
+            quadrature: q.into(),
+            wavelengths: n,
+            delta_e2000_mean: de,
+            delta_e2000_masked_mean: de,
+            mae_linear_mean: de,
+        }
+    }
+
+    #[test]
+    fn tradeoff_pairs_only_swept_and_timed_configurations() {
+        let mode = |m: &str, de: f64| ModeResult {
+            mode: m.into(),
+            wavelengths: None,
+            quadrature: None,
+            image: String::new(),
+            heatmap: String::new(),
+            errors: errors(de),
+        };
+        let case = CaseResult {
+            id: "c".into(),
+            title: String::new(),
+            truth_image: String::new(),
+            width: 1,
+            height: 1,
+            truth_spp: 1,
+            transport: "direct".into(),
+            noise_floor: errors(0.0),
+            masked_fraction: 0.0,
+            modes: vec![mode("ours", 9.0), mode("rgb", 2.5)],
+            sweep: vec![
+                point("ours", "midpoint", 4, 3.0),
+                point("ours", "prefiltered", 4, 2.0),
+                point("ours", "prefiltered", 8, 1.0),
+            ],
+        };
+        let ft = |m: &str, q: Option<&str>, n: Option<usize>, ms: f64| FrameTime {
+            mode: m.into(),
+            wavelengths: n,
+            quadrature: q.map(Into::into),
+            median_ms: ms,
+        };
+        let times = [
+            ft("rgb", None, None, 5.0),
+            ft("ours", Some("prefiltered"), Some(1), 6.0),
+            ft("ours", Some("prefiltered"), Some(4), 7.0),
+            ft("ours", Some("midpoint"), Some(4), 7.5),
+            ft("ours", Some("prefiltered"), Some(8), 8.0),
+            ft("naive", Some("prefiltered"), Some(8), 8.5),
+        ];
+        let t = tradeoff(&case, &times);
+        type Row<'a> = (&'a str, Option<&'a str>, Option<usize>, f64, f64);
+        let got: Vec<Row> = t
+            .iter()
+            .map(|p| {
+                (p.mode.as_str(), p.quadrature.as_deref(), p.wavelengths, p.median_ms, p.delta_e2000_mean)
+            })
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("rgb", None, None, 5.0, 2.5),
+                ("ours", Some("prefiltered"), Some(4), 7.0, 2.0),
+                ("ours", Some("midpoint"), Some(4), 7.5, 3.0),
+                ("ours", Some("prefiltered"), Some(8), 8.0, 1.0),
+            ]
+        );
+    }
 }

@@ -76,7 +76,9 @@ pub fn bars(title: &str, y_label: &str, groups: &[String], series: &[(&str, Vec<
 }
 
 /// Line chart on a log x axis with ticks at the data's own x values (N = 1, 2, 4, …), so the
-/// axis reads as the measured configurations rather than a decade grid.
+/// axis reads as the measured configurations rather than a decade grid. Ticks closer than
+/// [`MIN_TICK_GAP`] of the axis to the previous one are dropped, so a dense sweep
+/// (N = 16, 18, 20, …) does not print its labels over each other.
 pub fn lines(
     title: &str,
     x_label: &str,
@@ -93,6 +95,7 @@ pub fn lines(
         xs.sort_by(f64::total_cmp);
         xs.dedup();
         let (xmin, xmax) = (xs.first().copied().unwrap_or(1.0), xs.last().copied().unwrap_or(1.0));
+        let xs = thin_log_ticks(&xs, (xmax * 1.15 / (xmin / 1.15)).ln());
         let ymax = series.iter().flat_map(|(_, v)| v.iter().map(|p| p.1)).fold(0.0, f64::max);
         let mut chart = ChartBuilder::on(&plot)
             .caption(title, ("sans-serif", 18))
@@ -127,6 +130,74 @@ pub fn lines(
     Ok(svg)
 }
 
+/// Smallest distance between two labelled ticks, as a fraction of the axis.
+const MIN_TICK_GAP: f64 = 0.035;
+
+/// Keeps the sorted `xs` that lie at least [`MIN_TICK_GAP`] of a log axis spanning `span` (in
+/// natural log units) to the right of the last kept one.
+fn thin_log_ticks(xs: &[f64], span: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for &x in xs {
+        if out.last().is_none_or(|&l| (x / l).ln() >= MIN_TICK_GAP * span) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// A named series of points (x, y) each with a label printed beside it.
+pub type LabelledSeries<'a> = (&'a str, Vec<(f64, f64, String)>);
+
+/// Line chart on linear axes whose points carry a label (here: N beside each frame time), for
+/// curves that are not functions of a shared x such as error against frame time.
+pub fn labelled_lines(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[LabelledSeries],
+) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let (plot, side) = root.split_horizontally(SIZE.0 - LEGEND_W);
+        let pts = || series.iter().flat_map(|(_, v)| v.iter());
+        let xmin = pts().map(|p| p.0).fold(f64::INFINITY, f64::min);
+        let xmax = pts().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+        let (xmin, xmax) = if xmin.is_finite() { (xmin, xmax) } else { (0.0, 1.0) };
+        let pad = ((xmax - xmin) * 0.08).max(1e-3 * xmax.abs()).max(1e-6);
+        let ymax = pts().map(|p| p.1).fold(0.0, f64::max);
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(title, ("sans-serif", 18))
+            .margin(10)
+            .margin_right(20)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d((xmin - pad).max(0.0)..xmax + pad, 0.0..ymax.max(1e-6) * 1.1)
+            .map_err(|e| anyhow!("{e}"))?;
+        chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| anyhow!("{e}"))?;
+        for (si, (_, pts)) in series.iter().enumerate() {
+            let c = Palette99::pick(si).to_rgba();
+            // Darker than the line: the palette's light colours (yellow) are unreadable as text.
+            let (r, g, b) = Palette99::pick(si).rgb();
+            let ink = RGBColor((r as f32 * 0.6) as u8, (g as f32 * 0.6) as u8, (b as f32 * 0.6) as u8);
+            chart
+                .draw_series(LineSeries::new(pts.iter().map(|p| (p.0, p.1)), c.stroke_width(2)))
+                .map_err(|e| anyhow!("{e}"))?;
+            chart
+                .draw_series(pts.iter().map(|p| {
+                    EmptyElement::at((p.0, p.1))
+                        + Circle::new((0, 0), 3, c.filled())
+                        + Text::new(p.2.clone(), (4, -14), ("sans-serif", 11).into_font().color(&ink))
+                }))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        legend(&side, &series.iter().map(|s| s.0).collect::<Vec<_>>(), Mark::Line)?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(svg)
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -139,5 +210,32 @@ mod tests {
         let texts: Vec<&str> =
             l.split("</text>").filter_map(|t| t.rsplit_once('>')).map(|(_, s)| s.trim()).collect();
         assert!(texts.contains(&"1") && texts.contains(&"4") && !texts.contains(&"3"), "{texts:?}");
+    }
+
+    #[test]
+    fn dense_log_ticks_are_thinned_but_sparse_ones_kept() {
+        let xs = [4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0, 20.0, 24.0, 32.0, 48.0, 64.0, 256.0];
+        let span = (256.0f64 / 4.0).ln();
+        let kept = super::thin_log_ticks(&xs, span);
+        assert!(kept.len() < xs.len() && kept.contains(&4.0) && kept.contains(&256.0), "{kept:?}");
+        for w in kept.windows(2) {
+            assert!((w[1] / w[0]).ln() >= super::MIN_TICK_GAP * span, "{kept:?}");
+        }
+        let pow2 = [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0];
+        assert_eq!(super::thin_log_ticks(&pow2, 64f64.ln()), pow2);
+    }
+
+    #[test]
+    fn labelled_lines_print_their_labels() {
+        let l = super::labelled_lines(
+            "t",
+            "ms",
+            "ΔE",
+            &[("ours, prefiltered", vec![(10.0, 1.5, "N=4".into()), (20.0, 1.2, "N=16".into())])],
+        )
+        .unwrap();
+        assert!(
+            l.contains("<svg") && l.contains("N=4") && l.contains("N=16") && l.contains("ours, prefiltered")
+        );
     }
 }

@@ -1,8 +1,10 @@
 //! The report files: `results.json` (every number), `results.csv` (one row per case × mode,
-//! plus frame-time and jitter rows), SVG charts and `index.html`. Each is written atomically.
+//! plus sweep, frame-time, error-vs-frame-time and jitter rows), SVG charts and `index.html`.
+//! Each is written atomically.
 
-use super::{MODES, Results};
+use super::{MODES, Results, SPECTRAL_MODES};
 use anyhow::{Context, Result};
+use color::Quadrature;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -63,25 +65,20 @@ pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
     )?;
     let rgb = r.frame_times.iter().find(|f| f.mode == "rgb").map(|f| f.median_ms).unwrap_or(0.0);
     let nmax = r.frame_times.iter().filter_map(|f| f.wavelengths).max().unwrap_or(1) as f64;
-    let ft_series: Vec<(&str, Vec<(f64, f64)>)> = vec![
-        (
-            "ours (spectral)",
-            r.frame_times
+    let names = series_names();
+    let mut ft_series: Vec<(&str, Vec<(f64, f64)>)> = names
+        .iter()
+        .map(|(mode, q, label)| {
+            let pts = r
+                .frame_times
                 .iter()
-                .filter(|f| f.mode == "ours")
+                .filter(|f| f.mode == *mode && f.quadrature.as_deref() == Some(q.name()))
                 .map(|f| (f.wavelengths.unwrap_or(1) as f64, f.median_ms))
-                .collect(),
-        ),
-        (
-            "naive",
-            r.frame_times
-                .iter()
-                .filter(|f| f.mode == "naive")
-                .map(|f| (f.wavelengths.unwrap_or(1) as f64, f.median_ms))
-                .collect(),
-        ),
-        ("rgb (independent of N)", vec![(1.0, rgb), (nmax, rgb)]),
-    ];
+                .collect();
+            (label.as_str(), pts)
+        })
+        .collect();
+    ft_series.push(("rgb (independent of N)", vec![(1.0, rgb), (nmax, rgb)]));
     put(
         dir,
         "frame_time.svg",
@@ -93,6 +90,12 @@ pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
         )?
         .as_bytes(),
     )?;
+    for c in &r.cases {
+        put(dir, &sweep_svg_name(&c.id), sweep_chart(c)?.as_bytes())?;
+    }
+    if let Some(c) = r.cases.first() {
+        put(dir, TRADEOFF_SVG, tradeoff_chart(r, c)?.as_bytes())?;
+    }
     let js: Vec<(&str, Vec<(f64, f64)>)> = vec![
         (
             "equal spacing, one frame",
@@ -119,17 +122,99 @@ pub fn write_all(dir: &Path, r: &Results) -> Result<()> {
     Ok(())
 }
 
+/// The sweep's series in report order: (mode, quadrature, "ours, midpoint").
+fn series_names() -> Vec<(&'static str, Quadrature, String)> {
+    SPECTRAL_MODES
+        .iter()
+        .flat_map(|(_, m)| Quadrature::ALL.iter().map(move |q| (*m, *q, format!("{m}, {}", q.name()))))
+        .collect()
+}
+
+/// File name of a case's ΔE-vs-N chart.
+pub fn sweep_svg_name(id: &str) -> String {
+    format!("sweep_{id}.svg")
+}
+
+/// File name of the error-vs-frame-time chart.
+pub const TRADEOFF_SVG: &str = "error_vs_frame_time.svg";
+
+/// The N values a case's sweep measured, ascending.
+fn sweep_counts(c: &super::CaseResult) -> Vec<usize> {
+    let mut ns: Vec<usize> = c.sweep.iter().map(|p| p.wavelengths).collect();
+    ns.sort_unstable();
+    ns.dedup();
+    ns
+}
+
+fn rgb_mean(c: &super::CaseResult) -> Option<f64> {
+    c.modes.iter().find(|m| m.mode == "rgb").map(|m| m.errors.delta_e2000.mean)
+}
+
+/// Mean ΔE2000 against N for one case: one line per mode × quadrature, rgb (which has no N) as
+/// a horizontal line across the swept N.
+fn sweep_chart(c: &super::CaseResult) -> Result<String> {
+    let ns = sweep_counts(c);
+    let names = series_names();
+    let mut series: Vec<(&str, Vec<(f64, f64)>)> = names
+        .iter()
+        .map(|(mode, q, label)| {
+            let pts = ns
+                .iter()
+                .filter_map(|&n| c.sweep_point(mode, q.name(), n).map(|p| (n as f64, p.delta_e2000_mean)))
+                .collect();
+            (label.as_str(), pts)
+        })
+        .collect();
+    let (lo, hi) = (ns.first().copied().unwrap_or(1) as f64, ns.last().copied().unwrap_or(1) as f64);
+    if let Some(rgb) = rgb_mean(c) {
+        series.push(("rgb (no N)", vec![(lo, rgb), (hi, rgb)]));
+    }
+    super::plot::lines(
+        &format!("{}: mean ΔE2000 against N (truth noise {:.3})", c.id, c.noise_floor.delta_e2000.mean),
+        "wavelengths N (log scale)",
+        "mean ΔE2000",
+        &series,
+    )
+}
+
+/// Mean ΔE2000 of the frame-time case against median frame time: the curve N is chosen from.
+fn tradeoff_chart(r: &Results, c: &super::CaseResult) -> Result<String> {
+    let names = series_names();
+    let mut series: Vec<super::plot::LabelledSeries> = names
+        .iter()
+        .map(|(mode, q, label)| {
+            let pts = r
+                .tradeoff
+                .iter()
+                .filter(|p| p.mode == *mode && p.quadrature.as_deref() == Some(q.name()))
+                .map(|p| (p.median_ms, p.delta_e2000_mean, format!("{}", p.wavelengths.unwrap_or(0))))
+                .collect();
+            (label.as_str(), pts)
+        })
+        .collect();
+    if let Some(p) = r.tradeoff.iter().find(|p| p.mode == "rgb") {
+        series.push(("rgb", vec![(p.median_ms, p.delta_e2000_mean, "rgb".into())]));
+    }
+    super::plot::labelled_lines(
+        &format!("{}: mean ΔE2000 against frame time (labels: N)", c.id),
+        &format!("median ms per frame at {}×{}", r.budget.bench_width, r.budget.bench_height),
+        &format!("mean ΔE2000 at {}×{}", c.width, c.height),
+        &series,
+    )
+}
+
 /// Every number as CSV sections separated by a blank line.
 pub fn csv(r: &Results) -> String {
     let mut s = String::from(
-        "case,transport,width,height,truth_spp,mode,wavelengths,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
+        "case,transport,width,height,truth_spp,mode,wavelengths,quadrature,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
     );
     for c in &r.cases {
-        let rows = c.modes.iter().map(|m| (m.mode.as_str(), m.wavelengths, &m.errors));
-        for (mode, n, e) in rows.chain(std::iter::once(("truth_noise", None, &c.noise_floor))) {
+        let rows =
+            c.modes.iter().map(|m| (m.mode.as_str(), m.wavelengths, m.quadrature.as_deref(), &m.errors));
+        for (mode, n, q, e) in rows.chain(std::iter::once(("truth_noise", None, None, &c.noise_floor))) {
             let _ = writeln!(
                 s,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 c.id,
                 c.transport,
                 c.width,
@@ -137,6 +222,7 @@ pub fn csv(r: &Results) -> String {
                 c.truth_spp,
                 mode,
                 n.map(|n| n.to_string()).unwrap_or_default(),
+                q.unwrap_or_default(),
                 e.delta_e2000.mean,
                 e.delta_e2000.median,
                 e.delta_e2000.p95,
@@ -148,14 +234,43 @@ pub fn csv(r: &Results) -> String {
             );
         }
     }
-    s.push_str("\nframe_time_mode,wavelengths,median_ms\n");
+    s.push_str("\nsweep_case,mode,quadrature,wavelengths,de_mean,de_mean_masked,mae_mean\n");
+    for c in &r.cases {
+        for p in &c.sweep {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{},{},{}",
+                c.id,
+                p.mode,
+                p.quadrature,
+                p.wavelengths,
+                p.delta_e2000_mean,
+                p.delta_e2000_masked_mean,
+                p.mae_linear_mean
+            );
+        }
+    }
+    s.push_str("\nframe_time_mode,wavelengths,quadrature,median_ms\n");
     for f in &r.frame_times {
         let _ = writeln!(
             s,
-            "{},{},{}",
+            "{},{},{},{}",
             f.mode,
             f.wavelengths.map(|n| n.to_string()).unwrap_or_default(),
+            f.quadrature.as_deref().unwrap_or_default(),
             f.median_ms
+        );
+    }
+    s.push_str("\ntradeoff_mode,wavelengths,quadrature,median_ms,de_mean\n");
+    for p in &r.tradeoff {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{}",
+            p.mode,
+            p.wavelengths.map(|n| n.to_string()).unwrap_or_default(),
+            p.quadrature.as_deref().unwrap_or_default(),
+            p.median_ms,
+            p.delta_e2000_mean
         );
     }
     s.push_str("\njitter_total_wavelengths,frames,equal_spacing_de_mean,jittered_de_mean\n");
@@ -176,7 +291,7 @@ fn esc(s: &str) -> String {
 /// The headline table (mean ΔE2000, whole image / masked) as Markdown, for the README.
 pub fn markdown_table(r: &Results) -> String {
     let mut s = String::from(
-        "| case | ours ΔE00 | naive ΔE00 | rgb ΔE00 | truth noise ΔE00 | ours / naive / rgb, edge-masked |\n|---|---|---|---|---|---|\n",
+        "| case | N, quadrature (ours, naive) | ours ΔE00 | naive ΔE00 | rgb ΔE00 | truth noise ΔE00 | ours / naive / rgb, edge-masked |\n|---|---|---|---|---|---|---|\n",
     );
     for c in &r.cases {
         let m = |i: usize| c.modes[i].errors.delta_e2000.mean;
@@ -188,8 +303,9 @@ pub fn markdown_table(r: &Results) -> String {
         };
         let _ = writeln!(
             s,
-            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {masked} |",
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {masked} |",
             c.id,
+            headline_config(c),
             m(0),
             m(1),
             m(2),
@@ -197,6 +313,49 @@ pub fn markdown_table(r: &Results) -> String {
         );
     }
     s
+}
+
+/// The sweep of every case as Markdown: one table per case, N in columns, mean ΔE2000.
+pub fn markdown_sweep(r: &Results) -> String {
+    let mut s = String::new();
+    for c in &r.cases {
+        let ns = sweep_counts(c);
+        let _ = write!(
+            s,
+            "\n{} (mean ΔE2000; rgb {}, truth noise {:.3})\n\n| mode, quadrature |",
+            c.id,
+            rgb_mean(c).map(|v| format!("{v:.3}")).unwrap_or("–".into()),
+            c.noise_floor.delta_e2000.mean
+        );
+        for n in &ns {
+            let _ = write!(s, " N={n} |");
+        }
+        s.push_str("\n|---|");
+        s.push_str(&"---|".repeat(ns.len()));
+        s.push('\n');
+        for (mode, q, label) in series_names() {
+            let _ = write!(s, "| {label} |");
+            for &n in &ns {
+                match c.sweep_point(mode, q.name(), n) {
+                    Some(p) => {
+                        let _ = write!(s, " {:.3} |", p.delta_e2000_mean);
+                    }
+                    None => s.push_str(" – |"),
+                }
+            }
+            s.push('\n');
+        }
+    }
+    s
+}
+
+/// "N = 16, prefiltered": what the headline's spectral modes ran with in a case.
+fn headline_config(c: &super::CaseResult) -> String {
+    c.modes
+        .iter()
+        .find(|m| m.wavelengths.is_some())
+        .map(|m| format!("N = {}, {}", m.wavelengths.unwrap_or(0), m.quadrature.as_deref().unwrap_or("?")))
+        .unwrap_or_else(|| "–".into())
 }
 
 /// Whether the case's masked numbers mean anything (volumetric truths get no edge mask).
@@ -208,6 +367,79 @@ fn has_mask(c: &super::CaseResult) -> bool {
 fn budget_of(r: &Results, transport: &str) -> Option<String> {
     let c = r.cases.iter().find(|c| c.transport == transport)?;
     Some(format!("{} spp, {}×{}", c.truth_spp, c.width, c.height))
+}
+
+/// A case's sweep: a table (rows mode × quadrature, columns N) and its ΔE-vs-N chart.
+fn sweep_html(h: &mut String, c: &super::CaseResult) {
+    let ns = sweep_counts(c);
+    if ns.is_empty() {
+        return;
+    }
+    let noise = c.noise_floor.delta_e2000.mean;
+    let rgb = rgb_mean(c);
+    let _ = write!(
+        h,
+        "<h3>{id}: mean ΔE2000 against N, both quadratures</h3><p>Same truth as above. Green: below rgb \
+         ({rgb}) by more than the truth noise ({noise:.3}). Masked means and MAE per point are in results.json \
+         and results.csv.</p><table><tr><th>mode, quadrature</th>",
+        id = esc(&c.id),
+        rgb = rgb.map(|v| format!("{v:.3}")).unwrap_or("–".into()),
+    );
+    for n in &ns {
+        let _ = write!(h, "<th>N={n}</th>");
+    }
+    h.push_str("</tr>");
+    for (mode, q, label) in series_names() {
+        let _ = write!(h, "<tr><td>{}</td>", esc(&label));
+        for &n in &ns {
+            match c.sweep_point(mode, q.name(), n) {
+                Some(p) => {
+                    let beats = rgb.is_some_and(|g| p.delta_e2000_mean + noise < g);
+                    let cls = if beats { " class=\"best\"" } else { "" };
+                    let _ = write!(h, "<td{cls}>{:.3}</td>", p.delta_e2000_mean);
+                }
+                None => h.push_str("<td>–</td>"),
+            }
+        }
+        h.push_str("</tr>");
+    }
+    let span = ns.len();
+    if let Some(g) = rgb {
+        let _ = write!(h, "<tr><td>rgb (no N)</td><td colspan=\"{span}\">{g:.3}</td></tr>");
+    }
+    let _ = write!(h, "<tr><td>truth noise</td><td colspan=\"{span}\">{noise:.3}</td></tr></table>");
+    let _ = write!(h, "<img src=\"{}\" alt=\"mean ΔE2000 against N\">", esc(&sweep_svg_name(&c.id)));
+}
+
+/// The error-vs-frame-time section: chart and table.
+fn tradeoff_html(h: &mut String, r: &Results) {
+    let Some(c) = r.cases.first() else { return };
+    let _ = write!(
+        h,
+        "<h2>Error against frame time: choosing N</h2><p>Case {id}: median frame time at {bw}×{bh} (table above) \
+         beside mean ΔE2000 against truth at {w}×{h} (the sweep), for every N that was both timed and swept. \
+         A configuration is worth using only if no other one is both faster and closer to truth.</p>\
+         <img src=\"{svg}\" alt=\"mean ΔE2000 against frame time\"><table><tr><th>mode</th><th>quadrature</th>\
+         <th>N</th><th>median ms</th><th>mean ΔE00</th></tr>",
+        id = esc(&c.id),
+        bw = r.budget.bench_width,
+        bh = r.budget.bench_height,
+        w = c.width,
+        h = c.height,
+        svg = TRADEOFF_SVG,
+    );
+    for p in &r.tradeoff {
+        let _ = write!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.3}</td></tr>",
+            esc(&p.mode),
+            p.quadrature.as_deref().unwrap_or("–"),
+            p.wavelengths.map(|n| n.to_string()).unwrap_or("–".into()),
+            p.median_ms,
+            p.delta_e2000_mean
+        );
+    }
+    h.push_str("</table>");
 }
 
 fn html(r: &Results) -> String {
@@ -246,7 +478,11 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
     for n in &r.notes {
         let _ = write!(h, "<p><b>Note:</b> {}</p>", esc(n));
     }
-    h.push_str("<h2>Mean errors</h2><table><tr><th>case</th>");
+    h.push_str(
+        "<h2>Mean errors</h2><p>ours and naive at each case's N with the renderer's default quadrature (column \
+         “N, quadrature”); every N in both quadratures is in the sweep under each case.</p>\
+         <table><tr><th>case</th><th>N, quadrature</th>",
+    );
     for (_, n) in MODES {
         let _ = write!(h, "<th>{n} ΔE00</th>");
     }
@@ -263,7 +499,7 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
         let best = (0..3).min_by(|&a, &b| {
             c.modes[a].errors.delta_e2000.mean.total_cmp(&c.modes[b].errors.delta_e2000.mean)
         });
-        let _ = write!(h, "<tr><td>{}</td>", esc(&c.id));
+        let _ = write!(h, "<tr><td>{}</td><td>{}</td>", esc(&c.id), esc(&headline_config(c)));
         for (i, m) in c.modes.iter().enumerate() {
             let cls = if Some(i) == best { " class=\"best\"" } else { "" };
             let _ = write!(h, "<td{cls}>{:.3}</td>", m.errors.delta_e2000.mean);
@@ -312,10 +548,11 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
         for m in &c.modes {
             let _ = write!(
                 h,
-                "<figure><img class=\"px\" src=\"{}\"><figcaption>{}{} — ΔE00 {:.3}</figcaption></figure>",
+                "<figure><img class=\"px\" src=\"{}\"><figcaption>{}{}{} — ΔE00 {:.3}</figcaption></figure>",
                 esc(&m.image),
                 esc(&m.mode),
                 m.wavelengths.map(|n| format!(" N={n}")).unwrap_or_default(),
+                m.quadrature.as_deref().map(|q| format!(", {}", esc(q))).unwrap_or_default(),
                 m.errors.delta_e2000.mean
             );
         }
@@ -329,10 +566,11 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
             );
         }
         h.push_str("</div>");
+        sweep_html(&mut h, c);
     }
     let _ = write!(
         h,
-        r#"<h2>Frame time against N (paper Fig. 4)</h2><p>Scene {}, {}×{}, median of {} frames, CPU wall time from submission to finished read-back.</p><img src="frame_time.svg" alt="frame time plot"><table><tr><th>mode</th><th>N</th><th>median ms</th></tr>"#,
+        r#"<h2>Frame time against N (paper Fig. 4)</h2><p>Scene {}, {}×{}, median of {} frames, CPU wall time from submission to finished read-back.</p><img src="frame_time.svg" alt="frame time plot"><table><tr><th>mode</th><th>quadrature</th><th>N</th><th>median ms</th></tr>"#,
         esc(&r.frame_time_scene),
         r.budget.bench_width,
         r.budget.bench_height,
@@ -341,18 +579,22 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
     for f in &r.frame_times {
         let _ = write!(
             h,
-            "<tr><td>{}</td><td>{}</td><td>{:.2}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td></tr>",
             f.mode,
+            f.quadrature.as_deref().unwrap_or("–"),
             f.wavelengths.map(|n| n.to_string()).unwrap_or("–".into()),
             f.median_ms
         );
     }
+    h.push_str("</table>");
+    tradeoff_html(&mut h, r);
     let _ = write!(
         h,
-        r#"</table><h2>Beyond the paper: jittered wavelengths with temporal accumulation</h2><p>Scene {}, range {:.0}–{:.0} nm (truth over the same range). Equal spacing renders all N wavelengths in one frame; jittered renders {} per frame at a stratified random offset and averages the frames (each frame normalised by dense integrals, so the mean is unbiased). The viewer does the same live: <code>spectra view</code>, key J / “accumulate (jittered λ)”.</p><img src="jitter.svg" alt="jitter plot"><table><tr><th>total N</th><th>frames</th><th>equal spacing ΔE00</th><th>jittered ΔE00</th></tr>"#,
+        r#"<h2>Beyond the paper: jittered wavelengths with temporal accumulation</h2><p>Scene {}, range {:.0}–{:.0} nm (truth over the same range), ours with the {} quadrature. Equal spacing renders all N wavelengths in one frame; jittered renders {} per frame at a stratified random offset and averages the frames (each frame normalised by dense integrals, so the mean is unbiased). The viewer does the same live: <code>spectra view</code>, key J / “accumulate (jittered λ)”.</p><img src="jitter.svg" alt="jitter plot"><table><tr><th>total N</th><th>frames</th><th>equal spacing ΔE00</th><th>jittered ΔE00</th></tr>"#,
         esc(&r.jitter_scene),
         r.jitter_range[0],
         r.jitter_range[1],
+        esc(&r.jitter_quadrature),
         r.budget.jitter_per_frame
     );
     for j in &r.jitter {

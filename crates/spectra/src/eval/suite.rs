@@ -20,6 +20,9 @@ pub struct Budget {
     pub bench_height: u32,
     pub bench_frames: usize,
     pub bench_counts: Vec<usize>,
+    /// The error-vs-N sweep (ours and naive, both quadratures, every case). Its intersection
+    /// with `bench_counts` is where the error-vs-frame-time curve has points.
+    pub sweep_counts: Vec<usize>,
     /// Jittered accumulation: wavelengths per frame and the frame counts to accumulate.
     pub jitter_per_frame: usize,
     pub jitter_frames: Vec<usize>,
@@ -43,6 +46,7 @@ impl Budget {
             bench_height: 192,
             bench_frames: 9,
             bench_counts: vec![1, 2, 4, 8, 16, 32],
+            sweep_counts: vec![4, 8, 16],
             jitter_per_frame: 6,
             jitter_frames: vec![1, 2, 4, 8],
             // Clear ocean at the built-in's 10 m: ≈ 7 s per truth render here, truth noise
@@ -63,6 +67,7 @@ impl Budget {
             bench_height: 480,
             bench_frames: 31,
             bench_counts: vec![1, 2, 4, 8, 16, 32, 64],
+            sweep_counts: vec![4, 8, 16, 32, 64],
             jitter_per_frame: 6,
             jitter_frames: vec![1, 2, 4, 8, 16],
             // Four times the quick samples (half the noise) on 1.6× the pixels: the four types
@@ -227,6 +232,12 @@ mod tests {
         assert_eq!(o.for_case(&uw), (64, 48, 256));
         assert_eq!(o.for_case(&case("metamerism").unwrap()), (64, 48, 256));
         assert_eq!(notes(&q).len(), 1);
+        // The error-vs-frame-time curve needs N values that are both swept and timed.
+        for b in [Budget::quick(), Budget::full()] {
+            for n in [4, 8, 16] {
+                assert!(b.sweep_counts.contains(&n) && b.bench_counts.contains(&n), "N = {n}");
+            }
+        }
         assert!(notes(&["metamerism".to_string()]).is_empty());
     }
 }
