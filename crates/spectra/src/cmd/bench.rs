@@ -79,19 +79,25 @@ pub fn parse_rules(s: &str) -> Result<Vec<Quadrature>> {
 
 /// Parses `1,2,4` into wavelength counts, each within the renderer's limit.
 pub fn parse_counts(s: &str) -> Result<Vec<usize>> {
+    parse_counts_for("--wavelengths", s)
+}
+
+/// Parses a comma list of wavelength counts given with `flag` (named in the errors): each within
+/// 1..=MAX_WAVELENGTHS, duplicates dropped, at least one, in the order given.
+pub fn parse_counts_for(flag: &str, s: &str) -> Result<Vec<usize>> {
+    let max = render::settings::MAX_WAVELENGTHS;
     let mut out = Vec::new();
     for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let n: usize =
-            part.parse().map_err(|_| anyhow!("--wavelengths '{s}': '{part}' is not a whole number"))?;
-        if n == 0 || n > render::settings::MAX_WAVELENGTHS {
-            bail!("--wavelengths '{s}': {n} is outside 1..={}", render::settings::MAX_WAVELENGTHS);
+        let n: usize = part.parse().map_err(|_| anyhow!("{flag} '{s}': '{part}' is not a whole number"))?;
+        if n == 0 || n > max {
+            bail!("{flag} '{s}': {n} is outside 1..={max}");
         }
         if !out.contains(&n) {
             out.push(n);
         }
     }
     if out.is_empty() {
-        bail!("--wavelengths '{s}': give at least one count, e.g. 1,2,4,8");
+        bail!("{flag} '{s}': give at least one count, e.g. 1,2,4,8");
     }
     Ok(out)
 }

@@ -2,7 +2,7 @@
 //! directory with an HTML report. See `crate::eval` and docs/evaluation.md.
 
 use crate::eval::{self, Config, suite};
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use clap::Args as ClapArgs;
 use std::path::PathBuf;
 
@@ -66,20 +66,7 @@ pub fn run(a: Args) -> Result<()> {
 /// `--sweep 4,8,16`: distinct counts in 1..=MAX_WAVELENGTHS, ascending (the charts draw lines
 /// through them in order), or an error naming the bad value.
 pub fn parse_sweep(s: &str) -> Result<Vec<usize>> {
-    let max = render::settings::MAX_WAVELENGTHS;
-    let mut out = Vec::new();
-    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let n: usize = part.parse().map_err(|_| anyhow!("--sweep '{s}': '{part}' is not a whole number"))?;
-        if n == 0 || n > max {
-            bail!("--sweep '{s}': {n} is outside 1..={max}");
-        }
-        if !out.contains(&n) {
-            out.push(n);
-        }
-    }
-    if out.is_empty() {
-        bail!("--sweep '{s}': give at least one count, e.g. 4,8,16");
-    }
+    let mut out = crate::cmd::bench::parse_counts_for("--sweep", s)?;
     out.sort_unstable();
     Ok(out)
 }
