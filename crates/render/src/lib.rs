@@ -2,10 +2,10 @@
 //!
 //! Four passes (plus one shadow map per light): G-buffer → spectral shading → custom → post.
 //! The shading pass turns each pixel's RGB base colour into a Jakob–Hanika sigmoid spectrum,
-//! evaluates it at N wavelengths against each light's sampled emission and a Lambert + GGX BRDF, and
-//! integrates with precomputed observer×Δλ weights into XYZ and linear sRGB. Three modes run
-//! on the same pipelines and switch per frame: `rgb` (classic, baseline), `naive` (box
-//! upsampling) and `spectral`.
+//! evaluates it at N node wavelengths, and integrates it with a Lambert + GGX BRDF against each
+//! light's precomputed node weights (light × observer × quadrature rule, prefiltered by default:
+//! `color::quadrature`) into XYZ and linear sRGB. Three modes switch per frame: `rgb` (classic,
+//! baseline; its own shading entry point), `naive` (box upsampling) and `spectral`.
 //!
 //! Conventions (so that `spectral` equals `rgb` for diffuse surfaces under D65-white lights):
 //! lights without a spectrum are upsampled with the "illuminant" variant (`s·ρ(rgb/s)·D65`,

@@ -108,12 +108,14 @@ pub struct RenderSettings {
     /// Measure each pass with GPU timestamp queries (when the adapter supports them).
     pub timestamps: bool,
     /// Stratified wavelength jitter for frame accumulation: `Some(u)` with u in [0, 1) puts
-    /// sample i at `range.min + (i + u)·Δ` instead of the bin centre. It also switches every
+    /// node i at `range.min + (i + u)·Δ` instead of the bin centre. It also switches every
     /// normalisation (emission weights, the white correction of the XYZ → RGB matrix, the
-    /// scale of spectral lights) from "these N samples" to a dense 1 nm integral over `range`,
-    /// so that each frame is an unbiased estimate of the continuous integral and the average
-    /// of frames at stratified offsets converges to it. `None` (the default) is the midpoint
-    /// rule with per-N normalisation, which makes white exact at every N.
+    /// scale of spectral lights) from "these N nodes" to a dense 1 nm integral over `range`.
+    /// With the midpoint rule each frame is then an unbiased estimate of the continuous
+    /// integral and the average of frames at stratified offsets converges to it; with the
+    /// prefiltered rule the average settles at the interpolation error instead (a shifted,
+    /// prefiltered grid cannot be unbiased: docs/quadrature.md). `None` (the default) keeps the
+    /// nodes at the bin centres with per-N normalisation, which makes white exact at every N.
     pub jitter: Option<f32>,
 }
 
