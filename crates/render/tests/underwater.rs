@@ -60,6 +60,7 @@ fn floor_scene() -> Scene {
         camera,
         spectral: SpectralSettings::default(),
         water: None,
+        environment: None,
     }
 }
 

@@ -146,11 +146,12 @@ pub(crate) fn light(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<Lig
     Ok(LightExtras { spectrum, stands_in_for_node })
 }
 
-/// Scene-level extras (root, asset or scene): `spectra` and `water`.
+/// Scene-level extras (root, asset or scene): `spectra`, `water` and `environment`.
 #[derive(Default)]
 pub(crate) struct SceneExtras {
     pub spectral: SpectralSettings,
     pub water: Option<WaterSettings>,
+    pub environment: Option<crate::Environment>,
 }
 
 pub(crate) fn scene(
@@ -160,14 +161,60 @@ pub(crate) fn scene(
     out: &mut SceneExtras,
 ) -> Result<(), SceneError> {
     let at = format!("{at}.extras");
-    check_keys(ctx, &at, map, &["spectra", "water"])?;
+    check_keys(ctx, &at, map, &["spectra", "water", "environment"])?;
     if let Some(v) = map.get("spectra") {
         out.spectral = spectra(ctx, &format!("{at}.spectra"), v)?;
     }
     if let Some(v) = map.get("water") {
         out.water = Some(water(ctx, &format!("{at}.water"), v)?);
     }
+    if let Some(v) = map.get("environment") {
+        out.environment = environment(ctx, &format!("{at}.environment"), v)?;
+    }
     Ok(())
+}
+
+/// `"environment": "default"`, `"none"`, or `{"file": "sky.hdr", "intensity": 1, "rotation": 0}`
+/// (file relative to the scene, rotation in degrees about +Y; `"file": "default"` also works).
+fn environment(ctx: &Ctx, at: &str, v: &Value) -> Result<Option<crate::Environment>, SceneError> {
+    use crate::Environment;
+    let named = |name: &str, f: &str| -> Result<Option<Environment>, SceneError> {
+        match name {
+            "default" => Ok(Some(Environment::default_sky())),
+            "none" => Ok(None),
+            rel => {
+                let path = ctx.resolve(f, rel)?;
+                Environment::load(&path).map(Some).map_err(|e| ctx.extras(f, e.to_string()))
+            }
+        }
+    };
+    if let Some(name) = v.as_str() {
+        return match name {
+            "default" | "none" => named(name, at),
+            _ => Err(ctx.extras(
+                at,
+                format!("expected \"default\", \"none\" or an object with a file, got \"{name}\""),
+            )),
+        };
+    }
+    let map =
+        v.as_object().ok_or_else(|| ctx.extras(at, "expected \"default\", \"none\" or {\"file\": …}"))?;
+    check_keys(ctx, at, map, &["file", "intensity", "rotation"])?;
+    let ff = format!("{at}.file");
+    let file = map
+        .get("file")
+        .and_then(Value::as_str)
+        .ok_or_else(|| ctx.extras(&ff, "required: an equirectangular .hdr or .exr, relative to the scene"))?;
+    let Some(mut env) = named(file, &ff)? else { return Ok(None) };
+    if let Some(k) = map.get("intensity") {
+        let f = format!("{at}.intensity");
+        env = env.with_intensity(finite(ctx, &f, k)?).map_err(|e| ctx.extras(&f, e.message))?;
+    }
+    if let Some(r) = map.get("rotation") {
+        let f = format!("{at}.rotation");
+        env = env.with_rotation_degrees(finite(ctx, &f, r)?).map_err(|e| ctx.extras(&f, e.message))?;
+    }
+    Ok(Some(env))
 }
 
 fn spectra(ctx: &Ctx, at: &str, v: &Value) -> Result<SpectralSettings, SceneError> {

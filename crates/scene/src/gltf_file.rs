@@ -142,6 +142,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         camera,
         spectral: sx.spectral,
         water: sx.water,
+        environment: sx.environment,
     };
     crate::sky::sync(&mut scene).map_err(|m| ctx.extras("water.sky", m))?;
     Ok(scene)

@@ -9,6 +9,7 @@ mod accessors;
 pub mod builtin;
 mod context;
 pub mod emission;
+pub mod environment;
 mod error;
 pub mod export;
 mod extras;
@@ -28,6 +29,7 @@ use color::Spectrum;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 pub use builtin::{BUILTIN_NAMES, builtin};
+pub use environment::{Environment, EnvironmentError};
 pub use error::{Result, SceneError};
 pub use export::write_gltf;
 pub use gltf_file::{load, load_slice};
@@ -56,6 +58,9 @@ pub struct Scene {
     pub spectral: SpectralSettings,
     /// Underwater settings (see the underwater issue); `None` for scenes in air.
     pub water: Option<WaterSettings>,
+    /// Light arriving from infinitely far away ([`environment`]); from the file's
+    /// `extras.environment` or the command line. `None`: no environment light.
+    pub environment: Option<Environment>,
 }
 
 /// A triangle mesh in world space.

@@ -13,6 +13,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         camera: Camera { transform: Mat4::IDENTITY, yfov: 0.8, znear: 0.01, zfar: 100.0, aspect: None },
         spectral: SpectralSettings::default(),
         water: None,
+        environment: None,
     }
 }
 

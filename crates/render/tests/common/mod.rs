@@ -124,6 +124,7 @@ impl Chart {
             camera: chart_camera(),
             spectral: SpectralSettings::default(),
             water: None,
+            environment: None,
         }
     }
 }

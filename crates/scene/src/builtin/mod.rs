@@ -50,6 +50,7 @@ pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
         camera,
         spectral: SpectralSettings { white: Some("D65".into()), ..SpectralSettings::default() },
         water: None,
+        environment: None,
     }
 }
 

@@ -1,0 +1,501 @@
+//! Environment light: radiance arriving from infinitely far away, as an equirectangular image of
+//! linear RGB radiance in the scene's colour space (linear sRGB), read by both renderers.
+//!
+//! # Convention (one home: both renderers call [`Environment::direction`] / [`Environment::uv`])
+//!
+//! Image coordinates (u, v) ∈ [0, 1)², u to the right, v down (row 0 at the top):
+//!
+//! ```text
+//! θ = π·v            (0 = straight up, +Y)
+//! φ = 2π·(u − ½)
+//! d = (sin θ sin φ, cos θ, −sin θ cos φ)   then rotated by `rotation` about +Y
+//! ```
+//!
+//! so the centre of the image is the horizon seen looking down −Z (the default glTF camera)
+//! and +X is to its right, as in every glTF viewer. Each texel is a constant radiance over its
+//! patch of sphere (solid angle `Δφ·(cos θ₀ − cos θ₁)`); the path tracer integrates exactly that
+//! piecewise-constant function, the real-time renderer filters it (bilinear, prefiltered mips).
+//!
+//! The colour of a texel is a radiance, upsampled to a spectrum as an illuminant (the
+//! "unbounded" variant both renderers use for RGB lights and emissive surfaces): `s·ρ(rgb/s)·W(λ)`
+//! with `s = 2·max(rgb)` and W the colour space's white, so RGB (1, 1, 1) is exactly the white
+//! (D65 for sRGB) and RGB and spectral modes see the same light.
+//!
+//! Input is refused, with the file and the reason, when it is not a regular file, not an HDR
+//! image (`.hdr` Radiance RGBE or `.exr` OpenEXR), larger than [`MAX_INPUT_WIDTH`] ×
+//! [`MAX_INPUT_HEIGHT`], not 2:1, empty, or has a negative or non-finite texel. Images wider than
+//! [`WORKING_WIDTH`] are box-filtered down (exactly: the mean radiance of each block, so the
+//! integral over the sphere is kept), which is what both renderers then see.
+
+use std::f32::consts::PI;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+/// Widest equirectangular image accepted on input.
+pub const MAX_INPUT_WIDTH: u32 = 16384;
+/// Tallest equirectangular image accepted on input.
+pub const MAX_INPUT_HEIGHT: u32 = 8192;
+/// Largest input file (bytes): an HDR of the largest accepted size, uncompressed, fits easily.
+pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+/// Width both renderers work at: larger images are box-filtered down to at most this.
+pub const WORKING_WIDTH: u32 = 2048;
+/// Largest accepted `intensity`.
+pub const MAX_INTENSITY: f32 = 1e6;
+
+/// The radiance of the default environment's sky (its ground is [`DEFAULT_GROUND`] × this).
+pub const DEFAULT_SKY: f32 = 1.0;
+/// Albedo of the default environment's ground: a Lambertian ground of this albedo under the
+/// uniform sky has exactly this fraction of the sky's radiance.
+pub const DEFAULT_GROUND: f32 = 0.25;
+
+/// An environment map could not be used; the message names the file and the problem.
+#[derive(Debug, thiserror::Error)]
+#[error("environment {}: {message}", file.display())]
+pub struct EnvironmentError {
+    pub file: PathBuf,
+    pub message: String,
+}
+
+/// An equirectangular environment (see the module docs for the convention).
+#[derive(Clone, Debug)]
+pub struct Environment {
+    /// Where it came from: a path, `default` or `uniform`; used in messages and reports.
+    pub source: String,
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB radiance, row-major from the top row (+Y), before `intensity`.
+    pub texels: Vec<Vec3>,
+    /// Multiplies every texel.
+    pub intensity: f32,
+    /// Rotation about +Y, radians (positive turns the image towards +X... counter-clockwise seen
+    /// from above).
+    pub rotation: f32,
+}
+
+impl Environment {
+    /// Validates an image of linear RGB radiance; `source` names it in errors.
+    pub fn from_rgb(
+        source: &str,
+        width: u32,
+        height: u32,
+        texels: Vec<Vec3>,
+    ) -> Result<Self, EnvironmentError> {
+        let err = |message: String| EnvironmentError { file: PathBuf::from(source), message };
+        if width == 0 || height == 0 {
+            return Err(err(format!("the image is empty ({width}×{height})")));
+        }
+        if width > MAX_INPUT_WIDTH || height > MAX_INPUT_HEIGHT {
+            return Err(err(format!(
+                "{width}×{height} is larger than the {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} accepted"
+            )));
+        }
+        if width.abs_diff(2 * height) > 1 {
+            return Err(err(format!(
+                "an equirectangular (latitude-longitude) map is twice as wide as it is tall; this one is \
+                 {width}×{height}"
+            )));
+        }
+        if texels.len() != width as usize * height as usize {
+            return Err(err(format!("{} texels for {width}×{height}", texels.len())));
+        }
+        if let Some(i) = texels.iter().position(|t| !t.is_finite() || t.min_element() < 0.0) {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            return Err(err(format!(
+                "texel ({x}, {y}) is {} — radiance must be finite and not negative",
+                texels[i]
+            )));
+        }
+        let env =
+            Environment { source: source.to_string(), width, height, texels, intensity: 1.0, rotation: 0.0 };
+        Ok(env.reduced(WORKING_WIDTH))
+    }
+
+    /// Reads an equirectangular `.hdr` (Radiance RGBE) or `.exr` (OpenEXR, first RGB(A) layer)
+    /// of linear radiance.
+    pub fn load(path: &Path) -> Result<Self, EnvironmentError> {
+        let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
+        let meta = std::fs::metadata(path).map_err(|e| err(format!("cannot read it: {e}")))?;
+        if !meta.is_file() {
+            return Err(err("not a regular file".into()));
+        }
+        if meta.len() > MAX_INPUT_BYTES {
+            return Err(err(format!("{} bytes is more than the {MAX_INPUT_BYTES} accepted", meta.len())));
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let format = match ext.as_deref() {
+            Some("hdr") => image::ImageFormat::Hdr,
+            Some("exr") => image::ImageFormat::OpenExr,
+            _ => {
+                return Err(err(
+                    "not an HDR environment: give an equirectangular .hdr (Radiance) or .exr (OpenEXR) file \
+                     of linear radiance"
+                        .into(),
+                ));
+            }
+        };
+        let mut reader = image::ImageReader::open(path).map_err(|e| err(format!("cannot read it: {e}")))?;
+        reader.set_format(format);
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_INPUT_WIDTH);
+        limits.max_image_height = Some(MAX_INPUT_HEIGHT);
+        limits.max_alloc = Some(4 * 4 * MAX_INPUT_WIDTH as u64 * MAX_INPUT_HEIGHT as u64 / 2);
+        reader.limits(limits);
+        let img = reader.decode().map_err(|e| err(format!("not a readable {format:?} image: {e}")))?;
+        let rgb = img.into_rgb32f();
+        let (w, h) = rgb.dimensions();
+        let texels = rgb.pixels().map(|p| Vec3::from_array(p.0)).collect();
+        Self::from_rgb(&path.display().to_string(), w, h, texels)
+    }
+
+    /// A constant radiance in every direction (the white furnace).
+    pub fn uniform(rgb: Vec3) -> Self {
+        Environment {
+            source: "uniform".into(),
+            width: 8,
+            height: 4,
+            texels: vec![rgb; 32],
+            intensity: 1.0,
+            rotation: 0.0,
+        }
+    }
+
+    /// The default environment: a uniform white sky of radiance [`DEFAULT_SKY`] (RGB (1, 1, 1),
+    /// i.e. exactly the colour space's white, D65 for sRGB) above the horizon and a grey ground of
+    /// albedo [`DEFAULT_GROUND`] below it. A neutral studio light that shows materials as they
+    /// are, like the neutral environments glTF viewers light with.
+    pub fn default_sky() -> Self {
+        let (w, h) = (64u32, 32u32);
+        let texels = (0..h)
+            .flat_map(|y| {
+                let v = if y < h / 2 { DEFAULT_SKY } else { DEFAULT_SKY * DEFAULT_GROUND };
+                std::iter::repeat_n(Vec3::splat(v), w as usize)
+            })
+            .collect();
+        Environment { source: "default".into(), width: w, height: h, texels, intensity: 1.0, rotation: 0.0 }
+    }
+
+    pub fn with_intensity(mut self, k: f32) -> Result<Self, EnvironmentError> {
+        if !k.is_finite() || !(0.0..=MAX_INTENSITY).contains(&k) {
+            return Err(EnvironmentError {
+                file: PathBuf::from(&self.source),
+                message: format!("intensity must be between 0 and {MAX_INTENSITY} (got {k})"),
+            });
+        }
+        self.intensity = k;
+        Ok(self)
+    }
+
+    /// Rotation about +Y in degrees.
+    pub fn with_rotation_degrees(mut self, deg: f32) -> Result<Self, EnvironmentError> {
+        if !deg.is_finite() {
+            return Err(EnvironmentError {
+                file: PathBuf::from(&self.source),
+                message: format!("rotation must be a finite number of degrees (got {deg})"),
+            });
+        }
+        self.rotation = deg.rem_euclid(360.0).to_radians();
+        Ok(self)
+    }
+
+    /// Box-filters down by an integer factor until the width is at most `max_width`.
+    fn reduced(self, max_width: u32) -> Self {
+        if self.width <= max_width {
+            return self;
+        }
+        let f = self.width.div_ceil(max_width);
+        let (w, h) = (self.width / f, (self.height / f).max(1));
+        let mut texels = vec![Vec3::ZERO; (w * h) as usize];
+        // Each output texel is the solid-angle-weighted mean of its block, so ∫L dω is kept.
+        for y in 0..h {
+            for x in 0..w {
+                let (mut sum, mut wsum) = (Vec3::ZERO, 0.0f32);
+                for sy in y * f..((y + 1) * f).min(self.height) {
+                    let s = self.row_solid_angle(sy);
+                    for sx in x * f..(x + 1) * f {
+                        sum += self.texels[(sy * self.width + sx) as usize] * s;
+                        wsum += s;
+                    }
+                }
+                texels[(y * w + x) as usize] = if wsum > 0.0 { sum / wsum } else { Vec3::ZERO };
+            }
+        }
+        Environment { width: w, height: h, texels, ..self }
+    }
+
+    /// Solid angle of one texel of row `y` (all texels of a row are equal).
+    pub fn row_solid_angle(&self, y: u32) -> f32 {
+        let t0 = PI * y as f32 / self.height as f32;
+        let t1 = PI * (y + 1) as f32 / self.height as f32;
+        2.0 * PI / self.width as f32 * (t0.cos() - t1.cos())
+    }
+
+    /// World direction of image coordinates (u, v) ∈ [0, 1]², rotation applied.
+    pub fn direction(&self, uv: Vec2) -> Vec3 {
+        let theta = PI * uv.y;
+        let phi = 2.0 * PI * (uv.x - 0.5) + self.rotation;
+        let s = theta.sin();
+        Vec3::new(s * phi.sin(), theta.cos(), -s * phi.cos())
+    }
+
+    /// Image coordinates of a unit world direction (inverse of [`Self::direction`]).
+    pub fn uv(&self, d: Vec3) -> Vec2 {
+        let phi = d.x.atan2(-d.z) - self.rotation;
+        let u = (phi / (2.0 * PI) + 0.5).rem_euclid(1.0);
+        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+        Vec2::new(u, v)
+    }
+
+    /// Index into `texels` of the texel that direction `d` falls in.
+    pub fn texel_index(&self, d: Vec3) -> usize {
+        let uv = self.uv(d);
+        let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
+        (y * self.width + x) as usize
+    }
+
+    /// Radiance (linear RGB, intensity applied) arriving from direction `d` (unit, pointing
+    /// away from the scene): the texel's constant value.
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        self.texels[self.texel_index(d)] * self.intensity
+    }
+
+    /// ∫ L dω over the sphere per channel (intensity applied).
+    pub fn integral(&self) -> Vec3 {
+        (0..self.height)
+            .map(|y| {
+                let row: Vec3 =
+                    self.texels[(y * self.width) as usize..((y + 1) * self.width) as usize].iter().sum();
+                row * self.row_solid_angle(y)
+            })
+            .sum::<Vec3>()
+            * self.intensity
+    }
+
+    /// Whether every texel is black (or the intensity is 0): such an environment lights nothing.
+    pub fn is_black(&self) -> bool {
+        self.intensity == 0.0 || self.texels.iter().all(|t| *t == Vec3::ZERO)
+    }
+}
+
+/// What lights a scene, for the "is anything lit at all" decision both renderers share.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LightSources {
+    /// Punctual lights (sky stand-ins included).
+    pub punctual: usize,
+    /// Meshes whose material emits.
+    pub emissive_meshes: usize,
+    /// Whether a non-black environment surrounds the scene.
+    pub environment: bool,
+}
+
+impl LightSources {
+    pub fn of(scene: &crate::Scene) -> Self {
+        LightSources {
+            punctual: scene.lights.len(),
+            emissive_meshes: scene
+                .meshes
+                .iter()
+                .filter(|m| {
+                    scene.materials.get(m.material).is_some_and(|mat| mat.emissive.max_element() > 0.0)
+                })
+                .count(),
+            environment: scene.environment.as_ref().is_some_and(|e| !e.is_black()),
+        }
+    }
+
+    pub fn any(&self) -> bool {
+        self.punctual > 0 || self.emissive_meshes > 0 || self.environment
+    }
+}
+
+/// The environment asked for on a command line: `--env`, `--env-intensity`, `--env-rotation`.
+#[derive(Clone, Debug, Default)]
+pub struct EnvironmentChoice {
+    /// `none`, `default`, or a path to an equirectangular `.hdr`/`.exr`; `None` keeps the scene's
+    /// own (`extras.environment`), or the default one when the scene has no light at all.
+    pub env: Option<String>,
+    pub intensity: Option<f32>,
+    /// Degrees about +Y.
+    pub rotation: Option<f32>,
+}
+
+impl EnvironmentChoice {
+    /// Sets `scene.environment` as asked and returns a message for the user when the choice was
+    /// made for them (the default environment for a scene with no lights) or when nothing lights
+    /// the scene at all (a warning: the image will be black).
+    pub fn apply(&self, scene: &mut crate::Scene) -> Result<Option<String>, EnvironmentError> {
+        let mut note = None;
+        match self.env.as_deref() {
+            Some("none") => scene.environment = None,
+            Some("default") => scene.environment = Some(Environment::default_sky()),
+            Some(path) => scene.environment = Some(Environment::load(Path::new(path))?),
+            None => {
+                if !LightSources::of(scene).any() {
+                    scene.environment = Some(Environment::default_sky());
+                    note = Some(format!(
+                        "note: {} has no lights: lighting it with the default environment (a uniform white \
+                         sky over a grey ground; --env FILE.hdr for another, --env none for none)",
+                        scene.source
+                    ));
+                }
+            }
+        }
+        if self.intensity.is_some() || self.rotation.is_some() {
+            let Some(env) = scene.environment.take() else {
+                return Err(EnvironmentError {
+                    file: PathBuf::from(self.env.as_deref().unwrap_or("none")),
+                    message: "--env-intensity / --env-rotation given, but the scene has no environment \
+                              (give --env FILE or --env default)"
+                        .into(),
+                });
+            };
+            let env = match self.intensity {
+                Some(k) => env.with_intensity(k)?,
+                None => env,
+            };
+            let env = match self.rotation {
+                Some(r) => env.with_rotation_degrees(r)?,
+                None => env,
+            };
+            scene.environment = Some(env);
+        }
+        if !LightSources::of(scene).any() {
+            note = Some(format!(
+                "warning: nothing lights {}: it has no lights, no emissive surfaces and no environment, so \
+                 the image will be black (drop --env none, or give --env FILE.hdr)",
+                scene.source
+            ));
+        }
+        Ok(note)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn direction_and_uv_are_inverse_and_follow_the_convention() {
+        let mut e = Environment::default_sky();
+        for rot in [0.0f32, 0.7, 3.0] {
+            e.rotation = rot;
+            for (u, v) in [(0.1, 0.2), (0.5, 0.5), (0.9, 0.7), (0.3, 0.95)] {
+                let d = e.direction(Vec2::new(u, v));
+                assert!((d.length() - 1.0).abs() < 1e-5);
+                let back = e.uv(d);
+                assert!((back - Vec2::new(u, v)).abs().max_element() < 1e-5, "{u} {v} {back}");
+            }
+        }
+        e.rotation = 0.0;
+        assert!((e.direction(Vec2::new(0.5, 0.5)) - Vec3::NEG_Z).length() < 1e-6);
+        assert!((e.direction(Vec2::new(0.75, 0.5)) - Vec3::X).length() < 1e-6);
+        assert!((e.direction(Vec2::new(0.3, 0.0)) - Vec3::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn solid_angles_cover_the_sphere() {
+        let e = Environment::default_sky();
+        let total: f32 = (0..e.height).map(|y| e.row_solid_angle(y) * e.width as f32).sum();
+        assert!((total - 4.0 * PI).abs() < 1e-4);
+        let u = Environment::uniform(Vec3::ONE);
+        assert!((u.integral() - Vec3::splat(4.0 * PI)).abs().max_element() < 1e-4);
+    }
+
+    #[test]
+    fn default_sky_is_white_above_and_ground_below() {
+        let e = Environment::default_sky();
+        assert_eq!(e.radiance(Vec3::new(0.1, 0.9, 0.2).normalize()), Vec3::ONE);
+        assert_eq!(e.radiance(Vec3::new(0.1, -0.9, 0.2).normalize()), Vec3::splat(DEFAULT_GROUND));
+    }
+
+    #[test]
+    fn reduction_keeps_the_integral() {
+        let (w, h) = (WORKING_WIDTH * 3, WORKING_WIDTH * 3 / 2);
+        let texels = (0..w * h).map(|i| Vec3::splat(((i as u64 * 7919) % 13) as f32)).collect();
+        let big =
+            Environment { source: "t".into(), width: w, height: h, texels, intensity: 1.0, rotation: 0.0 };
+        let want = big.integral();
+        let small = big.reduced(WORKING_WIDTH);
+        assert!(small.width <= WORKING_WIDTH);
+        assert!(((small.integral() - want) / want).abs().max_element() < 1e-3);
+    }
+
+    #[test]
+    fn bad_images_are_refused_with_the_reason() {
+        let e = |w, h, t: Vec<Vec3>| Environment::from_rgb("sky.hdr", w, h, t).unwrap_err().to_string();
+        assert!(e(0, 0, vec![]).contains("empty"));
+        let m = e(100000, 1, vec![Vec3::ONE; 100000]);
+        assert!(m.contains("sky.hdr") && m.contains("100000"), "{m}");
+        assert!(e(4, 4, vec![Vec3::ONE; 16]).contains("twice as wide"));
+        let mut t = vec![Vec3::ONE; 8];
+        t[5] = Vec3::new(f32::NAN, 0.0, 0.0);
+        assert!(e(4, 2, t.clone()).contains("(1, 1)"));
+        t[5] = Vec3::new(-1.0, 0.0, 0.0);
+        assert!(e(4, 2, t).contains("negative"));
+        let env = Environment::uniform(Vec3::ONE);
+        assert!(env.clone().with_intensity(f32::NAN).unwrap_err().to_string().contains("intensity"));
+        assert!(env.with_rotation_degrees(f32::INFINITY).is_err());
+    }
+
+    #[test]
+    fn a_scene_without_lights_gets_the_default_environment_and_none_warns() {
+        let mut s = crate::builtin("cornell").unwrap();
+        s.lights.clear();
+        s.materials.iter_mut().for_each(|m| m.emissive = Vec3::ZERO);
+        let mut auto = s.clone();
+        let note = EnvironmentChoice::default().apply(&mut auto).unwrap().unwrap();
+        assert!(note.contains("default environment"), "{note}");
+        assert_eq!(auto.environment.as_ref().unwrap().source, "default");
+        let mut none = s.clone();
+        let choice = EnvironmentChoice { env: Some("none".into()), ..Default::default() };
+        assert!(choice.apply(&mut none).unwrap().unwrap().contains("black"));
+        let lit = crate::builtin("cornell").unwrap();
+        let mut kept = lit.clone();
+        assert!(EnvironmentChoice::default().apply(&mut kept).unwrap().is_none());
+        assert!(kept.environment.is_none());
+        let turned =
+            EnvironmentChoice { env: Some("default".into()), intensity: Some(2.0), rotation: Some(90.0) };
+        let mut t = lit.clone();
+        turned.apply(&mut t).unwrap();
+        let e = t.environment.unwrap();
+        assert_eq!(e.intensity, 2.0);
+        assert!((e.rotation - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        let orphan = EnvironmentChoice { env: Some("none".into()), intensity: Some(2.0), rotation: None };
+        assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
+    }
+
+    #[test]
+    fn an_hdr_file_round_trips() {
+        let dir = std::env::temp_dir().join(format!("spectra-env-hdr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.hdr");
+        let px: Vec<image::Rgb<f32>> = (0..32).map(|i| image::Rgb([i as f32 * 0.5, 1.0, 0.25])).collect();
+        let f = std::fs::File::create(&p).unwrap();
+        image::codecs::hdr::HdrEncoder::new(f).encode(&px, 8, 4).unwrap();
+        let e = Environment::load(&p).unwrap();
+        assert_eq!((e.width, e.height), (8, 4));
+        assert!((e.texels[3] - Vec3::new(1.5, 1.0, 0.25)).abs().max_element() < 0.02);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn files_that_are_not_environments_are_refused_naming_the_file() {
+        let dir = std::env::temp_dir().join(format!("spectra-env-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let missing = Environment::load(&dir.join("missing.hdr")).unwrap_err().to_string();
+        assert!(missing.contains("missing.hdr"), "{missing}");
+        let png = dir.join("sky.png");
+        std::fs::write(&png, b"x").unwrap();
+        assert!(Environment::load(&png).unwrap_err().to_string().contains("not an HDR"));
+        let corrupt = dir.join("corrupt.hdr");
+        std::fs::write(&corrupt, b"#?RADIANCE\ngarbage").unwrap();
+        let m = Environment::load(&corrupt).unwrap_err().to_string();
+        assert!(m.contains("corrupt.hdr") && m.contains("not a readable"), "{m}");
+        let bad_exr = dir.join("corrupt.exr");
+        std::fs::write(&bad_exr, [0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 1, 2, 3]).unwrap();
+        assert!(Environment::load(&bad_exr).unwrap_err().to_string().contains("corrupt.exr"));
+        assert!(Environment::load(&dir).unwrap_err().to_string().contains("not a regular file"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
