@@ -1,0 +1,681 @@
+#!/usr/bin/env python3
+"""Conformance run over real glTF assets (the Khronos glTF sample models).
+
+For each model: `spectra render` in rgb and spectral mode, `spectra truth` (direct lighting),
+`spectra diff --json` of each render against the truth (per pixel and on BLOCK x BLOCK block
+means), and a "black" check of every image (mean Rec. 709 luminance of the linear EXR, read
+here with the standard library). Writes OUT/conformance.json and OUT/conformance.md, one row
+per model; exits 1 if a listed model fails to load or render, or any of its images is black
+(--allow-fail: exit 0 anyway).
+
+    tools/conformance.py --fetch ~/khronos                     # download the default models, then run
+    tools/conformance.py ~/khronos --out conformance-out        # run on models already there
+    tools/conformance.py PATH/glTF-Sample-Assets/Models --all   # every model found
+
+Layout of the model root (as in KhronosGroup/glTF-Sample-Assets `Models/`):
+`ROOT/<Model>/glTF-Binary/<Model>.glb` or `ROOT/<Model>/glTF/<Model>.gltf` (the .glb is used
+when both exist; --variant glTF picks the other). A root holding a `Models/` folder works too.
+
+Python 3 standard library only. docs/conformance.md explains the table.
+"""
+
+import argparse
+import json
+import math
+import os
+import shlex
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+import zlib
+
+DEFAULT_MODELS = ["DamagedHelmet", "FlightHelmet", "WaterBottle", "Avocado", "BoxTextured", "Duck"]
+FETCH_BASE = "https://raw.githubusercontent.com/KhronosGroup/glTF-Sample-Assets/main/Models"
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+LUMA = (0.2126, 0.7152, 0.0722)  # linear sRGB / Rec. 709 -> Y
+
+
+class Interrupted(Exception):
+    pass
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+# ---------------------------------------------------------------------------------------------
+# OpenEXR reading (scan-line images, NONE / RLE / ZIPS / ZIP compression, half/float/uint).
+# `spectra` writes ZIP-compressed float scan lines; other compressions are refused by name.
+
+COMPRESSION_NAMES = ["NONE", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB"]
+LINES_PER_CHUNK = {0: 1, 1: 1, 2: 1, 3: 16}
+SAMPLE_BYTES = {0: 4, 1: 2, 2: 4}  # UINT, HALF, FLOAT
+SAMPLE_FORMAT = {0: "I", 1: "e", 2: "f"}
+
+
+def _undo_predictor_and_interleave(raw):
+    # Inverse of OpenEXR's ZIP/RLE preprocessing: delta predictor, then the two halves of the
+    # buffer interleaved byte by byte.
+    b = bytearray(raw)
+    for i in range(1, len(b)):
+        b[i] = (b[i - 1] + b[i] - 128) & 0xFF
+    half = (len(b) + 1) // 2
+    out = bytearray(len(b))
+    out[0::2] = b[:half]
+    out[1::2] = b[half:]
+    return bytes(out)
+
+
+def _rle_decode(data, expected):
+    out = bytearray()
+    i = 0
+    while i < len(data) and len(out) < expected:
+        n = struct.unpack_from("b", data, i)[0]
+        i += 1
+        if n < 0:
+            out += data[i : i - n]
+            i -= n
+        else:
+            out += data[i : i + 1] * (n + 1)
+            i += 1
+    return bytes(out)
+
+
+def read_exr(path):
+    """Returns (width, height, {channel: list of floats, row-major})."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] != b"\x76\x2f\x31\x01":
+        raise ValueError(f"{path}: not an OpenEXR file")
+    flags = struct.unpack_from("<I", data, 4)[0]
+    if flags & 0x200 or flags & 0x1000 or flags & 0x800:
+        raise ValueError(f"{path}: tiled, multi-part or deep EXR is not supported here")
+    pos = 8
+    channels, compression, window = [], None, None
+    while True:
+        end = data.index(b"\0", pos)
+        name = data[pos:end].decode()
+        pos = end + 1
+        if not name:
+            break
+        end = data.index(b"\0", pos)
+        pos = end + 1
+        size = struct.unpack_from("<i", data, pos)[0]
+        pos += 4
+        value = data[pos : pos + size]
+        pos += size
+        if name == "channels":
+            p = 0
+            while value[p] != 0:
+                e = value.index(b"\0", p)
+                cname = value[p:e].decode()
+                ptype, _, xs, ys = struct.unpack_from("<iB3xii", value, e + 1)
+                channels.append((cname, ptype, xs, ys))
+                p = e + 1 + 16
+        elif name == "compression":
+            compression = value[0]
+        elif name == "dataWindow":
+            window = struct.unpack("<iiii", value)
+    if window is None or compression is None or not channels:
+        raise ValueError(f"{path}: EXR header lacks channels, compression or dataWindow")
+    if compression not in LINES_PER_CHUNK:
+        cname = COMPRESSION_NAMES[compression] if compression < len(COMPRESSION_NAMES) else compression
+        raise ValueError(f"{path}: EXR compression {cname} is not supported by this reader")
+    if any(xs != 1 or ys != 1 for _, _, xs, ys in channels):
+        raise ValueError(f"{path}: subsampled EXR channels are not supported")
+    channels.sort(key=lambda c: c[0])  # file order is alphabetical
+    x0, y0, x1, y1 = window
+    w, h = x1 - x0 + 1, y1 - y0 + 1
+    lines = LINES_PER_CHUNK[compression]
+    nchunks = (h + lines - 1) // lines
+    offsets = struct.unpack_from(f"<{nchunks}Q", data, pos)
+    out = {c[0]: [0.0] * (w * h) for c in channels}
+    row_bytes = sum(SAMPLE_BYTES[c[1]] for c in channels) * w
+    for off in offsets:
+        y, size = struct.unpack_from("<ii", data, off)
+        chunk = data[off + 8 : off + 8 + size]
+        nlines = min(lines, y1 + 1 - y)
+        expected = row_bytes * nlines
+        if size < expected:
+            if compression in (2, 3):
+                chunk = _undo_predictor_and_interleave(zlib.decompress(chunk))
+            elif compression == 1:
+                chunk = _undo_predictor_and_interleave(_rle_decode(chunk, expected))
+        if len(chunk) != expected:
+            raise ValueError(f"{path}: scan-line chunk at y={y} has {len(chunk)} bytes, expected {expected}")
+        p = 0
+        for ly in range(nlines):
+            row = (y - y0 + ly) * w
+            for cname, ptype, _, _ in channels:
+                n = SAMPLE_BYTES[ptype] * w
+                out[cname][row : row + w] = struct.unpack_from(f"<{w}{SAMPLE_FORMAT[ptype]}", chunk, p)
+                p += n
+    return w, h, out
+
+
+def image_stats(path, lit_threshold):
+    """Mean/max luminance and the fraction of pixels brighter than lit_threshold."""
+    w, h, ch = read_exr(path)
+    _CACHE[path] = (w, h, ch)
+    missing = [c for c in "RGB" if c not in ch]
+    if missing:
+        raise ValueError(f"{path}: no {', '.join(missing)} channel")
+    r, g, b = ch["R"], ch["G"], ch["B"]
+    total, peak, lit, bad = 0.0, 0.0, 0, 0
+    for i in range(w * h):
+        y = LUMA[0] * r[i] + LUMA[1] * g[i] + LUMA[2] * b[i]
+        if not math.isfinite(y):
+            bad += 1
+            continue
+        total += y
+        peak = max(peak, y)
+        if y > lit_threshold:
+            lit += 1
+    return {
+        "width": w,
+        "height": h,
+        "mean_luminance": total / (w * h),
+        "max_luminance": peak,
+        "lit_fraction": lit / (w * h),
+        "non_finite_pixels": bad,
+    }
+
+
+_CACHE = {}
+
+
+def _srgb8(v):
+    v = 0.0 if not (v > 0.0) else min(v, 1.0)
+    v = 12.92 * v if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055
+    return int(round(v * 255))
+
+
+def write_preview(exr_path, png_path):
+    """The EXR as an 8-bit sRGB PNG, clamped like `spectra render --out x.png --tonemap none`."""
+    w, h, ch = _CACHE.pop(exr_path, None) or read_exr(exr_path)
+    lut = {}
+    rows = bytearray()
+    for y in range(h):
+        rows.append(0)
+        for x in range(w):
+            i = y * w + x
+            for c in "RGB":
+                v = ch[c][i]
+                e = lut.get(v)
+                if e is None:
+                    e = lut[v] = _srgb8(v)
+                rows.append(e)
+
+    def chunk(kind, payload):
+        return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
+
+    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(bytes(rows), 6)) + chunk(b"IEND", b"")
+    with open(png_path, "wb") as f:
+        f.write(png)
+
+
+# ---------------------------------------------------------------------------------------------
+# Running spectra
+
+
+class Runner:
+    def __init__(self, spectra, timeout):
+        self.spectra = spectra
+        self.timeout = timeout
+        self.env = dict(os.environ)
+        if not self.env.get("XDG_RUNTIME_DIR"):
+            # The software Vulkan driver complains without one; a private directory is enough.
+            self.env["XDG_RUNTIME_DIR"] = tempfile.mkdtemp(prefix="spectra-xdg-")
+            os.chmod(self.env["XDG_RUNTIME_DIR"], 0o700)
+        self.proc = None
+
+    def run(self, args):
+        """Runs `spectra ARGS`; returns (exit code, stdout, stderr, seconds)."""
+        cmd = [self.spectra, *args]
+        t0 = time.monotonic()
+        # Own process group: Ctrl-C reaches this script, which then stops the child itself.
+        self.proc = subprocess.Popen(
+            cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=self.env, start_new_session=True
+        )
+        try:
+            out, err = self.proc.communicate(timeout=self.timeout)
+            code = self.proc.returncode
+        except subprocess.TimeoutExpired:
+            self.stop()
+            out, err = self.proc.communicate()
+            code = None
+            err = (err or "") + f"\ntimed out after {self.timeout} s"
+        except KeyboardInterrupt:
+            self.stop()
+            raise Interrupted() from None
+        finally:
+            self.proc = None if self.proc is None or self.proc.poll() is not None else self.proc
+        return code, out, err, time.monotonic() - t0
+
+    def stop(self):
+        p = self.proc
+        if p is None or p.poll() is not None:
+            return
+        try:
+            os.killpg(p.pid, signal.SIGTERM)
+            p.wait(timeout=5)
+        except (ProcessLookupError, subprocess.TimeoutExpired):
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            p.wait()
+
+
+def error_message(stderr, code):
+    """The most useful line of a failed command's stderr (anyhow prints 'Error: ...')."""
+    lines = [ln.strip() for ln in (stderr or "").splitlines() if ln.strip()]
+    for i, ln in enumerate(lines):
+        if ln.startswith("Error:") or ln.startswith("error:"):
+            rest = [x for x in lines[i + 1 :] if x not in ("Caused by:",)]
+            return " ".join([ln.split(":", 1)[1].strip()] + rest)[:600]
+    tail = " ".join(lines[-3:])[:600]
+    return tail or f"exit code {code}"
+
+
+def notes_of(stderr):
+    return [ln.strip() for ln in (stderr or "").splitlines() if ln.strip().lower().startswith(("note", "warning"))]
+
+
+def find_model(root, name, variant):
+    cands = {
+        "glTF-Binary": os.path.join(root, name, "glTF-Binary", name + ".glb"),
+        "glTF": os.path.join(root, name, "glTF", name + ".gltf"),
+    }
+    order = ["glTF-Binary", "glTF"] if variant == "glTF-Binary" else ["glTF", "glTF-Binary"]
+    for v in order:
+        if os.path.isfile(cands[v]):
+            return cands[v]
+    return None
+
+
+def list_models(root):
+    names = []
+    for d in sorted(os.listdir(root)):
+        if find_model(root, d, "glTF-Binary"):
+            names.append(d)
+    return names
+
+
+def env_args(a):
+    args = []
+    if a.env != "auto":
+        args += ["--env", a.env]
+    if a.env_intensity is not None:
+        args += ["--env-intensity", str(a.env_intensity)]
+    if a.env_rotation is not None:
+        args += ["--env-rotation", str(a.env_rotation)]
+    return args
+
+
+def run_model(a, runner, name, path, outdir):
+    res = {"model": name, "file": path, "status": "ok", "error": None, "renders": {}, "diffs": {}, "notes": []}
+    os.makedirs(outdir, exist_ok=True)
+    common = ["--size", a.size, *env_args(a)]
+    jobs = [
+        ("rgb", ["render", path, "--mode", "rgb", *common, *shlex.split(a.render_args)]),
+        ("spectral", ["render", path, "--mode", "spectral", *common, *shlex.split(a.render_args)]),
+        ("truth", ["truth", path, *common, "--spp", str(a.spp), *shlex.split(a.truth_args)]),
+    ]
+    for key, args in jobs:
+        img = os.path.join(outdir, key + ".exr")
+        if os.path.exists(img):
+            os.remove(img)
+        args = [*args, "--out", img]
+        log(f"    {key:<9} spectra {' '.join(shlex.quote(x) for x in args)}")
+        code, out, err, secs = runner.run(args)
+        r = {"command": ["spectra", *args], "exit_code": code, "seconds": round(secs, 2), "notes": notes_of(err)}
+        res["renders"][key] = r
+        for n in r["notes"]:
+            if n not in res["notes"]:
+                res["notes"].append(n)
+        if code != 0 or not os.path.isfile(img):
+            r["error"] = error_message(err, code)
+            log(f"    {key:<9} FAILED ({secs:.1f} s): {r['error']}")
+            if res["status"] == "ok":
+                res["status"] = "error"
+                res["error"] = f"{key}: {r['error']}"
+            continue
+        try:
+            r.update(image_stats(img, a.lit_threshold))
+            r["black"] = r["mean_luminance"] < a.black_threshold or r["lit_fraction"] < a.min_lit_fraction
+            write_preview(img, os.path.join(outdir, key + ".png"))
+        except (ValueError, OSError, struct.error, zlib.error) as e:
+            r["error"] = f"cannot read the image: {e}"
+            r["black"] = None
+        log(
+            f"    {key:<9} {secs:6.1f} s  mean Y {r.get('mean_luminance', float('nan')):.4g}"
+            f"{'  BLACK' if r.get('black') else ''}"
+        )
+    truth = os.path.join(outdir, "truth.exr")
+    for key in ("spectral", "rgb"):
+        img = os.path.join(outdir, key + ".exr")
+        if not (os.path.isfile(truth) and os.path.isfile(img)) or res["renders"][key].get("exit_code") != 0:
+            continue
+        d = {}
+        for block in sorted({1, a.block}):
+            args = ["diff", truth, img, "--json", "--block", str(block)]
+            if block == a.block:
+                args += ["--heatmap", os.path.join(outdir, f"de_{key}_block{block}.png")]
+            code, out, err, _ = runner.run(args)
+            if code != 0:
+                d[f"block{block}"] = {"error": error_message(err, code)}
+                continue
+            j = json.loads(out)
+            d[f"block{block}"] = {
+                "delta_e2000_mean": j["delta_e2000"]["mean"],
+                "delta_e2000_p95": j["delta_e2000"]["p95"],
+                "mae_linear_mean": j["mae_linear"]["mean"],
+            }
+        res["diffs"][f"{key}_vs_truth"] = d
+        be = d.get(f"block{a.block}", {}).get("delta_e2000_mean")
+        if be is not None:
+            log(f"    ΔE00 {key} vs truth, {a.block}x{a.block} block mean: {be:.3f}")
+    return res
+
+
+# ---------------------------------------------------------------------------------------------
+# Report
+
+
+def fmt(v, prec=2):
+    return "–" if v is None else f"{v:.{prec}f}"
+
+
+def fmtg(v):
+    return "–" if v is None else f"{v:.3g}"
+
+
+def black_cell(r):
+    if r is None or r.get("exit_code") != 0:
+        return "–"
+    b = r.get("black")
+    return "?" if b is None else ("**yes**" if b else "no")
+
+
+def write_reports(a, results, meta):
+    os.makedirs(a.out, exist_ok=True)
+    doc = {**meta, "models": results}
+    tmp = os.path.join(a.out, "conformance.json.tmp")
+    with open(tmp, "w") as f:
+        json.dump(doc, f, indent=2)
+        f.write("\n")
+    os.replace(tmp, os.path.join(a.out, "conformance.json"))
+
+    blk = f"block{a.block}"
+    lines = [
+        "# Conformance: Khronos glTF sample models",
+        "",
+        f"`{meta['command']}`",
+        "",
+        f"{meta['size']} px, environment `{a.env}`"
+        + (f" × {a.env_intensity}" if a.env_intensity is not None else "")
+        + f", truth {a.spp} spp (`{' '.join(meta['truth_flags'])}`); ΔE2000 = mean CIEDE2000 against the truth"
+        f" on {a.block}×{a.block} block means (per pixel in brackets); black = mean luminance Y < {a.black_threshold}"
+        f" or fewer than {a.min_lit_fraction:.0%} of the pixels above Y = {a.lit_threshold}; mean Y is that of the"
+        f" linear image (1 = the default sky's radiance); times are wall-clock seconds per command (process"
+        f" start, scene load and upload included). Model paths are relative to `{meta['root']}`.",
+        "",
+        "| model | load | black rgb / spectral / truth | mean Y rgb / spectral / truth | ΔE00 spectral–truth |"
+        " ΔE00 rgb–truth | seconds rgb / spectral / truth |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    def short(text):
+        return (text or "").replace(meta["root"] + os.sep, "").replace("|", "\\|")
+
+    for r in results:
+        rs = r.get("renders", {})
+        if r["status"] != "ok" and not any(x.get("exit_code") == 0 for x in rs.values()):
+            err = short(r.get("error"))
+            lines.append(f"| {r['model']} | error: {err} | – | – | – | – | – |")
+            continue
+        load = "ok" if r["status"] == "ok" else "error: " + short(r.get("error"))
+        blacks = " / ".join(black_cell(rs.get(k)) for k in ("rgb", "spectral", "truth"))
+        means = " / ".join(fmtg(rs.get(k, {}).get("mean_luminance")) for k in ("rgb", "spectral", "truth"))
+
+        def de(key, r=r):
+            d = r.get("diffs", {}).get(key, {})
+            b, p = d.get(blk, {}).get("delta_e2000_mean"), d.get("block1", {}).get("delta_e2000_mean")
+            return "–" if b is None else f"{b:.2f} ({fmt(p)})"
+
+        secs = " / ".join(fmt(rs.get(k, {}).get("seconds"), 1) for k in ("rgb", "spectral", "truth"))
+        des = f"{de('spectral_vs_truth')} | {de('rgb_vs_truth')}"
+        lines.append(f"| {r['model']} | {load} | {blacks} | {means} | {des} | {secs} |")
+    lines.append("")
+    notes = sorted({n for r in results for n in r.get("notes", [])})
+    if notes:
+        lines += ["Notes printed by spectra:", ""] + [f"- {n}" for n in notes] + [""]
+    if meta.get("interrupted"):
+        lines += ["**Interrupted**: the table holds the models finished before Ctrl-C.", ""]
+    lines.append(f"Machine: {meta['machine']}; spectra: `{meta['spectra']}`; {meta['date']}.")
+    lines.append("")
+    tmp = os.path.join(a.out, "conformance.md.tmp")
+    with open(tmp, "w") as f:
+        f.write("\n".join(lines))
+    os.replace(tmp, os.path.join(a.out, "conformance.md"))
+
+
+def machine():
+    cpu = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for ln in f:
+                if ln.startswith("model name"):
+                    cpu = ln.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores"
+
+
+# ---------------------------------------------------------------------------------------------
+# Fetching models from GitHub
+
+
+def download(url, dest, timeout=60):
+    if os.path.isfile(dest) and os.path.getsize(dest) > 0:
+        return "present"
+    os.makedirs(os.path.dirname(dest), exist_ok=True)
+    tmp = dest + ".part"
+    try:
+        with urllib.request.urlopen(url, timeout=timeout) as r, open(tmp, "wb") as f:
+            while True:
+                buf = r.read(1 << 16)
+                if not buf:
+                    break
+                f.write(buf)
+        head = open(tmp, "rb").read(64)
+        if head.startswith(b"version https://git-lfs"):
+            raise ValueError(f"{url} is a Git LFS pointer, not the file")
+        os.replace(tmp, dest)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return "downloaded"
+
+
+def fetch_model(base, name, dest_root, variant):
+    """Downloads one model (the .glb, else the .gltf with its buffers and images) and its
+    LICENSE.md / README.md. Returns the local path."""
+    q = urllib.parse.quote
+    mdir = os.path.join(dest_root, name)
+    for extra in ("LICENSE.md", "README.md"):
+        try:
+            download(f"{base}/{q(name)}/{extra}", os.path.join(mdir, extra))
+        except urllib.error.HTTPError:
+            pass
+    if variant == "glTF-Binary":
+        glb = os.path.join(mdir, "glTF-Binary", name + ".glb")
+        try:
+            how = download(f"{base}/{q(name)}/glTF-Binary/{q(name)}.glb", glb)
+            log(f"  {name}: glTF-Binary/{name}.glb {how}")
+            return glb
+        except urllib.error.HTTPError as e:
+            if e.code != 404:
+                raise
+            log(f"  {name}: no .glb, fetching the glTF folder")
+    gdir = os.path.join(mdir, "glTF")
+    gltf = os.path.join(gdir, name + ".gltf")
+    download(f"{base}/{q(name)}/glTF/{q(name)}.gltf", gltf)
+    with open(gltf, encoding="utf-8") as f:
+        doc = json.load(f)
+    uris = [x.get("uri") for x in doc.get("buffers", []) + doc.get("images", [])]
+    uris = [u for u in uris if u and not u.startswith("data:")]
+    for u in uris:
+        rel = urllib.parse.unquote(u)
+        if rel.startswith("/") or ".." in rel.split("/"):
+            raise ValueError(f"{name}.gltf: refusing the URI {u!r} (outside the model folder)")
+        how = download(f"{base}/{q(name)}/glTF/{q(rel)}", os.path.join(gdir, rel))
+        log(f"  {name}: glTF/{rel} {how}")
+    return gltf
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt()
+
+
+def main():
+    signal.signal(signal.SIGTERM, _terminate)  # stop as cleanly on kill as on Ctrl-C
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("root", nargs="?",
+                    help="folder of models (<root>/<Model>/glTF-Binary/<Model>.glb or glTF/<Model>.gltf)")
+    ap.add_argument("--models", help=f"comma-separated model names (default: {','.join(DEFAULT_MODELS)})")
+    ap.add_argument("--all", action="store_true", help="every model found under the root")
+    ap.add_argument("--variant", choices=["glTF-Binary", "glTF"], default="glTF-Binary",
+                    help="which file to prefer when a model has both (default: glTF-Binary)")
+    ap.add_argument("--spectra", default=os.path.join(REPO_ROOT, "target", "release", "spectra"),
+                    help="the spectra binary (default: target/release/spectra of this repository)")
+    ap.add_argument("--out", default="conformance-out", help="output folder (default: conformance-out)")
+    ap.add_argument("--env", default="default",
+                    help="environment for every render: default, none, a .hdr/.exr file, or auto (pass no --env: "
+                         "the renderers' own choice) (default: default)")
+    ap.add_argument("--env-intensity", type=float)
+    ap.add_argument("--env-rotation", type=float, help="passed through to --env-rotation")
+    ap.add_argument("--size", default="320x240", help="image size WxH (default: 320x240)")
+    ap.add_argument("--spp", type=int, default=64, help="truth samples per pixel (default: 64)")
+    ap.add_argument("--truth-args", default="--direct-only",
+                    help="extra flags for spectra truth (default: --direct-only)")
+    ap.add_argument("--render-args", default="", help="extra flags for both spectra render runs")
+    ap.add_argument("--block", type=int, default=8, help="block size of the block-mean ΔE2000 (default: 8)")
+    ap.add_argument("--black-threshold", type=float, default=1e-3,
+                    help="an image whose mean luminance is below this is black (default: 1e-3)")
+    ap.add_argument("--lit-threshold", type=float, default=1e-2,
+                    help="a pixel whose luminance is above this is lit (default: 0.01)")
+    ap.add_argument("--min-lit-fraction", type=float, default=0.05,
+                    help="an image with fewer lit pixels than this fraction is black too (default: 0.05)")
+    ap.add_argument("--timeout", type=float, default=1800, help="seconds allowed per spectra command (default: 1800)")
+    ap.add_argument("--allow-fail", action="store_true", help="exit 0 even if a model is black or fails")
+    ap.add_argument("--fetch", metavar="DIR", help="download the listed models from GitHub into DIR first "
+                    "(files already there are kept), then run on DIR unless a root is given")
+    ap.add_argument("--fetch-only", action="store_true", help="with --fetch: download, do not render")
+    ap.add_argument("--fetch-base", default=FETCH_BASE, help=f"where --fetch downloads from (default: {FETCH_BASE})")
+    a = ap.parse_args()
+
+    models = [m.strip() for m in a.models.split(",") if m.strip()] if a.models else list(DEFAULT_MODELS)
+    if a.fetch:
+        if a.all:
+            ap.error("--fetch downloads a list of models; --all needs them present")
+        log(f"fetching {len(models)} models into {a.fetch} from {a.fetch_base}")
+        failed = []
+        try:
+            for m in models:
+                try:
+                    fetch_model(a.fetch_base.rstrip("/"), m, a.fetch, a.variant)
+                except (urllib.error.URLError, OSError, ValueError) as e:
+                    log(f"  {m}: download failed: {e}")
+                    failed.append(m)
+        except KeyboardInterrupt:
+            log("interrupted")
+            return 130
+        if failed:
+            log(f"could not download: {', '.join(failed)}")
+        if a.fetch_only:
+            return 1 if failed else 0
+        a.root = a.root or a.fetch
+    if not a.root:
+        ap.error("give the model folder (or --fetch DIR)")
+    root = a.root
+    if os.path.isdir(os.path.join(root, "Models")):
+        root = os.path.join(root, "Models")
+    if not os.path.isdir(root):
+        ap.error(f"{root}: not a folder")
+    if a.all:
+        models = list_models(root)
+    if not os.path.isfile(a.spectra) or not os.access(a.spectra, os.X_OK):
+        ap.error(f"{a.spectra}: no spectra binary there (cargo build --release -p spectra, or --spectra PATH)")
+    if a.block < 1:
+        ap.error("--block must be at least 1")
+
+    meta = {
+        "command": "tools/conformance.py " + " ".join(shlex.quote(x) for x in sys.argv[1:]),
+        "root": os.path.abspath(root),
+        "spectra": a.spectra,
+        "size": a.size,
+        "env": a.env,
+        "env_intensity": a.env_intensity,
+        "spp": a.spp,
+        "truth_flags": shlex.split(a.truth_args),
+        "render_flags": shlex.split(a.render_args),
+        "block": a.block,
+        "black_threshold": a.black_threshold,
+        "lit_threshold": a.lit_threshold,
+        "min_lit_fraction": a.min_lit_fraction,
+        "machine": machine(),
+        "date": time.strftime("%Y-%m-%d %H:%M %Z"),
+        "interrupted": False,
+    }
+    runner = Runner(a.spectra, a.timeout)
+    results = []
+    t_start = time.monotonic()
+    try:
+        for i, m in enumerate(models, 1):
+            path = find_model(root, m, a.variant)
+            log(f"[{i}/{len(models)}] {m}: {path or 'not found'}")
+            if path is None:
+                results.append({"model": m, "file": None, "status": "error",
+                                "error": f"not found under {root} (glTF-Binary/{m}.glb or glTF/{m}.gltf)",
+                                "renders": {}, "diffs": {}, "notes": []})
+            else:
+                results.append(run_model(a, runner, m, path, os.path.join(a.out, m)))
+            write_reports(a, results, meta)
+    except (Interrupted, KeyboardInterrupt):
+        runner.stop()
+        meta["interrupted"] = True
+        write_reports(a, results, meta)
+        log(f"interrupted: {len(results)} models in {os.path.join(a.out, 'conformance.md')}")
+        return 130
+    meta["seconds"] = round(time.monotonic() - t_start, 1)
+    write_reports(a, results, meta)
+
+    bad = []
+    for r in results:
+        if r["status"] != "ok":
+            bad.append(f"{r['model']}: {r['error']}")
+        for k, x in r.get("renders", {}).items():
+            if x.get("black"):
+                bad.append(f"{r['model']}: {k} render is black (mean luminance {x['mean_luminance']:.3g})")
+    log(f"wrote {os.path.join(a.out, 'conformance.md')} and conformance.json ({meta['seconds']} s)")
+    for b in bad:
+        log(f"FAIL {b}")
+    if bad and not a.allow_fail:
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
