@@ -25,6 +25,8 @@
 //! ```
 
 pub mod coeff_table;
+pub mod env_gpu;
+pub mod environment;
 pub mod error;
 pub mod gpu;
 pub mod passes;

@@ -2,6 +2,7 @@
 //! [`Renderer::render`] draws one frame with the [`RenderSettings`] given for that frame.
 
 use crate::coeff_table::GpuCoeffTable;
+use crate::env_gpu::{EnvUniforms, GpuEnvironment};
 use crate::error::{RenderError, Result};
 use crate::gpu::Gpu;
 use crate::passes::SharedLayouts;
@@ -42,6 +43,8 @@ struct SpectralState {
     bind_group: wgpu::BindGroup,
     custom_bind_group: wgpu::BindGroup,
     n_lights: u32,
+    /// XYZ of each environment basis spectrum (Σ of its node weights).
+    env_totals: [[f32; 4]; 4],
 }
 
 /// Bind groups that reference the size-dependent targets.
@@ -80,6 +83,8 @@ pub struct Renderer {
     custom_generation: u64,
     scene: Option<GpuScene>,
     scene_generation: u64,
+    environment: GpuEnvironment,
+    env_buffer: wgpu::Buffer,
     spectral: Option<SpectralState>,
     targets: Option<(Targets, TargetBindings)>,
     timer: Option<Timer>,
@@ -124,6 +129,13 @@ impl Renderer {
         });
         let timer =
             gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Timer::new(device, &gpu.queue));
+        let environment = GpuEnvironment::new(device, &gpu.queue, None);
+        let env_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("environment uniforms"),
+            size: std::mem::size_of::<EnvUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         Ok(Renderer {
             gpu,
             shared,
@@ -143,6 +155,8 @@ impl Renderer {
             custom_generation: 0,
             scene: None,
             scene_generation: 0,
+            environment,
+            env_buffer,
             spectral: None,
             targets: None,
             timer,
@@ -157,12 +171,40 @@ impl Renderer {
         &self.table
     }
 
-    /// Uploads `scene` (geometry, materials, textures, lights), replacing the previous one.
+    /// Uploads `scene` (geometry, materials, textures, lights, environment), replacing the
+    /// previous one.
     pub fn set_scene(&mut self, scene: &scene::Scene) -> Result<()> {
         self.scene =
             Some(GpuScene::upload(&self.gpu.device, &self.gpu.queue, &self.gbuffer.material_layout, scene)?);
-        self.scene_generation += 1;
+        self.set_environment(scene.environment.as_ref());
         Ok(())
+    }
+
+    /// Replaces the environment light (prefilters it: tens of milliseconds for a 512-wide map,
+    /// more the first time it is shown in spectral mode). `None`: no environment.
+    pub fn set_environment(&mut self, env: Option<&scene::Environment>) {
+        self.environment = GpuEnvironment::new(&self.gpu.device, &self.gpu.queue, env);
+        self.scene_generation += 1;
+    }
+
+    /// Changes the environment's intensity and rotation (radians about +Y) without
+    /// prefiltering again. Ignored when there is no environment.
+    pub fn set_environment_transform(&mut self, intensity: f32, rotation: f32) {
+        if let Some(e) = self.environment.source.as_mut() {
+            e.intensity = intensity;
+            e.rotation = rotation;
+        }
+    }
+
+    /// The environment in use, if any.
+    pub fn environment(&self) -> Option<&scene::Environment> {
+        self.environment.source.as_ref()
+    }
+
+    /// Fraction of the environment's weighted spectral energy the spectral mode's basis does not
+    /// capture (see [`crate::environment`]); `None` before a spectral frame or without one.
+    pub fn environment_residual(&self) -> Option<f64> {
+        self.environment.spectral.as_ref().map(|(b, _)| b.residual)
     }
 
     /// The camera the current scene was authored with.
@@ -321,9 +363,12 @@ impl Renderer {
             exposure: settings.exposure_ev.exp2(),
             tonemap: settings.tonemap.gpu(),
             table_res: self.gpu_table.res,
-            _pad: [0; 2],
+            flags: if settings.lambert { 1 } else { 0 },
+            _pad: 0,
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+        let env_uniforms = self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral);
+        self.gpu.queue.write_buffer(&self.env_buffer, 0, bytemuck::bytes_of(&env_uniforms));
 
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
@@ -501,6 +546,9 @@ impl Renderer {
             return Ok(());
         }
         let setup = SpectralSetup::new(settings)?;
+        if settings.mode == Mode::Spectral {
+            self.environment.ensure_spectral(&self.gpu.device, &self.gpu.queue, &self.table);
+        }
         let scene = self.scene.as_ref().expect("render checks the scene first");
         let device = &self.gpu.device;
         let groups = setup.gpu_groups();
@@ -538,6 +586,33 @@ impl Renderer {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
+        // The environment's basis spectra: node weights [j · n_groups + g] and XYZ totals.
+        let mut env_weights: Vec<crate::spectral_data::GroupWeights> = Vec::new();
+        let mut env_totals = [[0f32; 4]; 4];
+        if self.environment.source.is_some() && settings.mode != Mode::Rgb {
+            let white = &setup.white;
+            let basis: Vec<Vec<[f64; 3]>> = match (settings.mode, &self.environment.spectral) {
+                (Mode::Spectral, Some((b, _))) => (0..crate::environment::K)
+                    .map(|j| setup.weights_of(|l| b.eval(j, l) * white.eval(l)))
+                    .collect(),
+                _ => (0..crate::environment::K)
+                    .map(|j| {
+                        let (blue_max, green_max) = crate::spectral_data::naive_band_edges();
+                        setup.weights_of(|l| {
+                            let band = crate::spectral_data::naive_band(l, blue_max, green_max);
+                            if band == j { white.eval(l) } else { 0.0 }
+                        })
+                    })
+                    .collect(),
+            };
+            for (j, w) in basis.iter().enumerate() {
+                let t = SpectralSetup::light_total(w);
+                env_totals[j] = [t[0] as f32, t[1] as f32, t[2] as f32, 0.0];
+                env_weights.extend(setup.gpu_weights(w));
+            }
+        }
+        let env_weight_buf = GpuEnvironment::storage(device, &env_weights);
+        let env_tex = self.environment.textures(settings.mode == Mode::Spectral);
         let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
         let light_buf = storage("lights", bytemuck::cast_slice(&lights));
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
@@ -553,6 +628,24 @@ impl Renderer {
                     resource: wgpu::BindingResource::TextureView(&self.gpu_table.view),
                 },
                 wgpu::BindGroupEntry { binding: 4, resource: self.gpu_table.scale.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: env_weight_buf.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&env_tex.radiance),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(&env_tex.irradiance),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: wgpu::BindingResource::TextureView(&self.environment.lut),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: wgpu::BindingResource::Sampler(&self.environment.sampler),
+                },
+                wgpu::BindGroupEntry { binding: 10, resource: self.env_buffer.as_entire_binding() },
             ],
         });
 
@@ -583,7 +676,8 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 1, resource: custom_spec_buf.as_entire_binding() },
             ],
         });
-        self.spectral = Some(SpectralState { key, setup, bind_group, custom_bind_group, n_lights });
+        self.spectral =
+            Some(SpectralState { key, setup, bind_group, custom_bind_group, n_lights, env_totals });
         Ok(())
     }
 }

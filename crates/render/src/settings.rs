@@ -117,6 +117,10 @@ pub struct RenderSettings {
     /// prefiltered grid cannot be unbiased: docs/quadrature.md). `None` (the default) keeps the
     /// nodes at the bin centres with per-N normalisation, which makes white exact at every N.
     pub jitter: Option<f32>,
+    /// Replace the glTF BRDF by Lambert (base colour / π, no specular) for every surface and
+    /// light, as the path tracer's `lambert` does: for comparisons with renderers that lack the
+    /// glTF BRDF, and the white furnace.
+    pub lambert: bool,
 }
 
 impl Default for RenderSettings {
@@ -132,6 +136,7 @@ impl Default for RenderSettings {
             shadows: true,
             timestamps: false,
             jitter: None,
+            lambert: false,
         }
     }
 }

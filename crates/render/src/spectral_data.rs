@@ -310,7 +310,7 @@ pub fn naive_band_edges() -> (f64, f64) {
 }
 
 /// 0 = red, 1 = green, 2 = blue: the channel whose band contains `lambda`.
-fn naive_band(lambda: f64, blue_max: f64, green_max: f64) -> usize {
+pub fn naive_band(lambda: f64, blue_max: f64, green_max: f64) -> usize {
     if lambda < blue_max {
         2
     } else if lambda < green_max {

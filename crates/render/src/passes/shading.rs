@@ -48,6 +48,7 @@ impl ShadingPass {
             &[
                 shader::COMMON,
                 shader::SPECTRAL,
+                shader::ENVIRONMENT,
                 shader::CUSTOM_API,
                 custom_source,
                 include_str!("shading.wgsl"),

@@ -1,5 +1,6 @@
 // Pass 2: spectral (or RGB) shading of the G-buffer into the HDR target.
-// Prepended: wgsl/common.wgsl, wgsl/spectral.wgsl, wgsl/custom_api.wgsl, then the custom shader.
+// Prepended: wgsl/common.wgsl, wgsl/spectral.wgsl, wgsl/environment.wgsl, wgsl/custom_api.wgsl,
+// then the custom shader.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 
@@ -48,6 +49,10 @@ fn light_visibility(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return shadow_visibility(layer, p, n);
 }
 
+fn lambert_only() -> bool {
+    return (frame.flags & FLAG_LAMBERT) != 0u;
+}
+
 // Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
 // where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
@@ -59,6 +64,9 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
     let nl = dot(n, wi);
     if (nl <= 0.0 || atten <= 0.0) { return vec2<f32>(0.0); }
     atten *= light_visibility(li, p, n);
+    if (lambert_only()) {
+        return vec2<f32>(nl * atten / PI, 0.0);
+    }
     let h = normalize(wi + v);
     let nv = max(dot(n, v), 1e-4);
     let nh = max(dot(n, h), 0.0);
@@ -111,6 +119,12 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
         }
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
+        if (env_enabled()) {
+            let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+            rgb += s.base * et.a.rgb + et.b.rgb;
+        }
+    } else if (env_enabled() && env.flags.y != 0u) {
+        rgb = env_background(ctx.view_dir).rgb;
     }
     return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
 }
@@ -129,8 +143,14 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     // The spectral loop reads each light's factors once per wavelength group.
     var fa: array<f32, MAX_LIGHTS>;
     var fb: array<f32, MAX_LIGHTS>;
+    // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
+    var et: EnvTerms;
+    let has_env = env_enabled();
     if (!background) {
         let s = load_surface(px);
+        if (has_env) {
+            et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+        }
         base = s.base;
         emission = s.emission;
         ctx.normal = s.normal;
@@ -158,6 +178,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         }
     }
     if (background && !CUSTOM_SPECTRAL) {
+        if (has_env && env.flags.y != 0u) {
+            return vec4<f32>(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)), 1.0);
+        }
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let ng = frame.n_groups;
@@ -167,6 +190,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if (!CUSTOM_SPECTRAL) {
         for (var li = 0u; li < n_lights; li++) {
             xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
+        }
+        if (has_env) {
+            xyz += env_xyz(et.b);
         }
     }
     let zero = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
@@ -186,6 +212,12 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             acc_a += w * fa[li];
             if (CUSTOM_SPECTRAL) {
                 acc_b += w * fb[li];
+            }
+        }
+        if (has_env && !background) {
+            acc_a += env_w(et.a, g, ng);
+            if (CUSTOM_SPECTRAL) {
+                acc_b += env_w(et.b, g, ng);
             }
         }
         var em = vec4<f32>(0.0);

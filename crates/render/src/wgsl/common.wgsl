@@ -21,7 +21,11 @@ struct FrameUniforms {
     tonemap: u32,
     // Resolution of the Jakob–Hanika coefficient table.
     table_res: u32,
+    // Bit 0: Lambert only (base colour / π, no specular), RenderSettings::lambert.
+    flags: u32,
 };
+
+const FLAG_LAMBERT: u32 = 1u;
 
 const MODE_RGB: u32 = 0u;
 const MODE_NAIVE: u32 = 1u;

@@ -9,3 +9,35 @@ pub mod render;
 pub mod truth;
 pub mod upsample;
 pub mod view;
+
+/// The environment light on the command line, shared by `render`, `view` and `truth`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct EnvArgs {
+    /// Environment light: an equirectangular .hdr or .exr of linear radiance, `default` (a
+    /// uniform white D65 sky over a grey ground) or `none`. Default: the scene's own
+    /// (extras.environment), else the default environment when the scene has no lights at all.
+    #[arg(long, value_name = "FILE|default|none")]
+    pub env: Option<String>,
+    /// Multiplies the environment's radiance.
+    #[arg(long, value_name = "K")]
+    pub env_intensity: Option<f32>,
+    /// Turns the environment about +Y, degrees.
+    #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
+    pub env_rotation: Option<f32>,
+}
+
+impl EnvArgs {
+    /// Sets the scene's environment as asked; prints the note (default environment chosen) or
+    /// warning (nothing lights the scene) on stderr.
+    pub fn apply(&self, scene: &mut scene::Scene) -> anyhow::Result<()> {
+        let choice = scene::environment::EnvironmentChoice {
+            env: self.env.clone(),
+            intensity: self.env_intensity,
+            rotation: self.env_rotation,
+        };
+        if let Some(note) = choice.apply(scene)? {
+            eprintln!("{note}");
+        }
+        Ok(())
+    }
+}

@@ -88,6 +88,12 @@ pub struct LookArgs {
     /// reflection and total internal reflection of the water below, not of the sea floor).
     #[arg(long)]
     pub water_surface: bool,
+    #[command(flatten)]
+    pub env: super::EnvArgs,
+    /// Lambert only: every surface reflects base colour / π, no specular (like `truth
+    /// --lambert`; for comparisons with renderers without the glTF BRDF, and the white furnace).
+    #[arg(long)]
+    pub lambert: bool,
 }
 
 impl LookArgs {
@@ -231,6 +237,7 @@ fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
         timestamps: false,
         jitter: None,
         quadrature: args.look.quadrature,
+        lambert: args.look.lambert,
     };
     s.validate()
         .map_err(|e| if s.wavelengths == 0 { anyhow!("--wavelengths 0: {e}") } else { anyhow!("{e}") })?;
@@ -253,7 +260,9 @@ pub fn load_table(explicit: Option<&Path>) -> Result<Arc<CoeffTable>> {
 pub fn run(args: RenderArgs) -> Result<()> {
     let format = out_format(&args.out)?;
     let (width, height) = parse_size(&args.size)?;
-    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene =
+        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    args.look.env.apply(&mut scene)?;
     let settings = settings(&args, &scene)?;
     let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
     let table = load_table(args.look.table.as_deref())?;
@@ -286,6 +295,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());
         format!(", under water {ty} at {} m", m.depth)
     });
+    let under = match &scene.environment {
+        Some(e) => format!("{under}, environment {} × {}", e.source, e.intensity),
+        None => under,
+    };
     eprintln!(
         "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
         args.out.display(),

@@ -42,6 +42,7 @@ pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSetti
         timestamps: true,
         jitter: None,
         quadrature: args.look.quadrature,
+        lambert: args.look.lambert,
     };
     s.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(s)
@@ -54,7 +55,9 @@ fn display_named(display: Option<std::ffi::OsString>) -> bool {
 
 pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
-    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene =
+        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    args.look.env.apply(&mut scene)?;
     let settings = initial_settings(&args, &scene)?;
     let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
     let water_options = args.look.underwater()?;

@@ -1,0 +1,171 @@
+//! The environment's GPU resources: prefiltered coefficient maps (one set per coefficient
+//! space: RGB for the rgb and naive modes, the PCA basis for spectral), the split-sum table, a
+//! sampler and the per-frame uniforms. See [`crate::environment`] for what the maps hold.
+
+use crate::environment::{self, EnvMaps, LUT_SIZE, Map, SpectralBasis};
+use color::upsample::CoeffTable;
+use glam::Vec4;
+use half::f16;
+use wgpu::util::DeviceExt;
+
+/// Per-frame environment parameters. Matches `EnvUniforms` in `wgsl/environment.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct EnvUniforms {
+    /// XYZ of each basis spectrum seen by a reflectance of one (Σ of its node weights); the
+    /// spectral and naive modes' background and specular. w unused.
+    pub totals: [[f32; 4]; 4],
+    /// Rotation about +Y (radians), the coarsest mip level's index, intensity, unused.
+    pub params: [f32; 4],
+    /// x: 1 when there is an environment; y: 1 when it is drawn as the background.
+    pub flags: [u32; 4],
+}
+
+/// The textures of one coefficient space.
+pub struct EnvTextures {
+    pub radiance: wgpu::TextureView,
+    pub irradiance: wgpu::TextureView,
+    pub max_lod: f32,
+}
+
+/// An environment on the GPU (or the black stand-in when the scene has none).
+pub struct GpuEnvironment {
+    /// The scene's environment (intensity and rotation are read every frame).
+    pub source: Option<scene::Environment>,
+    rgb_map: Option<Map>,
+    pub rgb: EnvTextures,
+    /// Built on first use in spectral mode.
+    pub spectral: Option<(SpectralBasis, EnvTextures)>,
+    pub lut: wgpu::TextureView,
+    pub sampler: wgpu::Sampler,
+}
+
+fn upload_map(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, levels: &[Map]) -> wgpu::TextureView {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: levels[0].width, height: levels[0].height, depth_or_array_layers: 1 },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (mip, level) in levels.iter().enumerate() {
+        let data: Vec<[f16; 4]> = level.texels.iter().map(|t| t.to_array().map(f16::from_f32)).collect();
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: mip as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(&data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(8 * level.width),
+                rows_per_image: Some(level.height),
+            },
+            wgpu::Extent3d { width: level.width, height: level.height, depth_or_array_layers: 1 },
+        );
+    }
+    texture.create_view(&Default::default())
+}
+
+fn upload_maps(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, maps: &EnvMaps) -> EnvTextures {
+    EnvTextures {
+        radiance: upload_map(device, queue, &format!("{label} radiance"), &maps.radiance),
+        irradiance: upload_map(
+            device,
+            queue,
+            &format!("{label} irradiance"),
+            std::slice::from_ref(&maps.irradiance),
+        ),
+        max_lod: (maps.radiance.len() - 1) as f32,
+    }
+}
+
+impl GpuEnvironment {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, env: Option<&scene::Environment>) -> Self {
+        let black = Map { width: 2, height: 1, texels: vec![Vec4::ZERO; 2] };
+        let (rgb_map, maps) = match env {
+            Some(e) => {
+                let m = environment::rgb_map(e);
+                let maps = environment::prefilter(&m);
+                (Some(m), maps)
+            }
+            None => (None, EnvMaps { radiance: vec![black.clone()], irradiance: black }),
+        };
+        let rgb = upload_maps(device, queue, "environment (rgb)", &maps);
+        let lut: Vec<[f16; 4]> = environment::brdf_lut()
+            .into_iter()
+            .map(|ab| [f16::from_f32(ab[0]), f16::from_f32(ab[1]), f16::ZERO, f16::ZERO])
+            .collect();
+        let lut = device
+            .create_texture_with_data(
+                queue,
+                &wgpu::TextureDescriptor {
+                    label: Some("split-sum table"),
+                    size: wgpu::Extent3d { width: LUT_SIZE, height: LUT_SIZE, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba16Float,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytemuck::cast_slice(&lut),
+            )
+            .create_view(&Default::default());
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        GpuEnvironment { source: env.cloned(), rgb_map, rgb, spectral: None, lut, sampler }
+    }
+
+    /// Builds the spectral maps if the scene has an environment and they are not built yet.
+    pub fn ensure_spectral(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, table: &CoeffTable) {
+        if self.spectral.is_some() {
+            return;
+        }
+        let Some(m) = &self.rgb_map else { return };
+        let (basis, coeffs) = environment::spectral_basis(m, table);
+        let maps = environment::prefilter(&coeffs);
+        self.spectral = Some((basis, upload_maps(device, queue, "environment (spectral)", &maps)));
+    }
+
+    /// The frame's uniforms for `totals` (XYZ per basis spectrum).
+    pub fn uniforms(&self, totals: [[f32; 4]; 4], spectral: bool) -> EnvUniforms {
+        let Some(env) = &self.source else { return EnvUniforms::default() };
+        let max_lod = match (&self.spectral, spectral) {
+            (Some((_, t)), true) => t.max_lod,
+            _ => self.rgb.max_lod,
+        };
+        EnvUniforms { totals, params: [env.rotation, max_lod, env.intensity, 0.0], flags: [1, 1, 0, 0] }
+    }
+
+    /// The textures for `spectral` (PCA basis) or RGB coefficients.
+    pub fn textures(&self, spectral: bool) -> &EnvTextures {
+        match (&self.spectral, spectral) {
+            (Some((_, t)), true) => t,
+            _ => &self.rgb,
+        }
+    }
+
+    pub fn storage(device: &wgpu::Device, weights: &[crate::spectral_data::GroupWeights]) -> wgpu::Buffer {
+        let fallback = [[[0f32; 4]; 3]];
+        let w = if weights.is_empty() { &fallback[..] } else { weights };
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("environment basis weights"),
+            contents: bytemuck::cast_slice(w),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    }
+}

@@ -1,0 +1,84 @@
+// The environment light (src/environment.rs, src/env_gpu.rs): K = 4 coefficient maps whose
+// coefficients multiply the basis spectra's node weights. Bind group 2, after the spectral data.
+
+// Layout must match `EnvUniforms` in src/env_gpu.rs.
+struct EnvUniforms {
+    // XYZ of each basis spectrum seen by a reflectance of one (spectral and naive modes).
+    totals: array<vec4<f32>, 4>,
+    // x: rotation about +Y (radians), y: coarsest mip level, z: intensity.
+    params: vec4<f32>,
+    // x: 1 when there is an environment, y: 1 when it is the background.
+    flags: vec4<u32>,
+};
+
+// Node weights of basis spectrum j for group g at env_weights[j * n_groups + g].
+@group(2) @binding(5) var<storage, read> env_weights: array<mat3x4<f32>>;
+// Radiance coefficients, prefiltered: mip level m for GGX roughness m / (levels − 1).
+@group(2) @binding(6) var env_radiance: texture_2d<f32>;
+// Irradiance coefficients E(n) = ∫ L max(n·l, 0) dl.
+@group(2) @binding(7) var env_irradiance: texture_2d<f32>;
+// Split-sum table: (A, B) at (n·v, roughness).
+@group(2) @binding(8) var env_lut: texture_2d<f32>;
+@group(2) @binding(9) var env_sampler: sampler;
+@group(2) @binding(10) var<uniform> env: EnvUniforms;
+
+const ENV_LUT_SIZE: f32 = 32.0;
+
+fn env_enabled() -> bool {
+    return env.flags.x != 0u;
+}
+
+// Image coordinates of a world direction (scene::environment's convention: u = ½ + φ/2π with
+// φ = atan2(x, −z) − rotation, v = θ/π from +Y).
+fn env_uv(d: vec3<f32>) -> vec2<f32> {
+    let phi = atan2(d.x, -d.z) - env.params.x;
+    return vec2<f32>(fract(phi / (2.0 * PI) + 0.5), acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
+
+// Coefficients of the radiance arriving from direction d (unfiltered: the background).
+fn env_background(d: vec3<f32>) -> vec4<f32> {
+    return textureSampleLevel(env_radiance, env_sampler, env_uv(d), 0.0) * env.params.z;
+}
+
+// What the environment contributes at a surface, as two coefficient vectors: `a` multiplies
+// the reflectance ρ(λ) (diffuse, and metals' tinted specular), `b` does not (dielectric and
+// edge specular), like `light_factors` for a punctual light.
+struct EnvTerms {
+    a: vec4<f32>,
+    b: vec4<f32>,
+};
+
+fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool) -> EnvTerms {
+    var t: EnvTerms;
+    if (!env_enabled()) {
+        return t;
+    }
+    let k = env.params.z;
+    let irr = textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * k;
+    if (lambert) {
+        t.a = irr / PI;
+        return t;
+    }
+    let nv = max(dot(n, v), 1e-4);
+    let r = reflect(-v, n);
+    let half_texel = 0.5 / ENV_LUT_SIZE;
+    let lut_uv = clamp(vec2<f32>(nv, roughness), vec2<f32>(half_texel), vec2<f32>(1.0 - half_texel));
+    let ab = textureSampleLevel(env_lut, env_sampler, lut_uv, 0.0).xy;
+    let spec = textureSampleLevel(env_radiance, env_sampler, env_uv(r), roughness * env.params.y) * k;
+    // Directional albedo of the dielectric specular lobe: what the diffuse layer does not get.
+    let f_d = 0.04 * ab.x + ab.y;
+    t.a = (1.0 - metallic) * (1.0 - f_d) / PI * irr + metallic * ab.x * spec;
+    t.b = ((1.0 - metallic) * f_d + metallic * ab.y) * spec;
+    return t;
+}
+
+// Node weights of coefficients c for group g: Σ_j c_j · B_{j,g}.
+fn env_w(c: vec4<f32>, g: u32, n_groups: u32) -> mat3x4<f32> {
+    return env_weights[g] * c.x + env_weights[n_groups + g] * c.y + env_weights[2u * n_groups + g] * c.z
+        + env_weights[3u * n_groups + g] * c.w;
+}
+
+// XYZ of coefficients c seen by a reflectance of one.
+fn env_xyz(c: vec4<f32>) -> vec3<f32> {
+    return env.totals[0].xyz * c.x + env.totals[1].xyz * c.y + env.totals[2].xyz * c.z + env.totals[3].xyz * c.w;
+}

@@ -1,0 +1,127 @@
+//! The environment light against closed forms: the white furnace (a white Lambertian sphere in a
+//! uniform environment of radiance 1 is 1 everywhere), the default sky's irradiance on a sphere
+//! (sky 1 above, ground g below: a face turned up sees 1, sideways (1 + g)/2), the background,
+//! rotation, and the chart under the default sky in every mode.
+
+mod common;
+
+use common::renderer;
+use glam::{Vec2, Vec3, Vec4};
+use render::{Mode, RenderSettings};
+use scene::{Camera, Environment, Material, Mesh, Scene, SpectralSettings};
+
+fn sphere(n: u32) -> Mesh {
+    let mut m = Mesh::default();
+    for i in 0..=n {
+        let theta = std::f32::consts::PI * i as f32 / n as f32;
+        for j in 0..=2 * n {
+            let phi = std::f32::consts::PI * j as f32 / n as f32;
+            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            m.positions.push(p);
+            m.normals.push(p);
+            m.uvs.push(Vec2::new(j as f32 / (2 * n) as f32, i as f32 / n as f32));
+        }
+    }
+    let row = 2 * n + 1;
+    for i in 0..n {
+        for j in 0..2 * n {
+            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
+            m.indices.extend([a, b, c, b, d, c]);
+        }
+    }
+    m
+}
+
+fn sphere_scene(env: Environment) -> Scene {
+    Scene {
+        source: "test:sphere".into(),
+        meshes: vec![sphere(48)],
+        materials: vec![Material { base_color: Vec4::ONE, ..Default::default() }],
+        textures: vec![],
+        lights: vec![],
+        camera: Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 0.6),
+        spectral: SpectralSettings::default(),
+        water: None,
+        environment: Some(env),
+    }
+}
+
+const SIZE: u32 = 48;
+
+fn render(scene: &Scene, settings: &RenderSettings) -> Vec<[f32; 4]> {
+    let mut r = renderer();
+    r.set_scene(scene).unwrap();
+    r.resize(SIZE, SIZE).unwrap();
+    r.render(&scene.camera, settings).unwrap();
+    r.read_hdr().unwrap()
+}
+
+fn settings(mode: Mode, n: usize) -> RenderSettings {
+    RenderSettings { mode, wavelengths: n, lambert: true, shadows: false, ..Default::default() }
+}
+
+#[test]
+fn white_furnace_is_one_in_every_mode() {
+    let scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    for (mode, n) in [(Mode::Rgb, 16), (Mode::Naive, 16), (Mode::Spectral, 16), (Mode::Spectral, 5)] {
+        let img = render(&scene, &settings(mode, n));
+        // Every pixel, sphere and background alike.
+        for (i, px) in img.iter().enumerate() {
+            for (c, v) in px[..3].iter().enumerate() {
+                assert!((v - 1.0).abs() < 0.01, "{mode:?} N={n}: pixel {i} channel {c} = {v}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_gltf_brdf_keeps_energy_in_the_furnace() {
+    // Dielectric, rough: diffuse (1 − F_avg) + specular F_avg = 1 by construction of the split sum.
+    let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    scene.materials[0].roughness = 1.0;
+    let s = RenderSettings { lambert: false, ..settings(Mode::Spectral, 16) };
+    let img = render(&scene, &s);
+    let centre = img[(SIZE / 2 * SIZE + SIZE / 2) as usize];
+    assert!((centre[1] - 1.0).abs() < 0.03, "{centre:?}");
+}
+
+#[test]
+fn default_sky_lights_a_white_sphere_as_the_closed_form_says() {
+    let g = scene::environment::DEFAULT_GROUND;
+    let scene = sphere_scene(Environment::default_sky());
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        let img = render(&scene, &settings(mode, 16));
+        let at = |x: u32, y: u32| img[(y * SIZE + x) as usize];
+        // The centre faces the camera (+Z, horizontal): (1 + g) / 2.
+        let c = at(SIZE / 2, SIZE / 2);
+        let want = (1.0 + g) / 2.0;
+        assert!((c[1] - want).abs() < 0.03 * want, "{mode:?}: centre {c:?}, want {want}");
+        // Background: sky above, ground below.
+        assert!((at(1, 1)[1] - 1.0).abs() < 0.01, "{mode:?}: {:?}", at(1, 1));
+        assert!((at(1, SIZE - 2)[1] - g).abs() < 0.01, "{mode:?}: {:?}", at(1, SIZE - 2));
+        // Near the top of the sphere the normal points up: brighter than the centre.
+        let top = (0..SIZE / 2).map(|y| at(SIZE / 2, y)).find(|p| (p[1] - 1.0).abs() > 0.02).unwrap();
+        assert!(top[1] > c[1], "{mode:?}: top {top:?} vs centre {c:?}");
+    }
+}
+
+#[test]
+fn rotation_turns_the_environment_about_y() {
+    // Red towards −Z (the image's centre half), blue behind: the background straight ahead is red;
+    // rotated by 180° it is blue.
+    let (w, h) = (16u32, 8u32);
+    let texels = (0..w * h)
+        .map(|i| if (4..12).contains(&(i % w)) { Vec3::new(1.0, 0.0, 0.0) } else { Vec3::new(0.0, 0.0, 1.0) })
+        .collect();
+    let env = Environment::from_rgb("halves", w, h, texels).unwrap();
+    let mut scene = sphere_scene(env.clone());
+    // A background pixel near the left edge, looking almost down −Z.
+    let px = (SIZE / 2 * SIZE + 1) as usize;
+    let img = render(&scene, &settings(Mode::Rgb, 16));
+    let c = img[px];
+    assert!(c[0] > 0.9 && c[2] < 0.1, "{c:?}");
+    scene.environment = Some(env.with_rotation_degrees(180.0).unwrap());
+    let img = render(&scene, &settings(Mode::Rgb, 16));
+    let c = img[px];
+    assert!(c[2] > 0.9 && c[0] < 0.1, "{c:?}");
+}
