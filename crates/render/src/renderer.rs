@@ -196,6 +196,12 @@ impl Renderer {
         }
     }
 
+    /// Emissive polygons lit with as area lights, and (count, fraction of emitted power) of those
+    /// left out because the renderer handles at most `MAX_LIGHTS` lights in all.
+    pub fn emitter_summary(&self) -> Option<(usize, usize, f64)> {
+        self.scene.as_ref().map(|s| (s.emitters.len(), s.dropped_emitters.0, s.dropped_emitters.1))
+    }
+
     /// The environment in use, if any.
     pub fn environment(&self) -> Option<&scene::Environment> {
         self.environment.source.as_ref()
@@ -563,6 +569,18 @@ impl Renderer {
             let mut gpu = GpuLight::new(light, setup.light_rgb(&light.emission));
             if settings.mode != Mode::Rgb {
                 let w = setup.light_weights(&light.emission, settings.mode, &self.table)?;
+                let total = SpectralSetup::light_total(&w);
+                gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
+                light_weights.extend(setup.gpu_weights(&w));
+            } else {
+                light_weights.extend(std::iter::repeat_n([[0f32; 4]; 3], ng));
+            }
+            lights.push(gpu);
+        }
+        for e in &scene.emitters {
+            let mut gpu = GpuLight::polygon(e, setup.light_rgb(&e.emission));
+            if settings.mode != Mode::Rgb {
+                let w = setup.light_weights(&e.emission, settings.mode, &self.table)?;
                 let total = SpectralSetup::light_total(&w);
                 gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
                 light_weights.extend(setup.gpu_weights(&w));

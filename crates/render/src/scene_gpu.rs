@@ -55,6 +55,9 @@ pub struct GpuLight {
     /// Spectral modes: XYZ of the light seen by a reflectance of one (the sum of its node
     /// weights), for the terms that do not depend on the surface's reflectance (specular).
     pub xyz: [f32; 4],
+    /// Polygon lights (kind 3): the fourth vertex (xyz; a copy of the third for a triangle) and
+    /// the vertex count (w).
+    pub extra: [f32; 4],
 }
 
 impl GpuLight {
@@ -90,6 +93,22 @@ impl GpuLight {
     }
 }
 
+impl GpuLight {
+    /// An emissive polygon ([`scene::emitters::Emitter`]) as a light of kind 3: vertices in
+    /// `pos_kind`, `dir_range`, `cone` and `extra` (xyz), `rgb` its radiance for the RGB mode.
+    pub fn polygon(e: &scene::emitters::Emitter, rgb: [f64; 3]) -> Self {
+        let v = |i: usize| e.vertices[i.min(e.vertices.len() - 1)];
+        GpuLight {
+            pos_kind: v(0).extend(3.0).to_array(),
+            dir_range: v(1).extend(0.0).to_array(),
+            cone: v(2).extend(e.area).to_array(),
+            rgb: [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0],
+            xyz: [0.0; 4],
+            extra: v(3).extend(e.vertices.len() as f32).to_array(),
+        }
+    }
+}
+
 /// One indexed draw.
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
@@ -106,6 +125,11 @@ pub struct GpuScene {
     pub draws: Vec<Draw>,
     pub materials: Vec<wgpu::BindGroup>,
     pub lights: Vec<scene::Light>,
+    /// Emissive polygons lit with as area lights (after `lights` in the GPU light list), the
+    /// brightest that fit in [`MAX_LIGHTS`].
+    pub emitters: Vec<scene::emitters::Emitter>,
+    /// Emissive polygons left out by the cap, and the fraction of the emitted power they carry.
+    pub dropped_emitters: (usize, f64),
     pub camera: scene::Camera,
     /// World-space bounding box of all geometry.
     pub bounds: (Vec3, Vec3),
@@ -183,6 +207,17 @@ impl GpuScene {
         if vertices.is_empty() {
             return Err(bad("the scene has no geometry".into()));
         }
+        let mut emitters = scene::emitters::emitters(s);
+        let room = MAX_LIGHTS - s.lights.len();
+        let dropped_emitters = if emitters.len() > room {
+            let total: f64 = emitters.iter().map(|e| e.power()).sum();
+            let kept: f64 = emitters[..room].iter().map(|e| e.power()).sum();
+            let n = emitters.len() - room;
+            emitters.truncate(room);
+            (n, if total > 0.0 { 1.0 - kept / total } else { 0.0 })
+        } else {
+            (0, 0.0)
+        };
         let textures = upload_textures(device, queue, s)?;
         let defaults = DefaultTextures::new(device, queue);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -270,6 +305,8 @@ impl GpuScene {
             draws,
             materials,
             lights: s.lights.clone(),
+            emitters,
+            dropped_emitters,
             camera: s.camera,
             bounds: (lo, hi),
         })

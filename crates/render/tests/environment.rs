@@ -125,3 +125,70 @@ fn rotation_turns_the_environment_about_y() {
     let c = img[px];
     assert!(c[2] > 0.9 && c[0] < 0.1, "{c:?}");
 }
+
+fn quad(centre: Vec3, half: f32, normal_down: bool, y_plane: bool) -> Mesh {
+    let (a, b) = (half, half);
+    let positions = if y_plane {
+        vec![
+            centre + Vec3::new(-a, 0.0, -b),
+            centre + Vec3::new(a, 0.0, -b),
+            centre + Vec3::new(a, 0.0, b),
+            centre + Vec3::new(-a, 0.0, b),
+        ]
+    } else {
+        unreachable!()
+    };
+    let n = if normal_down { Vec3::NEG_Y } else { Vec3::Y };
+    // Counter-clockwise seen from the side the normal points to.
+    let indices = if normal_down { vec![0, 1, 2, 0, 2, 3] } else { vec![0, 2, 1, 0, 3, 2] };
+    Mesh { positions, normals: vec![n; 4], tangents: vec![], uvs: vec![Vec2::ZERO; 4], indices, material: 0 }
+}
+
+/// E/L at the origin (normal +Y) from a square of half-side `half` at height `h` above it,
+/// by a 400² midpoint sum of cos·cos/r².
+fn square_irradiance(half: f32, h: f32) -> f64 {
+    let n = 400;
+    let d = 2.0 * half as f64 / n as f64;
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let x = -half as f64 + (i as f64 + 0.5) * d;
+            let z = -half as f64 + (j as f64 + 0.5) * d;
+            let r2 = x * x + z * z + (h * h) as f64;
+            sum += (h as f64 / r2.sqrt()).powi(2) / r2 * d * d;
+        }
+    }
+    sum
+}
+
+#[test]
+fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
+    let mut floor = quad(Vec3::ZERO, 3.0, false, true);
+    floor.material = 0;
+    let mut lamp = quad(Vec3::new(0.0, 1.0, 0.0), 0.5, true, true);
+    lamp.material = 1;
+    let radiance = 2.0f32;
+    let scene = Scene {
+        source: "test:lamp".into(),
+        meshes: vec![floor, lamp],
+        materials: vec![
+            Material { base_color: Vec4::ONE, ..Default::default() },
+            Material { base_color: Vec4::ONE, emissive: Vec3::splat(radiance), ..Default::default() },
+        ],
+        textures: vec![],
+        lights: vec![],
+        camera: Camera::look_at(Vec3::new(0.0, 0.5, 3.0), Vec3::ZERO, Vec3::Y, 0.3),
+        spectral: SpectralSettings::default(),
+        water: None,
+        environment: None,
+    };
+    let want = radiance as f64 * square_irradiance(0.5, 1.0) / std::f64::consts::PI;
+    for (mode, shadows) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {
+        let s = RenderSettings { shadows, ..settings(mode, 16) };
+        let img = render(&scene, &s);
+        let c = img[(SIZE / 2 * SIZE + SIZE / 2) as usize];
+        for v in &c[..3] {
+            assert!((*v as f64 - want).abs() < 0.01 * want, "{mode:?} shadows {shadows}: {c:?}, want {want}");
+        }
+    }
+}

@@ -9,6 +9,7 @@ mod accessors;
 pub mod builtin;
 mod context;
 pub mod emission;
+pub mod emitters;
 pub mod environment;
 mod error;
 pub mod export;

@@ -58,6 +58,9 @@ fn lambert_only() -> bool {
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
 fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+    if (u32(lights[li].pos_kind.w) == 3u) {
+        return polygon_factors(li, p, n, v, metallic, roughness);
+    }
     let inc = light_incidence(li, p);
     let wi = inc.xyz;
     var atten = inc.w;
@@ -82,6 +85,99 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
     let k = nl * atten;
     let a = k * ((1.0 - metallic) * (1.0 - f_dielectric) / PI + metallic * dv * (1.0 - fres));
     let b = k * dv * ((1.0 - metallic) * f_dielectric + metallic * fres);
+    return vec2<f32>(a, b);
+}
+
+// E/L of a polygon light at p with normal n: ∫ max(n·l, 0) dl over the polygon clipped to
+// the hemisphere of n (Lambert's formula, exact: the cosine-weighted solid angle), i.e. the
+// irradiance per unit radiance.
+fn polygon_irradiance(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let count = polygon_count(li);
+    // Clip (Sutherland–Hodgman) against the plane n·x = 0 through p: at most 5 vertices.
+    var q: array<vec3<f32>, 5>;
+    var m = 0u;
+    for (var i = 0u; i < count; i++) {
+        let a = polygon_vertex(li, i) - p;
+        let b = polygon_vertex(li, (i + 1u) % count) - p;
+        let da = dot(n, a);
+        let db = dot(n, b);
+        if (da > 0.0) {
+            q[m] = a;
+            m++;
+        }
+        if ((da > 0.0) != (db > 0.0)) {
+            q[m] = a + (b - a) * (da / (da - db));
+            m++;
+        }
+    }
+    if (m < 3u) { return 0.0; }
+    var sum = 0.0;
+    for (var i = 0u; i < m; i++) {
+        let a = normalize(q[i]);
+        let b = normalize(q[(i + 1u) % m]);
+        let c = cross(a, b);
+        let s = length(c);
+        if (s > 1e-7) {
+            sum += atan2(s, dot(a, b)) * dot(n, c) / s;
+        }
+    }
+    return 0.5 * abs(sum);
+}
+
+// `light_factors` for a polygon light (an emissive surface, src/scene_gpu.rs): diffuse exactly
+// (polygon_irradiance), specular by the representative point (Karis 2013: the point of the
+// polygon nearest the mirror ray, with the lobe widened by the light's size), shadowed by one
+// shadow map from the centroid.
+fn polygon_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+    let ln = polygon_normal(li);
+    let v0 = polygon_vertex(li, 0u);
+    // One-sided: nothing reaches points behind the emitting side.
+    if (dot(p - v0, ln) <= 0.0) { return vec2<f32>(0.0); }
+    let g = polygon_irradiance(li, p, n);
+    if (g <= 0.0) { return vec2<f32>(0.0); }
+    let vis = light_visibility(li, p, n);
+    if (lambert_only()) {
+        return vec2<f32>(g * vis / PI, 0.0);
+    }
+    // Representative point: where the mirror ray meets the light's plane, else the centroid,
+    // pulled into the polygon's bounding sphere.
+    let c = polygon_centroid(li);
+    let r = reflect(-v, n);
+    let denom = dot(ln, r);
+    var q = c;
+    if (denom < -1e-6) {
+        let t = dot(ln, v0 - p) / denom;
+        if (t > 0.0) { q = p + r * t; }
+    }
+    let area = lights[li].cone.w;
+    let radius = sqrt(area / PI);
+    let off = q - c;
+    let ol = length(off);
+    if (ol > radius) { q = c + off * (radius / ol); }
+    let d = q - p;
+    let dist2 = max(dot(d, d), 1e-8);
+    let wi = d * inverseSqrt(dist2);
+    let nl = dot(n, wi);
+    let nv = max(dot(n, v), 1e-4);
+    let h = normalize(wi + v);
+    let nh = max(dot(n, h), 0.0);
+    let vh = max(dot(v, h), 0.0);
+    let alpha = max(roughness * roughness, 1e-3);
+    // Widened lobe and its energy normalisation (α/α')².
+    let alpha_w = clamp(alpha + radius / (2.0 * sqrt(dist2)), alpha, 1.0);
+    let a2 = alpha_w * alpha_w;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let dist_d = a2 / (PI * dd * dd) * (alpha / alpha_w) * (alpha / alpha_w);
+    let a2v = alpha * alpha;
+    let nlc = max(nl, 1e-4);
+    let vis_s = 0.5 / (nlc * sqrt(nv * nv * (1.0 - a2v) + a2v) + nv * sqrt(nlc * nlc * (1.0 - a2v) + a2v));
+    // Solid angle of the polygon from p (as a disc of its area seen at the light's cosine).
+    let omega = min(area * max(dot(ln, -wi), 0.0) / dist2, 2.0 * PI);
+    let dv = select(0.0, dist_d * vis_s * nl * omega, nl > 0.0);
+    let fres = pow(1.0 - vh, 5.0);
+    let f_dielectric = 0.04 + 0.96 * fres;
+    let a = vis * ((1.0 - metallic) * (1.0 - f_dielectric) * g / PI + metallic * dv * (1.0 - fres));
+    let b = vis * dv * ((1.0 - metallic) * f_dielectric + metallic * fres);
     return vec2<f32>(a, b);
 }
 

@@ -163,7 +163,7 @@ impl ShadowPass {
     /// Chooses the shadowed lights of `scene` (none when `enabled` is false), uploads their
     /// matrices for the shadow and shading passes.
     pub fn update(&mut self, queue: &wgpu::Queue, scene: &GpuScene, enabled: bool) {
-        let (uniforms, layers) = assign(&scene.lights, scene.bounds, enabled);
+        let (uniforms, layers) = assign(&scene.lights, &scene.emitters, scene.bounds, enabled);
         for (layer, (buffer, _)) in uniforms.view_proj.iter().zip(&self.layer_buffers).take(layers.len()) {
             queue.write_buffer(buffer, 0, bytemuck::bytes_of(layer));
         }
@@ -218,7 +218,12 @@ impl ShadowPass {
 }
 
 /// Gives the first [`MAX_SHADOWS`] lights that have a frustum a layer each, in scene order.
-fn assign(lights: &[scene::Light], bounds: (Vec3, Vec3), enabled: bool) -> (ShadowUniforms, Vec<Layer>) {
+fn assign(
+    lights: &[scene::Light],
+    emitters: &[scene::emitters::Emitter],
+    bounds: (Vec3, Vec3),
+    enabled: bool,
+) -> (ShadowUniforms, Vec<Layer>) {
     let mut u = ShadowUniforms {
         view_proj: [Mat4::IDENTITY.to_cols_array_2d(); MAX_SHADOWS],
         bias: [[0.0; 4]; MAX_SHADOWS],
@@ -238,6 +243,20 @@ fn assign(lights: &[scene::Light], bounds: (Vec3, Vec3), enabled: bool) -> (Shad
         u.bias[layer][0] = bias;
         u.layer_of_light[li / 4][li % 4] = layer as u32;
         layers.push(Layer { skip_mesh: light.stands_in_for });
+    }
+    // Emissive polygons follow the punctual lights in the GPU list: each shadowed from its
+    // centroid, looking along its normal (150° wide), without its own mesh.
+    for (ei, e) in emitters.iter().enumerate() {
+        let li = lights.len() + ei;
+        if layers.len() == MAX_SHADOWS || li >= MAX_LIGHTS {
+            break;
+        }
+        let Some((view_proj, bias)) = emitter_view_proj(e, bounds) else { continue };
+        let layer = layers.len();
+        u.view_proj[layer] = view_proj.to_cols_array_2d();
+        u.bias[layer][0] = bias;
+        u.layer_of_light[li / 4][li % 4] = layer as u32;
+        layers.push(Layer { skip_mesh: Some(e.mesh) });
     }
     (u, layers)
 }
@@ -277,6 +296,21 @@ pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Ma
     }
 }
 
+/// The shadow frustum of an emissive polygon: a 150° perspective from its centroid along its
+/// emitting normal (what lies outside it is treated as lit; the polygon's extent is ignored, so
+/// shadows are as hard as a point light's at the centroid).
+pub fn emitter_view_proj(e: &scene::emitters::Emitter, bounds: (Vec3, Vec3)) -> Option<(Mat4, f32)> {
+    let centre = (bounds.0 + bounds.1) * 0.5;
+    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let texel = 2.0 * radius / SHADOW_SIZE as f32;
+    let d = e.normal.try_normalize()?;
+    let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let eye = e.centroid() + d * (1e-4 * radius);
+    let far = (eye - centre).length() + radius * 2.0;
+    let view = Mat4::look_at_rh(eye, eye + d, up);
+    Some((Mat4::perspective_rh(150f32.to_radians(), 1.0, far * 1e-3, far) * view, texel * 1.5))
+}
+
 // `layer_of_light` packs four lights per vec4<u32>.
 const _: () = assert!(MAX_LIGHTS.is_multiple_of(4));
 
@@ -306,7 +340,7 @@ mod tests {
         let degenerate = LightKind::Directional { direction: Vec3::ZERO };
         let mut lights = vec![light(degenerate, None), light(sun.clone(), Some(3))];
         lights.extend((0..MAX_SHADOWS).map(|_| light(sun.clone(), None)));
-        let (u, layers) = assign(&lights, bounds, true);
+        let (u, layers) = assign(&lights, &[], bounds, true);
         let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
         assert_eq!(layer(0), NO_SHADOW, "no frustum, no map");
         assert_eq!(
@@ -317,7 +351,7 @@ mod tests {
         assert_eq!(layers.len(), MAX_SHADOWS);
         assert_eq!(layers[0].skip_mesh, Some(3), "a stand-in skips its own mesh");
         assert!(layers[1..].iter().all(|l| l.skip_mesh.is_none()));
-        let (u, layers) = assign(&lights, bounds, false);
+        let (u, layers) = assign(&lights, &[], bounds, false);
         assert!(layers.is_empty() && u.layer_of_light.iter().flatten().all(|&l| l == NO_SHADOW));
     }
 }

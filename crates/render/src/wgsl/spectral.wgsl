@@ -19,7 +19,7 @@ struct WavelengthGroup {
 // A light. Its node weights live in `light_weights[light * n_groups + group]`.
 struct GpuLight {
     // xyz position (point/spot) or direction the light travels (directional); w = kind
-    // (0 directional, 1 point, 2 spot).
+    // (0 directional, 1 point, 2 spot, 3 polygon).
     pos_kind: vec4<f32>,
     // xyz spot direction (unit, away from the light); w = range (0 = infinite).
     dir_range: vec4<f32>,
@@ -31,7 +31,40 @@ struct GpuLight {
     // Spectral modes: XYZ of the light seen by a reflectance of one (Σ of its node weights),
     // for the terms that do not depend on the reflectance (specular). w unused.
     xyz: vec4<f32>,
+    // Polygon lights (kind 3, emissive surfaces): vertices in pos_kind.xyz, dir_range.xyz,
+    // cone.xyz (cone.w = area) and extra.xyz (a copy of the third for a triangle); extra.w =
+    // vertex count.
+    extra: vec4<f32>,
 };
+
+fn polygon_vertex(li: u32, i: u32) -> vec3<f32> {
+    let l = lights[li];
+    switch i {
+        case 0u: { return l.pos_kind.xyz; }
+        case 1u: { return l.dir_range.xyz; }
+        case 2u: { return l.cone.xyz; }
+        default: { return l.extra.xyz; }
+    }
+}
+
+fn polygon_count(li: u32) -> u32 {
+    return u32(lights[li].extra.w);
+}
+
+fn polygon_centroid(li: u32) -> vec3<f32> {
+    let n = polygon_count(li);
+    var c = vec3<f32>(0.0);
+    for (var i = 0u; i < n; i++) {
+        c += polygon_vertex(li, i);
+    }
+    return c / f32(n);
+}
+
+// Unit normal of the emitting side (the vertices wind counter-clockwise seen from it).
+fn polygon_normal(li: u32) -> vec3<f32> {
+    let a = polygon_vertex(li, 0u);
+    return normalize(cross(polygon_vertex(li, 1u) - a, polygon_vertex(li, 2u) - a));
+}
 
 // Unit direction from `p` towards light `li` (xyz) and the light's distance falloff at `p`
 // (w): 1 for a directional light; 1/r² × the glTF range window × the spot cone otherwise.
@@ -40,6 +73,16 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
     let kind = u32(light.pos_kind.w);
     if (kind == 0u) {
         return vec4<f32>(-light.pos_kind.xyz, 1.0);
+    }
+    if (kind == 3u) {
+        // A polygon seen from afar: a point at its centroid with intensity L·area·cos (the
+        // shading pass integrates polygons exactly; this serves the custom hooks).
+        let c = polygon_centroid(li);
+        let d = c - p;
+        let dist2 = max(dot(d, d), 1e-8);
+        let wi = d * inverseSqrt(dist2);
+        let cos_l = max(dot(polygon_normal(li), -wi), 0.0);
+        return vec4<f32>(wi, light.cone.w * cos_l / dist2);
     }
     let d = light.pos_kind.xyz - p;
     let dist2 = max(dot(d, d), 1e-8);
