@@ -80,6 +80,8 @@ struct Running {
     last_view: Option<(scene::Camera, RenderSettings)>,
     /// The water panel, when the camera is under water.
     water: Option<WaterState>,
+    /// The environment panel.
+    env: super::environment::EnvControls,
 }
 
 /// The water the viewer started with and the panel's edits of it.
@@ -202,6 +204,7 @@ impl Running {
             pending_free: Vec::new(),
             last_view: None,
             water,
+            env: super::environment::EnvControls::new(opts.scene.environment.clone()),
         })
     }
 
@@ -333,11 +336,13 @@ impl Running {
         let (times, adapter) = (self.times, self.adapter.clone());
         let controls = &mut self.controls;
         let water = &mut self.water;
+        let env = &mut self.env;
         let mut out = ctx.run_pass(raw, |ctx| {
             egui::Window::new("spectra").default_pos([8.0, 8.0]).default_width(300.0).vscroll(true).show(
                 ctx,
                 |ui| {
                     controls.ui(ui, &times, &adapter, size);
+                    ui.collapsing("environment", |ui| env.ui(ui));
                     if let Some(w) = water {
                         ui.collapsing("water", |ui| {
                             w.wanted.ui(ui);
@@ -362,6 +367,9 @@ impl Running {
         }
         self.pending_free.extend(out.textures_delta.free.drain());
         self.controls.commit();
+        if self.env.apply(&mut self.renderer) {
+            self.last_view = None;
+        }
         if let Some(w) = &mut self.water
             && w.wanted != w.applied
         {
