@@ -159,35 +159,83 @@ def read_exr(path):
     return w, h, out
 
 
-def image_stats(path, lit_threshold):
-    """Mean/max luminance and the fraction of pixels brighter than lit_threshold."""
-    w, h, ch = read_exr(path)
-    _CACHE[path] = (w, h, ch)
-    missing = [c for c in "RGB" if c not in ch]
-    if missing:
-        raise ValueError(f"{path}: no {', '.join(missing)} channel")
-    r, g, b = ch["R"], ch["G"], ch["B"]
-    total, peak, lit, bad = 0.0, 0.0, 0, 0
+def luminance(ch, i):
+    return LUMA[0] * ch["R"][i] + LUMA[1] * ch["G"][i] + LUMA[2] * ch["B"][i]
+
+
+def image_stats(w, h, ch, lit_threshold, mask=None):
+    """Mean/max luminance and the fraction of pixels brighter than lit_threshold, over the
+    pixels where mask is True (all when mask is None)."""
+    total, peak, lit, bad, n = 0.0, 0.0, 0, 0, 0
     for i in range(w * h):
-        y = LUMA[0] * r[i] + LUMA[1] * g[i] + LUMA[2] * b[i]
+        if mask is not None and not mask[i]:
+            continue
+        y = luminance(ch, i)
         if not math.isfinite(y):
             bad += 1
             continue
+        n += 1
         total += y
         peak = max(peak, y)
         if y > lit_threshold:
             lit += 1
     return {
-        "width": w,
-        "height": h,
-        "mean_luminance": total / (w * h),
+        "pixels": n,
+        "mean_luminance": total / n if n else 0.0,
         "max_luminance": peak,
-        "lit_fraction": lit / (w * h),
+        "lit_fraction": lit / n if n else 0.0,
         "non_finite_pixels": bad,
     }
 
 
-_CACHE = {}
+def model_delta_e(csv_path, mask, width, block):
+    """Mean ΔE2000 over the model: from `spectra diff --per-pixel-out` (one row per pixel, or per
+    block with --block), keeping the pixels, or blocks at least half covered, of the model."""
+    total, n = 0.0, 0
+    with open(csv_path) as f:
+        next(f)
+        for line in f:
+            x, y, de = line.split(",")[:3]
+            x, y = int(x), int(y)
+            inside = 0
+            for yy in range(y * block, y * block + block):
+                row = yy * width
+                for xx in range(x * block, x * block + block):
+                    inside += mask[row + xx]
+            if 2 * inside >= block * block:
+                total += float(de)
+                n += 1
+    return {"model_delta_e2000_mean": total / n if n else None, "model_units": n}
+
+
+def default_background_mask(w, h, ch, k):
+    """True where a pixel shows the model, False where it shows the default environment's
+    background: its sky (k, k, k), its ground (k/4, k/4, k/4), or the blurred horizon between
+    them, which is neutral and constant along a row (the camera has no roll). Computed on the
+    noise-free rgb render and applied to all three images."""
+    model = [True] * (w * h)
+    for y in range(h):
+        neutral = []
+        for x in range(w):
+            i = y * w + x
+            r, g, b = ch["R"][i], ch["G"][i], ch["B"][i]
+            m = max(r, g, b)
+            if m > 0.0 and m - min(r, g, b) <= 1e-3 * m and 0.2475 * k <= m <= 1.005 * k:
+                neutral.append((m / k, i))
+        neutral.sort()
+        # Clusters of values within 0.5 % of their neighbours: the sky, the ground, or a
+        # horizon row (slowly varying along the row) when the cluster spans a tenth of the row.
+        start = 0
+        for j in range(1, len(neutral) + 1):
+            if j < len(neutral) and neutral[j][0] - neutral[j - 1][0] <= 0.005 * neutral[j][0]:
+                continue
+            cluster = neutral[start:j]
+            wide = len(cluster) >= 0.1 * w
+            for v, i in cluster:
+                if wide or abs(v - 0.25) <= 0.0025 or abs(v - 1.0) <= 0.005:
+                    model[i] = False
+            start = j
+    return model
 
 
 def _srgb8(v):
@@ -196,9 +244,9 @@ def _srgb8(v):
     return int(round(v * 255))
 
 
-def write_preview(exr_path, png_path):
+def write_preview(exr_path, png_path, image=None):
     """The EXR as an 8-bit sRGB PNG, clamped like `spectra render --out x.png --tonemap none`."""
-    w, h, ch = _CACHE.pop(exr_path, None) or read_exr(exr_path)
+    w, h, ch = image or read_exr(exr_path)
     lut = {}
     rows = bytearray()
     for y in range(h):
@@ -329,6 +377,7 @@ def run_model(a, runner, name, path, outdir):
         ("spectral", ["render", path, "--mode", "spectral", *common, *shlex.split(a.render_args)]),
         ("truth", ["truth", path, *common, "--spp", str(a.spp), *shlex.split(a.truth_args)]),
     ]
+    images = {}
     for key, args in jobs:
         img = os.path.join(outdir, key + ".exr")
         if os.path.exists(img):
@@ -349,18 +398,49 @@ def run_model(a, runner, name, path, outdir):
                 res["error"] = f"{key}: {r['error']}"
             continue
         try:
-            r.update(image_stats(img, a.lit_threshold))
-            r["black"] = r["mean_luminance"] < a.black_threshold or r["lit_fraction"] < a.min_lit_fraction
-            write_preview(img, os.path.join(outdir, key + ".png"))
+            images[key] = read_exr(img)
+            write_preview(img, os.path.join(outdir, key + ".png"), images[key])
         except (ValueError, OSError, struct.error, zlib.error) as e:
             r["error"] = f"cannot read the image: {e}"
-            r["black"] = None
-        log(
-            f"    {key:<9} {secs:6.1f} s  mean Y {r.get('mean_luminance', float('nan')):.4g}"
-            f"{'  BLACK' if r.get('black') else ''}"
-        )
+        log(f"    {key:<9} {secs:6.1f} s")
+    # Black check: over the model's pixels when the background is the default environment's
+    # (found on the rgb render, which has no noise), else over the whole image.
+    mask, k = None, a.env_intensity if a.env_intensity is not None else 1.0
+    default_bg = a.env == "default" or (a.env == "auto" and any("default environment" in n for n in res["notes"]))
+    base = images.get("rgb") or images.get("spectral")
+    if default_bg and base is not None:
+        mask = default_background_mask(*base, k)
+        res["model_coverage"] = sum(mask) / len(mask)
+        log(f"    model covers {res['model_coverage']:.1%} of the image (the rest is the default background)")
+    for key, (w, h, ch) in images.items():
+        r = res["renders"][key]
+        m = mask if mask is not None and len(mask) == w * h else None
+        r.update({"width": w, "height": h, "image": image_stats(w, h, ch, a.lit_threshold)})
+        if m is not None:
+            r["model"] = image_stats(w, h, ch, a.lit_threshold, m)
+        st = r.get("model", r["image"])
+        r["black"] = st["pixels"] == 0 or st["mean_luminance"] < a.black_threshold or (
+            st["lit_fraction"] < a.min_lit_fraction)
+        r["mean_luminance"] = st["mean_luminance"]
+        r["black_over"] = "model" if m is not None else "image"
+        log(f"    {key:<9} mean Y {st['mean_luminance']:.4g} over the {r['black_over']}, "
+            f"{st['lit_fraction']:.1%} lit{'  BLACK' if r['black'] else ''}")
     truth = os.path.join(outdir, "truth.exr")
-    for key in ("spectral", "rgb"):
+    keys = ["spectral", "rgb"]
+    if a.noise_floor and os.path.isfile(truth) and res["renders"]["truth"].get("exit_code") == 0:
+        # The truth's own noise: a second truth with another seed, measured like the renders.
+        seed2 = os.path.join(outdir, "truth_seed2.exr")
+        if os.path.exists(seed2):
+            os.remove(seed2)
+        args = [*jobs[2][1], "--seed", "2", "--out", seed2]
+        log(f"    {'truth2':<9} spectra {' '.join(shlex.quote(x) for x in args)}")
+        code, out, err, secs = runner.run(args)
+        res["renders"]["truth_seed2"] = {"command": ["spectra", *args], "exit_code": code, "seconds": round(secs, 2)}
+        if code == 0:
+            keys.append("truth_seed2")
+        else:
+            res["renders"]["truth_seed2"]["error"] = error_message(err, code)
+    for key in keys:
         img = os.path.join(outdir, key + ".exr")
         if not (os.path.isfile(truth) and os.path.isfile(img)) or res["renders"][key].get("exit_code") != 0:
             continue
@@ -369,6 +449,9 @@ def run_model(a, runner, name, path, outdir):
             args = ["diff", truth, img, "--json", "--block", str(block)]
             if block == a.block:
                 args += ["--heatmap", os.path.join(outdir, f"de_{key}_block{block}.png")]
+            csv_path = os.path.join(outdir, f".de_{key}_block{block}.csv")
+            if mask is not None:
+                args += ["--per-pixel-out", csv_path]
             code, out, err, _ = runner.run(args)
             if code != 0:
                 d[f"block{block}"] = {"error": error_message(err, code)}
@@ -379,10 +462,15 @@ def run_model(a, runner, name, path, outdir):
                 "delta_e2000_p95": j["delta_e2000"]["p95"],
                 "mae_linear_mean": j["mae_linear"]["mean"],
             }
+            if mask is not None and os.path.isfile(csv_path):
+                d[f"block{block}"].update(model_delta_e(csv_path, mask, images["truth"][0], block))
+                os.remove(csv_path)
         res["diffs"][f"{key}_vs_truth"] = d
-        be = d.get(f"block{a.block}", {}).get("delta_e2000_mean")
-        if be is not None:
-            log(f"    ΔE00 {key} vs truth, {a.block}x{a.block} block mean: {be:.3f}")
+        be = d.get(f"block{a.block}", {})
+        if be.get("delta_e2000_mean") is not None:
+            log(f"    ΔE00 {key} vs truth, {a.block}x{a.block} block mean: {be['delta_e2000_mean']:.3f} over the image"
+                + (f", {be['model_delta_e2000_mean']:.3f} over the model's {be['model_units']} blocks"
+                   if be.get("model_delta_e2000_mean") is not None else ""))
     return res
 
 
@@ -423,14 +511,19 @@ def write_reports(a, results, meta):
         f"{meta['size']} px, environment `{a.env}`"
         + (f" × {a.env_intensity}" if a.env_intensity is not None else "")
         + f", truth {a.spp} spp (`{' '.join(meta['truth_flags'])}`); ΔE2000 = mean CIEDE2000 against the truth"
-        f" on {a.block}×{a.block} block means (per pixel in brackets); black = mean luminance Y < {a.black_threshold}"
-        f" or fewer than {a.min_lit_fraction:.0%} of the pixels above Y = {a.lit_threshold}; mean Y is that of the"
-        f" linear image (1 = the default sky's radiance); times are wall-clock seconds per command (process"
-        f" start, scene load and upload included). Model paths are relative to `{meta['root']}`.",
+        f" on {a.block}×{a.block} block means (per pixel in brackets), over the whole image and over the model"
+        f" (the blocks at least half covered by it; the pixels of it); truth noise = the same block-mean ΔE00"
+        f" between the truth and a second truth with --seed 2; black = mean luminance Y < {a.black_threshold}"
+        f" or fewer than {a.min_lit_fraction:.0%} of the pixels above Y = {a.lit_threshold}, counted over the"
+        f" model's pixels (model px: the share of the image that is not the default environment's background)"
+        f" when the environment is the default one, else over the whole image; mean Y likewise, linear"
+        f" (1 = the default sky's radiance); seconds = wall-clock time per command (process start, scene"
+        f" load and upload included). Model paths are relative to `{meta['root']}`.",
         "",
-        "| model | load | black rgb / spectral / truth | mean Y rgb / spectral / truth | ΔE00 spectral–truth |"
-        " ΔE00 rgb–truth | seconds rgb / spectral / truth |",
-        "|---|---|---|---|---|---|---|",
+        "| model | load | model px | black rgb / spectral / truth | mean Y rgb / spectral / truth |"
+        " ΔE00 spectral–truth: image | ΔE00 spectral–truth: model | ΔE00 rgb–truth: image | ΔE00 rgb–truth: model"
+        " | truth noise: image / model | seconds rgb / spectral / truth |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     def short(text):
         return (text or "").replace(meta["root"] + os.sep, "").replace("|", "\\|")
@@ -439,7 +532,7 @@ def write_reports(a, results, meta):
         rs = r.get("renders", {})
         if r["status"] != "ok" and not any(x.get("exit_code") == 0 for x in rs.values()):
             err = short(r.get("error"))
-            lines.append(f"| {r['model']} | error: {err} | – | – | – | – | – |")
+            lines.append(f"| {r['model']} | error: {err} | – | – | – | – | – | – | – | – | – |")
             continue
         load = "ok" if r["status"] == "ok" else "error: " + short(r.get("error"))
         blacks = " / ".join(black_cell(rs.get(k)) for k in ("rgb", "spectral", "truth"))
@@ -447,16 +540,23 @@ def write_reports(a, results, meta):
 
         def de(key, r=r):
             d = r.get("diffs", {}).get(key, {})
-            b, p = d.get(blk, {}).get("delta_e2000_mean"), d.get("block1", {}).get("delta_e2000_mean")
-            return "–" if b is None else f"{b:.2f} ({fmt(p)})"
+            cells = []
+            for field in ("delta_e2000_mean", "model_delta_e2000_mean"):
+                b, p = d.get(blk, {}).get(field), d.get("block1", {}).get(field)
+                cells.append("–" if b is None else f"{b:.2f} ({fmt(p)})")
+            return " | ".join(cells)
 
         secs = " / ".join(fmt(rs.get(k, {}).get("seconds"), 1) for k in ("rgb", "spectral", "truth"))
-        des = f"{de('spectral_vs_truth')} | {de('rgb_vs_truth')}"
-        lines.append(f"| {r['model']} | {load} | {blacks} | {means} | {des} | {secs} |")
+        noise = r.get("diffs", {}).get("truth_seed2_vs_truth", {}).get(blk, {})
+        noise = " / ".join(fmt(noise.get(f)) for f in ("delta_e2000_mean", "model_delta_e2000_mean"))
+        des = f"{de('spectral_vs_truth')} | {de('rgb_vs_truth')} | {noise}"
+        cov = r.get("model_coverage")
+        cov = "–" if cov is None else f"{cov:.0%}"
+        lines.append(f"| {r['model']} | {load} | {cov} | {blacks} | {means} | {des} | {secs} |")
     lines.append("")
     notes = sorted({n for r in results for n in r.get("notes", [])})
     if notes:
-        lines += ["Notes printed by spectra:", ""] + [f"- {n}" for n in notes] + [""]
+        lines += ["Notes printed by spectra:", ""] + [f"- {short(n)}" for n in notes] + [""]
     if meta.get("interrupted"):
         lines += ["**Interrupted**: the table holds the models finished before Ctrl-C.", ""]
     lines.append(f"Machine: {meta['machine']}; spectra: `{meta['spectra']}`; {meta['date']}.")
@@ -571,6 +671,8 @@ def main():
     ap.add_argument("--truth-args", default="--direct-only",
                     help="extra flags for spectra truth (default: --direct-only)")
     ap.add_argument("--render-args", default="", help="extra flags for both spectra render runs")
+    ap.add_argument("--no-noise-floor", dest="noise_floor", action="store_false",
+                    help="skip the second truth (--seed 2) that measures the truth's own noise")
     ap.add_argument("--block", type=int, default=8, help="block size of the block-mean ΔE2000 (default: 8)")
     ap.add_argument("--black-threshold", type=float, default=1e-3,
                     help="an image whose mean luminance is below this is black (default: 1e-3)")
