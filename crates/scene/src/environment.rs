@@ -278,34 +278,52 @@ impl Environment {
     }
 }
 
+/// Mean irradiance (in the units where the default sky gives π on an upward face) below which
+/// emissive surfaces are glow, not lighting: 1 % of the default sky's.
+pub const EMISSIVE_LIGHTING_THRESHOLD: f64 = 0.01 * std::f64::consts::PI;
+
 /// What lights a scene, for the "is anything lit at all" decision both renderers share.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LightSources {
     /// Punctual lights (sky stand-ins included).
     pub punctual: usize,
-    /// Meshes whose material emits.
-    pub emissive_meshes: usize,
+    /// Emissive polygons (`crate::emitters`).
+    pub emitters: usize,
+    /// The flux the emissive surfaces emit (π·L·A each), spread over the scene's bounding
+    /// sphere: the mean irradiance they give. A lamp (bevy's CornellBox.glb: ≈ 1.5) lights the
+    /// scene; an emissive texture of small glowing details (DamagedHelmet's: ≈ 0.01) does not.
+    pub emissive_irradiance: f64,
     /// Whether a non-black environment surrounds the scene.
     pub environment: bool,
 }
 
 impl LightSources {
     pub fn of(scene: &crate::Scene) -> Self {
+        let emitters = crate::emitters::emitters(scene);
+        let flux: f64 = emitters.iter().map(|e| std::f64::consts::PI * e.power()).sum();
+        let radius = scene.bounds().map_or(0.0, |(lo, hi)| 0.5 * (hi - lo).length() as f64);
+        let emissive_irradiance = if radius > 0.0 {
+            flux / (4.0 * std::f64::consts::PI * radius * radius)
+        } else if flux > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
         LightSources {
             punctual: scene.lights.len(),
-            emissive_meshes: scene
-                .meshes
-                .iter()
-                .filter(|m| {
-                    scene.materials.get(m.material).is_some_and(|mat| mat.emissive.max_element() > 0.0)
-                })
-                .count(),
+            emitters: emitters.len(),
+            emissive_irradiance,
             environment: scene.environment.as_ref().is_some_and(|e| !e.is_black()),
         }
     }
 
+    /// Whether emissive surfaces are bright enough to count as the scene's lighting.
+    pub fn emitters_light(&self) -> bool {
+        self.emissive_irradiance >= EMISSIVE_LIGHTING_THRESHOLD
+    }
+
     pub fn any(&self) -> bool {
-        self.punctual > 0 || self.emissive_meshes > 0 || self.environment
+        self.punctual > 0 || self.emitters_light() || self.environment
     }
 }
 
@@ -362,8 +380,9 @@ impl EnvironmentChoice {
         }
         if !LightSources::of(scene).any() {
             note = Some(format!(
-                "warning: nothing lights {}: it has no lights, no emissive surfaces and no environment, so \
-                 the image will be black (drop --env none, or give --env FILE.hdr)",
+                "warning: nothing lights {}: it has no lights, no environment and no emissive surface bright \
+                 enough to light it, so the image will be (nearly) black (drop --env none, or give --env \
+                 FILE.hdr)",
                 scene.source
             ));
         }
@@ -461,6 +480,16 @@ mod tests {
         let e = t.environment.unwrap();
         assert_eq!(e.intensity, 2.0);
         assert!((e.rotation - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        // Lit by an emissive lamp alone (its stand-in light removed): no default environment;
+        // the same lamp dimmed to a glow: the default environment.
+        let mut lamp_only = lit.clone();
+        lamp_only.lights.clear();
+        assert!(LightSources::of(&lamp_only).emitters_light(), "{:?}", LightSources::of(&lamp_only));
+        assert!(EnvironmentChoice::default().apply(&mut lamp_only.clone()).unwrap().is_none());
+        let mut glow = lamp_only.clone();
+        glow.materials.iter_mut().for_each(|m| m.emissive *= 1e-4);
+        assert!(!LightSources::of(&glow).emitters_light());
+        assert!(EnvironmentChoice::default().apply(&mut glow).unwrap().is_some());
         let orphan = EnvironmentChoice { env: Some("none".into()), intensity: Some(2.0), rotation: None };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
     }

@@ -31,6 +31,8 @@ use std::time::Instant;
 pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
     pub scene: String,
+    #[command(flatten)]
+    pub env: super::EnvArgs,
     /// Frame size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
     pub size: String,
@@ -268,7 +270,9 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--frames 0: measure at least one frame");
     }
     let counts = parse_counts(&args.wavelengths)?;
-    let scene = scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene =
+        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    args.env.apply(&mut scene)?;
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
     r.set_scene(&scene)?;
     r.resize(width, height)?;
