@@ -295,9 +295,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());
         format!(", under water {ty} at {} m", m.depth)
     });
-    let under = match &scene.environment {
-        Some(e) => format!("{under}, environment {} × {}", e.source, e.intensity),
-        None => under,
+    let under = match (&scene.environment, r.environment_residual()) {
+        (Some(e), Some(res)) => {
+            format!("{under}, environment {} × {} (basis residual {res:.1e})", e.source, e.intensity)
+        }
+        (Some(e), None) => format!("{under}, environment {} × {}", e.source, e.intensity),
+        (None, _) => under,
+    };
+    let under = match r.emitter_summary() {
+        Some((n, 0, _)) if n > 0 => format!("{under}, {n} emissive polygon light(s)"),
+        Some((n, dropped, frac)) if dropped > 0 => format!(
+            "{under}, {n} emissive polygon lights (warning: {dropped} more left out, {:.1} % of the emitted power)",
+            100.0 * frac
+        ),
+        _ => under,
     };
     eprintln!(
         "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
