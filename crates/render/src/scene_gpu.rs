@@ -233,10 +233,15 @@ impl GpuScene {
             let tex = |r: &Option<scene::TextureRef>, default: &wgpu::TextureView| -> wgpu::TextureView {
                 r.map(|r| textures[r.index].clone()).unwrap_or_else(|| default.clone())
             };
-            for r in
-                [&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture]
-                    .into_iter()
-                    .flatten()
+            for r in [
+                &m.base_color_texture,
+                &m.metallic_roughness_texture,
+                &m.normal_texture,
+                &m.emissive_texture,
+                &m.occlusion_texture,
+            ]
+            .into_iter()
+            .flatten()
             {
                 if r.index >= textures.len() {
                     return Err(bad(format!(
@@ -250,7 +255,12 @@ impl GpuScene {
             let u = MaterialUniforms {
                 base_color: m.base_color.to_array(),
                 emissive: m.emissive.extend(m.normal_scale).to_array(),
-                params: [m.metallic, m.roughness, m.normal_texture.is_some() as u8 as f32, 0.0],
+                params: [
+                    m.metallic,
+                    m.roughness,
+                    m.normal_texture.is_some() as u8 as f32,
+                    if m.occlusion_texture.is_some() { m.occlusion_strength } else { 0.0 },
+                ],
             };
             let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(&m.name),
@@ -262,6 +272,7 @@ impl GpuScene {
                 tex(&m.metallic_roughness_texture, &defaults.white_linear),
                 tex(&m.normal_texture, &defaults.flat_normal),
                 tex(&m.emissive_texture, &defaults.white_srgb),
+                tex(&m.occlusion_texture, &defaults.white_linear),
             ];
             materials.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some(&m.name),
@@ -285,6 +296,10 @@ impl GpuScene {
                         resource: wgpu::BindingResource::TextureView(&views[3]),
                     },
                     wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(&sampler) },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: wgpu::BindingResource::TextureView(&views[4]),
+                    },
                 ],
             }));
         }

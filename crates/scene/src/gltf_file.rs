@@ -363,6 +363,11 @@ impl Loader<'_> {
                 Some(self.texture(&format!("{at}.normalTexture"), t.texture(), t.tex_coord(), false)?);
             out.normal_scale = t.scale();
         }
+        if let Some(t) = m.occlusion_texture() {
+            out.occlusion_texture =
+                Some(self.texture(&format!("{at}.occlusionTexture"), t.texture(), t.tex_coord(), false)?);
+            out.occlusion_strength = t.strength().clamp(0.0, 1.0);
+        }
         if let Some(t) = m.emissive_texture() {
             out.emissive_texture =
                 Some(self.texture(&format!("{at}.emissiveTexture"), t.texture(), t.tex_coord(), true)?);

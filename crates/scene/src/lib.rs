@@ -92,6 +92,11 @@ pub struct Material {
     pub metallic_roughness_texture: Option<TextureRef>,
     pub normal_texture: Option<TextureRef>,
     pub normal_scale: f32,
+    /// glTF `occlusionTexture` (R channel, linear): the author's baked ambient occlusion. The
+    /// real-time renderer darkens its environment light with it (glTF: "indirect lighting");
+    /// the path tracer traces occlusion and ignores it.
+    pub occlusion_texture: Option<TextureRef>,
+    pub occlusion_strength: f32,
     /// Linear RGB, already multiplied by `KHR_materials_emissive_strength`.
     pub emissive: Vec3,
     pub emissive_texture: Option<TextureRef>,
@@ -113,6 +118,8 @@ impl Default for Material {
             metallic_roughness_texture: None,
             normal_texture: None,
             normal_scale: 1.0,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
             emissive: Vec3::ZERO,
             emissive_texture: None,
             spectral: None,

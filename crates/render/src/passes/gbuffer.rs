@@ -37,6 +37,7 @@ impl GBufferPass {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                texture(6),
             ],
         });
         let module = shader::compile(device, "gbuffer", &[shader::COMMON, include_str!("gbuffer.wgsl")])?;

@@ -7,7 +7,8 @@ struct MaterialUniforms {
     base_color: vec4<f32>,
     // rgb emissive (linear, strength applied), w = normal scale.
     emissive: vec4<f32>,
-    // x metallic, y roughness, z = 1 when the mesh has tangents and a normal map.
+    // x metallic, y roughness, z = 1 when the mesh has tangents and a normal map, w occlusion
+    // strength (0 without an occlusion texture).
     params: vec4<f32>,
 };
 
@@ -17,6 +18,7 @@ struct MaterialUniforms {
 @group(1) @binding(3) var normal_tex: texture_2d<f32>;
 @group(1) @binding(4) var emissive_tex: texture_2d<f32>;
 @group(1) @binding(5) var material_sampler: sampler;
+@group(1) @binding(6) var occlusion_tex: texture_2d<f32>;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -47,7 +49,8 @@ struct GBufferOut {
     @location(0) base: vec4<f32>,
     // xyz unit world normal, w roughness.
     @location(1) normal: vec4<f32>,
-    // rgb linear emission, a = 1 where geometry was drawn.
+    // rgb linear emission, a ambient occlusion (glTF occlusionTexture × strength; 1 = none),
+    // applied to the environment light only.
     @location(2) emission: vec4<f32>,
 };
 
@@ -70,6 +73,7 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     var o: GBufferOut;
     o.base = vec4<f32>(base.rgb, clamp(material.params.x * mr.b, 0.0, 1.0));
     o.normal = vec4<f32>(n, clamp(material.params.y * mr.g, 0.0, 1.0));
-    o.emission = vec4<f32>(emissive, 1.0);
+    let ao = 1.0 + material.params.w * (textureSample(occlusion_tex, material_sampler, v.uv).r - 1.0);
+    o.emission = vec4<f32>(emissive, clamp(ao, 0.0, 1.0));
     return o;
 }

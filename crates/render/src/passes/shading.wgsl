@@ -188,12 +188,15 @@ struct GSurface {
     normal: vec3<f32>,
     metallic: f32,
     roughness: f32,
+    // The material's ambient occlusion (glTF occlusionTexture), for the environment only.
+    occlusion: f32,
 };
 
 fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
-    return GSurface(b.rgb, textureLoad(gbuf_emission, px, 0).rgb, normalize(nr.xyz), b.a, nr.w);
+    let e = textureLoad(gbuf_emission, px, 0);
+    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), b.a, nr.w, e.a);
 }
 
 // RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
@@ -217,7 +220,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (env_enabled()) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
-            rgb += s.base * et.a.rgb + et.b.rgb;
+            rgb += (s.base * et.a.rgb + et.b.rgb) * s.occlusion;
         }
     } else if (env_enabled() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
@@ -246,6 +249,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         let s = load_surface(px);
         if (has_env) {
             et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+            et.a *= s.occlusion;
+            et.b *= s.occlusion;
         }
         base = s.base;
         emission = s.emission;
