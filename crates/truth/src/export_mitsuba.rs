@@ -180,6 +180,9 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
     if world.surface.is_some() {
         unsupported.push("water surface (Fresnel, TIR) and the sky seen through it".into());
     }
+    if let Some(env) = &world.env_map {
+        unsupported.push(format!("environment map ({})", env.env.source));
+    }
     let white = &world.units;
     let doc = json!({
         "source": scene.source,

@@ -1,7 +1,7 @@
 //! The light transport estimator: unidirectional path tracing with next-event estimation,
-//! multiple importance sampling (power heuristic) between BRDF/phase sampling and emissive
-//! triangles, delta lights by NEE only, Russian roulette, and free-flight sampling in a
-//! homogeneous medium with spectral MIS over the four hero wavelengths.
+//! multiple importance sampling (power heuristic) between BRDF/phase sampling and each of the
+//! emissive triangles and the environment map, delta lights by NEE only, Russian roulette, and
+//! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
 use crate::bsdf::Brdf;
 use crate::material;
@@ -73,8 +73,9 @@ impl Integrator<'_, '_> {
         }
     }
 
-    /// Light arriving at `p` from every delta light and one emissive-triangle sample, times
-    /// the vertex's scattering function, MIS-weighted against the vertex's own sampling.
+    /// Light arriving at `p` from every delta light, one emissive-triangle sample and one
+    /// environment-map sample, times the vertex's scattering function, MIS-weighted against the
+    /// vertex's own sampling.
     fn direct(
         &self,
         p: Vec3,
@@ -129,6 +130,20 @@ impl Integrator<'_, '_> {
                             let mis = power_heuristic(pdf_l, pdf_v);
                             sum += f * le * self.transmittance(o, wi, tmax, l) * (mis / pdf_l);
                         }
+                    }
+                }
+            }
+        }
+        if let Some(env) = &w.env_map {
+            let u: [f32; 6] = std::array::from_fn(|_| rng.uniform());
+            if let Some(es) = env.sample(u) {
+                let (f, pdf_v) = v.eval(wo, es.wi);
+                if f != Vec4::ZERO {
+                    let le = env.texel_radiance(es.texel, l);
+                    let o = origin(es.wi);
+                    if le != Vec4::ZERO && !w.geometry.occluded(o, es.wi, f32::INFINITY) {
+                        let mis = power_heuristic(es.pdf, pdf_v);
+                        sum += f * le * self.transmittance(o, es.wi, f32::INFINITY, l) * (mis / es.pdf);
                     }
                 }
             }
@@ -232,6 +247,12 @@ impl Integrator<'_, '_> {
             let Some(hit) = hit else {
                 if let Some(env) = &w.environment {
                     radiance += f / mean(p) * env.eval4(l);
+                }
+                if let Some(env) = &w.env_map {
+                    // Camera rays and specular vertices (prev_pdf = 0) cannot be found by
+                    // light sampling: full weight.
+                    let mis = if prev_pdf > 0.0 { power_heuristic(prev_pdf, env.pdf(d)) } else { 1.0 };
+                    radiance += f / mean(p) * env.radiance(d, l) * mis;
                 }
                 break;
             };

@@ -6,7 +6,8 @@
 //! - Reflectances are measured spectra where the material has them, otherwise the same
 //!   Jakob–Hanika upsampling the renderer uses ([`upsample::RgbToSpectrum`]).
 //! - Hero-wavelength sampling (four wavelengths per path), next-event estimation with MIS for
-//!   emissive meshes, Russian roulette, a homogeneous participating medium ([`Medium`]).
+//!   emissive meshes and the environment map ([`env_map`], importance-sampled ∝ luminance),
+//!   Russian roulette, a homogeneous participating medium ([`Medium`]).
 //! - Output is XYZ with the normalisation of [`color::SpectralIntegrator`]: a perfect white lit
 //!   by the scene white has Y = 1, and an RGB (1,1,1) D65 light gives the RGB renderer's values.
 //! - Deterministic for a seed (per-pixel random streams), cancellable, reports progress.
@@ -14,6 +15,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod env_map;
 pub mod error;
 pub mod export_mitsuba;
 pub mod integrator;

@@ -57,3 +57,43 @@ pub fn quad(c: Vec3, n: Vec3, h: f32, material: usize) -> Mesh {
         ..Default::default()
     }
 }
+
+/// A UV sphere of radius `r` around `c`, `n` segments around and `n/2` from pole to pole,
+/// wound counter-clockwise seen from outside, with no vertex normals (flat shading: the
+/// shading normal is the geometric one, so a white Lambertian sphere conserves energy exactly).
+pub fn sphere(c: Vec3, r: f32, n: u32, material: usize) -> Mesh {
+    let rows = n / 2;
+    let mut m = Mesh { material, ..Default::default() };
+    for i in 0..=rows {
+        let theta = std::f32::consts::PI * i as f32 / rows as f32;
+        for j in 0..=n {
+            let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
+            let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            m.positions.push(c + d * r);
+        }
+    }
+    for i in 0..rows {
+        for j in 0..n {
+            let (a, b) = (i * (n + 1) + j, (i + 1) * (n + 1) + j);
+            // (a+1 − a) × (b − a) ∝ ∂φ × ∂θ, which points outwards (the test below checks).
+            if i > 0 {
+                m.indices.extend([a, a + 1, b]);
+            }
+            if i + 1 < rows {
+                m.indices.extend([a + 1, b + 1, b]);
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn sphere_faces_outwards() {
+    let m = sphere(Vec3::new(1.0, 2.0, 3.0), 0.5, 16, 0);
+    for t in m.indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| m.positions[t[k] as usize]);
+        let n = (b - a).cross(c - a);
+        assert!(n.length() > 0.0);
+        assert!(n.dot((a + b + c) / 3.0 - Vec3::new(1.0, 2.0, 3.0)) > 0.0, "{t:?}");
+    }
+}

@@ -2,6 +2,7 @@
 //! the optional medium, and the surface queries the integrator makes at a hit.
 
 use crate::accel::{Geometry, Hit};
+use crate::env_map::EnvMap;
 use crate::error::{Result, TruthError};
 use crate::lights::{DeltaLight, EmissionUnits, EmitterDistribution, luminance};
 use crate::material::{self, PreparedMaterial};
@@ -42,6 +43,9 @@ pub struct World<'s> {
     pub areas: Vec<f32>,
     /// Uniform radiance arriving from infinity along rays that escape the scene.
     pub environment: Option<crate::spectral::DenseSpectrum>,
+    /// The scene's environment map ([`scene::Scene::environment`]), sampled by next-event
+    /// estimation and seen by escaping rays; `None` when it has none or it is black.
+    pub env_map: Option<EnvMap<'s>>,
     /// The water surface above the medium, with the sky seen through it (see
     /// [`crate::water_surface`]); from the medium's `surface_ior` and the scene's sky stand-ins.
     pub surface: Option<Surface>,
@@ -101,6 +105,21 @@ impl<'s> World<'s> {
             geometry.len(),
         );
         let surface = water_surface(scene, medium, &units, upsampler, range).map_err(bad)?;
+        let env_map = match &scene.environment {
+            Some(env) if !env.is_black() => {
+                if surface.is_some() {
+                    // Its light would have to come in through the water surface (Fresnel, Snell's
+                    // window); the surface shows the scene's uniform sky only.
+                    return Err(bad(format!(
+                        "an environment map ({}) cannot light a scene under a water surface: the \
+                         surface shows the water settings' sky (drop the environment, e.g. --env none)",
+                        env.source
+                    )));
+                }
+                Some(EnvMap::new(env, &units, upsampler).map_err(bad)?)
+            }
+            _ => None,
+        };
         let medium = medium.map(|m| PreparedMedium::new(m, range)).transpose()?;
         Ok(World {
             scene,
@@ -114,6 +133,7 @@ impl<'s> World<'s> {
             emission_spectra,
             areas,
             environment: None,
+            env_map,
             surface,
         })
     }
