@@ -26,6 +26,10 @@ pub struct Args {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
     pub size: String,
+    // The environment light (--env, --env-intensity, --env-rotation), shared with `render`;
+    // importance-sampled ∝ luminance with MIS against the BRDF (truth::env_map).
+    #[command(flatten)]
+    pub env: super::EnvArgs,
     /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
     #[arg(long)]
     pub range: Option<String>,
@@ -127,7 +131,8 @@ pub fn run(a: Args) -> Result<()> {
             bail!("--xyz needs an .exr output (PNG is display-encoded sRGB)");
         }
     }
-    let scene = scene::load_any(&a.scene).with_context(|| format!("loading scene '{}'", a.scene))?;
+    let mut scene = scene::load_any(&a.scene).with_context(|| format!("loading scene '{}'", a.scene))?;
+    a.env.apply(&mut scene)?;
     let st = settings(&a, &scene)?;
     color::upsample::install_interrupt_handler();
     let table = match &a.table {
@@ -176,8 +181,12 @@ pub fn run(a: Args) -> Result<()> {
         .with_context(|| format!("writing {}", out.display()))?;
     let paths = st.width as f64 * st.height as f64 * st.spp as f64;
     let y = img.mean()[1];
+    let env = match &scene.environment {
+        Some(e) => format!(", environment {} × {}", e.source, e.intensity),
+        None => String::new(),
+    };
     eprintln!(
-        "{}: {} {}×{} at {} spp, {:.0}–{:.0} nm{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
+        "{}: {} {}×{} at {} spp, {:.0}–{:.0} nm{}{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
         out.display(),
         scene.source,
         st.width,
@@ -187,6 +196,7 @@ pub fn run(a: Args) -> Result<()> {
         st.range.max,
         if st.direct_only { ", direct only" } else { "" },
         if st.lambert { ", Lambert" } else { "" },
+        env,
         secs,
         prep.as_secs_f64(),
         paths / secs / 1e6,
@@ -219,6 +229,55 @@ mod tests {
         assert!(e(&["--xyz", "--out", "x.png"]).contains("--xyz"));
         assert!(e(&["--size", "0x4", "--out", "x.exr"]).contains("positive"));
         assert!(!std::path::Path::new("x.exr").exists());
+    }
+
+    /// `--env FILE` that cannot be used is an error naming the file, before any work, and
+    /// nothing is written.
+    #[test]
+    fn a_bad_environment_file_is_an_error_naming_it() {
+        let dir = std::env::temp_dir().join(format!("spectra-truth-env-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = dir.join("t.exr");
+        let out_s = out.display().to_string();
+        let missing = dir.join("missing-sky.hdr").display().to_string();
+        let m = format!("{:#}", run(args(&["--env", &missing, "--out", &out_s])).unwrap_err());
+        assert!(m.contains("missing-sky.hdr"), "{m}");
+        let corrupt = dir.join("corrupt.exr");
+        std::fs::write(&corrupt, b"not an exr").unwrap();
+        let c = corrupt.display().to_string();
+        let m = format!("{:#}", run(args(&["--env", &c, "--out", &out_s])).unwrap_err());
+        assert!(m.contains("corrupt.exr"), "{m}");
+        let m = format!(
+            "{:#}",
+            run(args(&["--env", "none", "--env-intensity", "2", "--out", &out_s])).unwrap_err()
+        );
+        assert!(m.contains("--env-intensity"), "{m}");
+        assert!(!out.exists());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// `--env default` on the Cornell box gives the tracer an environment map; `--env none`
+    /// none; under water an environment map is refused by the tracer.
+    #[test]
+    fn env_flags_reach_the_tracer() {
+        let up = truth::upsample::GreyOnly;
+        for (flags, want) in
+            [(&["--env", "default", "--env-rotation", "-30"][..], true), (&["--env", "none"][..], false)]
+        {
+            let a = args(flags);
+            let mut scene = scene::builtin("cornell").unwrap();
+            a.env.apply(&mut scene).unwrap();
+            let st = settings(&a, &scene).unwrap();
+            let w = World::new(&scene, &up, &st.white, st.range, None).unwrap();
+            assert_eq!(w.env_map.is_some(), want, "{flags:?}");
+        }
+        let mut a = args(&["--env", "default"]);
+        a.scene = "underwater".into();
+        let mut scene = scene::builtin("underwater").unwrap();
+        a.env.apply(&mut scene).unwrap();
+        let st = settings(&a, &scene).unwrap();
+        let e = World::new(&scene, &up, &st.white, st.range, st.medium.as_ref()).err().unwrap();
+        assert!(e.to_string().contains("environment map"), "{e}");
     }
 
     /// The underwater scene's truth has the water surface and, from the scene's sky stand-in,
