@@ -7,11 +7,7 @@ use std::process::Command;
 
 fn spectra(args: &[&str]) -> std::process::Output {
     let out = Command::new(env!("CARGO_BIN_EXE_spectra")).args(args).output().expect("running spectra");
-    assert!(
-        out.status.success(),
-        "spectra {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "spectra {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
     out
 }
 
@@ -52,5 +48,42 @@ fn an_emissive_ceiling_lights_the_box_in_real_time_as_in_truth() {
     let de = block_de(&truth, &rt);
     assert!(de <= 3.0, "block-mean ΔE2000 {de:.2} > 3");
     eprintln!("emissive ceiling, spectral vs truth (direct): block-mean ΔE2000 {de:.3}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The ColorChecker without its light: the default environment lights it (with a note), and an
+/// HDR environment too; the real-time renderer (rgb and spectral) agrees with the path tracer's
+/// direct lighting. A flat chart sees the whole sky, so the real-time renderer's missing
+/// environment shadowing does not enter.
+#[test]
+fn a_chart_without_lights_is_lit_by_the_environment_as_in_truth() {
+    let d = dir("env");
+    let mut s = scene::builtin("colorchecker").unwrap();
+    s.lights.clear();
+    let file = d.join("chart.gltf");
+    scene::write_gltf(&s, &file).unwrap();
+    let f = file.display().to_string();
+    let hdr = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/environments/rooitou_park.hdr");
+    for env in [None, Some(hdr)] {
+        let mut extra: Vec<&str> = vec![];
+        if let Some(e) = env {
+            extra.extend(["--env", e]);
+        }
+        let truth = p(&d, "truth.exr");
+        let mut a = vec!["truth", &f, "--direct-only", "--spp", "256", "--size", "96x64", "--out", &truth];
+        a.extend(&extra);
+        let out = spectra(&a);
+        let note = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(note.contains("default environment"), env.is_none(), "{note}");
+        for mode in ["rgb", "spectral"] {
+            let rt = p(&d, &format!("{mode}.exr"));
+            let mut a = vec!["render", &f, "--mode", mode, "--size", "96x64", "--out", &rt];
+            a.extend(&extra);
+            spectra(&a);
+            let de = block_de(&truth, &rt);
+            eprintln!("chart, environment {env:?}, {mode} vs truth (direct): block-mean ΔE2000 {de:.3}");
+            assert!(de <= 1.5, "{mode}, environment {env:?}: block-mean ΔE2000 {de:.2} > 1.5");
+        }
+    }
     let _ = std::fs::remove_dir_all(&d);
 }
