@@ -403,15 +403,28 @@ def run_model(a, runner, name, path, outdir):
         except (ValueError, OSError, struct.error, zlib.error) as e:
             r["error"] = f"cannot read the image: {e}"
         log(f"    {key:<9} {secs:6.1f} s")
-    # Black check: over the model's pixels when the background is the default environment's
-    # (found on the rgb render, which has no noise), else over the whole image.
+    # Which pixels show the model: the background of the default environment is known, so it is
+    # found on an rgb render under it (no noise); the camera does not depend on the environment,
+    # so under any other environment one more rgb render with --env default gives the mask.
     mask, k = None, a.env_intensity if a.env_intensity is not None else 1.0
     default_bg = a.env == "default" or (a.env == "auto" and any("default environment" in n for n in res["notes"]))
-    base = images.get("rgb") or images.get("spectral")
-    if default_bg and base is not None:
+    base = images.get("rgb") if default_bg else None
+    if not default_bg and images and not a.no_mask:
+        k = 1.0
+        mask_img = os.path.join(outdir, ".mask.exr")
+        args = ["render", path, "--mode", "rgb", "--size", a.size, "--env", "default", *shlex.split(a.render_args),
+                "--out", mask_img]
+        log(f"    {'mask':<9} spectra {' '.join(shlex.quote(x) for x in args)}")
+        code, _, err, _ = runner.run(args)
+        if code == 0:
+            base = read_exr(mask_img)
+            os.remove(mask_img)
+        else:
+            log(f"    mask      FAILED: {error_message(err, code)}")
+    if base is not None:
         mask = default_background_mask(*base, k)
         res["model_coverage"] = sum(mask) / len(mask)
-        log(f"    model covers {res['model_coverage']:.1%} of the image (the rest is the default background)")
+        log(f"    model covers {res['model_coverage']:.1%} of the image")
     for key, (w, h, ch) in images.items():
         r = res["renders"][key]
         m = mask if mask is not None and len(mask) == w * h else None
@@ -515,8 +528,8 @@ def write_reports(a, results, meta):
         f" (the blocks at least half covered by it; the pixels of it); truth noise = the same block-mean ΔE00"
         f" between the truth and a second truth with --seed 2; black = mean luminance Y < {a.black_threshold}"
         f" or fewer than {a.min_lit_fraction:.0%} of the pixels above Y = {a.lit_threshold}, counted over the"
-        f" model's pixels (model px: the share of the image that is not the default environment's background)"
-        f" when the environment is the default one, else over the whole image; mean Y likewise, linear"
+        f" model's pixels (model px: the share of the image that is not background, found on an rgb render"
+        f" under the default environment) unless --no-mask, else over the whole image; mean Y likewise, linear"
         f" (1 = the default sky's radiance); seconds = wall-clock time per command (process start, scene"
         f" load and upload included). Model paths are relative to `{meta['root']}`.",
         "",
@@ -671,6 +684,9 @@ def main():
     ap.add_argument("--truth-args", default="--direct-only",
                     help="extra flags for spectra truth (default: --direct-only)")
     ap.add_argument("--render-args", default="", help="extra flags for both spectra render runs")
+    ap.add_argument("--no-mask", action="store_true",
+                    help="under an environment other than the default: skip the extra rgb render under the default "
+                         "environment that finds the model's pixels (figures are then over the whole image)")
     ap.add_argument("--no-noise-floor", dest="noise_floor", action="store_false",
                     help="skip the second truth (--seed 2) that measures the truth's own noise")
     ap.add_argument("--block", type=int, default=8, help="block size of the block-mean ΔE2000 (default: 8)")
