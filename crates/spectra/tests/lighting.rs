@@ -87,3 +87,33 @@ fn a_chart_without_lights_is_lit_by_the_environment_as_in_truth() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A missing, corrupt or non-HDR environment is an error naming the file, for both renderers,
+/// and no output is written.
+#[test]
+fn bad_environment_files_are_errors_naming_the_file() {
+    let d = dir("bad");
+    let corrupt = d.join("corrupt.hdr");
+    std::fs::write(&corrupt, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n\x01\x02").unwrap();
+    let png = d.join("sky.png");
+    std::fs::write(&png, b"\x89PNG\r\n\x1a\n").unwrap();
+    let missing = d.join("missing.hdr");
+    for bad in [&corrupt, &png, &missing] {
+        let b = bad.display().to_string();
+        for cmd in ["render", "truth"] {
+            let out_file = d.join(format!("{cmd}.exr"));
+            let o = out_file.display().to_string();
+            let out = Command::new(env!("CARGO_BIN_EXE_spectra"))
+                .args([cmd, "cornell", "--env", &b, "--size", "16x16", "--out", &o])
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(!out.status.success(), "{cmd} --env {b} succeeded");
+            let name = bad.file_name().unwrap().to_string_lossy();
+            assert!(err.contains(name.as_ref()), "{cmd} --env {b}: {err}");
+            assert!(!err.contains("panicked"), "{err}");
+            assert!(!out_file.exists(), "{cmd} wrote {o} despite the error");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
