@@ -34,6 +34,7 @@ fn sphere(n: u32) -> Mesh {
 
 fn sphere_scene(env: Environment) -> Scene {
     Scene {
+        warnings: vec![],
         source: "test:sphere".into(),
         meshes: vec![sphere(48)],
         materials: vec![Material { base_color: Vec4::ONE, ..Default::default() }],
@@ -141,7 +142,16 @@ fn quad(centre: Vec3, half: f32, normal_down: bool, y_plane: bool) -> Mesh {
     let n = if normal_down { Vec3::NEG_Y } else { Vec3::Y };
     // Counter-clockwise seen from the side the normal points to.
     let indices = if normal_down { vec![0, 1, 2, 0, 2, 3] } else { vec![0, 2, 1, 0, 3, 2] };
-    Mesh { positions, normals: vec![n; 4], tangents: vec![], uvs: vec![Vec2::ZERO; 4], indices, material: 0 }
+    Mesh {
+        colors: vec![],
+        uvs1: vec![],
+        positions,
+        normals: vec![n; 4],
+        tangents: vec![],
+        uvs: vec![Vec2::ZERO; 4],
+        indices,
+        material: 0,
+    }
 }
 
 /// E/L at the origin (normal +Y) from a square of half-side `half` at height `h` above it,
@@ -169,6 +179,7 @@ fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
     lamp.material = 1;
     let radiance = 2.0f32;
     let scene = Scene {
+        warnings: vec![],
         source: "test:lamp".into(),
         meshes: vec![floor, lamp],
         materials: vec![
@@ -199,13 +210,15 @@ fn the_occlusion_texture_darkens_the_environment_only() {
     // the environment term is scaled by 1 + 0.8·(0.5 − 1) = 0.6 (the background stays 1).
     let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
     scene.textures.push(scene::Texture {
+        sampler: Default::default(),
         name: "ao".into(),
         width: 2,
         height: 2,
         rgba8: [128u8, 128, 128, 255].repeat(4),
         srgb: false,
     });
-    scene.materials[0].occlusion_texture = Some(scene::TextureRef { index: 0, tex_coord: 0 });
+    scene.materials[0].occlusion_texture =
+        Some(scene::TextureRef { transform: None, index: 0, tex_coord: 0 });
     scene.materials[0].occlusion_strength = 0.8;
     let img = render(&scene, &settings(Mode::Spectral, 16));
     let c = img[(SIZE / 2 * SIZE + SIZE / 2) as usize];

@@ -25,13 +25,27 @@ fn textured_and_normal_mapped_patch_matches_cpu_brdf() {
     let mut scene = chart.scene(white_light(2.0, None), 0.7, 0.0);
     scene.lights[0].kind = scene::LightKind::Directional { direction: -wi };
     scene.textures = vec![
-        Texture { name: "base".into(), width: 1, height: 1, rgba8: base.to_vec(), srgb: true },
-        Texture { name: "normal".into(), width: 1, height: 1, rgba8: tilt.to_vec(), srgb: false },
+        Texture {
+            sampler: Default::default(),
+            name: "base".into(),
+            width: 1,
+            height: 1,
+            rgba8: base.to_vec(),
+            srgb: true,
+        },
+        Texture {
+            sampler: Default::default(),
+            name: "normal".into(),
+            width: 1,
+            height: 1,
+            rgba8: tilt.to_vec(),
+            srgb: false,
+        },
     ];
     let m = &mut scene.materials[0];
     m.base_color = glam::Vec4::new(0.5, 1.0, 1.0, 1.0);
-    m.base_color_texture = Some(TextureRef { index: 0, tex_coord: 0 });
-    m.normal_texture = Some(TextureRef { index: 1, tex_coord: 0 });
+    m.base_color_texture = Some(TextureRef { transform: None, index: 0, tex_coord: 0 });
+    m.normal_texture = Some(TextureRef { transform: None, index: 1, tex_coord: 0 });
 
     let mut r = renderer();
     r.set_scene(&scene).unwrap();

@@ -119,6 +119,8 @@ fn occluder_casts_a_shadow_from_the_main_light() {
         scene::LightKind::Directional { direction: Vec3::new(0.3, -0.3, -1.0).normalize() };
     let z = 1.5;
     scene.meshes.push(Mesh {
+        colors: vec![],
+        uvs1: vec![],
         positions: vec![
             Vec3::new(-1.0, -0.5, z),
             Vec3::new(0.0, -0.5, z),
@@ -226,7 +228,8 @@ fn bad_input_is_an_error_not_a_panic() {
     let e = r.set_scene(&scene).unwrap_err().to_string();
     assert!(e.contains("test:chart") && e.contains("99"), "{e}");
     let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
-    scene.materials[0].base_color_texture = Some(scene::TextureRef { index: 3, tex_coord: 0 });
+    scene.materials[0].base_color_texture =
+        Some(scene::TextureRef { transform: None, index: 3, tex_coord: 0 });
     let e = r.set_scene(&scene).unwrap_err().to_string();
     assert!(e.contains("texture 3"), "{e}");
     r.set_scene(&chart.scene(white_light(1.0, None), 1.0, 0.0)).unwrap();

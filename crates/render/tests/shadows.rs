@@ -41,6 +41,8 @@ fn hidden_by(r: Rect, z: f32) -> Rect {
 
 fn quad(r: Rect, z: f32, material: usize) -> Mesh {
     Mesh {
+        colors: vec![],
+        uvs1: vec![],
         positions: vec![
             Vec3::new(r.0, r.2, z),
             Vec3::new(r.1, r.2, z),

@@ -35,8 +35,11 @@ fn floor_scene() -> Scene {
     camera.znear = 0.05;
     camera.zfar = 500.0;
     Scene {
+        warnings: vec![],
         source: "test:underwater-floor".into(),
         meshes: vec![Mesh {
+            colors: vec![],
+            uvs1: vec![],
             positions: p.to_vec(),
             normals: vec![Vec3::Y; 4],
             tangents: vec![],
@@ -396,6 +399,8 @@ fn single_scattering_is_shadowed_under_a_roof() {
         Vec3::new(30.0, 3.5, 10.0),
     ];
     scene.meshes.push(Mesh {
+        colors: vec![],
+        uvs1: vec![],
         positions: roof.to_vec(),
         normals: vec![Vec3::NEG_Y; 4],
         tangents: vec![],

@@ -163,6 +163,8 @@ mod tests {
         ];
         let n = if flip { Vec3::Y } else { Vec3::NEG_Y };
         Mesh {
+            colors: vec![],
+            uvs1: vec![],
             positions,
             normals: vec![n; 4],
             tangents: vec![],

@@ -134,6 +134,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
     }
     let camera = camera.unwrap_or_else(|| Camera::framing(crate::framing::bounds(&meshes)));
     let mut scene = Scene {
+        warnings: vec![],
         source: ctx.path.display().to_string(),
         meshes,
         materials,
@@ -265,7 +266,14 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<Camera, Scene
     }
     // A camera's frame is rigid; drop any scale the node hierarchy carries.
     let (_, rot, pos) = world.to_scale_rotation_translation();
-    Ok(Camera { transform: Mat4::from_rotation_translation(rot.normalize(), pos), yfov, znear, zfar, aspect })
+    Ok(Camera {
+        ortho: None,
+        transform: Mat4::from_rotation_translation(rot.normalize(), pos),
+        yfov,
+        znear,
+        zfar,
+        aspect,
+    })
 }
 
 fn light_of(
@@ -422,7 +430,7 @@ impl Loader<'_> {
                 .invalid(at, format!("uses TEXCOORD_{tex_coord}; only TEXCOORD_0 is supported")));
         }
         if let Some(&index) = self.tex_map.get(&(t.index(), srgb)) {
-            return Ok(TextureRef { index, tex_coord });
+            return Ok(TextureRef { transform: None, index, tex_coord });
         }
         let img = t.source();
         let iat = format!("images[{}]", img.index());
@@ -451,8 +459,8 @@ impl Loader<'_> {
         let (width, height, rgba8) = self.images[&img.index()].clone();
         let name = t.name().or(img.name()).map_or_else(|| format!("texture {}", t.index()), str::to_string);
         let index = self.textures.len();
-        self.textures.push(Texture { name, width, height, rgba8, srgb });
+        self.textures.push(Texture { sampler: Default::default(), name, width, height, rgba8, srgb });
         self.tex_map.insert((t.index(), srgb), index);
-        Ok(TextureRef { index, tex_coord })
+        Ok(TextureRef { transform: None, index, tex_coord })
     }
 }

@@ -59,6 +59,9 @@ pub struct Scene {
     pub spectral: SpectralSettings,
     /// Underwater settings (see the underwater issue); `None` for scenes in air.
     pub water: Option<WaterSettings>,
+    /// What the loader skipped or approximated (unsupported optional extensions, points and
+    /// lines, …), one line each, for the command line to print.
+    pub warnings: Vec<String>,
     /// Light arriving from infinitely far away ([`environment`]); from the file's
     /// `extras.environment` or the command line. `None`: no environment light.
     pub environment: Option<Environment>,
@@ -74,6 +77,12 @@ pub struct Mesh {
     pub tangents: Vec<Vec4>,
     /// `TEXCOORD_0`, one per position; empty when the primitive has no texture coordinates.
     pub uvs: Vec<Vec2>,
+    /// `TEXCOORD_1`, one per position; empty when the primitive has none. A texture whose
+    /// [`TextureRef::tex_coord`] is 1 reads these.
+    pub uvs1: Vec<Vec2>,
+    /// `COLOR_0` as linear RGBA, one per position; empty = white. Multiplies the base colour
+    /// (glTF 2.0 §3.9.2).
+    pub colors: Vec<Vec4>,
     /// Triangle list, counter-clockwise front faces.
     pub indices: Vec<u32>,
     pub material: usize,
@@ -100,6 +109,12 @@ pub struct Material {
     /// Linear RGB, already multiplied by `KHR_materials_emissive_strength`.
     pub emissive: Vec3,
     pub emissive_texture: Option<TextureRef>,
+    /// glTF `alphaMode` with `alphaCutoff`; the alpha is base colour alpha × texture alpha ×
+    /// `COLOR_0` alpha.
+    pub alpha_mode: AlphaMode,
+    /// glTF `doubleSided`: back faces are drawn (normal flipped towards the viewer) only when
+    /// true; single-sided back faces are culled by the rasteriser and not hit by the tracer.
+    pub double_sided: bool,
     /// Measured reflectance spectra that override the RGB base colour for ground truth.
     pub spectral: Option<SpectralReflectance>,
     /// Spectral radiance of the emission, scaled so its luminance equals that of `emissive`
@@ -122,8 +137,90 @@ impl Default for Material {
             occlusion_strength: 1.0,
             emissive: Vec3::ZERO,
             emissive_texture: None,
+            alpha_mode: AlphaMode::Opaque,
+            // Built-in scenes are seen from inside (Cornell boxes); glTF files say what they are
+            // (glTF's own default is false).
+            double_sided: true,
             spectral: None,
             emission_spectrum: None,
+        }
+    }
+}
+
+/// glTF `alphaMode`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum AlphaMode {
+    /// Alpha ignored.
+    #[default]
+    Opaque,
+    /// Fully opaque where alpha ≥ cutoff, absent elsewhere (foliage, cut-outs).
+    Mask { cutoff: f32 },
+    /// Alpha is coverage: a fraction `alpha` of the light is stopped by the surface (decals,
+    /// glass-like see-through geometry without refraction).
+    Blend,
+}
+
+/// `KHR_texture_transform`: uv' = T(offset) · R(rotation) · S(scale) · uv.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureTransform {
+    pub offset: Vec2,
+    /// Radians, counter-clockwise in UV space.
+    pub rotation: f32,
+    pub scale: Vec2,
+}
+
+impl TextureTransform {
+    /// The 3×3 matrix of the extension's definition (column-major, for `uv' = M · (u, v, 1)`).
+    pub fn matrix(&self) -> glam::Mat3 {
+        let (s, c) = self.rotation.sin_cos();
+        let t = glam::Mat3::from_cols(Vec3::X, Vec3::Y, self.offset.extend(1.0));
+        let r = glam::Mat3::from_cols(Vec3::new(c, -s, 0.0), Vec3::new(s, c, 0.0), Vec3::Z);
+        let sc = glam::Mat3::from_diagonal(self.scale.extend(1.0));
+        t * r * sc
+    }
+
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        (self.matrix() * uv.extend(1.0)).truncate()
+    }
+}
+
+/// Texture wrap mode (glTF sampler `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    ClampToEdge,
+    MirroredRepeat,
+}
+
+/// Texture filter (glTF sampler `magFilter`/`minFilter`; mipmapped minification filters are
+/// `Linear`/`Nearest` with [`Sampler::mipmaps`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Filter {
+    Nearest,
+    #[default]
+    Linear,
+}
+
+/// How a texture is sampled (glTF `samplers[i]`; the defaults are glTF's: repeat, linear,
+/// mipmapped).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    pub wrap_s: Wrap,
+    pub wrap_t: Wrap,
+    pub mag: Filter,
+    pub min: Filter,
+    pub mipmaps: bool,
+}
+
+impl Default for Sampler {
+    fn default() -> Self {
+        Sampler {
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::Repeat,
+            mag: Filter::Linear,
+            min: Filter::Linear,
+            mipmaps: true,
         }
     }
 }
@@ -144,11 +241,19 @@ pub struct PaletteEntry {
     pub spectrum: Spectrum,
 }
 
-/// A texture reference with its UV set.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A texture reference with its UV set and optional `KHR_texture_transform`.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
     pub index: usize,
+    /// 0 = `TEXCOORD_0` ([`Mesh::uvs`]), 1 = `TEXCOORD_1` ([`Mesh::uvs1`]).
     pub tex_coord: u32,
+    pub transform: Option<TextureTransform>,
+}
+
+impl TextureRef {
+    pub fn new(index: usize) -> Self {
+        TextureRef { index, tex_coord: 0, transform: None }
+    }
 }
 
 /// An RGBA8 image. `srgb` says whether the RGB channels are sRGB-encoded (base colour,
@@ -160,6 +265,7 @@ pub struct Texture {
     pub height: u32,
     pub rgba8: Vec<u8>,
     pub srgb: bool,
+    pub sampler: Sampler,
 }
 
 /// A light's emission: RGB (linear sRGB, the glTF way) and optionally a spectrum.
@@ -211,6 +317,9 @@ pub struct Camera {
     pub zfar: f32,
     /// Width / height the scene was authored for; renderers use their own target's aspect.
     pub aspect: Option<f32>,
+    /// `Some((xmag, ymag))`: an orthographic camera of half-width xmag and half-height ymag
+    /// (glTF); `yfov` is then unused.
+    pub ortho: Option<(f32, f32)>,
 }
 
 impl Camera {
@@ -221,6 +330,7 @@ impl Camera {
             znear: 0.01,
             zfar: 1000.0,
             aspect: None,
+            ortho: None,
         }
     }
 

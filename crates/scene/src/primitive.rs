@@ -133,7 +133,7 @@ pub(crate) fn build(
     let mut mesh = match normals {
         Some(normals) => {
             let tangents = file_tangents.unwrap_or_default();
-            Mesh { positions, normals, tangents, uvs, indices, material }
+            Mesh { colors: vec![], uvs1: vec![], positions, normals, tangents, uvs, indices, material }
         }
         None => {
             // glTF: without normals, flat normals. Each triangle needs its own vertices.
@@ -151,7 +151,16 @@ pub(crate) fn build(
                 .collect();
             indices = (0..p.len() as u32).collect();
             // File tangents were per original vertex; flat shading re-indexed, so regenerate.
-            Mesh { positions: p, normals: nrm, tangents: Vec::new(), uvs: uv, indices, material }
+            Mesh {
+                colors: vec![],
+                uvs1: vec![],
+                positions: p,
+                normals: nrm,
+                tangents: Vec::new(),
+                uvs: uv,
+                indices,
+                material,
+            }
         }
     };
     for nrm in &mut mesh.normals {
@@ -167,7 +176,16 @@ pub(crate) fn build(
         }
         let (p, nrm, uv, t, idx) =
             tangents::generate(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
-        mesh = Mesh { positions: p, normals: nrm, tangents: t, uvs: uv, indices: idx, material };
+        mesh = Mesh {
+            colors: vec![],
+            uvs1: vec![],
+            positions: p,
+            normals: nrm,
+            tangents: t,
+            uvs: uv,
+            indices: idx,
+            material,
+        };
     }
     if !needs_tangents {
         mesh.tangents.clear();
@@ -207,6 +225,8 @@ mod tests {
     #[test]
     fn mirroring_flips_winding_and_handedness() {
         let mut m = Mesh {
+            colors: vec![],
+            uvs1: vec![],
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
             normals: vec![Vec3::Z; 3],
             tangents: vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 3],

@@ -142,6 +142,7 @@ mod tests {
     #[test]
     fn palette_matches_texels_and_falls_back_to_upsampling() {
         let t = Texture {
+            sampler: Default::default(),
             name: "p".into(),
             width: 2,
             height: 1,
@@ -149,7 +150,7 @@ mod tests {
             srgb: true,
         };
         let m = Material {
-            base_color_texture: Some(TextureRef { index: 0, tex_coord: 0 }),
+            base_color_texture: Some(TextureRef { transform: None, index: 0, tex_coord: 0 }),
             spectral: Some(SpectralReflectance::Palette(vec![PaletteEntry {
                 rgb8: [10, 20, 30],
                 spectrum: Spectrum::Constant(0.3),
@@ -166,10 +167,18 @@ mod tests {
 
     #[test]
     fn flat_normal_map_keeps_the_normal() {
-        let t =
-            Texture { name: "n".into(), width: 1, height: 1, rgba8: vec![128, 128, 255, 255], srgb: false };
-        let m =
-            Material { normal_texture: Some(TextureRef { index: 0, tex_coord: 0 }), ..Default::default() };
+        let t = Texture {
+            sampler: Default::default(),
+            name: "n".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![128, 128, 255, 255],
+            srgb: false,
+        };
+        let m = Material {
+            normal_texture: Some(TextureRef { transform: None, index: 0, tex_coord: 0 }),
+            ..Default::default()
+        };
         let n = mapped_normal(&m, &[t], Vec2::ZERO, Vec3::Y, Some(glam::Vec4::new(1.0, 0.0, 0.0, 1.0)));
         assert!((n - Vec3::Y).length() < 0.01);
     }

@@ -5,12 +5,20 @@ use scene::{Camera, Light, Material, Mesh, Scene, SpectralSettings};
 
 pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light>) -> Scene {
     Scene {
+        warnings: vec![],
         source: "test".into(),
         meshes,
         materials,
         textures: vec![],
         lights,
-        camera: Camera { transform: Mat4::IDENTITY, yfov: 0.8, znear: 0.01, zfar: 100.0, aspect: None },
+        camera: Camera {
+            ortho: None,
+            transform: Mat4::IDENTITY,
+            yfov: 0.8,
+            znear: 0.01,
+            zfar: 100.0,
+            aspect: None,
+        },
         spectral: SpectralSettings::default(),
         water: None,
         environment: None,

@@ -64,7 +64,14 @@ mod tests {
     use super::*;
 
     fn tex(w: u32, h: u32, px: &[[u8; 4]], srgb: bool) -> Texture {
-        Texture { name: "t".into(), width: w, height: h, rgba8: px.concat(), srgb }
+        Texture {
+            sampler: Default::default(),
+            name: "t".into(),
+            width: w,
+            height: h,
+            rgba8: px.concat(),
+            srgb,
+        }
     }
 
     #[test]

@@ -95,6 +95,8 @@ impl Chart {
             let o = self.origin(i % self.cols, i / self.cols);
             let p = |x: f32, y: f32| Vec3::new(o.x + x, o.y + y, 0.0);
             meshes.push(Mesh {
+                colors: vec![],
+                uvs1: vec![],
                 positions: vec![p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)],
                 normals: vec![Vec3::Z; 4],
                 tangents: vec![],
@@ -111,6 +113,7 @@ impl Chart {
             });
         }
         Scene {
+            warnings: vec![],
             source: "test:chart".into(),
             meshes,
             materials,

@@ -42,7 +42,14 @@ pub fn chart_texture() -> Texture {
             rgba[o + 3] = 255;
         }
     }
-    Texture { name: "ColorChecker Classic (sRGB, D65)".into(), width: w, height: h, rgba8: rgba, srgb: true }
+    Texture {
+        sampler: Default::default(),
+        name: "ColorChecker Classic (sRGB, D65)".into(),
+        width: w,
+        height: h,
+        rgba8: rgba,
+        srgb: true,
+    }
 }
 
 pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
@@ -63,7 +70,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
     s.textures.push(chart_texture());
     let mut chart = measured_material("ColorChecker Classic", &patch(0));
     chart.base_color = glam::Vec4::ONE;
-    chart.base_color_texture = Some(TextureRef { index: 0, tex_coord: 0 });
+    chart.base_color_texture = Some(TextureRef { transform: None, index: 0, tex_coord: 0 });
     chart.spectral = Some(SpectralReflectance::Palette(palette));
     s.materials.push(chart);
     s.meshes.push(shapes::quad(Vec3::new(-cw * 0.5, -ch * 0.5, 0.0), Vec3::X * cw, Vec3::Y * ch, 0));

@@ -84,7 +84,7 @@ fn pattern(name: &str, w: u32, h: u32, colours: &[[u8; 3]], at: impl Fn(u32, u32
             rgba.push(255);
         }
     }
-    Texture { name: name.into(), width: w, height: h, rgba8: rgba, srgb: true }
+    Texture { sampler: Default::default(), name: name.into(), width: w, height: h, rgba8: rgba, srgb: true }
 }
 
 /// A palette-textured material over the named ColorChecker patches.
@@ -104,7 +104,7 @@ fn palette_material(
         texels.iter().zip(spectra).map(|(&rgb8, spectrum)| PaletteEntry { rgb8, spectrum }).collect();
     s.materials.push(Material {
         name: name.into(),
-        base_color_texture: Some(TextureRef { index: tex, tex_coord: 0 }),
+        base_color_texture: Some(TextureRef { transform: None, index: tex, tex_coord: 0 }),
         spectral: Some(SpectralReflectance::Palette(palette)),
         ..Material::default()
     });

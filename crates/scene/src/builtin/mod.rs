@@ -42,6 +42,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
 /// the CLI.
 pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
     Scene {
+        warnings: vec![],
         source: ctx.path.display().to_string(),
         meshes: Vec::new(),
         materials: Vec::new(),

@@ -10,6 +10,8 @@ use crate::Mesh;
 pub(crate) fn quad(o: Vec3, u: Vec3, v: Vec3, material: usize) -> Mesh {
     let n = u.cross(v).normalize();
     Mesh {
+        colors: vec![],
+        uvs1: vec![],
         positions: vec![o, o + u, o + u + v, o + v],
         normals: vec![n; 4],
         tangents: Vec::new(),

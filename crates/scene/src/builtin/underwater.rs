@@ -55,7 +55,7 @@ fn sand_texture() -> Texture {
             rgba.push(255);
         }
     }
-    Texture { name: "sand".into(), width: n, height: n, rgba8: rgba, srgb: true }
+    Texture { sampler: Default::default(), name: "sand".into(), width: n, height: n, rgba8: rgba, srgb: true }
 }
 
 /// Orange and white stripes, like a marker buoy.
@@ -68,14 +68,21 @@ fn stripe_texture() -> Texture {
             rgba.extend_from_slice(&px);
         }
     }
-    Texture { name: "stripes".into(), width: n, height: n, rgba8: rgba, srgb: true }
+    Texture {
+        sampler: Default::default(),
+        name: "stripes".into(),
+        width: n,
+        height: n,
+        rgba8: rgba,
+        srgb: true,
+    }
 }
 
 fn textured(name: &str, index: usize) -> Material {
     Material {
         name: name.into(),
         base_color: Vec4::ONE,
-        base_color_texture: Some(TextureRef { index, tex_coord: 0 }),
+        base_color_texture: Some(TextureRef { transform: None, index, tex_coord: 0 }),
         roughness: 1.0,
         ..Material::default()
     }

@@ -102,6 +102,7 @@ impl CameraController {
     /// The camera to render (camera-to-world, looking down −Z, +Y up).
     pub fn camera(&self) -> scene::Camera {
         scene::Camera {
+            ortho: None,
             transform: Mat4::look_to_rh(self.position, self.forward(), Vec3::Y).inverse(),
             yfov: self.yfov,
             znear: self.znear,
