@@ -14,8 +14,10 @@
 //! a cosine lobe into an irradiance map) exactly as RGB maps are, and the shader turns a filtered
 //! coefficient vector into node weights with the basis's node weights `B_j = weights(φ_j·W)`
 //! (prefiltered or midpoint quadrature, like any light). The truncation error is measured when the
-//! basis is built ([`SpectralBasis::residual`]: the fraction of weighted energy not captured); an
-//! environment whose texels all have one colour (the default sky) is captured exactly.
+//! basis is built ([`SpectralBasis::residual`]: the largest relative error of a texel's shape);
+//! an environment whose texels all have one colour (the default sky) is captured exactly. The PCA
+//! is fitted to the texels' shapes (each normalised to unit length), not their energy, so a sun
+//! that holds most of the power does not take every component from the sky.
 //!
 //! RGB mode uses the texels' RGB as its three coefficients. Naive mode uses the same RGB
 //! coefficients with the box spectra `band_c(λ)·W(λ)` as basis: exact, since box upsampling is
@@ -138,7 +140,8 @@ pub struct EnvMaps {
 #[derive(Clone, Debug)]
 pub struct SpectralBasis {
     pub phi: Vec<[f64; GRID_N]>,
-    /// Fraction of the weighted energy Σ_t Ω_t‖x_t‖² the K components do not capture.
+    /// The largest relative error of a texel's spectral shape after projection on the K
+    /// components, ‖x − Σⱼ αⱼφⱼ‖ / ‖x‖ in the observer-weighted norm (0 = every texel exact).
     pub residual: f64,
 }
 
@@ -196,34 +199,46 @@ pub fn spectral_basis(rgb: &Map, table: &color::upsample::CoeffTable) -> (Spectr
             std::array::from_fn(|i| if s > 0.0 { s * poly.eval(grid(i)) * sw[i] } else { 0.0 })
         })
         .collect();
+    // The basis is fitted to the texels' spectral *shapes* (each normalised to unit length),
+    // weighted by solid angle only: fitted to energy, a sun holding most of the power would take
+    // every component and leave the sky's colour to chance (measured: 0.70 ΔE2000 between the
+    // spectral and rgb backgrounds of rooitou_park with energy weighting).
     let mut c = vec![0.0f64; GRID_N * GRID_N];
     for y in 0..rgb.height {
         let om = rgb.row_solid_angle(y) as f64;
         for x in &samples[(y * rgb.width) as usize..((y + 1) * rgb.width) as usize] {
+            let n2: f64 = x.iter().map(|v| v * v).sum();
+            if n2 <= 0.0 {
+                continue;
+            }
+            let k = om / n2;
             for i in 0..GRID_N {
-                let xi = x[i] * om;
-                if xi == 0.0 {
-                    continue;
-                }
+                let xi = x[i] * k;
                 for j in 0..GRID_N {
                     c[i * GRID_N + j] += xi * x[j];
                 }
             }
         }
     }
-    let total: f64 = (0..GRID_N).map(|i| c[i * GRID_N + i]).sum();
     let vecs = top_eigenvectors(&c, GRID_N, K);
-    let captured: f64 = vecs.iter().map(|v| rayleigh(&c, v)).sum();
-    let residual = if total > 0.0 { ((total - captured) / total).max(0.0) } else { 0.0 };
     let phi = vecs.iter().map(|v| std::array::from_fn(|i| v[i] / sw[i])).collect();
-    let texels = samples
+    let project = |x: &[f64; GRID_N]| -> [f64; K] {
+        std::array::from_fn(|j| (0..GRID_N).map(|i| x[i] * vecs[j][i]).sum::<f64>())
+    };
+    let texels = samples.par_iter().map(|x| Vec4::from_array(project(x).map(|a| a as f32))).collect();
+    // Relative error of each texel's shape, ‖x − Σ αⱼ vⱼ‖ / ‖x‖ in the weighted norm.
+    let residual = samples
         .par_iter()
         .map(|x| {
-            let a: [f32; K] =
-                std::array::from_fn(|j| (0..GRID_N).map(|i| x[i] * vecs[j][i]).sum::<f64>() as f32);
-            Vec4::from_array(a)
+            let n2: f64 = x.iter().map(|v| v * v).sum();
+            if n2 <= 0.0 {
+                return 0.0;
+            }
+            let a = project(x);
+            let captured: f64 = a.iter().map(|v| v * v).sum();
+            ((n2 - captured).max(0.0) / n2).sqrt()
         })
-        .collect();
+        .reduce(|| 0.0, f64::max);
     (SpectralBasis { phi, residual }, Map { width: rgb.width, height: rgb.height, texels })
 }
 
@@ -458,7 +473,7 @@ mod tests {
     fn pca_is_exact_for_a_one_colour_environment_and_close_for_a_photo_like_one() {
         let table = color::upsample::table("srgb").unwrap();
         let (basis, coeffs) = spectral_basis(&rgb_map(&Environment::default_sky()), &table);
-        assert!(basis.residual < 1e-9, "{}", basis.residual);
+        assert!(basis.residual < 1e-6, "{}", basis.residual);
         // Reconstruct a ground texel's smooth part: 0.25 grey → s·ρ = 2·0.125·ρ(½) = 0.25.
         let t = coeffs.texels.last().unwrap();
         let x: f64 = (0..K).map(|j| t[j] as f64 * basis.eval(j, 550.0)).sum();
@@ -474,6 +489,6 @@ mod tests {
             .collect();
         let env = Environment::from_rgb("wheel", w, h, texels).unwrap();
         let (basis, _) = spectral_basis(&rgb_map(&env), &table);
-        assert!(basis.residual < 0.01, "residual {}", basis.residual);
+        assert!(basis.residual < 0.1, "residual {}", basis.residual);
     }
 }

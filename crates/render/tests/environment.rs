@@ -226,3 +226,35 @@ fn the_occlusion_texture_darkens_the_environment_only() {
     assert!((c[1] - want).abs() < 0.01, "{c:?} vs {want}");
     assert!((img[0][1] - 1.0).abs() < 0.01, "background {:?}", img[0]);
 }
+
+/// The spectral mode's K-term basis reproduces each shipped HDR environment as the RGB mode
+/// shows it (the background is the unfiltered map: any basis error is seen there directly).
+#[test]
+fn the_spectral_basis_reproduces_the_shipped_environments() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/environments");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "hdr"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no HDRs in {}", dir.display());
+    for f in files {
+        let env = Environment::load(&f).unwrap();
+        let mut scene = sphere_scene(env);
+        // A sphere too small to matter: this is about the background.
+        scene.meshes[0].positions.iter_mut().for_each(|p| *p *= 0.01);
+        let rgb = render(&scene, &settings(Mode::Rgb, 16));
+        let spectral = render(&scene, &settings(Mode::Spectral, 16));
+        let de: Vec<f64> = rgb
+            .iter()
+            .zip(&spectral)
+            .map(|(a, b)| {
+                color::delta_e::ciede2000(common::lab(common::rgb_of(a)), common::lab(common::rgb_of(b)))
+            })
+            .collect();
+        let (mean, p99) = common::stats(de);
+        eprintln!("{}: spectral vs rgb background ΔE2000 mean {mean:.3}, p99 {p99:.3}", f.display());
+        assert!(mean < 0.3 && p99 < 1.5, "{}: mean {mean:.3}, p99 {p99:.3}", f.display());
+    }
+}
