@@ -24,6 +24,21 @@ use glam::Mat4;
 use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
+/// The camera's projection for a target of width / height `aspect`: perspective from `yfov`, or
+/// orthographic with half-height `ymag` and half-width `ymag × aspect` (like the perspective
+/// camera, the target's aspect wins over the one the file was authored for, so nothing is
+/// stretched; `xmag` is then unused).
+pub fn projection(camera: &scene::Camera, aspect: f32) -> Mat4 {
+    match camera.ortho {
+        Some((_, ymag)) => {
+            let y = ymag.abs();
+            let x = y * aspect;
+            Mat4::orthographic_rh(-x, x, -y, y, camera.znear, camera.zfar)
+        }
+        None => Mat4::perspective_rh(camera.yfov, aspect, camera.znear, camera.zfar),
+    }
+}
+
 /// What the per-wavelength buffers were built for; a change triggers a re-upload.
 #[derive(Clone, Debug, PartialEq)]
 struct SpectralKey {
@@ -110,7 +125,7 @@ impl Renderer {
         let shared = SharedLayouts::new(device);
         let custom = CustomShader::default();
         let gbuffer = GBufferPass::new(device, &shared)?;
-        let shadow = ShadowPass::new(device)?;
+        let shadow = ShadowPass::new(device, &gbuffer.material_layout)?;
         let shading = ShadingPass::new(device, &shared, &custom.assembled())?;
         let custom_pass = CustomPass::new(device, &shared, &custom.assembled())?;
         let post = PostPass::new(device, &shared)?;
@@ -347,14 +362,26 @@ impl Renderer {
             return Err(RenderError::Settings("no render size: call resize first".into()));
         };
         let (width, height) = (targets.width, targets.height);
+        if let Some((xmag, ymag)) = camera.ortho
+            && !(ymag.is_finite() && ymag != 0.0 && xmag.is_finite() && camera.zfar > camera.znear)
+        {
+            return Err(RenderError::Settings(format!(
+                "orthographic camera with xmag {xmag}, ymag {ymag}, znear {}, zfar {}: the \
+                 magnifications must be finite and non-zero and zfar > znear",
+                camera.znear, camera.zfar
+            )));
+        }
         self.update_spectral(settings)?;
         let spectral = self.spectral.as_ref().expect("update_spectral sets it");
         let scene = self.scene.as_ref().expect("checked above");
-        self.shadow.update(&self.gpu.queue, scene, settings.shadows);
+        // The number this frame will have in the running mean (see `accumulate` below): the
+        // salt of the stochastic transparency, so that its noise averages out over frames.
+        let frame_index = if self.accumulating { self.accumulated.saturating_add(1) } else { 0 };
+        self.shadow.update(&self.gpu.queue, scene, settings.shadows, frame_index);
 
         let aspect = width as f32 / height as f32;
         let view = camera.transform.inverse();
-        let proj = Mat4::perspective_rh(camera.yfov, aspect, camera.znear, camera.zfar);
+        let proj = projection(camera, aspect);
         let view_proj = proj * view;
         let m = spectral.setup.xyz_to_rgb;
         let uniforms = FrameUniforms {
@@ -369,8 +396,8 @@ impl Renderer {
             exposure: settings.exposure_ev.exp2(),
             tonemap: settings.tonemap.gpu(),
             table_res: self.gpu_table.res,
-            flags: if settings.lambert { 1 } else { 0 },
-            _pad: 0,
+            flags: if settings.lambert { 1 } else { 0 } | if camera.ortho.is_some() { 2 } else { 0 },
+            frame_index,
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         let env_uniforms = self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral);

@@ -7,6 +7,7 @@ pub(crate) const COMMON: &str = include_str!("wgsl/common.wgsl");
 pub(crate) const SPECTRAL: &str = include_str!("wgsl/spectral.wgsl");
 pub(crate) const ENVIRONMENT: &str = include_str!("wgsl/environment.wgsl");
 pub(crate) const CUSTOM_API: &str = include_str!("wgsl/custom_api.wgsl");
+pub(crate) const MATERIAL: &str = include_str!("wgsl/material.wgsl");
 
 /// Concatenates `parts` and compiles them, turning validation errors into a [`RenderError`]
 /// instead of wgpu's default panic (custom shaders come from users).

@@ -15,17 +15,18 @@ pub struct FrameUniforms {
     pub exposure: f32,
     pub tonemap: u32,
     pub table_res: u32,
-    /// Bit 0: Lambert only (`RenderSettings::lambert`).
+    /// Bit 0: Lambert only (`RenderSettings::lambert`); bit 1: orthographic camera.
     pub flags: u32,
-    /// The WGSL struct's size is rounded up to its 16-byte alignment.
-    pub _pad: u32,
+    /// Salt of the stochastic (`BLEND`) transparency hash: the frame's number in the running
+    /// mean when accumulating, 0 otherwise (the same noise every frame).
+    pub frame_index: u32,
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn size_matches_wgsl() {
-        // 2 mat4 (128) + vec4 (16) + mat3x3 (48) + vec4 (16) + 7 scalars (28), rounded to 16.
+        // 2 mat4 (128) + vec4 (16) + mat3x3 (48) + vec4 (16) + 8 scalars (32), rounded to 16.
         assert_eq!(std::mem::size_of::<super::FrameUniforms>(), 240);
     }
 }

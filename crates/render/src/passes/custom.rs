@@ -14,8 +14,10 @@
 //! ```
 //!
 //! Inputs available to the hooks (see `wgsl/custom_api.wgsl` and `wgsl/spectral.wgsl`):
-//! - `ctx: SurfaceContext` — world position, unit normal, unit view direction (camera → pixel),
-//!   distance from the camera, `background` flag, pixel coordinates. Background pixels are
+//! - `ctx: SurfaceContext` — world position, unit normal, unit view direction (camera → pixel;
+//!   the camera's forward axis for an orthographic camera), the view ray's `origin` (the camera
+//!   position, or its plane's point on the pixel's ray when orthographic) and the distance from
+//!   it, `background` flag, pixel coordinates. Background pixels are
 //!   shaded too (radiance 0 before the hook), so fog or water can add in-scattered light.
 //! - `custom.params` — sixteen floats from [`CustomShader::params`].
 //! - `custom_spectra[group * 4 + s]` — spectrum `s` of [`CustomShader::spectra`] sampled at the

@@ -1,46 +1,31 @@
-//! Pass 1: rasterise the scene into the G-buffer — depth, base colour × texture (+ metallic),
-//! normal (normal-mapped through tangents, + roughness), and emission.
+//! Pass 1: rasterise the scene into the G-buffer — depth, base colour × texture × `COLOR_0`
+//! (+ metallic), normal (normal-mapped through tangents, + roughness), and emission.
+//!
+//! Four pipelines, chosen per draw: single-sided materials cull back faces (glTF
+//! `doubleSided: false`), double-sided ones do not and flip the normal of back faces towards
+//! the viewer; `MASK` and `BLEND` materials use the fragment entry point that may discard
+//! (below the cutoff, or stochastically for `BLEND`, see `wgsl/material.wgsl`), opaque ones one
+//! without discard so that early depth testing stays on.
 
-use super::{DEPTH_FORMAT, GBUFFER_FORMATS, SharedLayouts, uniform_entry};
+use super::{DEPTH_FORMAT, GBUFFER_FORMATS, SharedLayouts};
 use crate::error::Result;
-use crate::scene_gpu::{GpuScene, Vertex};
+use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
 
 pub struct GBufferPass {
     pub material_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    /// `[double_sided][alpha_tested]`.
+    pipelines: [[wgpu::RenderPipeline; 2]; 2],
 }
 
 impl GBufferPass {
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("material"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                texture(1),
-                texture(2),
-                texture(3),
-                texture(4),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                texture(6),
-            ],
-        });
-        let module = shader::compile(device, "gbuffer", &[shader::COMMON, include_str!("gbuffer.wgsl")])?;
+        let material_layout = scene_gpu::material_layout(device);
+        let module = shader::compile(
+            device,
+            "gbuffer",
+            &[shader::COMMON, shader::MATERIAL, include_str!("gbuffer.wgsl")],
+        )?;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),
             bind_group_layouts: &[Some(&shared.frame), Some(&material_layout)],
@@ -49,37 +34,45 @@ impl GBufferPass {
         let targets = GBUFFER_FORMATS.map(|format| {
             Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
         });
-        let pipeline = shader::checked(device, "gbuffer pipeline", || {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("gbuffer"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(Vertex::layout())],
-                },
-                // Two-sided: the fragment shader flips back-face normals.
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &targets,
-                }),
-                multiview_mask: None,
-                cache: None,
+        let pipeline = |double_sided: bool, alpha: bool| {
+            shader::checked(device, "gbuffer pipeline", || {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("gbuffer"),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[Some(Vertex::layout())],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some(if alpha { "fs_alpha" } else { "fs_main" }),
+                        compilation_options: Default::default(),
+                        targets: &targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
             })
-        })?;
-        Ok(GBufferPass { material_layout, pipeline })
+        };
+        let pipelines = [
+            [pipeline(false, false)?, pipeline(false, true)?],
+            [pipeline(true, false)?, pipeline(true, true)?],
+        ];
+        Ok(GBufferPass { material_layout, pipelines })
     }
 
     /// Clears and fills `colour` (the three G-buffer targets) and `depth`.
@@ -118,8 +111,16 @@ impl GBufferPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, frame, &[]);
-        scene.draw(&mut pass, true);
+        scene.bind_buffers(&mut pass);
+        let mut current = None;
+        for d in &scene.draws {
+            let key = (d.double_sided as usize, d.alpha_tested as usize);
+            if current != Some(key) {
+                pass.set_pipeline(&self.pipelines[key.0][key.1]);
+                current = Some(key);
+            }
+            scene.draw_one(&mut pass, d);
+        }
     }
 }

@@ -19,7 +19,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let n = normalize(nr.xyz);
-    let v = normalize(frame.camera_pos.xyz - p);
+    let v = normalize(view_origin(in.pos.xy, p, frame) - p);
     let inc = light_incidence(0u, p);
     let nl = max(dot(n, inc.xyz), 0.0);
     let h = normalize(inc.xyz + v);

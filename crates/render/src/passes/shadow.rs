@@ -6,6 +6,18 @@
 //! perspective frustum of their outer cone; point lights a perspective frustum aimed at the
 //! scene's centre (at most 150°: points outside it are treated as lit).
 //!
+//! Materials: single-sided geometry (glTF `doubleSided: false`) is drawn with the faces that
+//! look *towards the light* culled, so a single-sided surface casts a shadow only onto what
+//! lies on its front side. This is the convention both renderers share — a single-sided back
+//! face is invisible to every ray, and the path tracer's shadow rays start at the shaded point:
+//! from there a surface blocks the light only if the point sees its front face, i.e. its back
+//! faces the light. (Closed single-sided meshes shadow as before; an inward-facing single-sided
+//! room keeps outside light out; a single-sided ground plane does not shadow itself, and
+//! objects above it shadow it.) Double-sided geometry is drawn without culling. `MASK` and
+//! `BLEND` materials run a fragment stage with the G-buffer's alpha: texels below the cutoff,
+//! or the stochastically dropped fraction 1 − alpha of a blended surface, let the light through
+//! (see `wgsl/material.wgsl`).
+//!
 //! Lights are given layers in scene order, skipping those without a usable frustum
 //! (degenerate direction); lights beyond [`MAX_SHADOWS`] are **unshadowed**. Stand-in lights
 //! (`Light::stands_in_for`) cast shadows like any other, but their own emissive mesh is left
@@ -47,8 +59,17 @@ struct Layer {
     skip_mesh: Option<usize>,
 }
 
+/// Byte-for-byte `ShadowLayer` in `shadow.wgsl`: one layer's light and hash salt.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct LayerUniforms {
+    view_proj: [[f32; 4]; 4],
+    params: [u32; 4],
+}
+
 pub struct ShadowPass {
-    pipeline: wgpu::RenderPipeline,
+    /// `[double_sided][alpha_tested]`.
+    pipelines: [[wgpu::RenderPipeline; 2]; 2],
     /// All layers, for sampling (`texture_depth_2d_array`).
     pub view: wgpu::TextureView,
     pub sampler: wgpu::Sampler,
@@ -63,41 +84,57 @@ pub struct ShadowPass {
 }
 
 impl ShadowPass {
-    pub fn new(device: &wgpu::Device) -> Result<Self> {
-        let module = shader::compile(device, "shadow", &[include_str!("shadow.wgsl")])?;
+    /// `material_layout`: the material bind group's (group 1), shared with the G-buffer pass.
+    pub fn new(device: &wgpu::Device, material_layout: &wgpu::BindGroupLayout) -> Result<Self> {
+        let module = shader::compile(device, "shadow", &[shader::MATERIAL, include_str!("shadow.wgsl")])?;
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow light"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow"),
-            bind_group_layouts: &[Some(&light_layout)],
+            bind_group_layouts: &[Some(&light_layout), Some(material_layout)],
             immediate_size: 0,
         });
-        let pipeline = shader::checked(device, "shadow pipeline", || {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("shadow"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_shadow"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(crate::scene_gpu::Vertex::layout())],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 },
-                }),
-                multisample: Default::default(),
-                fragment: None,
-                multiview_mask: None,
-                cache: None,
+        let pipeline = |double_sided: bool, alpha: bool| {
+            shader::checked(device, "shadow pipeline", || {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("shadow"),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("vs_shadow"),
+                        compilation_options: Default::default(),
+                        buffers: &[Some(crate::scene_gpu::Vertex::layout())],
+                    },
+                    // Single-sided: keep only faces whose back is towards the light (module docs).
+                    primitive: wgpu::PrimitiveState {
+                        cull_mode: if double_sided { None } else { Some(wgpu::Face::Front) },
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias: wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 },
+                    }),
+                    multisample: Default::default(),
+                    fragment: alpha.then(|| wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some("fs_shadow_alpha"),
+                        compilation_options: Default::default(),
+                        targets: &[],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
             })
-        })?;
+        };
+        let pipelines = [
+            [pipeline(false, false)?, pipeline(false, true)?],
+            [pipeline(true, false)?, pipeline(true, true)?],
+        ];
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
             size: wgpu::Extent3d {
@@ -132,7 +169,7 @@ impl ShadowPass {
             .map(|_| {
                 let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("shadow light view-projection"),
-                    size: std::mem::size_of::<[[f32; 4]; 4]>() as u64,
+                    size: std::mem::size_of::<LayerUniforms>() as u64,
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
@@ -157,15 +194,20 @@ impl ShadowPass {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        Ok(ShadowPass { pipeline, view, sampler, uniforms, layer_views, layer_buffers, active: Vec::new() })
+        Ok(ShadowPass { pipelines, view, sampler, uniforms, layer_views, layer_buffers, active: Vec::new() })
     }
 
     /// Chooses the shadowed lights of `scene` (none when `enabled` is false), uploads their
-    /// matrices for the shadow and shading passes.
-    pub fn update(&mut self, queue: &wgpu::Queue, scene: &GpuScene, enabled: bool) {
+    /// matrices for the shadow and shading passes. `frame_index` salts the stochastic
+    /// transparency of `BLEND` materials (as in the G-buffer).
+    pub fn update(&mut self, queue: &wgpu::Queue, scene: &GpuScene, enabled: bool, frame_index: u32) {
         let (uniforms, layers) = assign(&scene.lights, &scene.emitters, scene.bounds, enabled);
-        for (layer, (buffer, _)) in uniforms.view_proj.iter().zip(&self.layer_buffers).take(layers.len()) {
-            queue.write_buffer(buffer, 0, bytemuck::bytes_of(layer));
+        for (i, (view_proj, (buffer, _))) in
+            uniforms.view_proj.iter().zip(&self.layer_buffers).take(layers.len()).enumerate()
+        {
+            let salt = frame_index.wrapping_mul(MAX_SHADOWS as u32).wrapping_add(i as u32);
+            let u = LayerUniforms { view_proj: *view_proj, params: [salt, 0, 0, 0] };
+            queue.write_buffer(buffer, 0, bytemuck::bytes_of(&u));
         }
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
         self.active = layers;
@@ -204,14 +246,19 @@ impl ShadowPass {
                 multiview_mask: None,
             });
             let Some(layer) = self.active.get(i) else { continue };
-            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.layer_buffers[i].1, &[]);
-            pass.set_vertex_buffer(0, scene.vertices.slice(..));
-            pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            scene.bind_buffers(&mut pass);
+            let mut current = None;
             for (mi, d) in scene.draws.iter().enumerate() {
-                if layer.skip_mesh != Some(mi) {
-                    pass.draw_indexed(d.first_index..d.first_index + d.index_count, d.base_vertex, 0..1);
+                if layer.skip_mesh == Some(mi) {
+                    continue;
                 }
+                let key = (d.double_sided as usize, d.alpha_tested as usize);
+                if current != Some(key) {
+                    pass.set_pipeline(&self.pipelines[key.0][key.1]);
+                    current = Some(key);
+                }
+                scene.draw_one(&mut pass, d);
             }
         }
     }
@@ -317,6 +364,11 @@ const _: () = assert!(MAX_LIGHTS.is_multiple_of(4));
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn layer_uniforms_match_wgsl() {
+        assert_eq!(std::mem::size_of::<LayerUniforms>(), 64 + 16);
+    }
 
     fn light(kind: LightKind, stands_in_for: Option<usize>) -> scene::Light {
         scene::Light {

@@ -112,7 +112,7 @@ fn uw_prepare(ctx: SurfaceContext) {
     uw_steps = m;
     if (!UW_MARCH || m == 0u) { return; }
     let fm = f32(m);
-    let cam = frame.camera_pos.xyz;
+    let cam = ctx.origin;
     var n = 0u;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         if (n == UW_SS_LIGHTS) { break; }

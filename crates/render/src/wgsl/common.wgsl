@@ -22,10 +22,15 @@ struct FrameUniforms {
     // Resolution of the Jakob–Hanika coefficient table.
     table_res: u32,
     // Bit 0: Lambert only (base colour / π, no specular), RenderSettings::lambert.
+    // Bit 1: orthographic camera (parallel view rays).
     flags: u32,
+    // Salt of the stochastic transparency hash (wgsl/material.wgsl): the frame's number in the
+    // accumulated mean, 0 without accumulation.
+    frame_index: u32,
 };
 
 const FLAG_LAMBERT: u32 = 1u;
+const FLAG_ORTHO: u32 = 2u;
 
 const MODE_RGB: u32 = 0u;
 const MODE_NAIVE: u32 = 1u;
@@ -37,6 +42,17 @@ fn world_from_depth(pixel: vec2<f32>, depth: f32, f: FrameUniforms) -> vec3<f32>
     let ndc = vec2<f32>(pixel.x * f.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * f.viewport.w * 2.0);
     let h = f.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
     return h.xyz / h.w;
+}
+
+// Where the view ray through `pixel` that reaches world point `p` starts: the camera position,
+// or for an orthographic camera the point of the camera's plane on that (parallel) ray.
+fn view_origin(pixel: vec2<f32>, p: vec3<f32>, f: FrameUniforms) -> vec3<f32> {
+    let cam = f.camera_pos.xyz;
+    if ((f.flags & FLAG_ORTHO) == 0u) {
+        return cam;
+    }
+    let forward = normalize(world_from_depth(pixel, 1.0, f) - world_from_depth(pixel, 0.0, f));
+    return p - forward * dot(p - cam, forward);
 }
 
 // A triangle that covers the screen; the fullscreen passes draw 3 vertices without buffers.

@@ -22,10 +22,14 @@ struct SurfaceContext {
     world_pos: vec3<f32>,
     // Unit world normal (zero for background).
     normal: vec3<f32>,
-    // Unit direction from the camera through the pixel.
+    // Unit direction from the camera through the pixel (the camera's forward axis everywhere
+    // for an orthographic camera).
     view_dir: vec3<f32>,
-    // Distance from the camera to `world_pos` in scene units (0 for background).
+    // Distance from `origin` to `world_pos` in scene units (0 for background).
     distance: f32,
+    // Where the view ray starts: the camera position, or for an orthographic camera the point
+    // of the camera's plane on this pixel's ray.
+    origin: vec3<f32>,
     // True where no geometry was drawn.
     background: bool,
     // Pixel coordinates.
@@ -37,8 +41,10 @@ struct SurfaceContext {
 fn surface_context(pos: vec2<f32>, depth: f32, f: FrameUniforms) -> SurfaceContext {
     let background = depth >= 1.0;
     let p = world_from_depth(pos, depth, f);
-    let to_p = p - f.camera_pos.xyz;
+    let origin = view_origin(pos, p, f);
+    let to_p = p - origin;
     var ctx: SurfaceContext;
+    ctx.origin = origin;
     ctx.world_pos = p;
     ctx.view_dir = normalize(to_p);
     ctx.distance = select(length(to_p), 0.0, background);

@@ -1,0 +1,77 @@
+// A material (bind group 1 of the G-buffer and shadow passes): factors, five textures each
+// with its own sampler, UV set and KHR_texture_transform, and the alpha mode. Prepended to
+// passes/gbuffer.wgsl and passes/shadow.wgsl.
+
+// Layout matches `MaterialUniforms` in src/scene_gpu.rs.
+struct MaterialUniforms {
+    base_color: vec4<f32>,
+    // rgb emissive (linear, strength applied), w = normal scale.
+    emissive: vec4<f32>,
+    // x metallic, y roughness, z = 1 when the mesh has tangents and a normal map, w occlusion
+    // strength (0 without an occlusion texture).
+    params: vec4<f32>,
+    // x alpha mode (ALPHA_*), y alpha cutoff, z = 1 when double-sided.
+    alpha: vec4<f32>,
+    // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
+    // (m10, m11, m12, 0); uv' = M · (u, v, 1).
+    uv_rows: array<vec4<f32>, 10>,
+};
+
+const ALPHA_OPAQUE: u32 = 0u;
+const ALPHA_MASK: u32 = 1u;
+const ALPHA_BLEND: u32 = 2u;
+
+const TEX_BASE: u32 = 0u;
+const TEX_METAL_ROUGH: u32 = 1u;
+const TEX_NORMAL: u32 = 2u;
+const TEX_EMISSIVE: u32 = 3u;
+const TEX_OCCLUSION: u32 = 4u;
+
+@group(1) @binding(0) var<uniform> material: MaterialUniforms;
+@group(1) @binding(1) var base_color_tex: texture_2d<f32>;
+@group(1) @binding(2) var metal_rough_tex: texture_2d<f32>;
+@group(1) @binding(3) var normal_tex: texture_2d<f32>;
+@group(1) @binding(4) var emissive_tex: texture_2d<f32>;
+@group(1) @binding(5) var occlusion_tex: texture_2d<f32>;
+@group(1) @binding(6) var base_color_smp: sampler;
+@group(1) @binding(7) var metal_rough_smp: sampler;
+@group(1) @binding(8) var normal_smp: sampler;
+@group(1) @binding(9) var emissive_smp: sampler;
+@group(1) @binding(10) var occlusion_smp: sampler;
+
+// The texture coordinates of slot `slot`: its UV set, transformed.
+fn material_uv(slot: u32, uv0: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {
+    let r0 = material.uv_rows[2u * slot];
+    let r1 = material.uv_rows[2u * slot + 1u];
+    let uv = vec3<f32>(select(uv0, uv1, r0.w > 0.5), 1.0);
+    return vec2<f32>(dot(r0.xyz, uv), dot(r1.xyz, uv));
+}
+
+// PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering").
+fn pcg_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// A uniform number in [0, 1) from a pixel, its depth (so that stacked surfaces are
+// independent) and a salt (the frame index when accumulating, and the shadow layer).
+fn coverage_hash(pixel: vec2<f32>, depth: f32, salt: u32) -> f32 {
+    let p = vec2<u32>(pixel);
+    let h = pcg_hash(p.x ^ pcg_hash(p.y ^ pcg_hash(salt ^ pcg_hash(bitcast<u32>(depth)))));
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Whether a fragment of coverage `alpha` (base colour × texture × COLOR_0 alpha) is absent:
+// MASK below the cutoff; BLEND stochastically, kept with probability alpha (hashed: the same
+// pixel, depth and salt always give the same answer).
+fn alpha_discards(alpha: f32, pixel: vec2<f32>, depth: f32, salt: u32) -> bool {
+    let mode = u32(material.alpha.x + 0.5);
+    if (mode == ALPHA_MASK) {
+        return alpha < material.alpha.y;
+    }
+    if (mode == ALPHA_BLEND) {
+        return coverage_hash(pixel, depth, salt) >= alpha;
+    }
+    return false;
+}
