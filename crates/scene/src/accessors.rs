@@ -1,28 +1,73 @@
-//! Bounds checks on glTF accessors before the `gltf` crate's reader touches them.
+//! Checking and reading glTF accessors.
 //!
-//! The reader slices buffers with unchecked arithmetic (`count - 1`, `stride * count`) and reads
-//! elements with slice indexing, so a file that lies about counts, strides or types would panic
-//! inside it. Every accessor is checked here first, so malformed files become errors naming the
-//! accessor instead.
+//! Every accessor is checked here before it is read: its type against what its use allows (glTF
+//! 2.0 and `KHR_mesh_quantization`), and its element range against its buffer view and buffer, so
+//! a file that lies about counts, strides or types gives an error naming the accessor instead of
+//! a panic. Reading converts any stored component type to `f32` the glTF way (normalized integers
+//! to [0, 1] or [-1, 1], other integers as their values), which is all dequantization needs; the
+//! node transform does the rest.
 
 use gltf::accessor::{DataType, Dimensions};
 
 use crate::context::Ctx;
 use crate::error::SceneError;
 
-/// What an attribute may be stored as.
+/// What an accessor may be stored as for one use.
 pub(crate) struct Expect {
-    pub dims: Dimensions,
+    pub dims: &'static [Dimensions],
     pub types: &'static [DataType],
+    /// Integer types that must carry `"normalized": true` for this use.
+    pub normalized: &'static [DataType],
 }
 
-pub(crate) const POSITION: Expect = Expect { dims: Dimensions::Vec3, types: &[DataType::F32] };
-pub(crate) const NORMAL: Expect = Expect { dims: Dimensions::Vec3, types: &[DataType::F32] };
-pub(crate) const TANGENT: Expect = Expect { dims: Dimensions::Vec4, types: &[DataType::F32] };
-pub(crate) const TEXCOORD: Expect =
-    Expect { dims: Dimensions::Vec2, types: &[DataType::F32, DataType::U8, DataType::U16] };
+use DataType::{F32, I8, I16, U8, U16, U32};
+
+/// Integer types `KHR_mesh_quantization` allows where values need not be normalized.
+const ANY_INT: &[DataType] = &[F32, I8, U8, I16, U16];
+
+pub(crate) const POSITION: Expect = Expect { dims: &[Dimensions::Vec3], types: ANY_INT, normalized: &[] };
+pub(crate) const NORMAL: Expect =
+    Expect { dims: &[Dimensions::Vec3], types: &[F32, I8, I16], normalized: &[I8, I16] };
+pub(crate) const TANGENT: Expect =
+    Expect { dims: &[Dimensions::Vec4], types: &[F32, I8, I16], normalized: &[I8, I16] };
+pub(crate) const TEXCOORD: Expect = Expect { dims: &[Dimensions::Vec2], types: ANY_INT, normalized: &[] };
+pub(crate) const COLOR: Expect =
+    Expect { dims: &[Dimensions::Vec3, Dimensions::Vec4], types: &[F32, U8, U16], normalized: &[U8, U16] };
 pub(crate) const INDEX: Expect =
-    Expect { dims: Dimensions::Scalar, types: &[DataType::U8, DataType::U16, DataType::U32] };
+    Expect { dims: &[Dimensions::Scalar], types: &[U8, U16, U32], normalized: &[] };
+/// `EXT_mesh_gpu_instancing` (with `KHR_mesh_quantization`).
+pub(crate) const TRANSLATION: Expect = Expect { dims: &[Dimensions::Vec3], types: ANY_INT, normalized: &[] };
+pub(crate) const ROTATION: Expect =
+    Expect { dims: &[Dimensions::Vec4], types: &[F32, I8, I16], normalized: &[I8, I16] };
+pub(crate) const SCALE: Expect = Expect { dims: &[Dimensions::Vec3], types: ANY_INT, normalized: &[] };
+
+/// The glTF spelling of a component type, for messages.
+pub(crate) fn type_name(t: DataType) -> &'static str {
+    match t {
+        I8 => "BYTE",
+        U8 => "UNSIGNED_BYTE",
+        I16 => "SHORT",
+        U16 => "UNSIGNED_SHORT",
+        U32 => "UNSIGNED_INT",
+        F32 => "FLOAT",
+    }
+}
+
+fn dims_name(d: Dimensions) -> &'static str {
+    match d {
+        Dimensions::Scalar => "SCALAR",
+        Dimensions::Vec2 => "VEC2",
+        Dimensions::Vec3 => "VEC3",
+        Dimensions::Vec4 => "VEC4",
+        Dimensions::Mat2 => "MAT2",
+        Dimensions::Mat3 => "MAT3",
+        Dimensions::Mat4 => "MAT4",
+    }
+}
+
+fn list<T: Copy>(items: &[T], name: fn(T) -> &'static str) -> String {
+    items.iter().map(|&t| name(t)).collect::<Vec<_>>().join(" or ")
+}
 
 fn range_in(
     ctx: &Ctx,
@@ -63,7 +108,8 @@ fn range_in(
     }
 }
 
-/// Checks that `acc` has the expected type and lies inside its buffer.
+/// Checks that `acc` has a type `want` allows and lies inside its buffer. `at` names the use
+/// (`meshes[0].primitives[1].attributes.NORMAL`).
 pub(crate) fn check(
     ctx: &Ctx,
     at: &str,
@@ -71,16 +117,27 @@ pub(crate) fn check(
     want: &Expect,
     buffers: &[Vec<u8>],
 ) -> Result<(), SceneError> {
-    let at = format!("{at} (accessors[{}])", acc.index());
-    if acc.dimensions() != want.dims || !want.types.contains(&acc.data_type()) {
+    let ai = acc.index();
+    let at = format!("{at} (accessors[{ai}])");
+    let (dims, ty) = (acc.dimensions(), acc.data_type());
+    if !want.dims.contains(&dims) || !want.types.contains(&ty) {
         return Err(ctx.invalid(
             &at,
             format!(
-                "stored as {:?} {:?}, expected {:?} of {:?}",
-                acc.dimensions(),
-                acc.data_type(),
-                want.dims,
-                want.types
+                "stored as {} of {}, expected {} of {}",
+                dims_name(dims),
+                type_name(ty),
+                list(want.dims, dims_name),
+                list(want.types, type_name)
+            ),
+        ));
+    }
+    if want.normalized.contains(&ty) && !acc.normalized() {
+        return Err(ctx.invalid(
+            format!("accessors[{ai}].normalized"),
+            format!(
+                "{at} is stored as {}, which must be normalized (\"normalized\": true; glTF 2.0 and KHR_mesh_quantization)",
+                type_name(ty)
             ),
         ));
     }
@@ -114,4 +171,144 @@ pub(crate) fn check(
         range_in(ctx, &format!("{at}.sparse.values"), &val.view(), buffers, val.offset(), n, size)?;
     }
     Ok(())
+}
+
+/// The bytes of `view` (already range-checked by [`check`]).
+fn view_bytes<'a>(view: &gltf::buffer::View, buffers: &'a [Vec<u8>]) -> &'a [u8] {
+    &buffers[view.buffer().index()][view.offset()..view.offset() + view.length()]
+}
+
+/// One component at the start of `b`, converted the glTF way.
+fn component(b: &[u8], ty: DataType, normalized: bool) -> f32 {
+    let v = match ty {
+        F32 => return f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        I8 => b[0] as i8 as f32,
+        U8 => b[0] as f32,
+        I16 => i16::from_le_bytes([b[0], b[1]]) as f32,
+        U16 => u16::from_le_bytes([b[0], b[1]]) as f32,
+        U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+    };
+    if !normalized {
+        return v;
+    }
+    // glTF 2.0 §3.11: signed values map to [-1, 1] with the most negative clamped.
+    match ty {
+        I8 => (v / 127.0).max(-1.0),
+        U8 => v / 255.0,
+        I16 => (v / 32767.0).max(-1.0),
+        U16 => v / 65535.0,
+        U32 => (v as f64 / u32::MAX as f64) as f32,
+        F32 => v,
+    }
+}
+
+fn index_at(b: &[u8], ty: &gltf::accessor::sparse::IndexType) -> usize {
+    use gltf::accessor::sparse::IndexType as T;
+    match ty {
+        T::U8 => b[0] as usize,
+        T::U16 => u16::from_le_bytes([b[0], b[1]]) as usize,
+        T::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+    }
+}
+
+/// Reads a checked accessor as `count × components` floats (sparse substitution applied).
+pub(crate) fn read_f32(
+    ctx: &Ctx,
+    at: &str,
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+) -> Result<Vec<f32>, SceneError> {
+    let n = acc.dimensions().multiplicity();
+    let (ty, norm, count) = (acc.data_type(), acc.normalized(), acc.count());
+    let csize = ty.size();
+    let mut out = vec![0.0f32; count * n];
+    if let Some(view) = acc.view() {
+        let data = &view_bytes(&view, buffers)[acc.offset()..];
+        let stride = view.stride().unwrap_or(csize * n);
+        for (i, e) in out.chunks_exact_mut(n).enumerate() {
+            let el = &data[i * stride..];
+            for (c, v) in e.iter_mut().enumerate() {
+                *v = component(&el[c * csize..], ty, norm);
+            }
+        }
+    }
+    if let Some(sp) = acc.sparse() {
+        let (idx, val) = (sp.indices(), sp.values());
+        let ib = &view_bytes(&idx.view(), buffers)[idx.offset()..];
+        let vb = &view_bytes(&val.view(), buffers)[val.offset()..];
+        let (it, isz) = (idx.index_type(), idx.index_type().size());
+        for k in 0..sp.count() {
+            let i = index_at(&ib[k * isz..], &it);
+            if i >= count {
+                return Err(ctx.invalid(
+                    format!("{at} (accessors[{}]).sparse.indices", acc.index()),
+                    format!("index {i} is out of range for {count} elements"),
+                ));
+            }
+            for c in 0..n {
+                out[i * n + c] = component(&vb[(k * n + c) * csize..], ty, norm);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a checked SCALAR accessor of unsigned integers (indices) exactly.
+pub(crate) fn read_u32(
+    ctx: &Ctx,
+    at: &str,
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+) -> Result<Vec<u32>, SceneError> {
+    let ty = acc.data_type();
+    let size = ty.size();
+    let get = |b: &[u8]| match ty {
+        U8 => b[0] as u32,
+        U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    };
+    let count = acc.count();
+    let mut out = vec![0u32; count];
+    if let Some(view) = acc.view() {
+        let data = &view_bytes(&view, buffers)[acc.offset()..];
+        let stride = view.stride().unwrap_or(size);
+        for (i, v) in out.iter_mut().enumerate() {
+            *v = get(&data[i * stride..]);
+        }
+    }
+    if let Some(sp) = acc.sparse() {
+        let (idx, val) = (sp.indices(), sp.values());
+        let ib = &view_bytes(&idx.view(), buffers)[idx.offset()..];
+        let vb = &view_bytes(&val.view(), buffers)[val.offset()..];
+        let (it, isz) = (idx.index_type(), idx.index_type().size());
+        for k in 0..sp.count() {
+            let i = index_at(&ib[k * isz..], &it);
+            if i >= count {
+                return Err(ctx.invalid(
+                    format!("{at} (accessors[{}]).sparse.indices", acc.index()),
+                    format!("index {i} is out of range for {count} elements"),
+                ));
+            }
+            out[i] = get(&vb[k * size..]);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normalized_integers_follow_the_spec() {
+        assert_eq!(component(&[127], I8, true), 1.0);
+        assert_eq!(component(&[0x80], I8, true), -1.0);
+        assert_eq!(component(&[0x81], I8, true), -1.0);
+        assert_eq!(component(&[255], U8, true), 1.0);
+        assert_eq!(component(&(-32767i16).to_le_bytes(), I16, true), -1.0);
+        assert_eq!(component(&65535u16.to_le_bytes(), U16, true), 1.0);
+        assert_eq!(component(&(-300i16).to_le_bytes(), I16, false), -300.0);
+        assert_eq!(component(&200u8.to_le_bytes(), U8, false), 200.0);
+        assert_eq!(component(&1.5f32.to_le_bytes(), F32, false), 1.5);
+    }
 }

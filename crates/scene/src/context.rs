@@ -33,7 +33,7 @@ impl Ctx {
     }
 
     pub fn io(&self, file: &Path, source: std::io::Error) -> SceneError {
-        SceneError::Io { path: self.path.clone(), file: file.to_path_buf(), source }
+        SceneError::Io { path: self.path.clone(), file: file.to_path_buf(), cause: source }
     }
 
     /// Resolves a relative reference (already percent-decoded) against the scene's directory.

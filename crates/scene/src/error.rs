@@ -7,25 +7,24 @@ use thiserror::Error;
 /// A scene could not be loaded. Every variant names the file (or `builtin:NAME`) and, where it
 /// applies, the glTF index or the JSON field (`materials[2].extras.reflectance.sampled`) at fault,
 /// so a CLI can print the message as it is.
+///
+/// The underlying error (I/O, glTF parser) is part of the message and deliberately *not* exposed
+/// as [`std::error::Error::source`]: callers that print the whole chain (`anyhow`'s `{:#}`) would
+/// otherwise show it twice.
 #[derive(Debug, Error)]
 pub enum SceneError {
     /// The file (or a file it references) could not be read.
-    #[error("{}: cannot read {}: {source}", path.display(), file.display())]
+    #[error("{}: cannot read {}: {cause}", path.display(), file.display())]
     Io {
         /// The scene file.
         path: PathBuf,
         /// The file that failed: the scene itself, a buffer, an image or a CSV spectrum.
         file: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The bytes are not a glTF 2.0 document (bad JSON, bad GLB header, failed validation).
-    #[error("{}: not a valid glTF 2.0 file: {source}", path.display())]
-    Gltf {
-        path: PathBuf,
-        #[source]
-        source: gltf::Error,
-    },
+    #[error("{}: not a valid glTF 2.0 file: {cause}", path.display())]
+    Gltf { path: PathBuf, cause: gltf::Error },
     /// The document parsed but something in it cannot be used; `at` is a glTF path such as
     /// `meshes[0].primitives[1]`.
     #[error("{}: {at}: {message}", path.display())]

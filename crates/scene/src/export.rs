@@ -15,7 +15,7 @@ use glam::{Quat, Vec3};
 use serde_json::{Value, json};
 
 use crate::error::SceneError;
-use crate::{LightKind, Scene, SpectralReflectance, Texture};
+use crate::{AlphaMode, Filter, LightKind, Sampler, Scene, SpectralReflectance, Texture, Wrap};
 
 fn spectrum_json(s: &Spectrum) -> Value {
     match s {
@@ -27,6 +27,26 @@ fn spectrum_json(s: &Spectrum) -> Value {
             json!({"sampled": {"wavelengths": lambda, "values": values}})
         }
     }
+}
+
+/// A glTF sampler object; mipmapped minification is written as the `*_MIPMAP_LINEAR` filters.
+fn sampler_json(s: &Sampler) -> Value {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 10497,
+        Wrap::ClampToEdge => 33071,
+        Wrap::MirroredRepeat => 33648,
+    };
+    let mag = match s.mag {
+        Filter::Nearest => 9728,
+        Filter::Linear => 9729,
+    };
+    let min = match (s.min, s.mipmaps) {
+        (Filter::Nearest, false) => 9728,
+        (Filter::Linear, false) => 9729,
+        (Filter::Nearest, true) => 9986,
+        (Filter::Linear, true) => 9987,
+    };
+    json!({"wrapS": wrap(s.wrap_s), "wrapT": wrap(s.wrap_t), "magFilter": mag, "minFilter": min})
 }
 
 fn data_uri(mime: &str, bytes: &[u8]) -> String {
@@ -86,6 +106,14 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
             let uv = floats(&mut m.uvs.iter().flat_map(|p| p.to_array()));
             attrs.insert("TEXCOORD_0".into(), json!(push(&uv, 34962, n, F32, "VEC2", None)));
         }
+        if !m.uvs1.is_empty() {
+            let uv = floats(&mut m.uvs1.iter().flat_map(|p| p.to_array()));
+            attrs.insert("TEXCOORD_1".into(), json!(push(&uv, 34962, n, F32, "VEC2", None)));
+        }
+        if !m.colors.is_empty() {
+            let c = floats(&mut m.colors.iter().flat_map(|p| p.to_array()));
+            attrs.insert("COLOR_0".into(), json!(push(&c, 34962, n, F32, "VEC4", None)));
+        }
         if !m.tangents.is_empty() {
             let t = floats(&mut m.tangents.iter().flat_map(|p| p.to_array()));
             attrs.insert("TANGENT".into(), json!(push(&t, 34962, n, F32, "VEC4", None)));
@@ -97,12 +125,27 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
     }
 
     let mut images = Vec::new();
-    for t in &scene.textures {
+    let mut samplers: Vec<Value> = Vec::new();
+    let mut textures = Vec::new();
+    for (i, t) in scene.textures.iter().enumerate() {
         images.push(json!({"name": t.name, "uri": data_uri("image/png", &png(t)?)}));
+        let s = sampler_json(&t.sampler);
+        let si = samplers.iter().position(|x| *x == s).unwrap_or_else(|| {
+            samplers.push(s);
+            samplers.len() - 1
+        });
+        textures.push(json!({"source": i, "sampler": si}));
     }
-    let textures: Vec<Value> =
-        (0..scene.textures.len()).map(|i| json!({"source": i, "sampler": 0})).collect();
-    let tex = |r: &crate::TextureRef| json!({"index": r.index, "texCoord": r.tex_coord});
+    let mut uses_transform = false;
+    let mut tex = |r: &crate::TextureRef| {
+        let mut j = json!({"index": r.index, "texCoord": r.tex_coord});
+        if let Some(t) = &r.transform {
+            uses_transform = true;
+            j["extensions"] = json!({"KHR_texture_transform": {
+                "offset": t.offset.to_array(), "rotation": t.rotation, "scale": t.scale.to_array()}});
+        }
+        j
+    };
 
     let mut materials = Vec::new();
     for m in &scene.materials {
@@ -113,10 +156,22 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
         if let Some(t) = &m.metallic_roughness_texture {
             pbr["metallicRoughnessTexture"] = tex(t);
         }
-        let mut j = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        let mut j = json!({"name": m.name, "pbrMetallicRoughness": pbr, "doubleSided": m.double_sided});
+        match m.alpha_mode {
+            AlphaMode::Opaque => {}
+            AlphaMode::Mask { cutoff } => {
+                j["alphaMode"] = json!("MASK");
+                j["alphaCutoff"] = json!(cutoff);
+            }
+            AlphaMode::Blend => j["alphaMode"] = json!("BLEND"),
+        }
         if let Some(t) = &m.normal_texture {
             j["normalTexture"] = tex(t);
             j["normalTexture"]["scale"] = json!(m.normal_scale);
+        }
+        if let Some(t) = &m.occlusion_texture {
+            j["occlusionTexture"] = tex(t);
+            j["occlusionTexture"]["strength"] = json!(m.occlusion_strength);
         }
         // glTF caps emissiveFactor at 1; the rest goes into the strength extension.
         let strength = m.emissive.max_element();
@@ -197,10 +252,17 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
 
     let c = &scene.camera;
     let (_, rot, pos) = c.transform.to_scale_rotation_translation();
-    let mut persp = json!({"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar});
-    if let Some(a) = c.aspect {
-        persp["aspectRatio"] = json!(a);
-    }
+    let camera = match c.ortho {
+        Some((xmag, ymag)) => json!({"type": "orthographic",
+            "orthographic": {"xmag": xmag, "ymag": ymag, "znear": c.znear, "zfar": c.zfar}}),
+        None => {
+            let mut persp = json!({"yfov": c.yfov, "znear": c.znear, "zfar": c.zfar});
+            if let Some(a) = c.aspect {
+                persp["aspectRatio"] = json!(a);
+            }
+            json!({"type": "perspective", "perspective": persp})
+        }
+    };
     nodes.push(
         json!({"name": "camera", "camera": 0, "translation": pos.to_array(), "rotation": rot.to_array()}),
     );
@@ -244,7 +306,7 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
-        "cameras": [{"type": "perspective", "perspective": persp}],
+        "cameras": [camera],
         "extensions": {"KHR_lights_punctual": {"lights": lights}},
         "accessors": accessors,
         "bufferViews": views,
@@ -253,8 +315,10 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
     if !images.is_empty() {
         doc["images"] = json!(images);
         doc["textures"] = json!(textures);
-        // Nearest filtering: palette lookups need unblended texels.
-        doc["samplers"] = json!([{"magFilter": 9728, "minFilter": 9728}]);
+        doc["samplers"] = json!(samplers);
+    }
+    if uses_transform {
+        doc["extensionsUsed"].as_array_mut().expect("written above").push(json!("KHR_texture_transform"));
     }
     if !scene_extras.is_empty() {
         doc["scenes"][0]["extras"] = Value::Object(scene_extras);
@@ -269,7 +333,7 @@ pub fn write_gltf(scene: &Scene, path: &Path) -> Result<(), SceneError> {
         |m: String| SceneError::Invalid { path: path.to_path_buf(), at: "export".into(), message: m };
     let doc = to_gltf_json(scene).map_err(invalid)?;
     let text = serde_json::to_string_pretty(&doc).map_err(|e| invalid(e.to_string()))?;
-    let io = |e| SceneError::Io { path: path.to_path_buf(), file: path.to_path_buf(), source: e };
+    let io = |e| SceneError::Io { path: path.to_path_buf(), file: path.to_path_buf(), cause: e };
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = path.file_name().ok_or_else(|| invalid("the path has no file name".into()))?;
     let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));

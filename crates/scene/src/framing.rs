@@ -7,6 +7,11 @@ use crate::{Camera, Mesh, Scene};
 /// Vertical field of view of the default camera: 45°, a common "normal lens".
 pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
+/// From the scene's centre towards the default camera (normalised on use): to the right, above
+/// and in front (+X, +Y, +Z), a three-quarter view that shows three faces of a box and never
+/// sees a flat asset lying in a principal plane edge-on.
+pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(1.0, 0.6, 1.4);
+
 /// Axis-aligned bounds of all mesh positions, `None` when there are none.
 pub fn bounds(meshes: &[Mesh]) -> Option<(Vec3, Vec3)> {
     let mut it = meshes.iter().flat_map(|m| m.positions.iter().copied());
@@ -22,9 +27,10 @@ impl Scene {
 }
 
 impl Camera {
-    /// The default camera: looks down −Z at the centre of `bounds` from far enough along +Z
-    /// that the bounding sphere fits the vertical field of view (with 10% margin), +Y up, 45°.
-    /// Near and far planes enclose the sphere. With no geometry: at the origin looking down −Z.
+    /// The default camera: looks at the centre of `bounds` from [`DEFAULT_VIEW_DIRECTION`]
+    /// (above, front, right), far enough that the bounding sphere fits the vertical field of view
+    /// with 10% margin, +Y up, 45°. Near and far planes enclose the sphere. With no geometry: at
+    /// the origin looking down −Z.
     pub fn framing(bounds: Option<(Vec3, Vec3)>) -> Camera {
         let Some((lo, hi)) = bounds else {
             return Camera::look_at(Vec3::ZERO, -Vec3::Z, Vec3::Y, DEFAULT_YFOV);
@@ -32,7 +38,8 @@ impl Camera {
         let centre = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
         let dist = 1.1 * radius / (DEFAULT_YFOV * 0.5).sin();
-        let mut cam = Camera::look_at(centre + Vec3::Z * dist, centre, Vec3::Y, DEFAULT_YFOV);
+        let dir = DEFAULT_VIEW_DIRECTION.normalize();
+        let mut cam = Camera::look_at(centre + dir * dist, centre, Vec3::Y, DEFAULT_YFOV);
         cam.znear = ((dist - radius) * 0.5).max(dist * 1e-3);
         cam.zfar = (dist + radius) * 2.0;
         cam
@@ -60,5 +67,20 @@ mod tests {
             assert!(depth > cam.znear && depth < cam.zfar, "corner {c} at depth {depth}");
             assert!(v.y.abs() / depth < half && v.x.abs() / depth < half, "corner {c} outside a square view");
         }
+    }
+
+    #[test]
+    fn default_camera_sees_a_flat_asset_from_above_front_right() {
+        // A unit square in the XY plane facing +Z (TwoSidedPlane) and one in XZ facing +Y.
+        for (lo, hi, normal) in [
+            (Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::Z),
+            (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::Y),
+        ] {
+            let cam = Camera::framing(Some((lo, hi)));
+            let to_eye = (cam.position() - (lo + hi) * 0.5).normalize();
+            assert!(to_eye.dot(normal) > 0.3, "{normal}: seen at a grazing angle from {to_eye}");
+            assert!(to_eye.x > 0.0 && to_eye.y > 0.0 && to_eye.z > 0.0, "{to_eye}");
+        }
+        assert!(Camera::framing(None).position() == Vec3::ZERO);
     }
 }

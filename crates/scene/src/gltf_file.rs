@@ -1,27 +1,30 @@
 //! Loading a `.gltf` / `.glb` file into a [`Scene`].
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use glam::{Mat4, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind;
+use serde_json::Value;
 
 use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::extras::{self, SceneExtras};
+use crate::primitive::Needs;
 use crate::{
-    Camera, Emission, Light, LightKind, Material, Scene, SpectralReflectance, Texture, TextureRef, primitive,
-    uri,
+    AlphaMode, Camera, Emission, Filter, Light, LightKind, Material, Mesh, Sampler, Scene,
+    SpectralReflectance, Texture, TextureRef, Wrap, gltf_ext, instancing, meshopt_decode, primitive, uri,
 };
 
-/// Extensions whose meaning this loader implements; a file that *requires* any other is refused
-/// rather than drawn wrongly.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+/// The most triangles a scene may have after instancing and node flattening: a small hostile
+/// file (one mesh referenced by many instances) must not exhaust memory.
+pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
 ///
 /// Geometry is flattened to world space; spectral `extras` are resolved; errors name the file
-/// and the glTF index or JSON field at fault. See `docs/scene-format.md`.
+/// and the glTF index or JSON field at fault. What was ignored or approximated is listed in
+/// [`Scene::warnings`]. See `docs/scene-format.md`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     let path = path.as_ref();
     let ctx = Ctx::file(path);
@@ -36,20 +39,35 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
     from_slice(&ctx, bytes)
 }
 
+/// The document's JSON as written (the `gltf` crate drops what it does not know, such as most
+/// extension objects).
+fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
+    let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
+    let json = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.json.into_owned()
+    } else {
+        bytes.to_vec()
+    };
+    serde_json::from_slice(&json).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))
+}
+
 pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
-    let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), source: e };
+    let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
+    // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
+    // problems (a wrong type in a sampler field) with a less helpful message.
+    let raw = raw_json(ctx, bytes)?;
+    gltf_ext::precheck(ctx, &raw)?;
     let g = gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_err)?;
-    let root = g.document.into_json();
+    let mut root = g.document.into_json();
+    // Checked by `gltf_ext::precheck` against what this loader implements; the crate's own check
+    // only knows the extensions it parses itself.
+    root.extensions_required.clear();
     precheck(ctx, &root)?;
     let document = gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
-    if let Some(ext) = doc.extensions_required().find(|e| !SUPPORTED_REQUIRED.contains(e)) {
-        return Err(ctx.invalid(
-            "extensionsRequired",
-            format!("extension {ext} is required by the file but not supported"),
-        ));
-    }
-    let buffers = load_buffers(ctx, doc, g.blob.as_deref())?;
+    let mut warnings = gltf_ext::warnings(&raw);
+    let mut buffers = load_buffers(ctx, doc, g.blob.as_deref(), &raw)?;
+    meshopt_decode::decode(ctx, &raw, &mut buffers)?;
     let gscene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
@@ -58,16 +76,25 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
 
     let mut loader = Loader {
         ctx,
+        raw: &raw,
         buffers: &buffers,
         textures: Vec::new(),
         tex_map: HashMap::new(),
         images: HashMap::new(),
     };
-    let mut materials = doc.materials().map(|m| loader.material(&m)).collect::<Result<Vec<_>, _>>()?;
+    let mut materials = Vec::new();
+    let mut needs = Vec::new();
+    for m in doc.materials() {
+        let (mat, need) = loader.material(&m)?;
+        materials.push(mat);
+        needs.push(need);
+    }
     let default_material = materials.len();
     let mut uses_default = false;
 
-    let mut meshes = Vec::new();
+    let mut meshes: Vec<Mesh> = Vec::new();
+    let mut triangles = 0usize;
+    let mut skipped_modes: HashSet<(usize, usize)> = HashSet::new();
     let mut lights = Vec::new();
     let mut camera = None;
     // Depth-first over the scene graph in file order; "first camera" means first in this order.
@@ -87,9 +114,27 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
             return Err(ctx.invalid(at, "transform is not finite"));
         }
         if let Some(mesh) = node.mesh() {
-            first_mesh_of_node.insert(node.index(), meshes.len());
+            // EXT_mesh_gpu_instancing: the mesh is drawn once per instance, each placed by its
+            // own transform within the node's frame; without it, once at the node.
+            let worlds: Vec<Mat4> = match instancing::transforms(ctx, &raw, doc, node.index(), &buffers)? {
+                Some(instances) => instances.into_iter().map(|m| world * m).collect(),
+                None => vec![world],
+            };
+            if let Some(bad) = worlds.iter().position(|w| !w.is_finite()) {
+                return Err(ctx.invalid(&at, format!("the transform of instance {bad} is not finite")));
+            }
+            let first = meshes.len();
             for prim in mesh.primitives() {
                 let pat = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
+                if !primitive::is_triangles(prim.mode()) {
+                    if skipped_modes.insert((mesh.index(), prim.index())) {
+                        warnings.push(format!(
+                            "{pat}: mode {:?} (points or lines) is not drawn, having no area; skipped",
+                            prim.mode()
+                        ));
+                    }
+                    continue;
+                }
                 let mi = match prim.material().index() {
                     Some(i) => i,
                     None => {
@@ -97,12 +142,33 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
                         default_material
                     }
                 };
-                let needs_tangents = materials.get(mi).is_some_and(|m| m.normal_texture.is_some());
-                meshes.push(primitive::build(ctx, &pat, &prim, world, &buffers, mi, needs_tangents)?);
+                let need = needs.get(mi).cloned().unwrap_or_default();
+                let local = primitive::build(ctx, &pat, &prim, &buffers, mi, &need)?;
+                let added = (local.indices.len() / 3).saturating_mul(worlds.len());
+                triangles = triangles.saturating_add(added);
+                if triangles > MAX_TRIANGLES {
+                    return Err(ctx.invalid(
+                        &at,
+                        format!(
+                            "{pat} drawn {} time(s) brings the scene to {triangles} triangles, more than the {MAX_TRIANGLES} this loader accepts",
+                            worlds.len()
+                        ),
+                    ));
+                }
+                for w in &worlds {
+                    let mut m = local.clone();
+                    primitive::to_world(&mut m, *w);
+                    meshes.push(m);
+                }
+            }
+            if meshes.len() > first {
+                first_mesh_of_node.insert(node.index(), first);
             }
         }
         if let (Some(cam), None) = (node.camera(), &camera) {
-            camera = Some(camera_of(ctx, &cam, world)?);
+            let (c, warning) = camera_of(ctx, &cam, world)?;
+            warnings.extend(warning);
+            camera = Some(c);
         }
         if let Some(light) = node.light() {
             let (l, stand_in) = light_of(ctx, &light, &node, world)?;
@@ -130,11 +196,12 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         lights[li].stands_in_for = Some(mesh);
     }
     if uses_default {
-        materials.push(Material { name: "default".into(), ..Material::default() });
+        // glTF's default material: white, fully rough, dielectric, single-sided.
+        materials.push(Material { name: "default".into(), double_sided: false, ..Material::default() });
     }
     let camera = camera.unwrap_or_else(|| Camera::framing(crate::framing::bounds(&meshes)));
     let mut scene = Scene {
-        warnings: vec![],
+        warnings,
         source: ctx.path.display().to_string(),
         meshes,
         materials,
@@ -195,10 +262,28 @@ fn precheck(ctx: &Ctx, root: &gltf::json::Root) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn load_buffers(ctx: &Ctx, doc: &gltf::Document, blob: Option<&[u8]>) -> Result<Vec<Vec<u8>>, SceneError> {
+fn load_buffers(
+    ctx: &Ctx,
+    doc: &gltf::Document,
+    blob: Option<&[u8]>,
+    raw: &Value,
+) -> Result<Vec<Vec<u8>>, SceneError> {
     doc.buffers()
         .map(|b| {
             let at = format!("buffers[{}]", b.index());
+            if let Some(len) = meshopt_decode::fallback_len(raw, b.index()) {
+                // Filled by decoding the EXT_meshopt_compression views that point into it.
+                if len > meshopt_decode::MAX_FALLBACK_BYTES {
+                    return Err(ctx.invalid(
+                        format!("{at}.byteLength"),
+                        format!(
+                            "{len} bytes of decompressed data is more than this loader accepts ({} bytes)",
+                            meshopt_decode::MAX_FALLBACK_BYTES
+                        ),
+                    ));
+                }
+                return Ok(vec![0; len as usize]);
+            }
             let data = match b.source() {
                 gltf::buffer::Source::Bin => blob
                     .ok_or_else(|| ctx.invalid(&at, "refers to the GLB binary chunk, but the file has none"))?
@@ -245,10 +330,42 @@ fn scene_extras(ctx: &Ctx, doc: &gltf::Document, scene: &gltf::Scene) -> Result<
     Ok(out)
 }
 
-fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<Camera, SceneError> {
+/// The camera of `cam` at node transform `world`, and a warning when it had to be changed.
+fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Option<String>), SceneError> {
     let at = format!("cameras[{}]", cam.index());
-    let gltf::camera::Projection::Perspective(p) = cam.projection() else {
-        return Err(ctx.invalid(at, "orthographic cameras are not supported; use a perspective camera"));
+    // A camera's frame is rigid; drop any scale the node hierarchy carries.
+    let (_, rot, pos) = world.to_scale_rotation_translation();
+    let transform = Mat4::from_rotation_translation(rot.normalize(), pos);
+    let p = match cam.projection() {
+        gltf::camera::Projection::Perspective(p) => p,
+        gltf::camera::Projection::Orthographic(o) => {
+            let (xmag, ymag, znear, zfar) = (o.xmag(), o.ymag(), o.znear(), o.zfar());
+            if !(xmag.is_finite() && ymag.is_finite() && xmag != 0.0 && ymag != 0.0) {
+                return Err(ctx.invalid(
+                    format!("{at}.orthographic"),
+                    format!("xmag and ymag must be finite and non-zero, got {xmag}, {ymag}"),
+                ));
+            }
+            if !(znear >= 0.0 && zfar.is_finite() && zfar > znear) {
+                return Err(ctx.invalid(
+                    format!("{at}.orthographic"),
+                    format!("needs 0 ≤ znear < zfar, finite, got znear {znear}, zfar {zfar}"),
+                ));
+            }
+            let warning = (xmag < 0.0 || ymag < 0.0).then(|| {
+                format!("{at}: negative xmag/ymag ({xmag}, {ymag}) would mirror the image; drawn unmirrored")
+            });
+            let (xmag, ymag) = (xmag.abs(), ymag.abs());
+            let camera = Camera {
+                transform,
+                yfov: crate::framing::DEFAULT_YFOV,
+                znear,
+                zfar,
+                aspect: Some(xmag / ymag),
+                ortho: Some((xmag, ymag)),
+            };
+            return Ok((camera, warning));
+        }
     };
     let (yfov, znear) = (p.yfov(), p.znear());
     if !(yfov > 0.0 && yfov < std::f32::consts::PI && znear > 0.0 && znear.is_finite()) {
@@ -264,16 +381,7 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<Camera, Scene
     if aspect.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
         return Err(ctx.invalid(at, "aspectRatio must be positive"));
     }
-    // A camera's frame is rigid; drop any scale the node hierarchy carries.
-    let (_, rot, pos) = world.to_scale_rotation_translation();
-    Ok(Camera {
-        ortho: None,
-        transform: Mat4::from_rotation_translation(rot.normalize(), pos),
-        yfov,
-        znear,
-        zfar,
-        aspect,
-    })
+    Ok((Camera { ortho: None, transform, yfov, znear, zfar, aspect }, None))
 }
 
 fn light_of(
@@ -329,33 +437,82 @@ fn light_of(
 /// Material and texture conversion, with textures shared between materials and decoded once.
 struct Loader<'a> {
     ctx: &'a Ctx,
+    /// The document's JSON, for extension objects the `gltf` crate does not parse.
+    raw: &'a Value,
     buffers: &'a [Vec<u8>],
     textures: Vec<Texture>,
-    /// (glTF texture index, sRGB?) → index in `textures`.
+    /// (glTF texture index, sRGB?) → index in `textures`. The sampler belongs to the glTF
+    /// texture, so it is part of what is shared.
     tex_map: HashMap<(usize, bool), usize>,
     /// glTF image index → decoded RGBA8.
     images: HashMap<usize, (u32, u32, Vec<u8>)>,
 }
 
+fn wrap(w: gltf::texture::WrappingMode) -> Wrap {
+    use gltf::texture::WrappingMode as W;
+    match w {
+        W::ClampToEdge => Wrap::ClampToEdge,
+        W::MirroredRepeat => Wrap::MirroredRepeat,
+        W::Repeat => Wrap::Repeat,
+    }
+}
+
+/// A glTF sampler; absent filters get glTF's usual defaults (linear, mipmapped).
+fn sampler_of(s: &gltf::texture::Sampler) -> Sampler {
+    use gltf::texture::{MagFilter, MinFilter};
+    let mag = match s.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Linear,
+    };
+    let (min, mipmaps) = match s.min_filter() {
+        None => (Filter::Linear, true),
+        Some(MinFilter::Nearest) => (Filter::Nearest, false),
+        Some(MinFilter::Linear) => (Filter::Linear, false),
+        Some(MinFilter::NearestMipmapNearest | MinFilter::NearestMipmapLinear) => (Filter::Nearest, true),
+        Some(MinFilter::LinearMipmapNearest | MinFilter::LinearMipmapLinear) => (Filter::Linear, true),
+    };
+    Sampler { wrap_s: wrap(s.wrap_s()), wrap_t: wrap(s.wrap_t()), mag, min, mipmaps }
+}
+
 impl Loader<'_> {
-    fn material(&mut self, m: &gltf::Material) -> Result<Material, SceneError> {
+    /// The material and what it asks of the primitives that use it.
+    fn material(&mut self, m: &gltf::Material) -> Result<(Material, Needs), SceneError> {
         let idx = m.index().expect("document materials have indices");
         let at = format!("materials[{idx}]");
         let pbr = m.pbr_metallic_roughness();
+        let alpha_mode = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            gltf::material::AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+                if !(cutoff >= 0.0 && cutoff.is_finite()) {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.alphaCutoff"),
+                        format!("must be a finite number ≥ 0, got {cutoff}"),
+                    ));
+                }
+                AlphaMode::Mask { cutoff }
+            }
+        };
         let mut out = Material {
             name: m.name().map_or_else(|| format!("material {idx}"), str::to_string),
             base_color: Vec4::from(pbr.base_color_factor()),
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
             emissive: Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
+            alpha_mode,
+            double_sided: m.double_sided(),
             ..Material::default()
         };
+        let raw = self.raw.pointer(&format!("/materials/{idx}"));
+        let info = |path: &str| raw.and_then(|r| r.pointer(path));
         if let Some(t) = pbr.base_color_texture() {
             out.base_color_texture = Some(self.texture(
                 &format!("{at}.pbrMetallicRoughness.baseColorTexture"),
                 t.texture(),
                 t.tex_coord(),
                 true,
+                info("/pbrMetallicRoughness/baseColorTexture"),
             )?);
         }
         if let Some(t) = pbr.metallic_roughness_texture() {
@@ -364,21 +521,37 @@ impl Loader<'_> {
                 t.texture(),
                 t.tex_coord(),
                 false,
+                info("/pbrMetallicRoughness/metallicRoughnessTexture"),
             )?);
         }
         if let Some(t) = m.normal_texture() {
-            out.normal_texture =
-                Some(self.texture(&format!("{at}.normalTexture"), t.texture(), t.tex_coord(), false)?);
+            out.normal_texture = Some(self.texture(
+                &format!("{at}.normalTexture"),
+                t.texture(),
+                t.tex_coord(),
+                false,
+                info("/normalTexture"),
+            )?);
             out.normal_scale = t.scale();
         }
         if let Some(t) = m.occlusion_texture() {
-            out.occlusion_texture =
-                Some(self.texture(&format!("{at}.occlusionTexture"), t.texture(), t.tex_coord(), false)?);
+            out.occlusion_texture = Some(self.texture(
+                &format!("{at}.occlusionTexture"),
+                t.texture(),
+                t.tex_coord(),
+                false,
+                info("/occlusionTexture"),
+            )?);
             out.occlusion_strength = t.strength().clamp(0.0, 1.0);
         }
         if let Some(t) = m.emissive_texture() {
-            out.emissive_texture =
-                Some(self.texture(&format!("{at}.emissiveTexture"), t.texture(), t.tex_coord(), true)?);
+            out.emissive_texture = Some(self.texture(
+                &format!("{at}.emissiveTexture"),
+                t.texture(),
+                t.tex_coord(),
+                true,
+                info("/emissiveTexture"),
+            )?);
         }
         let values = [
             out.base_color.to_array().as_slice(),
@@ -389,7 +562,21 @@ impl Loader<'_> {
         if values.iter().any(|v| !v.is_finite()) || out.emissive.min_element() < 0.0 {
             return Err(self.ctx.invalid(&at, "factors must be finite (and emissive non-negative)"));
         }
-        let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok(out) };
+        let named = [
+            ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),
+            ("pbrMetallicRoughness.metallicRoughnessTexture", &out.metallic_roughness_texture),
+            ("normalTexture", &out.normal_texture),
+            ("occlusionTexture", &out.occlusion_texture),
+            ("emissiveTexture", &out.emissive_texture),
+        ];
+        let needs = Needs {
+            normal_map_set: out.normal_texture.map(|t| t.tex_coord),
+            set1_user: named
+                .iter()
+                .find(|(_, t)| t.is_some_and(|t| t.tex_coord == 1))
+                .map(|(f, _)| format!("{at}.{f}")),
+        };
+        let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok((out, needs)) };
         let x = extras::material(self.ctx, &at, &map)?;
         if matches!(x.reflectance, Some(SpectralReflectance::Palette(_))) && out.base_color_texture.is_none()
         {
@@ -414,23 +601,31 @@ impl Loader<'_> {
             let e = Emission::new(out.emissive, 1.0, Some(&shape)).map_err(|msg| self.ctx.extras(&f, msg))?;
             out.emission_spectrum = e.spectrum;
         }
-        Ok(out)
+        Ok((out, needs))
     }
 
+    /// The texture of a textureInfo at `at` (`info` is its JSON): decoded once per glTF texture
+    /// and colour space, with its UV set and `KHR_texture_transform`.
     fn texture(
         &mut self,
         at: &str,
         t: gltf::Texture,
         tex_coord: u32,
         srgb: bool,
+        info: Option<&Value>,
     ) -> Result<TextureRef, SceneError> {
-        if tex_coord != 0 {
+        let (transform, over) = gltf_ext::texture_transform(self.ctx, at, info)?;
+        let (tex_coord, field) = match over {
+            Some(tc) => (tc, format!("{at}.extensions.KHR_texture_transform.texCoord")),
+            None => (tex_coord, format!("{at}.texCoord")),
+        };
+        if tex_coord > 1 {
             return Err(self
                 .ctx
-                .invalid(at, format!("uses TEXCOORD_{tex_coord}; only TEXCOORD_0 is supported")));
+                .invalid(field, format!("{tex_coord} is not supported (TEXCOORD_0 and TEXCOORD_1 are)")));
         }
         if let Some(&index) = self.tex_map.get(&(t.index(), srgb)) {
-            return Ok(TextureRef { transform: None, index, tex_coord });
+            return Ok(TextureRef { transform, index, tex_coord });
         }
         let img = t.source();
         let iat = format!("images[{}]", img.index());
@@ -459,8 +654,9 @@ impl Loader<'_> {
         let (width, height, rgba8) = self.images[&img.index()].clone();
         let name = t.name().or(img.name()).map_or_else(|| format!("texture {}", t.index()), str::to_string);
         let index = self.textures.len();
-        self.textures.push(Texture { sampler: Default::default(), name, width, height, rgba8, srgb });
+        let sampler = sampler_of(&t.sampler());
+        self.textures.push(Texture { sampler, name, width, height, rgba8, srgb });
         self.tex_map.insert((t.index(), srgb), index);
-        Ok(TextureRef { transform: None, index, tex_coord })
+        Ok(TextureRef { transform, index, tex_coord })
     }
 }

@@ -15,7 +15,10 @@ mod error;
 pub mod export;
 mod extras;
 pub mod framing;
+mod gltf_ext;
 mod gltf_file;
+mod instancing;
+mod meshopt_decode;
 mod primitive;
 pub mod sky;
 pub mod spectrum_desc;
@@ -33,7 +36,7 @@ pub use builtin::{BUILTIN_NAMES, builtin};
 pub use environment::{Environment, EnvironmentError};
 pub use error::{Result, SceneError};
 pub use export::write_gltf;
-pub use gltf_file::{load, load_slice};
+pub use gltf_file::{MAX_TRIANGLES, load, load_slice};
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
 /// argument ends in `.gltf` or `.glb` (any case), from that file.

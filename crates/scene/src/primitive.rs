@@ -1,5 +1,6 @@
-//! One glTF primitive → one world-space [`Mesh`]: triangulation, flat normals when the file has
-//! none, MikkTSpace tangents when a normal map needs them, and the node transform applied.
+//! One glTF primitive → one [`Mesh`]: attributes read and dequantized, triangulation, flat
+//! normals when the file has none, MikkTSpace tangents when a normal map needs them; then
+//! [`to_world`] applies a node (or instance) transform.
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
@@ -31,94 +32,79 @@ fn triangulate(ctx: &Ctx, at: &str, mode: Mode, idx: Vec<u32>) -> Result<Vec<u32
     })
 }
 
-fn accessor<'a>(
-    ctx: &Ctx,
-    at: &str,
-    acc: Option<gltf::Accessor<'a>>,
-    want: &Expect,
-    buffers: &[Vec<u8>],
-) -> Result<Option<gltf::Accessor<'a>>, SceneError> {
-    if let Some(a) = &acc {
-        accessors::check(ctx, at, a, want, buffers)?;
-    }
-    Ok(acc)
+/// What the primitive's material asks of its vertex data.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Needs {
+    /// The UV set of the material's normal map, which orients generated tangents.
+    pub normal_map_set: Option<u32>,
+    /// The field of a texture that reads `TEXCOORD_1`, if any (named in the error when the
+    /// primitive has none).
+    pub set1_user: Option<String>,
 }
 
-/// Builds the world-space mesh of `prim` under node transform `world`. `material` is the index
-/// the mesh will use; `needs_tangents` is set when that material has a normal map.
+/// Whether a primitive mode has area (the others are points and lines).
+pub(crate) fn is_triangles(mode: Mode) -> bool {
+    matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
+}
+
+fn corners<T: Copy>(v: &[T], idx: &[u32]) -> Vec<T> {
+    if v.is_empty() { Vec::new() } else { idx.iter().map(|&i| v[i as usize]).collect() }
+}
+
+/// Builds the mesh of `prim` in its node's local space (see [`to_world`]). `material` is the
+/// index the mesh will use.
 pub(crate) fn build(
     ctx: &Ctx,
     at: &str,
     prim: &gltf::Primitive,
-    world: Mat4,
     buffers: &[Vec<u8>],
     material: usize,
-    needs_tangents: bool,
+    needs: &Needs,
 ) -> Result<Mesh, SceneError> {
     use gltf::Semantic as S;
-    let pos_acc = accessor(
-        ctx,
-        &format!("{at}.attributes.POSITION"),
-        prim.get(&S::Positions),
-        &accessors::POSITION,
-        buffers,
-    )?
-    .ok_or_else(|| ctx.invalid(at, "has no POSITION attribute"))?;
-    let n_acc = accessor(
-        ctx,
-        &format!("{at}.attributes.NORMAL"),
-        prim.get(&S::Normals),
-        &accessors::NORMAL,
-        buffers,
-    )?;
-    let t_acc = accessor(
-        ctx,
-        &format!("{at}.attributes.TANGENT"),
-        prim.get(&S::Tangents),
-        &accessors::TANGENT,
-        buffers,
-    )?;
-    let uv_acc = accessor(
-        ctx,
-        &format!("{at}.attributes.TEXCOORD_0"),
-        prim.get(&S::TexCoords(0)),
-        &accessors::TEXCOORD,
-        buffers,
-    )?;
-    let i_acc = accessor(ctx, &format!("{at}.indices"), prim.indices(), &accessors::INDEX, buffers)?;
+    let pos_at = format!("{at}.attributes.POSITION");
+    let pos_acc = prim.get(&S::Positions).ok_or_else(|| ctx.invalid(at, "has no POSITION attribute"))?;
+    accessors::check(ctx, &pos_at, &pos_acc, &accessors::POSITION, buffers)?;
     let n = pos_acc.count();
-    for (name, a) in [("NORMAL", &n_acc), ("TANGENT", &t_acc), ("TEXCOORD_0", &uv_acc)] {
-        if let Some(a) = a
-            && a.count() != n
-        {
+    // Each attribute checked (type, range, count), then read as floats, `width` per vertex.
+    let attr = |sem: S, name: &str, want: &Expect| -> Result<Option<(Vec<f32>, usize)>, SceneError> {
+        let Some(a) = prim.get(&sem) else { return Ok(None) };
+        let f = format!("{at}.attributes.{name}");
+        accessors::check(ctx, &f, &a, want, buffers)?;
+        if a.count() != n {
             return Err(ctx.invalid(at, format!("{name} has {} elements but POSITION has {n}", a.count())));
         }
-    }
-
-    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let short = |what: &str| ctx.invalid(at, format!("{what} could not be read from its buffer"));
-    let positions: Vec<Vec3> =
-        reader.read_positions().ok_or_else(|| short("POSITION"))?.map(Vec3::from).collect();
-    let normals: Option<Vec<Vec3>> = match &n_acc {
-        Some(_) => Some(reader.read_normals().ok_or_else(|| short("NORMAL"))?.map(Vec3::from).collect()),
-        None => None,
+        Ok(Some((accessors::read_f32(ctx, &f, &a, buffers)?, a.dimensions().multiplicity())))
     };
-    let file_tangents: Option<Vec<Vec4>> = match &t_acc {
-        Some(_) => Some(reader.read_tangents().ok_or_else(|| short("TANGENT"))?.map(Vec4::from).collect()),
-        None => None,
+    let vec2 = |v: Option<(Vec<f32>, usize)>| -> Vec<Vec2> {
+        v.map(|(f, _)| f.chunks_exact(2).map(Vec2::from_slice).collect()).unwrap_or_default()
     };
-    let uvs: Vec<Vec2> = match &uv_acc {
-        Some(_) => {
-            reader.read_tex_coords(0).ok_or_else(|| short("TEXCOORD_0"))?.into_f32().map(Vec2::from).collect()
-        }
+    let vec3 = |v: Option<(Vec<f32>, usize)>| -> Option<Vec<Vec3>> {
+        v.map(|(f, _)| f.chunks_exact(3).map(Vec3::from_slice).collect())
+    };
+    let positions =
+        vec3(Some((accessors::read_f32(ctx, &pos_at, &pos_acc, buffers)?, 3))).unwrap_or_default();
+    let normals = vec3(attr(S::Normals, "NORMAL", &accessors::NORMAL)?);
+    let file_tangents: Vec<Vec4> = attr(S::Tangents, "TANGENT", &accessors::TANGENT)?
+        .map(|(f, _)| f.chunks_exact(4).map(Vec4::from_slice).collect())
+        .unwrap_or_default();
+    let uvs = vec2(attr(S::TexCoords(0), "TEXCOORD_0", &accessors::TEXCOORD)?);
+    let uvs1 = vec2(attr(S::TexCoords(1), "TEXCOORD_1", &accessors::TEXCOORD)?);
+    let colors: Vec<Vec4> = match attr(S::Colors(0), "COLOR_0", &accessors::COLOR)? {
+        Some((f, 3)) => f.chunks_exact(3).map(|c| Vec3::from_slice(c).extend(1.0)).collect(),
+        Some((f, _)) => f.chunks_exact(4).map(Vec4::from_slice).collect(),
         None => Vec::new(),
     };
-    let raw_idx: Vec<u32> = match &i_acc {
-        Some(_) => reader.read_indices().ok_or_else(|| short("indices"))?.into_u32().collect(),
+    let raw_idx: Vec<u32> = match prim.indices() {
+        Some(a) => {
+            let f = format!("{at}.indices");
+            accessors::check(ctx, &f, &a, &accessors::INDEX, buffers)?;
+            accessors::read_u32(ctx, &f, &a, buffers)?
+        }
         None => (0..n as u32).collect(),
     };
     if positions.len() != n || raw_idx.is_empty() {
-        return Err(short("the vertex data"));
+        return Err(ctx.invalid(at, "the vertex data could not be read from its buffer"));
     }
     if let Some(bad) = raw_idx.iter().find(|&&i| i as usize >= n) {
         return Err(
@@ -126,21 +112,25 @@ pub(crate) fn build(
         );
     }
     if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-        return Err(ctx.invalid(format!("{at}.attributes.POSITION"), format!("non-finite position {p}")));
+        return Err(ctx.invalid(pos_at, format!("non-finite position {p}")));
     }
-    let mut indices = triangulate(ctx, at, prim.mode(), raw_idx)?;
+    if let Some(field) = &needs.set1_user
+        && uvs1.is_empty()
+    {
+        return Err(ctx.invalid(
+            at,
+            format!("{field} reads TEXCOORD_1, but the primitive has no TEXCOORD_1 attribute"),
+        ));
+    }
+    let indices = triangulate(ctx, at, prim.mode(), raw_idx)?;
 
     let mut mesh = match normals {
         Some(normals) => {
-            let tangents = file_tangents.unwrap_or_default();
-            Mesh { colors: vec![], uvs1: vec![], positions, normals, tangents, uvs, indices, material }
+            Mesh { colors, uvs1, positions, normals, tangents: file_tangents, uvs, indices, material }
         }
         None => {
             // glTF: without normals, flat normals. Each triangle needs its own vertices.
-            let corner = |i: &u32| *i as usize;
-            let p: Vec<Vec3> = indices.iter().map(|i| positions[corner(i)]).collect();
-            let uv: Vec<Vec2> =
-                if uvs.is_empty() { Vec::new() } else { indices.iter().map(|i| uvs[corner(i)]).collect() };
+            let p = corners(&positions, &indices);
             let nrm: Vec<Vec3> = p
                 .chunks_exact(3)
                 .flat_map(|t| {
@@ -149,16 +139,15 @@ pub(crate) fn build(
                     [if f == Vec3::ZERO { Vec3::Z } else { f }; 3]
                 })
                 .collect();
-            indices = (0..p.len() as u32).collect();
             // File tangents were per original vertex; flat shading re-indexed, so regenerate.
             Mesh {
-                colors: vec![],
-                uvs1: vec![],
+                colors: corners(&colors, &indices),
+                uvs1: corners(&uvs1, &indices),
+                uvs: corners(&uvs, &indices),
                 positions: p,
                 normals: nrm,
                 tangents: Vec::new(),
-                uvs: uv,
-                indices,
+                indices: (0..indices.len() as u32).collect(),
                 material,
             }
         }
@@ -167,36 +156,37 @@ pub(crate) fn build(
         // Files carry un-normalised or zero normals surprisingly often.
         *nrm = nrm.try_normalize().unwrap_or(Vec3::Z);
     }
-    if needs_tangents && mesh.tangents.is_empty() {
-        if mesh.uvs.is_empty() {
-            return Err(ctx.invalid(
-                at,
-                "its material has a normal map but the primitive has no TEXCOORD_0 to orient it",
-            ));
+    match needs.normal_map_set {
+        Some(set) if mesh.tangents.is_empty() => {
+            let uv = if set == 1 { &mesh.uvs1 } else { &mesh.uvs };
+            if uv.is_empty() {
+                return Err(ctx.invalid(
+                    at,
+                    format!("its material has a normal map on TEXCOORD_{set} but the primitive has no TEXCOORD_{set} to orient it"),
+                ));
+            }
+            let t = tangents::generate(&mesh.positions, &mesh.normals, uv, &mesh.indices);
+            let idx = std::mem::take(&mut mesh.indices);
+            mesh = Mesh {
+                positions: corners(&mesh.positions, &idx),
+                normals: corners(&mesh.normals, &idx),
+                uvs: corners(&mesh.uvs, &idx),
+                uvs1: corners(&mesh.uvs1, &idx),
+                colors: corners(&mesh.colors, &idx),
+                tangents: t,
+                indices: (0..idx.len() as u32).collect(),
+                material,
+            };
         }
-        let (p, nrm, uv, t, idx) =
-            tangents::generate(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
-        mesh = Mesh {
-            colors: vec![],
-            uvs1: vec![],
-            positions: p,
-            normals: nrm,
-            tangents: t,
-            uvs: uv,
-            indices: idx,
-            material,
-        };
+        Some(_) => {}
+        None => mesh.tangents.clear(),
     }
-    if !needs_tangents {
-        mesh.tangents.clear();
-    }
-    to_world(&mut mesh, world);
     Ok(mesh)
 }
 
 /// Applies a node transform: positions by the matrix, normals by its inverse transpose,
 /// tangents by its linear part with handedness flipped and winding reversed when it mirrors.
-fn to_world(mesh: &mut Mesh, world: Mat4) {
+pub(crate) fn to_world(mesh: &mut Mesh, world: Mat4) {
     let lin = Mat3::from_mat4(world);
     let det = lin.determinant();
     let normal_m = if det.abs() > f32::MIN_POSITIVE { lin.inverse().transpose() } else { lin };

@@ -45,13 +45,9 @@ impl Geometry for Soup<'_> {
     }
 }
 
-/// Positions, normals, UVs, tangents and indices of an un-indexed mesh.
-pub(crate) type Unindexed = (Vec<Vec3>, Vec<Vec3>, Vec<Vec2>, Vec<Vec4>, Vec<u32>);
-
-/// MikkTSpace tangents for an indexed triangle mesh. MikkTSpace works per face corner, so the
-/// result is un-indexed: returns new positions/normals/uvs/tangents with one vertex per corner
-/// and the trivial index list.
-pub(crate) fn generate(positions: &[Vec3], normals: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Unindexed {
+/// MikkTSpace tangents for an indexed triangle mesh, one per face corner (`indices[k]` gets
+/// `result[k]`): MikkTSpace works per corner, so the caller un-indexes the mesh to use them.
+pub(crate) fn generate(positions: &[Vec3], normals: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Vec<Vec4> {
     let mut soup = Soup { positions, normals, uvs, indices, out: vec![Vec4::ZERO; indices.len()] };
     // The crate's error type has no variants today; should one appear, fall back to arbitrary
     // frames orthogonal to the normals rather than fail the load.
@@ -60,14 +56,7 @@ pub(crate) fn generate(positions: &[Vec3], normals: &[Vec3], uvs: &[Vec2], indic
             *t = normals[*i as usize].any_orthonormal_vector().extend(1.0);
         }
     }
-    let corner = |i: &u32| *i as usize;
-    (
-        indices.iter().map(|i| positions[corner(i)]).collect(),
-        indices.iter().map(|i| normals[corner(i)]).collect(),
-        indices.iter().map(|i| uvs[corner(i)]).collect(),
-        soup.out,
-        (0..indices.len() as u32).collect(),
-    )
+    soup.out
 }
 
 #[cfg(test)]
@@ -79,8 +68,8 @@ mod tests {
         let p = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
         let n = [Vec3::Z; 4];
         let uv = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
-        let (_, _, _, t, idx) = generate(&p, &n, &uv, &[0, 1, 2, 0, 2, 3]);
-        assert_eq!(idx.len(), 6);
+        let t = generate(&p, &n, &uv, &[0, 1, 2, 0, 2, 3]);
+        assert_eq!(t.len(), 6);
         for t in t {
             assert!(t.truncate().abs_diff_eq(Vec3::X, 1e-5), "{t}");
             // glTF's v runs down the image, here along −y; the bitangent cross(n, t)·w must

@@ -45,11 +45,19 @@ pub mod single;
 /// Refractive index of sea water used to bend the sun direction (visible band, ≈ 1.34).
 pub const WATER_IOR: f64 = 1.34;
 
+impl From<ColorError> for WaterError {
+    fn from(e: ColorError) -> Self {
+        WaterError::Color(e)
+    }
+}
+
 /// What [`WaterMedium`] refuses.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum WaterError {
+    /// The colour error's text is in the message, so it is not also chained as the source
+    /// (a `{:#}` print of the chain would show it twice).
     #[error("water: {0}")]
-    Color(#[from] ColorError),
+    Color(ColorError),
     #[error("water depth must be a finite number of metres ≥ 0 (positive downwards), got {0}")]
     BadDepth(f64),
     #[error("water scale (metres per scene unit) must be finite and > 0, got {0}")]

@@ -1,0 +1,273 @@
+//! glTF extensions: which are implemented, what happens to the others, and the checks that read
+//! the document's JSON directly — before the `gltf` crate validates it, so that our message names
+//! the real problem ("Draco compression is not supported; decompress with …") rather than a
+//! symptom of it ("accessors[0].bufferView: Missing data"), and for extension objects the crate
+//! does not parse (`KHR_texture_transform` on every textureInfo, `EXT_mesh_gpu_instancing`).
+
+use glam::Vec2;
+use serde_json::Value;
+
+use crate::TextureTransform;
+use crate::context::Ctx;
+use crate::error::SceneError;
+
+/// Extensions whose meaning the loader implements; a file may require any of them.
+pub(crate) const SUPPORTED: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+    "KHR_mesh_quantization",
+    "EXT_mesh_gpu_instancing",
+    "EXT_meshopt_compression",
+];
+
+const DECOMPRESS: &str = "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
+const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
+const WEBP: &str = "convert its WebP textures first, e.g. `npx @gltf-transform/cli png in.glb out.glb`";
+const DDS: &str = "re-export the file with PNG or JPEG textures";
+
+/// An unsupported extension: what a file loses when it is ignored (optional), and what to do
+/// when the file requires it.
+fn unsupported(ext: &str) -> (&'static str, &'static str) {
+    match ext {
+        "KHR_draco_mesh_compression" => (
+            "its Draco-compressed geometry is not decoded; the uncompressed copies in the file are drawn",
+            DECOMPRESS,
+        ),
+        "KHR_texture_basisu" => {
+            ("its KTX2/Basis textures are not decoded; the PNG/JPEG fallbacks are used", KTX2)
+        }
+        "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
+        "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
+        "KHR_materials_transmission" => (
+            "transmission is ignored: see-through (glass-like) materials are drawn opaque",
+            "this renderer has no refraction",
+        ),
+        "KHR_materials_volume" => {
+            ("volume absorption (thickness, attenuation colour) is ignored", "this renderer has no volumes")
+        }
+        "KHR_materials_clearcoat" => ("the clear-coat layer is ignored", "this renderer has no clear coat"),
+        "KHR_materials_sheen" => ("sheen (cloth, velvet) is ignored", "this renderer has no sheen"),
+        "KHR_materials_specular" => (
+            "specular strength and colour are ignored (dielectrics use F0 = 0.04)",
+            "this renderer has no specular extension",
+        ),
+        "KHR_materials_ior" => {
+            ("the index of refraction is ignored (1.5 is used)", "this renderer fixes the IOR at 1.5")
+        }
+        "KHR_materials_iridescence" => {
+            ("iridescence (thin films) is ignored", "this renderer has no thin films")
+        }
+        "KHR_materials_anisotropy" => {
+            ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
+        }
+        "KHR_materials_dispersion" => ("dispersion is ignored", "this renderer has no refraction"),
+        "KHR_materials_diffuse_transmission" => {
+            ("diffuse transmission is ignored", "this renderer has no translucency")
+        }
+        "KHR_materials_unlit" => ("unlit materials are shaded as lit", "this renderer has no unlit shading"),
+        "KHR_materials_pbrSpecularGlossiness" => (
+            "specular-glossiness materials are drawn with their metallic-roughness values",
+            "convert the materials to metallic-roughness, e.g. `npx @gltf-transform/cli metalrough in.glb out.glb`",
+        ),
+        "KHR_materials_variants" => ("material variants are ignored; the default materials are drawn", ""),
+        "KHR_animation_pointer" => ("animations are ignored; the scene is drawn at rest", ""),
+        "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
+        _ => ("it is ignored", ""),
+    }
+}
+
+fn strings(v: Option<&Value>) -> impl Iterator<Item = &str> {
+    v.and_then(Value::as_array).into_iter().flatten().filter_map(Value::as_str)
+}
+
+/// Refuses a file that requires an extension the loader does not implement, with what to do.
+pub(crate) fn check_required(ctx: &Ctx, raw: &Value) -> Result<(), SceneError> {
+    for (i, ext) in strings(raw.get("extensionsRequired")).enumerate() {
+        if SUPPORTED.contains(&ext) {
+            continue;
+        }
+        let (_, what_to_do) = unsupported(ext);
+        let advice = if what_to_do.is_empty() { String::new() } else { format!("; {what_to_do}") };
+        return Err(ctx.invalid(
+            format!("extensionsRequired[{i}]"),
+            format!("the file requires {ext}, which is not supported{advice}"),
+        ));
+    }
+    Ok(())
+}
+
+/// One line for each extension the file uses (optionally) that the loader ignores, naming what
+/// is lost.
+pub(crate) fn warnings(raw: &Value) -> Vec<String> {
+    let required: Vec<&str> = strings(raw.get("extensionsRequired")).collect();
+    strings(raw.get("extensionsUsed"))
+        .filter(|e| !SUPPORTED.contains(e) && !required.contains(e))
+        .filter_map(|e| {
+            let (lost, _) = unsupported(e);
+            (!lost.is_empty()).then(|| format!("{e} is not supported: {lost}"))
+        })
+        .collect()
+}
+
+/// Checks of the raw JSON that must come before validation (see the module documentation):
+/// compressed geometry or textures without an uncompressed fallback, sampler enums and alpha
+/// cutoffs.
+pub(crate) fn precheck(ctx: &Ctx, raw: &Value) -> Result<(), SceneError> {
+    check_required(ctx, raw)?;
+    let arr = |k: &str| raw.get(k).and_then(Value::as_array).map(Vec::as_slice).unwrap_or_default();
+    let accessors = arr("accessors");
+    for (mi, m) in arr("meshes").iter().enumerate() {
+        for (pi, p) in m.get("primitives").and_then(Value::as_array).into_iter().flatten().enumerate() {
+            if p.pointer("/extensions/KHR_draco_mesh_compression").is_none() {
+                continue;
+            }
+            let mut used =
+                p.get("attributes").and_then(Value::as_object).into_iter().flat_map(|a| a.values());
+            let no_data = |v: &Value| {
+                v.as_u64()
+                    .and_then(|i| accessors.get(i as usize))
+                    .is_some_and(|a| a.get("bufferView").is_none() && a.get("sparse").is_none())
+            };
+            if used.any(no_data) || p.get("indices").is_some_and(no_data) {
+                return Err(ctx.invalid(
+                    format!("meshes[{mi}].primitives[{pi}]"),
+                    format!("its geometry is only Draco-compressed (KHR_draco_mesh_compression), which is not supported; {DECOMPRESS}"),
+                ));
+            }
+        }
+    }
+    for (ti, t) in arr("textures").iter().enumerate() {
+        if t.get("source").is_some() {
+            continue;
+        }
+        for (ext, advice) in
+            [("KHR_texture_basisu", KTX2), ("EXT_texture_webp", WEBP), ("MSFT_texture_dds", DDS)]
+        {
+            if t.pointer(&format!("/extensions/{ext}")).is_some() {
+                return Err(ctx.invalid(
+                    format!("textures[{ti}]"),
+                    format!("its only image is in {ext}, which is not supported; {advice}"),
+                ));
+            }
+        }
+    }
+    for (si, s) in arr("samplers").iter().enumerate() {
+        let fields: [(&str, &[(u64, &str)]); 4] = [
+            ("wrapS", &[(33071, "CLAMP_TO_EDGE"), (33648, "MIRRORED_REPEAT"), (10497, "REPEAT")]),
+            ("wrapT", &[(33071, "CLAMP_TO_EDGE"), (33648, "MIRRORED_REPEAT"), (10497, "REPEAT")]),
+            ("magFilter", &[(9728, "NEAREST"), (9729, "LINEAR")]),
+            (
+                "minFilter",
+                &[
+                    (9728, "NEAREST"),
+                    (9729, "LINEAR"),
+                    (9984, "NEAREST_MIPMAP_NEAREST"),
+                    (9985, "LINEAR_MIPMAP_NEAREST"),
+                    (9986, "NEAREST_MIPMAP_LINEAR"),
+                    (9987, "LINEAR_MIPMAP_LINEAR"),
+                ],
+            ),
+        ];
+        for (f, allowed) in fields {
+            let Some(v) = s.get(f) else { continue };
+            if !v.as_u64().is_some_and(|x| allowed.iter().any(|(a, _)| *a == x)) {
+                let names: Vec<String> = allowed.iter().map(|(n, s)| format!("{n} {s}")).collect();
+                return Err(ctx.invalid(
+                    format!("samplers[{si}].{f}"),
+                    format!("{v} is not a valid value ({})", names.join(", ")),
+                ));
+            }
+        }
+    }
+    for (mi, m) in arr("materials").iter().enumerate() {
+        if let Some(v) = m.get("alphaCutoff")
+            && !v.as_f64().is_some_and(|c| c >= 0.0 && (c as f32).is_finite())
+        {
+            return Err(ctx.invalid(
+                format!("materials[{mi}].alphaCutoff"),
+                format!("must be a finite number ≥ 0, got {v}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The `KHR_texture_transform` of a textureInfo (`info` is its JSON object, `at` its path):
+/// the transform (`None` when absent or the identity) and the `texCoord` override, if any.
+pub(crate) fn texture_transform(
+    ctx: &Ctx,
+    at: &str,
+    info: Option<&Value>,
+) -> Result<(Option<TextureTransform>, Option<u32>), SceneError> {
+    let Some(ext) = info.and_then(|i| i.pointer("/extensions/KHR_texture_transform")) else {
+        return Ok((None, None));
+    };
+    let at = format!("{at}.extensions.KHR_texture_transform");
+    let bad =
+        |k: &str, what: &str| ctx.invalid(format!("{at}.{k}"), format!("must be {what}, got {}", ext[k]));
+    let pair = |k: &str, default: Vec2| -> Result<Vec2, SceneError> {
+        let Some(v) = ext.get(k) else { return Ok(default) };
+        match v.as_array().map(|a| a.iter().map(Value::as_f64).collect::<Vec<_>>()).as_deref() {
+            Some([Some(x), Some(y)]) if (*x as f32).is_finite() && (*y as f32).is_finite() => {
+                Ok(Vec2::new(*x as f32, *y as f32))
+            }
+            _ => Err(bad(k, "two finite numbers")),
+        }
+    };
+    let offset = pair("offset", Vec2::ZERO)?;
+    let scale = pair("scale", Vec2::ONE)?;
+    let rotation = match ext.get("rotation") {
+        None => 0.0,
+        Some(v) => v
+            .as_f64()
+            .map(|r| r as f32)
+            .filter(|r| r.is_finite())
+            .ok_or_else(|| bad("rotation", "a finite number"))?,
+    };
+    let tex_coord = match ext.get("texCoord") {
+        None => None,
+        Some(v) => Some(
+            v.as_u64()
+                .and_then(|t| u32::try_from(t).ok())
+                .ok_or_else(|| bad("texCoord", "a non-negative integer"))?,
+        ),
+    };
+    let t = TextureTransform { offset, rotation, scale };
+    let identity = offset == Vec2::ZERO && rotation == 0.0 && scale == Vec2::ONE;
+    Ok(((!identity).then_some(t), tex_coord))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn optional_extensions_warn_required_ones_refuse_with_advice() {
+        let raw = json!({
+            "extensionsUsed": ["KHR_materials_transmission", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
+            "extensionsRequired": ["KHR_draco_mesh_compression"],
+        });
+        let w = warnings(&raw);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("KHR_materials_transmission") && w[0].contains("opaque"), "{w:?}");
+        let e = check_required(&Ctx::builtin("t"), &raw).unwrap_err().to_string();
+        assert!(e.contains("extensionsRequired[0]") && e.contains("KHR_draco_mesh_compression"), "{e}");
+        assert!(e.contains("@gltf-transform/cli copy"), "{e}");
+    }
+
+    #[test]
+    fn texture_transform_parses_and_names_bad_fields() {
+        let c = Ctx::builtin("t");
+        let info = json!({"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 1.5, "texCoord": 1}}});
+        let (t, tc) = texture_transform(&c, "m", Some(&info)).unwrap();
+        let t = t.unwrap();
+        assert_eq!((t.offset, t.rotation, t.scale, tc), (Vec2::new(0.5, 0.0), 1.5, Vec2::ONE, Some(1)));
+        let identity = json!({"extensions": {"KHR_texture_transform": {}}});
+        assert_eq!(texture_transform(&c, "m", Some(&identity)).unwrap(), (None, None));
+        let bad = json!({"extensions": {"KHR_texture_transform": {"scale": [1]}}});
+        let e = texture_transform(&c, "materials[0].normalTexture", Some(&bad)).unwrap_err().to_string();
+        assert!(e.contains("materials[0].normalTexture.extensions.KHR_texture_transform.scale"), "{e}");
+    }
+}

@@ -1,0 +1,647 @@
+//! glTF features beyond the basics, each on a small document built here: vertex colours, a second
+//! UV set, alpha modes, double-sidedness, samplers, KHR_texture_transform, EXT_mesh_gpu_instancing,
+//! KHR_mesh_quantization, EXT_meshopt_compression, points and lines, orthographic cameras and
+//! what happens to unsupported extensions — and, for each, the error a bad file gets.
+
+use base64::Engine;
+use glam::{Vec2, Vec3, Vec4};
+use scene::{AlphaMode, Filter, Scene, TextureTransform, Wrap};
+use serde_json::{Value, json};
+
+const I8: u32 = 5120;
+const U8: u32 = 5121;
+const I16: u32 = 5122;
+const U16: u32 = 5123;
+const F32: u32 = 5126;
+
+fn data_uri(mime: &str, bytes: &[u8]) -> String {
+    format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
+}
+
+/// The binary part of a test document: buffer views and accessors in one buffer.
+#[derive(Default)]
+struct Bin {
+    bytes: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+fn components(ty: &str) -> usize {
+    match ty {
+        "SCALAR" => 1,
+        "VEC2" => 2,
+        "VEC3" => 3,
+        _ => 4,
+    }
+}
+
+impl Bin {
+    fn view(&mut self, data: &[u8], stride: Option<usize>) -> usize {
+        while !self.bytes.len().is_multiple_of(4) {
+            self.bytes.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bytes.len(), "byteLength": data.len()});
+        if let Some(s) = stride {
+            v["byteStride"] = json!(s);
+        }
+        self.bytes.extend_from_slice(data);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    /// An accessor of `vals` stored as `ctype`; elements padded to 4 bytes as glTF asks of vertex
+    /// attributes; min/max written (POSITION needs them).
+    fn acc(&mut self, vals: &[f64], ctype: u32, ty: &str, normalized: bool) -> usize {
+        let n = components(ty);
+        let count = vals.len() / n;
+        let csize = match ctype {
+            I8 | U8 => 1,
+            I16 | U16 => 2,
+            _ => 4,
+        };
+        let elem = n * csize;
+        let stride = if ty == "SCALAR" { elem } else { elem.div_ceil(4) * 4 };
+        let mut data = Vec::new();
+        for e in vals.chunks(n) {
+            for &v in e {
+                match ctype {
+                    I8 => data.push(v as i8 as u8),
+                    U8 => data.push(v as u8),
+                    I16 => data.extend((v as i16).to_le_bytes()),
+                    U16 => data.extend((v as u16).to_le_bytes()),
+                    5125 => data.extend((v as u32).to_le_bytes()),
+                    _ => data.extend((v as f32).to_le_bytes()),
+                }
+            }
+            data.resize(data.len() + stride - elem, 0);
+        }
+        let view = self.view(&data, (stride != elem).then_some(stride));
+        let mut a = json!({"bufferView": view, "componentType": ctype, "count": count, "type": ty});
+        if normalized {
+            a["normalized"] = json!(true);
+        }
+        let lo: Vec<f64> =
+            (0..n).map(|c| vals.iter().skip(c).step_by(n).copied().fold(f64::MAX, f64::min)).collect();
+        let hi: Vec<f64> =
+            (0..n).map(|c| vals.iter().skip(c).step_by(n).copied().fold(f64::MIN, f64::max)).collect();
+        a["min"] = json!(lo);
+        a["max"] = json!(hi);
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    fn f32s(&mut self, vals: &[f64], ty: &str) -> usize {
+        self.acc(vals, F32, ty, false)
+    }
+
+    /// A unit right triangle in the XY plane facing +Z.
+    fn triangle(&mut self) -> usize {
+        self.f32s(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], "VEC3")
+    }
+
+    /// `doc` completed with the buffer, views and accessors.
+    fn finish(self, mut doc: Value) -> Value {
+        doc["asset"] = json!({"version": "2.0"});
+        doc["buffers"] = json!([{"byteLength": self.bytes.len(), "uri": data_uri("application/octet-stream", &self.bytes)}]);
+        doc["bufferViews"] = json!(self.views);
+        doc["accessors"] = json!(self.accessors);
+        if doc.get("scenes").is_none() {
+            let n = doc["nodes"].as_array().map_or(0, Vec::len);
+            doc["scenes"] = json!([{"nodes": (0..n).collect::<Vec<_>>()}]);
+        }
+        doc
+    }
+}
+
+/// A 2×2 RGBA PNG as a data URI.
+fn png_uri() -> String {
+    let img =
+        image::RgbaImage::from_raw(2, 2, vec![255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 9, 9, 9, 9])
+            .unwrap();
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    data_uri("image/png", &out.into_inner())
+}
+
+fn load(doc: &Value) -> Result<Scene, String> {
+    scene::load_slice("t.gltf", doc.to_string().as_bytes(), None).map_err(|e| e.to_string())
+}
+
+fn error(doc: &Value) -> String {
+    match load(doc) {
+        Ok(_) => panic!("loaded without error"),
+        Err(e) => e,
+    }
+}
+
+fn assert_has(e: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(e.contains(p), "error lacks '{p}': {e}");
+    }
+}
+
+/// One node, one mesh of the given primitives, and the given materials and textures.
+fn single_mesh(b: Bin, primitives: Value, materials: Value) -> Value {
+    let mut doc = json!({
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": primitives}],
+        "materials": materials,
+    });
+    let textures = doc["materials"].to_string().contains("\"index\"");
+    if textures {
+        doc["images"] = json!([{"uri": png_uri()}]);
+        doc["textures"] = json!([{"source": 0}]);
+    }
+    b.finish(doc)
+}
+
+#[test]
+fn vertex_colours_and_the_second_uv_set() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let rgba8 =
+        b.acc(&[255.0, 0.0, 0.0, 255.0, 0.0, 255.0, 0.0, 51.0, 0.0, 0.0, 255.0, 0.0], U8, "VEC4", true);
+    let rgb_f = b.f32s(&[0.5, 0.25, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0], "VEC3");
+    let rgba16 =
+        b.acc(&[65535.0, 0.0, 0.0, 32768.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 65535.0], U16, "VEC4", true);
+    let uv0 = b.f32s(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], "VEC2");
+    let uv1 = b.acc(&[0.0, 0.0, 65535.0, 0.0, 0.0, 65535.0], U16, "VEC2", true);
+    let doc = single_mesh(
+        b,
+        json!([
+            {"attributes": {"POSITION": pos, "COLOR_0": rgba8, "TEXCOORD_0": uv0, "TEXCOORD_1": uv1}, "material": 0},
+            {"attributes": {"POSITION": pos, "COLOR_0": rgb_f}},
+            {"attributes": {"POSITION": pos, "COLOR_0": rgba16}},
+        ]),
+        json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}},
+                "emissiveTexture": {"index": 0}}]),
+    );
+    let s = load(&doc).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let m = &s.meshes[0];
+    assert_eq!(
+        m.colors,
+        vec![Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, 0.2), Vec4::new(0.0, 0.0, 1.0, 0.0)]
+    );
+    assert_eq!(m.uvs1, vec![Vec2::ZERO, Vec2::X, Vec2::Y]);
+    assert_eq!(m.uvs, vec![Vec2::ZERO, Vec2::X, Vec2::Y]);
+    let mat = &s.materials[0];
+    assert_eq!(mat.base_color_texture.unwrap().tex_coord, 1);
+    assert_eq!(mat.emissive_texture.unwrap().tex_coord, 0);
+    // VEC3 colours get alpha 1; 16-bit colours are normalized by 65535.
+    assert_eq!(s.meshes[1].colors[0], Vec4::new(0.5, 0.25, 1.0, 1.0));
+    let c = s.meshes[2].colors[0];
+    assert!((c.w - 32768.0 / 65535.0).abs() < 1e-6 && c.x == 1.0, "{c}");
+    // A mesh without COLOR_0 has none (white).
+    assert!(scene::builtin("cornell").unwrap().meshes.iter().all(|m| m.colors.is_empty()));
+}
+
+#[test]
+fn bad_uv_sets_and_colours_are_named() {
+    let make = |tex: Value, with_uv1: bool, colour_normalized: bool| {
+        let mut b = Bin::default();
+        let pos = b.triangle();
+        let uv = b.f32s(&[0.0; 6], "VEC2");
+        let col = b.acc(&[255.0; 12], U8, "VEC4", colour_normalized);
+        let mut attrs = json!({"POSITION": pos, "TEXCOORD_0": uv, "COLOR_0": col});
+        if with_uv1 {
+            attrs["TEXCOORD_1"] = json!(uv);
+        }
+        single_mesh(
+            b,
+            json!([{"attributes": attrs, "material": 0}]),
+            json!([{"pbrMetallicRoughness": {"baseColorTexture": tex}}]),
+        )
+    };
+    assert!(load(&make(json!({"index": 0, "texCoord": 1}), true, true)).is_ok());
+    let e = error(&make(json!({"index": 0, "texCoord": 2}), true, true));
+    assert!(
+        e.ends_with("materials[0].pbrMetallicRoughness.baseColorTexture.texCoord: 2 is not supported (TEXCOORD_0 and TEXCOORD_1 are)"),
+        "{e}"
+    );
+    let e = error(&make(
+        json!({"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 3}}}),
+        true,
+        true,
+    ));
+    assert_has(&e, &["baseColorTexture.extensions.KHR_texture_transform.texCoord: 3 is not supported"]);
+    let e = error(&make(json!({"index": 0, "texCoord": 1}), false, true));
+    assert_has(
+        &e,
+        &[
+            "meshes[0].primitives[0]",
+            "materials[0].pbrMetallicRoughness.baseColorTexture reads TEXCOORD_1",
+            "no TEXCOORD_1",
+        ],
+    );
+    let e = error(&make(json!({"index": 0}), true, false));
+    assert_has(&e, &["accessors[2].normalized", "COLOR_0", "UNSIGNED_BYTE", "must be normalized"]);
+}
+
+#[test]
+fn alpha_modes_cutoffs_and_double_sidedness() {
+    let make = |materials: Value| {
+        let mut b = Bin::default();
+        let pos = b.triangle();
+        let n = materials.as_array().unwrap().len();
+        let prims: Vec<Value> = (0..=n)
+            .map(|i| {
+                if i < n {
+                    json!({"attributes": {"POSITION": pos}, "material": i})
+                } else {
+                    json!({"attributes": {"POSITION": pos}})
+                }
+            })
+            .collect();
+        single_mesh(b, json!(prims), materials)
+    };
+    let s = load(&make(json!([
+        {},
+        {"alphaMode": "MASK"},
+        {"alphaMode": "MASK", "alphaCutoff": 0.25, "doubleSided": true},
+        {"alphaMode": "BLEND", "doubleSided": false},
+        {"alphaMode": "OPAQUE", "alphaCutoff": 0.9},
+    ])))
+    .unwrap();
+    let modes: Vec<(AlphaMode, bool)> = s.materials.iter().map(|m| (m.alpha_mode, m.double_sided)).collect();
+    assert_eq!(
+        modes,
+        vec![
+            (AlphaMode::Opaque, false),
+            (AlphaMode::Mask { cutoff: 0.5 }, false),
+            (AlphaMode::Mask { cutoff: 0.25 }, true),
+            (AlphaMode::Blend, false),
+            (AlphaMode::Opaque, false),
+            // glTF's default material (for the primitive without one) is single-sided too.
+            (AlphaMode::Opaque, false),
+        ]
+    );
+    assert_eq!(s.materials[5].name, "default");
+    // Built-in scenes keep their double-sided surfaces.
+    assert!(scene::builtin("cornell").unwrap().materials.iter().all(|m| m.double_sided));
+    for bad in [json!(-0.5), json!(1e39), json!("half")] {
+        let e = error(&make(json!([{"alphaMode": "MASK", "alphaCutoff": bad}])));
+        assert_has(&e, &["materials[0].alphaCutoff", "finite number ≥ 0"]);
+    }
+}
+
+#[test]
+fn samplers_wrap_filter_and_textures_stay_shared() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0; 6], "VEC2");
+    let mut doc = single_mesh(
+        b,
+        json!([{"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": 0},
+               {"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": 1}]),
+        json!([
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 1}}},
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "emissiveTexture": {"index": 2},
+             "occlusionTexture": {"index": 1, "strength": 0.5}},
+        ]),
+    );
+    doc["samplers"] = json!([
+        {"wrapS": 33071, "wrapT": 33648, "magFilter": 9728, "minFilter": 9986},
+        {"wrapS": 10497, "minFilter": 9729},
+    ]);
+    doc["textures"] = json!([{"source": 0, "sampler": 0}, {"source": 0, "sampler": 1}, {"source": 0}]);
+    let s = load(&doc).unwrap();
+    // Texture 0 is shared by both materials; 1 by metallic-roughness and occlusion (both linear).
+    assert_eq!(s.textures.len(), 3, "{:?}", s.textures.iter().map(|t| &t.name).collect::<Vec<_>>());
+    let (m0, m1) = (&s.materials[0], &s.materials[1]);
+    assert_eq!(m0.base_color_texture.unwrap().index, m1.base_color_texture.unwrap().index);
+    assert_eq!(m0.metallic_roughness_texture.unwrap().index, m1.occlusion_texture.unwrap().index);
+    assert_eq!(m1.occlusion_strength, 0.5);
+    let t0 = s.textures[m0.base_color_texture.unwrap().index].sampler;
+    assert_eq!(
+        (t0.wrap_s, t0.wrap_t, t0.mag, t0.min, t0.mipmaps),
+        (Wrap::ClampToEdge, Wrap::MirroredRepeat, Filter::Nearest, Filter::Nearest, true)
+    );
+    let t1 = s.textures[m0.metallic_roughness_texture.unwrap().index].sampler;
+    assert_eq!(
+        (t1.wrap_s, t1.wrap_t, t1.mag, t1.min, t1.mipmaps),
+        (Wrap::Repeat, Wrap::Repeat, Filter::Linear, Filter::Linear, false)
+    );
+    // No sampler: glTF's defaults, repeat and linear with mipmaps.
+    assert_eq!(s.textures[m1.emissive_texture.unwrap().index].sampler, scene::Sampler::default());
+    assert!(scene::Sampler::default().mipmaps);
+
+    let mut bad = doc.clone();
+    bad["samplers"][0]["wrapS"] = json!(12345);
+    assert_has(
+        &error(&bad),
+        &["t.gltf: samplers[0].wrapS: 12345 is not a valid value", "33071 CLAMP_TO_EDGE"],
+    );
+    let mut bad = doc.clone();
+    bad["samplers"][1]["minFilter"] = json!(9728.5);
+    assert_has(&error(&bad), &["samplers[1].minFilter"]);
+}
+
+#[test]
+fn texture_transform_on_every_texture_info() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0; 6], "VEC2");
+    let tt = |x: Value| json!({"index": 0, "extensions": {"KHR_texture_transform": x}});
+    let doc = single_mesh(
+        b,
+        json!([{"attributes": {"POSITION": pos, "TEXCOORD_0": uv, "TEXCOORD_1": uv, "NORMAL": pos}, "material": 0}]),
+        json!([{
+            "pbrMetallicRoughness": {
+                "baseColorTexture": tt(json!({"offset": [0.5, 0.25], "rotation": 1.5707964, "scale": [2, 3]})),
+                "metallicRoughnessTexture": tt(json!({"scale": [4, 4], "texCoord": 1})),
+            },
+            "normalTexture": tt(json!({"offset": [1, 0]})),
+            "occlusionTexture": tt(json!({"rotation": 0.5})),
+            "emissiveTexture": tt(json!({})),
+        }]),
+    );
+    let s = load(&doc).unwrap();
+    let m = &s.materials[0];
+    let base = m.base_color_texture.unwrap();
+    let t = base.transform.unwrap();
+    assert_eq!(
+        t,
+        TextureTransform { offset: Vec2::new(0.5, 0.25), rotation: 1.5707964, scale: Vec2::new(2.0, 3.0) }
+    );
+    // The extension's own example: scale, then rotate, then offset.
+    assert!(t.apply(Vec2::new(1.0, 0.0)).abs_diff_eq(Vec2::new(0.5, -1.75), 1e-5), "{}", t.apply(Vec2::X));
+    let mr = m.metallic_roughness_texture.unwrap();
+    assert_eq!((mr.tex_coord, mr.transform.unwrap().scale), (1, Vec2::splat(4.0)));
+    assert_eq!(m.normal_texture.unwrap().transform.unwrap().offset, Vec2::X);
+    assert_eq!(m.occlusion_texture.unwrap().transform.unwrap().rotation, 0.5);
+    assert_eq!(m.emissive_texture.unwrap().transform, None, "the identity is no transform");
+    // Same texture, different transforms: still one decoded texture.
+    assert_eq!(s.textures.iter().filter(|t| t.srgb).count(), 1);
+}
+
+#[test]
+fn gpu_instancing_expands_instances_under_the_node_transform() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let t = b.f32s(&[0.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 10.0, 0.0], "VEC3");
+    // Instance 1 turned 90° about +Z (short-normalized quaternion), instance 2 scaled by 2.
+    let h = 0.70710677 * 32767.0;
+    let r = b.acc(&[0.0, 0.0, 0.0, 32767.0, 0.0, 0.0, h, h, 0.0, 0.0, 0.0, 32767.0], I16, "VEC4", true);
+    let s = b.f32s(&[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0], "VEC3");
+    let doc = b.finish(json!({
+        "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+        "extensionsRequired": ["EXT_mesh_gpu_instancing"],
+        "nodes": [{"mesh": 0, "translation": [0, 0, -5],
+                   "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": t, "ROTATION": r, "SCALE": s}}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+    }));
+    let sc = load(&doc).unwrap();
+    assert_eq!(sc.meshes.len(), 3);
+    let close = |a: Vec3, b: Vec3| a.abs_diff_eq(b, 1e-3);
+    assert!(close(sc.meshes[0].positions[1], Vec3::new(1.0, 0.0, -5.0)), "{:?}", sc.meshes[0].positions);
+    assert!(close(sc.meshes[1].positions[1], Vec3::new(10.0, 1.0, -5.0)), "{:?}", sc.meshes[1].positions);
+    assert!(close(sc.meshes[2].positions[2], Vec3::new(0.0, 12.0, -5.0)), "{:?}", sc.meshes[2].positions);
+    assert!(sc.meshes.iter().all(|m| m.normals.iter().all(|n| close(*n, Vec3::Z))));
+
+    let mut bad = doc.clone();
+    bad["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = json!(99);
+    assert_has(&error(&bad), &["nodes[0].extensions.EXT_mesh_gpu_instancing.attributes.SCALE", "99"]);
+    let mut bad = doc.clone();
+    bad["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = json!(r);
+    assert_has(&error(&bad), &["SCALE (accessors[2])", "VEC4"]);
+}
+
+#[test]
+fn instancing_cannot_blow_up_the_triangle_count() {
+    // 1000 triangles × 20001 instances: a few hundred kilobytes asking for 20 M triangles.
+    let mut b = Bin::default();
+    let tris: Vec<f64> =
+        (0..1000).flat_map(|i| [i as f64, 0.0, 0.0, i as f64 + 1.0, 0.0, 0.0, i as f64, 1.0, 0.0]).collect();
+    let pos = b.f32s(&tris, "VEC3");
+    let t = b.f32s(&vec![0.0; 3 * 20_001], "VEC3");
+    let doc = b.finish(json!({
+        "nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": t}}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+    }));
+    let e = error(&doc);
+    assert_has(
+        &e,
+        &[
+            "t.gltf: nodes[0]",
+            "meshes[0].primitives[0] drawn 20001 time(s)",
+            "20001000 triangles",
+            "20000000",
+        ],
+    );
+}
+
+#[test]
+fn quantized_attributes_are_dequantized() {
+    let mut b = Bin::default();
+    // Positions as plain shorts, scaled back by the node (the usual quantizer output).
+    let pos = b.acc(&[0.0, 0.0, 0.0, 1000.0, 0.0, 0.0, 0.0, -1000.0, 0.0], I16, "VEC3", false);
+    let nrm = b.acc(&[0.0, 0.0, 127.0, 0.0, 0.0, -128.0, 127.0, 0.0, 0.0], I8, "VEC3", true);
+    let uv = b.acc(&[0.0, 255.0, 255.0, 0.0, 128.0, 128.0], U8, "VEC2", true);
+    let uv_int = b.acc(&[0.0, 2.0, 4.0, 0.0, 1.0, 1.0], U8, "VEC2", false);
+    let tan = b.acc(
+        &[32767.0, 0.0, 0.0, 32767.0, 32767.0, 0.0, 0.0, -32767.0, 0.0, 32767.0, 0.0, 32767.0],
+        I16,
+        "VEC4",
+        true,
+    );
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_mesh_quantization"],
+        "extensionsRequired": ["KHR_mesh_quantization"],
+        "nodes": [{"mesh": 0, "scale": [0.001, 0.001, 0.001]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv, "TEXCOORD_1": uv_int, "TANGENT": tan}, "material": 0}]}],
+        "materials": [{"normalTexture": {"index": 0}}],
+        "images": [{"uri": png_uri()}],
+        "textures": [{"source": 0}],
+    }));
+    let s = load(&doc).unwrap();
+    let m = &s.meshes[0];
+    assert!(
+        m.positions[1].abs_diff_eq(Vec3::X, 1e-6) && m.positions[2].abs_diff_eq(-Vec3::Y, 1e-6),
+        "{:?}",
+        m.positions
+    );
+    assert_eq!(m.normals, vec![Vec3::Z, -Vec3::Z, Vec3::X]);
+    assert!(
+        m.uvs[0].abs_diff_eq(Vec2::new(0.0, 1.0), 1e-6)
+            && m.uvs[2].abs_diff_eq(Vec2::splat(128.0 / 255.0), 1e-6)
+    );
+    assert_eq!(m.uvs1[1], Vec2::new(4.0, 0.0));
+    assert_eq!(m.tangents[0], Vec4::new(1.0, 0.0, 0.0, 1.0));
+    assert_eq!(m.tangents[1].w, -1.0);
+
+    let mut bad = doc.clone();
+    bad["accessors"][nrm].as_object_mut().unwrap().remove("normalized");
+    assert_has(&error(&bad), &["t.gltf: accessors[1].normalized", "NORMAL", "BYTE", "must be normalized"]);
+    let mut bad = doc.clone();
+    bad["accessors"][pos]["componentType"] = json!(5125);
+    assert_has(&error(&bad), &["POSITION (accessors[0])", "UNSIGNED_INT"]);
+}
+
+#[test]
+fn meshopt_compressed_views_are_decoded() {
+    // Source data: a quad with float positions and u16 indices.
+    let positions: [[f32; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let idx = [0u32, 1, 2, 0, 2, 3];
+    let vbytes: Vec<[u8; 12]> = positions
+        .iter()
+        .map(|p| p.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>().try_into().unwrap())
+        .collect();
+    let venc = meshopt::encode_vertex_buffer(&vbytes).unwrap();
+    let ienc = meshopt::encode_index_buffer(&idx, 4).unwrap();
+    let mut compressed = venc.clone();
+    while !compressed.len().is_multiple_of(4) {
+        compressed.push(0);
+    }
+    let ioff = compressed.len();
+    compressed.extend(&ienc);
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["EXT_meshopt_compression"],
+        "extensionsRequired": ["EXT_meshopt_compression"],
+        "buffers": [
+            {"byteLength": compressed.len(), "uri": data_uri("application/octet-stream", &compressed)},
+            {"byteLength": 48 + 12, "extensions": {"EXT_meshopt_compression": {"fallback": true}}},
+        ],
+        "bufferViews": [
+            {"buffer": 1, "byteOffset": 0, "byteLength": 48, "byteStride": 12,
+             "extensions": {"EXT_meshopt_compression": {"buffer": 0, "byteLength": venc.len(), "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"}}},
+            {"buffer": 1, "byteOffset": 48, "byteLength": 12,
+             "extensions": {"EXT_meshopt_compression": {"buffer": 0, "byteOffset": ioff, "byteLength": ienc.len(), "byteStride": 2, "count": 6, "mode": "TRIANGLES"}}},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": F32, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": U16, "count": 6, "type": "SCALAR"},
+        ],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "scenes": [{"nodes": [0]}],
+    });
+    let s = load(&doc).unwrap();
+    let m = &s.meshes[0];
+    // Flat normals un-index the quad: corners in index order.
+    let want: Vec<Vec3> = idx.iter().map(|&i| Vec3::from(positions[i as usize])).collect();
+    assert_eq!(m.positions, want);
+
+    let mut bad = doc.clone();
+    bad["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["byteStride"] = json!(6);
+    assert_has(&error(&bad), &["bufferViews[0].extensions.EXT_meshopt_compression", "byteStride"]);
+    let mut bad = doc.clone();
+    bad["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["mode"] = json!("SOUP");
+    assert_has(&error(&bad), &["EXT_meshopt_compression.mode", "SOUP"]);
+    let mut bad = doc.clone();
+    bad["bufferViews"][1]["extensions"]["EXT_meshopt_compression"]["byteLength"] = json!(3);
+    assert_has(&error(&bad), &["bufferViews[1].extensions.EXT_meshopt_compression", "cannot be decoded"]);
+    let mut bad = doc.clone();
+    bad["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["count"] = json!(5);
+    assert_has(&error(&bad), &["count 5 × byteStride 12 exceeds the view's byteLength 48"]);
+    let mut bad = doc.clone();
+    bad["buffers"][1]["byteLength"] = json!(1u64 << 40);
+    assert_has(&error(&bad), &["buffers[1].byteLength"]);
+}
+
+#[test]
+fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let base = b.finish(
+        json!({"nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}]}),
+    );
+
+    // Draco, required: our message, once, before validation can complain about missing data.
+    let mut d = base.clone();
+    d["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+    d["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    d["accessors"][0].as_object_mut().unwrap().remove("bufferView");
+    d["meshes"][0]["primitives"][0]["extensions"] =
+        json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
+    let e = error(&d);
+    assert_has(
+        &e,
+        &[
+            "extensionsRequired[0]",
+            "KHR_draco_mesh_compression",
+            "npx @gltf-transform/cli copy in.glb out.glb",
+        ],
+    );
+    assert!(!e.contains("Missing data"), "{e}");
+    // Draco only used, but no uncompressed data: named at the primitive.
+    d.as_object_mut().unwrap().remove("extensionsRequired");
+    assert_has(&error(&d), &["meshes[0].primitives[0]", "Draco", "gltf-transform"]);
+    // Draco used with an uncompressed fallback: drawn, with a warning.
+    let mut d = base.clone();
+    d["extensionsUsed"] =
+        json!(["KHR_draco_mesh_compression", "KHR_materials_transmission", "KHR_materials_variants"]);
+    d["meshes"][0]["primitives"][0]["extensions"] =
+        json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
+    let s = load(&d).unwrap();
+    assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
+    assert!(
+        s.warnings[1].starts_with("KHR_materials_transmission is not supported: ")
+            && s.warnings[1].contains("opaque")
+    );
+    // KTX2 only: a texture without a PNG/JPEG source.
+    let mut d = base.clone();
+    d["extensionsUsed"] = json!(["KHR_texture_basisu"]);
+    d["textures"] = json!([{"extensions": {"KHR_texture_basisu": {"source": 0}}}]);
+    d["images"] = json!([{"uri": "x.ktx2"}]);
+    assert_has(&error(&d), &["textures[0]", "KHR_texture_basisu", "ktxdecompress"]);
+    d["extensionsRequired"] = json!(["KHR_texture_basisu"]);
+    assert_has(&error(&d), &["extensionsRequired[0]", "KHR_texture_basisu", "ktxdecompress"]);
+    // A required material extension: refused, naming it.
+    let mut d = base.clone();
+    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_volume"]);
+    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_volume"]);
+}
+
+#[test]
+fn points_and_lines_are_skipped_with_a_warning() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let line = b.acc(&[0.0, 1.0, 1.0, 2.0], U8, "SCALAR", false);
+    let doc = b.finish(json!({
+        "nodes": [{"mesh": 0}, {"mesh": 0}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": pos}, "mode": 0},
+            {"attributes": {"POSITION": pos}, "indices": line, "mode": 1},
+            {"attributes": {"POSITION": pos}, "mode": 5},
+            {"attributes": {"POSITION": pos}, "mode": 3},
+        ]}],
+    }));
+    let s = load(&doc).unwrap();
+    // The strip primitive of each of the two nodes.
+    assert_eq!(s.meshes.len(), 2);
+    assert_eq!(s.meshes[0].indices.len(), 3);
+    // One warning per primitive, not per node that draws it.
+    assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
+    assert!(s.warnings[1].starts_with("meshes[0].primitives[1]: mode Lines"), "{:?}", s.warnings);
+    // A mesh of lines only: its node draws nothing, and cannot be a stand-in's mesh.
+    let mut d = doc.clone();
+    d["meshes"][0]["primitives"] = json!([{"attributes": {"POSITION": pos}, "mode": 1}]);
+    let s = load(&d).unwrap();
+    assert!(s.meshes.is_empty() && s.warnings.len() == 1);
+}
+
+#[test]
+fn orthographic_cameras_are_read() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let doc = b.finish(json!({
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1.5, "znear": 0, "zfar": 10}}],
+    }));
+    let s = load(&doc).unwrap();
+    let c = s.camera;
+    assert_eq!((c.ortho, c.znear, c.zfar), (Some((2.0, 1.5)), 0.0, 10.0));
+    assert!(c.position().abs_diff_eq(Vec3::new(0.0, 0.0, 3.0), 1e-6));
+    assert!(s.warnings.is_empty());
+    for (o, field) in [
+        (json!({"xmag": 0, "ymag": 1, "znear": 0, "zfar": 1}), "xmag"),
+        (json!({"xmag": 1, "ymag": 1, "znear": 2, "zfar": 1}), "zfar"),
+    ] {
+        let mut d = doc.clone();
+        d["cameras"][0]["orthographic"] = o;
+        assert_has(&error(&d), &["cameras[0].orthographic", field]);
+    }
+}
