@@ -272,6 +272,7 @@ pub fn run(args: Args) -> Result<()> {
     let counts = parse_counts(&args.wavelengths)?;
     let mut scene =
         scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    super::print_warnings(&scene);
     args.env.apply(&mut scene)?;
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
     r.set_scene(&scene)?;

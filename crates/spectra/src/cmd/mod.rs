@@ -10,6 +10,14 @@ pub mod truth;
 pub mod upsample;
 pub mod view;
 
+/// Prints what the loader skipped or approximated, one `warning: <scene>: <text>` line each on
+/// stderr (unsupported optional glTF extensions, points and lines, …).
+pub fn print_warnings(scene: &scene::Scene) {
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.source);
+    }
+}
+
 /// The environment light on the command line, shared by `render`, `view` and `truth`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct EnvArgs {

@@ -262,6 +262,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (width, height) = parse_size(&args.size)?;
     let mut scene =
         scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    super::print_warnings(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = settings(&args, &scene)?;
     let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;

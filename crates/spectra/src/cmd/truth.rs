@@ -132,6 +132,7 @@ pub fn run(a: Args) -> Result<()> {
         }
     }
     let mut scene = scene::load_any(&a.scene).with_context(|| format!("loading scene '{}'", a.scene))?;
+    super::print_warnings(&scene);
     a.env.apply(&mut scene)?;
     let st = settings(&a, &scene)?;
     color::upsample::install_interrupt_handler();

@@ -57,6 +57,7 @@ pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
     let mut scene =
         scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    super::print_warnings(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = initial_settings(&args, &scene)?;
     let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
