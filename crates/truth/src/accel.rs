@@ -9,6 +9,11 @@ use obvhs::{
 use scene::Scene;
 use std::time::Duration;
 
+/// [`Geometry::filter`] bit: the material is single-sided (glTF `doubleSided: false`).
+pub const SINGLE_SIDED: u8 = 1;
+/// [`Geometry::filter`] bit: the material's alpha mode is `Mask` or `Blend`.
+pub const NOT_OPAQUE: u8 = 2;
+
 /// A triangle's place in the scene.
 #[derive(Clone, Copy, Debug)]
 pub struct TriRef {
@@ -29,6 +34,10 @@ pub struct Hit {
 pub struct Geometry {
     pub refs: Vec<TriRef>,
     pub verts: Vec<[Vec3; 3]>,
+    /// Per triangle: [`SINGLE_SIDED`] | [`NOT_OPAQUE`] from its material; 0 (opaque,
+    /// double-sided) triangles never call the filter of [`Geometry::intersect_filtered`].
+    pub filter: Vec<u8>,
+    any_filtered: bool,
     bvh: Option<CwBvh>,
 }
 
@@ -75,6 +84,7 @@ impl Geometry {
     pub fn new(scene: &Scene) -> Result<Self, String> {
         let mut refs = Vec::new();
         let mut verts = Vec::new();
+        let mut filter = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
             if m.indices.len() % 3 != 0 {
                 return Err(format!("mesh {mi} has {} indices, not a multiple of 3", m.indices.len()));
@@ -82,6 +92,9 @@ impl Geometry {
             if m.material >= scene.materials.len() {
                 return Err(format!("mesh {mi} uses material {} of {}", m.material, scene.materials.len()));
             }
+            let mat = &scene.materials[m.material];
+            let flags = if mat.double_sided { 0 } else { SINGLE_SIDED }
+                | if mat.alpha_mode == scene::AlphaMode::Opaque { 0 } else { NOT_OPAQUE };
             for (k, c) in m.indices.chunks_exact(3).enumerate() {
                 let p = |i: u32| m.positions.get(i as usize).copied();
                 let (Some(a), Some(b), Some(cc)) = (p(c[0]), p(c[1]), p(c[2])) else {
@@ -96,6 +109,7 @@ impl Geometry {
                 }
                 refs.push(TriRef { mesh: mi as u32, first: (3 * k) as u32 });
                 verts.push([a, b, cc]);
+                filter.push(flags);
             }
         }
         let bvh = (!verts.is_empty()).then(|| {
@@ -103,7 +117,8 @@ impl Geometry {
                 verts.iter().map(|v| Triangle { v0: v3a(v[0]), v1: v3a(v[1]), v2: v3a(v[2]) }).collect();
             build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default())
         });
-        Ok(Geometry { refs, verts, bvh })
+        let any_filtered = filter.iter().any(|&f| f != 0);
+        Ok(Geometry { refs, verts, filter, any_filtered, bvh })
     }
 
     pub fn len(&self) -> usize {
@@ -114,32 +129,63 @@ impl Geometry {
         self.verts.is_empty()
     }
 
-    /// Closest hit along `o + t·d`, t in (0, tmax).
+    /// Closest hit along `o + t·d`, t in (0, tmax), with every triangle taken as there.
     pub fn intersect(&self, o: Vec3, d: Vec3, tmax: f32) -> Option<Hit> {
+        self.intersect_filtered(o, d, tmax, |_, _, _| true)
+    }
+
+    /// Whether anything blocks the open segment `o + t·d`, t in (0, tmax), every triangle taken
+    /// as there.
+    pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
+        self.occluded_filtered(o, d, tmax, |_, _, _| true)
+    }
+
+    /// The closest hit along `o + t·d`, t in (0, tmax), that `pass(tri, b1, b2)` accepts; hits it
+    /// rejects are as if the triangle were not there. `pass` is asked only about triangles marked
+    /// nonzero [`Geometry::filter`]; a scene without any traverses exactly as without a filter.
+    pub fn intersect_filtered(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        mut pass: impl FnMut(u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
         let mut best: Option<Hit> = None;
         let mut hit = obvhs::ray::RayHit::none();
+        let any = self.any_filtered;
         bvh.ray_traverse(ray, &mut hit, |r, id| {
             let tri = bvh.primitive_indices[id];
             match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax) {
-                Some((t, b1, b2)) => {
+                Some((t, b1, b2)) if !(any && self.filter[tri as usize] != 0) || pass(tri, b1, b2) => {
                     best = Some(Hit { t, tri, b1, b2 });
                     t
                 }
-                None => f32::INFINITY,
+                _ => f32::INFINITY,
             }
         });
         best
     }
 
-    /// Whether anything blocks the open segment `o + t·d`, t in (0, tmax).
-    pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32) -> bool {
+    /// Whether a hit that `pass` accepts lies on the open segment `o + t·d`, t in (0, tmax)
+    /// (the same filter as [`Geometry::intersect_filtered`]).
+    pub fn occluded_filtered(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        tmax: f32,
+        mut pass: impl FnMut(u32, f32, f32) -> bool,
+    ) -> bool {
         let Some(bvh) = self.bvh.as_ref() else { return false };
         let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
+        let any = self.any_filtered;
         !bvh.ray_traverse_miss(ray, |r, id| {
             let tri = bvh.primitive_indices[id];
-            intersect_triangle(&self.verts[tri as usize], o, d, r.tmax).map_or(f32::INFINITY, |h| h.0)
+            match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax) {
+                Some((t, b1, b2)) if !(any && self.filter[tri as usize] != 0) || pass(tri, b1, b2) => t,
+                _ => f32::INFINITY,
+            }
         })
     }
 }

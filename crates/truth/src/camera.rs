@@ -1,59 +1,98 @@
-//! The pinhole camera, exactly as the rasteriser projects: glTF camera space (looking down
-//! −Z, +Y up), vertical field of view, aspect ratio of the output image.
+//! The camera, exactly as the rasteriser projects: glTF camera space (looking down −Z, +Y up),
+//! the aspect ratio of the output image, and either a pinhole (vertical field of view) or an
+//! orthographic projection (glTF `orthographic`: parallel rays along −Z).
 
 use glam::{Vec2, Vec3};
 use scene::Camera;
 
 #[derive(Clone, Copy, Debug)]
-pub struct PinholeCamera {
+pub struct RayCamera {
     origin: Vec3,
+    /// Half the image plane's width and height: at unit distance for a pinhole, in scene
+    /// units for an orthographic camera.
     right: Vec3,
     up: Vec3,
     forward: Vec3,
+    ortho: bool,
     width: f32,
     height: f32,
 }
 
-impl PinholeCamera {
+impl RayCamera {
+    /// Orthographic cameras span ±ymag vertically and ±ymag × (width / height) horizontally:
+    /// the output's aspect wins, as for the pinhole's field of view, so an image of aspect
+    /// xmag / ymag spans exactly ±xmag.
     pub fn new(cam: &Camera, width: u32, height: u32) -> Self {
         let t = cam.transform;
-        let tan = (cam.yfov * 0.5).tan();
         let aspect = width as f32 / height as f32;
-        PinholeCamera {
+        // Scale in the transform must change neither the field of view nor the orthographic
+        // extent: normalise the axes.
+        let (half_h, ortho) = match cam.ortho {
+            Some((_, ymag)) => (ymag.abs(), true),
+            None => ((cam.yfov * 0.5).tan(), false),
+        };
+        RayCamera {
             origin: t.transform_point3(Vec3::ZERO),
-            // Scale in the transform must not change the field of view: normalise the axes.
-            right: t.transform_vector3(Vec3::X).normalize() * tan * aspect,
-            up: t.transform_vector3(Vec3::Y).normalize() * tan,
+            right: t.transform_vector3(Vec3::X).normalize() * half_h * aspect,
+            up: t.transform_vector3(Vec3::Y).normalize() * half_h,
             forward: t.transform_vector3(-Vec3::Z).normalize(),
+            ortho,
             width: width as f32,
             height: height as f32,
         }
     }
 
-    pub fn origin(&self) -> Vec3 {
-        self.origin
-    }
-
-    /// Unit direction through image position `p` in pixels (origin top-left, y down).
-    pub fn direction(&self, p: Vec2) -> Vec3 {
+    /// The ray (origin, unit direction) through image position `p` in pixels (origin
+    /// top-left, y down). Orthographic rays start on the camera's z = 0 plane.
+    pub fn ray(&self, p: Vec2) -> (Vec3, Vec3) {
         let x = 2.0 * p.x / self.width - 1.0;
         let y = 1.0 - 2.0 * p.y / self.height;
-        (self.forward + self.right * x + self.up * y).normalize()
+        if self.ortho {
+            (self.origin + self.right * x + self.up * y, self.forward)
+        } else {
+            (self.origin, (self.forward + self.right * x + self.up * y).normalize())
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Mat4;
 
     #[test]
     fn centre_looks_at_target_and_edges_span_the_fov() {
         let cam = Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 0.8);
-        let c = PinholeCamera::new(&cam, 200, 100);
-        assert!((c.direction(Vec2::new(100.0, 50.0)) - (-Vec3::Z)).length() < 1e-6);
-        let top = c.direction(Vec2::new(100.0, 0.0));
+        let c = RayCamera::new(&cam, 200, 100);
+        let dir = |p| c.ray(p).1;
+        assert_eq!(c.ray(Vec2::new(3.0, 7.0)).0, Vec3::new(0.0, 1.0, 5.0));
+        assert!((dir(Vec2::new(100.0, 50.0)) - (-Vec3::Z)).length() < 1e-6);
+        let top = dir(Vec2::new(100.0, 0.0));
         assert!((top.angle_between(-Vec3::Z) - 0.4).abs() < 1e-5 && top.y > 0.0);
-        let right = c.direction(Vec2::new(200.0, 50.0));
+        let right = dir(Vec2::new(200.0, 50.0));
         assert!(right.x > 0.0 && ((right.x / -right.z) - 2.0 * 0.4f32.tan()).abs() < 1e-5);
+    }
+
+    /// Orthographic rays are parallel to the camera's −Z and their origins cover ±xmag × ±ymag
+    /// of the camera plane (image aspect = xmag / ymag), scale in the transform ignored.
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_the_magnification() {
+        let (xmag, ymag) = (3.0, 1.5);
+        let mut cam = Camera::look_at(Vec3::new(1.0, 2.0, 5.0), Vec3::new(1.0, 2.0, 0.0), Vec3::Y, 0.8);
+        cam.transform *= Mat4::from_scale(Vec3::splat(2.0));
+        cam.ortho = Some((xmag, ymag));
+        let c = RayCamera::new(&cam, 200, 100);
+        for p in [Vec2::ZERO, Vec2::new(200.0, 100.0), Vec2::new(37.0, 81.0), Vec2::new(100.0, 50.0)] {
+            let (o, d) = c.ray(p);
+            assert!((d - (-Vec3::Z)).length() < 1e-6, "{d}");
+            assert!((o.z - 5.0).abs() < 1e-5);
+        }
+        let o = |x, y| c.ray(Vec2::new(x, y)).0;
+        assert!((o(100.0, 50.0) - Vec3::new(1.0, 2.0, 5.0)).length() < 1e-5);
+        assert!((o(0.0, 0.0) - Vec3::new(1.0 - xmag, 2.0 + ymag, 5.0)).length() < 1e-5);
+        assert!((o(200.0, 100.0) - Vec3::new(1.0 + xmag, 2.0 - ymag, 5.0)).length() < 1e-5);
+        // A square image keeps ymag and narrows to ±ymag horizontally.
+        let sq = RayCamera::new(&cam, 64, 64);
+        assert!((sq.ray(Vec2::new(64.0, 0.0)).0 - Vec3::new(1.0 + ymag, 2.0 + ymag, 5.0)).length() < 1e-5);
     }
 }

@@ -5,7 +5,7 @@
 //! Spectra are written in tracer units (see [`crate::lights`]) together with `k_white`
 //! (∫ȳ·W dλ over the range), so the consumer can convert to its own radiance normalisation.
 //! Anything without a faithful Mitsuba equivalent (spot lights' glTF cone, palettes, emissive
-//! textures) is listed under `"unsupported"` rather than silently approximated.
+//! textures, alpha modes, single-sided materials, vertex colours, samplers) is listed under `"unsupported"` rather than silently approximated.
 
 use crate::error::{Result, TruthError};
 use crate::world::World;
@@ -134,6 +134,21 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
             if m.emissive_texture.is_some() {
                 unsupported.push(format!("material {i} '{}': emissive texture", m.name));
             }
+            if m.alpha_mode != scene::AlphaMode::Opaque {
+                unsupported.push(format!("material {i} '{}': alpha mode {:?}", m.name, m.alpha_mode));
+            }
+            if !m.double_sided {
+                unsupported.push(format!("material {i} '{}': single-sided (back faces invisible)", m.name));
+            }
+            let refs = [m.base_color_texture, m.metallic_roughness_texture, m.normal_texture, m.emissive_texture];
+            for r in refs.iter().flatten() {
+                if r.tex_coord != 0 || r.transform.is_some() {
+                    unsupported.push(format!("material {i} '{}': TEXCOORD_{} / texture transform", m.name, r.tex_coord));
+                }
+                if scene.textures.get(r.index).is_some_and(|t| t.sampler != scene::Sampler::default()) {
+                    unsupported.push(format!("material {i} '{}': texture sampler {}", m.name, r.index));
+                }
+            }
             let emission = (m.emissive != Vec3::ZERO).then(|| match &world.emission_spectra[i] {
                 Some(s) => sampled(world, |l| s.eval(l)),
                 None => sampled(world, |l| world.units.rgb(m.emissive, world.upsampler, Vec4::splat(l)).x),
@@ -149,6 +164,9 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
     for (i, m) in scene.meshes.iter().enumerate() {
         if m.indices.is_empty() {
             continue;
+        }
+        if !m.colors.is_empty() {
+            unsupported.push(format!("mesh {i}: vertex colours (COLOR_0)"));
         }
         let p = dir.join(format!("mesh_{i}.ply"));
         fs::write(&p, ply(m)).map_err(io(&p))?;
@@ -177,6 +195,9 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
         }
     }
 
+    if cam.ortho.is_some() {
+        unsupported.push("orthographic camera (exported with the perspective fov)".into());
+    }
     if world.surface.is_some() {
         unsupported.push("water surface (Fresnel, TIR) and the sky seen through it".into());
     }

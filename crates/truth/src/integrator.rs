@@ -98,7 +98,7 @@ impl Integrator<'_, '_> {
             let o = origin(s.wi);
             let tmax =
                 if s.dist.is_finite() { (s.dist - (o - p).length()) * (1.0 - 1e-5) } else { f32::INFINITY };
-            if w.geometry.occluded(o, s.wi, tmax) {
+            if w.occluded(o, s.wi, tmax, w.ray_key(rng)) {
                 continue;
             }
             sum += f * light.spectrum.eval4(l) * s.scale * self.transmittance(o, s.wi, tmax, l);
@@ -112,7 +112,9 @@ impl Integrator<'_, '_> {
             let dist = d2.sqrt();
             if dist > 0.0 {
                 let wi = to / dist;
-                let le = w.emitted(&q, -wi, l);
+                // A sampled point where the emitter is cut out or see-through emits with the
+                // probability a ray would stop there (what BRDF sampling finds).
+                let le = w.emitted(&q, -wi, l) * w.coverage(tri, b1, b2, wi);
                 let cos_l = q.ng.dot(wi).abs();
                 if le != Vec4::ZERO && cos_l > 0.0 {
                     let (f, pdf_v) = v.eval(wo, wi);
@@ -126,7 +128,7 @@ impl Integrator<'_, '_> {
                         let seg = end - o;
                         let tmax = seg.length();
                         let dir = seg / tmax;
-                        if !w.geometry.occluded(o, dir, tmax) {
+                        if !w.occluded(o, dir, tmax, w.ray_key(rng)) {
                             let mis = power_heuristic(pdf_l, pdf_v);
                             sum += f * le * self.transmittance(o, wi, tmax, l) * (mis / pdf_l);
                         }
@@ -141,7 +143,7 @@ impl Integrator<'_, '_> {
                 if f != Vec4::ZERO {
                     let le = env.texel_radiance(es.texel, l);
                     let o = origin(es.wi);
-                    if le != Vec4::ZERO && !w.geometry.occluded(o, es.wi, f32::INFINITY) {
+                    if le != Vec4::ZERO && !w.occluded(o, es.wi, f32::INFINITY, w.ray_key(rng)) {
                         let mis = power_heuristic(es.pdf, pdf_v);
                         sum += f * le * self.transmittance(o, es.wi, f32::INFINITY, l) * (mis / es.pdf);
                     }
@@ -167,7 +169,7 @@ impl Integrator<'_, '_> {
         let mut prev_pdf = 0.0f32;
         let mut depth = 0u32;
         loop {
-            let hit = w.geometry.intersect(o, d, f32::INFINITY);
+            let hit = w.intersect(o, d, f32::INFINITY, w.ray_key(rng));
             let mut t_hit = hit.map_or(f32::INFINITY, |h| h.t);
             // The water surface, from below, comes before anything above it.
             let at_surface = w.surface.as_ref().and_then(|s| s.crossing(o, d)).filter(|&t| t <= t_hit);
@@ -274,11 +276,12 @@ impl Integrator<'_, '_> {
                 break;
             }
 
-            // Two-sided shading: face the normals towards the viewer.
+            // Double-sided materials face their normals towards the viewer; a single-sided one
+            // is hit from the front only (`World::coverage`), so the flip never applies to it.
             let flip = if s.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
             let ng = s.ng * flip;
             let mat = &w.scene.materials[s.material];
-            let mut ns = material::mapped_normal(mat, &w.scene.textures, s.uv, s.n_vertex * flip, s.tangent);
+            let mut ns = material::mapped_normal(mat, &w.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
             if ns.dot(wo) <= 0.0 {
                 ns = ng;
             }
@@ -287,10 +290,11 @@ impl Integrator<'_, '_> {
                 &w.materials[s.material],
                 &w.scene.textures,
                 w.upsampler,
-                s.uv,
+                &s.tc,
+                s.color,
                 l,
             );
-            let (metallic, roughness) = material::metallic_roughness(mat, &w.scene.textures, s.uv);
+            let (metallic, roughness) = material::metallic_roughness(mat, &w.scene.textures, &s.tc);
             let brdf =
                 if self.lambert { Brdf::lambertian(base) } else { Brdf::new(base, metallic, roughness) };
             let frame = Frame::from_normal(ns);

@@ -309,11 +309,12 @@ fn env_furnace_white_sphere_renders_one() {
     scene.camera = scene::Camera::look_at(Vec3::new(0.0, 0.6, 3.0), Vec3::ZERO, Vec3::Y, 0.8);
     let (w, h) = (24u32, 24u32);
     let world = World::new(&scene, &GreyOnly, &d65(), WavelengthRange::VISIBLE, None).unwrap();
-    let cam = crate::camera::PinholeCamera::new(&scene.camera, w, h);
+    let cam = crate::camera::RayCamera::new(&scene.camera, w, h);
     let on_sphere: Vec<bool> = (0..w * h)
         .map(|i| {
             let px = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            world.geometry.intersect(cam.origin(), cam.direction(px), f32::INFINITY).is_some()
+            let (o, d) = cam.ray(px);
+            world.geometry.intersect(o, d, f32::INFINITY).is_some()
         })
         .collect();
     let n_sphere = on_sphere.iter().filter(|&&b| b).count();

@@ -34,6 +34,8 @@ pub mod water_surface;
 pub mod world;
 
 #[cfg(test)]
+mod gltf_features_tests;
+#[cfg(test)]
 mod testing;
 
 pub use error::{Result, TruthError};

@@ -29,30 +29,62 @@ impl PreparedMaterial {
     }
 }
 
-fn tex<'a>(textures: &'a [Texture], r: &Option<TextureRef>) -> Option<&'a Texture> {
-    r.as_ref().and_then(|r| textures.get(r.index)).filter(|t| t.width > 0 && t.height > 0)
+/// The texture coordinate sets at a surface point (`TEXCOORD_0`, `TEXCOORD_1`); each texture
+/// reads the set its [`TextureRef::tex_coord`] names, through its `KHR_texture_transform`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TexCoords(pub [Vec2; 2]);
+
+impl TexCoords {
+    /// Both sets at `uv` (tests; meshes with one set).
+    pub fn one(uv: Vec2) -> Self {
+        TexCoords([uv; 2])
+    }
+
+    /// The coordinates texture reference `r` samples at.
+    #[inline]
+    pub fn at(&self, r: &TextureRef) -> Vec2 {
+        let uv = self.0.get(r.tex_coord as usize).copied().unwrap_or(Vec2::ZERO);
+        r.transform.map_or(uv, |t| t.apply(uv))
+    }
+}
+
+/// The texture `r` refers to and the coordinates to read it at.
+fn tex<'a>(textures: &'a [Texture], r: &Option<TextureRef>, tc: &TexCoords) -> Option<(&'a Texture, Vec2)> {
+    let r = r.as_ref()?;
+    let t = textures.get(r.index).filter(|t| t.width > 0 && t.height > 0)?;
+    Some((t, tc.at(r)))
+}
+
+/// Coverage: base colour alpha × base colour texture alpha × `COLOR_0` alpha (`color.w`).
+/// What `alphaMode` MASK compares with the cutoff and BLEND uses as opacity.
+pub fn alpha(m: &Material, textures: &[Texture], tc: &TexCoords, color: Vec4) -> f32 {
+    let t = tex(textures, &m.base_color_texture, tc).map_or(1.0, |(t, uv)| texture::sample_alpha(t, uv));
+    m.base_color.w * t * color.w
 }
 
 /// Base colour reflectance at four wavelengths.
 ///
 /// Measured spectra replace the RGB: `Uniform` everywhere, `Palette` per texel (each of the
 /// four texels of the bilinear footprint contributes its own spectrum, so the filtering
-/// happens in the spectral domain). Everything else is base factor × filtered texture,
-/// upsampled.
+/// happens in the spectral domain). Everything else is base factor × `COLOR_0` (`color`) ×
+/// filtered texture, upsampled. Measured spectra replace the factor and `COLOR_0` too (both are
+/// RGB stand-ins for the spectrum); texels the palette does not list keep them.
+#[allow(clippy::too_many_arguments)]
 pub fn base_reflectance(
     m: &Material,
     pm: &PreparedMaterial,
     textures: &[Texture],
     up: &dyn RgbToSpectrum,
-    uv: Vec2,
+    tc: &TexCoords,
+    color: Vec4,
     l: Vec4,
 ) -> Vec4 {
     if let Some(u) = &pm.uniform {
         return u.eval4(l);
     }
-    let factor = m.base_color.truncate();
-    let t = tex(textures, &m.base_color_texture);
-    if let (false, Some(t)) = (pm.palette.is_empty(), t) {
+    let factor = m.base_color.truncate() * color.truncate();
+    let t = tex(textures, &m.base_color_texture, tc);
+    if let (false, Some((t, uv))) = (pm.palette.is_empty(), t) {
         let f = texture::footprint(t, uv);
         let mut acc = Vec4::ZERO;
         for (&at, w) in f.texels.iter().zip(f.weights) {
@@ -72,16 +104,16 @@ pub fn base_reflectance(
         return acc;
     }
     let rgb = match t {
-        Some(t) => texture::sample(t, uv).truncate() * factor,
+        Some((t, uv)) => texture::sample(t, uv).truncate() * factor,
         None => factor,
     };
     upsample::reflectance(up, rgb.to_array(), l)
 }
 
 /// (metallic, roughness) with the texture applied (glTF: B = metallic, G = roughness).
-pub fn metallic_roughness(m: &Material, textures: &[Texture], uv: Vec2) -> (f32, f32) {
-    match tex(textures, &m.metallic_roughness_texture) {
-        Some(t) => {
+pub fn metallic_roughness(m: &Material, textures: &[Texture], tc: &TexCoords) -> (f32, f32) {
+    match tex(textures, &m.metallic_roughness_texture, tc) {
+        Some((t, uv)) => {
             let s = texture::sample(t, uv);
             (m.metallic * s.z, m.roughness * s.y)
         }
@@ -90,9 +122,9 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture], uv: Vec2) -> (f32,
 }
 
 /// Linear emissive RGB (factor × sRGB-decoded texture).
-pub fn emissive_rgb(m: &Material, textures: &[Texture], uv: Vec2) -> Vec3 {
-    match tex(textures, &m.emissive_texture) {
-        Some(t) => m.emissive * texture::sample(t, uv).truncate(),
+pub fn emissive_rgb(m: &Material, textures: &[Texture], tc: &TexCoords) -> Vec3 {
+    match tex(textures, &m.emissive_texture, tc) {
+        Some((t, uv)) => m.emissive * texture::sample(t, uv).truncate(),
         None => m.emissive,
     }
 }
@@ -102,11 +134,11 @@ pub fn emissive_rgb(m: &Material, textures: &[Texture], uv: Vec2) -> Vec3 {
 pub fn mapped_normal(
     m: &Material,
     textures: &[Texture],
-    uv: Vec2,
+    tc: &TexCoords,
     n: Vec3,
     tangent: Option<glam::Vec4>,
 ) -> Vec3 {
-    let (Some(t), Some(tan)) = (tex(textures, &m.normal_texture), tangent) else { return n };
+    let (Some((t, uv)), Some(tan)) = (tex(textures, &m.normal_texture, tc), tangent) else { return n };
     let s = texture::sample(t, uv);
     let mut v = Vec3::new(2.0 * s.x - 1.0, 2.0 * s.y - 1.0, 2.0 * s.z - 1.0);
     v.x *= m.normal_scale;
@@ -133,7 +165,7 @@ mod tests {
         let s = Spectrum::piecewise(vec![380.0, 730.0], vec![0.2, 0.9]).unwrap();
         let m = Material { spectral: Some(SpectralReflectance::Uniform(s.clone())), ..Default::default() };
         let pm = PreparedMaterial::new(&m, WavelengthRange::VISIBLE);
-        let r = base_reflectance(&m, &pm, &[], &GreyOnly, Vec2::ZERO, l());
+        let r = base_reflectance(&m, &pm, &[], &GreyOnly, &TexCoords::default(), Vec4::ONE, l());
         for (a, b) in r.to_array().iter().zip(l().to_array()) {
             assert!((*a as f64 - s.eval(b as f64)).abs() < 1e-5);
         }
@@ -158,8 +190,10 @@ mod tests {
             ..Default::default()
         };
         let pm = PreparedMaterial::new(&m, WavelengthRange::VISIBLE);
-        let at =
-            |u: f32| base_reflectance(&m, &pm, std::slice::from_ref(&t), &GreyOnly, Vec2::new(u, 0.5), l());
+        let at = |u: f32| {
+            let tc = TexCoords::one(Vec2::new(u, 0.5));
+            base_reflectance(&m, &pm, std::slice::from_ref(&t), &GreyOnly, &tc, Vec4::ONE, l())
+        };
         assert!((at(0.25) - Vec4::splat(0.3)).abs().max_element() < 1e-5);
         assert!((at(0.75) - Vec4::ONE).abs().max_element() < 1e-5);
         assert!((at(0.5) - Vec4::splat(0.65)).abs().max_element() < 1e-5);
@@ -179,7 +213,13 @@ mod tests {
             normal_texture: Some(TextureRef { transform: None, index: 0, tex_coord: 0 }),
             ..Default::default()
         };
-        let n = mapped_normal(&m, &[t], Vec2::ZERO, Vec3::Y, Some(glam::Vec4::new(1.0, 0.0, 0.0, 1.0)));
+        let n = mapped_normal(
+            &m,
+            &[t],
+            &TexCoords::default(),
+            Vec3::Y,
+            Some(glam::Vec4::new(1.0, 0.0, 0.0, 1.0)),
+        );
         assert!((n - Vec3::Y).length() < 0.01);
     }
 }

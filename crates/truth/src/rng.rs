@@ -31,6 +31,20 @@ impl Sampler {
     pub fn next2(&mut self) -> [f32; 2] {
         [self.uniform(), self.uniform()]
     }
+
+    /// 64 random bits: the key of one ray's stochastic decisions ([`hash_uniform`]).
+    #[inline]
+    pub fn key(&mut self) -> u64 {
+        ((self.0.next_u32() as u64) << 32) | self.0.next_u32() as u64
+    }
+}
+
+/// A uniform number in [0, 1) that depends only on (`key`, `x`): the same triangle seen twice
+/// by one ray (a triangle the BVH builder split over several leaves) gets the same value, and
+/// the value never depends on traversal order or thread.
+#[inline]
+pub fn hash_uniform(key: u64, x: u64) -> f32 {
+    (mix(key ^ mix(x)) >> 40) as f32 * (1.0 / 16_777_216.0)
 }
 
 #[cfg(test)]

@@ -1,18 +1,19 @@
 //! A scene prepared for path tracing: the BVH, per-material spectra, lights in tracer units,
 //! the optional medium, and the surface queries the integrator makes at a hit.
 
-use crate::accel::{Geometry, Hit};
+use crate::accel::{Geometry, Hit, NOT_OPAQUE, SINGLE_SIDED};
 use crate::env_map::EnvMap;
 use crate::error::{Result, TruthError};
 use crate::lights::{DeltaLight, EmissionUnits, EmitterDistribution, luminance};
-use crate::material::{self, PreparedMaterial};
+use crate::material::{self, PreparedMaterial, TexCoords};
 use crate::medium::{Medium, PreparedMedium};
+use crate::rng::{Sampler, hash_uniform};
 use crate::spectral::DenseSpectrum;
 use crate::upsample::RgbToSpectrum;
 use crate::water_surface::Surface;
 use color::{Spectrum, WavelengthRange};
 use glam::{Vec2, Vec3, Vec4};
-use scene::Scene;
+use scene::{AlphaMode, Scene};
 
 /// Everything about a surface point the integrator needs.
 #[derive(Clone, Copy, Debug)]
@@ -22,7 +23,10 @@ pub struct SurfacePoint {
     pub ng: Vec3,
     /// Interpolated vertex normal (before normal mapping); defines the emitting side.
     pub n_vertex: Vec3,
-    pub uv: Vec2,
+    /// `TEXCOORD_0` and `TEXCOORD_1` (zero where the mesh has none).
+    pub tc: TexCoords,
+    /// `COLOR_0`, linear RGBA (white where the mesh has none).
+    pub color: Vec4,
     pub tangent: Option<Vec4>,
     pub material: usize,
     pub tri: u32,
@@ -49,6 +53,9 @@ pub struct World<'s> {
     /// The water surface above the medium, with the sky seen through it (see
     /// [`crate::water_surface`]); from the medium's `surface_ior` and the scene's sky stand-ins.
     pub surface: Option<Surface>,
+    /// Some triangle has an `AlphaMode::Blend` material: rays then draw a key from the path's
+    /// sampler for their stochastic opacity decisions ([`World::ray_key`]).
+    pub stochastic: bool,
 }
 
 impl<'s> World<'s> {
@@ -73,6 +80,17 @@ impl<'s> World<'s> {
                 )));
             }
         }
+        for (i, m) in scene.materials.iter().enumerate() {
+            if let AlphaMode::Mask { cutoff } = m.alpha_mode
+                && !cutoff.is_finite()
+            {
+                return Err(bad(format!("material {i} ('{}') has alpha cutoff {cutoff}", m.name)));
+            }
+        }
+        let stochastic = geometry.refs.iter().any(|r| {
+            let m = &scene.materials[scene.meshes[r.mesh as usize].material];
+            m.alpha_mode == AlphaMode::Blend
+        });
         let units = EmissionUnits::new(white, range);
         let materials = scene.materials.iter().map(|m| PreparedMaterial::new(m, range)).collect();
         // Stand-ins approximate emissive meshes for rasterisers; the meshes themselves are
@@ -135,6 +153,7 @@ impl<'s> World<'s> {
             environment: None,
             env_map,
             surface,
+            stochastic,
         })
     }
 
@@ -146,43 +165,40 @@ impl<'s> World<'s> {
         self
     }
 
-    fn vertex_attrs(&self, tri: u32, b1: f32, b2: f32) -> (Vec3, Vec2, Option<Vec4>) {
+    /// The three vertex indices of triangle `tri` and its mesh.
+    fn corners(&self, tri: u32) -> (&scene::Mesh, [usize; 3]) {
         let r = self.geometry.refs[tri as usize];
         let m = &self.scene.meshes[r.mesh as usize];
-        let idx = &m.indices[r.first as usize..r.first as usize + 3];
-        let b0 = 1.0 - b1 - b2;
-        let lerp3 = |a: &[Vec3]| -> Option<Vec3> {
-            Some(a.get(idx[0] as usize)? * b0 + *a.get(idx[1] as usize)? * b1 + *a.get(idx[2] as usize)? * b2)
-        };
-        let v = &self.geometry.verts[tri as usize];
-        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        let n = lerp3(&m.normals).and_then(|n| n.try_normalize()).unwrap_or(ng);
-        let uv = (|| {
-            Some(
-                m.uvs.get(idx[0] as usize)? * b0
-                    + *m.uvs.get(idx[1] as usize)? * b1
-                    + *m.uvs.get(idx[2] as usize)? * b2,
-            )
-        })()
-        .unwrap_or(Vec2::ZERO);
-        let tangent = (|| {
-            let t = &m.tangents;
-            Some(t.get(idx[0] as usize)? * b0 + *t.get(idx[1] as usize)? * b1 + *t.get(idx[2] as usize)? * b2)
-        })()
-        .or_else(|| self.uv_tangent(tri, n));
-        (n, uv, tangent)
+        let i = r.first as usize;
+        (m, [m.indices[i] as usize, m.indices[i + 1] as usize, m.indices[i + 2] as usize])
     }
 
-    /// A tangent from the triangle's UV gradients, for normal-mapped meshes without tangents.
+    fn vertex_attrs(&self, tri: u32, b1: f32, b2: f32) -> (Vec3, TexCoords, Vec4, Option<Vec4>) {
+        let (m, idx) = self.corners(tri);
+        let b = [1.0 - b1 - b2, b1, b2];
+        let v = &self.geometry.verts[tri as usize];
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        let n = lerp(&m.normals, idx, b).and_then(|n| n.try_normalize()).unwrap_or(ng);
+        let tc = TexCoords([
+            lerp(&m.uvs, idx, b).unwrap_or(Vec2::ZERO),
+            lerp(&m.uvs1, idx, b).unwrap_or(Vec2::ZERO),
+        ]);
+        let color = lerp(&m.colors, idx, b).unwrap_or(Vec4::ONE);
+        let tangent = lerp(&m.tangents, idx, b).or_else(|| self.uv_tangent(tri, n));
+        (n, tc, color, tangent)
+    }
+
+    /// A tangent from the triangle's UV gradients (the normal map's UV set and transform), for
+    /// normal-mapped meshes without tangents.
     fn uv_tangent(&self, tri: u32, n: Vec3) -> Option<Vec4> {
-        let r = self.geometry.refs[tri as usize];
-        let m = &self.scene.meshes[r.mesh as usize];
-        m.normal_texture_or_none(&self.scene.materials)?;
-        let idx = &m.indices[r.first as usize..r.first as usize + 3];
-        let uv = [m.uvs.get(idx[0] as usize)?, m.uvs.get(idx[1] as usize)?, m.uvs.get(idx[2] as usize)?];
+        let (m, idx) = self.corners(tri);
+        let r = self.scene.materials.get(m.material)?.normal_texture?;
+        let set = if r.tex_coord == 1 { &m.uvs1 } else { &m.uvs };
+        let uv = idx.map(|i| set.get(i).map(|&uv| r.transform.map_or(uv, |t| t.apply(uv))));
+        let [Some(uv0), Some(uv1), Some(uv2)] = uv else { return None };
         let v = &self.geometry.verts[tri as usize];
         let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-        let (d1, d2) = (*uv[1] - *uv[0], *uv[2] - *uv[0]);
+        let (d1, d2) = (uv1 - uv0, uv2 - uv0);
         let det = d1.x * d2.y - d2.x * d1.y;
         if det.abs() < 1e-12 {
             return None;
@@ -196,7 +212,7 @@ impl<'s> World<'s> {
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
         let v = &self.geometry.verts[hit.tri as usize];
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        let (n_vertex, uv, tangent) = self.vertex_attrs(hit.tri, hit.b1, hit.b2);
+        let (n_vertex, tc, color, tangent) = self.vertex_attrs(hit.tri, hit.b1, hit.b2);
         // The barycentric point is more precise than o + t·d far from the origin.
         let p = v[0] * (1.0 - hit.b1 - hit.b2) + v[1] * hit.b1 + v[2] * hit.b2;
         let r = self.geometry.refs[hit.tri as usize];
@@ -204,7 +220,8 @@ impl<'s> World<'s> {
             p,
             ng,
             n_vertex,
-            uv,
+            tc,
+            color,
             tangent,
             material: self.scene.meshes[r.mesh as usize].material,
             tri: hit.tri,
@@ -216,6 +233,66 @@ impl<'s> World<'s> {
         self.surface(&Hit { t: 0.0, tri, b1, b2 })
     }
 
+    /// The probability that a ray travelling along `d` stops at (`tri`, b1, b2) rather than
+    /// passing as if the triangle were not there: 0 on the back of a single-sided material
+    /// (glTF `doubleSided: false`), 0 or 1 by the alpha test of `AlphaMode::Mask`, the alpha of
+    /// `AlphaMode::Blend` (base colour alpha × texture alpha × `COLOR_0` alpha), else 1.
+    pub fn coverage(&self, tri: u32, b1: f32, b2: f32, d: Vec3) -> f32 {
+        let flags = self.geometry.filter[tri as usize];
+        if flags & SINGLE_SIDED != 0 {
+            let v = &self.geometry.verts[tri as usize];
+            if (v[1] - v[0]).cross(v[2] - v[0]).dot(d) > 0.0 {
+                return 0.0;
+            }
+        }
+        if flags & NOT_OPAQUE == 0 {
+            return 1.0;
+        }
+        let (m, idx) = self.corners(tri);
+        let mat = &self.scene.materials[m.material];
+        let alpha = || {
+            let b = [1.0 - b1 - b2, b1, b2];
+            let mut tc = TexCoords::default();
+            if let Some(r) = &mat.base_color_texture {
+                let set = if r.tex_coord == 1 { &m.uvs1 } else { &m.uvs };
+                tc.0[(r.tex_coord as usize).min(1)] = lerp(set, idx, b).unwrap_or(Vec2::ZERO);
+            }
+            let color = lerp(&m.colors, idx, b).unwrap_or(Vec4::ONE);
+            material::alpha(mat, &self.scene.textures, &tc, color)
+        };
+        match mat.alpha_mode {
+            AlphaMode::Opaque => 1.0,
+            AlphaMode::Mask { cutoff } => (alpha() >= cutoff) as u8 as f32,
+            AlphaMode::Blend => alpha().clamp(0.0, 1.0),
+        }
+    }
+
+    /// Whether a ray with key `key` ([`World::ray_key`]) travelling along `d` stops at the hit:
+    /// [`World::coverage`] decided by a hash of the key and the triangle.
+    #[inline]
+    pub fn stops(&self, tri: u32, b1: f32, b2: f32, d: Vec3, key: u64) -> bool {
+        let c = self.coverage(tri, b1, b2, d);
+        c >= 1.0 || (c > 0.0 && hash_uniform(key, tri as u64) < c)
+    }
+
+    /// The key of a ray's stochastic-opacity decisions: drawn from the path's sampler when the
+    /// scene has `AlphaMode::Blend` geometry (0, and no draw, otherwise), so images stay a
+    /// function of the seed.
+    #[inline]
+    pub fn ray_key(&self, rng: &mut Sampler) -> u64 {
+        if self.stochastic { rng.key() } else { 0 }
+    }
+
+    /// The closest hit along `o + t·d`, t in (0, tmax), where the ray stops ([`World::stops`]).
+    pub fn intersect(&self, o: Vec3, d: Vec3, tmax: f32, key: u64) -> Option<Hit> {
+        self.geometry.intersect_filtered(o, d, tmax, |tri, b1, b2| self.stops(tri, b1, b2, d, key))
+    }
+
+    /// Whether a shadow ray is stopped on the open segment `o + t·d`, t in (0, tmax).
+    pub fn occluded(&self, o: Vec3, d: Vec3, tmax: f32, key: u64) -> bool {
+        self.geometry.occluded_filtered(o, d, tmax, |tri, b1, b2| self.stops(tri, b1, b2, d, key))
+    }
+
     /// Radiance leaving `s` towards `wo` (unit, away from the surface); emission is one-sided,
     /// on the side the vertex normals point to.
     pub fn emitted(&self, s: &SurfacePoint, wo: Vec3, l: Vec4) -> Vec4 {
@@ -223,7 +300,7 @@ impl<'s> World<'s> {
         if m.emissive == Vec3::ZERO || s.n_vertex.dot(wo) <= 0.0 {
             return Vec4::ZERO;
         }
-        let rgb = material::emissive_rgb(m, &self.scene.textures, s.uv);
+        let rgb = material::emissive_rgb(m, &self.scene.textures, &s.tc);
         match &self.emission_spectra[s.material] {
             // A measured spectrum, modulated by the emissive texture's luminance.
             Some(spec) => {
@@ -234,6 +311,15 @@ impl<'s> World<'s> {
             None => self.units.rgb(rgb, self.upsampler, l),
         }
     }
+}
+
+/// A vertex attribute at barycentrics `b` of the corners `idx`; `None` when the mesh lacks it.
+#[inline]
+fn lerp<T>(a: &[T], idx: [usize; 3], b: [f32; 3]) -> Option<T>
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+{
+    Some(*a.get(idx[0])? * b[0] + *a.get(idx[1])? * b[1] + *a.get(idx[2])? * b[2])
 }
 
 /// The water surface of `medium`, lit by the sky whose irradiance below the surface the scene's
@@ -269,17 +355,6 @@ fn water_surface(
                                              surface to see it through (a medium from truth::water)"
             .into()),
         None => Ok(None),
-    }
-}
-
-/// A glTF mesh asks for tangents only when its material has a normal map.
-trait NormalMapped {
-    fn normal_texture_or_none(&self, materials: &[scene::Material]) -> Option<()>;
-}
-
-impl NormalMapped for scene::Mesh {
-    fn normal_texture_or_none(&self, materials: &[scene::Material]) -> Option<()> {
-        materials.get(self.material)?.normal_texture.map(|_| ())
     }
 }
 
