@@ -15,7 +15,8 @@ pub struct EnvUniforms {
     /// XYZ of each basis spectrum seen by a reflectance of one (Σ of its node weights); the
     /// spectral and naive modes' background and specular. w unused.
     pub totals: [[f32; 4]; 4],
-    /// Rotation about +Y (radians), the coarsest mip level's index, intensity, unused.
+    /// Rotation about +Y (radians), the coarsest mip level's index, intensity, and the world
+    /// radius of the screen-space occlusion search (0 = off).
     pub params: [f32; 4],
     /// x: 1 when there is an environment; y: 1 when it is drawn as the background.
     pub flags: [u32; 4],
@@ -141,14 +142,19 @@ impl GpuEnvironment {
         self.spectral = Some((basis, upload_maps(device, queue, "environment (spectral)", &maps)));
     }
 
-    /// The frame's uniforms for `totals` (XYZ per basis spectrum).
-    pub fn uniforms(&self, totals: [[f32; 4]; 4], spectral: bool) -> EnvUniforms {
+    /// The frame's uniforms for `totals` (XYZ per basis spectrum) and an occlusion search radius
+    /// in world units (0 = no screen-space occlusion).
+    pub fn uniforms(&self, totals: [[f32; 4]; 4], spectral: bool, occlusion_radius: f32) -> EnvUniforms {
         let Some(env) = &self.source else { return EnvUniforms::default() };
         let max_lod = match (&self.spectral, spectral) {
             (Some((_, t)), true) => t.max_lod,
             _ => self.rgb.max_lod,
         };
-        EnvUniforms { totals, params: [env.rotation, max_lod, env.intensity, 0.0], flags: [1, 1, 0, 0] }
+        EnvUniforms {
+            totals,
+            params: [env.rotation, max_lod, env.intensity, occlusion_radius],
+            flags: [1, 1, 0, 0],
+        }
     }
 
     /// The textures for `spectral` (PCA basis) or RGB coefficients.

@@ -400,7 +400,11 @@ impl Renderer {
             frame_index,
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
-        let env_uniforms = self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral);
+        // Screen-space occlusion of the environment searches half the scene's bounding radius.
+        let occlusion_radius =
+            if settings.env_occlusion { 0.5 * (scene.bounds.1 - scene.bounds.0).length() * 0.5 } else { 0.0 };
+        let env_uniforms =
+            self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral, occlusion_radius);
         self.gpu.queue.write_buffer(&self.env_buffer, 0, bytemuck::bytes_of(&env_uniforms));
 
         let (targets, bindings) = self.targets.as_ref().expect("checked above");

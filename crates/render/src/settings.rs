@@ -121,6 +121,9 @@ pub struct RenderSettings {
     /// light, as the path tracer's `lambert` does: for comparisons with renderers that lack the
     /// glTF BRDF, and the white furnace.
     pub lambert: bool,
+    /// Screen-space occlusion of the environment light (horizon-based, from the depth buffer;
+    /// `wgsl/environment.wgsl`): concave parts and contact regions see less of the sky.
+    pub env_occlusion: bool,
 }
 
 impl Default for RenderSettings {
@@ -137,6 +140,7 @@ impl Default for RenderSettings {
             timestamps: false,
             jitter: None,
             lambert: false,
+            env_occlusion: true,
         }
     }
 }

@@ -5,7 +5,8 @@
 struct EnvUniforms {
     // XYZ of each basis spectrum seen by a reflectance of one (spectral and naive modes).
     totals: array<vec4<f32>, 4>,
-    // x: rotation about +Y (radians), y: coarsest mip level, z: intensity.
+    // x: rotation about +Y (radians), y: coarsest mip level, z: intensity, w: world radius of
+    // the screen-space occlusion search (0 = no occlusion).
     params: vec4<f32>,
     // x: 1 when there is an environment, y: 1 when it is the background.
     flags: vec4<u32>,

@@ -94,6 +94,10 @@ pub struct LookArgs {
     /// --lambert`; for comparisons with renderers without the glTF BRDF, and the white furnace).
     #[arg(long)]
     pub lambert: bool,
+    /// Turn off the screen-space occlusion of the environment light (then every point sees the
+    /// whole environment).
+    #[arg(long)]
+    pub no_env_occlusion: bool,
 }
 
 impl LookArgs {
@@ -238,6 +242,7 @@ fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
         jitter: None,
         quadrature: args.look.quadrature,
         lambert: args.look.lambert,
+        env_occlusion: !args.look.no_env_occlusion,
     };
     s.validate()
         .map_err(|e| if s.wavelengths == 0 { anyhow!("--wavelengths 0: {e}") } else { anyhow!("{e}") })?;

@@ -43,6 +43,7 @@ pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSetti
         jitter: None,
         quadrature: args.look.quadrature,
         lambert: args.look.lambert,
+        env_occlusion: !args.look.no_env_occlusion,
     };
     s.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(s)
