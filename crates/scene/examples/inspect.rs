@@ -22,26 +22,34 @@ fn main() {
         s.textures.len(),
         s.lights.len()
     );
+    for w in &s.warnings {
+        println!("warning: {w}");
+    }
     if let Some((lo, hi)) = s.bounds() {
         println!("bounds {lo} .. {hi}");
     }
     println!(
-        "camera at {} yfov {:.3} near {} far {} aspect {:?}",
+        "camera at {} yfov {:.3} near {} far {} aspect {:?} ortho {:?}",
         s.camera.position(),
         s.camera.yfov,
         s.camera.znear,
         s.camera.zfar,
-        s.camera.aspect
+        s.camera.aspect,
+        s.camera.ortho
     );
     for (i, m) in s.meshes.iter().enumerate() {
         println!(
-            "mesh {i}: {} vertices, {} triangles, tangents {}, uvs {}, material {} '{}'",
+            "mesh {i}: {} vertices, {} triangles, tangents {}, uvs {}, uvs1 {}, colors {}, material {} '{}' {:?}{}",
             m.positions.len(),
             m.indices.len() / 3,
             m.tangents.len(),
             m.uvs.len(),
+            m.uvs1.len(),
+            m.colors.len(),
             m.material,
-            s.materials[m.material].name
+            s.materials[m.material].name,
+            s.materials[m.material].alpha_mode,
+            if s.materials[m.material].double_sided { " double-sided" } else { "" }
         );
         // Triangles whose winding disagrees with their shading normals: a sign of a transform
         // or winding bug (or of a file authored inside-out).
