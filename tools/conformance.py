@@ -11,12 +11,20 @@ per model; exits 1 if a listed model fails to load or render, or any of its imag
     tools/conformance.py --fetch ~/khronos                     # download the default models, then run
     tools/conformance.py ~/khronos --out conformance-out        # run on models already there
     tools/conformance.py PATH/glTF-Sample-Assets/Models --all   # every model found
+    tools/conformance.py ~/khronos --set core --size 160x120     # the glTF conformance set (issue 12)
+
+Per model it also records the loader's `warning:` lines, the first line of any error, whether
+the files a .gltf refers to are all there ("incomplete" otherwise: nothing is rendered), and
+writes a contact sheet OUT/sheets/<Model>.png: rgb | spectral | truth | the Khronos screenshot
+(ROOT/<Model>/screenshot/screenshot.*). The screenshot column needs Pillow; without it the sheet
+holds the three renders only (standard library PNG). --resume reuses OUT/<Model>/result.json.
 
 Layout of the model root (as in KhronosGroup/glTF-Sample-Assets `Models/`):
 `ROOT/<Model>/glTF-Binary/<Model>.glb` or `ROOT/<Model>/glTF/<Model>.gltf` (the .glb is used
 when both exist; --variant glTF picks the other). A root holding a `Models/` folder works too.
 
-Python 3 standard library only. docs/conformance.md explains the table.
+Python 3 standard library only (Pillow optional, for the screenshot in the contact sheets).
+docs/conformance.md explains the table; docs/gltf-conformance.md has the glTF conformance run.
 """
 
 import argparse
@@ -36,6 +44,22 @@ import urllib.request
 import zlib
 
 DEFAULT_MODELS = ["DamagedHelmet", "FlightHelmet", "WaterBottle", "Avocado", "BoxTextured", "Duck"]
+# glTF conformance (issue 12): the Khronos test assets for the core spec and its extensions, then
+# the classic showcase models. `--set core`; `--set issue` is the assets the issue names.
+ISSUE_MODELS = [
+    "TextureSettingsTest", "AlphaBlendModeTest", "VertexColorTest", "BoxVertexColors", "MultiUVTest",
+    "TextureTransformTest", "TextureTransformMultiTest", "SimpleInstancing", "NegativeScaleTest", "OrientationTest",
+    "TextureCoordinateTest", "TwoSidedPlane", "MeshPrimitiveModes", "SimpleDolly",
+]
+CORE_MODELS = ISSUE_MODELS + [
+    "Cameras", "TextureLinearInterpolationTest", "TextureEncodingTest", "BoxTexturedNonPowerOfTwo", "BoxInterleaved",
+    "Box With Spaces", "NormalTangentTest", "NormalTangentMirrorTest", "MetalRoughSpheresNoTextures", "UnlitTest",
+    "EmissiveStrengthTest", "SimpleSparseAccessor", "TriangleWithoutIndices", "Triangle", "SimpleMeshes",
+    "MultipleScenes", "Cube", "Suzanne",
+    "Box", "BoxTextured", "Duck", "Avocado", "DamagedHelmet", "WaterBottle", "Lantern", "BoomBox", "Fox", "CesiumMan",
+    "CesiumMilkTruck", "Sponza", "MetalRoughSpheres", "FlightHelmet", "SciFiHelmet",
+]
+MODEL_SETS = {"default": DEFAULT_MODELS, "issue": ISSUE_MODELS, "core": CORE_MODELS}
 FETCH_BASE = "https://raw.githubusercontent.com/KhronosGroup/glTF-Sample-Assets/main/Models"
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LUMA = (0.2126, 0.7152, 0.0722)  # linear sRGB / Rec. 709 -> Y
@@ -244,13 +268,21 @@ def _srgb8(v):
     return int(round(v * 255))
 
 
-def write_preview(exr_path, png_path, image=None):
-    """The EXR as an 8-bit sRGB PNG, clamped like `spectra render --out x.png --tonemap none`."""
-    w, h, ch = image or read_exr(exr_path)
+def _png_bytes(w, h, rows):
+    def chunk(kind, payload):
+        return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
+
+    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(bytes(rows), 6)) + chunk(b"IEND", b"")
+    return png
+
+
+def _srgb_rows(w, h, ch):
+    """8-bit sRGB pixel rows (no filter byte) of a linear image, clamped."""
     lut = {}
-    rows = bytearray()
+    out = []
     for y in range(h):
-        rows.append(0)
+        row = bytearray()
         for x in range(w):
             i = y * w + x
             for c in "RGB":
@@ -258,15 +290,107 @@ def write_preview(exr_path, png_path, image=None):
                 e = lut.get(v)
                 if e is None:
                     e = lut[v] = _srgb8(v)
-                rows.append(e)
+                row.append(e)
+        out.append(row)
+    return out
 
-    def chunk(kind, payload):
-        return struct.pack(">I", len(payload)) + kind + payload + struct.pack(">I", zlib.crc32(kind + payload))
 
-    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(bytes(rows), 6)) + chunk(b"IEND", b"")
+def write_preview(exr_path, png_path, image=None):
+    """The EXR as an 8-bit sRGB PNG, clamped like `spectra render --out x.png --tonemap none`."""
+    w, h, ch = image or read_exr(exr_path)
+    rows = bytearray()
+    for r in _srgb_rows(w, h, ch):
+        rows.append(0)
+        rows += r
     with open(png_path, "wb") as f:
-        f.write(png)
+        f.write(_png_bytes(w, h, rows))
+
+
+SHEET_COLUMNS = ("rgb", "spectral", "truth")
+
+
+def find_screenshot(root, name):
+    d = os.path.join(root, name, "screenshot")
+    for ext in ("png", "jpg", "jpeg", "gif"):
+        p = os.path.join(d, "screenshot." + ext)
+        if os.path.isfile(p):
+            return p
+    return None
+
+
+def write_sheet(sheet_path, outdir, images, screenshot, title):
+    """Contact sheet: rgb | spectral | truth | Khronos screenshot, with labels (Pillow), or the
+    three renders side by side without labels or screenshot (standard library). A render that
+    failed is a grey tile. Returns a note on what was written."""
+    try:
+        from PIL import Image, ImageDraw
+    except ImportError:
+        Image = None
+    sizes = [(w, h) for (w, h, _) in images.values()]
+    if not sizes:
+        return "no sheet: nothing rendered"
+    w, h = sizes[0]
+    gap = 4
+    if Image is None:
+        cols = [_srgb_rows(*images[k]) if k in images and images[k][:2] == (w, h) else None for k in SHEET_COLUMNS]
+        W = len(cols) * w + (len(cols) - 1) * gap
+        rows = bytearray()
+        for y in range(h):
+            rows.append(0)
+            for j, c in enumerate(cols):
+                if j:
+                    rows += b"\xff" * (3 * gap)
+                rows += c[y] if c is not None else b"\x40" * (3 * w)
+        with open(sheet_path, "wb") as f:
+            f.write(_png_bytes(W, h, rows))
+        return "sheet without screenshot (no Pillow)"
+    tiles = []
+    for k in SHEET_COLUMNS:
+        png = os.path.join(outdir, k + ".png")
+        if k in images and os.path.isfile(png):
+            tiles.append((k, Image.open(png).convert("RGB")))
+        else:
+            tiles.append((k + " (failed)", Image.new("RGB", (w, h), (64, 64, 64))))
+    if screenshot:
+        try:
+            im = Image.open(screenshot)
+            im.seek(0)
+            im = im.convert("RGB")
+            sw = max(1, round(im.width * h / im.height))
+            tiles.append(("Khronos screenshot", im.resize((sw, h), Image.LANCZOS)))
+        except (OSError, ValueError) as e:
+            tiles.append((f"screenshot unreadable: {e}"[:40], Image.new("RGB", (w, h), (64, 64, 64))))
+    label_h = 14
+    W = sum(t.width for _, t in tiles) + gap * (len(tiles) - 1)
+    sheet = Image.new("RGB", (W, h + 2 * label_h), (255, 255, 255))
+    draw = ImageDraw.Draw(sheet)
+    draw.text((2, 1), title, fill=(0, 0, 0))
+    x = 0
+    for label, t in tiles:
+        draw.text((x + 2, label_h + 1), label, fill=(0, 0, 0))
+        sheet.paste(t, (x, 2 * label_h))
+        x += t.width + gap
+    sheet.save(sheet_path)
+    return "sheet" + (" with screenshot" if screenshot else " (no Khronos screenshot)")
+
+
+def missing_files(path):
+    """Files a .gltf refers to (buffers, images) that are not there."""
+    if not path.lower().endswith(".gltf"):
+        return []
+    try:
+        with open(path, encoding="utf-8") as f:
+            doc = json.load(f)
+    except (OSError, ValueError):
+        return []  # the loader reports it
+    out = []
+    for x in doc.get("buffers", []) + doc.get("images", []):
+        u = x.get("uri") if isinstance(x, dict) else None
+        if u and not u.startswith("data:"):
+            rel = urllib.parse.unquote(u)
+            if not os.path.isfile(os.path.join(os.path.dirname(path), rel)):
+                out.append(rel)
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -333,6 +457,30 @@ def error_message(stderr, code):
     return tail or f"exit code {code}"
 
 
+def first_error_line(stderr, code):
+    """The first line of the error as spectra prints it ('Error: ...' without the prefix)."""
+    for ln in (stderr or "").splitlines():
+        ln = ln.strip()
+        if ln.startswith(("Error:", "error:")):
+            return ln.split(":", 1)[1].strip()[:300]
+    lines = [ln.strip() for ln in (stderr or "").splitlines() if ln.strip()]
+    return lines[-1][:300] if lines else f"exit code {code}"
+
+
+def warnings_of(stderr, path=None):
+    """The loader's `warning: <scene>: <text>` lines, without the prefix and the scene's path."""
+    out = []
+    for ln in (stderr or "").splitlines():
+        ln = ln.strip()
+        if ln.lower().startswith("warning:"):
+            ln = ln.split(":", 1)[1].strip()
+            if path and ln.startswith(path + ":"):
+                ln = ln[len(path) + 1 :].strip()
+            if ln not in out:
+                out.append(ln)
+    return out
+
+
 def notes_of(stderr):
     return [ln.strip() for ln in (stderr or "").splitlines() if ln.strip().lower().startswith(("note", "warning"))]
 
@@ -369,8 +517,16 @@ def env_args(a):
 
 
 def run_model(a, runner, name, path, outdir):
-    res = {"model": name, "file": path, "status": "ok", "error": None, "renders": {}, "diffs": {}, "notes": []}
+    res = {"model": name, "file": path, "status": "ok", "error": None, "renders": {}, "diffs": {}, "notes": [],
+           "warnings": []}
     os.makedirs(outdir, exist_ok=True)
+    missing = missing_files(path)
+    if missing:
+        res["status"] = "incomplete"
+        res["error"] = "files missing (not rendered): " + ", ".join(missing)
+        res["error_first_line"] = res["error"]
+        log(f"    {res['error']}")
+        return res
     common = ["--size", a.size, *env_args(a)]
     jobs = [
         ("rgb", ["render", path, "--mode", "rgb", *common, *shlex.split(a.render_args)]),
@@ -390,8 +546,14 @@ def run_model(a, runner, name, path, outdir):
         for n in r["notes"]:
             if n not in res["notes"]:
                 res["notes"].append(n)
+        for wn in warnings_of(err, path):
+            if wn not in res["warnings"]:
+                res["warnings"].append(wn)
         if code != 0 or not os.path.isfile(img):
             r["error"] = error_message(err, code)
+            r["error_first_line"] = first_error_line(err, code)
+            if "error_first_line" not in res:
+                res["error_first_line"] = r["error_first_line"]
             log(f"    {key:<9} FAILED ({secs:.1f} s): {r['error']}")
             if res["status"] == "ok":
                 res["status"] = "error"
@@ -484,6 +646,19 @@ def run_model(a, runner, name, path, outdir):
             log(f"    ΔE00 {key} vs truth, {a.block}x{a.block} block mean: {be['delta_e2000_mean']:.3f} over the image"
                 + (f", {be['model_delta_e2000_mean']:.3f} over the model's {be['model_units']} blocks"
                    if be.get("model_delta_e2000_mean") is not None else ""))
+    if not a.no_sheets:
+        sheets = os.path.join(a.out, "sheets")
+        os.makedirs(sheets, exist_ok=True)
+        shot = find_screenshot(a.root_models, name)
+        sheet = os.path.join(sheets, name.replace(os.sep, "_") + ".png")
+        try:
+            what = write_sheet(sheet, outdir, images, shot, f"{name}  ({a.size}, truth {a.spp} spp)")
+            if os.path.isfile(sheet):
+                res["sheet"] = os.path.relpath(sheet, a.out)
+            res["screenshot"] = shot
+            log(f"    {what}: {sheet}")
+        except Exception as e:  # a sheet is a convenience: never fail the run over it
+            log(f"    sheet failed: {e}")
     return res
 
 
@@ -535,8 +710,8 @@ def write_reports(a, results, meta):
         "",
         "| model | load | model px | black rgb / spectral / truth | mean Y rgb / spectral / truth |"
         " ΔE00 spectral–truth: image | ΔE00 spectral–truth: model | ΔE00 rgb–truth: image | ΔE00 rgb–truth: model"
-        " | truth noise: image / model | seconds rgb / spectral / truth |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        " | truth noise: image / model | seconds rgb / spectral / truth | warnings |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     def short(text):
         return (text or "").replace(meta["root"] + os.sep, "").replace("|", "\\|")
@@ -545,7 +720,9 @@ def write_reports(a, results, meta):
         rs = r.get("renders", {})
         if r["status"] != "ok" and not any(x.get("exit_code") == 0 for x in rs.values()):
             err = short(r.get("error"))
-            lines.append(f"| {r['model']} | error: {err} | – | – | – | – | – | – | – | – | – |")
+            what = "incomplete" if r["status"] == "incomplete" else "error"
+            lines.append(f"| {r['model']} | {what}: {err} | – | – | – | – | – | – | – | – | – | "
+                         f"{len(r.get('warnings', []))} |")
             continue
         load = "ok" if r["status"] == "ok" else "error: " + short(r.get("error"))
         blacks = " / ".join(black_cell(rs.get(k)) for k in ("rgb", "spectral", "truth"))
@@ -565,9 +742,22 @@ def write_reports(a, results, meta):
         des = f"{de('spectral_vs_truth')} | {de('rgb_vs_truth')} | {noise}"
         cov = r.get("model_coverage")
         cov = "–" if cov is None else f"{cov:.0%}"
-        lines.append(f"| {r['model']} | {load} | {cov} | {blacks} | {means} | {des} | {secs} |")
+        lines.append(f"| {r['model']} | {load} | {cov} | {blacks} | {means} | {des} | {secs} | "
+                     f"{len(r.get('warnings', []))} |")
     lines.append("")
-    notes = sorted({n for r in results for n in r.get("notes", [])})
+    n_ok = sum(1 for r in results if r["status"] == "ok")
+    n_inc = sum(1 for r in results if r["status"] == "incomplete")
+    n_black = sum(1 for r in results if r["status"] == "ok" and any(x.get("black") for x in r["renders"].values()))
+    lines += [f"{n_ok} of {len(results)} models load and render in all three modes ({n_black} of them with a black"
+              f" image); {n_inc} incomplete (files missing, not rendered); "
+              f"{len(results) - n_ok - n_inc} fail.", ""]
+    warned = [r for r in results if r.get("warnings")]
+    if warned:
+        lines += ["Loader warnings:", ""]
+        for r in warned:
+            lines += [f"- {r['model']}: " + "; ".join(short(w) for w in r["warnings"])]
+        lines.append("")
+    notes = sorted({n for r in results for n in r.get("notes", []) if not n.lower().startswith("warning")})
     if notes:
         lines += ["Notes printed by spectra:", ""] + [f"- {short(n)}" for n in notes] + [""]
     if meta.get("interrupted"):
@@ -668,7 +858,14 @@ def main():
     ap.add_argument("root", nargs="?",
                     help="folder of models (<root>/<Model>/glTF-Binary/<Model>.glb or glTF/<Model>.gltf)")
     ap.add_argument("--models", help=f"comma-separated model names (default: {','.join(DEFAULT_MODELS)})")
+    ap.add_argument("--set", choices=sorted(MODEL_SETS), default=None,
+                    help="a named list of models: default (" + ",".join(DEFAULT_MODELS) + "), issue (the glTF test "
+                         "assets issue 12 names), core (those, the other core/extension test assets and the classic "
+                         "showcase models); --models overrides")
     ap.add_argument("--all", action="store_true", help="every model found under the root")
+    ap.add_argument("--no-sheets", action="store_true", help="do not write the contact sheets OUT/sheets/<Model>.png")
+    ap.add_argument("--resume", action="store_true",
+                    help="reuse OUT/<Model>/result.json of an earlier run (same --out) instead of rendering again")
     ap.add_argument("--variant", choices=["glTF-Binary", "glTF"], default="glTF-Binary",
                     help="which file to prefer when a model has both (default: glTF-Binary)")
     ap.add_argument("--spectra", default=os.path.join(REPO_ROOT, "target", "release", "spectra"),
@@ -704,7 +901,10 @@ def main():
     ap.add_argument("--fetch-base", default=FETCH_BASE, help=f"where --fetch downloads from (default: {FETCH_BASE})")
     a = ap.parse_args()
 
-    models = [m.strip() for m in a.models.split(",") if m.strip()] if a.models else list(DEFAULT_MODELS)
+    if a.models:
+        models = [m.strip() for m in a.models.split(",") if m.strip()]
+    else:
+        models = list(MODEL_SETS[a.set or "default"])
     if a.fetch:
         if a.all:
             ap.error("--fetch downloads a list of models; --all needs them present")
@@ -732,8 +932,11 @@ def main():
         root = os.path.join(root, "Models")
     if not os.path.isdir(root):
         ap.error(f"{root}: not a folder")
+    a.root_models = root
     if a.all:
-        models = list_models(root)
+        found = list_models(root)
+        # --all with --set/--models: the listed models first, then every other model found
+        models = models + [m for m in found if m not in models] if (a.set or a.models) else found
     if not os.path.isfile(a.spectra) or not os.access(a.spectra, os.X_OK):
         ap.error(f"{a.spectra}: no spectra binary there (cargo build --release -p spectra, or --spectra PATH)")
     if a.block < 1:
@@ -769,7 +972,17 @@ def main():
                                 "error": f"not found under {root} (glTF-Binary/{m}.glb or glTF/{m}.gltf)",
                                 "renders": {}, "diffs": {}, "notes": []})
             else:
-                results.append(run_model(a, runner, m, path, os.path.join(a.out, m)))
+                saved = os.path.join(a.out, m, "result.json")
+                r = None
+                if a.resume and os.path.isfile(saved):
+                    with open(saved) as f:
+                        r = json.load(f)
+                    log("    reused " + saved)
+                if r is None:
+                    r = run_model(a, runner, m, path, os.path.join(a.out, m))
+                    with open(saved, "w") as f:
+                        json.dump(r, f, indent=2)
+                results.append(r)
             write_reports(a, results, meta)
     except (Interrupted, KeyboardInterrupt):
         runner.stop()
@@ -783,7 +996,7 @@ def main():
     bad = []
     for r in results:
         if r["status"] != "ok":
-            bad.append(f"{r['model']}: {r['error']}")
+            bad.append(f"{r['model']}: {r.get('error_first_line') or r['error']}")
         for k, x in r.get("renders", {}).items():
             if x.get("black"):
                 bad.append(f"{r['model']}: {k} render is black (mean luminance {x['mean_luminance']:.3g})")
