@@ -27,6 +27,11 @@ pub struct CameraController {
     pub yfov: f32,
     pub znear: f32,
     pub zfar: f32,
+    /// The file's orthographic half-extents (xmag, ymag) at the starting orbit distance; zooming
+    /// scales them with the distance, as it would the view of a perspective camera.
+    pub ortho: Option<(f32, f32)>,
+    /// The orbit distance `ortho` belongs to.
+    pub ortho_distance: f32,
 }
 
 /// Unit forward vector for a yaw/pitch pair (yaw 0, pitch 0 → −Z).
@@ -54,6 +59,8 @@ impl CameraController {
             yfov: camera.yfov,
             znear: camera.znear,
             zfar: camera.zfar,
+            ortho: camera.ortho,
+            ortho_distance: distance,
         }
     }
 
@@ -101,8 +108,9 @@ impl CameraController {
 
     /// The camera to render (camera-to-world, looking down −Z, +Y up).
     pub fn camera(&self) -> scene::Camera {
+        let k = self.distance / self.ortho_distance.max(1e-12);
         scene::Camera {
-            ortho: None,
+            ortho: self.ortho.map(|(x, y)| (x * k, y * k)),
             transform: Mat4::look_to_rh(self.position, self.forward(), Vec3::Y).inverse(),
             yfov: self.yfov,
             znear: self.znear,
@@ -169,6 +177,21 @@ mod tests {
             // The orbit target is the framed point (it lies on the view axis).
             assert!(close(ctl.target(), target, 1e-4), "{} vs {target}", ctl.target());
         }
+    }
+
+    #[test]
+    fn an_orthographic_camera_stays_orthographic_and_zoom_scales_it() {
+        let target = Vec3::ZERO;
+        let mut c = cam(Vec3::new(0.0, 0.0, 4.0), target);
+        c.ortho = Some((2.0, 1.0));
+        let mut ctl = CameraController::from_camera(&c, target, 2.0);
+        assert_eq!(ctl.camera().ortho, Some((2.0, 1.0)));
+        ctl.orbit(0.3, 0.1);
+        assert_eq!(ctl.camera().ortho, Some((2.0, 1.0)));
+        ctl.zoom(1.0);
+        let (x, y) = ctl.camera().ortho.unwrap();
+        assert!((x - 1.8).abs() < 1e-5 && (y - 0.9).abs() < 1e-5, "{x} {y}");
+        assert_eq!(CameraController::from_camera(&cam(Vec3::Z, target), target, 2.0).camera().ortho, None);
     }
 
     #[test]
