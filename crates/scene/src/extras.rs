@@ -154,6 +154,37 @@ pub(crate) struct SceneExtras {
     pub environment: Option<crate::Environment>,
 }
 
+/// The keys [`scene`] reads.
+pub(crate) const SCENE_KEYS: &[&str] = &["spectra", "water", "environment"];
+
+/// Edit distance, for telling a misspelt key from someone else's metadata.
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// `asset.extras` is where tools put their own metadata (Sketchfab and the Khronos samples:
+/// `author`, `license`, `source`, `title`): keep our keys and near-misses of them (so a typo is
+/// still an error naming it), drop the rest.
+pub(crate) fn without_metadata(map: Map<String, Value>, ours: &[&str]) -> Map<String, Value> {
+    map.into_iter()
+        .filter(|(k, _)| {
+            let lower = k.to_ascii_lowercase();
+            ours.iter().any(|o| distance(&lower, o) <= 2)
+        })
+        .collect()
+}
+
 pub(crate) fn scene(
     ctx: &Ctx,
     at: &str,
@@ -161,7 +192,7 @@ pub(crate) fn scene(
     out: &mut SceneExtras,
 ) -> Result<(), SceneError> {
     let at = format!("{at}.extras");
-    check_keys(ctx, &at, map, &["spectra", "water", "environment"])?;
+    check_keys(ctx, &at, map, SCENE_KEYS)?;
     if let Some(v) = map.get("spectra") {
         out.spectral = spectra(ctx, &format!("{at}.spectra"), v)?;
     }
@@ -310,4 +341,20 @@ fn water(ctx: &Ctx, at: &str, v: &Value) -> Result<WaterSettings, SceneError> {
         ));
     }
     Ok(WaterSettings { water_type, depth, sun_direction: sun, scale, sky })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metadata_is_dropped_but_misspellings_are_kept() {
+        let m: Map<String, Value> = serde_json::from_str(
+            r#"{"author": "x", "license": "y", "title": "z", "spectra": {}, "Watre": 1, "enviroment": 2}"#,
+        )
+        .unwrap();
+        let kept: Vec<String> = without_metadata(m, SCENE_KEYS).keys().cloned().collect();
+        assert_eq!(kept, ["Watre", "enviroment", "spectra"]);
+        assert_eq!(distance("reflectence", "reflectance"), 1);
+    }
 }

@@ -306,7 +306,11 @@ fn load_buffers(
 fn scene_extras(ctx: &Ctx, doc: &gltf::Document, scene: &gltf::Scene) -> Result<SceneExtras, SceneError> {
     let root = doc.as_json();
     let sources = [
-        ("asset".to_string(), extras::object(ctx, "asset", &root.asset.extras)?),
+        (
+            "asset".to_string(),
+            extras::object(ctx, "asset", &root.asset.extras)?
+                .map(|m| extras::without_metadata(m, extras::SCENE_KEYS)),
+        ),
         ("root".to_string(), extras::object(ctx, "root", &root.extras)?),
         (
             format!("scenes[{}]", scene.index()),

@@ -146,6 +146,15 @@ fn bad_extras() {
         }),
         &["lights[0].extras.stands_in_for", "does not emit"],
     );
+    // asset.extras carries other tools' metadata (author, license): ignored, but a near-miss of a
+    // key we read is still a typo to report.
+    let mut d = fixture();
+    d["asset"]["extras"] = json!({"author": "someone", "license": "CC-BY-4.0", "title": "t"});
+    assert!(scene::load_slice("meta.gltf", d.to_string().as_bytes(), Some(&data(""))).is_ok());
+    expect(
+        &mutate(|d| d["asset"]["extras"] = json!({"author": "a", "watr": {}})),
+        &["asset.extras.watr", "unknown key"],
+    );
     expect(
         &mutate(|d| d["extras"]["spectra"]["wavelenghts"] = json!(8)),
         &["root.extras.spectra.wavelenghts", "unknown key"],
