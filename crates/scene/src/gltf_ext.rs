@@ -21,10 +21,25 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "EXT_meshopt_compression",
 ];
 
-const DECOMPRESS: &str = "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
-const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
-const WEBP: &str = "convert its WebP textures first, e.g. `npx @gltf-transform/cli png in.glb out.glb`";
-const DDS: &str = "re-export the file with PNG or JPEG textures";
+pub(crate) const DECOMPRESS: &str =
+    "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
+pub(crate) const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
+pub(crate) const WEBP: &str =
+    "convert its WebP textures first, e.g. `npx @gltf-transform/cli png in.glb out.glb`";
+pub(crate) const DDS: &str = "re-export the file with PNG or JPEG textures";
+
+/// An image format recognised by its first bytes that the loader cannot decode, with what to do.
+pub(crate) fn undecodable_image(bytes: &[u8]) -> Option<(&'static str, &'static str)> {
+    if bytes.starts_with(b"\xabKTX 20\xbb") {
+        Some(("KTX2", KTX2))
+    } else if bytes.starts_with(b"RIFF") && bytes.get(8..12) == Some(b"WEBP") {
+        Some(("WebP", WEBP))
+    } else if bytes.starts_with(b"DDS ") {
+        Some(("DDS", DDS))
+    } else {
+        None
+    }
+}
 
 /// An unsupported extension: what a file loses when it is ignored (optional), and what to do
 /// when the file requires it.

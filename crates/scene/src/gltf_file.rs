@@ -647,6 +647,11 @@ impl Loader<'_> {
                 }
                 gltf::image::Source::Uri { uri, .. } => uri::read(self.ctx, &format!("{iat}.uri"), uri)?.0,
             };
+            if let Some((format, advice)) = gltf_ext::undecodable_image(&bytes) {
+                return Err(self
+                    .ctx
+                    .invalid(&iat, format!("is a {format} image, which is not supported; {advice}")));
+            }
             let decoded = image::ImageReader::new(std::io::Cursor::new(&bytes))
                 .with_guessed_format()
                 .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?

@@ -588,6 +588,14 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     assert_has(&error(&d), &["textures[0]", "KHR_texture_basisu", "ktxdecompress"]);
     d["extensionsRequired"] = json!(["KHR_texture_basisu"]);
     assert_has(&error(&d), &["extensionsRequired[0]", "KHR_texture_basisu", "ktxdecompress"]);
+    // A KTX2 file given as an ordinary image (no extension at all): named, with the same advice.
+    let mut d = base.clone();
+    let ktx2 = b"\xabKTX 20\xbb\r\n\x1a\n and then some";
+    d["images"] = json!([{"uri": data_uri("image/ktx2", ktx2)}]);
+    d["textures"] = json!([{"source": 0}]);
+    d["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+    d["meshes"][0]["primitives"][0]["material"] = json!(0);
+    assert_has(&error(&d), &["images[0]: is a KTX2 image", "ktxdecompress"]);
     // A required material extension: refused, naming it.
     let mut d = base.clone();
     d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_volume"]);
