@@ -596,22 +596,17 @@ impl Renderer {
         let mut lights = Vec::new();
         // light_weights[light · n_groups + group]: the light's node weights (mat3x4 in WGSL).
         let mut light_weights: Vec<crate::spectral_data::GroupWeights> = Vec::new();
-        for light in &scene.lights {
-            let mut gpu = GpuLight::new(light, setup.light_rgb(&light.emission));
+        // Punctual lights, then the emissive polygons: each a GPU light and its emission.
+        let sources =
+            scene.lights.iter().map(|l| (GpuLight::new(l, setup.light_rgb(&l.emission)), &l.emission)).chain(
+                scene
+                    .emitters
+                    .iter()
+                    .map(|e| (GpuLight::polygon(e, setup.light_rgb(&e.emission)), &e.emission)),
+            );
+        for (mut gpu, emission) in sources {
             if settings.mode != Mode::Rgb {
-                let w = setup.light_weights(&light.emission, settings.mode, &self.table)?;
-                let total = SpectralSetup::light_total(&w);
-                gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
-                light_weights.extend(setup.gpu_weights(&w));
-            } else {
-                light_weights.extend(std::iter::repeat_n([[0f32; 4]; 3], ng));
-            }
-            lights.push(gpu);
-        }
-        for e in &scene.emitters {
-            let mut gpu = GpuLight::polygon(e, setup.light_rgb(&e.emission));
-            if settings.mode != Mode::Rgb {
-                let w = setup.light_weights(&e.emission, settings.mode, &self.table)?;
+                let w = setup.light_weights(emission, settings.mode, &self.table)?;
                 let total = SpectralSetup::light_total(&w);
                 gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
                 light_weights.extend(setup.gpu_weights(&w));

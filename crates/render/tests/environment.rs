@@ -127,31 +127,15 @@ fn rotation_turns_the_environment_about_y() {
     assert!(c[2] > 0.9 && c[0] < 0.1, "{c:?}");
 }
 
-fn quad(centre: Vec3, half: f32, normal_down: bool, y_plane: bool) -> Mesh {
-    let (a, b) = (half, half);
-    let positions = if y_plane {
-        vec![
-            centre + Vec3::new(-a, 0.0, -b),
-            centre + Vec3::new(a, 0.0, -b),
-            centre + Vec3::new(a, 0.0, b),
-            centre + Vec3::new(-a, 0.0, b),
-        ]
-    } else {
-        unreachable!()
-    };
+/// A horizontal square of half-side `half` centred at `centre`, facing down or up.
+fn quad(centre: Vec3, half: f32, normal_down: bool) -> Mesh {
+    let positions = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .map(|(x, z)| centre + Vec3::new(x * half, 0.0, z * half))
+        .to_vec();
     let n = if normal_down { Vec3::NEG_Y } else { Vec3::Y };
     // Counter-clockwise seen from the side the normal points to.
     let indices = if normal_down { vec![0, 1, 2, 0, 2, 3] } else { vec![0, 2, 1, 0, 3, 2] };
-    Mesh {
-        colors: vec![],
-        uvs1: vec![],
-        positions,
-        normals: vec![n; 4],
-        tangents: vec![],
-        uvs: vec![Vec2::ZERO; 4],
-        indices,
-        material: 0,
-    }
+    Mesh { positions, normals: vec![n; 4], uvs: vec![Vec2::ZERO; 4], indices, ..Default::default() }
 }
 
 /// E/L at the origin (normal +Y) from a square of half-side `half` at height `h` above it,
@@ -173,9 +157,9 @@ fn square_irradiance(half: f32, h: f32) -> f64 {
 
 #[test]
 fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
-    let mut floor = quad(Vec3::ZERO, 3.0, false, true);
+    let mut floor = quad(Vec3::ZERO, 3.0, false);
     floor.material = 0;
-    let mut lamp = quad(Vec3::new(0.0, 1.0, 0.0), 0.5, true, true);
+    let mut lamp = quad(Vec3::new(0.0, 1.0, 0.0), 0.5, true);
     lamp.material = 1;
     let radiance = 2.0f32;
     let scene = Scene {
