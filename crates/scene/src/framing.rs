@@ -12,6 +12,11 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 /// sees a flat asset lying in a principal plane edge-on.
 pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(1.0, 0.6, 1.4);
 
+/// A scene whose depth (z extent) is at most this fraction of its larger side is a board facing
+/// ±Z (the Khronos test assets: TextureSettingsTest, VertexColorTest, …): the default camera
+/// looks at it head-on from +Z, the glTF front, as their reference screenshots do.
+pub const BOARD_DEPTH_RATIO: f32 = 0.2;
+
 /// Axis-aligned bounds of all mesh positions, `None` when there are none.
 pub fn bounds(meshes: &[Mesh]) -> Option<(Vec3, Vec3)> {
     let mut it = meshes.iter().flat_map(|m| m.positions.iter().copied());
@@ -28,9 +33,10 @@ impl Scene {
 
 impl Camera {
     /// The default camera: looks at the centre of `bounds` from [`DEFAULT_VIEW_DIRECTION`]
-    /// (above, front, right), far enough that the bounding sphere fits the vertical field of view
-    /// with 10% margin, +Y up, 45°. Near and far planes enclose the sphere. With no geometry: at
-    /// the origin looking down −Z.
+    /// (above, front, right) — or head-on from +Z for a board facing ±Z ([`BOARD_DEPTH_RATIO`]) —
+    /// far enough that the bounding sphere fits the vertical field of view with 10% margin, +Y
+    /// up, 45°. Near and far planes enclose the sphere. With no geometry: at the origin looking
+    /// down −Z.
     pub fn framing(bounds: Option<(Vec3, Vec3)>) -> Camera {
         let Some((lo, hi)) = bounds else {
             return Camera::look_at(Vec3::ZERO, -Vec3::Z, Vec3::Y, DEFAULT_YFOV);
@@ -38,7 +44,9 @@ impl Camera {
         let centre = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
         let dist = 1.1 * radius / (DEFAULT_YFOV * 0.5).sin();
-        let dir = DEFAULT_VIEW_DIRECTION.normalize();
+        let size = hi - lo;
+        let board = size.z <= BOARD_DEPTH_RATIO * size.x.max(size.y);
+        let dir = if board { Vec3::Z } else { DEFAULT_VIEW_DIRECTION.normalize() };
         let mut cam = Camera::look_at(centre + dir * dist, centre, Vec3::Y, DEFAULT_YFOV);
         cam.znear = ((dist - radius) * 0.5).max(dist * 1e-3);
         cam.zfar = (dist + radius) * 2.0;
@@ -70,17 +78,29 @@ mod tests {
     }
 
     #[test]
-    fn default_camera_sees_a_flat_asset_from_above_front_right() {
-        // A unit square in the XY plane facing +Z (TwoSidedPlane) and one in XZ facing +Y.
-        for (lo, hi, normal) in [
-            (Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::Z),
-            (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::Y),
-        ] {
+    fn default_camera_never_sees_a_flat_asset_edge_on() {
+        let to_eye = |lo: Vec3, hi: Vec3| {
             let cam = Camera::framing(Some((lo, hi)));
-            let to_eye = (cam.position() - (lo + hi) * 0.5).normalize();
-            assert!(to_eye.dot(normal) > 0.3, "{normal}: seen at a grazing angle from {to_eye}");
-            assert!(to_eye.x > 0.0 && to_eye.y > 0.0 && to_eye.z > 0.0, "{to_eye}");
+            let d = (cam.position() - (lo + hi) * 0.5).normalize();
+            // Looking at the centre, +Y up.
+            assert!(cam.transform.transform_vector3(-Vec3::Z).abs_diff_eq(-d, 1e-5));
+            assert!(cam.transform.transform_vector3(Vec3::X).y.abs() < 1e-5);
+            d
+        };
+        // Lying in XZ facing +Y (TwoSidedPlane), in YZ facing +X, and a box: three-quarter view
+        // from above, front and right.
+        for (lo, hi, normal) in [
+            (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::Y),
+            (Vec3::new(0.0, -1.0, -1.0), Vec3::new(0.0, 1.0, 1.0), Vec3::X),
+            (Vec3::ZERO, Vec3::ONE, Vec3::ONE.normalize()),
+        ] {
+            let d = to_eye(lo, hi);
+            assert!(d.dot(normal) > 0.3, "{normal}: seen at a grazing angle from {d}");
+            assert!(d.x > 0.0 && d.y > 0.0 && d.z > 0.0, "{d}");
         }
+        // A board facing +Z (the test assets): head-on.
+        let d = to_eye(Vec3::new(-5.0, -5.0, -0.15), Vec3::new(5.0, 4.5, 0.1));
+        assert!(d.abs_diff_eq(Vec3::Z, 1e-6), "{d}");
         assert!(Camera::framing(None).position() == Vec3::ZERO);
     }
 }
