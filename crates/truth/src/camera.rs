@@ -14,6 +14,10 @@ pub struct RayCamera {
     up: Vec3,
     forward: Vec3,
     ortho: bool,
+    /// Distance along `forward` of the near clipping plane (glTF `znear` × the transform's
+    /// scale, as the rasteriser's view matrix applies it): camera rays start on it, so geometry
+    /// the rasteriser clips (a cockpit around the camera) is not seen here either.
+    near: f32,
     width: f32,
     height: f32,
 }
@@ -31,7 +35,9 @@ impl RayCamera {
             Some((_, ymag)) => (ymag.abs(), true),
             None => ((cam.yfov * 0.5).tan(), false),
         };
+        let near = cam.znear.max(0.0) * t.transform_vector3(-Vec3::Z).length();
         RayCamera {
+            near: if near.is_finite() { near } else { 0.0 },
             origin: t.transform_point3(Vec3::ZERO),
             right: t.transform_vector3(Vec3::X).normalize() * half_h * aspect,
             up: t.transform_vector3(Vec3::Y).normalize() * half_h,
@@ -43,14 +49,16 @@ impl RayCamera {
     }
 
     /// The ray (origin, unit direction) through image position `p` in pixels (origin
-    /// top-left, y down). Orthographic rays start on the camera's z = 0 plane.
+    /// top-left, y down). Rays start on the near clipping plane (orthographic rays: the camera's
+    /// z = −near plane).
     pub fn ray(&self, p: Vec2) -> (Vec3, Vec3) {
         let x = 2.0 * p.x / self.width - 1.0;
         let y = 1.0 - 2.0 * p.y / self.height;
         if self.ortho {
-            (self.origin + self.right * x + self.up * y, self.forward)
+            (self.origin + self.right * x + self.up * y + self.forward * self.near, self.forward)
         } else {
-            (self.origin, (self.forward + self.right * x + self.up * y).normalize())
+            let d = (self.forward + self.right * x + self.up * y).normalize();
+            (self.origin + d * (self.near / d.dot(self.forward)), d)
         }
     }
 }
@@ -65,7 +73,10 @@ mod tests {
         let cam = Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 0.8);
         let c = RayCamera::new(&cam, 200, 100);
         let dir = |p| c.ray(p).1;
-        assert_eq!(c.ray(Vec2::new(3.0, 7.0)).0, Vec3::new(0.0, 1.0, 5.0));
+        // Rays start on the near plane (look_at's znear is 0.01, 5 units from the target).
+        let (o, d) = c.ray(Vec2::new(3.0, 7.0));
+        assert!(((o - Vec3::new(0.0, 1.0, 5.0)).dot(-Vec3::Z) - 0.01).abs() < 1e-6);
+        assert!((o - d * (0.01 / d.dot(-Vec3::Z)) - Vec3::new(0.0, 1.0, 5.0)).length() < 1e-5);
         assert!((dir(Vec2::new(100.0, 50.0)) - (-Vec3::Z)).length() < 1e-6);
         let top = dir(Vec2::new(100.0, 0.0));
         assert!((top.angle_between(-Vec3::Z) - 0.4).abs() < 1e-5 && top.y > 0.0);
@@ -81,6 +92,7 @@ mod tests {
         let mut cam = Camera::look_at(Vec3::new(1.0, 2.0, 5.0), Vec3::new(1.0, 2.0, 0.0), Vec3::Y, 0.8);
         cam.transform *= Mat4::from_scale(Vec3::splat(2.0));
         cam.ortho = Some((xmag, ymag));
+        cam.znear = 0.0;
         let c = RayCamera::new(&cam, 200, 100);
         for p in [Vec2::ZERO, Vec2::new(200.0, 100.0), Vec2::new(37.0, 81.0), Vec2::new(100.0, 50.0)] {
             let (o, d) = c.ray(p);
@@ -94,5 +106,9 @@ mod tests {
         // A square image keeps ymag and narrows to ±ymag horizontally.
         let sq = RayCamera::new(&cam, 64, 64);
         assert!((sq.ray(Vec2::new(64.0, 0.0)).0 - Vec3::new(1.0 + ymag, 2.0 + ymag, 5.0)).length() < 1e-5);
+        // The near plane, scaled like the rasteriser's view matrix scales it: 0.5 × 2 in front.
+        cam.znear = 0.5;
+        let near = RayCamera::new(&cam, 200, 100);
+        assert!((near.ray(Vec2::new(37.0, 81.0)).0.z - 4.0).abs() < 1e-5);
     }
 }
