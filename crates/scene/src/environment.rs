@@ -289,9 +289,10 @@ pub struct LightSources {
     pub punctual: usize,
     /// Emissive polygons (`crate::emitters`).
     pub emitters: usize,
-    /// The flux the emissive surfaces emit (π·L·A each), spread over the scene's bounding
-    /// sphere: the mean irradiance they give. A lamp (bevy's CornellBox.glb: ≈ 1.5) lights the
-    /// scene; an emissive texture of small glowing details (DamagedHelmet's: ≈ 0.01) does not.
+    /// The flux the untextured emissive surfaces emit (π·L·A each), spread over the scene's
+    /// bounding sphere: the mean irradiance they give. A lamp (bevy's CornellBox.glb: ≈ 1.5)
+    /// lights the scene; textured emitters (DamagedHelmet's glowing details, MultiUVTest's
+    /// logos) never count: they are glow, shown but not lit with by glTF viewers.
     pub emissive_irradiance: f64,
     /// Whether a non-black environment surrounds the scene.
     pub environment: bool,
@@ -300,7 +301,13 @@ pub struct LightSources {
 impl LightSources {
     pub fn of(scene: &crate::Scene) -> Self {
         let emitters = crate::emitters::emitters(scene);
-        let flux: f64 = emitters.iter().map(|e| std::f64::consts::PI * e.power()).sum();
+        // Lamps are uniform emitters; a textured emitter (a screen, a logo, glowing details) is
+        // glow that viewers show but do not light with, however bright.
+        let lamp = |e: &&crate::emitters::Emitter| {
+            let m = scene.meshes[e.mesh].material;
+            scene.materials.get(m).is_some_and(|m| m.emissive_texture.is_none())
+        };
+        let flux: f64 = emitters.iter().filter(lamp).map(|e| std::f64::consts::PI * e.power()).sum();
         let radius = scene.bounds().map_or(0.0, |(lo, hi)| 0.5 * (hi - lo).length() as f64);
         let emissive_irradiance = if radius > 0.0 {
             flux / (4.0 * std::f64::consts::PI * radius * radius)
@@ -490,6 +497,22 @@ mod tests {
         glow.materials.iter_mut().for_each(|m| m.emissive *= 1e-4);
         assert!(!LightSources::of(&glow).emitters_light());
         assert!(EnvironmentChoice::default().apply(&mut glow).unwrap().is_some());
+        // The same lamp with an emissive texture (white, so it is as bright): a textured emitter
+        // is glow, not a lamp.
+        let mut textured = lamp_only.clone();
+        textured.textures.push(crate::Texture {
+            name: "white".into(),
+            width: 1,
+            height: 1,
+            rgba8: vec![255; 4],
+            srgb: true,
+            sampler: Default::default(),
+        });
+        let t = textured.textures.len() - 1;
+        textured.materials.iter_mut().filter(|m| m.emissive.max_element() > 0.0).for_each(|m| {
+            m.emissive_texture = Some(crate::TextureRef::new(t));
+        });
+        assert!(!LightSources::of(&textured).emitters_light());
         let orphan = EnvironmentChoice { env: Some("none".into()), intensity: Some(2.0), rotation: None };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
     }
