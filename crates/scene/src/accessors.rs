@@ -232,25 +232,40 @@ pub(crate) fn read_f32(
             }
         }
     }
-    if let Some(sp) = acc.sparse() {
-        let (idx, val) = (sp.indices(), sp.values());
-        let ib = &view_bytes(&idx.view(), buffers)[idx.offset()..];
-        let vb = &view_bytes(&val.view(), buffers)[val.offset()..];
-        let (it, isz) = (idx.index_type(), idx.index_type().size());
-        for k in 0..sp.count() {
-            let i = index_at(&ib[k * isz..], &it);
-            if i >= count {
-                return Err(ctx.invalid(
-                    format!("{at} (accessors[{}]).sparse.indices", acc.index()),
-                    format!("index {i} is out of range for {count} elements"),
-                ));
-            }
-            for c in 0..n {
-                out[i * n + c] = component(&vb[(k * n + c) * csize..], ty, norm);
-            }
+    sparse(ctx, at, acc, buffers, count, |k, i, vb| {
+        for c in 0..n {
+            out[i * n + c] = component(&vb[(k * n + c) * csize..], ty, norm);
         }
-    }
+    })?;
     Ok(out)
+}
+
+/// Calls `set(k, i, values)` for each sparse substitution k of `acc` (target element i, the
+/// values' bytes), refusing an index past `count`.
+fn sparse(
+    ctx: &Ctx,
+    at: &str,
+    acc: &gltf::Accessor,
+    buffers: &[Vec<u8>],
+    count: usize,
+    mut set: impl FnMut(usize, usize, &[u8]),
+) -> Result<(), SceneError> {
+    let Some(sp) = acc.sparse() else { return Ok(()) };
+    let (idx, val) = (sp.indices(), sp.values());
+    let ib = &view_bytes(&idx.view(), buffers)[idx.offset()..];
+    let vb = &view_bytes(&val.view(), buffers)[val.offset()..];
+    let (it, isz) = (idx.index_type(), idx.index_type().size());
+    for k in 0..sp.count() {
+        let i = index_at(&ib[k * isz..], &it);
+        if i >= count {
+            return Err(ctx.invalid(
+                format!("{at} (accessors[{}]).sparse.indices", acc.index()),
+                format!("index {i} is out of range for {count} elements"),
+            ));
+        }
+        set(k, i, vb);
+    }
+    Ok(())
 }
 
 /// Reads a checked SCALAR accessor of unsigned integers (indices) exactly.
@@ -276,22 +291,7 @@ pub(crate) fn read_u32(
             *v = get(&data[i * stride..]);
         }
     }
-    if let Some(sp) = acc.sparse() {
-        let (idx, val) = (sp.indices(), sp.values());
-        let ib = &view_bytes(&idx.view(), buffers)[idx.offset()..];
-        let vb = &view_bytes(&val.view(), buffers)[val.offset()..];
-        let (it, isz) = (idx.index_type(), idx.index_type().size());
-        for k in 0..sp.count() {
-            let i = index_at(&ib[k * isz..], &it);
-            if i >= count {
-                return Err(ctx.invalid(
-                    format!("{at} (accessors[{}]).sparse.indices", acc.index()),
-                    format!("index {i} is out of range for {count} elements"),
-                ));
-            }
-            out[i] = get(&vb[k * size..]);
-        }
-    }
+    sparse(ctx, at, acc, buffers, count, |k, i, vb| out[i] = get(&vb[k * size..]))?;
     Ok(out)
 }
 
