@@ -510,6 +510,7 @@ impl Loader<'_> {
         };
         let raw = self.raw.pointer(&format!("/materials/{idx}"));
         let info = |path: &str| raw.and_then(|r| r.pointer(path));
+        out.unlit = info("/extensions/KHR_materials_unlit").is_some();
         if let Some(t) = pbr.base_color_texture() {
             out.base_color_texture = Some(self.texture(
                 &format!("{at}.pbrMetallicRoughness.baseColorTexture"),
@@ -580,6 +581,12 @@ impl Loader<'_> {
                 .find(|(_, t)| t.is_some_and(|t| t.tex_coord == 1))
                 .map(|(f, _)| format!("{at}.{f}")),
         };
+        if out.unlit {
+            // KHR_materials_unlit: the base colour is all the surface shows; its emission would
+            // otherwise be added to it and make it a light source.
+            out.emissive = Vec3::ZERO;
+            out.emissive_texture = None;
+        }
         let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok((out, needs)) };
         let x = extras::material(self.ctx, &at, &map)?;
         if matches!(x.reflectance, Some(SpectralReflectance::Palette(_))) && out.base_color_texture.is_none()

@@ -123,6 +123,12 @@ pub struct Material {
     /// Spectral radiance of the emission, scaled so its luminance equals that of `emissive`
     /// (same convention as [`Emission`]); `None` = upsample `emissive` as RGB.
     pub emission_spectrum: Option<Spectrum>,
+    /// `KHR_materials_unlit`: the surface shows its base colour (factor × texture × `COLOR_0`)
+    /// whatever the lighting, and reflects nothing. Both renderers draw it as an emitter whose
+    /// RGB is the base colour, upsampled like every RGB emission (the illuminant variant, so
+    /// white is the scene's white); it does not light other surfaces in real time, and in the
+    /// path tracer only through paths that hit it (it is not a light source).
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -146,6 +152,7 @@ impl Default for Material {
             double_sided: true,
             spectral: None,
             emission_spectrum: None,
+            unlit: false,
         }
     }
 }

@@ -653,3 +653,31 @@ fn orthographic_cameras_are_read() {
         assert_has(&error(&d), &["cameras[0].orthographic", field]);
     }
 }
+
+#[test]
+fn unlit_materials_load_as_unlit_without_emission_and_round_trip() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_unlit"],
+        "extensionsRequired": ["KHR_materials_unlit"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0}, {"attributes": {"POSITION": pos}, "material": 1}]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1.0, 1.0]}, "emissiveFactor": [1.0, 1.0, 1.0],
+             "extensions": {"KHR_materials_unlit": {}}},
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1.0, 1.0]}}
+        ],
+    }));
+    let s = load(&doc).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let (u, lit) = (&s.materials[0], &s.materials[1]);
+    assert!(u.unlit && !lit.unlit);
+    assert_eq!(u.base_color, Vec4::new(0.5, 0.25, 1.0, 1.0));
+    // Its emission would make it a light source: dropped, as the extension's shading ignores it.
+    assert_eq!(u.emissive, Vec3::ZERO);
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert!(back.materials[0].unlit && !back.materials[1].unlit);
+}

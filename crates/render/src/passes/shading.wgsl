@@ -287,13 +287,15 @@ struct GSurface {
     roughness: f32,
     // The material's ambient occlusion (glTF occlusionTexture), for the environment only.
     occlusion: f32,
+    // KHR_materials_unlit: only `emission` (its base colour) leaves the surface.
+    unlit: bool,
 };
 
 fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let e = textureLoad(gbuf_emission, px, 0);
-    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), b.a, nr.w, e.a);
+    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0);
 }
 
 // RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
@@ -308,14 +310,15 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         ctx.normal = s.normal;
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
-        for (var li = 0u; li < min(frame.n_lights, MAX_LIGHTS); li++) {
+        let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+        for (var li = 0u; li < n_lit; li++) {
             let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness);
             let e = lights[li].rgb.rgb;
             sum_a = fma(vec3<f32>(f.x), e, sum_a);
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
         }
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
-        if (env_enabled()) {
+        if (env_enabled() && !s.unlit) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
             let vis = s.occlusion * env_occlusion(in.pos.xy, ctx.world_pos, s.normal);
             rgb += (s.base * et.a.rgb + et.b.rgb) * vis;
@@ -345,7 +348,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let has_env = env_enabled();
     if (!background) {
         let s = load_surface(px);
-        if (has_env) {
+        if (has_env && !s.unlit) {
             et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
             let vis = s.occlusion * env_occlusion(in.pos.xy, p, s.normal);
             et.a *= vis;
@@ -354,7 +357,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         base = s.base;
         emission = s.emission;
         ctx.normal = s.normal;
-        n_lights = min(frame.n_lights, MAX_LIGHTS);
+        n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
             let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness);
             fa[li] = f.x;
