@@ -11,6 +11,7 @@ use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::extras::{self, SceneExtras};
 use crate::primitive::Needs;
+use crate::spec_gloss;
 use crate::{
     AlphaMode, Camera, Emission, Filter, Light, LightKind, Material, Mesh, Sampler, Scene,
     SpectralReflectance, Texture, TextureRef, Wrap, gltf_ext, instancing, meshopt_decode, primitive, uri,
@@ -76,6 +77,8 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
 
     let mut loader = Loader {
         ctx,
+        doc,
+        warnings: Vec::new(),
         raw: &raw,
         buffers: &buffers,
         textures: Vec::new(),
@@ -89,6 +92,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         materials.push(mat);
         needs.push(need);
     }
+    warnings.append(&mut loader.warnings);
     let default_material = materials.len();
     let mut uses_default = false;
 
@@ -441,6 +445,9 @@ fn light_of(
 /// Material and texture conversion, with textures shared between materials and decoded once.
 struct Loader<'a> {
     ctx: &'a Ctx,
+    doc: &'a gltf::Document,
+    /// What the materials lose or approximate, for [`Scene::warnings`].
+    warnings: Vec<String>,
     /// The document's JSON, for extension objects the `gltf` crate does not parse.
     raw: &'a Value,
     buffers: &'a [Vec<u8>],
@@ -558,6 +565,9 @@ impl Loader<'_> {
                 info("/emissiveTexture"),
             )?);
         }
+        if let Some(sg) = info("/extensions/KHR_materials_pbrSpecularGlossiness") {
+            self.spec_gloss(&at, sg, &mut out)?;
+        }
         let values = [
             out.base_color.to_array().as_slice(),
             &[out.metallic, out.roughness, out.normal_scale],
@@ -613,6 +623,83 @@ impl Loader<'_> {
             out.emission_spectrum = e.spectrum;
         }
         Ok((out, needs))
+    }
+
+    /// `KHR_materials_pbrSpecularGlossiness` (`sg` is its JSON) converted into `out`'s
+    /// metallic-roughness factors and textures (`spec_gloss`).
+    fn spec_gloss(&mut self, at: &str, sg: &Value, out: &mut Material) -> Result<(), SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_pbrSpecularGlossiness");
+        let factor = |key: &str, default: Vec4, n: usize| -> Result<Vec4, SceneError> {
+            let Some(v) = sg.get(key) else { return Ok(default) };
+            let nums: Option<Vec<f32>> = match v.as_array() {
+                Some(a) => a.iter().map(|x| x.as_f64().map(|x| x as f32)).collect(),
+                None => v.as_f64().map(|x| vec![x as f32]),
+            };
+            match nums {
+                Some(x) if x.len() == n && x.iter().all(|c| (0.0..=1.0).contains(c)) => {
+                    let mut f = default;
+                    for (i, c) in x.into_iter().enumerate() {
+                        f[i] = c;
+                    }
+                    Ok(f)
+                }
+                _ => Err(self.ctx.invalid(
+                    format!("{at}.{key}"),
+                    format!(
+                        "must be {} in [0, 1]",
+                        if n == 1 { "a number".to_string() } else { format!("{n} numbers") }
+                    ),
+                )),
+            }
+        };
+        let diffuse = factor("diffuseFactor", Vec4::ONE, 4)?;
+        let specular = factor("specularFactor", Vec4::ONE, 3)?.truncate();
+        let glossiness = factor("glossinessFactor", Vec4::ONE, 1)?.x;
+        let mut texture = |key: &str| -> Result<Option<TextureRef>, SceneError> {
+            let Some(info) = sg.get(key) else { return Ok(None) };
+            let field = format!("{at}.{key}");
+            let t = info
+                .get("index")
+                .and_then(Value::as_u64)
+                .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
+                .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
+            let tex_coord =
+                info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
+            self.texture(&field, t, tex_coord, true, Some(info)).map(Some)
+        };
+        let diffuse_tex = texture("diffuseTexture")?;
+        let mut sg_tex = texture("specularGlossinessTexture")?;
+        if let (Some(d), Some(g)) = (&diffuse_tex, &sg_tex)
+            && (d.tex_coord != g.tex_coord || d.transform != g.transform)
+        {
+            self.warnings.push(format!(
+                "{at}: the diffuse and specular-glossiness textures use different UV sets or transforms; \
+                 the material is converted from the diffuse texture and the specular/glossiness factors only"
+            ));
+            sg_tex = None;
+        }
+        let converted = spec_gloss::convert(diffuse, specular, glossiness);
+        out.base_color = converted.base_color;
+        out.metallic = converted.metallic;
+        out.roughness = converted.roughness;
+        out.base_color_texture = None;
+        out.metallic_roughness_texture = None;
+        let Some(placement) = diffuse_tex.or(sg_tex) else { return Ok(()) };
+        let source = |r: &Option<TextureRef>, factor: Vec4| spec_gloss::Source {
+            texture: r.map(|r| &self.textures[r.index]),
+            factor,
+        };
+        let (base, mr) = spec_gloss::convert_textures(
+            &out.name,
+            &source(&diffuse_tex, diffuse),
+            &source(&sg_tex, specular.extend(glossiness)),
+        );
+        let placed = |index: usize| TextureRef { index, ..placement };
+        out.base_color_texture = Some(placed(self.textures.len()));
+        out.metallic_roughness_texture = Some(placed(self.textures.len() + 1));
+        self.textures.extend([base, mr]);
+        (out.base_color, out.metallic, out.roughness) = (Vec4::ONE, 1.0, 1.0);
+        Ok(())
     }
 
     /// The texture of a textureInfo at `at` (`info` is its JSON): decoded once per glTF texture

@@ -21,6 +21,7 @@ mod instancing;
 mod meshopt_decode;
 mod primitive;
 pub mod sky;
+pub mod spec_gloss;
 pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
