@@ -18,6 +18,15 @@ const MAX_SHADOWS: u32 = 8u;
 // Value of `layer_of_light` for a light without a shadow map.
 const NO_SHADOW: u32 = 0xffffffffu;
 
+// Features a scene may not need, set per pipeline (`Variant` in src/passes/shading.rs): without
+// them the driver compiles the shader without their code.
+override HAS_POLYGONS: bool = true;
+override HAS_ENV: bool = true;
+
+fn shading_env() -> bool {
+    return HAS_ENV && env_enabled();
+}
+
 // Layout must match `ShadowUniforms` in src/passes/shadow.rs.
 struct ShadowUniforms {
     view_proj: array<mat4x4<f32>, MAX_SHADOWS>,
@@ -58,7 +67,7 @@ fn lambert_only() -> bool {
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
 fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
-    if (u32(lights[li].pos_kind.w) == 3u) {
+    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
         return polygon_factors(li, p, n, v, metallic, roughness);
     }
     let inc = light_incidence(li, p);
@@ -318,12 +327,12 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
         }
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
-        if (env_enabled() && !s.unlit) {
+        if (shading_env() && !s.unlit) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
             let vis = s.occlusion * env_occlusion(in.pos.xy, ctx.world_pos, s.normal);
             rgb += (s.base * et.a.rgb + et.b.rgb) * vis;
         }
-    } else if (env_enabled() && env.flags.y != 0u) {
+    } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
     return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
@@ -345,7 +354,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     var fb: array<f32, MAX_LIGHTS>;
     // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
     var et: EnvTerms;
-    let has_env = env_enabled();
+    let has_env = shading_env();
     if (!background) {
         let s = load_surface(px);
         if (has_env && !s.unlit) {
