@@ -21,22 +21,48 @@ use crate::{
 /// file (one mesh referenced by many instances) must not exhaust memory.
 pub const MAX_TRIANGLES: usize = 20_000_000;
 
+/// Largest `.gltf`/`.glb` file, and largest external buffer (`.bin`), read (bytes). A scene at
+/// [`MAX_TRIANGLES`] fits; the cap keeps a hostile reference (a huge or growing file) from
+/// exhausting memory.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Largest encoded image file (PNG/JPEG) read for a texture (bytes).
+pub const MAX_IMAGE_FILE_BYTES: u64 = 256 << 20;
+/// Largest texture width or height, read from the image header before decoding.
+pub const MAX_IMAGE_DIMENSION: u32 = 16384;
+/// Largest decoded texture (bytes of RGBA8): 8192² (or 16384 × 4096).
+pub const MAX_IMAGE_DECODED_BYTES: u64 = 256 << 20;
+
+/// How a scene file may be loaded.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions {
+    /// Let file references (buffers, images, CSV spectra, environment maps) leave the scene's
+    /// folder: absolute paths, `..`, symlinks pointing elsewhere. Off by default, so a scene
+    /// from elsewhere cannot read other files (`--allow-outside-scene-dir`).
+    pub allow_outside_scene_dir: bool,
+}
+
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
 ///
 /// Geometry is flattened to world space; spectral `extras` are resolved; errors name the file
 /// and the glTF index or JSON field at fault. What was ignored or approximated is listed in
 /// [`Scene::warnings`]. See `docs/scene-format.md`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] with options.
+pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, SceneError> {
     let path = path.as_ref();
-    let ctx = Ctx::file(path);
-    let bytes = std::fs::read(path).map_err(|e| ctx.io(path, e))?;
+    let mut ctx = Ctx::file(path);
+    ctx.allow_outside = opts.allow_outside_scene_dir;
+    let bytes = color::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| ctx.io(path, e))?;
     from_slice(&ctx, &bytes)
 }
 
-/// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given.
-/// `name` is used in messages in place of a path.
+/// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
+/// (and must stay inside it). `name` is used in messages in place of a path.
 pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, SceneError> {
-    let ctx = Ctx { path: name.into(), dir: base_dir.map(Path::to_path_buf) };
+    let ctx = Ctx { path: name.into(), dir: base_dir.map(Path::to_path_buf), allow_outside: false };
     from_slice(&ctx, bytes)
 }
 
@@ -292,7 +318,7 @@ fn load_buffers(
                 gltf::buffer::Source::Bin => blob
                     .ok_or_else(|| ctx.invalid(&at, "refers to the GLB binary chunk, but the file has none"))?
                     .to_vec(),
-                gltf::buffer::Source::Uri(u) => uri::read(ctx, &format!("{at}.uri"), u)?.0,
+                gltf::buffer::Source::Uri(u) => uri::read(ctx, &format!("{at}.uri"), u, MAX_FILE_BYTES)?.0,
             };
             if data.len() < b.length() {
                 return Err(ctx.invalid(
@@ -739,16 +765,46 @@ impl Loader<'_> {
                         })?
                         .to_vec()
                 }
-                gltf::image::Source::Uri { uri, .. } => uri::read(self.ctx, &format!("{iat}.uri"), uri)?.0,
+                gltf::image::Source::Uri { uri, .. } => {
+                    uri::read(self.ctx, &format!("{iat}.uri"), uri, MAX_IMAGE_FILE_BYTES)?.0
+                }
             };
             if let Some((format, advice)) = gltf_ext::undecodable_image(&bytes) {
                 return Err(self
                     .ctx
                     .invalid(&iat, format!("is a {format} image, which is not supported; {advice}")));
             }
-            let decoded = image::ImageReader::new(std::io::Cursor::new(&bytes))
+            let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
                 .with_guessed_format()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            // Checked against the header before any pixel buffer is allocated: a few bytes of
+            // PNG can claim 2³¹ × 2³¹ pixels.
+            let (w, h) = reader
+                .into_dimensions()
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            if w > MAX_IMAGE_DIMENSION
+                || h > MAX_IMAGE_DIMENSION
+                || 4 * w as u64 * h as u64 > MAX_IMAGE_DECODED_BYTES
+            {
+                return Err(self.ctx.invalid(
+                    &iat,
+                    format!(
+                        "the image is {w}×{h}; at most {MAX_IMAGE_DIMENSION} on a side and {} MiB decoded \
+                         (RGBA8) are accepted",
+                        MAX_IMAGE_DECODED_BYTES >> 20
+                    ),
+                ));
+            }
+            let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+                .with_guessed_format()
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(MAX_IMAGE_DIMENSION);
+            limits.max_image_height = Some(MAX_IMAGE_DIMENSION);
+            // Decoding may hold the image at 16 bits per channel before conversion.
+            limits.max_alloc = Some(2 * MAX_IMAGE_DECODED_BYTES);
+            reader.limits(limits);
+            let decoded = reader
                 .decode()
                 .map_err(|e| self.ctx.invalid(&iat, format!("cannot decode image: {e}")))?
                 .into_rgba8();

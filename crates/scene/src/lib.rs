@@ -37,14 +37,22 @@ pub use builtin::{BUILTIN_NAMES, builtin};
 pub use environment::{Environment, EnvironmentError};
 pub use error::{Result, SceneError};
 pub use export::write_gltf;
-pub use gltf_file::{MAX_TRIANGLES, load, load_slice};
+pub use gltf_file::{
+    LoadOptions, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION, MAX_IMAGE_FILE_BYTES,
+    MAX_TRIANGLES, load, load_slice, load_with,
+};
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
 /// argument ends in `.gltf` or `.glb` (any case), from that file.
 pub fn load_any(name_or_path: &str) -> Result<Scene> {
+    load_any_with(name_or_path, &LoadOptions::default())
+}
+
+/// [`load_any`] with options for a file.
+pub fn load_any_with(name_or_path: &str, opts: &LoadOptions) -> Result<Scene> {
     let lower = name_or_path.to_ascii_lowercase();
     if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-        load(Path::new(name_or_path))
+        load_with(Path::new(name_or_path), opts)
     } else {
         builtin(name_or_path)
     }

@@ -136,10 +136,14 @@ pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
     }
 }
 
+/// Largest CSV spectrum file read (bytes): a spectrum sampled every 0.01 nm over 200–2000 nm
+/// is well under it.
+pub const MAX_CSV_BYTES: u64 = 16 << 20;
+
 /// Reads a two-column CSV spectrum; errors carry the line number.
 pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result<Spectrum, SceneError> {
-    let bytes =
-        std::fs::read(file).map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
+    let bytes = color::input::read_regular(file, MAX_CSV_BYTES)
+        .map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
     let csv_err = |line: u64, message: String| SceneError::Csv {
         path: ctx.path.clone(),
         field: field.to_string(),
@@ -178,11 +182,11 @@ pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result
             }
             // The first row may be a header such as `wavelength,value`.
             _ if lambda.is_empty() && n == 0 && parse(&rec[0]).is_none() => {}
-            _ => {
-                return Err(csv_err(
-                    line,
-                    format!("cannot read '{}', '{}' as two finite numbers", &rec[0], &rec[1]),
-                ));
+            (l, _) => {
+                // Which column, not its text: the file may not be a spectrum at all (a
+                // mistyped or hostile reference), and its content must not be echoed.
+                let col = if l.is_none() { "1 (wavelength)" } else { "2 (value)" };
+                return Err(csv_err(line, format!("column {col} is not a finite number")));
             }
         }
     }
@@ -265,7 +269,12 @@ mod tests {
     #[test]
     fn csv_errors_carry_line_numbers() {
         let e = msg(json!({"csv": "bad_value.csv"}));
-        assert!(e.contains("bad_value.csv: line 4") && e.contains("abc"), "{e}");
+        assert!(
+            e.contains("bad_value.csv: line 4")
+                && e.contains("column 2 (value) is not a finite number")
+                && !e.contains("abc"),
+            "{e}"
+        );
         let e = msg(json!({"csv": "not_increasing.csv"}));
         assert!(e.contains("line 3") && e.contains("increase strictly"), "{e}");
         let e = msg(json!({"csv": "missing.csv"}));

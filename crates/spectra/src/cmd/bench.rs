@@ -32,6 +32,8 @@ pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
+    pub files: super::SceneFileArgs,
+    #[command(flatten)]
     pub env: super::EnvArgs,
     /// Frame size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
@@ -270,8 +272,7 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--frames 0: measure at least one frame");
     }
     let counts = parse_counts(&args.wavelengths)?;
-    let mut scene =
-        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.env.apply(&mut scene)?;
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
