@@ -32,6 +32,14 @@ pub const MAX_IMAGE_DIMENSION: u32 = 16384;
 /// Largest decoded texture (bytes of RGBA8): 8192² (or 16384 × 4096).
 pub const MAX_IMAGE_DECODED_BYTES: u64 = 256 << 20;
 
+/// Largest light `intensity × max(color)` accepted (candela, lux for directional lights).
+/// The sun gives about 1.2·10⁵ lux; far larger finite values only overflow the renderers' f32
+/// arithmetic into black or NaN pixels.
+pub const MAX_LIGHT_INTENSITY: f32 = 1.0e9;
+/// Largest emissive component (`emissiveFactor × emissiveStrength`): radiance relative to the
+/// default sky's 1, as generous as the environment's intensity cap.
+pub const MAX_EMISSIVE: f32 = 1.0e6;
+
 /// How a scene file may be loaded.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct LoadOptions {
@@ -367,8 +375,15 @@ fn scene_extras(ctx: &Ctx, doc: &gltf::Document, scene: &gltf::Scene) -> Result<
 /// The camera of `cam` at node transform `world`, and a warning when it had to be changed.
 fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Option<String>), SceneError> {
     let at = format!("cameras[{}]", cam.index());
-    // A camera's frame is rigid; drop any scale the node hierarchy carries.
-    let (_, rot, pos) = world.to_scale_rotation_translation();
+    // A camera's frame is rigid; drop any scale the node hierarchy carries. A zero scale leaves
+    // no rotation to recover (the image would silently be black).
+    let (scale, rot, pos) = world.to_scale_rotation_translation();
+    if !(scale.abs().min_element() > 1e-12 && rot.is_finite() && rot.length() > 0.5) {
+        return Err(ctx.invalid(
+            at,
+            "the camera's node transform is degenerate (a scale of 0 somewhere in its hierarchy), so it has no direction",
+        ));
+    }
     let transform = Mat4::from_rotation_translation(rot.normalize(), pos);
     let p = match cam.projection() {
         gltf::camera::Projection::Perspective(p) => p,
@@ -430,6 +445,14 @@ fn light_of(
         ctx.invalid(format!("nodes[{}]", node.index()), "light node transform collapses its direction")
     })?;
     let range = l.range();
+    if let Some(r) = range
+        && !(r > 0.0 && r.is_finite())
+    {
+        return Err(ctx.invalid(
+            format!("{at}.range"),
+            format!("must be greater than 0 (KHR_lights_punctual), got {r}"),
+        ));
+    }
     let kind = match l.kind() {
         Kind::Point => LightKind::Point { position, range },
         Kind::Directional => LightKind::Directional { direction },
@@ -456,6 +479,15 @@ fn light_of(
     let intensity = l.intensity();
     if !(rgb.is_finite() && rgb.min_element() >= 0.0 && intensity.is_finite() && intensity >= 0.0) {
         return Err(ctx.invalid(at, "color and intensity must be finite and non-negative"));
+    }
+    if rgb.max_element() * intensity > MAX_LIGHT_INTENSITY {
+        return Err(ctx.invalid(
+            format!("{at}.intensity"),
+            format!(
+                "intensity × color is {:e}; at most {MAX_LIGHT_INTENSITY:e} is accepted",
+                rgb.max_element() * intensity
+            ),
+        ));
     }
     let x = match extras::object(ctx, &at, l.extras())? {
         Some(map) => extras::light(ctx, &at, &map)?,
@@ -602,6 +634,34 @@ impl Loader<'_> {
         .concat();
         if values.iter().any(|v| !v.is_finite()) || out.emissive.min_element() < 0.0 {
             return Err(self.ctx.invalid(&at, "factors must be finite (and emissive non-negative)"));
+        }
+        // glTF 2.0 gives these factors the range [0, 1]; outside it they are not materials
+        // (a negative albedo, a roughness of 5), and the renderers' results are meaningless.
+        let unit = [
+            (
+                "pbrMetallicRoughness.baseColorFactor",
+                out.base_color.min_element(),
+                out.base_color.max_element(),
+            ),
+            ("pbrMetallicRoughness.metallicFactor", out.metallic, out.metallic),
+            ("pbrMetallicRoughness.roughnessFactor", out.roughness, out.roughness),
+        ];
+        for (field, lo, hi) in unit {
+            if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) {
+                return Err(self.ctx.invalid(
+                    format!("{at}.{field}"),
+                    format!("must lie in [0, 1] (glTF 2.0), got values from {lo} to {hi}"),
+                ));
+            }
+        }
+        if out.emissive.max_element() > MAX_EMISSIVE {
+            return Err(self.ctx.invalid(
+                format!("{at}.emissiveFactor"),
+                format!(
+                    "emissiveFactor × emissiveStrength reaches {:e}; at most {MAX_EMISSIVE:e} is accepted",
+                    out.emissive.max_element()
+                ),
+            ));
         }
         let named = [
             ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),

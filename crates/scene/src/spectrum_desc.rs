@@ -19,8 +19,20 @@ use serde_json::Value;
 use crate::context::Ctx;
 use crate::error::SceneError;
 
-/// Parses and resolves a SpectrumDesc found at JSON path `field`.
+/// Parses and resolves a SpectrumDesc found at JSON path `field`, refusing one that evaluates
+/// to NaN or infinity anywhere in 360–830 nm (range checks such as [0, 1] for a reflectance
+/// compare with `max`, which skips NaN, so they cannot be relied on to catch it).
 pub(crate) fn resolve(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
+    let s = resolve_unchecked(ctx, field, v)?;
+    let (lo, hi) = (color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX);
+    let steps = (hi - lo).round() as usize;
+    if let Some(l) = (0..=steps).map(|i| lo + i as f64).find(|&l| !s.eval(l).is_finite()) {
+        return Err(ctx.extras(field, format!("the spectrum is not finite at {l} nm")));
+    }
+    Ok(s)
+}
+
+fn resolve_unchecked(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
     let err = |f: &str, m: String| ctx.extras(f, m);
     match v {
         Value::String(name) => color::illuminant::by_name(name).map_err(|e| err(field, e.to_string())),
@@ -253,7 +265,7 @@ mod tests {
         let e = msg(json!({"sampled": {"wavelengths": [400, 500], "values": [1, 1], "scale": 2}}));
         assert!(e.contains("sampled.scale") && e.contains("unknown key"), "{e}");
         let e = msg(json!({"blackbody": -5}));
-        assert!(e.contains("blackbody") && e.contains("positive"), "{e}");
+        assert!(e.contains("blackbody") && e.contains("500–1000000 K"), "{e}");
         let e = msg(json!({"colorchecker": 25}));
         assert!(e.contains("1–24"), "{e}");
         let e = msg(json!({"colorchecker": "neutral"}));

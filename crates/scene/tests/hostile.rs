@@ -295,3 +295,87 @@ fn environment_maps_claiming_huge_sizes_are_refused_quickly() {
         assert!(e.contains("zero.hdr") && e.contains("a device"), "{e}");
     }
 }
+
+/// The embedded triangle with an emissive material, a camera and a point light, for value checks.
+fn lit(edit: impl FnOnce(&mut Value)) -> Result<scene::Scene, String> {
+    embedded(|d| {
+        d["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_emissive_strength"]);
+        d["materials"] = json!([{"emissiveFactor": [1, 1, 1]}]);
+        d["meshes"][0]["primitives"][0]["material"] = json!(0);
+        d["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}]);
+        d["extensions"] = json!({"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 10}]}});
+        d["nodes"] = json!([{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]},
+                            {"translation": [0, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}]);
+        d["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+        edit(d);
+    })
+}
+
+fn light(d: &mut Value) -> &mut Value {
+    &mut d["extensions"]["KHR_lights_punctual"]["lights"][0]
+}
+
+#[test]
+fn finite_but_absurd_values_are_refused_with_their_path() {
+    assert!(lit(|_| {}).is_ok(), "{:?}", lit(|_| {}).err());
+    type Edit = Box<dyn FnOnce(&mut Value)>;
+    let cases: Vec<(Edit, &[&str])> = vec![
+        (Box::new(|d| light(d)["intensity"] = json!(1e38)), &["lights[0].intensity", "at most"]),
+        (Box::new(|d| light(d)["color"] = json!([1e30, 1, 1])), &["lights[0].intensity", "at most"]),
+        (Box::new(|d| light(d)["range"] = json!(0)), &["lights[0].range", "greater than 0"]),
+        (
+            Box::new(|d| {
+                d["materials"][0]["extensions"] =
+                    json!({"KHR_materials_emissive_strength": {"emissiveStrength": 1e38}})
+            }),
+            &["materials[0].emissiveFactor", "at most"],
+        ),
+        (
+            Box::new(|d| {
+                d["materials"][0]["pbrMetallicRoughness"] = json!({"baseColorFactor": [-0.5, 0.5, 0.5, 1]})
+            }),
+            &["materials[0].pbrMetallicRoughness.baseColorFactor", "[0, 1]"],
+        ),
+        (
+            Box::new(|d| d["materials"][0]["pbrMetallicRoughness"] = json!({"roughnessFactor": -1})),
+            &["materials[0].pbrMetallicRoughness.roughnessFactor", "[0, 1]"],
+        ),
+        (
+            Box::new(|d| d["materials"][0]["extras"] = json!({"reflectance": {"blackbody": 1e-300}})),
+            &["materials[0].extras.reflectance", "blackbody"],
+        ),
+        (Box::new(|d| d["nodes"][1]["scale"] = json!([0, 0, 0])), &["cameras[0]", "degenerate"]),
+        (Box::new(|d| d["nodes"][1]["scale"] = json!([1, 0, 1])), &["cameras[0]", "degenerate"]),
+    ];
+    for (edit, parts) in cases {
+        let e = lit(edit).unwrap_err();
+        assert_has(&e, parts);
+    }
+}
+
+#[test]
+fn a_stand_in_for_a_node_without_drawn_primitives_is_refused() {
+    // Node 0's mesh draws nothing (its only primitive is POINTS); node 1 has an emissive mesh.
+    // The old loader bound the light to node 1's mesh (or panicked when nothing followed).
+    let e = lit(|d| {
+        d["meshes"] = json!([{"primitives": [{"attributes": {"POSITION": 0}, "mode": 0}]},
+                             {"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}]);
+        d["nodes"] = json!([{"mesh": 0}, {"mesh": 1},
+                            {"translation": [0, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}]);
+        d["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+        d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"] = json!({"stands_in_for": 0});
+    })
+    .unwrap_err();
+    assert_has(&e, &["lights[0].extras.stands_in_for", "node 0 is not a mesh node"]);
+    // Last in the file, with nothing after it to bind to.
+    let e = lit(|d| {
+        d["meshes"] = json!([{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+                             {"primitives": [{"attributes": {"POSITION": 0}, "mode": 1}]}]);
+        d["nodes"] = json!([{"mesh": 0}, {"translation": [0, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                            {"mesh": 1}]);
+        d["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+        d["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"] = json!({"stands_in_for": 2});
+    })
+    .unwrap_err();
+    assert_has(&e, &["lights[0].extras.stands_in_for", "node 2 is not a mesh node"]);
+}

@@ -92,3 +92,22 @@ fn device_inputs_are_refused() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Values that are finite but absurd used to give a black or NaN image with exit 0.
+#[test]
+fn absurd_settings_are_refused_before_rendering() {
+    let d = tmp("absurd");
+    let out = d.join("t.exr");
+    let o = out.to_str().unwrap();
+    let base = ["truth", "cornell", "--spp", "1", "--size", "8x8", "--out", o];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [base, extra].concat()
+    }
+    refused(&with(&base, &["--range", "500:500.0000001"]), &["1 nm"]);
+    refused(&with(&base, &["--white", "1K"]), &["500–1000000 K"]);
+    let m = d.join("m.json");
+    std::fs::write(&m, r#"{"sigma_a": 1e39, "sigma_s": 0}"#).unwrap();
+    refused(&with(&base, &["--medium", m.to_str().unwrap()]), &["sigma_a", "1000000"]);
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
