@@ -90,11 +90,19 @@ fn check_size(path: &Path, format: &'static str, w: u64, h: u64) -> Result<()> {
 /// Alpha is dropped, not composited: renders and references are opaque.
 pub fn read_image(path: impl AsRef<Path>) -> Result<Image> {
     let path = path.as_ref();
-    let format = format_of(path)?;
+    format_of(path)?;
     let bytes = color::input::read_regular(path, MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
+    decode_image(path, &bytes)
+}
+
+/// Decodes the bytes of an EXR or PNG file as [`read_image`] does, the format chosen by the
+/// extension of `path` (which only names the image in messages).
+pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {
+    let path = path.as_ref();
+    let format = format_of(path)?;
     match format {
-        Format::Exr => read_exr(path, &bytes),
-        Format::Png => read_png(path, &bytes),
+        Format::Exr => read_exr(path, bytes),
+        Format::Png => read_png(path, bytes),
     }
 }
 

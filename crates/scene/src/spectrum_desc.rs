@@ -156,6 +156,17 @@ pub const MAX_CSV_BYTES: u64 = 16 << 20;
 pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result<Spectrum, SceneError> {
     let bytes = color::input::read_regular(file, MAX_CSV_BYTES)
         .map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
+    parse_csv(ctx, field, file, &bytes)
+}
+
+/// Parses the bytes of a CSV spectrum `name` as a scene's `{"csv": …}` would (for tools and the
+/// fuzz harness); the error is the one-line message a scene would give.
+pub fn csv_spectrum(name: &str, bytes: &[u8]) -> Result<Spectrum, SceneError> {
+    let ctx = Ctx::builtin("csv");
+    parse_csv(&ctx, "csv", std::path::Path::new(name), bytes)
+}
+
+fn parse_csv(ctx: &Ctx, field: &str, file: &std::path::Path, bytes: &[u8]) -> Result<Spectrum, SceneError> {
     let csv_err = |line: u64, message: String| SceneError::Csv {
         path: ctx.path.clone(),
         field: field.to_string(),
@@ -168,7 +179,7 @@ pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result
         .flexible(true)
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_reader(bytes.as_slice());
+        .from_reader(bytes);
     let (mut lambda, mut values, mut lines) = (Vec::new(), Vec::new(), Vec::new());
     for (n, rec) in rdr.records().enumerate() {
         let rec = rec.map_err(|e| {

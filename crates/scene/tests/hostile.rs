@@ -379,3 +379,18 @@ fn a_stand_in_for_a_node_without_drawn_primitives_is_refused() {
     .unwrap_err();
     assert_has(&e, &["lights[0].extras.stands_in_for", "node 2 is not a mesh node"]);
 }
+
+/// Found by crates/fuzz: a GLB header declaring a length under its own 12 bytes made the `gltf`
+/// crate subtract with overflow (a panic in debug builds).
+#[test]
+fn a_glb_shorter_than_its_header_is_refused() {
+    for len in [0u32, 1, 11] {
+        let mut glb = b"glTF\x02\0\0\0".to_vec();
+        glb.extend_from_slice(&len.to_le_bytes());
+        glb.extend_from_slice(b"\x10\0\0\0JSON{\"asset\":{}}  ");
+        let e = scene::load_slice("short.glb", &glb, None).unwrap_err().to_string();
+        assert_has(&e, &["short.glb", "GLB header", "12-byte header"]);
+    }
+    let e = scene::load_slice("tiny.glb", b"glTF\x02\0", None).unwrap_err().to_string();
+    assert_has(&e, &["tiny.glb", "GLB header"]);
+}
