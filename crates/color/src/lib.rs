@@ -2,6 +2,7 @@
 //! CIELAB and CIEDE2000, and RGB→spectrum upsampling. No GPU code lives here; the renderer
 //! and the path tracer both build on it.
 
+pub mod cancel;
 pub mod colorspace;
 pub mod data;
 pub mod delta_e;
@@ -11,6 +12,7 @@ pub mod input;
 pub mod lab;
 pub mod metrics;
 pub mod observer;
+pub mod outfile;
 pub mod quadrature;
 pub mod spectrum;
 pub mod upsample;

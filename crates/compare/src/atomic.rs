@@ -2,45 +2,14 @@
 //! renamed over the destination only once complete. A failed or interrupted write therefore
 //! never leaves a truncated file under the requested name.
 
-use std::io::Write;
 use std::path::Path;
 
 use crate::error::{CompareError, Result};
 
-/// Writes `bytes` to `path` atomically (same-directory temp file + rename).
-///
-/// The temp file is named `.<file name>.<random>.tmp` so a leftover from a killed process is
-/// recognisable; on any error it is removed before returning.
+/// Writes `bytes` to `path` atomically (same-directory `O_EXCL` temp file + rename; the mode of
+/// an existing file kept; leftovers of killed writers removed): [`color::outfile::write_atomic`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| CompareError::io(path, std::io::Error::other("path has no file name")))?
-        .to_string_lossy()
-        .into_owned();
-    if !dir.is_dir() {
-        let msg = format!("directory {} does not exist", dir.display());
-        return Err(CompareError::io(path, std::io::Error::new(std::io::ErrorKind::NotFound, msg)));
-    }
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| CompareError::io(path, e))?;
-    // Temp files are created 0600; an image or report is for everyone who can read the folder.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    tmp.write_all(bytes).map_err(|e| CompareError::io(path, e))?;
-    tmp.as_file().sync_all().map_err(|e| CompareError::io(path, e))?;
-    // On failure `PersistError` hands the temp file back; dropping it deletes it.
-    tmp.persist(path).map_err(|e| CompareError::io(path, e.error))?;
-    Ok(())
+    color::outfile::write_atomic(path, bytes).map_err(|e| CompareError::io(path, e))
 }
 
 #[cfg(test)]

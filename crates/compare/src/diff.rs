@@ -19,6 +19,11 @@ use crate::error::{CompareError, Result};
 use crate::image::Image;
 use crate::io::to_display;
 
+/// The smallest white luminance accepted (see [`DiffMaps::compute`]).
+pub const MIN_WHITE_LUMINANCE: f64 = 1e-20;
+/// The largest white luminance accepted.
+pub const MAX_WHITE_LUMINANCE: f64 = 1e20;
+
 /// Choices that change the metric values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiffOptions {
@@ -72,6 +77,7 @@ impl DiffMaps {
     ///
     /// Errors: images of different sizes (both sizes in the message), a NaN/∞ pixel in either
     /// (named "reference"/"test" with its coordinates), a non-positive or non-finite white.
+    /// Pixel values (finite f32, ≤ 3.4·10³⁸) over the white then stay far from f64 overflow.
     pub fn compute(reference: &Image, test: &Image, options: DiffOptions) -> Result<DiffMaps> {
         reference.validate()?;
         test.validate()?;
@@ -81,9 +87,11 @@ impl DiffMaps {
         reference.check_finite("reference")?;
         test.check_finite("test")?;
         let y = options.white_luminance;
-        if !(y.is_finite() && y > 0.0) {
+        // Not just positive: a subnormal white (1e-310) turns every pixel's L* infinite and
+        // ΔE NaN.
+        if !(MIN_WHITE_LUMINANCE..=MAX_WHITE_LUMINANCE).contains(&y) {
             return Err(CompareError::InvalidOption(format!(
-                "white luminance must be positive and finite, got {y}"
+                "white luminance must be between {MIN_WHITE_LUMINANCE:e} and {MAX_WHITE_LUMINANCE:e}, got {y:e}"
             )));
         }
         let space = RgbColorSpace::srgb();
@@ -257,5 +265,18 @@ mod tests {
         assert!(e.contains("test") && e.contains("(2, 1)"), "{e}");
         let e = DiffMaps::compute(&a, &a, DiffOptions { white_luminance: 0.0 }).unwrap_err().to_string();
         assert!(e.contains("white luminance"), "{e}");
+        // A subnormal white used to reach the summary as NaN ΔE and panic there.
+        for y in [1e-310, 1e-21, 1e21, f64::INFINITY] {
+            let e = DiffMaps::compute(&a, &a, DiffOptions { white_luminance: y }).unwrap_err().to_string();
+            assert!(e.contains("white luminance") && e.contains("1e-20"), "{e}");
+        }
+        // The extremes accepted stay finite with the largest and smallest pixel values.
+        let mut b = a.clone();
+        b.get_mut(0, 0)[1] = f32::MAX;
+        b.get_mut(1, 0)[2] = f32::MIN_POSITIVE;
+        for y in [MIN_WHITE_LUMINANCE, MAX_WHITE_LUMINANCE] {
+            let s = DiffMaps::compute(&a, &b, DiffOptions { white_luminance: y }).unwrap().summary();
+            assert!(s.delta_e2000.max.is_finite() && s.mae_linear.max.is_finite(), "{y}");
+        }
     }
 }

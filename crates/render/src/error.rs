@@ -26,6 +26,9 @@ pub enum RenderError {
     Gpu(String),
     #[error("reading back from the GPU failed: {0}")]
     Readback(String),
+    /// The process's cancellation token ([`color::cancel`]) was set while waiting for the GPU.
+    #[error("interrupted")]
+    Cancelled,
 }
 
 pub type Result<T, E = RenderError> = std::result::Result<T, E>;

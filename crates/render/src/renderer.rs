@@ -189,10 +189,35 @@ impl Renderer {
     /// Uploads `scene` (geometry, materials, textures, lights, environment), replacing the
     /// previous one.
     pub fn set_scene(&mut self, scene: &scene::Scene) -> Result<()> {
-        self.scene =
-            Some(GpuScene::upload(&self.gpu.device, &self.gpu.queue, &self.gbuffer.material_layout, scene)?);
+        self.set_scene_with_buffer_limit(scene, self.gpu.device.limits().max_buffer_size)
+    }
+
+    /// [`Self::set_scene`] with vertex and index buffers of at most `max_buffer_bytes` each
+    /// (large meshes are split over several; tests use a small limit to exercise that).
+    pub fn set_scene_with_buffer_limit(&mut self, scene: &scene::Scene, max_buffer_bytes: u64) -> Result<()> {
+        // The old scene's buffers go first: two multi-gigabyte scenes need not coexist.
+        self.scene = None;
+        self.scene = Some(GpuScene::upload_with_buffer_limit(
+            &self.gpu.device,
+            &self.gpu.queue,
+            &self.gbuffer.material_layout,
+            scene,
+            max_buffer_bytes,
+        )?);
         self.set_environment(scene.environment.as_ref());
         Ok(())
+    }
+
+    /// How many vertex/index buffer pairs the scene's meshes occupy (more than one when they
+    /// exceed the device's `max_buffer_size`).
+    pub fn scene_buffer_count(&self) -> usize {
+        self.scene.as_ref().map_or(0, |s| s.chunks.len())
+    }
+
+    /// What the last [`Self::set_scene`] had to change to fit the device (oversized textures
+    /// downscaled, …), one line each, for the caller to show as warnings.
+    pub fn scene_warnings(&self) -> &[String] {
+        self.scene.as_ref().map_or(&[], |s| &s.warnings)
     }
 
     /// Replaces the environment light (prefilters it: tens of milliseconds for a 512-wide map,
@@ -354,6 +379,9 @@ impl Renderer {
 
     /// Renders one frame from `camera`. Requires [`Self::set_scene`] and [`Self::resize`].
     pub fn render(&mut self, camera: &scene::Camera, settings: &RenderSettings) -> Result<()> {
+        if color::cancel::is_cancelled() {
+            return Err(RenderError::Cancelled);
+        }
         settings.validate()?;
         if self.scene.is_none() {
             return Err(RenderError::Settings("no scene: call set_scene first".into()));
@@ -479,6 +507,12 @@ impl Renderer {
             Some(t) if t.pending => t.read(&self.gpu.device).map(Some),
             _ => Ok(None),
         }
+    }
+
+    /// Waits for the frames submitted so far; [`RenderError::Cancelled`] on Ctrl-C (see
+    /// [`color::cancel`]), without waiting for the GPU to finish.
+    pub fn wait(&self) -> Result<()> {
+        readback::wait(&self.gpu.device)
     }
 
     /// The display image as tightly packed RGBA8 (sRGB-encoded) rows.

@@ -1,5 +1,5 @@
-//! A scene uploaded to the GPU: one vertex and one index buffer for all meshes, a bind group
-//! per material, and the lights (their per-wavelength spectra are built by the renderer
+//! A scene uploaded to the GPU: vertex and index buffers holding all meshes (as few as the
+//! device's `max_buffer_size` allows; see [`Chunks`]), a bind group per material, and the lights (their per-wavelength spectra are built by the renderer
 //! because they depend on the settings).
 //!
 //! Textures are uploaded with a full mip chain (CPU box filter; sRGB textures are decoded to
@@ -212,6 +212,10 @@ impl GpuLight {
 /// One indexed draw.
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
+    /// The vertex/index buffer pair ([`GpuScene::chunks`]) it reads.
+    pub chunk: usize,
+    /// The scene mesh it draws (part of: a mesh larger than a buffer is several draws).
+    pub mesh: usize,
     pub first_index: u32,
     pub index_count: u32,
     pub base_vertex: i32,
@@ -222,10 +226,140 @@ pub struct Draw {
     pub alpha_tested: bool,
 }
 
-pub struct GpuScene {
-    pub source: String,
+/// A vertex buffer and the index buffer whose indices refer to it.
+pub struct Chunk {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
+}
+
+/// Packs meshes into vertex/index buffer pairs no larger than a byte limit (the device's
+/// `max_buffer_size`, 256 MiB by default: 3.7 M vertices of 72 bytes). Whole meshes go in the
+/// current pair while they fit; a mesh larger than a pair is cut into runs of triangles, each
+/// run with its own copy of the vertices it uses. Each full pair is uploaded at once and its
+/// CPU copy dropped, so the upload needs one pair of memory besides the scene.
+struct Chunks<'a> {
+    device: &'a wgpu::Device,
+    max_vertices: usize,
+    max_indices: usize,
+    vertices: Vec<Vertex>,
+    indices: Vec<u32>,
+    done: Vec<Chunk>,
+}
+
+impl<'a> Chunks<'a> {
+    fn new(device: &'a wgpu::Device, max_bytes: u64) -> Self {
+        let per = |size: usize| ((max_bytes / size as u64) as usize).max(3);
+        Chunks {
+            device,
+            max_vertices: per(std::mem::size_of::<Vertex>()),
+            // Indices are u32, and must stay addressable by `first_index: u32`.
+            max_indices: per(4).min(u32::MAX as usize / 3 * 3),
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            done: Vec::new(),
+        }
+    }
+
+    fn flush(&mut self) {
+        if self.indices.is_empty() {
+            return;
+        }
+        let n = self.done.len();
+        let vertices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&format!("vertices {n}")),
+            contents: bytemuck::cast_slice(&self.vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let indices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(&format!("indices {n}")),
+            contents: bytemuck::cast_slice(&self.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        self.done.push(Chunk { vertices, indices });
+        self.vertices = Vec::new();
+        self.indices = Vec::new();
+    }
+
+    /// Adds one mesh (`template` gives the material flags); returns its draws.
+    fn add(&mut self, vertices: Vec<Vertex>, indices: &[u32], template: Draw) -> Vec<Draw> {
+        let fits = |c: &Self| {
+            c.vertices.len() + vertices.len() <= c.max_vertices
+                && c.indices.len() + indices.len() <= c.max_indices
+        };
+        if !fits(self) {
+            self.flush();
+        }
+        if fits(self) {
+            let d = Draw {
+                chunk: self.done.len(),
+                first_index: self.indices.len() as u32,
+                index_count: indices.len() as u32,
+                base_vertex: self.vertices.len() as i32,
+                ..template
+            };
+            self.vertices.extend_from_slice(&vertices);
+            self.indices.extend_from_slice(indices);
+            return vec![d];
+        }
+        // Larger than a whole pair: triangle runs, vertices remapped per pair.
+        const NONE: u32 = u32::MAX;
+        let mut remap = vec![NONE; vertices.len()];
+        let mut touched: Vec<u32> = Vec::new();
+        let mut draws = Vec::new();
+        let mut start = 0u32;
+        for tri in indices.chunks_exact(3) {
+            let new_vertices = tri.iter().filter(|&&v| remap[v as usize] == NONE).count();
+            if self.vertices.len() + new_vertices > self.max_vertices
+                || self.indices.len() + 3 > self.max_indices
+            {
+                let count = self.indices.len() as u32 - start;
+                if count > 0 {
+                    draws.push(Draw {
+                        chunk: self.done.len(),
+                        first_index: start,
+                        index_count: count,
+                        base_vertex: 0,
+                        ..template
+                    });
+                }
+                self.flush();
+                for v in touched.drain(..) {
+                    remap[v as usize] = NONE;
+                }
+                start = 0;
+            }
+            for &v in tri {
+                if remap[v as usize] == NONE {
+                    remap[v as usize] = self.vertices.len() as u32;
+                    self.vertices.push(vertices[v as usize]);
+                    touched.push(v);
+                }
+                self.indices.push(remap[v as usize]);
+            }
+        }
+        let count = self.indices.len() as u32 - start;
+        if count > 0 {
+            draws.push(Draw {
+                chunk: self.done.len(),
+                first_index: start,
+                index_count: count,
+                base_vertex: 0,
+                ..template
+            });
+        }
+        draws
+    }
+
+    fn finish(mut self) -> Vec<Chunk> {
+        self.flush();
+        self.done
+    }
+}
+
+pub struct GpuScene {
+    pub source: String,
+    /// Vertex/index buffer pairs, each within the device's `max_buffer_size`.
+    pub chunks: Vec<Chunk>,
     pub draws: Vec<Draw>,
     pub materials: Vec<wgpu::BindGroup>,
     pub lights: Vec<scene::Light>,
@@ -237,6 +371,8 @@ pub struct GpuScene {
     pub camera: scene::Camera,
     /// World-space bounding box of all geometry.
     pub bounds: (Vec3, Vec3),
+    /// What the upload had to change to fit the device (textures downscaled, …).
+    pub warnings: Vec<String>,
 }
 
 impl GpuScene {
@@ -246,6 +382,19 @@ impl GpuScene {
         layout: &wgpu::BindGroupLayout,
         s: &Scene,
     ) -> Result<Self> {
+        Self::upload_with_buffer_limit(device, queue, layout, s, device.limits().max_buffer_size)
+    }
+
+    /// [`Self::upload`] with vertex/index buffers of at most `max_buffer_bytes` (tests lower
+    /// it to exercise the splitting of large meshes on small scenes).
+    pub fn upload_with_buffer_limit(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layout: &wgpu::BindGroupLayout,
+        s: &Scene,
+        max_buffer_bytes: u64,
+    ) -> Result<Self> {
+        let max_buffer_bytes = max_buffer_bytes.min(device.limits().max_buffer_size);
         let bad = |problem: String| RenderError::Scene { source_name: s.source.clone(), problem };
         if s.lights.len() > MAX_LIGHTS {
             return Err(bad(format!(
@@ -253,8 +402,7 @@ impl GpuScene {
                 s.lights.len()
             )));
         }
-        let mut vertices: Vec<Vertex> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
+        let mut chunks = Chunks::new(device, max_buffer_bytes);
         let mut draws = Vec::new();
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for (mi, m) in s.meshes.iter().enumerate() {
@@ -298,7 +446,7 @@ impl GpuScene {
             } else {
                 vec![Vec4::ZERO; n]
             };
-            let base = vertices.len();
+            let mut vertices = Vec::with_capacity(n);
             for i in 0..n {
                 let p = m.positions[i];
                 lo = lo.min(p);
@@ -312,17 +460,21 @@ impl GpuScene {
                     uv1: m.uvs1.get(i).copied().unwrap_or(Vec2::ZERO).to_array(),
                 });
             }
-            draws.push(Draw {
-                first_index: indices.len() as u32,
-                index_count: m.indices.len() as u32,
-                base_vertex: base as i32,
+            drop((normals, tangents));
+            let template = Draw {
+                chunk: 0,
+                mesh: mi,
+                first_index: 0,
+                index_count: 0,
+                base_vertex: 0,
                 material: m.material,
                 double_sided: mat.double_sided,
                 alpha_tested: mat.alpha_mode != AlphaMode::Opaque,
-            });
-            indices.extend_from_slice(&m.indices);
+            };
+            draws.extend(chunks.add(vertices, &m.indices, template));
         }
-        if vertices.is_empty() {
+        let chunks = chunks.finish();
+        if chunks.is_empty() {
             return Err(bad("the scene has no geometry".into()));
         }
         let mut emitters = scene::emitters::emitters(s);
@@ -336,7 +488,8 @@ impl GpuScene {
         } else {
             (0, 0.0)
         };
-        let textures = upload_textures(device, queue, s)?;
+        let mut warnings = Vec::new();
+        let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
         let mut materials = Vec::new();
@@ -408,20 +561,9 @@ impl GpuScene {
                 entries: &entries,
             }));
         }
-        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("indices"),
-            contents: bytemuck::cast_slice(&indices),
-            usage: wgpu::BufferUsages::INDEX,
-        });
         Ok(GpuScene {
             source: s.source.clone(),
-            vertices,
-            indices,
+            chunks,
             draws,
             materials,
             lights: s.lights.clone(),
@@ -429,17 +571,17 @@ impl GpuScene {
             dropped_emitters,
             camera: s.camera,
             bounds: (lo, hi),
+            warnings,
         })
     }
 
-    /// Binds the vertex and index buffers for [`Self::draw_one`].
-    pub fn bind_buffers(&self, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_vertex_buffer(0, self.vertices.slice(..));
-        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-    }
-
-    /// Records draw `d` with its material at group 1; the caller has set the pipeline.
+    /// Records draw `d` with its material at group 1 and its buffers; the caller has set the
+    /// pipeline. (Setting the buffers per draw costs little: a scene has few chunks and
+    /// draws, and it keeps the passes unaware of the chunking.)
     pub fn draw_one(&self, pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
+        let c = &self.chunks[d.chunk];
+        pass.set_vertex_buffer(0, c.vertices.slice(..));
+        pass.set_index_buffer(c.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.set_bind_group(1, &self.materials[d.material], &[]);
         pass.draw_indexed(d.first_index..d.first_index + d.index_count, d.base_vertex, 0..1);
     }
@@ -483,7 +625,13 @@ impl SamplerCache {
     }
 }
 
-fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, s: &Scene) -> Result<Vec<wgpu::TextureView>> {
+fn upload_textures(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    s: &Scene,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<wgpu::TextureView>> {
+    let max = device.limits().max_texture_dimension_2d;
     s.textures
         .iter()
         .enumerate()
@@ -501,13 +649,62 @@ fn upload_textures(device: &wgpu::Device, queue: &wgpu::Queue, s: &Scene) -> Res
                     ),
                 });
             }
+            let shrunk = fit_texture(t.width, t.height, &t.rgba8, t.srgb, max);
+            let (width, height, rgba8) = match &shrunk {
+                Some((w, h, data)) => {
+                    warnings.push(format!(
+                        "texture {i} '{}' is {}×{}, larger than this GPU's limit of {max} a side: \
+                         downscaled to {w}×{h}",
+                        t.name, t.width, t.height
+                    ));
+                    (*w, *h, data.as_slice())
+                }
+                None => (t.width, t.height, t.rgba8.as_slice()),
+            };
             if t.srgb {
-                Ok(srgb8_as_linear_f16(device, queue, &t.name, t.width, t.height, &t.rgba8))
+                Ok(srgb8_as_linear_f16(device, queue, &t.name, width, height, rgba8))
             } else {
-                Ok(linear8_mipmapped(device, queue, &t.name, t.width, t.height, &t.rgba8))
+                Ok(linear8_mipmapped(device, queue, &t.name, width, height, rgba8))
             }
         })
         .collect()
+}
+
+/// An RGBA8 image halved (box filter, in linear light for sRGB data) until both sides are at
+/// most `max`; `None` when it fits already. Halving keeps the aspect ratio (to the rounding of
+/// odd sides) and filters every source texel.
+pub fn fit_texture(
+    width: u32,
+    height: u32,
+    rgba8: &[u8],
+    srgb: bool,
+    max: u32,
+) -> Option<(u32, u32, Vec<u8>)> {
+    if width <= max && height <= max {
+        return None;
+    }
+    let decode: Vec<f32> = (0..=255u8)
+        .map(
+            |v| if srgb { color::colorspace::srgb_decode(v as f64 / 255.0) as f32 } else { v as f32 / 255.0 },
+        )
+        .collect();
+    let encode = |v: f32, c: usize| {
+        let v = v.clamp(0.0, 1.0) as f64;
+        let e = if srgb && c < 3 { color::colorspace::srgb_encode(v) } else { v };
+        (e * 255.0).round() as u8
+    };
+    let (mut w, mut h, mut data) = (width, height, rgba8.to_vec());
+    while w > max || h > max {
+        let level = downsample(w, h, |x, y| {
+            let i = 4 * (y as usize * w as usize + x as usize);
+            std::array::from_fn(
+                |c| if c < 3 { decode[data[i + c] as usize] } else { data[i + 3] as f32 / 255.0 },
+            )
+        });
+        data = level.iter().flat_map(|t| std::array::from_fn::<u8, 4, _>(|c| encode(t[c], c))).collect();
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+    }
+    Some((w, h, data))
 }
 
 pub(crate) fn rgba8_texture(
@@ -800,6 +997,24 @@ mod tests {
         // Slots without a texture: identity on TEXCOORD_0.
         assert_eq!(u.uv[0], [1.0, 0.0, 0.0, 0.0]);
         assert_eq!(u.uv[1], [0.0, 1.0, 0.0, 0.0]);
+    }
+
+    /// A texture wider than the device limit (16385×2 used to panic in wgpu) is halved until it
+    /// fits, averaging in linear light.
+    #[test]
+    fn oversized_textures_are_halved_to_the_limit() {
+        assert!(fit_texture(4, 4, &[0; 64], true, 4).is_none());
+        let (w, h) = (16385u32, 2u32);
+        // Alternating black and white columns: linear mean 0.5, sRGB-encoded 188.
+        let data: Vec<u8> =
+            (0..w * h).flat_map(|i| if i % 2 == 0 { [0, 0, 0, 255] } else { [255, 255, 255, 255] }).collect();
+        let (fw, fh, out) = fit_texture(w, h, &data, true, 16384).unwrap();
+        assert_eq!((fw, fh, out.len()), (8192, 1, 8192 * 4));
+        assert!(out.chunks_exact(4).all(|p| (187..=189).contains(&p[0]) && p[3] == 255), "{:?}", &out[..8]);
+        let (_, _, lin) = fit_texture(w, h, &data, false, 16384).unwrap();
+        assert!(lin.chunks_exact(4).all(|p| (127..=128).contains(&p[0])), "{:?}", &lin[..8]);
+        let (fw, fh, _) = fit_texture(40_000, 1, &vec![7; 160_000], false, 8192).unwrap();
+        assert_eq!((fw, fh), (5000, 1));
     }
 
     #[test]

@@ -337,18 +337,9 @@ pub fn write_gltf(scene: &Scene, path: &Path) -> Result<(), SceneError> {
     let doc = to_gltf_json(scene).map_err(invalid)?;
     let text = serde_json::to_string_pretty(&doc).map_err(|e| invalid(e.to_string()))?;
     let io = |e| SceneError::Io { path: path.to_path_buf(), file: path.to_path_buf(), cause: e };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| invalid("the path has no file name".into()))?;
-    let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
+    color::outfile::write_atomic_with(path, |f| {
         f.write_all(text.as_bytes())?;
-        f.write_all(b"\n")?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+        f.write_all(b"\n")
+    })
+    .map_err(io)
 }

@@ -41,8 +41,91 @@ enum Command {
     Eval(cmd::eval::Args),
 }
 
+/// Exit status after Ctrl-C, as shells report a process ended by SIGINT (128 + 2).
+const EXIT_INTERRUPTED: i32 = 130;
+
+/// How long the cooperative stop may take before the process is ended anyway.
+const FORCED_EXIT_AFTER: std::time::Duration = std::time::Duration::from_millis(900);
+
+/// Ctrl-C sets the process's cancellation token ([`color::cancel`]), which every long loop
+/// polls: the command stops within a fraction of a second, removes its temporary files and
+/// writes nothing. A few driver calls cannot be interrupted (lavapipe compiling a pipeline
+/// with LLVM, a `vkQueueSubmit` that waits for the previous frame); if the command has not
+/// ended [`FORCED_EXIT_AFTER`] the Ctrl-C, the process exits anyway. That is safe for the
+/// outputs, which only ever appear by an atomic rename: at worst a temporary file is left,
+/// named with the pid so that the next write of the same file removes it. A second Ctrl-C
+/// exits at once.
+fn install_interrupt_handler() {
+    let r = ctrlc::set_handler(|| {
+        if color::cancel::is_cancelled() {
+            eprintln!("\ninterrupted twice: exiting at once");
+            exit_now();
+        }
+        color::cancel::cancel();
+        std::thread::spawn(|| {
+            std::thread::sleep(FORCED_EXIT_AFTER);
+            eprintln!("interrupted (Ctrl-C): stopped (forced: the GPU driver was busy); no output written");
+            exit_now();
+        });
+    });
+    if let Err(e) = r {
+        eprintln!("warning: Ctrl-C handler not installed ({e}); Ctrl-C will end the process without cleanup");
+    }
+}
+
+/// A headless command on a server without `XDG_RUNTIME_DIR`: the Vulkan driver probes the
+/// Wayland window system when the instance is created, and libwayland prints "error:
+/// XDG_RUNTIME_DIR is invalid or not set in the environment." twice although nothing is wrong.
+/// A private (0700, mkdtemp) runtime directory for this process alone silences it; it is
+/// empty, so no window system is found, and removed on exit. Must run before any thread is
+/// started (it sets an environment variable).
+/// The private runtime directory, for the forced exit (which skips destructors) to remove.
+static RUNTIME_DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+
+/// Ends the process now with [`EXIT_INTERRUPTED`], after removing the private runtime directory.
+fn exit_now() -> ! {
+    if let Some(d) = RUNTIME_DIR.get() {
+        let _ = std::fs::remove_dir(d);
+    }
+    // SAFETY: _exit(2) has no preconditions; it skips atexit handlers, which could wait for the
+    // GPU driver's threads.
+    unsafe { libc::_exit(EXIT_INTERRUPTED) }
+}
+
+fn quiet_runtime_dir(headless: bool) -> Option<tempfile::TempDir> {
+    if !headless || std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir()) {
+        return None;
+    }
+    let mut builder = tempfile::Builder::new();
+    builder.prefix("spectra-runtime-");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o700));
+    }
+    let dir = builder.tempdir().ok()?;
+    let _ = RUNTIME_DIR.set(dir.path().to_path_buf());
+    // SAFETY: called first thing in `main`, before any other thread exists.
+    unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir.path()) };
+    Some(dir)
+}
+
 fn main() {
     let cli = Cli::parse();
+    let runtime_dir = quiet_runtime_dir(!matches!(cli.command, Command::View(_)));
+    // Rust ignores SIGPIPE, so printing to a closed pipe (`spectra diff … --json | head -c
+    // 100`) would panic; the default action ends the process quietly, as for any Unix filter.
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to the default has no preconditions.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+    install_interrupt_handler();
+    let unwritten = match cli.command {
+        // The suite keeps the cases it finished; the summary is what is missing.
+        Command::Eval(_) => "results.json and index.html not written",
+        _ => "no output written",
+    };
     let result: anyhow::Result<()> = match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Render(a) => cmd::render::run(a),
@@ -54,9 +137,20 @@ fn main() {
         Command::Bench(a) => cmd::bench::run(a),
         Command::Eval(a) => cmd::eval::run(a),
     };
-    if let Err(e) = result {
-        // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
-    }
+    let code = match result {
+        Ok(()) => 0,
+        // Whatever error the interruption surfaced as ("fit interrupted", a GPU wait cut
+        // short), the user pressed Ctrl-C: say so once.
+        Err(_) if color::cancel::is_cancelled() => {
+            eprintln!("interrupted (Ctrl-C): stopped; {unwritten}");
+            EXIT_INTERRUPTED
+        }
+        Err(e) => {
+            // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".
+            eprintln!("error: {e:#}");
+            1
+        }
+    };
+    drop(runtime_dir);
+    std::process::exit(code);
 }

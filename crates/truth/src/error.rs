@@ -8,6 +8,12 @@ pub enum TruthError {
     NoSamples,
     #[error("image size {0}×{1} is invalid: both sides must be at least 1 pixel")]
     BadSize(u32, u32),
+    #[error(
+        "image size {0}×{1} is too large: at most {max_side} pixels a side and {max_px} pixels (8192×8192) in all",
+        max_side = crate::render::MAX_SIDE,
+        max_px = crate::render::MAX_PIXELS
+    )]
+    TooLarge(u32, u32),
     #[error("invalid medium: {0}")]
     BadMedium(String),
     #[error("scene '{scene}': {why}")]

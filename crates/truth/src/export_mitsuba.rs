@@ -77,24 +77,16 @@ pub fn export(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<
             source: std::io::Error::new(std::io::ErrorKind::AlreadyExists, "already exists; remove it first"),
         });
     }
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "export".into());
-    let tmp = dir.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let res = write_all(world, width, height, &tmp);
-    match res {
-        Ok(unsupported) => {
-            fs::rename(&tmp, dir).map_err(io(dir))?;
-            Ok(unsupported)
-        }
-        Err(e) => {
-            let _ = fs::remove_dir_all(&tmp);
-            Err(e)
-        }
-    }
+    // An unpredictable private directory (mkdtemp) is filled, then renamed into place: a
+    // predictable name made with `create_dir_all` would follow a symlink planted there.
+    let tmp = color::outfile::temp_dir_next_to(dir).map_err(io(dir))?;
+    let unsupported = write_all(world, width, height, tmp.path())?;
+    color::outfile::persist_dir(tmp, dir).map_err(io(dir))?;
+    Ok(unsupported)
 }
 
 fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<String>> {
     let scene = world.scene;
-    fs::create_dir_all(dir).map_err(io(dir))?;
     let mut unsupported = Vec::new();
 
     let cam = &scene.camera;

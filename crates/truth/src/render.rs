@@ -21,6 +21,14 @@ fn r2(shift: [f32; 2], s: u32) -> [f32; 2] {
     std::array::from_fn(|i| ((shift[i] as f64 + s as f64 * A[i]).fract() as f32).min(0.999_999_94))
 }
 
+/// Samples between two looks at the cancellation token (a few hundred microseconds at most).
+const CANCEL_POLL_SAMPLES: u32 = 64;
+
+/// The largest image side `truth` renders, in pixels.
+pub const MAX_SIDE: u32 = 32_768;
+/// The most pixels `truth` renders: 8192² (the XYZ image alone is 12 bytes a pixel, 0.8 GB).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
 /// What to render and how.
 #[derive(Clone, Debug)]
 pub struct Settings {
@@ -65,6 +73,13 @@ impl Settings {
         }
         if self.width == 0 || self.height == 0 {
             return Err(TruthError::BadSize(self.width, self.height));
+        }
+        // Checked before anything is allocated: `4294967295x1` used to try.
+        if self.width > MAX_SIDE
+            || self.height > MAX_SIDE
+            || self.width as u64 * self.height as u64 > MAX_PIXELS
+        {
+            return Err(TruthError::TooLarge(self.width, self.height));
         }
         if let Some(m) = &self.medium {
             m.validate(self.range)?;
@@ -151,6 +166,11 @@ pub fn render_world(
                 // each sample still uniform, so the estimate stays unbiased.
                 let shift = rng.next2();
                 for s in 0..settings.spp {
+                    // Polled every few samples, not only per pixel: at `--spp 10⁸` one pixel
+                    // takes minutes.
+                    if s % CANCEL_POLL_SAMPLES == 0 && s > 0 && cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
                     let jitter = r2(shift, s);
                     let (origin, dir) = camera.ray(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
                     // Hero wavelengths stratified over the pixel's samples (one stratum of
@@ -256,12 +276,38 @@ mod tests {
         render(scene, &GreyOnly, st, &AtomicBool::new(false), &|_| {}).unwrap()
     }
 
+    /// Ctrl-C at a huge sample count stops inside the pixel, not after it (which would take
+    /// hours at `--spp 10⁸`).
+    #[test]
+    fn cancel_stops_within_a_pixel() {
+        let scene = small_scene();
+        let st = Settings::new(1, 1, u32::MAX).unwrap();
+        let cancel: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx
+                .send(matches!(render(&scene, &GreyOnly, &st, cancel, &|_| {}), Err(TruthError::Cancelled)));
+        });
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        cancel.store(true, Ordering::SeqCst);
+        let t = std::time::Instant::now();
+        let cancelled =
+            rx.recv_timeout(std::time::Duration::from_secs(5)).expect("still rendering 5 s after cancel");
+        assert!(cancelled);
+        assert!(t.elapsed().as_secs_f64() < 1.0, "{:?}", t.elapsed());
+    }
+
     #[test]
     fn cancel_and_bad_settings_are_errors() {
         let scene = small_scene();
         let st = Settings::new(8, 8, 2).unwrap();
         let r = render(&scene, &GreyOnly, &st, &AtomicBool::new(true), &|_| {});
         assert!(matches!(r, Err(TruthError::Cancelled)));
+        for (w, h) in [(u32::MAX, 1), (MAX_SIDE + 1, 1), (8193, 8192)] {
+            let e = Settings::new(w, h, 1).unwrap().validate().unwrap_err().to_string();
+            assert!(e.contains(&format!("{w}×{h}")) && e.contains("8192"), "{e}");
+        }
+        assert!(Settings::new(MAX_SIDE, 2048, 1).unwrap().validate().is_ok());
         let zero = Settings { spp: 0, ..st.clone() };
         assert!(matches!(
             render(&scene, &GreyOnly, &zero, &AtomicBool::new(false), &|_| {}),

@@ -135,7 +135,7 @@ pub fn table(space_name: &str) -> Result<Arc<CoeffTable>> {
 
 /// The default table of `space`: from this process's memory, else the cache file, else
 /// fitted (with a progress bar on stderr) and cached. Ctrl-C during the fit (once
-/// [`crate::upsample::install_interrupt_handler`] ran) returns an error and writes nothing.
+/// the program installed a handler that calls [`crate::cancel::cancel`]) returns an error and writes nothing.
 pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
     if let Some(t) = MEMO.lock().ok().and_then(|m| m.as_ref().and_then(|m| m.get(&space.name).cloned())) {
         return Ok(t);

@@ -302,7 +302,7 @@ pub fn node_rgb(res: usize, scale: &[f64], l: usize, k: usize, j: usize, i: usiz
 
 /// Fits a `res`³ table for `space` with rgb2spec's grid, showing progress on `progress`.
 /// Stops early when [`crate::upsample::interrupt_flag`] is set (Ctrl-C once
-/// [`crate::upsample::install_interrupt_handler`] ran).
+/// the program installed a handler that calls [`crate::cancel::cancel`]).
 pub fn fit_table(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
     fit_table_with(space, &FitOptions::new(res), progress, crate::upsample::interrupt_flag())
 }

@@ -39,22 +39,10 @@ pub use table::CoeffTable;
 use crate::colorspace::RgbColorSpace;
 use crate::error::Result;
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
-/// Set by the Ctrl-C handler ([`install_interrupt_handler`]); long fits poll it and stop
-/// without writing anything.
+/// The process's cancellation token ([`crate::cancel::token`]): long fits poll it and stop
+/// without writing anything. The program, not this library, installs the Ctrl-C handler.
 pub fn interrupt_flag() -> &'static AtomicBool {
-    &INTERRUPTED
-}
-
-/// Installs a Ctrl-C handler that sets [`interrupt_flag`]. Safe to call more than once; if the
-/// program already installed its own handler this does nothing (that handler should set the
-/// flag itself via [`interrupt_flag`]).
-pub fn install_interrupt_handler() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst));
-    });
+    crate::cancel::token()
 }
 
 /// The fit behind the default tables: [`TABLE_RES`]³ nodes on [`fit::spectra_scale`]'s

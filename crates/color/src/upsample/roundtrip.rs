@@ -32,6 +32,23 @@ pub fn splitmix64(state: &mut u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The most colours a round trip measures: 10⁷ take ~0.3 GB (colours and errors) and a few
+/// seconds per core; more would only spend memory (the statistics have long converged).
+pub const MAX_COLOURS: usize = 10_000_000;
+
+/// Refuses 0 colours and more than [`MAX_COLOURS`] before anything is allocated.
+pub fn check_count(n: usize) -> Result<()> {
+    if n == 0 {
+        return Err(ColorError::Table("a round trip needs at least one colour (got 0)".into()));
+    }
+    if n > MAX_COLOURS {
+        return Err(ColorError::Table(format!(
+            "a round trip of {n} colours is too many: at most {MAX_COLOURS}"
+        )));
+    }
+    Ok(())
+}
+
 /// `n` colours uniform in the linear unit cube.
 pub fn random_colours(n: usize, seed: u64) -> Vec<[f64; 3]> {
     let mut s = seed;
@@ -57,9 +74,7 @@ pub fn summarise(colours: &[[f64; 3]], de: &[f64]) -> Result<RoundTrip> {
 
 /// Round trip through `table` exactly as a renderer uses it: trilinear fetch, then evaluate.
 pub fn roundtrip_table(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u64) -> Result<RoundTrip> {
-    if n == 0 {
-        return Err(ColorError::Table("a round trip needs at least one colour (got 0)".into()));
-    }
+    check_count(n)?;
     let model = LabModel::new(space)?;
     let colours = random_colours(n, seed);
     let de = delta_e_all(&model, &colours, |rgb| model.xyz(nm_to_normalised(table.fetch(rgb).c)));
@@ -74,9 +89,7 @@ pub fn roundtrip_upsampler(
     n: usize,
     seed: u64,
 ) -> Result<RoundTrip> {
-    if n == 0 {
-        return Err(ColorError::Table("a round trip needs at least one colour (got 0)".into()));
-    }
+    check_count(n)?;
     let model = LabModel::new(space)?;
     let colours = random_colours(n, seed);
     let de = delta_e_all(&model, &colours, |rgb| match up.reflectance(rgb) {

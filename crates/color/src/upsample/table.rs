@@ -12,7 +12,6 @@
 //! `scale` is stored in the file, a table may use any increasing brightness grid and stay
 //! readable by every rgb2spec-compatible renderer.
 
-use std::io::Write;
 use std::path::Path;
 
 use crate::error::{ColorError, Result};
@@ -255,27 +254,11 @@ pub fn check_rgb(rgb: [f64; 3]) -> Result<()> {
     Ok(())
 }
 
-/// Writes `bytes` to a temporary file next to `path`, then renames it into place.
+/// Writes `bytes` to a temporary file next to `path`, then renames it into place
+/// ([`crate::outfile::write_atomic`]).
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let origin = path.display().to_string();
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| {
-        table_err(&origin, format!("cannot create a temporary file in {}: {e}", dir.display()))
-    })?;
-    // Temporary files are created owner-only; a table is ordinary data, readable by all.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    tmp.write_all(bytes)
-        .and_then(|_| tmp.as_file().sync_all())
-        .map_err(|e| table_err(&origin, format!("cannot write: {e}")))?;
-    tmp.persist(path).map_err(|e| table_err(&origin, format!("cannot rename into place: {}", e.error)))?;
-    Ok(())
+    crate::outfile::write_atomic(path, bytes)
+        .map_err(|e| table_err(&path.display().to_string(), format!("cannot write: {e}")))
 }
 
 #[cfg(test)]

@@ -112,7 +112,6 @@ impl GBufferPass {
             multiview_mask: None,
         });
         pass.set_bind_group(0, frame, &[]);
-        scene.bind_buffers(&mut pass);
         let mut current = None;
         for d in &scene.draws {
             let key = (d.double_sided as usize, d.alpha_tested as usize);

@@ -247,10 +247,9 @@ impl ShadowPass {
             });
             let Some(layer) = self.active.get(i) else { continue };
             pass.set_bind_group(0, &self.layer_buffers[i].1, &[]);
-            scene.bind_buffers(&mut pass);
             let mut current = None;
-            for (mi, d) in scene.draws.iter().enumerate() {
-                if layer.skip_mesh == Some(mi) {
+            for d in &scene.draws {
+                if layer.skip_mesh == Some(d.mesh) {
                     continue;
                 }
                 let key = (d.double_sided as usize, d.alpha_tested as usize);

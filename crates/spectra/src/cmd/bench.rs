@@ -272,6 +272,9 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--frames 0: measure at least one frame");
     }
     let counts = parse_counts(&args.wavelengths)?;
+    if let Some(path) = &args.csv {
+        super::check_output("--csv", path)?;
+    }
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.env.apply(&mut scene)?;
@@ -308,8 +311,7 @@ pub fn run(args: Args) -> Result<()> {
             .expect("static template")
             .progress_chars("=> "),
     );
-    let interrupted = color::upsample::interrupt_flag();
-    color::upsample::install_interrupt_handler();
+    let interrupted = color::cancel::token();
     let mut rows = Vec::new();
     for (mode, quadrature, reference, n) in configs {
         bar.set_message(format!("{} N={}", mode.name(), n.map(|n| n.to_string()).unwrap_or("–".into())));
@@ -334,10 +336,7 @@ pub fn run(args: Args) -> Result<()> {
             // Reading the timestamps waits for the frame; without them, wait explicitly.
             let t = r.read_timings()?;
             if t.is_none() {
-                r.gpu()
-                    .device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+                r.wait()?;
             }
             let wall = t0.elapsed().as_secs_f64() * 1e3;
             if i >= args.warmup {

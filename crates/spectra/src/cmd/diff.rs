@@ -42,6 +42,10 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     // Check cheap things before reading possibly large images.
     let colormap = ColorMap::by_name(&args.colormap)?;
+    let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
+    if !(lo..=hi).contains(&args.white_y) {
+        anyhow::bail!("--white-y {:e}: the white luminance must be between {lo:e} and {hi:e}", args.white_y);
+    }
     if let Some(h) = &args.heatmap
         && !h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
     {

@@ -34,7 +34,11 @@ pub fn run(a: Args) -> Result<()> {
     if !(2..=upsample::table::MAX_RES).contains(&a.res) {
         bail!("--res {} is outside 2..={}", a.res, upsample::table::MAX_RES);
     }
-    upsample::install_interrupt_handler();
+    super::check_output("--out", &a.out)?;
+    // Checked before the fit (minutes), not after it.
+    if a.check > 0 {
+        roundtrip::check_count(a.check).map_err(|e| anyhow::anyhow!("--check {}: {e}", a.check))?;
+    }
     let opt = if a.rgb2spec { FitOptions::new(a.res) } else { FitOptions::spectra(a.res) };
     let t0 = Instant::now();
     let pb = cache::fit_progress(&format!("fitting {} {}³", space.name, a.res));

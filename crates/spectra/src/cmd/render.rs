@@ -257,29 +257,32 @@ pub fn load_table(explicit: Option<&Path>) -> Result<Arc<CoeffTable>> {
         Some(p) => {
             Ok(Arc::new(CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?))
         }
-        None => {
-            color::upsample::install_interrupt_handler();
-            color::upsample::table("srgb").context("the sRGB coefficient table")
-        }
+        None => color::upsample::table("srgb").context("the sRGB coefficient table"),
     }
 }
 
-pub fn run(args: RenderArgs) -> Result<()> {
-    let format = out_format(&args.out)?;
-    let (width, height) = parse_size(&args.size)?;
-    let mut scene = args.files.load(&args.scene)?;
-    super::print_warnings(&scene);
-    args.look.env.apply(&mut scene)?;
-    let settings = settings(&args, &scene)?;
-    let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
-    let table = load_table(args.look.table.as_deref())?;
-    let mut r = Renderer::with_table(table)?;
-    r.set_scene(&scene)?;
-    if let Some(m) = &water {
+/// Renders the frame and writes `args.out`.
+fn render_frame(
+    r: &mut Renderer,
+    args: &RenderArgs,
+    scene: &scene::Scene,
+    settings: &RenderSettings,
+    water: Option<&scene::water::WaterMedium>,
+    format: OutFormat,
+    (width, height): (u32, u32),
+) -> Result<()> {
+    r.set_scene(scene)?;
+    for w in r.scene_warnings() {
+        eprintln!("warning: {}: {w}", scene.source);
+    }
+    if let Some(m) = water {
         r.set_custom_shader(render::passes::underwater::shader_with(m, &args.look.underwater()?))?;
     }
     r.resize(width, height)?;
-    r.render(&scene.camera, &settings)?;
+    r.render(&scene.camera, settings)?;
+    // Encoding a large image takes seconds; Ctrl-C meanwhile must not be followed by a write.
+    let interrupted =
+        || if color::cancel::is_cancelled() { Err(render::RenderError::Cancelled) } else { Ok(()) };
     match format {
         OutFormat::Png => {
             let rgba = r.read_ldr()?;
@@ -287,6 +290,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 image::RgbaImage::from_raw(width, height, rgba).context("readback has the wrong size")?;
             let mut bytes = std::io::Cursor::new(Vec::new());
             img.write_to(&mut bytes, image::ImageFormat::Png).context("encoding PNG")?;
+            interrupted()?;
             compare::atomic::write_atomic(&args.out, bytes.get_ref())
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
@@ -294,9 +298,33 @@ pub fn run(args: RenderArgs) -> Result<()> {
             let k = settings.exposure_ev.exp2();
             let data = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
             let img = compare::image::Image::new(width, height, data)?;
+            interrupted()?;
             compare::io::write_image(&args.out, &img, Default::default())
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
+    }
+    Ok(())
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let format = out_format(&args.out)?;
+    let (width, height) = parse_size(&args.size)?;
+    super::check_output("--out", &args.out)?;
+    let mut scene = args.files.load(&args.scene)?;
+    super::print_warnings(&scene);
+    args.look.env.apply(&mut scene)?;
+    let settings = settings(&args, &scene)?;
+    let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
+    let table = load_table(args.look.table.as_deref())?;
+    let mut r = Renderer::with_table(table)?;
+    let frame = render_frame(&mut r, &args, &scene, &settings, water.as_ref(), format, (width, height));
+    if let Err(e) = frame {
+        if color::cancel::is_cancelled() {
+            // Dropping the device waits for the frame in flight (28 s at 4096² on lavapipe):
+            // the process is about to exit, so let the OS reclaim it instead.
+            std::mem::forget(r);
+        }
+        return Err(e);
     }
     let under = water.as_ref().map_or(String::new(), |m| {
         let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());

@@ -131,12 +131,18 @@ pub fn run(a: Args) -> Result<()> {
         if a.xyz && ext != "exr" {
             bail!("--xyz needs an .exr output (PNG is display-encoded sRGB)");
         }
+        super::check_output("--out", out)?;
+    }
+    if let Some(dir) = &a.export_mitsuba {
+        if std::fs::symlink_metadata(dir).is_ok() {
+            bail!("--export-mitsuba {}: already exists; remove it first", dir.display());
+        }
+        super::check_output("--export-mitsuba", dir)?;
     }
     let mut scene = a.files.load(&a.scene)?;
     super::print_warnings(&scene);
     a.env.apply(&mut scene)?;
     let st = settings(&a, &scene)?;
-    color::upsample::install_interrupt_handler();
     let table = match &a.table {
         Some(p) => std::sync::Arc::new(
             color::upsample::CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?,
@@ -166,7 +172,7 @@ pub fn run(a: Args) -> Result<()> {
         pb.set_style(style.progress_chars("=> "));
     }
     let t1 = Instant::now();
-    let cancel = color::upsample::interrupt_flag();
+    let cancel = color::cancel::token();
     let img = truth::render_world(&world, &st, cancel, &|rows| pb.set_position(rows));
     pb.finish_and_clear();
     let img = match img {
@@ -230,6 +236,15 @@ mod tests {
         assert!(e(&["--out", "x.bmp"]).contains(".exr"));
         assert!(e(&["--xyz", "--out", "x.png"]).contains("--xyz"));
         assert!(e(&["--size", "0x4", "--out", "x.exr"]).contains("positive"));
+        let m = e(&["--size", "4294967295x1", "--out", "x.exr"]);
+        assert!(m.contains("too large") && m.contains("4294967295"), "{m}");
+        // The directory is checked before the render, not after it.
+        let t = std::time::Instant::now();
+        let m = e(&["--spp", "100000", "--out", "no-such-dir/x.exr"]);
+        assert!(m.contains("--out") && m.contains("no-such-dir") && m.contains("does not exist"), "{m}");
+        assert!(t.elapsed().as_secs() < 5);
+        let m = e(&["--export-mitsuba", "no-such-dir/export"]);
+        assert!(m.contains("--export-mitsuba") && m.contains("does not exist"), "{m}");
         assert!(!std::path::Path::new("x.exr").exists());
     }
 

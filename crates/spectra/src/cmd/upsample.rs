@@ -62,10 +62,7 @@ fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
             Ok(Box::new(method::Jakob(Arc::new(t))))
         }
         (Some(_), _) => bail!("--table only applies to --method jakob"),
-        _ => {
-            upsample::install_interrupt_handler();
-            Ok(upsample::upsampler(m, space).with_context(|| format!("getting the {} table", space.name))?)
-        }
+        _ => Ok(upsample::upsampler(m, space).with_context(|| format!("getting the {} table", space.name))?),
     }
 }
 
@@ -75,9 +72,7 @@ pub fn run(a: Args) -> Result<()> {
         return bench(&a, &space);
     }
     if let Some(n) = a.roundtrip {
-        if n == 0 {
-            bail!("--roundtrip needs at least one colour");
-        }
+        roundtrip::check_count(n).map_err(|e| anyhow::anyhow!("--roundtrip {n}: {e}"))?;
         if !a.rgb.is_empty() {
             bail!("--roundtrip measures random colours; do not also give R G B");
         }

@@ -1,0 +1,26 @@
+//! The process's one cancellation token.
+//!
+//! The binary installs the Ctrl-C handler that sets it; long computations anywhere in the
+//! workspace (table fits, the path tracer's sample loops, GPU waits, benchmarks) poll it and
+//! return an "interrupted" error, writing nothing. It lives here, in the lowest crate, so that
+//! every crate can poll the same flag without depending on a signal-handling crate; a library
+//! never installs a handler itself (that would fight the program's own).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static CANCELLED: AtomicBool = AtomicBool::new(false);
+
+/// The token itself, for APIs that take a `&AtomicBool` (so tests can pass their own).
+pub fn token() -> &'static AtomicBool {
+    &CANCELLED
+}
+
+/// True once cancellation was requested (Ctrl-C in the `spectra` binary).
+pub fn is_cancelled() -> bool {
+    CANCELLED.load(Ordering::Relaxed)
+}
+
+/// Requests cancellation: what the signal handler calls.
+pub fn cancel() {
+    CANCELLED.store(true, Ordering::SeqCst);
+}

@@ -1,0 +1,263 @@
+//! Output files that appear complete or not at all, created safely.
+//!
+//! Every file the workspace writes goes through [`write_atomic`]: the bytes go to a temporary
+//! file created with `O_EXCL` (the `tempfile` crate) in the destination's directory, which is
+//! renamed over the destination only once complete. The temporary name is unpredictable (no
+//! symlink can be planted for it), and carries the writer's process id, so that a leftover
+//! from a process killed with `kill -9` is recognised and removed by the next write of the
+//! same file ([`remove_stale_temps`]). An existing destination keeps its permission bits; a new
+//! one gets `0666` minus the umask, like any file a shell redirection creates.
+
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// The directory a file `path` goes in (`.` for a bare file name).
+pub fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+fn file_name(path: &Path) -> io::Result<String> {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path has no file name"))
+}
+
+/// Checks, before any long work, that `path` could be written: its directory exists and is a
+/// directory we may create files in, and `path` itself is not a directory. Creates and removes
+/// a temporary file to find out (the only reliable test of permission).
+pub fn check_writable(path: &Path) -> io::Result<()> {
+    let dir = parent_dir(path);
+    file_name(path)?;
+    if !dir.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("directory {} does not exist", dir.display()),
+        ));
+    }
+    if path.is_dir() {
+        return Err(io::Error::new(io::ErrorKind::IsADirectory, "is a directory"));
+    }
+    tempfile::Builder::new()
+        .prefix(".spectra-check.")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| io::Error::new(e.kind(), format!("cannot create files in {}: {e}", dir.display())))
+}
+
+/// The process's umask: read from `/proc/self/status` (setting and restoring it with
+/// `umask(2)` would race with other threads creating files). `0o022` where unknown.
+pub fn umask() -> u32 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("Umask:"))
+                .and_then(|v| u32::from_str_radix(v.trim(), 8).ok())
+        })
+        .unwrap_or(0o022)
+}
+
+/// Writes `bytes` to `path` atomically; see the module documentation.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomic_with(path, |f| f.write_all(bytes))
+}
+
+/// [`write_atomic`] with the content written by `fill` (for encoders that stream).
+pub fn write_atomic_with(
+    path: &Path,
+    fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>,
+) -> io::Result<()> {
+    let dir = parent_dir(path);
+    let name = file_name(path)?;
+    if !dir.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("directory {} does not exist", dir.display()),
+        ));
+    }
+    remove_stale_temps(dir, &name);
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{name}.{}.", std::process::id());
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    let existing = std::fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| m.permissions());
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // Passed to open(2), so the umask applies, as for any newly created file.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
+    // An existing file keeps its mode: replacing a private (0600) file must not publish it.
+    #[cfg(unix)]
+    if let Some(p) = existing {
+        tmp.as_file().set_permissions(p)?;
+    }
+    fill(tmp.as_file_mut())?;
+    tmp.as_file().sync_all()?;
+    // On failure `PersistError` hands the temp file back; dropping it deletes it.
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// The process id in a temporary name `.<name>.<pid>.<random>.tmp`, if it is one.
+fn temp_owner(entry: &str, name: &str) -> Option<u32> {
+    let rest = entry.strip_prefix('.')?.strip_prefix(name)?.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (pid, random) = rest.split_once('.')?;
+    (!random.is_empty()).then_some(())?;
+    pid.parse().ok()
+}
+
+/// Removes temporary files of `name` in `dir` left by writers that no longer run (killed
+/// with `kill -9` or by a power cut). A writer that still runs keeps its file. Where process
+/// ids cannot be checked (no `/proc`), only leftovers older than a day are removed.
+pub fn remove_stale_temps(dir: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let proc = Path::new("/proc/self").exists();
+    for e in entries.flatten() {
+        let entry = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = temp_owner(&entry, name) else { continue };
+        let stale = if proc {
+            pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists()
+        } else {
+            e.metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age.as_secs() > 86_400)
+        };
+        // Only regular files: never follow or remove anything else planted under that name.
+        if stale && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// A new private (0700) directory next to `target`, created atomically with an unpredictable
+/// name (`mkdtemp`), for building a directory output that is renamed into place when
+/// complete. Unlike `create_dir_all` on a predictable name, it cannot be redirected by a
+/// planted symlink. Removed on drop unless [`persist_dir`] moved it.
+pub fn temp_dir_next_to(target: &Path) -> io::Result<tempfile::TempDir> {
+    let dir = parent_dir(target);
+    let name = file_name(target)?;
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}.{}.", std::process::id()))
+        .suffix(".tmp")
+        .tempdir_in(dir)
+}
+
+/// Renames a directory made by [`temp_dir_next_to`] to `target` and gives it the mode a new
+/// directory would have (0777 minus the umask). Fails, leaving `target` alone, if `target`
+/// exists; the temporary directory is then removed.
+pub fn persist_dir(tmp: tempfile::TempDir, target: &Path) -> io::Result<PathBuf> {
+    if std::fs::symlink_metadata(target).is_ok() {
+        return Err(io::Error::new(io::ErrorKind::AlreadyExists, "already exists; remove it first"));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o777 & !umask()))?;
+    }
+    std::fs::rename(tmp.path(), target)?;
+    // Renamed away: nothing left for the guard to delete.
+    let _ = tmp.keep();
+    Ok(target.to_path_buf())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[cfg(unix)]
+    fn mode(p: &Path) -> u32 {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::metadata(p).unwrap().permissions().mode() & 0o777
+    }
+
+    /// Replacing a private file keeps it private (the old writer forced 0644).
+    #[cfg(unix)]
+    #[test]
+    fn an_existing_files_mode_is_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("secret.exr");
+        std::fs::write(&p, b"old").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_atomic(&p, b"new").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"new");
+        assert_eq!(mode(&p), 0o600);
+        let q = dir.path().join("fresh.png");
+        write_atomic(&q, b"x").unwrap();
+        assert_eq!(mode(&q), 0o666 & !umask());
+    }
+
+    /// A temp file of a writer killed with -9 is removed by the next write of the same file;
+    /// a live writer's (this process's) and other files' are kept.
+    #[test]
+    fn stale_temps_are_removed_on_the_next_write() {
+        let dir = tempfile::tempdir().unwrap();
+        // pid_max is at most 2^22 on Linux: this process cannot exist.
+        let dead = dir.path().join(".out.png.4194305.AbC123.tmp");
+        let live = dir.path().join(format!(".out.png.{}.XyZ789.tmp", std::process::id()));
+        let other = dir.path().join(".other.png.4194305.AbC123.tmp");
+        for f in [&dead, &live, &other] {
+            std::fs::write(f, b"partial").unwrap();
+        }
+        write_atomic(&dir.path().join("out.png"), b"png").unwrap();
+        let want = [
+            ".other.png.4194305.AbC123.tmp".to_string(),
+            live.file_name().unwrap().to_string_lossy().into(),
+            "out.png".into(),
+        ];
+        let mut want = want.to_vec();
+        want.sort();
+        assert_eq!(entries(dir.path()), want);
+    }
+
+    #[test]
+    fn failed_writes_leave_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.bin");
+        let e = write_atomic_with(&p, |_| Err(io::Error::other("encoder failed"))).unwrap_err();
+        assert!(e.to_string().contains("encoder failed"));
+        assert!(entries(dir.path()).is_empty());
+        let e = check_writable(&dir.path().join("missing/x.bin")).unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+        assert!(check_writable(&p).is_ok());
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    /// A symlink planted where the old exporter's predictable temp directory went is not
+    /// followed: the directory is built under an unpredictable name and renamed.
+    #[cfg(unix)]
+    #[test]
+    fn directory_outputs_ignore_planted_symlinks() {
+        let dir = tempfile::tempdir().unwrap();
+        let elsewhere = tempfile::tempdir().unwrap();
+        let target = dir.path().join("export");
+        let planted = dir.path().join(format!(".export.tmp-{}", std::process::id()));
+        std::os::unix::fs::symlink(elsewhere.path(), &planted).unwrap();
+        let tmp = temp_dir_next_to(&target).unwrap();
+        std::fs::write(tmp.path().join("scene.xml"), b"<scene/>").unwrap();
+        persist_dir(tmp, &target).unwrap();
+        assert!(target.join("scene.xml").is_file());
+        assert!(entries(elsewhere.path()).is_empty());
+        assert_eq!(mode(&target), 0o777 & !umask());
+        let tmp = temp_dir_next_to(&target).unwrap();
+        let kept = tmp.path().to_path_buf();
+        assert!(persist_dir(tmp, &target).is_err());
+        assert!(!kept.exists());
+    }
+}

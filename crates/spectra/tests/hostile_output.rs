@@ -1,0 +1,68 @@
+//! Requests that used to panic or allocate without bound (issue 14), run through the binary:
+//! each must end with one `error:` line naming the flag, exit status 1, and no panic.
+
+use std::process::{Command, Stdio};
+
+fn spectra(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_spectra")).args(args).output().expect("spawn spectra")
+}
+
+fn refused(args: &[&str], needles: &[&str]) {
+    let t = std::time::Instant::now();
+    let out = spectra(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: '{n}' not in {err}");
+    }
+    // Refused up front, not after minutes of work or gigabytes of allocation.
+    assert!(t.elapsed().as_secs() < 20, "{args:?} took {:?}", t.elapsed());
+}
+
+fn two_images(dir: &std::path::Path) -> (String, String) {
+    let a = dir.join("a.png");
+    let b = dir.join("b.png");
+    image::RgbaImage::from_pixel(8, 8, image::Rgba([40, 80, 120, 255])).save(&a).unwrap();
+    image::RgbaImage::from_pixel(8, 8, image::Rgba([42, 80, 118, 255])).save(&b).unwrap();
+    (a.display().to_string(), b.display().to_string())
+}
+
+#[test]
+fn absurd_counts_and_sizes_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_images(dir.path());
+    refused(&["diff", &a, &b, "--white-y", "1e-310"], &["--white-y", "1e-310", "white luminance"]);
+    refused(&["upsample", "--roundtrip", "18446744073709551615"], &["--roundtrip", "at most"]);
+    let out = dir.path().join("t.coeff").display().to_string();
+    refused(
+        &["lut", "--res", "8", "--check", "18446744073709551615", "--out", &out],
+        &["--check", "at most"],
+    );
+    let exr = dir.path().join("t.exr").display().to_string();
+    refused(&["truth", "cornell", "--size", "4294967295x1", "--out", &exr], &["4294967295", "too large"]);
+    let missing = dir.path().join("no/such/dir/t.exr").display().to_string();
+    refused(&["truth", "cornell", "--spp", "100000", "--out", &missing], &["--out", "does not exist"]);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+/// `spectra diff … --json | head -c 100`: the reader goes away; the writer ends quietly
+/// (killed by SIGPIPE like any Unix filter), without a panic message.
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_images(dir.path());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_spectra"))
+        .args(["diff", &a, &b, "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
+    use std::os::unix::process::ExitStatusExt;
+    assert!(out.status.success() || out.status.signal() == Some(libc::SIGPIPE), "{:?}: {err}", out.status);
+}
