@@ -63,6 +63,8 @@ pub const MAX_INPUT_BYTES: u64 = 1 << 30;
 /// any pixel is decoded, so a few hundred bytes claiming 100000² pixels are refused at once.
 /// Held as three f32 per pixel, an image at the cap takes 768 MiB.
 pub const MAX_INPUT_PIXELS: u64 = 1 << 26;
+/// Most bytes of samples an EXR may decode to (all its channels, 4 bytes a sample).
+pub const MAX_DECODED_BYTES: u64 = 1 << 30;
 /// Largest width or height read.
 pub const MAX_INPUT_DIMENSION: u64 = 1 << 16;
 
@@ -114,11 +116,12 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
     for h in &meta.headers {
         let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
         check_size(path, "OpenEXR", w, ht)?;
-        // Many channels multiply the samples held while reading.
-        if h.channels.list.len() > 64 {
+        // Every channel is read (not only R, G, B), so the channels multiply the memory.
+        let n = h.channels.list.len() as u64;
+        if n > 64 || w * ht * n * 4 > MAX_DECODED_BYTES {
             return Err(decode(format!(
-                "{} channels in a layer; at most 64 are read",
-                h.channels.list.len()
+                "{w}×{ht} with {n} channels; at most 64 channels and {} MiB of samples are read",
+                MAX_DECODED_BYTES >> 20
             )));
         }
     }

@@ -15,7 +15,7 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// The fuzzed parsers.
-pub const TARGETS: &[&str] = &["gltf", "coeff", "csv", "medium", "exr", "png"];
+pub const TARGETS: &[&str] = &["gltf", "coeff", "csv", "medium", "exr", "png", "env"];
 
 /// Runs one input through `target`'s parser. `Err` is fine (refused input); a panic is not.
 pub fn run_one(target: &str, data: &[u8]) {
@@ -33,6 +33,11 @@ pub fn run_one(target: &str, data: &[u8]) {
         }
         "exr" => drop(compare::decode_image("fuzz.exr", data)),
         "png" => drop(compare::decode_image("fuzz.png", data)),
+        // Environment maps: Radiance (starts with "#?") or OpenEXR.
+        "env" => {
+            let name = if data.starts_with(b"#?") { "fuzz.hdr" } else { "fuzz.exr" };
+            drop(scene::Environment::from_bytes(std::path::Path::new(name), data))
+        }
         other => panic!("unknown fuzz target {other}; targets: {TARGETS:?}"),
     }
 }
@@ -180,6 +185,18 @@ pub struct Report {
 /// first). Crashing inputs are collected, not retried; interesting growth is not tracked (no
 /// coverage feedback on stable), so each input is a mutation of a seed.
 pub fn fuzz(target: &str, seed: u64, execs: u64, seconds: f64) -> Report {
+    fuzz_with(target, seed, execs, seconds, None)
+}
+
+/// [`fuzz`], writing each input to `current` before running it when given: an abort (a failed
+/// allocation, a stack overflow) cannot be caught, and this leaves the input that caused it.
+pub fn fuzz_with(
+    target: &str,
+    seed: u64,
+    execs: u64,
+    seconds: f64,
+    current: Option<&std::path::Path>,
+) -> Report {
     let seeds = corpus(target);
     assert!(!seeds.is_empty(), "no seeds for {target}");
     let mut rng = Rng(seed);
@@ -195,6 +212,9 @@ pub fn fuzz(target: &str, seed: u64, execs: u64, seconds: f64) -> Report {
             mutate(&mut rng, &mut d, other);
             d
         });
+        if let Some(p) = current {
+            std::fs::write(p, &input).expect("writing the current input");
+        }
         if let Some(msg) = check(target, &input) {
             report.crashes.push((input, msg));
         }

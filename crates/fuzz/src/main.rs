@@ -4,7 +4,9 @@
 //! executions, time, crashes and the process's peak resident memory. Crashing inputs are
 //! written to `crates/fuzz/crashes/<target>-<n>.bin` and the exit status is 1; each belongs in
 //! a regression test once fixed; `TARGET --replay FILE` runs one input uncaught, for a backtrace.
-//! The acceptance run is `--execs 1000000` per target.
+//! `--keep-current` writes each input to `crashes/<target>-current.bin` before running it, so
+//! an abort (a failed allocation) leaves its input behind. The acceptance run is
+//! `--execs 1000000` per target.
 
 use std::time::Instant;
 
@@ -34,7 +36,12 @@ fn main() {
     let mut failed = false;
     for t in targets {
         let start = Instant::now();
-        let r = fuzz::fuzz(t, seed, execs, seconds);
+        let current = args.iter().any(|a| a == "--keep-current").then(|| {
+            let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("crashes");
+            std::fs::create_dir_all(&dir).unwrap();
+            dir.join(format!("{t}-current.bin"))
+        });
+        let r = fuzz::fuzz_with(t, seed, execs, seconds, current.as_deref());
         let secs = start.elapsed().as_secs_f64();
         println!(
             "{t}: {} executions in {secs:.1} s ({:.0}/s), {} crashes, peak RSS so far {} MiB",

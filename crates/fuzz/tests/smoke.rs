@@ -33,6 +33,10 @@ fn each_corpus_has_a_valid_seed() {
             "medium" => truth::Medium::from_json(std::str::from_utf8(s).unwrap(), "m").is_ok(),
             "exr" => compare::decode_image("s.exr", s).is_ok(),
             "png" => compare::decode_image("s.png", s).is_ok(),
+            "env" => {
+                let name = if s.starts_with(b"#?") { "s.hdr" } else { "s.exr" };
+                scene::Environment::from_bytes(std::path::Path::new(name), s).is_ok()
+            }
             _ => unreachable!(),
         });
         assert!(ok, "{t}: no valid seed in corpus/{t}");

@@ -117,20 +117,58 @@ impl Environment {
         let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
         // What kind of file it is before what its name says (a directory named x.hdr).
         color::input::open_regular(path).map_err(|e| err(format!("cannot read it: {e}")))?;
-        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        let format = match ext.as_deref() {
-            Some("hdr") => image::ImageFormat::Hdr,
-            Some("exr") => image::ImageFormat::OpenExr,
-            _ => {
-                return Err(err(
-                    "not an HDR environment: give an equirectangular .hdr (Radiance) or .exr (OpenEXR) file \
-                     of linear radiance"
-                        .into(),
-                ));
-            }
-        };
+        let format = Self::format_of(path)?;
         let bytes = color::input::read_regular(path, MAX_INPUT_BYTES)
             .map_err(|e| err(format!("cannot read it: {e}")))?;
+        Self::decode(path, format, &bytes)
+    }
+
+    /// An environment from the bytes of a `.hdr` or `.exr` file; `name` (its extension picks the
+    /// format) names it in messages. What [`Self::load`] does after reading, for tools and the
+    /// fuzz harness.
+    pub fn from_bytes(name: &Path, bytes: &[u8]) -> Result<Self, EnvironmentError> {
+        Self::decode(name, Self::format_of(name)?, bytes)
+    }
+
+    fn format_of(path: &Path) -> Result<image::ImageFormat, EnvironmentError> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("hdr") => Ok(image::ImageFormat::Hdr),
+            Some("exr") => Ok(image::ImageFormat::OpenExr),
+            _ => Err(EnvironmentError {
+                file: path.to_path_buf(),
+                message: "not an HDR environment: give an equirectangular .hdr (Radiance) or .exr (OpenEXR) \
+                          file of linear radiance"
+                    .into(),
+            }),
+        }
+    }
+
+    fn decode(path: &Path, format: image::ImageFormat, bytes: &[u8]) -> Result<Self, EnvironmentError> {
+        let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
+        if format == image::ImageFormat::OpenExr {
+            // The `image` crate applies its limits only after the `exr` crate has decoded the
+            // blocks, which allocate what the header claims (a 685-byte file asked for 35 GB;
+            // found by crates/fuzz). So the headers are checked here first.
+            let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+                .map_err(|e| err(format!("not a readable OpenExr image: {e}")))?;
+            if meta.headers.len() > 16 {
+                return Err(err(format!("{} layers; at most 16 are read", meta.headers.len())));
+            }
+            for h in &meta.headers {
+                let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+                if w > MAX_INPUT_WIDTH as usize
+                    || ht > MAX_INPUT_HEIGHT as usize
+                    || h.channels.list.len() > 16
+                {
+                    return Err(err(format!(
+                        "a layer is {w}×{ht} with {} channels; at most {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} and 16 \
+                         channels are accepted",
+                        h.channels.list.len()
+                    )));
+                }
+            }
+        }
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         reader.set_format(format);
         let mut limits = image::Limits::default();

@@ -394,3 +394,14 @@ fn a_glb_shorter_than_its_header_is_refused() {
     let e = scene::load_slice("tiny.glb", b"glTF\x02\0", None).unwrap_err().to_string();
     assert_has(&e, &["tiny.glb", "GLB header"]);
 }
+
+/// Found by crates/fuzz: a 685-byte EXR whose header made the `exr` crate's ZIP decoder ask for
+/// 35 GB (an abort, not a panic) through `image`, whose limits apply only after decoding.
+#[test]
+fn an_exr_environment_is_checked_before_its_blocks_are_decoded() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz-env-35gb.exr");
+    let t = Instant::now();
+    let e = scene::Environment::load(&p).unwrap_err().to_string();
+    assert!(e.contains("fuzz-env-35gb.exr"), "{e}");
+    assert!(t.elapsed() < Duration::from_secs(5), "took {:?}", t.elapsed());
+}
