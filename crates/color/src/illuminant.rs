@@ -38,6 +38,10 @@ mod tests {
         assert!(by_name("F11").is_ok());
         assert!(by_name("LED-B3").is_ok());
         assert!(matches!(by_name("3200K").unwrap(), Spectrum::Blackbody { .. }));
+        // A "1K" white renders black; 1e-300 K gave NaN.
+        for bad in ["1K", "blackbody:1e-300", "blackbody:1e300"] {
+            assert!(by_name(bad).unwrap_err().to_string().contains("500"), "{bad}");
+        }
         assert!(matches!(by_name("blackbody:6500").unwrap(), Spectrum::Blackbody { .. }));
         let e = by_name("D42").unwrap_err().to_string();
         assert!(e.contains("D42") && e.contains("D65"), "{e}");

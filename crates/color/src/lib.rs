@@ -8,6 +8,7 @@ pub mod data;
 pub mod delta_e;
 pub mod error;
 pub mod illuminant;
+pub mod input;
 pub mod lab;
 pub mod metrics;
 pub mod observer;

@@ -7,6 +7,10 @@ use crate::error::{ColorError, Result};
 pub const LAMBDA_MIN: f64 = 360.0;
 /// Highest wavelength for which spectra has observer data (nm).
 pub const LAMBDA_MAX: f64 = 830.0;
+/// Coolest blackbody accepted (K): a dull red glow; cooler ones emit nothing visible.
+pub const BLACKBODY_MIN_KELVIN: f64 = 500.0;
+/// Hottest blackbody accepted (K).
+pub const BLACKBODY_MAX_KELVIN: f64 = 1.0e6;
 
 /// A spectral distribution over wavelength in nanometres.
 ///
@@ -35,9 +39,11 @@ pub fn planck(lambda_nm: f64, kelvin: f64) -> f64 {
 impl Spectrum {
     /// A blackbody emitter, normalised to a peak of 1 (Wien's displacement law gives the peak).
     pub fn blackbody(kelvin: f64) -> Result<Self> {
-        if !(kelvin.is_finite() && kelvin > 0.0) {
+        // Below the range the visible emission underflows relative to the peak (a "1K" white
+        // renders black, 1e-300 K gives NaN); above it the shape no longer changes.
+        if !(BLACKBODY_MIN_KELVIN..=BLACKBODY_MAX_KELVIN).contains(&kelvin) {
             return Err(ColorError::BadSpectrum(format!(
-                "blackbody temperature must be a positive number of kelvin, got {kelvin}"
+                "blackbody temperature must be {BLACKBODY_MIN_KELVIN}–{BLACKBODY_MAX_KELVIN} K, got {kelvin}"
             )));
         }
         let peak_nm = 2.897_771_955e6 / kelvin;

@@ -13,6 +13,8 @@ pub struct WavelengthRange {
 impl WavelengthRange {
     /// The visible range the paper renders by default.
     pub const VISIBLE: WavelengthRange = WavelengthRange { min: 380.0, max: 730.0 };
+    /// Narrowest range accepted (nm).
+    pub const MIN_WIDTH: f64 = 1.0;
     /// The full range of the CIE observer tables.
     pub const FULL: WavelengthRange = WavelengthRange { min: LAMBDA_MIN, max: LAMBDA_MAX };
 
@@ -23,6 +25,10 @@ impl WavelengthRange {
         }
         if min >= max {
             return bad("the minimum must be below the maximum");
+        }
+        // A sliver of a range (500:500.0000001) integrates to nothing: a silent black image.
+        if max - min < Self::MIN_WIDTH {
+            return bad("the range must be at least 1 nm wide");
         }
         if min < LAMBDA_MIN || max > LAMBDA_MAX {
             return bad("spectra has observer data for 360–830 nm only");

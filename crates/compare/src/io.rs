@@ -57,6 +57,29 @@ fn format_of(path: &Path) -> Result<Format> {
     }
 }
 
+/// Largest image file read (bytes).
+pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+/// Largest image read, in pixels (e.g. 8192 × 8192): checked against the file's header before
+/// any pixel is decoded, so a few hundred bytes claiming 100000² pixels are refused at once.
+/// Held as three f32 per pixel, an image at the cap takes 768 MiB.
+pub const MAX_INPUT_PIXELS: u64 = 1 << 26;
+/// Largest width or height read.
+pub const MAX_INPUT_DIMENSION: u64 = 1 << 16;
+
+fn check_size(path: &Path, format: &'static str, w: u64, h: u64) -> Result<()> {
+    if w > MAX_INPUT_DIMENSION || h > MAX_INPUT_DIMENSION || w.saturating_mul(h) > MAX_INPUT_PIXELS {
+        return Err(CompareError::Decode {
+            path: path.into(),
+            format,
+            reason: format!(
+                "the image is {w}×{h}; at most {MAX_INPUT_DIMENSION} on a side and {MAX_INPUT_PIXELS} pixels \
+                 are accepted"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Reads an EXR or PNG file into linear sRGB.
 ///
 /// EXR: the first valid layer at its largest resolution; channels `R`, `G`, `B` are required
@@ -67,16 +90,41 @@ fn format_of(path: &Path) -> Result<Format> {
 /// Alpha is dropped, not composited: renders and references are opaque.
 pub fn read_image(path: impl AsRef<Path>) -> Result<Image> {
     let path = path.as_ref();
+    format_of(path)?;
+    let bytes = color::input::read_regular(path, MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
+    decode_image(path, &bytes)
+}
+
+/// Decodes the bytes of an EXR or PNG file as [`read_image`] does, the format chosen by the
+/// extension of `path` (which only names the image in messages).
+pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {
+    let path = path.as_ref();
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|e| CompareError::io(path, e))?;
     match format {
-        Format::Exr => read_exr(path, &bytes),
-        Format::Png => read_png(path, &bytes),
+        Format::Exr => read_exr(path, bytes),
+        Format::Png => read_png(path, bytes),
     }
 }
 
 fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
+    // The headers first: the reader allocates every layer's samples from its data window.
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| decode(e.to_string()))?;
+    for h in &meta.headers {
+        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        check_size(path, "OpenEXR", w, ht)?;
+        // Many channels multiply the samples held while reading.
+        if h.channels.list.len() > 64 {
+            return Err(decode(format!(
+                "{} channels in a layer; at most 64 are read",
+                h.channels.list.len()
+            )));
+        }
+    }
+    if meta.headers.len() > 64 {
+        return Err(decode(format!("{} layers; at most 64 are read", meta.headers.len())));
+    }
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -120,8 +168,17 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
 
 fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "PNG", reason };
-    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
-        .map_err(|e| decode(e.to_string()))?;
+    let png = || image::ImageReader::with_format(Cursor::new(bytes), image::ImageFormat::Png);
+    let (w, h) = png().into_dimensions().map_err(|e| decode(e.to_string()))?;
+    check_size(path, "PNG", w.into(), h.into())?;
+    let mut reader = png();
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_INPUT_DIMENSION as u32);
+    limits.max_image_height = Some(MAX_INPUT_DIMENSION as u32);
+    // RGBA at 16 bits per channel.
+    limits.max_alloc = Some(8 * MAX_INPUT_PIXELS);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| decode(e.to_string()))?;
     let ct = img.color();
     let bits_per_channel = ct.bits_per_pixel() / u16::from(ct.channel_count());
     let (width, height) = (img.width(), img.height());
@@ -218,6 +275,7 @@ fn encode_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<Vec<u8>>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use image::ImageEncoder;
 
     fn test_image() -> Image {
         // HDR and negative values on purpose: EXR must keep them.
@@ -337,6 +395,73 @@ mod tests {
         std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
         let e = read_image(&cut).unwrap_err().to_string();
         assert!(e.contains("cut.exr"), "{e}");
+    }
+
+    /// `bytes` of an EXR with its dataWindow replaced by (0, 0)–(w−1, h−1).
+    fn claim_size(bytes: &[u8], w: i32, h: i32) -> Vec<u8> {
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|x| x == key).unwrap() + key.len() + 4;
+        let mut out = bytes.to_vec();
+        for (i, v) in [0i32, 0, w - 1, h - 1].iter().enumerate() {
+            out[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        out
+    }
+
+    #[test]
+    fn huge_claimed_sizes_are_refused_before_decoding() {
+        // A few hundred bytes claiming 100000² pixels made the old reader allocate 40 GB.
+        let dir = tempfile::tempdir().unwrap();
+        let small = dir.path().join("small.exr");
+        write_image(&small, &Image::filled(2, 2, [0.5; 3]).unwrap(), WriteOptions::default()).unwrap();
+        let bytes = std::fs::read(&small).unwrap();
+        let huge = dir.path().join("huge.exr");
+        std::fs::write(&huge, claim_size(&bytes, 100_000, 100_000)).unwrap();
+        let t = std::time::Instant::now();
+        let e = read_image(&huge).unwrap_err().to_string();
+        assert!(e.contains("huge.exr") && e.contains("100000×100000") && e.contains("accepted"), "{e}");
+        assert!(t.elapsed() < std::time::Duration::from_secs(2));
+
+        let png = dir.path().join("huge.png");
+        let mut b = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut b)
+            .write_image(&[0; 16], 2, 2, image::ExtendedColorType::Rgba8)
+            .unwrap();
+        // IHDR width and height sit right after the signature, the length and "IHDR".
+        b[16..20].copy_from_slice(&100_000u32.to_be_bytes());
+        b[20..24].copy_from_slice(&100_000u32.to_be_bytes());
+        let crc = crc32(&b[12..29]);
+        b[29..33].copy_from_slice(&crc.to_be_bytes());
+        std::fs::write(&png, b).unwrap();
+        let e = read_image(&png).unwrap_err().to_string();
+        assert!(e.contains("huge.png") && e.contains("100000×100000") && e.contains("accepted"), "{e}");
+    }
+
+    fn crc32(data: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in data {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+            }
+        }
+        !c
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_directories_are_not_read() {
+        let e = read_image("/dev/zero.exr").unwrap_err().to_string();
+        assert!(e.contains("/dev/zero.exr"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path().join("d.exr");
+        std::fs::create_dir(&d).unwrap();
+        let e = read_image(&d).unwrap_err().to_string();
+        assert!(e.contains("d.exr") && e.contains("a directory"), "{e}");
+        let link = dir.path().join("zero.png");
+        std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+        let e = read_image(&link).unwrap_err().to_string();
+        assert!(e.contains("zero.png") && e.contains("a device"), "{e}");
     }
 
     #[test]

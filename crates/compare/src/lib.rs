@@ -20,4 +20,4 @@ pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
-pub use io::{ExrPrecision, PngBitDepth, WriteOptions, read_image, write_image};
+pub use io::{ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_image};

@@ -10,7 +10,7 @@ use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::post::PostPass;
-use crate::passes::shading::ShadingPass;
+use crate::passes::shading::{ShadingPass, Variant};
 use crate::passes::shadow::ShadowPass;
 use crate::readback;
 use crate::scene_gpu::{GpuLight, GpuScene};
@@ -435,6 +435,9 @@ impl Renderer {
             self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral, occlusion_radius);
         self.gpu.queue.write_buffer(&self.env_buffer, 0, bytemuck::bytes_of(&env_uniforms));
 
+        let variant =
+            Variant { polygons: !scene.emitters.is_empty(), environment: env_uniforms.flags[0] != 0 };
+        self.shading.select(&self.gpu.device, variant)?;
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
         let ts = |i: usize| timer.map(|t| t.writes(i));

@@ -61,7 +61,7 @@ pub struct MaterialUniforms {
     /// metallic, roughness, 1 with a normal map, occlusion strength (0 without a texture).
     pub params: [f32; 4],
     /// x alpha mode ([`ALPHA_OPAQUE`], [`ALPHA_MASK`], [`ALPHA_BLEND`]), y alpha cutoff, z 1 when
-    /// double-sided.
+    /// double-sided, w 1 when unlit (`KHR_materials_unlit`).
     pub alpha: [f32; 4],
     /// Per texture slot, two rows of its `KHR_texture_transform` matrix: `(m00, m01, m02, set)`,
     /// `(m10, m11, m12, 0)` with `set` the UV set (0 or 1), so `uv' = M · (u, v, 1)`.
@@ -95,7 +95,7 @@ impl MaterialUniforms {
                 m.normal_texture.is_some() as u8 as f32,
                 if m.occlusion_texture.is_some() { m.occlusion_strength } else { 0.0 },
             ],
-            alpha: [mode, cutoff, m.double_sided as u8 as f32, 0.0],
+            alpha: [mode, cutoff, m.double_sided as u8 as f32, m.unlit as u8 as f32],
             uv,
         }
     }

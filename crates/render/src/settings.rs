@@ -190,8 +190,10 @@ mod tests {
         let bad = RenderSettings { observer: "cat".into(), ..Default::default() };
         assert!(bad.validate().unwrap_err().to_string().contains("cat"));
         assert!(RenderSettings { jitter: Some(0.0), ..Default::default() }.validate().is_ok());
+        // `WavelengthRange::new` refuses this too; the fields are public, so check both.
+        assert!(WavelengthRange::new(500.0, 500.0000001).is_err());
         let narrow =
-            RenderSettings { range: WavelengthRange::new(500.0, 500.0000001).unwrap(), ..Default::default() };
+            RenderSettings { range: WavelengthRange { min: 500.0, max: 500.0000001 }, ..Default::default() };
         assert!(narrow.validate().unwrap_err().to_string().contains("500.0000001"));
         for u in [1.0, -0.1, f32::NAN] {
             let bad = RenderSettings { jitter: Some(u), ..Default::default() };

@@ -730,3 +730,54 @@ fn bad_material_inputs_are_errors_naming_the_material() {
     let e = r.render(&cam, &settings(false)).unwrap_err().to_string();
     assert!(e.contains("orthographic") && e.contains("ymag 0"), "{e}");
 }
+
+#[test]
+fn unlit_surfaces_show_their_base_colour_whatever_the_light() {
+    // Left: unlit, base factor × COLOR_0; right: the same colour, lit by a grazing sun and the
+    // default sky (which the unlit quad must ignore too). Specular on, Lambert off, so that a
+    // highlight or the environment's specular would show on the unlit quad if it reflected.
+    let rects: [Rect; 2] = [(-2.0, -0.2, -1.0, 1.0), (0.2, 2.0, -1.0, 1.0)];
+    let mut meshes: Vec<Mesh> = rects.iter().enumerate().map(|(i, r)| quad(*r, 0.0, true, i)).collect();
+    meshes[0].colors = vec![Vec4::new(1.0, 0.5, 1.0, 1.0); 4];
+    let base = Vec4::new(0.8, 0.6, 0.2, 1.0);
+    let mut materials = vec![material("unlit", base), material("lit", base)];
+    materials[0].unlit = true;
+    materials[0].roughness = 0.2;
+    let mut s = scene(meshes, materials, vec![], vec![sun(Vec3::new(0.0, 1.0, -0.3), 20.0)]);
+    s.environment = Some(Environment::default_sky());
+    let (w, h) = (48, 24);
+    let cam = top_camera(Vec2::ZERO, 1.1);
+    let expected: Vec<Option<[f64; 3]>> = (0..h)
+        .flat_map(|py| (0..w).map(move |px| (px, py)))
+        .map(|(px, py)| {
+            let p = hit(&cam, w, h, px, py, 0.0);
+            inside(p, rects[0], 0.08).then_some([0.8, 0.3, 0.2])
+        })
+        .collect();
+    let dark = Scene { lights: vec![], environment: None, ..s.clone() };
+    let draw = |scene: &Scene, mode: Mode| -> Vec<[f64; 3]> {
+        let mut r = renderer();
+        r.set_scene(scene).unwrap();
+        r.resize(w, h).unwrap();
+        let settings = RenderSettings { mode, shadows: false, lambert: false, ..Default::default() };
+        r.render(&cam, &settings).unwrap();
+        r.read_hdr().unwrap().iter().map(rgb_of).collect()
+    };
+    // Naive mode's box spectra do not return an RGB exactly (the baseline's own error), so it
+    // is held only to ignoring the light.
+    for (mode, tol) in [(Mode::Rgb, Some(0.002)), (Mode::Naive, None), (Mode::Spectral, Some(0.02))] {
+        let actual = draw(&s, mode);
+        if let Some(tol) = tol {
+            assert_close(&format!("unlit-{mode:?}"), w, h, &actual, &expected, tol);
+        }
+        let unlit_in_the_dark: Vec<Option<[f64; 3]>> =
+            draw(&dark, mode).into_iter().zip(&expected).map(|(d, e)| e.map(|_| d)).collect();
+        assert_close(&format!("unlit-dark-{mode:?}"), w, h, &actual, &unlit_in_the_dark, 0.001);
+        // The lit quad beside it does change with the light (so the light is on).
+        let lit: Vec<usize> = (0..(w * h) as usize)
+            .filter(|&i| inside(hit(&cam, w, h, i as u32 % w, i as u32 / w, 0.0), rects[1], 0.08))
+            .collect();
+        let g = lit.iter().map(|&i| actual[i][1]).sum::<f64>() / lit.len() as f64;
+        assert!((g - 0.6).abs() > 0.05, "{mode:?}: the lit quad shows {g}, as if unlit");
+    }
+}

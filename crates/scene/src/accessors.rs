@@ -12,6 +12,14 @@ use gltf::accessor::{DataType, Dimensions};
 use crate::context::Ctx;
 use crate::error::SceneError;
 
+/// Most elements any accessor may have: three vertices per triangle at the scene's triangle cap
+/// ([`crate::MAX_TRIANGLES`]), the most an un-indexed mesh at that cap needs.
+pub const MAX_ACCESSOR_ELEMENTS: usize = 3 * crate::MAX_TRIANGLES;
+/// Most elements of a sparse accessor without a bufferView (zeros except for its sparse
+/// values): no data in the file backs its count, so a few bytes could otherwise ask for
+/// gigabytes. Real uses (a few morph-like edits of a small mesh) are far below it.
+pub const MAX_ZERO_FILLED_ELEMENTS: usize = 1 << 20;
+
 /// What an accessor may be stored as for one use.
 pub(crate) struct Expect {
     pub dims: &'static [Dimensions],
@@ -144,18 +152,41 @@ pub(crate) fn check(
     if acc.count() == 0 {
         return Err(ctx.invalid(&at, "count is 0"));
     }
+    if acc.count() > MAX_ACCESSOR_ELEMENTS {
+        return Err(ctx.invalid(
+            format!("accessors[{ai}].count"),
+            format!("{} elements is more than the {MAX_ACCESSOR_ELEMENTS} accepted", acc.count()),
+        ));
+    }
     let size = acc.size();
     match (acc.view(), acc.sparse()) {
         (Some(v), _) => range_in(ctx, &at, &v, buffers, acc.offset(), acc.count(), size)?,
         (None, None) => {
             return Err(ctx.invalid(&at, "has no bufferView (all-zero accessors are not supported)"));
         }
-        (None, Some(_)) => {}
+        (None, Some(_)) => {
+            if acc.count() > MAX_ZERO_FILLED_ELEMENTS {
+                return Err(ctx.invalid(
+                    format!("accessors[{ai}].count"),
+                    format!(
+                        "{} elements without a bufferView (zeros but for the sparse values) is more than \
+                         the {MAX_ZERO_FILLED_ELEMENTS} accepted",
+                        acc.count()
+                    ),
+                ));
+            }
+        }
     }
     if let Some(sp) = acc.sparse() {
         let n = sp.count();
         if n == 0 {
             return Err(ctx.invalid(&at, "sparse count is 0"));
+        }
+        if n > acc.count() {
+            return Err(ctx.invalid(
+                format!("accessors[{ai}].sparse.count"),
+                format!("{n} is more than the accessor's count {} (glTF 2.0 §5.1.8)", acc.count()),
+            ));
         }
         let idx = sp.indices();
         range_in(
@@ -258,9 +289,10 @@ fn sparse(
     for k in 0..sp.count() {
         let i = index_at(&ib[k * isz..], &it);
         if i >= count {
+            // The position, not the value: the bytes may come from a file that is not ours.
             return Err(ctx.invalid(
                 format!("{at} (accessors[{}]).sparse.indices", acc.index()),
-                format!("index {i} is out of range for {count} elements"),
+                format!("sparse index number {k} is out of range (not below the {count} elements)"),
             ));
         }
         set(k, i, vb);

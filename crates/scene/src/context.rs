@@ -1,6 +1,6 @@
 //! Where a scene comes from, so that every error can name the file and resolve relative paths.
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use crate::error::SceneError;
 
@@ -10,6 +10,8 @@ pub(crate) struct Ctx {
     pub path: PathBuf,
     /// `None` for built-in scenes: they reference no files.
     pub dir: Option<PathBuf>,
+    /// Whether file references may leave `dir` (`--allow-outside-scene-dir`).
+    pub allow_outside: bool,
 }
 
 impl Ctx {
@@ -17,11 +19,11 @@ impl Ctx {
         let dir = path
             .parent()
             .map(|p| if p.as_os_str().is_empty() { PathBuf::from(".") } else { p.to_path_buf() });
-        Ctx { path: path.to_path_buf(), dir }
+        Ctx { path: path.to_path_buf(), dir, allow_outside: false }
     }
 
     pub fn builtin(name: &str) -> Self {
-        Ctx { path: PathBuf::from(format!("builtin:{name}")), dir: None }
+        Ctx { path: PathBuf::from(format!("builtin:{name}")), dir: None, allow_outside: false }
     }
 
     pub fn extras(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
@@ -37,13 +39,45 @@ impl Ctx {
     }
 
     /// Resolves a relative reference (already percent-decoded) against the scene's directory.
-    /// `at` names the referring field for the error when the scene has no directory.
+    /// `at` names the referring field for the error.
+    ///
+    /// Unless `allow_outside` is set, the reference must stay inside the scene's folder: no
+    /// absolute path, no `..` component, and no symlink that resolves outside the folder. A scene
+    /// downloaded from anywhere must not be able to read (and leak into a render or a message)
+    /// files such as `~/.ssh/id_ed25519` or `/etc/shadow`. The rule is in docs/scene-format.md.
     pub fn resolve(&self, at: &str, rel: &str) -> Result<PathBuf, SceneError> {
-        match &self.dir {
-            Some(d) => Ok(d.join(rel)),
-            None => {
-                Err(self.invalid(at, format!("'{rel}' is a file reference, but this scene has no directory")))
-            }
+        let Some(d) = &self.dir else {
+            return Err(
+                self.invalid(at, format!("'{rel}' is a file reference, but this scene has no directory"))
+            );
+        };
+        if self.allow_outside {
+            return Ok(d.join(rel));
         }
+        let refuse = |why: &str| {
+            self.invalid(
+                at,
+                format!(
+                    "'{rel}' {why}; file references must stay inside the scene's folder \
+                     (--allow-outside-scene-dir lifts this)"
+                ),
+            )
+        };
+        let p = Path::new(rel);
+        if p.has_root() || p.components().any(|c| matches!(c, Component::Prefix(_) | Component::RootDir)) {
+            return Err(refuse("is an absolute path"));
+        }
+        if p.components().any(|c| c == Component::ParentDir) {
+            return Err(refuse("contains '..'"));
+        }
+        let joined = d.join(p);
+        // Symlinks: compare where the file really is with where the folder really is. A file
+        // that does not exist yet is left for the read to report.
+        if let (Ok(real), Ok(root)) = (joined.canonicalize(), d.canonicalize())
+            && !real.starts_with(&root)
+        {
+            return Err(refuse("resolves (through a symbolic link) outside the folder"));
+        }
+        Ok(joined)
     }
 }

@@ -115,13 +115,8 @@ impl Environment {
     /// of linear radiance.
     pub fn load(path: &Path) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
-        let meta = std::fs::metadata(path).map_err(|e| err(format!("cannot read it: {e}")))?;
-        if !meta.is_file() {
-            return Err(err("not a regular file".into()));
-        }
-        if meta.len() > MAX_INPUT_BYTES {
-            return Err(err(format!("{} bytes is more than the {MAX_INPUT_BYTES} accepted", meta.len())));
-        }
+        // What kind of file it is before what its name says (a directory named x.hdr).
+        color::input::open_regular(path).map_err(|e| err(format!("cannot read it: {e}")))?;
         let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let format = match ext.as_deref() {
             Some("hdr") => image::ImageFormat::Hdr,
@@ -134,7 +129,9 @@ impl Environment {
                 ));
             }
         };
-        let mut reader = image::ImageReader::open(path).map_err(|e| err(format!("cannot read it: {e}")))?;
+        let bytes = color::input::read_regular(path, MAX_INPUT_BYTES)
+            .map_err(|e| err(format!("cannot read it: {e}")))?;
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         reader.set_format(format);
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_INPUT_WIDTH);
@@ -547,7 +544,7 @@ mod tests {
         let bad_exr = dir.join("corrupt.exr");
         std::fs::write(&bad_exr, [0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0, 1, 2, 3]).unwrap();
         assert!(Environment::load(&bad_exr).unwrap_err().to_string().contains("corrupt.exr"));
-        assert!(Environment::load(&dir).unwrap_err().to_string().contains("not a regular file"));
+        assert!(Environment::load(&dir).unwrap_err().to_string().contains("a directory"));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

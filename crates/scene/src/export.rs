@@ -184,6 +184,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
         if let Some(t) = &m.emissive_texture {
             j["emissiveTexture"] = tex(t);
         }
+        if m.unlit {
+            j["extensions"]["KHR_materials_unlit"] = json!({});
+        }
         let mut extras = serde_json::Map::new();
         match &m.spectral {
             Some(SpectralReflectance::Uniform(s)) => {
@@ -300,7 +303,7 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
 
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength"],
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"],
         "scene": 0,
         "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
         "nodes": nodes,

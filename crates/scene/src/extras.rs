@@ -49,7 +49,8 @@ fn check_reflectance(ctx: &Ctx, field: &str, s: &Spectrum) -> Result<(), SceneEr
     let (lo, hi) = (color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX);
     let max = s.max_value(lo, hi);
     let min = -s.scaled(-1.0).max_value(lo, hi);
-    if min < 0.0 || max > 1.0 {
+    // Written so that NaN fails too.
+    if !(min >= 0.0 && max <= 1.0) {
         return Err(ctx.extras(
             field,
             format!("a reflectance must lie in [0, 1], this one spans {min:.4}–{max:.4} over {lo}–{hi} nm"),

@@ -19,6 +19,8 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
+    "KHR_materials_unlit",
+    "KHR_materials_pbrSpecularGlossiness",
 ];
 
 pub(crate) const DECOMPRESS: &str =
@@ -80,11 +82,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_diffuse_transmission" => {
             ("diffuse transmission is ignored", "this renderer has no translucency")
         }
-        "KHR_materials_unlit" => ("unlit materials are shaded as lit", "this renderer has no unlit shading"),
-        "KHR_materials_pbrSpecularGlossiness" => (
-            "specular-glossiness materials are drawn with their metallic-roughness values",
-            "convert the materials to metallic-roughness, e.g. `npx @gltf-transform/cli metalrough in.glb out.glb`",
-        ),
         "KHR_materials_variants" => ("material variants are ignored; the default materials are drawn", ""),
         "KHR_animation_pointer" => ("animations are ignored; the scene is drawn at rest", ""),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),

@@ -11,6 +11,7 @@ use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::extras::{self, SceneExtras};
 use crate::primitive::Needs;
+use crate::spec_gloss;
 use crate::{
     AlphaMode, Camera, Emission, Filter, Light, LightKind, Material, Mesh, Sampler, Scene,
     SpectralReflectance, Texture, TextureRef, Wrap, gltf_ext, instancing, meshopt_decode, primitive, uri,
@@ -20,22 +21,56 @@ use crate::{
 /// file (one mesh referenced by many instances) must not exhaust memory.
 pub const MAX_TRIANGLES: usize = 20_000_000;
 
+/// Largest `.gltf`/`.glb` file, and largest external buffer (`.bin`), read (bytes). A scene at
+/// [`MAX_TRIANGLES`] fits; the cap keeps a hostile reference (a huge or growing file) from
+/// exhausting memory.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Largest encoded image file (PNG/JPEG) read for a texture (bytes).
+pub const MAX_IMAGE_FILE_BYTES: u64 = 256 << 20;
+/// Largest texture width or height, read from the image header before decoding.
+pub const MAX_IMAGE_DIMENSION: u32 = 16384;
+/// Largest decoded texture (bytes of RGBA8): 8192² (or 16384 × 4096).
+pub const MAX_IMAGE_DECODED_BYTES: u64 = 256 << 20;
+
+/// Largest light `intensity × max(color)` accepted (candela, lux for directional lights).
+/// The sun gives about 1.2·10⁵ lux; far larger finite values only overflow the renderers' f32
+/// arithmetic into black or NaN pixels.
+pub const MAX_LIGHT_INTENSITY: f32 = 1.0e9;
+/// Largest emissive component (`emissiveFactor × emissiveStrength`): radiance relative to the
+/// default sky's 1, as generous as the environment's intensity cap.
+pub const MAX_EMISSIVE: f32 = 1.0e6;
+
+/// How a scene file may be loaded.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions {
+    /// Let file references (buffers, images, CSV spectra, environment maps) leave the scene's
+    /// folder: absolute paths, `..`, symlinks pointing elsewhere. Off by default, so a scene
+    /// from elsewhere cannot read other files (`--allow-outside-scene-dir`).
+    pub allow_outside_scene_dir: bool,
+}
+
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
 ///
 /// Geometry is flattened to world space; spectral `extras` are resolved; errors name the file
 /// and the glTF index or JSON field at fault. What was ignored or approximated is listed in
 /// [`Scene::warnings`]. See `docs/scene-format.md`.
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] with options.
+pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, SceneError> {
     let path = path.as_ref();
-    let ctx = Ctx::file(path);
-    let bytes = std::fs::read(path).map_err(|e| ctx.io(path, e))?;
+    let mut ctx = Ctx::file(path);
+    ctx.allow_outside = opts.allow_outside_scene_dir;
+    let bytes = color::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| ctx.io(path, e))?;
     from_slice(&ctx, &bytes)
 }
 
-/// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given.
-/// `name` is used in messages in place of a path.
+/// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
+/// (and must stay inside it). `name` is used in messages in place of a path.
 pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, SceneError> {
-    let ctx = Ctx { path: name.into(), dir: base_dir.map(Path::to_path_buf) };
+    let ctx = Ctx { path: name.into(), dir: base_dir.map(Path::to_path_buf), allow_outside: false };
     from_slice(&ctx, bytes)
 }
 
@@ -43,6 +78,13 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
 /// extension objects).
 fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
+    // The `gltf` crate subtracts the 12-byte header from the declared length unchecked (an
+    // overflow panic in debug builds, found by crates/fuzz).
+    if bytes.starts_with(b"glTF")
+        && bytes.get(8..12).is_none_or(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) < 12)
+    {
+        return Err(ctx.invalid("GLB header", "the declared length is shorter than the 12-byte header"));
+    }
     let json = if bytes.starts_with(b"glTF") {
         gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.json.into_owned()
     } else {
@@ -76,6 +118,8 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
 
     let mut loader = Loader {
         ctx,
+        doc,
+        warnings: Vec::new(),
         raw: &raw,
         buffers: &buffers,
         textures: Vec::new(),
@@ -89,6 +133,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         materials.push(mat);
         needs.push(need);
     }
+    warnings.append(&mut loader.warnings);
     let default_material = materials.len();
     let mut uses_default = false;
 
@@ -288,7 +333,7 @@ fn load_buffers(
                 gltf::buffer::Source::Bin => blob
                     .ok_or_else(|| ctx.invalid(&at, "refers to the GLB binary chunk, but the file has none"))?
                     .to_vec(),
-                gltf::buffer::Source::Uri(u) => uri::read(ctx, &format!("{at}.uri"), u)?.0,
+                gltf::buffer::Source::Uri(u) => uri::read(ctx, &format!("{at}.uri"), u, MAX_FILE_BYTES)?.0,
             };
             if data.len() < b.length() {
                 return Err(ctx.invalid(
@@ -337,8 +382,15 @@ fn scene_extras(ctx: &Ctx, doc: &gltf::Document, scene: &gltf::Scene) -> Result<
 /// The camera of `cam` at node transform `world`, and a warning when it had to be changed.
 fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Option<String>), SceneError> {
     let at = format!("cameras[{}]", cam.index());
-    // A camera's frame is rigid; drop any scale the node hierarchy carries.
-    let (_, rot, pos) = world.to_scale_rotation_translation();
+    // A camera's frame is rigid; drop any scale the node hierarchy carries. A zero scale leaves
+    // no rotation to recover (the image would silently be black).
+    let (scale, rot, pos) = world.to_scale_rotation_translation();
+    if !(scale.abs().min_element() > 1e-12 && rot.is_finite() && rot.length() > 0.5) {
+        return Err(ctx.invalid(
+            at,
+            "the camera's node transform is degenerate (a scale of 0 somewhere in its hierarchy), so it has no direction",
+        ));
+    }
     let transform = Mat4::from_rotation_translation(rot.normalize(), pos);
     let p = match cam.projection() {
         gltf::camera::Projection::Perspective(p) => p,
@@ -400,6 +452,14 @@ fn light_of(
         ctx.invalid(format!("nodes[{}]", node.index()), "light node transform collapses its direction")
     })?;
     let range = l.range();
+    if let Some(r) = range
+        && !(r > 0.0 && r.is_finite())
+    {
+        return Err(ctx.invalid(
+            format!("{at}.range"),
+            format!("must be greater than 0 (KHR_lights_punctual), got {r}"),
+        ));
+    }
     let kind = match l.kind() {
         Kind::Point => LightKind::Point { position, range },
         Kind::Directional => LightKind::Directional { direction },
@@ -427,6 +487,15 @@ fn light_of(
     if !(rgb.is_finite() && rgb.min_element() >= 0.0 && intensity.is_finite() && intensity >= 0.0) {
         return Err(ctx.invalid(at, "color and intensity must be finite and non-negative"));
     }
+    if rgb.max_element() * intensity > MAX_LIGHT_INTENSITY {
+        return Err(ctx.invalid(
+            format!("{at}.intensity"),
+            format!(
+                "intensity × color is {:e}; at most {MAX_LIGHT_INTENSITY:e} is accepted",
+                rgb.max_element() * intensity
+            ),
+        ));
+    }
     let x = match extras::object(ctx, &at, l.extras())? {
         Some(map) => extras::light(ctx, &at, &map)?,
         None => extras::LightExtras::default(),
@@ -441,6 +510,9 @@ fn light_of(
 /// Material and texture conversion, with textures shared between materials and decoded once.
 struct Loader<'a> {
     ctx: &'a Ctx,
+    doc: &'a gltf::Document,
+    /// What the materials lose or approximate, for [`Scene::warnings`].
+    warnings: Vec<String>,
     /// The document's JSON, for extension objects the `gltf` crate does not parse.
     raw: &'a Value,
     buffers: &'a [Vec<u8>],
@@ -510,6 +582,7 @@ impl Loader<'_> {
         };
         let raw = self.raw.pointer(&format!("/materials/{idx}"));
         let info = |path: &str| raw.and_then(|r| r.pointer(path));
+        out.unlit = info("/extensions/KHR_materials_unlit").is_some();
         if let Some(t) = pbr.base_color_texture() {
             out.base_color_texture = Some(self.texture(
                 &format!("{at}.pbrMetallicRoughness.baseColorTexture"),
@@ -557,6 +630,9 @@ impl Loader<'_> {
                 info("/emissiveTexture"),
             )?);
         }
+        if let Some(sg) = info("/extensions/KHR_materials_pbrSpecularGlossiness") {
+            self.spec_gloss(&at, sg, &mut out)?;
+        }
         let values = [
             out.base_color.to_array().as_slice(),
             &[out.metallic, out.roughness, out.normal_scale],
@@ -565,6 +641,34 @@ impl Loader<'_> {
         .concat();
         if values.iter().any(|v| !v.is_finite()) || out.emissive.min_element() < 0.0 {
             return Err(self.ctx.invalid(&at, "factors must be finite (and emissive non-negative)"));
+        }
+        // glTF 2.0 gives these factors the range [0, 1]; outside it they are not materials
+        // (a negative albedo, a roughness of 5), and the renderers' results are meaningless.
+        let unit = [
+            (
+                "pbrMetallicRoughness.baseColorFactor",
+                out.base_color.min_element(),
+                out.base_color.max_element(),
+            ),
+            ("pbrMetallicRoughness.metallicFactor", out.metallic, out.metallic),
+            ("pbrMetallicRoughness.roughnessFactor", out.roughness, out.roughness),
+        ];
+        for (field, lo, hi) in unit {
+            if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) {
+                return Err(self.ctx.invalid(
+                    format!("{at}.{field}"),
+                    format!("must lie in [0, 1] (glTF 2.0), got values from {lo} to {hi}"),
+                ));
+            }
+        }
+        if out.emissive.max_element() > MAX_EMISSIVE {
+            return Err(self.ctx.invalid(
+                format!("{at}.emissiveFactor"),
+                format!(
+                    "emissiveFactor × emissiveStrength reaches {:e}; at most {MAX_EMISSIVE:e} is accepted",
+                    out.emissive.max_element()
+                ),
+            ));
         }
         let named = [
             ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),
@@ -580,6 +684,12 @@ impl Loader<'_> {
                 .find(|(_, t)| t.is_some_and(|t| t.tex_coord == 1))
                 .map(|(f, _)| format!("{at}.{f}")),
         };
+        if out.unlit {
+            // KHR_materials_unlit: the base colour is all the surface shows; its emission would
+            // otherwise be added to it and make it a light source.
+            out.emissive = Vec3::ZERO;
+            out.emissive_texture = None;
+        }
         let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok((out, needs)) };
         let x = extras::material(self.ctx, &at, &map)?;
         if matches!(x.reflectance, Some(SpectralReflectance::Palette(_))) && out.base_color_texture.is_none()
@@ -606,6 +716,83 @@ impl Loader<'_> {
             out.emission_spectrum = e.spectrum;
         }
         Ok((out, needs))
+    }
+
+    /// `KHR_materials_pbrSpecularGlossiness` (`sg` is its JSON) converted into `out`'s
+    /// metallic-roughness factors and textures (`spec_gloss`).
+    fn spec_gloss(&mut self, at: &str, sg: &Value, out: &mut Material) -> Result<(), SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_pbrSpecularGlossiness");
+        let factor = |key: &str, default: Vec4, n: usize| -> Result<Vec4, SceneError> {
+            let Some(v) = sg.get(key) else { return Ok(default) };
+            let nums: Option<Vec<f32>> = match v.as_array() {
+                Some(a) => a.iter().map(|x| x.as_f64().map(|x| x as f32)).collect(),
+                None => v.as_f64().map(|x| vec![x as f32]),
+            };
+            match nums {
+                Some(x) if x.len() == n && x.iter().all(|c| (0.0..=1.0).contains(c)) => {
+                    let mut f = default;
+                    for (i, c) in x.into_iter().enumerate() {
+                        f[i] = c;
+                    }
+                    Ok(f)
+                }
+                _ => Err(self.ctx.invalid(
+                    format!("{at}.{key}"),
+                    format!(
+                        "must be {} in [0, 1]",
+                        if n == 1 { "a number".to_string() } else { format!("{n} numbers") }
+                    ),
+                )),
+            }
+        };
+        let diffuse = factor("diffuseFactor", Vec4::ONE, 4)?;
+        let specular = factor("specularFactor", Vec4::ONE, 3)?.truncate();
+        let glossiness = factor("glossinessFactor", Vec4::ONE, 1)?.x;
+        let mut texture = |key: &str| -> Result<Option<TextureRef>, SceneError> {
+            let Some(info) = sg.get(key) else { return Ok(None) };
+            let field = format!("{at}.{key}");
+            let t = info
+                .get("index")
+                .and_then(Value::as_u64)
+                .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
+                .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
+            let tex_coord =
+                info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
+            self.texture(&field, t, tex_coord, true, Some(info)).map(Some)
+        };
+        let diffuse_tex = texture("diffuseTexture")?;
+        let mut sg_tex = texture("specularGlossinessTexture")?;
+        if let (Some(d), Some(g)) = (&diffuse_tex, &sg_tex)
+            && (d.tex_coord != g.tex_coord || d.transform != g.transform)
+        {
+            self.warnings.push(format!(
+                "{at}: the diffuse and specular-glossiness textures use different UV sets or transforms; \
+                 the material is converted from the diffuse texture and the specular/glossiness factors only"
+            ));
+            sg_tex = None;
+        }
+        let converted = spec_gloss::convert(diffuse, specular, glossiness);
+        out.base_color = converted.base_color;
+        out.metallic = converted.metallic;
+        out.roughness = converted.roughness;
+        out.base_color_texture = None;
+        out.metallic_roughness_texture = None;
+        let Some(placement) = diffuse_tex.or(sg_tex) else { return Ok(()) };
+        let source = |r: &Option<TextureRef>, factor: Vec4| spec_gloss::Source {
+            texture: r.map(|r| &self.textures[r.index]),
+            factor,
+        };
+        let (base, mr) = spec_gloss::convert_textures(
+            &out.name,
+            &source(&diffuse_tex, diffuse),
+            &source(&sg_tex, specular.extend(glossiness)),
+        );
+        let placed = |index: usize| TextureRef { index, ..placement };
+        out.base_color_texture = Some(placed(self.textures.len()));
+        out.metallic_roughness_texture = Some(placed(self.textures.len() + 1));
+        self.textures.extend([base, mr]);
+        (out.base_color, out.metallic, out.roughness) = (Vec4::ONE, 1.0, 1.0);
+        Ok(())
     }
 
     /// The texture of a textureInfo at `at` (`info` is its JSON): decoded once per glTF texture
@@ -645,16 +832,46 @@ impl Loader<'_> {
                         })?
                         .to_vec()
                 }
-                gltf::image::Source::Uri { uri, .. } => uri::read(self.ctx, &format!("{iat}.uri"), uri)?.0,
+                gltf::image::Source::Uri { uri, .. } => {
+                    uri::read(self.ctx, &format!("{iat}.uri"), uri, MAX_IMAGE_FILE_BYTES)?.0
+                }
             };
             if let Some((format, advice)) = gltf_ext::undecodable_image(&bytes) {
                 return Err(self
                     .ctx
                     .invalid(&iat, format!("is a {format} image, which is not supported; {advice}")));
             }
-            let decoded = image::ImageReader::new(std::io::Cursor::new(&bytes))
+            let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
                 .with_guessed_format()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            // Checked against the header before any pixel buffer is allocated: a few bytes of
+            // PNG can claim 2³¹ × 2³¹ pixels.
+            let (w, h) = reader
+                .into_dimensions()
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            if w > MAX_IMAGE_DIMENSION
+                || h > MAX_IMAGE_DIMENSION
+                || 4 * w as u64 * h as u64 > MAX_IMAGE_DECODED_BYTES
+            {
+                return Err(self.ctx.invalid(
+                    &iat,
+                    format!(
+                        "the image is {w}×{h}; at most {MAX_IMAGE_DIMENSION} on a side and {} MiB decoded \
+                         (RGBA8) are accepted",
+                        MAX_IMAGE_DECODED_BYTES >> 20
+                    ),
+                ));
+            }
+            let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+                .with_guessed_format()
+                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(MAX_IMAGE_DIMENSION);
+            limits.max_image_height = Some(MAX_IMAGE_DIMENSION);
+            // Decoding may hold the image at 16 bits per channel before conversion.
+            limits.max_alloc = Some(2 * MAX_IMAGE_DECODED_BYTES);
+            reader.limits(limits);
+            let decoded = reader
                 .decode()
                 .map_err(|e| self.ctx.invalid(&iat, format!("cannot decode image: {e}")))?
                 .into_rgba8();

@@ -65,7 +65,7 @@ pub(crate) fn transforms(
                     if !(len > 1e-6 && len.is_finite()) {
                         return Err(ctx.invalid(
                             format!("{at}.attributes.ROTATION"),
-                            format!("instance {i} has no rotation (quaternion {q})"),
+                            format!("instance {i} has no rotation (a zero or non-finite quaternion)"),
                         ));
                     }
                     q / len

@@ -21,6 +21,7 @@ mod instancing;
 mod meshopt_decode;
 mod primitive;
 pub mod sky;
+pub mod spec_gloss;
 pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
@@ -36,14 +37,22 @@ pub use builtin::{BUILTIN_NAMES, builtin};
 pub use environment::{Environment, EnvironmentError};
 pub use error::{Result, SceneError};
 pub use export::write_gltf;
-pub use gltf_file::{MAX_TRIANGLES, load, load_slice};
+pub use gltf_file::{
+    LoadOptions, MAX_EMISSIVE, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION,
+    MAX_IMAGE_FILE_BYTES, MAX_LIGHT_INTENSITY, MAX_TRIANGLES, load, load_slice, load_with,
+};
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
 /// argument ends in `.gltf` or `.glb` (any case), from that file.
 pub fn load_any(name_or_path: &str) -> Result<Scene> {
+    load_any_with(name_or_path, &LoadOptions::default())
+}
+
+/// [`load_any`] with options for a file.
+pub fn load_any_with(name_or_path: &str, opts: &LoadOptions) -> Result<Scene> {
     let lower = name_or_path.to_ascii_lowercase();
     if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-        load(Path::new(name_or_path))
+        load_with(Path::new(name_or_path), opts)
     } else {
         builtin(name_or_path)
     }
@@ -123,6 +132,12 @@ pub struct Material {
     /// Spectral radiance of the emission, scaled so its luminance equals that of `emissive`
     /// (same convention as [`Emission`]); `None` = upsample `emissive` as RGB.
     pub emission_spectrum: Option<Spectrum>,
+    /// `KHR_materials_unlit`: the surface shows its base colour (factor × texture × `COLOR_0`)
+    /// whatever the lighting, and reflects nothing. Both renderers draw it as an emitter whose
+    /// RGB is the base colour, upsampled like every RGB emission (the illuminant variant, so
+    /// white is the scene's white); it does not light other surfaces in real time, and in the
+    /// path tracer only through paths that hit it (it is not a light source).
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -146,6 +161,7 @@ impl Default for Material {
             double_sided: true,
             spectral: None,
             emission_spectrum: None,
+            unlit: false,
         }
     }
 }

@@ -106,13 +106,16 @@ pub(crate) fn build(
     if positions.len() != n || raw_idx.is_empty() {
         return Err(ctx.invalid(at, "the vertex data could not be read from its buffer"));
     }
-    if let Some(bad) = raw_idx.iter().find(|&&i| i as usize >= n) {
-        return Err(
-            ctx.invalid(format!("{at}.indices"), format!("index {bad} is out of range for {n} vertices"))
-        );
+    // Messages give positions, never the values read: a buffer may be a file that is not the
+    // scene's (see `Ctx::resolve`), and its bytes must not be echoed.
+    if let Some(k) = raw_idx.iter().position(|&i| i as usize >= n) {
+        return Err(ctx.invalid(
+            format!("{at}.indices"),
+            format!("index number {k} is out of range (not below the {n} vertices)"),
+        ));
     }
-    if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-        return Err(ctx.invalid(pos_at, format!("non-finite position {p}")));
+    if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(ctx.invalid(pos_at, format!("position {k} is not finite")));
     }
     if let Some(field) = &needs.set1_user
         && uvs1.is_empty()

@@ -19,8 +19,20 @@ use serde_json::Value;
 use crate::context::Ctx;
 use crate::error::SceneError;
 
-/// Parses and resolves a SpectrumDesc found at JSON path `field`.
+/// Parses and resolves a SpectrumDesc found at JSON path `field`, refusing one that evaluates
+/// to NaN or infinity anywhere in 360–830 nm (range checks such as [0, 1] for a reflectance
+/// compare with `max`, which skips NaN, so they cannot be relied on to catch it).
 pub(crate) fn resolve(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
+    let s = resolve_unchecked(ctx, field, v)?;
+    let (lo, hi) = (color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX);
+    let steps = (hi - lo).round() as usize;
+    if let Some(l) = (0..=steps).map(|i| lo + i as f64).find(|&l| !s.eval(l).is_finite()) {
+        return Err(ctx.extras(field, format!("the spectrum is not finite at {l} nm")));
+    }
+    Ok(s)
+}
+
+fn resolve_unchecked(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, SceneError> {
     let err = |f: &str, m: String| ctx.extras(f, m);
     match v {
         Value::String(name) => color::illuminant::by_name(name).map_err(|e| err(field, e.to_string())),
@@ -136,10 +148,25 @@ pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
     }
 }
 
+/// Largest CSV spectrum file read (bytes): a spectrum sampled every 0.01 nm over 200–2000 nm
+/// is well under it.
+pub const MAX_CSV_BYTES: u64 = 16 << 20;
+
 /// Reads a two-column CSV spectrum; errors carry the line number.
 pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result<Spectrum, SceneError> {
-    let bytes =
-        std::fs::read(file).map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
+    let bytes = color::input::read_regular(file, MAX_CSV_BYTES)
+        .map_err(|e| ctx.extras(field, format!("cannot read {}: {e}", file.display())))?;
+    parse_csv(ctx, field, file, &bytes)
+}
+
+/// Parses the bytes of a CSV spectrum `name` as a scene's `{"csv": …}` would (for tools and the
+/// fuzz harness); the error is the one-line message a scene would give.
+pub fn csv_spectrum(name: &str, bytes: &[u8]) -> Result<Spectrum, SceneError> {
+    let ctx = Ctx::builtin("csv");
+    parse_csv(&ctx, "csv", std::path::Path::new(name), bytes)
+}
+
+fn parse_csv(ctx: &Ctx, field: &str, file: &std::path::Path, bytes: &[u8]) -> Result<Spectrum, SceneError> {
     let csv_err = |line: u64, message: String| SceneError::Csv {
         path: ctx.path.clone(),
         field: field.to_string(),
@@ -152,7 +179,7 @@ pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result
         .flexible(true)
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_reader(bytes.as_slice());
+        .from_reader(bytes);
     let (mut lambda, mut values, mut lines) = (Vec::new(), Vec::new(), Vec::new());
     for (n, rec) in rdr.records().enumerate() {
         let rec = rec.map_err(|e| {
@@ -178,11 +205,11 @@ pub(crate) fn read_csv(ctx: &Ctx, field: &str, file: &std::path::Path) -> Result
             }
             // The first row may be a header such as `wavelength,value`.
             _ if lambda.is_empty() && n == 0 && parse(&rec[0]).is_none() => {}
-            _ => {
-                return Err(csv_err(
-                    line,
-                    format!("cannot read '{}', '{}' as two finite numbers", &rec[0], &rec[1]),
-                ));
+            (l, _) => {
+                // Which column, not its text: the file may not be a spectrum at all (a
+                // mistyped or hostile reference), and its content must not be echoed.
+                let col = if l.is_none() { "1 (wavelength)" } else { "2 (value)" };
+                return Err(csv_err(line, format!("column {col} is not a finite number")));
             }
         }
     }
@@ -249,7 +276,7 @@ mod tests {
         let e = msg(json!({"sampled": {"wavelengths": [400, 500], "values": [1, 1], "scale": 2}}));
         assert!(e.contains("sampled.scale") && e.contains("unknown key"), "{e}");
         let e = msg(json!({"blackbody": -5}));
-        assert!(e.contains("blackbody") && e.contains("positive"), "{e}");
+        assert!(e.contains("blackbody") && e.contains("500–1000000 K"), "{e}");
         let e = msg(json!({"colorchecker": 25}));
         assert!(e.contains("1–24"), "{e}");
         let e = msg(json!({"colorchecker": "neutral"}));
@@ -265,7 +292,12 @@ mod tests {
     #[test]
     fn csv_errors_carry_line_numbers() {
         let e = msg(json!({"csv": "bad_value.csv"}));
-        assert!(e.contains("bad_value.csv: line 4") && e.contains("abc"), "{e}");
+        assert!(
+            e.contains("bad_value.csv: line 4")
+                && e.contains("column 2 (value) is not a finite number")
+                && !e.contains("abc"),
+            "{e}"
+        );
         let e = msg(json!({"csv": "not_increasing.csv"}));
         assert!(e.contains("line 3") && e.contains("increase strictly"), "{e}");
         let e = msg(json!({"csv": "missing.csv"}));

@@ -7,8 +7,14 @@ use base64::Engine;
 use crate::context::Ctx;
 use crate::error::SceneError;
 
-/// The bytes a glTF `uri` at field `at` refers to, and the MIME type a data URI declares.
-pub(crate) fn read(ctx: &Ctx, at: &str, uri: &str) -> Result<(Vec<u8>, Option<String>), SceneError> {
+/// The bytes a glTF `uri` at field `at` refers to (a file of at most `max_bytes`), and the MIME
+/// type a data URI declares.
+pub(crate) fn read(
+    ctx: &Ctx,
+    at: &str,
+    uri: &str,
+    max_bytes: u64,
+) -> Result<(Vec<u8>, Option<String>), SceneError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (header, payload) = rest
             .split_once(',')
@@ -33,7 +39,7 @@ pub(crate) fn read(ctx: &Ctx, at: &str, uri: &str) -> Result<(Vec<u8>, Option<St
         .decode_utf8()
         .map_err(|e| ctx.invalid(at, format!("'{uri}' is not valid percent-encoded UTF-8: {e}")))?;
     let file = ctx.resolve(at, &decoded)?;
-    let bytes = std::fs::read(&file)
+    let bytes = color::input::read_regular(&file, max_bytes)
         .map_err(|e| ctx.invalid(at, format!("cannot read '{}' ({}): {e}", decoded, file.display())))?;
     Ok((bytes, None))
 }

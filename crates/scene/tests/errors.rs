@@ -98,7 +98,7 @@ fn unsupported_geometry_and_structure() {
     );
     expect(
         &mutate(|d| d["buffers"][0]["uri"] = json!(uri)),
-        &["meshes[0].primitives[0].indices", "index 9", "4 vertices"],
+        &["meshes[0].primitives[0].indices", "index number 0 is out of range", "4 vertices"],
     );
 }
 

@@ -653,3 +653,86 @@ fn orthographic_cameras_are_read() {
         assert_has(&error(&d), &["cameras[0].orthographic", field]);
     }
 }
+
+#[test]
+fn unlit_materials_load_as_unlit_without_emission_and_round_trip() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_unlit"],
+        "extensionsRequired": ["KHR_materials_unlit"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0}, {"attributes": {"POSITION": pos}, "material": 1}]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1.0, 1.0]}, "emissiveFactor": [1.0, 1.0, 1.0],
+             "extensions": {"KHR_materials_unlit": {}}},
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1.0, 1.0]}}
+        ],
+    }));
+    let s = load(&doc).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let (u, lit) = (&s.materials[0], &s.materials[1]);
+    assert!(u.unlit && !lit.unlit);
+    assert_eq!(u.base_color, Vec4::new(0.5, 0.25, 1.0, 1.0));
+    // Its emission would make it a light source: dropped, as the extension's shading ignores it.
+    assert_eq!(u.emissive, Vec3::ZERO);
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert!(back.materials[0].unlit && !back.materials[1].unlit);
+}
+
+#[test]
+fn specular_glossiness_materials_are_converted_to_metallic_roughness() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let sg = |x: Value| json!({"extensions": {"KHR_materials_pbrSpecularGlossiness": x}});
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos}, "material": m});
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_pbrSpecularGlossiness"],
+        "extensionsRequired": ["KHR_materials_pbrSpecularGlossiness"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2)]}],
+        "materials": [
+            // Copper: black diffuse, coloured specular, glossy.
+            sg(json!({"diffuseFactor": [0.0, 0.0, 0.0, 1.0], "specularFactor": [0.95, 0.64, 0.54], "glossinessFactor": 0.8})),
+            // A dielectric: diffuse colour, 0.04 grey specular.
+            sg(json!({"diffuseFactor": [0.5, 0.2, 0.1, 0.7], "specularFactor": [0.04, 0.04, 0.04], "glossinessFactor": 0.25})),
+            // Textured: both textures on the same UVs.
+            sg(json!({"diffuseTexture": {"index": 0}, "specularGlossinessTexture": {"index": 0},
+                      "specularFactor": [0.04, 0.04, 0.04]})),
+        ],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    let s = load(&doc).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let (cu, die, tex) = (&s.materials[0], &s.materials[1], &s.materials[2]);
+    assert!((cu.metallic - 1.0).abs() < 1e-4 && (cu.roughness - 0.2).abs() < 1e-6, "{cu:?}");
+    assert!(cu.base_color.abs_diff_eq(Vec4::new(0.95, 0.64, 0.54, 1.0), 1e-4), "{cu:?}");
+    assert!(die.metallic.abs() < 1e-6 && (die.roughness - 0.75).abs() < 1e-6, "{die:?}");
+    assert!(die.base_color.abs_diff_eq(Vec4::new(0.5, 0.2, 0.1, 0.7), 1e-4), "{die:?}");
+    // The textured one gets two new textures (base colour sRGB, metallic-roughness linear) at
+    // the source's size, with the factors folded into them.
+    let (b, mr) = (tex.base_color_texture.unwrap(), tex.metallic_roughness_texture.unwrap());
+    let (bt, mt) = (&s.textures[b.index], &s.textures[mr.index]);
+    assert!(bt.srgb && !mt.srgb && (bt.width, bt.height, mt.width, mt.height) == (2, 2, 2, 2));
+    assert_eq!((tex.base_color, tex.metallic, tex.roughness), (Vec4::ONE, 1.0, 1.0));
+    // Texel 0 of png_uri is opaque red: base red, alpha 255, glossiness 1 → roughness 0.
+    assert_eq!(&bt.rgba8[0..4], &[255, 0, 0, 255]);
+    assert_eq!((mt.rgba8[1], mt.rgba8[2]), (0, 0));
+    // Texel 1 is green with alpha 128: glossiness 128/255 → roughness 127/255.
+    assert_eq!(mt.rgba8[5], 127);
+
+    // Out-of-range factors are named.
+    let mut bad = doc.clone();
+    bad["materials"][0]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["glossinessFactor"] = json!(1.5);
+    assert_has(
+        &error(&bad),
+        &["materials[0].extensions.KHR_materials_pbrSpecularGlossiness.glossinessFactor", "[0, 1]"],
+    );
+    let mut bad = doc.clone();
+    bad["materials"][2]["extensions"]["KHR_materials_pbrSpecularGlossiness"]["diffuseTexture"]["index"] =
+        json!(7);
+    assert_has(&error(&bad), &["diffuseTexture.index", "no texture"]);
+}

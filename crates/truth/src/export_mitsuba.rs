@@ -126,6 +126,9 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
             if m.emissive_texture.is_some() {
                 unsupported.push(format!("material {i} '{}': emissive texture", m.name));
             }
+            if m.unlit {
+                unsupported.push(format!("material {i} '{}': unlit (KHR_materials_unlit)", m.name));
+            }
             if m.alpha_mode != scene::AlphaMode::Opaque {
                 unsupported.push(format!("material {i} '{}': alpha mode {:?}", m.name, m.alpha_mode));
             }

@@ -336,3 +336,30 @@ fn nan_alpha_cutoff_is_an_error() {
     let e = World::new(&scene, &GreyOnly, &d65(), WavelengthRange::VISIBLE, None).err().unwrap();
     assert!(e.to_string().contains("alpha cutoff"), "{e}");
 }
+
+#[test]
+fn unlit_surfaces_emit_their_base_colour_and_reflect_nothing() {
+    // A grey unlit quad at y = 1 under the point light, seen from above: its colour × COLOR_0,
+    // upsampled as RGB emission, whatever the light; with every bounce allowed, the path ends
+    // on it (nothing reflected, so no noise at all).
+    let unlit = Material { unlit: true, ..grey(0.5) };
+    let mut s = floor_quad_light(unlit, Vec3::Y);
+    s.meshes[1].colors = vec![Vec4::new(1.2, 1.2, 1.2, 1.0); s.meshes[1].positions.len()];
+    let mut dark = s.clone();
+    dark.lights.clear();
+    let expected = {
+        let w = world(&s);
+        w.units.rgb(Vec3::splat(0.6), &GreyOnly, wl().0)
+    };
+    for scene in [&s, &dark] {
+        let w = world(scene);
+        let integ = Integrator { world: &w, direct_only: false, max_depth: 8, lambert: false };
+        let mut rng = Sampler::new(7, 0);
+        for _ in 0..16 {
+            let l = integ.radiance(Vec3::new(0.1, 1.5, 0.2), -Vec3::Y, &wl(), &mut rng);
+            assert!((l - expected).abs().max_element() < 1e-5 * expected.max_element(), "{l} vs {expected}");
+        }
+    }
+    // Not a light source: next-event estimation never samples it.
+    assert_eq!(world(&dark).emitters.pmf.iter().sum::<f32>(), 0.0);
+}

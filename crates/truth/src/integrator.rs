@@ -275,12 +275,16 @@ impl Integrator<'_, '_> {
             if (self.direct_only && depth >= 1) || depth + 1 > self.max_depth {
                 break;
             }
+            let mat = &w.scene.materials[s.material];
+            if mat.unlit {
+                // Unlit surfaces reflect nothing: the path ends in their colour.
+                break;
+            }
 
             // Double-sided materials face their normals towards the viewer; a single-sided one
             // is hit from the front only (`World::coverage`), so the flip never applies to it.
             let flip = if s.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
             let ng = s.ng * flip;
-            let mat = &w.scene.materials[s.material];
             let mut ns = material::mapped_normal(mat, &w.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
             if ns.dot(wo) <= 0.0 {
                 ns = ng;

@@ -110,6 +110,16 @@ pub fn base_reflectance(
     upsample::reflectance(up, rgb.to_array(), l)
 }
 
+/// What an unlit surface (`KHR_materials_unlit`) shows, as linear RGB: base factor × `COLOR_0`
+/// × texture, the colour a lit surface's reflectance would have had.
+pub fn unlit_rgb(m: &Material, textures: &[Texture], tc: &TexCoords, color: Vec4) -> Vec3 {
+    let factor = m.base_color.truncate() * color.truncate();
+    match tex(textures, &m.base_color_texture, tc) {
+        Some((t, uv)) => texture::sample(t, uv).truncate() * factor,
+        None => factor,
+    }
+}
+
 /// (metallic, roughness) with the texture applied (glTF: B = metallic, G = roughness).
 pub fn metallic_roughness(m: &Material, textures: &[Texture], tc: &TexCoords) -> (f32, f32) {
     match tex(textures, &m.metallic_roughness_texture, tc) {

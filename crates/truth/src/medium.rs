@@ -11,6 +11,11 @@ use color::{Spectrum, WavelengthRange};
 use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
 
+/// Largest absorption or scattering coefficient accepted (per scene unit): a mean free path of
+/// 10⁻⁶ units. Larger finite values (1e38, 1e39) overflow the tracer's f32 transmittance into
+/// black or NaN pixels.
+pub const MAX_SIGMA: f64 = 1.0e6;
+
 /// Where a medium is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Region {
@@ -48,6 +53,7 @@ pub struct Medium {
 impl Medium {
     /// Checks that the coefficients are finite and non-negative over `range` (1 nm steps) and
     /// that the phase function and region make sense.
+    /// Also refuses coefficients above [`MAX_SIGMA`].
     pub fn validate(&self, range: WavelengthRange) -> Result<()> {
         let bad = |s: String| Err(TruthError::BadMedium(s));
         for (name, s) in [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)] {
@@ -55,8 +61,10 @@ impl Medium {
             for i in 0..=n {
                 let l = (range.min + i as f64).min(range.max);
                 let v = s.eval(l);
-                if !v.is_finite() || v < 0.0 {
-                    return bad(format!("{name} is {v} at {l} nm; coefficients must be finite and ≥ 0"));
+                if !(0.0..=MAX_SIGMA).contains(&v) {
+                    return bad(format!(
+                        "{name} is {v} at {l} nm; coefficients must lie in 0–{MAX_SIGMA:e} per scene unit"
+                    ));
                 }
             }
         }

@@ -50,7 +50,18 @@ fn vec3(origin: &str, key: &str, v: Option<&Value>) -> Result<Vec3> {
     Ok(Vec3::new(f(0)? as f32, f(1)? as f32, f(2)? as f32))
 }
 
+/// Largest `--medium` file read (bytes); a sampled coefficient at 0.1 nm steps is far below it.
+pub const MAX_MEDIUM_FILE_BYTES: u64 = 1 << 20;
+
 impl Medium {
+    /// Reads and parses a medium file (only a regular file, at most [`MAX_MEDIUM_FILE_BYTES`]).
+    pub fn read(path: &std::path::Path) -> Result<Medium> {
+        let origin = path.display().to_string();
+        let text = color::input::read_regular_string(path, MAX_MEDIUM_FILE_BYTES)
+            .map_err(|e| bad(&origin, format!("cannot read: {e}")))?;
+        Self::from_json(&text, &origin)
+    }
+
     /// Parses the JSON form; `origin` (a file name) prefixes every error. Values are checked
     /// by [`Medium::validate`] at render time, against the render's wavelength range.
     pub fn from_json(text: &str, origin: &str) -> Result<Medium> {
@@ -93,6 +104,14 @@ impl Medium {
 mod tests {
     use super::*;
     use color::WavelengthRange;
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_are_not_read() {
+        // The old `read_to_string` read /dev/zero until memory ran out.
+        let e = Medium::read(std::path::Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("a device"), "{e}");
+    }
 
     #[test]
     fn parses_the_documented_form() {

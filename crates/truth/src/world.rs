@@ -297,6 +297,11 @@ impl<'s> World<'s> {
     /// on the side the vertex normals point to.
     pub fn emitted(&self, s: &SurfacePoint, wo: Vec3, l: Vec4) -> Vec4 {
         let m = &self.scene.materials[s.material];
+        if m.unlit {
+            // Seen from whichever side is visible: a single-sided back face is never hit.
+            let rgb = material::unlit_rgb(m, &self.scene.textures, &s.tc, s.color);
+            return self.units.rgb(rgb, self.upsampler, l);
+        }
         if m.emissive == Vec3::ZERO || s.n_vertex.dot(wo) <= 0.0 {
             return Vec4::ZERO;
         }

@@ -43,6 +43,57 @@ pub fn cache_path(space: &RgbColorSpace) -> Result<PathBuf> {
     Ok(cache_dir()?.join(format!("{}-{TABLE_RES}-v{TABLE_VERSION}.coeff", space.name)))
 }
 
+/// Marks the signature this cache appends after a table's payload (readers of `.coeff` files,
+/// ours and Mitsuba's, ignore trailing bytes).
+const SIGNATURE_TAG: &[u8] = b"\nspectra-cache-signature fnv1a64=";
+
+/// Most mean round-trip ΔE2000 a cached table may show on 32 random colours. Fitted tables are
+/// below it (2.7 even at 8³, the coarsest the tests fit; far less at 64³); a well-formed but
+/// wrong table is above it (all zeros, every colour the same grey: 24.6).
+const MAX_CACHED_MEAN_DE: f64 = 10.0;
+
+/// FNV-1a, 64 bits: enough to tell a damaged or substituted payload from the one we wrote (not
+/// a defence against someone forging it, which the round trip below covers for useless tables).
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+/// The `.coeff` bytes of `t` with this cache's signature appended.
+fn signed_bytes(t: &CoeffTable) -> Vec<u8> {
+    let mut out = t.to_bytes();
+    let sum = fnv1a64(&out);
+    out.extend_from_slice(SIGNATURE_TAG);
+    out.extend_from_slice(format!("{sum:016x}\n").as_bytes());
+    out
+}
+
+/// Writes a table to the cache atomically, signed.
+fn write_cached(t: &CoeffTable, path: &std::path::Path) -> Result<()> {
+    t.validate(&path.display().to_string())?;
+    crate::upsample::table::write_atomic(path, &signed_bytes(t))
+}
+
+/// The table cached at `path`, if it is one this cache wrote for `space` at resolution `res`:
+/// its signature matches its payload and a round trip of a few colours is accurate. Anything
+/// else (missing, truncated, damaged, unsigned, or well-formed but wrong) is `None`, to be
+/// refitted.
+pub fn read_cached(path: &std::path::Path, space: &RgbColorSpace, res: usize) -> Option<CoeffTable> {
+    let cap = CoeffTable::file_len(res) as u64 + 64;
+    let bytes = crate::input::read_regular(path, cap).ok()?;
+    let t = CoeffTable::from_bytes(&bytes, &path.display().to_string()).ok()?;
+    if t.res != res {
+        return None;
+    }
+    let (payload, trailer) = bytes.split_at(CoeffTable::file_len(res));
+    let hex = trailer.strip_prefix(SIGNATURE_TAG)?.strip_suffix(b"\n")?;
+    let sum = u64::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?;
+    if sum != fnv1a64(payload) {
+        return None;
+    }
+    let rt = crate::upsample::roundtrip::roundtrip_table(&t, space, 32, 1).ok()?;
+    (rt.stats.mean <= MAX_CACHED_MEAN_DE).then_some(t)
+}
+
 /// A progress bar on stderr (hidden automatically when stderr is not a terminal).
 pub fn fit_progress(what: &str) -> ProgressBar {
     let pb = ProgressBar::new(0);
@@ -59,9 +110,7 @@ pub fn fit_progress(what: &str) -> ProgressBar {
 /// [`crate::upsample::fit_default_res`] fit, written atomically to `path` (a failed write is
 /// not an error: the table is still good, it only costs a refit next time).
 pub fn load_or_fit(path: &std::path::Path, space: &RgbColorSpace, res: usize) -> Result<CoeffTable> {
-    if let Ok(t) = CoeffTable::read(path)
-        && t.res == res
-    {
+    if let Some(t) = read_cached(path, space, res) {
         return Ok(t);
     }
     let pb = fit_progress(&format!(
@@ -73,7 +122,7 @@ pub fn load_or_fit(path: &std::path::Path, space: &RgbColorSpace, res: usize) ->
     if let Some(dir) = path.parent() {
         let _ = std::fs::create_dir_all(dir);
     }
-    let _ = t.write(path);
+    let _ = write_cached(&t, path);
     Ok(t)
 }
 
@@ -92,9 +141,9 @@ pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
         return Ok(t);
     }
     let path = cache_path(space)?;
-    let table = match CoeffTable::read(&path) {
-        Ok(t) if t.res == TABLE_RES => t,
-        _ => {
+    let table = match read_cached(&path, space, TABLE_RES) {
+        Some(t) => t,
+        None => {
             let pb = fit_progress(&format!(
                 "fitting the {} spectral table (once; cached in {})",
                 space.name,
@@ -105,7 +154,7 @@ pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
                 let _ = std::fs::create_dir_all(dir);
             }
             // A read-only cache only means fitting again next time; the table is still good.
-            let _ = t.write(&path);
+            let _ = write_cached(&t, &path);
             t
         }
     };
@@ -133,5 +182,31 @@ mod tests {
         assert_eq!(load_or_fit(&path, &space, 8).unwrap(), fitted);
         assert_eq!(std::fs::read(&path).unwrap(), bytes);
         assert_eq!(std::fs::read_dir(path.parent().unwrap()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_well_formed_but_wrong_cached_table_is_refitted() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("srgb-8.coeff");
+        let space = RgbColorSpace::srgb();
+        let fitted = load_or_fit(&path, &space, 8).unwrap();
+        let good = std::fs::read(&path).unwrap();
+        assert!(read_cached(&path, &space, 8).is_some());
+        let zeros = CoeffTable { res: 8, scale: fitted.scale.clone(), data: vec![0.0; fitted.data.len()] };
+        // All zeros, plainly written (as the old cache did, or another tool): no signature.
+        zeros.write(&path).unwrap();
+        assert!(read_cached(&path, &space, 8).is_none());
+        assert_eq!(load_or_fit(&path, &space, 8).unwrap(), fitted);
+        assert_eq!(std::fs::read(&path).unwrap(), good);
+        // All zeros with a valid signature: the round trip catches it.
+        write_cached(&zeros, &path).unwrap();
+        assert!(read_cached(&path, &space, 8).is_none());
+        // One flipped bit in the payload: the signature catches it.
+        let mut flipped = good.clone();
+        flipped[1000] ^= 0x10;
+        std::fs::write(&path, &flipped).unwrap();
+        assert!(read_cached(&path, &space, 8).is_none());
+        assert_eq!(load_or_fit(&path, &space, 8).unwrap(), fitted);
+        assert_eq!(std::fs::read(&path).unwrap(), good);
     }
 }

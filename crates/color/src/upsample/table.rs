@@ -158,7 +158,10 @@ impl CoeffTable {
     /// Reads a `.coeff` file; errors name the file.
     pub fn read(path: &Path) -> Result<Self> {
         let origin = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| table_err(&origin, format!("cannot read: {e}")))?;
+        // A table at MAX_RES plus room for a trailer (Mitsuba appends one).
+        let cap = Self::file_len(MAX_RES) as u64 + crate::input::MIB;
+        let bytes = crate::input::read_regular(path, cap)
+            .map_err(|e| table_err(&origin, format!("cannot read: {e}")))?;
         Self::from_bytes(&bytes, &origin)
     }
 
@@ -279,6 +282,16 @@ mod tests {
             }
         }
         t
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn devices_and_directories_are_not_read() {
+        // The old `fs::read` read /dev/zero until memory ran out.
+        let e = CoeffTable::read(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("a device"), "{e}");
+        let e = CoeffTable::read(Path::new("/tmp")).unwrap_err().to_string();
+        assert!(e.contains("a directory"), "{e}");
     }
 
     #[test]

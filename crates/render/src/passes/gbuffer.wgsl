@@ -34,7 +34,8 @@ fn vs_main(v: VertexIn) -> VertexOut {
 }
 
 struct GBufferOut {
-    // rgb linear base colour, a metallic.
+    // rgb linear base colour, a metallic; a = UNLIT_MARK (negative) marks an unlit surface,
+    // whose colour is then in `emission`.
     @location(0) base: vec4<f32>,
     // xyz unit world normal, w roughness.
     @location(1) normal: vec4<f32>,
@@ -73,6 +74,11 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     o.normal = vec4<f32>(n, clamp(material.params.y * mr.g, 0.0, 1.0));
     let ao = 1.0 + material.params.w * (occlusion - 1.0);
     o.emission = vec4<f32>(emissive, clamp(ao, 0.0, 1.0));
+    if (material.alpha.w > 0.5) {
+        // KHR_materials_unlit: the base colour is what the surface shows; it reflects nothing.
+        o.base = vec4<f32>(0.0, 0.0, 0.0, UNLIT_MARK);
+        o.emission = vec4<f32>(base.rgb, 1.0);
+    }
     return o;
 }
 

@@ -168,9 +168,23 @@ pub(crate) fn fullscreen_pipeline_entry(
         bind_group_layouts: layouts,
         immediate_size: 0,
     });
+    fullscreen_pipeline_with(device, label, module, &layout, format, entry, &[])
+}
+
+/// [`fullscreen_pipeline_entry`] with a pipeline layout and values for the fragment shader's
+/// pipeline-overridable constants.
+pub(crate) fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
-        layout: Some(&layout),
+        layout: Some(layout),
         vertex: wgpu::VertexState {
             module,
             entry_point: Some("vs_fullscreen"),
@@ -183,7 +197,7 @@ pub(crate) fn fullscreen_pipeline_entry(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState {
                 format,
                 blend: None,

@@ -18,6 +18,15 @@ const MAX_SHADOWS: u32 = 8u;
 // Value of `layer_of_light` for a light without a shadow map.
 const NO_SHADOW: u32 = 0xffffffffu;
 
+// Features a scene may not need, set per pipeline (`Variant` in src/passes/shading.rs): without
+// them the driver compiles the shader without their code.
+override HAS_POLYGONS: bool = true;
+override HAS_ENV: bool = true;
+
+fn shading_env() -> bool {
+    return HAS_ENV && env_enabled();
+}
+
 // Layout must match `ShadowUniforms` in src/passes/shadow.rs.
 struct ShadowUniforms {
     view_proj: array<mat4x4<f32>, MAX_SHADOWS>,
@@ -58,7 +67,7 @@ fn lambert_only() -> bool {
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
 fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
-    if (u32(lights[li].pos_kind.w) == 3u) {
+    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
         return polygon_factors(li, p, n, v, metallic, roughness);
     }
     let inc = light_incidence(li, p);
@@ -287,13 +296,15 @@ struct GSurface {
     roughness: f32,
     // The material's ambient occlusion (glTF occlusionTexture), for the environment only.
     occlusion: f32,
+    // KHR_materials_unlit: only `emission` (its base colour) leaves the surface.
+    unlit: bool,
 };
 
 fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let e = textureLoad(gbuf_emission, px, 0);
-    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), b.a, nr.w, e.a);
+    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0);
 }
 
 // RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
@@ -308,19 +319,20 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         ctx.normal = s.normal;
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
-        for (var li = 0u; li < min(frame.n_lights, MAX_LIGHTS); li++) {
+        let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+        for (var li = 0u; li < n_lit; li++) {
             let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness);
             let e = lights[li].rgb.rgb;
             sum_a = fma(vec3<f32>(f.x), e, sum_a);
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
         }
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
-        if (env_enabled()) {
+        if (shading_env() && !s.unlit) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
             let vis = s.occlusion * env_occlusion(in.pos.xy, ctx.world_pos, s.normal);
             rgb += (s.base * et.a.rgb + et.b.rgb) * vis;
         }
-    } else if (env_enabled() && env.flags.y != 0u) {
+    } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
     return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
@@ -342,10 +354,10 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     var fb: array<f32, MAX_LIGHTS>;
     // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
     var et: EnvTerms;
-    let has_env = env_enabled();
+    let has_env = shading_env();
     if (!background) {
         let s = load_surface(px);
-        if (has_env) {
+        if (has_env && !s.unlit) {
             et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
             let vis = s.occlusion * env_occlusion(in.pos.xy, p, s.normal);
             et.a *= vis;
@@ -354,7 +366,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         base = s.base;
         emission = s.emission;
         ctx.normal = s.normal;
-        n_lights = min(frame.n_lights, MAX_LIGHTS);
+        n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
             let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness);
             fa[li] = f.x;

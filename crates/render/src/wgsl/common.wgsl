@@ -36,6 +36,9 @@ const MODE_RGB: u32 = 0u;
 const MODE_NAIVE: u32 = 1u;
 const MODE_SPECTRAL: u32 = 2u;
 const PI: f32 = 3.14159265358979;
+// The G-buffer's metallic channel of an unlit surface (KHR_materials_unlit): out of [0, 1], so
+// shading can tell it apart; its colour is stored as emission.
+const UNLIT_MARK: f32 = -1.0;
 
 // World position of a pixel from its depth (wgpu depth 0..1, y down in pixel space).
 fn world_from_depth(pixel: vec2<f32>, depth: f32, f: FrameUniforms) -> vec3<f32> {

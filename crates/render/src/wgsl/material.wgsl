@@ -10,7 +10,7 @@ struct MaterialUniforms {
     // x metallic, y roughness, z = 1 when the mesh has tangents and a normal map, w occlusion
     // strength (0 without an occlusion texture).
     params: vec4<f32>,
-    // x alpha mode (ALPHA_*), y alpha cutoff, z = 1 when double-sided.
+    // x alpha mode (ALPHA_*), y alpha cutoff, z = 1 when double-sided, w = 1 when unlit.
     alpha: vec4<f32>,
     // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
     // (m10, m11, m12, 0); uv' = M · (u, v, 1).

@@ -32,6 +32,8 @@ pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
+    pub files: super::SceneFileArgs,
+    #[command(flatten)]
     pub env: super::EnvArgs,
     /// Frame size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
@@ -273,8 +275,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.csv {
         super::check_output("--csv", path)?;
     }
-    let mut scene =
-        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.env.apply(&mut scene)?;
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;

@@ -22,6 +22,8 @@ pub struct Args {
     /// Built-in scene name or a .gltf/.glb file.
     #[arg(long, default_value = "metamerism")]
     pub scene: String,
+    #[command(flatten)]
+    pub files: super::SceneFileArgs,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "480x360")]
     pub size: String,
@@ -55,7 +57,9 @@ pub fn run(a: Args) -> Result<()> {
     for out in [&truth, &file("truth.png")] {
         let argv =
             ["truth", &a.scene, "--direct-only", "--spp", &spp, "--size", &a.size, "--out", path_str(out)?];
-        super::truth::run(parse(&argv)?)?;
+        let mut args: super::truth::Args = parse(&argv)?;
+        args.files = a.files.clone();
+        super::truth::run(args)?;
     }
 
     eprintln!("2/3 real-time renderer: rgb, naive and spectral modes");
@@ -64,7 +68,9 @@ pub fn run(a: Args) -> Result<()> {
         for ext in ["exr", "png"] {
             let out = file(&format!("{mode}.{ext}"));
             let argv = ["render", &a.scene, "--mode", mode, "--size", &a.size, "--out", path_str(&out)?];
-            super::render::run(parse(&argv)?)?;
+            let mut args: super::render::RenderArgs = parse(&argv)?;
+            args.files = a.files.clone();
+            super::render::run(args)?;
         }
     }
 

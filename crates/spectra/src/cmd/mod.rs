@@ -25,6 +25,26 @@ pub fn print_warnings(scene: &scene::Scene) {
     }
 }
 
+/// How a scene file is loaded, shared by every command that takes a scene (`render`, `view`,
+/// `truth`, `bench`).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SceneFileArgs {
+    /// Let the scene's file references (buffers, images, CSV spectra, environment maps) leave
+    /// its folder: absolute paths, `..`, symlinks to elsewhere. Off by default so that a scene
+    /// from elsewhere cannot read your other files (docs/scene-format.md, "File references").
+    #[arg(long)]
+    pub allow_outside_scene_dir: bool,
+}
+
+impl SceneFileArgs {
+    /// Loads a built-in scene or a .gltf/.glb file, with these options.
+    pub fn load(&self, name: &str) -> anyhow::Result<scene::Scene> {
+        use anyhow::Context;
+        let opts = scene::LoadOptions { allow_outside_scene_dir: self.allow_outside_scene_dir };
+        scene::load_any_with(name, &opts).with_context(|| format!("loading scene '{name}'"))
+    }
+}
+
 /// The environment light on the command line, shared by `render`, `view` and `truth`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct EnvArgs {

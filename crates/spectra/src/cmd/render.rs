@@ -14,6 +14,8 @@ pub struct RenderArgs {
     /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
+    pub files: super::SceneFileArgs,
+    #[command(flatten)]
     pub look: LookArgs,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
@@ -308,8 +310,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let format = out_format(&args.out)?;
     let (width, height) = parse_size(&args.size)?;
     super::check_output("--out", &args.out)?;
-    let mut scene =
-        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = settings(&args, &scene)?;

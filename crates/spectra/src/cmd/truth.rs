@@ -13,6 +13,8 @@ use truth::{Medium, Settings, TruthError, World};
 pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
+    #[command(flatten)]
+    pub files: super::SceneFileArgs,
     /// Samples (paths) per pixel; each path carries four wavelengths.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
@@ -100,8 +102,7 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
         s.white = color::illuminant::by_name(w)?;
     }
     if let Some(p) = &a.medium {
-        let text = std::fs::read_to_string(p).with_context(|| format!("reading medium {}", p.display()))?;
-        let m = Medium::from_json(&text, &p.display().to_string())?;
+        let m = Medium::read(p)?;
         m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
         s.medium = Some(m);
     }
@@ -138,7 +139,7 @@ pub fn run(a: Args) -> Result<()> {
         }
         super::check_output("--export-mitsuba", dir)?;
     }
-    let mut scene = scene::load_any(&a.scene).with_context(|| format!("loading scene '{}'", a.scene))?;
+    let mut scene = a.files.load(&a.scene)?;
     super::print_warnings(&scene);
     a.env.apply(&mut scene)?;
     let st = settings(&a, &scene)?;

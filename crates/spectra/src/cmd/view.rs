@@ -16,6 +16,8 @@ pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra rend
 pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
     pub scene: String,
+    #[command(flatten)]
+    pub files: super::SceneFileArgs,
     /// Initial window size WIDTHxHEIGHT (the renderer follows the window).
     #[arg(long, default_value = "960x640")]
     pub size: String,
@@ -56,8 +58,7 @@ fn display_named(display: Option<std::ffi::OsString>) -> bool {
 
 pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
-    let mut scene =
-        scene::load_any(&args.scene).with_context(|| format!("loading scene '{}'", args.scene))?;
+    let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = initial_settings(&args, &scene)?;

@@ -1,0 +1,113 @@
+//! Hostile input on the real binary (issue 14): a scene whose buffer lies outside its folder is
+//! refused with one line naming the URI, the rule and the flag that lifts it; with the flag it
+//! renders; inputs that are devices are refused rather than read forever. Uses `truth` (CPU) so
+//! no GPU is needed.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn spectra(args: &[&str]) -> Output {
+    let t = Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_spectra")).args(args).output().expect("running spectra");
+    assert!(t.elapsed() < Duration::from_secs(60), "spectra {args:?} took {:?}", t.elapsed());
+    out
+}
+
+fn refused(args: &[&str], parts: &[&str]) {
+    let out = spectra(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "spectra {args:?}: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(lines.len(), 1, "one error line: {err}");
+    for p in parts {
+        assert!(lines[0].contains(p), "'{p}' missing: {err}");
+    }
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("spectra-hostile-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The built-in Cornell box written as `dir/scene/box.gltf` with its buffer moved to
+/// `dir/shared/box.bin` and referenced as `../shared/box.bin`.
+fn scene_with_outside_buffer(dir: &Path) -> PathBuf {
+    let (sd, shared) = (dir.join("scene"), dir.join("shared"));
+    std::fs::create_dir_all(&sd).unwrap();
+    std::fs::create_dir_all(&shared).unwrap();
+    let file = sd.join("box.gltf");
+    scene::write_gltf(&scene::builtin("cornell").unwrap(), &file).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+    let uri = doc["buffers"][0]["uri"].as_str().unwrap().to_string();
+    let b64 =
+        uri.strip_prefix("data:application/octet-stream;base64,").expect("write_gltf embeds the buffer");
+    let bytes = base64::Engine::decode(&base64::engine::general_purpose::STANDARD, b64).unwrap();
+    std::fs::write(shared.join("box.bin"), bytes).unwrap();
+    doc["buffers"][0]["uri"] = "../shared/box.bin".into();
+    std::fs::write(&file, doc.to_string()).unwrap();
+    file
+}
+
+#[test]
+fn references_outside_the_scene_folder_need_the_flag() {
+    let d = tmp("outside");
+    let f = scene_with_outside_buffer(&d);
+    let f = f.to_str().unwrap();
+    let out = d.join("t.exr");
+    let o = out.to_str().unwrap();
+    let args = ["truth", f, "--spp", "1", "--size", "8x8", "--out", o];
+    refused(&args, &["box.gltf", "buffers[0].uri", "../shared/box.bin", "--allow-outside-scene-dir"]);
+    assert!(!out.exists(), "no output after an error");
+    let mut allowed = args.to_vec();
+    allowed.push("--allow-outside-scene-dir");
+    let r = spectra(&allowed);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[cfg(unix)]
+#[test]
+fn device_inputs_are_refused() {
+    let d = tmp("devices");
+    let out = d.join("t.exr");
+    let o = out.to_str().unwrap();
+    refused(
+        &["truth", "cornell", "--spp", "1", "--size", "8x8", "--medium", "/dev/zero", "--out", o],
+        &["/dev/zero", "a device"],
+    );
+    refused(
+        &["truth", "cornell", "--spp", "1", "--size", "8x8", "--table", "/dev/urandom", "--out", o],
+        &["/dev/urandom", "a device"],
+    );
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.exr")).unwrap();
+    let z = d.join("zero.exr");
+    refused(&["diff", z.to_str().unwrap(), z.to_str().unwrap()], &["zero.exr", "a device"]);
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.gltf")).unwrap();
+    let z = d.join("zero.gltf");
+    refused(&["truth", z.to_str().unwrap(), "--out", o], &["zero.gltf", "a device"]);
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Values that are finite but absurd used to give a black or NaN image with exit 0.
+#[test]
+fn absurd_settings_are_refused_before_rendering() {
+    let d = tmp("absurd");
+    let out = d.join("t.exr");
+    let o = out.to_str().unwrap();
+    let base = ["truth", "cornell", "--spp", "1", "--size", "8x8", "--out", o];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [base, extra].concat()
+    }
+    refused(&with(&base, &["--range", "500:500.0000001"]), &["1 nm"]);
+    refused(&with(&base, &["--white", "1K"]), &["500–1000000 K"]);
+    let m = d.join("m.json");
+    std::fs::write(&m, r#"{"sigma_a": 1e39, "sigma_s": 0}"#).unwrap();
+    refused(&with(&base, &["--medium", m.to_str().unwrap()]), &["sigma_a", "1000000"]);
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
