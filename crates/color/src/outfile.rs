@@ -129,9 +129,16 @@ pub fn remove_stale_temps(dir: &Path, name: &str) {
                 .and_then(|t| t.elapsed().ok())
                 .is_some_and(|age| age.as_secs() > 86_400)
         };
-        // Only regular files: never follow or remove anything else planted under that name.
-        if stale && e.file_type().is_ok_and(|t| t.is_file()) {
-            let _ = std::fs::remove_file(e.path());
+        // Regular files, and directories of [`temp_dir_next_to`]; `file_type` does not
+        // follow symlinks, so a link planted under such a name is never followed.
+        match e.file_type() {
+            Ok(t) if stale && t.is_file() => {
+                let _ = std::fs::remove_file(e.path());
+            }
+            Ok(t) if stale && t.is_dir() => {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
+            _ => {}
         }
     }
 }
@@ -143,10 +150,16 @@ pub fn remove_stale_temps(dir: &Path, name: &str) {
 pub fn temp_dir_next_to(target: &Path) -> io::Result<tempfile::TempDir> {
     let dir = parent_dir(target);
     let name = file_name(target)?;
-    tempfile::Builder::new()
-        .prefix(&format!(".{name}.{}.", std::process::id()))
-        .suffix(".tmp")
-        .tempdir_in(dir)
+    remove_stale_temps(dir, &name);
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{name}.{}.", std::process::id());
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o700));
+    }
+    builder.tempdir_in(dir)
 }
 
 /// Renames a directory made by [`temp_dir_next_to`] to `target` and gives it the mode a new
@@ -249,11 +262,19 @@ mod tests {
         let target = dir.path().join("export");
         let planted = dir.path().join(format!(".export.tmp-{}", std::process::id()));
         std::os::unix::fs::symlink(elsewhere.path(), &planted).unwrap();
+        // A dead writer's half-built export is removed; a link under such a name is not followed.
+        let stale = dir.path().join(".export.4194305.AbC123.tmp");
+        std::fs::create_dir(&stale).unwrap();
+        std::fs::write(stale.join("texture_0.ppm"), b"P6").unwrap();
+        std::fs::write(elsewhere.path().join("keep"), b"x").unwrap();
+        std::os::unix::fs::symlink(elsewhere.path(), dir.path().join(".export.4194306.XyZ789.tmp")).unwrap();
         let tmp = temp_dir_next_to(&target).unwrap();
+        assert_eq!(mode(tmp.path()), 0o700, "private while being built");
         std::fs::write(tmp.path().join("scene.xml"), b"<scene/>").unwrap();
         persist_dir(tmp, &target).unwrap();
         assert!(target.join("scene.xml").is_file());
-        assert!(entries(elsewhere.path()).is_empty());
+        assert!(!stale.exists());
+        assert_eq!(entries(elsewhere.path()), vec!["keep"]);
         assert_eq!(mode(&target), 0o777 & !umask());
         let tmp = temp_dir_next_to(&target).unwrap();
         let kept = tmp.path().to_path_buf();

@@ -6,6 +6,7 @@
 
 mod colorchecker;
 mod cornell;
+mod dense;
 mod metamerism;
 pub(crate) mod shapes;
 mod underwater;
@@ -17,7 +18,8 @@ use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::{Emission, Material, Scene, SpectralReflectance, SpectralSettings, srgb};
 
-/// Names accepted by [`builtin`].
+/// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
+/// about N triangles, for large-mesh measurements).
 pub const BUILTIN_NAMES: &[&str] = &["cornell", "colorchecker", "metamerism", "underwater"];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
@@ -28,6 +30,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "colorchecker" => colorchecker::build(&ctx),
         "metamerism" => metamerism::build(&ctx),
         "underwater" => underwater::build(&ctx),
+        other if other.starts_with("dense:") => dense::build(&ctx, &other["dense:".len()..]),
         _ => {
             return Err(SceneError::UnknownBuiltin {
                 name: name.to_string(),
