@@ -140,6 +140,12 @@ impl LabModel {
         LabModel { t, w, white: integ.white(), space: space.clone() }
     }
 
+    /// The XYZ weight of each wavelength (padding excluded): the generators of the
+    /// object-colour solid on this grid.
+    pub fn generators(&self) -> Vec<[f64; 3]> {
+        (0..self.t.len()).map(|i| [self.w[0][i], self.w[1][i], self.w[2][i]]).collect()
+    }
+
     /// Target Lab of a linear RGB colour, relative to the space's white.
     pub fn target_lab(&self, rgb: [f64; 3]) -> [f64; 3] {
         xyz_to_lab(self.space.rgb_to_xyz(rgb), self.space.white_xyz())
