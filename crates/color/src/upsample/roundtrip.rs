@@ -233,15 +233,15 @@ mod tests {
             RgbColorSpace::acescg(),
         ] {
             let model = LabModel::new(&space).unwrap();
-            // sRGB at the shipping resolution; the others at 16³ (greys and black are pinned,
-            // not fitted, so the resolution does not matter for them and 16³ keeps the test fast).
-            let small;
+            // All at the shipping resolution: above 0.5 the brightness weight is linear and the
+            // grey accuracy there depends on the level spacing (a 16³ grid misses by 0.13 %).
+            let other;
             let t = if space.name == "srgb" {
                 srgb_table()
             } else {
-                small =
-                    fit_table_with(&space, &FitOptions::spectra(16), &ProgressBar::hidden(), &never).unwrap();
-                &small
+                other =
+                    fit_table_with(&space, &FitOptions::spectra(64), &ProgressBar::hidden(), &never).unwrap();
+                &other
             };
             let black = ciede2000(model.target_lab([0.0; 3]), model.lab_of_nm(t.fetch([0.0; 3]).c));
             assert!(black <= 0.01, "{}: black ΔE2000 {black}", space.name);

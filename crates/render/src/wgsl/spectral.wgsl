@@ -127,18 +127,24 @@ fn find_interval(z: f32, res: u32) -> u32 {
     return min(lo, res - 2u);
 }
 
-// σ⁻¹(z) clamped to [1e-6, 1 − 1e-5]: color::upsample::table::z_logit (same constants).
+// σ⁻¹(z) clamped to [1e-6, 1 − 2e-4]: color::upsample::table::z_logit (same constants).
 fn z_logit(z_in: f32) -> f32 {
-    let z = clamp(z_in, 1e-6, 1.0 - 1e-5);
+    let z = clamp(z_in, 1e-6, 1.0 - 2e-4);
     return (2.0 * z - 1.0) / (2.0 * sqrt(z * (1.0 - z)));
 }
 
-// Brightness weight in σ⁻¹ space, as color::upsample::table::z_weight: a weight linear in z
-// bends greys between two levels (−3.9 % at 0.01); linear in σ⁻¹(z) keeps them exact.
+// Brightness weight in σ⁻¹ space for cells below 0.5, linear above, as
+// color::upsample::table::z_weight: a weight linear in z bends dark greys between two levels
+// (−3.9 % at 0.01); linear in σ⁻¹(z) keeps them exact.
 fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     let h0 = z_logit(s0);
     let h1 = z_logit(s1);
-    let w = select((z - s0) / (s1 - s0), (z_logit(z) - h0) / (h1 - h0), h1 > h0);
+    var w = 0.0;
+    if (h1 > h0 && s1 <= 0.5) {
+        w = (z_logit(z) - h0) / (h1 - h0);
+    } else if (s1 > s0) {
+        w = (z - s0) / (s1 - s0);
+    }
     return clamp(w, 0.0, 1.0);
 }
 
