@@ -140,6 +140,12 @@ impl LabModel {
         LabModel { t, w, white: integ.white(), space: space.clone() }
     }
 
+    /// The XYZ weight of each wavelength (padding excluded): the generators of the
+    /// object-colour solid on this grid.
+    pub fn generators(&self) -> Vec<[f64; 3]> {
+        (0..self.t.len()).map(|i| [self.w[0][i], self.w[1][i], self.w[2][i]]).collect()
+    }
+
     /// Target Lab of a linear RGB colour, relative to the space's white.
     pub fn target_lab(&self, rgb: [f64; 3]) -> [f64; 3] {
         xyz_to_lab(self.space.rgb_to_xyz(rgb), self.space.white_xyz())
@@ -380,9 +386,43 @@ pub fn fit_table_with(
             }
         }
     }
+    pin_grey_nodes(&mut table);
     progress.finish();
     table.validate("fitted table")?;
     Ok(table)
+}
+
+/// Whether node (k, j, i) is a grey (all three channels equal, black included), for the
+/// brightness grid `scale`.
+pub fn is_grey_node(res: usize, scale: &[f32], k: usize, j: usize, i: usize) -> bool {
+    scale[k] == 0.0 || (i == res - 1 && j == res - 1)
+}
+
+/// Sets every grey node to the flat reflectance `σ⁻¹(z)` (clamped at [`table::Z_LO`] and
+/// [`table::Z_HI`]). The flat spectrum is the exact solution, but Newton on black (no sigmoid
+/// reaches 0) and white (none reaches 1) runs off towards the coefficient clamp and stops
+/// wherever it is: exact black then came back at ΔE2000 ≈ 24 in the Rec.2020 and ACEScg tables.
+/// Flat greys at the σ⁻¹ levels are also what makes [`table::z_weight`] reproduce every grey
+/// between two levels.
+///
+/// [`table::Z_LO`]: crate::upsample::table::Z_LO
+/// [`table::Z_HI`]: crate::upsample::table::Z_HI
+/// [`table::z_weight`]: crate::upsample::table::z_weight
+pub fn pin_grey_nodes(table: &mut CoeffTable) {
+    let res = table.res;
+    for l in 0..3 {
+        for k in 0..res {
+            for j in 0..res {
+                for i in 0..res {
+                    if is_grey_node(res, &table.scale, k, j, i) {
+                        let o = table.index(l, k, j, i);
+                        let c0 = crate::upsample::table::z_logit(table.scale[k]);
+                        table.data[o..o + 3].copy_from_slice(&[0.0, 0.0, c0]);
+                    }
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 // validation code makes NaN fail a check; both lints would make this code harder to read.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod adversarial;
 pub mod boxes;
 pub mod cache;
 pub mod fit;

@@ -22,8 +22,8 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use crate::error::{ColorError, Result};
-use crate::upsample::fit::{LabModel, nm_to_normalised, normalised_to_nm};
-use crate::upsample::table::CoeffTable;
+use crate::upsample::fit::{LabModel, is_grey_node, nm_to_normalised, normalised_to_nm};
+use crate::upsample::table::{CoeffTable, z_weight};
 
 /// Knobs of [`refine_table`].
 #[derive(Clone, Debug)]
@@ -52,9 +52,17 @@ impl Default for RefineOptions {
 struct Grid<'a> {
     res: usize,
     scale: &'a [f64],
+    scale32: &'a [f32],
 }
 
 impl Grid<'_> {
+    /// Interpolation fractions of the point at fractions `f` of cell k: the brightness weight is
+    /// [`z_weight`]'s, exactly as [`CoeffTable::fetch`] blends the corners.
+    fn wf(&self, k: usize, f: [f64; 3]) -> [f64; 3] {
+        let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
+        [f[0], f[1], z_weight(z as f32, self.scale32[k], self.scale32[k + 1]) as f64]
+    }
+
     /// RGB at fractional grid coordinates inside cell (l, k, j, i).
     fn rgb(&self, l: usize, k: usize, j: usize, i: usize, f: [f64; 3]) -> [f64; 3] {
         let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
@@ -98,7 +106,7 @@ pub fn refine_table(
 ) -> Result<usize> {
     let res = table.res;
     let scale: Vec<f64> = table.scale.iter().map(|&s| s as f64).collect();
-    let grid = Grid { res, scale: &scale };
+    let grid = Grid { res, scale: &scale, scale32: &table.scale };
     // Work in normalised coefficients (trilinear interpolation commutes with the linear map).
     let mut a: Vec<[f64; 3]> = table
         .data
@@ -118,7 +126,7 @@ pub fn refine_table(
                 let r1 = res - 1;
                 let (i, j, k, l) = (c % r1, c / r1 % r1, c / r1 / r1 % r1, c / r1.pow(3));
                 let f = [0.5; 3];
-                let w = weights(f);
+                let w = weights(grid.wf(k, f));
                 let mut ac = [0.0; 3];
                 for (cn, wc) in w.iter().enumerate() {
                     let n = node_index(res, l, k + (cn >> 2 & 1), j + (cn >> 1 & 1), i + (cn & 1));
@@ -153,7 +161,8 @@ pub fn refine_table(
                                     any |= cell_poor(l, k - dk, j - dj, i - di);
                                 }
                             }
-                            if any {
+                            // Greys stay the exact flat spectra `pin_grey_nodes` set.
+                            if any && !is_grey_node(res, &table.scale, k, j, i) {
                                 nodes.push((l, k, j, i));
                             }
                         }
@@ -181,7 +190,7 @@ pub fn refine_table(
                             for &fy in &offs {
                                 for &fx in &offs {
                                     let f = [fx, fy, fz];
-                                    let w = weights(f);
+                                    let w = weights(grid.wf(ck, f));
                                     let mut rest = [0.0; 3];
                                     let mut wme = 0.0;
                                     for (cn, wc) in w.iter().enumerate() {

@@ -229,6 +229,50 @@ mod tests {
         assert!(de < 0.01, "illuminant white ΔE {de} ({xyz:?} vs {white:?})");
     }
 
+    /// Relative luminance error of grey `g` through `table`: Y of the fetched spectrum over Y of
+    /// the perfect reflector, against `g`.
+    fn grey_error(model: &LabModel, table: &CoeffTable, g: f64) -> f64 {
+        let y = model.xyz(nm_to_normalised(table.fetch([g; 3]).c))[1] / model.white[1];
+        y / g - 1.0
+    }
+
+    #[test]
+    fn black_and_greys_are_exact_in_every_space() {
+        let never = std::sync::atomic::AtomicBool::new(false);
+        for space in [
+            RgbColorSpace::srgb(),
+            RgbColorSpace::display_p3(),
+            RgbColorSpace::rec2020(),
+            RgbColorSpace::acescg(),
+        ] {
+            let model = LabModel::new(&space).unwrap();
+            // All at the shipping resolution: above 0.5 the brightness weight is linear and the
+            // grey accuracy there depends on the level spacing (a 16³ grid misses by 0.13 %).
+            let other;
+            let t = if space.name == "srgb" {
+                srgb_table()
+            } else {
+                other =
+                    fit_table_with(&space, &FitOptions::spectra(64), &ProgressBar::hidden(), &never).unwrap();
+                &other
+            };
+            let black = ciede2000(model.target_lab([0.0; 3]), model.lab_of_nm(t.fetch([0.0; 3]).c));
+            assert!(black <= 0.01, "{}: black ΔE2000 {black}", space.name);
+            let white = ciede2000(model.target_lab([1.0; 3]), model.lab_of_nm(t.fetch([1.0; 3]).c));
+            assert!(white <= 0.01, "{}: white ΔE2000 {white}", space.name);
+            // Greys 0.005…1, log-spaced so the dark end (where the z weight matters) is dense,
+            // plus every level and midpoints between levels near black and white.
+            let mut greys: Vec<f64> = (0..=400).map(|n| 0.005 * 200f64.powf(n as f64 / 400.0)).collect();
+            for w in t.scale.windows(2) {
+                greys.extend([w[0] as f64, 0.5 * (w[0] + w[1]) as f64]);
+            }
+            for g in greys.into_iter().filter(|&g| (0.005..=1.0).contains(&g)) {
+                let e = grey_error(&model, t, g);
+                assert!(e.abs() <= 1e-3, "{}: grey {g} luminance error {e}", space.name);
+            }
+        }
+    }
+
     #[test]
     fn zero_colours_is_an_error() {
         let e = roundtrip_table(srgb_table(), &RgbColorSpace::srgb(), 0, 1).unwrap_err().to_string();

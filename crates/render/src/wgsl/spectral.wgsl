@@ -127,8 +127,30 @@ fn find_interval(z: f32, res: u32) -> u32 {
     return min(lo, res - 2u);
 }
 
+// σ⁻¹(z) clamped to [1e-6, 1 − 2e-4]: color::upsample::table::z_logit (same constants).
+fn z_logit(z_in: f32) -> f32 {
+    let z = clamp(z_in, 1e-6, 1.0 - 2e-4);
+    return (2.0 * z - 1.0) / (2.0 * sqrt(z * (1.0 - z)));
+}
+
+// Brightness weight in σ⁻¹ space for cells below 0.5, linear above, as
+// color::upsample::table::z_weight: a weight linear in z bends dark greys between two levels
+// (−3.9 % at 0.01); linear in σ⁻¹(z) keeps them exact.
+fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
+    let h0 = z_logit(s0);
+    let h1 = z_logit(s1);
+    var w = 0.0;
+    if (h1 > h0 && s1 <= 0.5) {
+        w = (z_logit(z) - h0) / (h1 - h0);
+    } else if (s1 > s0) {
+        w = (z - s0) / (s1 - s0);
+    }
+    return clamp(w, 0.0, 1.0);
+}
+
 // Jakob–Hanika coefficients of a reflectance in [0, 1]³: manual trilinear interpolation with
-// textureLoad (exact in f32; rgba32float is not filterable everywhere).
+// textureLoad (exact in f32; rgba32float is not filterable everywhere), brightness weight in
+// σ⁻¹ space (z_weight).
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
     var l = 0u;
@@ -145,7 +167,7 @@ fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     let zi = find_interval(z, res);
     let x1 = x - f32(xi);
     let y1 = y - f32(yi);
-    let z1 = (z - coeff_scale[zi]) / (coeff_scale[zi + 1u] - coeff_scale[zi]);
+    let z1 = z_weight(z, coeff_scale[zi], coeff_scale[zi + 1u]);
     let base = vec3<i32>(i32(xi), i32(yi), i32(l * res + zi));
     let c000 = textureLoad(coeff_table, base, 0).xyz;
     let c100 = textureLoad(coeff_table, base + vec3<i32>(1, 0, 0), 0).xyz;
