@@ -31,15 +31,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     r.resize(w, h)?;
     for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8), (Mode::Spectral, 16), (Mode::Spectral, 32)] {
         let mut line = format!("{:>8} N={n:<3} {w}x{h}:", mode.name());
-        let mut dry_wet = [0.0; 3];
+        let mut dry_wet = [0.0; 4];
         let models = [
             ("dry", None),
             ("paper", Some(underwater::Options::paper())),
-            ("marched", Some(underwater::Options::default())),
+            ("marched", Some(underwater::Options::isotropic())),
+            ("light field", Some(underwater::Options::default())),
         ];
         for (k, (name, model)) in models.into_iter().enumerate() {
             r.set_custom_shader(match model {
-                Some(o) => underwater::shader_with(&medium, &o),
+                Some(o) => underwater::shader_with(&medium, &o)?,
                 None => CustomShader::default(),
             })?;
             let s = RenderSettings { mode, wavelengths: n, timestamps: true, ..Default::default() };
@@ -66,9 +67,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             line += &format!(" {name} {:.2} ms{gpu};", dry_wet[k]);
         }
         println!(
-            "{line} underwater cost: paper {:+.2} ms, marched {:+.2} ms",
+            "{line} underwater cost: paper {:+.2} ms, marched {:+.2} ms, light field {:+.2} ms",
             dry_wet[1] - dry_wet[0],
-            dry_wet[2] - dry_wet[0]
+            dry_wet[2] - dry_wet[0],
+            dry_wet[3] - dry_wet[0]
         );
     }
     Ok(())

@@ -730,12 +730,17 @@ impl Renderer {
             ],
         });
 
-        // custom_spectra[group * 4 + s] = spectrum s at the group's four wavelengths.
-        let mut custom_spectra = vec![[0f32; 4]; ng * 4];
+        // custom_spectra[group * 4 + s] = spectrum s < 4 at the group's four wavelengths; the
+        // spectra beyond the fourth (tables) follow at [s * n_groups + group].
+        let n_custom = self.custom.spectra.len();
+        let mut custom_spectra = vec![[0f32; 4]; ng * n_custom.max(4)];
         for (s, spectrum) in self.custom.spectra.iter().enumerate() {
             for g in 0..ng {
-                custom_spectra[g * 4 + s] =
-                    std::array::from_fn(|lane| spectrum.eval(padded_lambda[g * 4 + lane]) as f32);
+                let at = if s < 4 { g * 4 + s } else { s * ng + g };
+                custom_spectra[at] = match spectrum {
+                    color::Spectrum::Constant(v) => [*v as f32; 4],
+                    _ => std::array::from_fn(|lane| spectrum.eval(padded_lambda[g * 4 + lane]) as f32),
+                };
             }
         }
         let custom_uniforms = CustomUniforms {

@@ -181,7 +181,7 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
                 &mut r,
                 &scene,
                 &settings,
-                underwater::shader_with(&medium, &underwater::Options::paper()),
+                underwater::shader_with(&medium, &underwater::Options::paper()).unwrap(),
             );
             let setup = SpectralSetup::new(&settings).unwrap();
             // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
@@ -218,9 +218,11 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
     let dry = render(&mut r, &scene, &settings, CustomShader::default());
     let e_sun = 3.0;
     let to_sun = -light_dir().as_dvec3();
-    for options in [underwater::Options::paper(), underwater::Options { surface: true, ..Default::default() }]
-    {
-        let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
+    for options in [
+        underwater::Options::paper(),
+        underwater::Options { surface: true, ..underwater::Options::isotropic() },
+    ] {
+        let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
         let mut worst = 0.0f64;
         for py in 0..H {
             for px in 0..W {
@@ -296,8 +298,8 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
     let mut tally = Tally::default();
     // The default model, and scalar irradiance (Gershun) with other steps and g.
     let configs = [
-        ("IB", 5.0, 1.0, underwater::Options { surface: true, ..Default::default() }),
-        ("3C", 3.0, 0.5, underwater::Options::default()),
+        ("IB", 5.0, 1.0, underwater::Options { surface: true, ..underwater::Options::isotropic() }),
+        ("3C", 3.0, 0.5, underwater::Options::isotropic()),
         (
             "II",
             4.0,
@@ -308,9 +310,10 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
                 scalar_irradiance: true,
                 split_beams: true,
                 surface: false,
+                ..underwater::Options::isotropic()
             },
         ),
-        ("I", 8.0, 1.0, underwater::Options { split_beams: true, ..Default::default() }),
+        ("I", 8.0, 1.0, underwater::Options { split_beams: true, ..underwater::Options::isotropic() }),
     ];
     for (ty, depth, scale, options) in configs {
         let steps = options.steps;
@@ -327,7 +330,7 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
                 ..Default::default()
             };
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
-            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
+            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
@@ -412,7 +415,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
     r.set_scene(&scene).unwrap();
     r.resize(W, H).unwrap();
     let table = common::table();
-    let options = underwater::Options::default();
+    let options = underwater::Options::isotropic();
     let (depth, lambda) = (6.0, 500.0);
     let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
     let settings = RenderSettings {
@@ -424,7 +427,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
         ..Default::default()
     };
     let dry = render(&mut r, &scene, &settings, CustomShader::default());
-    let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options));
+    let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
     let setup = SpectralSetup::new(&settings).unwrap();
     let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
     let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
@@ -490,8 +493,12 @@ fn prefiltered_weights_pass_through_the_hook_node_by_node() {
         shadows: false,
         ..Default::default()
     };
-    let wet =
-        render(&mut r, &scene, &settings, underwater::shader_with(&medium, &underwater::Options::paper()));
+    let wet = render(
+        &mut r,
+        &scene,
+        &settings,
+        underwater::shader_with(&medium, &underwater::Options::paper()).unwrap(),
+    );
     let setup = SpectralSetup::new(&settings).unwrap();
     let w = setup.light_weights(&scene.lights[0].emission, Mode::Spectral, &table).unwrap();
     let mu = -light_dir().y as f64;
@@ -514,4 +521,107 @@ fn prefiltered_weights_pass_through_the_hook_node_by_node() {
     }
     eprintln!("prefiltered hook GPU vs CPU: worst relative error {worst:.2e} over {count} pixels");
     assert!(count > 500, "{count}");
+}
+
+/// The light-field model against its CPU reference, per wavelength and pixel: the surface term
+/// attenuated by the table's E_d (`LightFieldTable::attenuation`), the in-scattering
+/// `E_sun·∫J·e^{−c·t}dt` in closed form per depth segment (`light_field::ray_integral`, itself
+/// checked against quadrature in `scene`), plus the sun beam's single scattering
+/// (`single::beam`, unshadowed here). A coarse table (few photons) is enough: both sides read
+/// the same numbers.
+#[test]
+fn light_field_hook_matches_cpu_to_1e_3() {
+    use scene::water::light_field::{log_interp, ray_integral};
+    use scene::water::single;
+    let scene = floor_scene();
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let table = common::table();
+    let mut tally = Tally::default();
+    for (ty, depth, scale) in [("IB", 5.0, 1.0), ("3C", 12.0, 0.5), ("II", 30.0, 8.0)] {
+        let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
+        let options = underwater::Options { photons: 400, ..Default::default() };
+        let lf = underwater::light_field_table(&medium, &options).unwrap();
+        for lambda in [430.0, 500.0, 575.0, 640.0] {
+            let settings = RenderSettings {
+                mode: Mode::Spectral,
+                quadrature: Quadrature::Midpoint,
+                wavelengths: 1,
+                range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
+                shadows: true,
+                ..Default::default()
+            };
+            let dry = render(&mut r, &scene, &settings, CustomShader::default());
+            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
+            let setup = SpectralSetup::new(&settings).unwrap();
+            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+            let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
+            let k = medium.coefficients(lambda);
+            let to_sun = -light_dir().as_dvec3();
+            let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
+            let ed: [f64; scene::water::light_field::N_DEPTH] =
+                std::array::from_fn(|d| lf.e_d_node(d, lambda));
+            for py in 0..H {
+                for px in 0..W {
+                    let Some((dir, hit)) = pixel_ray(&scene.camera, px, py) else { continue };
+                    let w = dir.as_dvec3();
+                    let d = match hit {
+                        Some(t) => t as f64 * scale,
+                        None if w.y > 0.0 => depth / w.y,
+                        None => f64::INFINITY,
+                    };
+                    let col = lf.j_column(w, sun_h, lambda);
+                    let scatter = e_sun * ray_integral(&col, lf.z_max, k.c, depth, w.y, d)
+                        + single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
+                    let i = (py * W + px) as usize;
+                    let surface = match hit {
+                        Some(_) => {
+                            let zs = depth - d * w.y;
+                            DVec3::from(common::rgb_of(&dry[i]))
+                                * (log_interp(&ed, lf.z_max, zs) * (-k.c * d).exp())
+                        }
+                        None => DVec3::ZERO,
+                    };
+                    let want = surface + unit * scatter;
+                    let what =
+                        || format!("light field {ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
+                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
+                }
+            }
+        }
+    }
+    tally.finish("light-field hook");
+}
+
+/// Bad input: a sun below the horizon and a blend past the last type are errors naming the
+/// problem; a camera whose floor lies far beyond the table's depth range renders with the
+/// documented clamp (the last segment's decay), without NaN or negative pixels, in every mode.
+#[test]
+fn light_field_bad_input_errors_or_clamps_without_nan() {
+    let e =
+        WaterMedium::new(WaterType::parse("II").unwrap(), 5.0, Vec3::new(0.3, -0.1, 0.0), 1.0).unwrap_err();
+    assert!(e.to_string().contains("above the horizon"), "{e}");
+    let e = WaterType::parse("9C.5").unwrap_err();
+    assert!(e.to_string().contains("9C"), "{e}");
+    let bad = underwater::Options { steps: 0, ..Default::default() };
+    let m = WaterMedium::new(WaterType::parse("II").unwrap(), 5.0, Vec3::Y, 1.0).unwrap();
+    assert!(underwater::shader_with(&m, &bad).unwrap_err().to_string().contains("march steps"));
+    let scene = floor_scene();
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    // 1.5 scene units × 60 m: the floor is 90 m below a camera at 40 m, beyond the table's 60 m.
+    let medium = WaterMedium::new(WaterType::parse("9C").unwrap(), 40.0, Vec3::Y, 60.0).unwrap();
+    let options = underwater::Options { photons: 200, ..Default::default() };
+    let lf = underwater::light_field_table(&medium, &options).unwrap();
+    assert!(lf.z_max < 130.0);
+    for mode in [Mode::Spectral, Mode::Naive, Mode::Rgb] {
+        let settings = RenderSettings { mode, wavelengths: 8, ..Default::default() };
+        let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
+        assert!(
+            wet.iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)),
+            "{mode:?}: a NaN, infinite or negative pixel"
+        );
+    }
 }

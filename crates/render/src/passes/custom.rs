@@ -20,8 +20,10 @@
 //!   it, `background` flag, pixel coordinates. Background pixels are
 //!   shaded too (radiance 0 before the hook), so fog or water can add in-scattered light.
 //! - `custom.params` — sixteen floats from [`CustomShader::params`].
-//! - `custom_spectra[group * 4 + s]` — spectrum `s` of [`CustomShader::spectra`] sampled at the
-//!   four wavelengths of `group` (re-sampled by the renderer whenever the wavelengths change).
+//! - `custom_spectra[group * 4 + s]` — spectrum `s` (< 4) of [`CustomShader::spectra`] sampled
+//!   at the four wavelengths of `group` (re-sampled by the renderer whenever the wavelengths
+//!   change); spectra `s ≥ 4` (tables) at `custom_spectra[s * frame.n_groups + group]`. A
+//!   `Spectrum::Constant` fills all four lanes, which is how the RGB hook reads a table.
 //! - `wavelengths[group]` — node λ and the white's node weights; `light_w(li, group,
 //!   frame.n_groups)` — a light's node weights; `s3_scale`, `s3_xyz` for weighted radiance;
 //!   `frame` — matrices, camera, mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3.
@@ -58,8 +60,9 @@ pub struct CustomShader {
     pub spectra: Vec<Spectrum>,
 }
 
-/// Most spectra a custom shader can ask for.
-pub const MAX_CUSTOM_SPECTRA: usize = 4;
+/// Most spectra a custom shader can ask for: the first four at `custom_spectra[group * 4 + s]`,
+/// the rest (tables, e.g. the underwater light field) at `custom_spectra[s * n_groups + group]`.
+pub const MAX_CUSTOM_SPECTRA: usize = 16384;
 
 impl Default for CustomShader {
     fn default() -> Self {

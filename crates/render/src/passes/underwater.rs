@@ -40,7 +40,8 @@
 //! window) is drawn.
 
 use super::custom::CustomShader;
-use scene::water::WaterMedium;
+use scene::water::light_field::{self, LightFieldTable};
+use scene::water::{WaterError, WaterMedium};
 
 /// The WGSL hooks.
 pub const HOOKS: &str = include_str!("underwater.wgsl");
@@ -75,7 +76,21 @@ pub struct Options {
     /// Off by default: without the floor in the reflection it is further from the path-traced
     /// water than not drawing it (docs/underwater.md).
     pub surface: bool,
+    /// The in-scattering source from the water's own light field
+    /// (`scene::water::light_field`, same a, b and phase function as the path-traced truth)
+    /// instead of the paper's isotropic b·E0·e^{−Kd·z}/(4π), and the surface term attenuated
+    /// by that field's downwelling irradiance instead of the tabulated Kd. Needs `steps > 0`:
+    /// the table leaves the unscattered sun beam to the march.
+    pub light_field: bool,
+    /// With `light_field`, attenuate surfaces by the tabulated Kd anyway (the documented
+    /// option; the default derives the attenuation from a, b and the phase function).
+    pub tabulated_kd: bool,
+    /// Photons per wavelength node and source of the light-field solver.
+    pub photons: usize,
 }
+
+/// Default photons of the light-field solver (per wavelength node and source).
+pub const LIGHT_FIELD_PHOTONS: usize = 8000;
 
 impl Default for Options {
     fn default() -> Self {
@@ -85,6 +100,9 @@ impl Default for Options {
             scalar_irradiance: false,
             split_beams: false,
             surface: false,
+            light_field: true,
+            tabulated_kd: false,
+            photons: LIGHT_FIELD_PHOTONS,
         }
     }
 }
@@ -101,7 +119,12 @@ impl Options {
 
     /// The paper's model: analytic isotropic in-scattering only.
     pub fn paper() -> Self {
-        Options { steps: 0, ..Default::default() }
+        Options { steps: 0, light_field: false, ..Default::default() }
+    }
+
+    /// The previous default: the paper's isotropic term plus the marched single scattering.
+    pub fn isotropic() -> Self {
+        Options { light_field: false, ..Default::default() }
     }
 
     /// Checks the values a user can set.
@@ -111,6 +134,19 @@ impl Options {
         }
         if !(self.phase_g.is_finite() && self.phase_g.abs() < 1.0) {
             return Err(format!("phase function g must be in (−1, 1), got {}", self.phase_g));
+        }
+        if self.light_field && self.steps == 0 {
+            return Err("the light-field model needs march steps ≥ 1 (the table leaves the sun's \
+                        unscattered beam to the march); use the paper's model for no march"
+                .into());
+        }
+        if self.light_field && (self.split_beams || self.scalar_irradiance) {
+            return Err("split beams and scalar irradiance change the paper's isotropic term; \
+                        they need the isotropic model (--isotropic)"
+                .into());
+        }
+        if self.light_field && !(1..=10_000_000).contains(&self.photons) {
+            return Err(format!("light-field photons must be 1..=10000000, got {}", self.photons));
         }
         Ok(())
     }
@@ -152,15 +188,100 @@ pub fn spectra(medium: &WaterMedium) -> Vec<color::Spectrum> {
     vec![p.b.clone(), p.c.clone(), p.kd.clone()]
 }
 
+/// Deepest node of the light-field table for a camera at `depth` m: 20 m below the camera,
+/// rounded up to 20 m so that nearby depths share a cached table. Deeper points use the last
+/// segment's decay (`light_field::log_interp`).
+pub fn light_field_range(depth: f64) -> f64 {
+    20.0 * ((depth + 20.0) / 20.0).ceil()
+}
+
+/// The solver's input for `medium` (its refracted sun, its sky) with `options`.
+pub fn light_field_key(medium: &WaterMedium, options: &Options) -> light_field::LightFieldKey {
+    light_field::LightFieldKey {
+        properties: medium.properties.clone(),
+        name: medium.water_type.map_or_else(|| "custom".to_string(), |t| t.to_string()),
+        sun_mu: medium.sun_dir_underwater().y as f64,
+        sky: medium.sky,
+        z_max: light_field_range(medium.depth),
+        g: options.phase_g as f64,
+        photons: options.photons,
+    }
+}
+
+/// The light-field table for `medium`: from this process's memory, else the disk cache
+/// (`$SPECTRA_CACHE_DIR`, as the upsampling tables), else solved (with a progress bar on a
+/// terminal; a few seconds per water type and range) and cached.
+pub fn light_field_table(
+    medium: &WaterMedium,
+    options: &Options,
+) -> Result<std::sync::Arc<LightFieldTable>, WaterError> {
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Solved = Vec<(String, Arc<LightFieldTable>)>;
+    static MEMORY: OnceLock<Mutex<Solved>> = OnceLock::new();
+    let key = light_field_key(medium, options);
+    key.validate()?;
+    let name = key.cache_name();
+    let memory = MEMORY.get_or_init(Default::default);
+    if let Some((_, t)) = memory.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(n, _)| *n == name) {
+        return Ok(t.clone());
+    }
+    let dir = color::upsample::cache::cache_dir().ok();
+    let bar = indicatif::ProgressBar::new(2 * light_field::N_LAMBDA as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("light field {msg} [{bar:30}] {pos}/{len} ({elapsed})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("{} (solving once, then cached)", key.name));
+    let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+    let t =
+        LightFieldTable::cached(&key, dir.as_deref(), &progress, &std::sync::atomic::AtomicBool::new(false));
+    bar.finish_and_clear();
+    let t = Arc::new(t?);
+    memory.lock().unwrap_or_else(|e| e.into_inner()).push((name, t.clone()));
+    Ok(t)
+}
+
+/// The table as custom spectra (indices from 4, see `underwater.wgsl`): J per cell and E_d per
+/// depth node as piecewise-linear spectra over the table's wavelength nodes (resampled by the
+/// renderer at the frame's wavelengths), then the same at [`RGB_WAVELENGTHS`] as three
+/// constants each for the RGB hook.
+fn table_spectra(t: &LightFieldTable) -> Vec<color::Spectrum> {
+    use light_field::*;
+    let lambda: Vec<f64> = (0..N_LAMBDA).map(lambda_node).collect();
+    let cells = N_DEPTH * N_ELEV * N_AZ;
+    let row = |v: &[f32]| color::Spectrum::Piecewise {
+        lambda: lambda.clone(),
+        values: v.iter().map(|&x| x as f64).collect(),
+    };
+    let mut out = Vec::with_capacity(4 * (cells + N_DEPTH));
+    out.extend((0..cells).map(|c| row(&t.j[c * N_LAMBDA..(c + 1) * N_LAMBDA])));
+    out.extend((0..N_DEPTH).map(|d| row(&t.e_d[d * N_LAMBDA..(d + 1) * N_LAMBDA])));
+    for c in 0..cells {
+        for l in RGB_WAVELENGTHS {
+            let (d, rest) = (c / (N_ELEV * N_AZ), c % (N_ELEV * N_AZ));
+            out.push(color::Spectrum::Constant(t.j_node(d, rest / N_AZ, rest % N_AZ, l)));
+        }
+    }
+    for d in 0..N_DEPTH {
+        for l in RGB_WAVELENGTHS {
+            out.push(color::Spectrum::Constant(t.e_d_node(d, l)));
+        }
+    }
+    out
+}
+
 /// The underwater custom shader for `medium` with the default [`Options`].
-pub fn shader(medium: &WaterMedium) -> CustomShader {
+pub fn shader(medium: &WaterMedium) -> Result<CustomShader, WaterError> {
     shader_with(medium, &Options::default())
 }
 
 /// The underwater custom shader for `medium`. Whether it marches is decided here, at compile
-/// time (`options.steps > 0`); the step count itself, like the depth, is a parameter.
-pub fn shader_with(medium: &WaterMedium, options: &Options) -> CustomShader {
+/// time (`options.steps > 0`); the step count itself, like the depth, is a parameter. The
+/// light-field model solves (or loads) its table here; bad options or a bad sun are errors.
+pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShader, WaterError> {
     use scene::water::{WATER_IOR, fresnel::mean_transmittance};
+    options.validate().map_err(WaterError::BadQuery)?;
+    let table = if options.light_field { Some(light_field_table(medium, options)?) } else { None };
     let mut source = HOOKS.to_string();
     let mut set = |line: &str, value: String| {
         let (name, _) = line.split_once('=').expect("a const line");
@@ -174,7 +295,15 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> CustomShader {
         "const UW_SKY_NORM: f32 = 0.34;",
         format!("{:?}", (1.0 / (std::f64::consts::PI * mean_transmittance(WATER_IOR))) as f32),
     );
-    CustomShader { source, params: params_with(medium, options), spectra: spectra(medium) }
+    set("const UW_TABLE: bool = true;", options.light_field.to_string());
+    set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
+    let mut spectra = spectra(medium);
+    if let Some(t) = &table {
+        set("const UW_ZMAX: f32 = 40.0;", format!("{:?}", t.z_max as f32));
+        spectra.push(color::Spectrum::Constant(0.0));
+        spectra.extend(table_spectra(t));
+    }
+    Ok(CustomShader { source, params: params_with(medium, options), spectra })
 }
 
 #[cfg(test)]
@@ -194,13 +323,15 @@ mod tests {
         // Ocean water attenuates red more than blue, and its downwelling Kd by far (pure-water
         // absorption at 611 nm is ≈ 0.27 /m, in the blue ≈ 0.01 /m).
         assert!(p[4] > p[6] && p[8] > 3.0 * p[10], "{p:?}");
-        let s = shader_with(&m, &Options::paper());
+        let s = shader_with(&m, &Options::paper()).unwrap();
         assert_eq!(s.params[2], 0.0);
         assert!(
             s.source.contains("const UW_MARCH: bool = false;"),
             "the paper's model compiles without the march"
         );
-        assert!(shader(&m).source.contains("const UW_MARCH: bool = true;"));
+        assert!(
+            shader_with(&m, &Options::isotropic()).unwrap().source.contains("const UW_MARCH: bool = true;")
+        );
         assert_eq!(s.spectra.len(), 3);
         assert_eq!(s.spectra[2].eval(500.0), m.coefficients(500.0).kd);
     }

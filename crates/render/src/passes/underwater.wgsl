@@ -28,6 +28,23 @@ const UW_MARCH: bool = true;
 const UW_SURFACE: bool = true;
 const UW_N: f32 = 1.34;
 const UW_SKY_NORM: f32 = 0.34;
+// The light-field model (`underwater::Options::light_field`, scene::water::light_field): the
+// in-scattering source J(z, view, λ) of the water's own diffuse light field replaces the
+// paper's isotropic term, and surfaces are attenuated by the field's downwelling irradiance
+// E_d(z) (UW_TABLE_KD) instead of the tabulated Kd. `underwater::shader_with` writes these and
+// the table's depth range; the table's layout must match scene::water::light_field.
+const UW_TABLE: bool = true;
+const UW_TABLE_KD: bool = true;
+const UW_ZMAX: f32 = 40.0;
+const UW_ND: u32 = 16u;
+const UW_NE: u32 = 13u;
+const UW_NA: u32 = 9u;
+const UW_NC: u32 = UW_ND * UW_NE * UW_NA;
+// Spectrum indices (custom_spectra[s * n_groups + group]): J per cell, E_d per depth node, then
+// the RGB mode's copies, three constants each.
+const UW_T_J: u32 = 4u;
+const UW_T_ED: u32 = 4u + UW_NC;
+const UW_T_RGB: u32 = 4u + UW_NC + UW_ND;
 // Lights with single scattering, and march steps: must match underwater.rs.
 const UW_SS_LIGHTS: u32 = 4u;
 const UW_MAX_STEPS: u32 = 32u;
@@ -94,6 +111,194 @@ fn uw_emission(li: u32, group: u32, rgb: bool) -> mat3x4<f32> {
 
 const UW_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
 
+// Per-pixel part of the light-field integral, filled by `uw_prepare_table`: the four table
+// directions around the view (cell offsets within one depth slice) and their bilinear
+// weights; the ray cut at the depth nodes it crosses into pieces, each with its segment i,
+// start t0 (m), length (m, < 0 for a piece that runs forever) and depth offset z(t0) − z_i.
+var<private> uw_cell: array<u32, 4>;
+var<private> uw_cw: vec4<f32>;
+var<private> uw_np: u32 = 0u;
+var<private> uw_pn: array<u32, 16>;
+var<private> uw_pt: array<f32, 16>;
+var<private> uw_pl: array<f32, 16>;
+var<private> uw_pz: array<f32, 16>;
+
+fn uw_depth_node(i: u32) -> f32 {
+    let f = f32(i) / f32(UW_ND - 1u);
+    return UW_ZMAX * f * sqrt(f);
+}
+
+// atan(t) for t in [0, 1] to ~1e-8: one reduction by π/6, then the series to t¹¹. WGSL's
+// acos/atan2 may be off by 4096 ulp (Vulkan's precision rules), which moves the table's
+// direction interpolation by ~1e-3 of J.
+fn uw_atan01(t: f32) -> f32 {
+    var a = t;
+    var off = 0.0;
+    if (t > 0.26794919) {
+        a = (t * 1.7320508 - 1.0) / (t + 1.7320508);
+        off = 0.52359878;
+    }
+    let a2 = a * a;
+    return off + a * (1.0 - a2 * (1.0 / 3.0 - a2 * (0.2 - a2 * (1.0 / 7.0 - a2 * (1.0 / 9.0 - a2 / 11.0)))));
+}
+
+// The angle in [0, π] whose sine is s ≥ 0 and cosine c (any common scale).
+fn uw_angle(s: f32, c: f32) -> f32 {
+    let ac = abs(c);
+    var th = 0.0;
+    if (s <= ac) {
+        th = uw_atan01(s / max(ac, 1e-30));
+    } else {
+        th = 1.5707963 - uw_atan01(ac / s);
+    }
+    return select(th, 3.14159265358979 - th, c < 0.0);
+}
+
+// The segment [z_i, z_{i+1}] that holds depth z (the last one beyond the last node).
+fn uw_segment(z: f32) -> u32 {
+    var i = 0u;
+    loop {
+        if (i + 2u >= UW_ND || uw_depth_node(i + 1u) >= z) { break; }
+        i++;
+    }
+    return i;
+}
+
+fn uw_add_piece(t0: f32, t1: f32, infinite: bool, z0: f32, wy: f32) {
+    if (uw_np >= 16u) { return; }
+    let tm = select(0.5 * (t0 + t1), t0 + 1.0, infinite);
+    let i = uw_segment(max(z0 - tm * wy, 0.0));
+    uw_pn[uw_np] = i;
+    uw_pt[uw_np] = t0;
+    uw_pl[uw_np] = select(t1 - t0, -1.0, infinite);
+    uw_pz[uw_np] = max(z0 - t0 * wy, 0.0) - uw_depth_node(i);
+    uw_np++;
+}
+
+fn uw_prepare_table(w: vec3<f32>, z0: f32) {
+    // The view relative to the first sun (scene::water::light_field::view_coords).
+    var sun_h = vec3<f32>(0.0);
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        if (u32(l.w) == 0u && lights[li].cone.z < 0.5 && l.y < 0.0) {
+            let h = vec2<f32>(-l.x, -l.z);
+            if (dot(h, h) > 1e-12) { sun_h = vec3<f32>(normalize(h).x, 0.0, normalize(h).y); }
+            break;
+        }
+    }
+    let hw = vec3<f32>(w.x, 0.0, w.z);
+    let fe = uw_angle(length(hw), w.y) / 3.14159265358979 * f32(UW_NE - 1u);
+    var ph = 0.0;
+    if (length(hw) > 1e-6 && dot(sun_h, sun_h) > 0.5) {
+        ph = uw_angle(abs(cross(sun_h, hw).y), dot(sun_h, hw));
+    }
+    let fk = ph / 3.14159265358979 * f32(UW_NA - 1u);
+    let e0 = min(u32(floor(fe)), UW_NE - 2u);
+    let k0 = min(u32(floor(fk)), UW_NA - 2u);
+    let te = fe - f32(e0);
+    let tk = fk - f32(k0);
+    uw_cell[0] = e0 * UW_NA + k0;
+    uw_cell[1] = e0 * UW_NA + k0 + 1u;
+    uw_cell[2] = (e0 + 1u) * UW_NA + k0;
+    uw_cell[3] = (e0 + 1u) * UW_NA + k0 + 1u;
+    uw_cw = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
+    // Pieces between the node depths the ray crosses, in order along the ray.
+    uw_np = 0u;
+    var t = 0.0;
+    let wy = w.y;
+    if (abs(wy) > 1e-6) {
+        for (var n = 1u; n < UW_ND - 1u; n++) {
+            // Going down the nodes come in increasing depth, going up in decreasing depth.
+            let i = select(UW_ND - 1u - n, n, wy < 0.0);
+            let tc = (z0 - uw_depth_node(i)) / wy;
+            if (tc > t && (uw_infinite || tc < uw_d)) {
+                uw_add_piece(t, tc, false, z0, wy);
+                t = tc;
+            }
+        }
+    }
+    if (uw_infinite) {
+        uw_add_piece(t, t, true, z0, wy);
+    } else if (uw_d > t) {
+        uw_add_piece(t, uw_d, false, z0, wy);
+    }
+}
+
+// J at depth node d for the pixel's view (bilinear in direction), at the group's wavelengths
+// or in rgb mode at the three RGB wavelengths.
+fn uw_j_node(d: u32, group: u32, rgb: bool) -> vec4<f32> {
+    let ng = frame.n_groups;
+    var j = vec4<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        let cell = d * UW_NE * UW_NA + uw_cell[c];
+        var v: vec4<f32>;
+        if (rgb) {
+            let s = UW_T_RGB + 3u * cell;
+            v = vec4<f32>(custom_spectra[s * ng].x, custom_spectra[(s + 1u) * ng].x, custom_spectra[(s + 2u) * ng].x, 0.0);
+        } else {
+            v = custom_spectra[(UW_T_J + cell) * ng + group];
+        }
+        j += uw_cw[c] * v;
+    }
+    return j;
+}
+
+fn uw_ed_node(d: u32, group: u32, rgb: bool) -> vec4<f32> {
+    let ng = frame.n_groups;
+    if (rgb) {
+        let s = UW_T_RGB + 3u * UW_NC + 3u * d;
+        return vec4<f32>(custom_spectra[s * ng].x, custom_spectra[(s + 1u) * ng].x, custom_spectra[(s + 2u) * ng].x, 1.0);
+    }
+    return custom_spectra[(UW_T_ED + d) * ng + group];
+}
+
+// Decay rate of a column between nodes i and i + 1 (ln-linear interpolation), 0 where either
+// end is not positive (light_field::segment_rate).
+fn uw_rate(a: vec4<f32>, b: vec4<f32>, i: u32) -> vec4<f32> {
+    let ok = (a > vec4<f32>(0.0)) & (b > vec4<f32>(0.0));
+    let dz = uw_depth_node(i + 1u) - uw_depth_node(i);
+    return select(vec4<f32>(0.0), log(max(a, vec4<f32>(1e-30)) / max(b, vec4<f32>(1e-30))) / dz, ok);
+}
+
+// ∫ J(z(t), view)·e^{−c·t} dt along the view ray, exponential in depth within each piece and
+// integrated in closed form (CPU reference: light_field::ray_integral).
+fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
+    var sum = vec4<f32>(0.0);
+    for (var p = 0u; p < uw_np; p++) {
+        let i = uw_pn[p];
+        let ja = uw_j_node(i, group, rgb);
+        let k = uw_rate(ja, uw_j_node(i + 1u, group, rgb), i);
+        let j0 = ja * exp(-k * uw_pz[p]);
+        let infinite = uw_pl[p] < 0.0;
+        // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
+        let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
+        sum += j0 * uw_integral_to(rate, uw_pl[p], infinite) * exp(-c * uw_pt[p]);
+    }
+    return sum;
+}
+
+// The table's in-scattering for every sun (the table is per unit sun irradiance and already
+// holds the sky, so the sky stand-ins add nothing here; other suns reuse the first one's
+// table, a documented approximation).
+fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f32> {
+    let f = uw_table_integral(c, group, rgb, wy);
+    var total = UW_ZERO;
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
+        total += s3_scale(uw_emission(li, group, rgb), f);
+    }
+    return total;
+}
+
+// E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
+fn uw_table_attenuation(z: f32, group: u32, rgb: bool) -> vec4<f32> {
+    let i = uw_segment(z);
+    let a = uw_ed_node(i, group, rgb);
+    let k = uw_rate(a, uw_ed_node(i + 1u, group, rgb), i);
+    return a * exp(-k * (z - uw_depth_node(i)));
+}
+
 fn uw_prepare(ctx: SurfaceContext) {
     if (uw_ready) { return; }
     uw_ready = true;
@@ -107,6 +312,9 @@ fn uw_prepare(ctx: SurfaceContext) {
         uw_d = select(0.0, z0 / w.y, w.y > 0.0);
     } else {
         uw_d = ctx.distance * scale;
+    }
+    if (UW_TABLE) {
+        uw_prepare_table(w, z0);
     }
     let m = min(u32(custom.params[0].z), UW_MAX_STEPS);
     uw_steps = m;
@@ -272,7 +480,12 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
     let z0 = custom.params[0].x;
-    var l = uw_in_scatter(b, c, kd, group, rgb, wy, z0, uw_d, uw_infinite);
+    var l: mat3x4<f32>;
+    if (UW_TABLE) {
+        l = uw_table_in_scatter(c, group, rgb, wy);
+    } else {
+        l = uw_in_scatter(b, c, kd, group, rgb, wy, z0, uw_d, uw_infinite);
+    }
     if (UW_MARCH) {
         l += uw_single_scatter(b, c, group, rgb);
     }
@@ -281,7 +494,11 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     }
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
-        l += s3_scale(radiance, exp(-kd * zs) * exp(-c * uw_d));
+        var att = exp(-kd * zs);
+        if (UW_TABLE_KD) {
+            att = uw_table_attenuation(zs, group, rgb);
+        }
+        l += s3_scale(radiance, att * exp(-c * uw_d));
     }
     return l;
 }

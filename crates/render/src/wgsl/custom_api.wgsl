@@ -4,7 +4,7 @@
 struct CustomUniforms {
     // Sixteen free parameters, set with `CustomShader::params`.
     params: array<vec4<f32>, 4>,
-    // Number of spectra in `custom_spectra` per wavelength group (0..=4).
+    // Number of spectra in `custom_spectra` per wavelength group.
     n_spectra: u32,
     _pad0: u32,
     _pad1: u32,
@@ -13,7 +13,8 @@ struct CustomUniforms {
 
 @group(3) @binding(0) var<uniform> custom: CustomUniforms;
 // `CustomShader::spectra` resampled at the current wavelengths:
-// custom_spectra[group * 4 + s] holds spectrum s at the group's four wavelengths.
+// custom_spectra[group * 4 + s] holds spectrum s < 4 at the group's four wavelengths, and
+// custom_spectra[s * n_groups + group] spectrum s ≥ 4 (tables).
 @group(3) @binding(1) var<storage, read> custom_spectra: array<vec4<f32>>;
 
 // What the hooks know about the point being shaded.

@@ -39,6 +39,7 @@ use thiserror::Error;
 use crate::WaterSettings;
 
 pub mod fresnel;
+pub mod light_field;
 mod quadrature;
 pub mod single;
 
@@ -123,6 +124,9 @@ pub struct WaterMedium {
     pub sun_dir: Vec3,
     /// Metres per scene unit.
     pub scale: f64,
+    /// Sky plane irradiance below the surface as a multiple of the sun's (`water.sky`, see
+    /// `scene::sky`); 0 unless set from the scene's settings.
+    pub sky: f64,
 }
 
 impl WaterMedium {
@@ -164,12 +168,22 @@ impl WaterMedium {
             return Err(WaterError::BadSun(s.to_array()));
         }
         properties.validate()?;
-        Ok(WaterMedium { water_type: None, properties, depth, sun_dir: s.normalize().as_vec3(), scale })
+        Ok(WaterMedium {
+            water_type: None,
+            properties,
+            depth,
+            sun_dir: s.normalize().as_vec3(),
+            scale,
+            sky: 0.0,
+        })
     }
 
     /// From a scene's `WaterSettings` (type name parsed with [`WaterType::parse`]).
     pub fn from_settings(s: &WaterSettings) -> Result<Self, WaterError> {
-        Self::new(WaterType::parse(&s.water_type)?, s.depth as f64, s.sun_direction, s.scale as f64)
+        let mut m =
+            Self::new(WaterType::parse(&s.water_type)?, s.depth as f64, s.sun_direction, s.scale as f64)?;
+        m.sky = s.sky as f64;
+        Ok(m)
     }
 
     /// a, b, c, Kd at `lambda` nm.

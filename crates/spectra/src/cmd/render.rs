@@ -73,10 +73,23 @@ pub struct LookArgs {
     #[arg(long, value_name = "G", allow_negative_numbers = true,
           default_value_t = render::passes::underwater::Options::default().phase_g)]
     pub phase_g: f32,
-    /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance,
-    /// no single scattering; same as --scatter-steps 0).
-    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface"])]
+    /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance
+    /// attenuated by the tabulated Kd, no single scattering).
+    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface",
+          "isotropic", "tabulated_kd", "light_field_photons"])]
     pub paper_model: bool,
+    /// Under water: the paper's isotropic in-scattering term with the tabulated Kd plus the
+    /// marched single scattering (the previous default) instead of the light-field source.
+    #[arg(long, conflicts_with_all = ["tabulated_kd", "light_field_photons"])]
+    pub isotropic: bool,
+    /// Under water, light-field model: attenuate surfaces by the type's tabulated Kd instead
+    /// of the downwelling irradiance derived from a, b and the phase function.
+    #[arg(long)]
+    pub tabulated_kd: bool,
+    /// Under water, light-field model: photons per wavelength node and source for the
+    /// table's solver (solved once per water type, sun, sky and depth range, then cached).
+    #[arg(long, value_name = "N", default_value_t = render::passes::underwater::LIGHT_FIELD_PHOTONS)]
+    pub light_field_photons: usize,
     /// Under water: scatter the diffuse light's scalar irradiance (Kd/a)·E_d (Gershun's law)
     /// instead of the paper's plane irradiance E_d.
     #[arg(long)]
@@ -130,9 +143,12 @@ impl LookArgs {
                 scalar_irradiance: self.scalar_irradiance,
                 split_beams: self.split_beams,
                 surface: self.water_surface,
+                light_field: !(self.isotropic || self.scalar_irradiance || self.split_beams),
+                tabulated_kd: self.tabulated_kd,
+                photons: self.light_field_photons,
             }
         };
-        o.validate().map_err(|e| anyhow!("--scatter-steps/--phase-g: {e}"))?;
+        o.validate().map_err(|e| anyhow!("underwater model options: {e}"))?;
         Ok(o)
     }
 }
@@ -171,11 +187,39 @@ pub fn water_medium(
         }
         settings.depth = d as f32;
     }
+    // `water.sun_direction` drives the light-field table: a dry scene given --water takes it
+    // from the scene's sun (undoing the refraction), and a scene whose sun disagrees with its
+    // own setting is refused rather than rendered with a table for another sun.
+    let sun = scene.lights.iter().find_map(|l| match l.kind {
+        scene::LightKind::Directional { direction } if l.stands_in_for.is_none() && direction.y < 0.0 => {
+            Some(-direction.normalize())
+        }
+        _ => None,
+    });
+    if let (None, Some(to_sun)) = (&scene.water, sun) {
+        let h = glam::Vec3::new(to_sun.x, 0.0, to_sun.z) * scene::water::WATER_IOR as f32;
+        if h.length() < 1.0 {
+            settings.sun_direction = glam::Vec3::new(h.x, (1.0 - h.length_squared()).sqrt(), h.z);
+        }
+    }
     // The message already includes its cause; anyhow's chain would print it twice.
     let medium = scene::water::WaterMedium::from_settings(&settings).map_err(|e| match water {
         Some(w) => anyhow!("--water '{w}': {e}"),
         None => anyhow!("scene {}: water settings: {e}", scene.source),
     })?;
+    if let (Some(_), Some(to_sun)) = (&scene.water, sun) {
+        let want = medium.sun_dir_underwater();
+        let angle = to_sun.dot(want).clamp(-1.0, 1.0).acos().to_degrees();
+        if angle > 0.5 {
+            bail!(
+                "scene {}: its sun shines from {to_sun:?} under water, but water.sun_direction {:?} refracts \
+                 to {want:?} ({angle:.1}° apart); make the light's direction the refracted water.sun_direction \
+                 (the underwater light-field table is computed for water.sun_direction)",
+                scene.source,
+                medium.sun_dir
+            );
+        }
+    }
     // Both renderers put the whole scene under a flat surface `depth` above the camera: geometry
     // above it would be lit and seen as if under water by the rasteriser and as in air by the
     // path tracer.
@@ -276,7 +320,7 @@ fn render_frame(
         eprintln!("warning: {}: {w}", scene.source);
     }
     if let Some(m) = water {
-        r.set_custom_shader(render::passes::underwater::shader_with(m, &args.look.underwater()?))?;
+        r.set_custom_shader(render::passes::underwater::shader_with(m, &args.look.underwater()?)?)?;
     }
     r.resize(width, height)?;
     r.render(&scene.camera, settings)?;
@@ -398,5 +442,14 @@ mod tests {
         let wet = scene::builtin("underwater").unwrap();
         let m = water_medium(&wet, None, Some(20.0)).unwrap().unwrap();
         assert_eq!((m.water_type.unwrap().to_string(), m.depth), ("IB".to_string(), 20.0));
+        // water.sun_direction drives the light-field table: the built-in's sun is its refraction,
+        // a scene whose sun disagrees is refused, naming both.
+        let sun = wet.lights.iter().find(|l| l.stands_in_for.is_none()).unwrap();
+        let scene::LightKind::Directional { direction } = sun.kind else { panic!("a sun") };
+        assert!((-direction - m.sun_dir_underwater()).length() < 1e-5);
+        let mut tilted = wet.clone();
+        tilted.water.as_mut().unwrap().sun_direction = glam::Vec3::new(1.0, 0.3, 0.0).normalize();
+        let e = format!("{:#}", water_medium(&tilted, None, None).unwrap_err());
+        assert!(e.contains("water.sun_direction") && e.contains("°"), "{e}");
     }
 }

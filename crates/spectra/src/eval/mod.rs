@@ -408,7 +408,7 @@ fn renderer_for(
     let mut r = Renderer::with_table(table.clone())?;
     r.set_scene(&c.scene)?;
     if let Some(w) = water {
-        r.set_custom_shader(render::passes::underwater::shader(w))?;
+        r.set_custom_shader(render::passes::underwater::shader(w)?)?;
     }
     Ok(r)
 }

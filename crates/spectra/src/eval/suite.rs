@@ -34,6 +34,8 @@ pub struct Budget {
     pub water_spp: u32,
     /// Jerlov types of the underwater cases in the default suite.
     pub water_types: Vec<String>,
+    /// Camera depths (m) of the underwater cases; empty = the built-in's own depth (10 m).
+    pub water_depths: Vec<f64>,
 }
 
 impl Budget {
@@ -55,6 +57,7 @@ impl Budget {
             water_height: 96,
             water_spp: 1024,
             water_types: vec!["I".into()],
+            water_depths: vec![],
         }
     }
 
@@ -76,6 +79,8 @@ impl Budget {
             water_height: 120,
             water_spp: 4096,
             water_types: ["I", "IB", "II", "3C"].iter().map(|s| s.to_string()).collect(),
+            // The original implementation's evaluation depths (issue 13).
+            water_depths: vec![1.0, 5.0, 10.0, 20.0, 50.0],
         }
     }
 
@@ -112,15 +117,28 @@ pub struct Case {
 /// Case ids `spectra eval --scenes` accepts.
 pub const CASE_IDS: &[&str] = &["metamerism", "colorchecker-d65", "colorchecker-f11", "colorchecker-led"];
 
-/// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`).
-pub fn water_id(ty: &str) -> String {
-    format!("underwater-{}", ty.to_ascii_lowercase())
+/// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
+/// depth or at `depth` m (`underwater-ib-5m`).
+pub fn water_id(ty: &str, depth: Option<f64>) -> String {
+    match depth {
+        Some(d) => format!("underwater-{}-{d}m", ty.to_ascii_lowercase()),
+        None => format!("underwater-{}", ty.to_ascii_lowercase()),
+    }
 }
 
 /// The default suite: the direct-lighting cases, then the underwater scene in each of the
 /// budget's water types (paper Figs. 1–2). Other Jerlov types are opt-in (`--scenes underwater-iii`).
 pub fn default_ids(b: &Budget) -> Vec<String> {
-    CASE_IDS.iter().map(|s| s.to_string()).chain(b.water_types.iter().map(|t| water_id(t))).collect()
+    let depths: Vec<Option<f64>> = if b.water_depths.is_empty() {
+        vec![None]
+    } else {
+        b.water_depths.iter().map(|&d| Some(d)).collect()
+    };
+    CASE_IDS
+        .iter()
+        .map(|s| s.to_string())
+        .chain(b.water_types.iter().flat_map(|t| depths.iter().map(move |&d| water_id(t, d))))
+        .collect()
 }
 
 /// Notes the report carries for a run of `ids`.
@@ -162,13 +180,28 @@ pub fn case(id: &str) -> Result<Case> {
         "colorchecker-f11" => cc("F11", "ColorChecker under CIE F11 (narrow-band fluorescent)"),
         "colorchecker-led" => cc("LED-RGB1", "ColorChecker under CIE LED-RGB1 (three-peak LED)"),
         w if w.starts_with("underwater-") => {
-            let ty = w["underwater-".len()..].to_ascii_uppercase();
+            let rest = &w["underwater-".len()..];
+            // `underwater-TYPE-DEPTHm`: a depth suffix is a number of metres ending in `m`.
+            let (ty, depth) = match rest.rsplit_once('-') {
+                Some((t, d)) if d.ends_with('m') => {
+                    let m: f32 = d[..d.len() - 1]
+                        .parse()
+                        .ok()
+                        .filter(|m: &f32| m.is_finite() && *m >= 0.0)
+                        .with_context(|| {
+                        format!("eval scene '{w}': depth '{d}' is not metres ≥ 0 (e.g. 5m)")
+                    })?;
+                    (t.to_ascii_uppercase(), Some(m))
+                }
+                _ => (rest.to_ascii_uppercase(), None),
+            };
             let mut sc = scene::builtin("underwater")?;
             let base = sc.water.clone().context("the underwater built-in has no water settings")?;
-            sc.water = Some(scene::WaterSettings { water_type: ty.clone(), ..base });
+            let depth = depth.unwrap_or(base.depth);
+            sc.water = Some(scene::WaterSettings { water_type: ty.clone(), depth, ..base });
             Ok(Case {
                 id: id.into(),
-                title: format!("Underwater, Jerlov type {ty} (paper Figs. 1–2)"),
+                title: format!("Underwater, Jerlov type {ty} at {depth} m (paper Figs. 1–2)"),
                 scene: sc,
             })
         }
@@ -219,9 +252,15 @@ mod tests {
         assert_eq!(q.last().map(String::as_str), Some("underwater-i"));
         assert!(q.iter().any(|id| id == "metamerism"));
         let f = default_ids(&Budget::full());
-        for id in ["underwater-i", "underwater-ib", "underwater-ii", "underwater-3c"] {
-            assert!(f.iter().any(|x| x == id), "{id} missing from the full suite");
+        for ty in ["i", "ib", "ii", "3c"] {
+            for d in [1, 5, 10, 20, 50] {
+                let id = format!("underwater-{ty}-{d}m");
+                assert!(f.contains(&id), "{id} missing from the full suite");
+            }
         }
+        let deep = case("underwater-3c-50m").unwrap();
+        assert_eq!(deep.scene.water.as_ref().map(|w| (w.water_type.as_str(), w.depth)), Some(("3C", 50.0)));
+        assert!(case("underwater-3c-xm").unwrap_err().to_string().contains("metres"));
         let b = Budget::quick();
         let uw = case("underwater-i").unwrap();
         assert_eq!(uw.scene.water.as_ref().unwrap().water_type, "I");

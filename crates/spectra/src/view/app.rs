@@ -148,7 +148,7 @@ impl Running {
         let mut renderer = Renderer::with_gpu(gpu, opts.table.clone())?;
         renderer.set_scene(&opts.scene)?;
         if let Some(w) = &opts.water {
-            renderer.set_custom_shader(render::passes::underwater::shader_with(w, &opts.water_options))?;
+            renderer.set_custom_shader(render::passes::underwater::shader_with(w, &opts.water_options)?)?;
         }
         let water = opts.water.as_ref().map(|w| {
             let c = WaterControls::new(w, opts.water_options);

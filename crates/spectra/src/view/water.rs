@@ -40,6 +40,13 @@ impl WaterControls {
         self.water_type != applied.water_type
             || (self.options.steps > 0) != (applied.options.steps > 0)
             || self.options.surface != applied.options.surface
+            || self.options.light_field != applied.options.light_field
+            || self.options.tabulated_kd != applied.options.tabulated_kd
+            // The light-field table depends on g and on the depth range it covers.
+            || (self.options.light_field
+                && (self.options.phase_g != applied.options.phase_g
+                    || underwater::light_field_range(self.depth as f64)
+                        != underwater::light_field_range(applied.depth as f64)))
     }
 
     /// Applies `self` to `renderer`, coming from `applied`.
@@ -52,7 +59,7 @@ impl WaterControls {
         let medium = self.medium(base)?;
         self.options.validate().map_err(|e| anyhow::anyhow!(e))?;
         if self.needs_recompile(applied) {
-            renderer.set_custom_shader(underwater::shader_with(&medium, &self.options))?;
+            renderer.set_custom_shader(underwater::shader_with(&medium, &self.options)?)?;
         } else {
             renderer.set_custom_params(underwater::params_with(&medium, &self.options));
         }
@@ -68,6 +75,8 @@ impl WaterControls {
         });
         ui.add(egui::Slider::new(&mut self.depth, 0.0..=MAX_DEPTH).step_by(0.5).text("depth m"));
         let o = &mut self.options;
+        ui.checkbox(&mut o.light_field, "light-field source (off: the paper's isotropic term)");
+        ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.tabulated_kd, "tabulated Kd on surfaces"));
         ui.add(egui::Slider::new(&mut o.steps, 0..=MAX_STEPS).text("march steps (0 = off)"));
         ui.add_enabled(o.steps > 0, egui::Slider::new(&mut o.phase_g, 0.0..=0.99).text("phase g"));
         ui.add_enabled(o.steps > 0, egui::Checkbox::new(&mut o.split_beams, "split sun beams out of L_ms"));
@@ -91,8 +100,20 @@ mod tests {
 
     #[test]
     fn only_type_and_compiled_switches_recompile() {
-        let a = WaterControls::new(&base(), Options::default());
+        let a = WaterControls::new(&base(), Options::isotropic());
         assert_eq!((a.water_type.as_str(), a.depth), ("IB", 10.0));
+        // The light-field table is compiled in: its g and depth range recompile, a depth
+        // within the same range does not.
+        let lf = WaterControls::new(&base(), Options::default());
+        let mut e = lf.clone();
+        e.depth = 3.0;
+        assert!(!e.needs_recompile(&lf), "same table range");
+        e.depth = 30.0;
+        assert!(e.needs_recompile(&lf), "deeper table");
+        let mut e = lf.clone();
+        e.options.phase_g = 0.5;
+        assert!(e.needs_recompile(&lf), "the table depends on g");
+        assert!(a.needs_recompile(&lf), "light field on/off");
         let mut b = a.clone();
         b.depth = 3.0;
         b.options.steps = 8;
@@ -127,7 +148,7 @@ mod tests {
         r.set_scene(&scene).unwrap();
         r.resize(32, 24).unwrap();
         let start = WaterControls::new(&base, Options::default());
-        r.set_custom_shader(underwater::shader_with(&base, &start.options)).unwrap();
+        r.set_custom_shader(underwater::shader_with(&base, &start.options).unwrap()).unwrap();
         let before = render(&mut r);
         let mut edits = vec![];
         let mut e = start.clone();
@@ -146,7 +167,9 @@ mod tests {
             fresh.set_scene(&scene).unwrap();
             fresh.resize(32, 24).unwrap();
             fresh
-                .set_custom_shader(underwater::shader_with(&edit.medium(&base).unwrap(), &edit.options))
+                .set_custom_shader(
+                    underwater::shader_with(&edit.medium(&base).unwrap(), &edit.options).unwrap(),
+                )
                 .unwrap();
             assert_eq!(got, render(&mut fresh), "{edit:?}");
             applied = edit;
