@@ -47,3 +47,116 @@ impl GpuCoeffTable {
         GpuCoeffTable { res: res as u32, view: texture.create_view(&Default::default()), scale }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::Gpu;
+    use color::upsample::adversarial::{AdversarialOptions, adversarial_set};
+    use color::upsample::fit::{LabModel, nm_to_normalised};
+
+    /// The WGSL `fetch_coeffs` (f32, textureLoad) against the CPU `CoeffTable::fetch` on the
+    /// adversarial set of the sRGB table: corners, edges, faces, greys down to 10⁻⁶, the 3 %
+    /// next to black and white, and the worst colours the search finds. The brightness weight
+    /// is σ⁻¹-space in both; a mismatch in it would show at the dark greys first.
+    #[test]
+    fn gpu_fetch_matches_cpu_on_the_adversarial_set() {
+        let table = color::upsample::table("srgb").expect("the sRGB table");
+        let space = color::RgbColorSpace::srgb();
+        let colours: Vec<[f32; 4]> = adversarial_set(&table, &space, &AdversarialOptions::default())
+            .unwrap()
+            .into_iter()
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, 0.0])
+            .collect();
+        let gpu = Gpu::headless().unwrap_or_else(|e| panic!("{e}\n{}", Gpu::install_help()));
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let coeff = GpuCoeffTable::upload(device, queue, &table);
+        let src = format!(
+            "{}\n{}\n@group(2) @binding(10) var<storage, read> rgb_in: array<vec4<f32>>;\n\
+             @group(2) @binding(11) var<storage, read_write> c_out: array<vec4<f32>>;\n\
+             @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+             if (id.x >= arrayLength(&rgb_in)) {{ return; }}\n\
+             c_out[id.x] = vec4<f32>(fetch_coeffs(rgb_in[id.x].xyz, {}u), 0.0);\n}}\n",
+            crate::shader::COMMON,
+            crate::shader::SPECTRAL,
+            table.res
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("fetch test"),
+            source: wgpu::ShaderSource::Wgsl(src.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("fetch test"),
+            layout: None,
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(&colours),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let size = (colours.len() * 16) as u64;
+        let output = device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(2),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&coeff.view),
+                },
+                wgpu::BindGroupEntry { binding: 4, resource: coeff.scale.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 10, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 11, resource: output.as_entire_binding() },
+            ],
+        });
+        let empty: Vec<wgpu::BindGroup> = (0..2)
+            .map(|g| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: None,
+                    layout: &pipeline.get_bind_group_layout(g),
+                    entries: &[],
+                })
+            })
+            .collect();
+        let mut enc = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &empty[0], &[]);
+            pass.set_bind_group(1, &empty[1], &[]);
+            pass.set_bind_group(2, &bind, &[]);
+            pass.dispatch_workgroups(colours.len().div_ceil(64) as u32, 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
+        queue.submit([enc.finish()]);
+        let out: Vec<[f32; 4]> =
+            crate::readback::map_buffer(device, &staging, |b| bytemuck::cast_slice(b).to_vec()).unwrap();
+        let model = LabModel::new(&space).unwrap();
+        let mut worst = (0.0f64, [0.0f32; 4]);
+        for (rgb, g) in colours.iter().zip(&out) {
+            let cpu = table.fetch([rgb[0] as f64, rgb[1] as f64, rgb[2] as f64]).c;
+            let gpu = [g[0] as f64, g[1] as f64, g[2] as f64];
+            let lab = |c: [f64; 3]| model.lab_of_xyz(model.xyz(nm_to_normalised(c)));
+            let de = color::ciede2000(lab(cpu), lab(gpu));
+            if de > worst.0 {
+                worst = (de, *rgb);
+            }
+        }
+        assert!(worst.0 <= 1e-3, "GPU vs CPU fetch: ΔE2000 {} at RGB {:?}", worst.0, worst.1);
+    }
+}

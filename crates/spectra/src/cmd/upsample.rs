@@ -1,5 +1,5 @@
 //! `spectra upsample`: turn one RGB reflectance into a spectrum and show how well it round-trips;
-//! `--roundtrip N` measures a method over N random colours; `--bench` measures evaluation speed.
+//! `--roundtrip N` measures a method over N random colours (and a table adversarially); `--bench` measures evaluation speed.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -7,7 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use color::RgbColorSpace;
-use color::upsample::{self, CoeffTable, Method, Reflectance, Upsampler, fit::LabModel, method, roundtrip};
+use color::upsample::{
+    self, CoeffTable, Method, Reflectance, Upsampler, adversarial, fit::LabModel, method, roundtrip,
+};
 use serde_json::json;
 
 #[derive(clap::Args, Debug)]
@@ -66,6 +68,16 @@ fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
     }
 }
 
+fn print_adversarial(what: &str, r: &adversarial::Adversarial) {
+    println!(
+        "  {what} ({} colours): ΔE2000 max {:.4}  p99 {:.4}  mean {:.4}",
+        r.colours, r.stats.max, r.stats.p99, r.stats.mean
+    );
+    for w in r.worst.iter().take(5) {
+        println!("    RGB {:.4} {:.4} {:.4}: {:.4}", w.rgb[0], w.rgb[1], w.rgb[2], w.delta_e);
+    }
+}
+
 pub fn run(a: Args) -> Result<()> {
     let space = RgbColorSpace::by_name(&a.space)?;
     if a.bench {
@@ -80,10 +92,34 @@ pub fn run(a: Args) -> Result<()> {
         let t0 = Instant::now();
         let r = roundtrip::roundtrip_upsampler(up.as_ref(), &space, n, a.seed)?;
         let secs = t0.elapsed().as_secs_f64();
+        // A table is also searched adversarially: uniform colours almost never land on black,
+        // the grey axis or the last percent below white, where tables go wrong.
+        let adv = if up.method() == Method::Jakob {
+            let table = match &a.table {
+                Some(p) => Arc::new(CoeffTable::read(p)?),
+                None => upsample::table_for(&space)?,
+            };
+            let opt = adversarial::AdversarialOptions { seed: a.seed, ..Default::default() };
+            let own = adversarial::check(&table, &space, adversarial::Domain::Own, &opt)?;
+            let wide = if space.name != "srgb" {
+                Some((
+                    adversarial::check(&table, &space, adversarial::Domain::Srgb, &opt)?,
+                    adversarial::gamut_report(&table, &space, n, a.seed)?,
+                ))
+            } else {
+                None
+            };
+            Some((own, wide))
+        } else {
+            None
+        };
         if a.json {
             println!(
                 "{}",
-                json!({"space": space.name, "method": up.method().name(), "table": a.table, "roundtrip": r})
+                json!({"space": space.name, "method": up.method().name(), "table": a.table, "roundtrip": r,
+                       "adversarial": adv.as_ref().map(|x| &x.0),
+                       "adversarial_inside_srgb": adv.as_ref().and_then(|x| x.1.as_ref().map(|w| &w.0)),
+                       "gamut": adv.as_ref().and_then(|x| x.1.as_ref().map(|w| &w.1))})
             );
         } else {
             println!(
@@ -100,6 +136,26 @@ pub fn run(a: Args) -> Result<()> {
                 r.worst_rgb[1],
                 r.worst_rgb[2]
             );
+            if let Some((own, wide)) = &adv {
+                print_adversarial("adversarial search, whole cube", own);
+                if let Some((srgb, g)) = wide {
+                    print_adversarial("adversarial search, inside sRGB", srgb);
+                    let line = |what: &str, s: &Option<color::metrics::Stats>, n: usize| match s {
+                        Some(s) => println!(
+                            "  uniform, {what} ({n} colours): max {:.4}  p99 {:.4}  mean {:.4}",
+                            s.max, s.p99, s.mean
+                        ),
+                        None => println!("  uniform, {what}: no colours"),
+                    };
+                    line("inside sRGB", &g.inside_srgb, g.n_inside_srgb);
+                    line("outside sRGB, inside the object-colour solid", &g.inside_solid, g.n_inside_solid);
+                    line(
+                        "outside the object-colour solid (no reflectance exists)",
+                        &g.outside_solid,
+                        g.n_outside_solid,
+                    );
+                }
+            }
         }
         return Ok(());
     }
