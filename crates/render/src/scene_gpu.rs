@@ -260,6 +260,20 @@ impl<'a> Chunks<'a> {
         }
     }
 
+    /// Ends the run of indices from `start` in the open chunk as one draw (none if empty).
+    fn close_run(&self, draws: &mut Vec<Draw>, start: u32, template: Draw) {
+        let count = self.indices.len() as u32 - start;
+        if count > 0 {
+            draws.push(Draw {
+                chunk: self.done.len(),
+                first_index: start,
+                index_count: count,
+                base_vertex: 0,
+                ..template
+            });
+        }
+    }
+
     fn flush(&mut self) {
         if self.indices.is_empty() {
             return;
@@ -312,16 +326,7 @@ impl<'a> Chunks<'a> {
             if self.vertices.len() + new_vertices > self.max_vertices
                 || self.indices.len() + 3 > self.max_indices
             {
-                let count = self.indices.len() as u32 - start;
-                if count > 0 {
-                    draws.push(Draw {
-                        chunk: self.done.len(),
-                        first_index: start,
-                        index_count: count,
-                        base_vertex: 0,
-                        ..template
-                    });
-                }
+                self.close_run(&mut draws, start, template);
                 self.flush();
                 for v in touched.drain(..) {
                     remap[v as usize] = NONE;
@@ -337,16 +342,7 @@ impl<'a> Chunks<'a> {
                 self.indices.push(remap[v as usize]);
             }
         }
-        let count = self.indices.len() as u32 - start;
-        if count > 0 {
-            draws.push(Draw {
-                chunk: self.done.len(),
-                first_index: start,
-                index_count: count,
-                base_vertex: 0,
-                ..template
-            });
-        }
+        self.close_run(&mut draws, start, template);
         draws
     }
 
