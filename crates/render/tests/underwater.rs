@@ -94,6 +94,19 @@ fn pixel_ray(camera: &Camera, px: u32, py: u32) -> Option<(Vec3, Option<f32>)> {
     }
 }
 
+/// Spectral mode at the single wavelength `lambda` (a 1 nm range, midpoint rule), so that a
+/// pixel's value is that wavelength's radiance times a known constant.
+fn one_wavelength(lambda: f64, shadows: bool) -> RenderSettings {
+    RenderSettings {
+        mode: Mode::Spectral,
+        quadrature: Quadrature::Midpoint,
+        wavelengths: 1,
+        range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
+        shadows,
+        ..Default::default()
+    }
+}
+
 fn render(r: &mut Renderer, scene: &Scene, settings: &RenderSettings, custom: CustomShader) -> Vec<[f32; 4]> {
     r.set_custom_shader(custom).unwrap();
     r.render(&scene.camera, settings).unwrap();
@@ -168,14 +181,7 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
     for (ty, depth, scale) in [("IB", 5.0, 1.0), ("5C", 12.0, 0.5), ("III", 0.8, 2.0)] {
         let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         for lambda in [430.0, 500.0, 560.0, 640.0] {
-            let settings = RenderSettings {
-                mode: Mode::Spectral,
-                quadrature: Quadrature::Midpoint,
-                wavelengths: 1,
-                range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
-                shadows: false,
-                ..Default::default()
-            };
+            let settings = one_wavelength(lambda, false);
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
             let wet = render(
                 &mut r,
@@ -321,14 +327,7 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
         let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         let c_min = underwater::params_with(&medium, &options)[7] as f64;
         for lambda in [450.0, 530.0, 610.0] {
-            let settings = RenderSettings {
-                mode: Mode::Spectral,
-                quadrature: Quadrature::Midpoint,
-                wavelengths: 1,
-                range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
-                shadows: true,
-                ..Default::default()
-            };
+            let settings = one_wavelength(lambda, true);
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
             let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
@@ -418,14 +417,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
     let options = underwater::Options::isotropic();
     let (depth, lambda) = (6.0, 500.0);
     let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
-    let settings = RenderSettings {
-        mode: Mode::Spectral,
-        quadrature: Quadrature::Midpoint,
-        wavelengths: 1,
-        range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
-        shadows: true,
-        ..Default::default()
-    };
+    let settings = one_wavelength(lambda, true);
     let dry = render(&mut r, &scene, &settings, CustomShader::default());
     let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
     let setup = SpectralSetup::new(&settings).unwrap();
@@ -544,14 +536,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
         let options = underwater::Options { photons: 400, ..Default::default() };
         let lf = underwater::light_field_table(&medium, &options).unwrap();
         for lambda in [430.0, 500.0, 575.0, 640.0] {
-            let settings = RenderSettings {
-                mode: Mode::Spectral,
-                quadrature: Quadrature::Midpoint,
-                wavelengths: 1,
-                range: WavelengthRange::new(lambda - 0.5, lambda + 0.5).unwrap(),
-                shadows: true,
-                ..Default::default()
-            };
+            let settings = one_wavelength(lambda, true);
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
             let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
