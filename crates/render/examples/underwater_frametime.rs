@@ -1,11 +1,11 @@
 //! Frame-time cost of the underwater hooks (not a test): renders the built-in `underwater` scene
-//! dry, with the paper's model and with the default model (16-step single scattering) at
+//! dry, with the paper's model, the isotropic model + 16-step single scattering and the default
+//! (light-field) model, in the scene's water (type chosen, camera at 10 m, sea floor included) at
 //! N = 8, 16, 32 (and rgb) and prints the median wall-clock frame time and the shading pass's
 //! GPU time (where the hooks run) when timestamps are available.
 //!
 //! `cargo run --release -p render --example underwater_frametime -- [WIDTHxHEIGHT] [FRAMES] [TYPE]`
 
-use glam::Vec3;
 use render::passes::underwater;
 use render::{CustomShader, Mode, RenderSettings, Renderer};
 use scene::water::WaterMedium;
@@ -24,7 +24,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (w, h) = size.split_once('x').ok_or("size must be WxH")?;
     let (w, h): (u32, u32) = (w.parse()?, h.parse()?);
     let scene = scene::builtin("underwater")?;
-    let medium = WaterMedium::new(ty, 10.0, Vec3::Y, 1.0)?;
+    // The scene's own water (sun, sky) at 10 m with the chosen type, and the sea floor under
+    // its camera, as `spectra render underwater --water TYPE --depth 10` draws it.
+    let settings = scene.water.clone().ok_or("the underwater scene has water settings")?;
+    let mut medium = WaterMedium::from_settings(&scene::WaterSettings {
+        water_type: ty.to_string(),
+        depth: 10.0,
+        ..settings
+    })?;
+    medium.floor = scene::water::floor::below_camera(&scene, medium.scale)?;
     let mut r = Renderer::new()?;
     println!("adapter: {}", r.gpu().describe());
     r.set_scene(&scene)?;

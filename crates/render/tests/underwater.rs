@@ -523,7 +523,7 @@ fn prefiltered_weights_pass_through_the_hook_node_by_node() {
 /// the same numbers.
 #[test]
 fn light_field_hook_matches_cpu_to_1e_3() {
-    use scene::water::light_field::{log_interp, ray_integral};
+    use scene::water::light_field::{log_interp, ray_integral_by};
     use scene::water::single;
     let scene = floor_scene();
     let mut r = common::renderer();
@@ -531,10 +531,22 @@ fn light_field_hook_matches_cpu_to_1e_3() {
     r.resize(W, H).unwrap();
     let table = common::table();
     let mut tally = Tally::default();
-    for (ty, depth, scale) in [("IB", 5.0, 1.0), ("3C", 12.0, 0.5), ("II", 30.0, 8.0)] {
-        let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
+    for (ty, depth, scale, floor) in
+        [("IB", 5.0, 1.0, false), ("3C", 12.0, 0.5, true), ("II", 30.0, 8.0, false)]
+    {
+        let mut medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
+        if floor {
+            // A sea floor closes the column (the table ends at its depth).
+            medium.floor = Some(scene::water::floor::SeaFloor {
+                below_camera: 1.5 * scale,
+                rgb: [0.3; 3],
+                albedo: color::Spectrum::Constant(0.3),
+                extent: Some([-FX, -FZ, FX, 2.0]),
+            });
+        }
         let options = underwater::Options { photons: 400, ..Default::default() };
-        let lf = underwater::light_field_table(&medium, &options).unwrap();
+        let [lf, deep] = underwater::light_field_tables(&medium, &options).unwrap();
+        assert_eq!(lf.z_max, deep.z_max, "both tables share the depth nodes");
         for lambda in [430.0, 500.0, 575.0, 640.0] {
             let settings = one_wavelength(lambda, true);
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
@@ -545,8 +557,15 @@ fn light_field_hook_matches_cpu_to_1e_3() {
             let k = medium.coefficients(lambda);
             let to_sun = -light_dir().as_dvec3();
             let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
-            let ed: [f64; scene::water::light_field::N_DEPTH] =
-                std::array::from_fn(|d| lf.e_d_node(d, lambda));
+            let ed = |t: &scene::water::light_field::LightFieldTable| -> [f64; scene::water::light_field::N_DEPTH] {
+                std::array::from_fn(|d| t.e_d_node(d, lambda))
+            };
+            let cam = scene.camera.transform.w_axis.truncate().as_dvec3();
+            let (fx, fz) = (FX as f64, FZ as f64);
+            // Over the floor's extent (the test floor's quad), and the distance to its edge;
+            // without a floor every point is "over" it (both tables are the same).
+            let over = |x: f64, z: f64| !floor || (x.abs() <= fx && (-fz..=2.0).contains(&z));
+            let edge = |x: f64, z: f64| (x.abs() - fx).abs().min((z + fz).abs()).min((z - 2.0).abs());
             for py in 0..H {
                 for px in 0..W {
                     let Some((dir, hit)) = pixel_ray(&scene.camera, px, py) else { continue };
@@ -556,21 +575,78 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                         None if w.y > 0.0 => depth / w.y,
                         None => f64::INFINITY,
                     };
-                    let col = lf.j_column(w, sun_h, lambda);
-                    let scatter = e_sun * ray_integral(&col, lf.z_max, k.c, depth, w.y, d)
-                        + single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
+                    // Each piece of the ray reads the floored table over the floor, the
+                    // bottomless one beyond it; pixels with a piece, hit or mirrored landing
+                    // within a hair of the floor's edge could fall either side in f32 and are
+                    // left out.
+                    let near = std::cell::Cell::new(f64::INFINITY);
+                    let (col_floor, col_deep) =
+                        (lf.j_column(w, sun_h, lambda), deep.j_column(w, sun_h, lambda));
+                    let col_at = |t: f64, endless: bool| {
+                        if endless {
+                            // Below the floor's depth only the bottomless column makes sense.
+                            return col_deep;
+                        }
+                        let p = cam + w * (t / scale);
+                        near.set(near.get().min(edge(p.x, p.z) / (1.0 + t / scale)));
+                        if over(p.x, p.z) { col_floor } else { col_deep }
+                    };
+                    // A view leaves the floored column where it leaves the floor's extent or
+                    // reaches the floor's depth (the pass cuts it there).
+                    let cut = (floor && over(cam.x, cam.z)).then(|| {
+                        let mut te = if w.y < -1e-6 { (lf.z_max - depth) / -w.y } else { f64::INFINITY };
+                        for (o, dv, lo, hi) in [(cam.x, w.x, -fx, fx), (cam.z, w.z, -fz, 2.0)] {
+                            if dv > 1e-9 {
+                                te = te.min((hi - o) / dv * scale);
+                            }
+                            if dv < -1e-9 {
+                                te = te.min((lo - o) / dv * scale);
+                            }
+                        }
+                        te
+                    });
+                    let table_part = e_sun * ray_integral_by(&col_at, lf.z_max, k.c, depth, w.y, d, cut);
+                    let beam_part =
+                        single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
+                    let scatter = table_part + beam_part;
                     let i = (py * W + px) as usize;
+                    let reach = if hit.is_none() && w.y > 0.0 {
+                        (depth + lf.z_max) / (w.y * scale)
+                    } else {
+                        d / scale
+                    };
+                    let end = cam + w * reach;
+                    near.set(near.get().min(edge(end.x, end.z) / (1.0 + reach)));
+                    if floor && near.get() < 1e-3 {
+                        continue;
+                    }
                     let surface = match hit {
                         Some(_) => {
                             let zs = depth - d * w.y;
+                            let t = if over(end.x, end.z) { &lf } else { &deep };
                             DVec3::from(common::rgb_of(&dry[i]))
-                                * (log_interp(&ed, lf.z_max, zs) * (-k.c * d).exp())
+                                * (log_interp(&ed(t), lf.z_max, zs) * (-k.c * d).exp())
+                        }
+                        // Looking up at the surface: what it reflects (the table's), attenuated
+                        // over the path; no sky in this scene, so nothing through the window.
+                        // The floor shows in the mirror where the mirrored view lands on it.
+                        None if w.y > 0.0 => {
+                            let r = if over(end.x, end.z) {
+                                lf.surface_at(w, sun_h, lambda, true)
+                            } else {
+                                deep.surface_at(w, sun_h, lambda, false)
+                            };
+                            unit * (e_sun * r * (-k.c * d).exp())
                         }
                         None => DVec3::ZERO,
                     };
                     let want = surface + unit * scatter;
-                    let what =
-                        || format!("light field {ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
+                    let what = || {
+                        format!(
+                            "light field {ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py}) (table part \
+                             {table_part:.6}, beam part {beam_part:.6}, cut {cut:?})"
+                        )
+                    };
                     tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
                 }
             }

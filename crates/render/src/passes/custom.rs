@@ -62,7 +62,7 @@ pub struct CustomShader {
 
 /// Most spectra a custom shader can ask for: the first four at `custom_spectra[group * 4 + s]`,
 /// the rest (tables, e.g. the underwater light field) at `custom_spectra[s * n_groups + group]`.
-pub const MAX_CUSTOM_SPECTRA: usize = 16384;
+pub const MAX_CUSTOM_SPECTRA: usize = 32768;
 
 impl Default for CustomShader {
     fn default() -> Self {

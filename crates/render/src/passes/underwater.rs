@@ -72,9 +72,11 @@ pub struct Options {
     /// the paper's term.
     pub split_beams: bool,
     /// Draw the surface seen from below: the sky through Snell's window, Fresnel reflection and
-    /// total internal reflection of the water below (not of the sea floor or other objects).
-    /// Off by default: without the floor in the reflection it is further from the path-traced
-    /// water than not drawing it (docs/underwater.md).
+    /// total internal reflection of what lies below. With the light-field model (default on)
+    /// the reflection is the table's (`LightFieldTable::surface`: the water's light and the
+    /// lit sea floor, not other objects); with the isotropic model (default off) it is the
+    /// water's isotropic in-scattering alone, which is further from the path-traced water than
+    /// not drawing it (docs/underwater.md).
     pub surface: bool,
     /// The in-scattering source from the water's own light field
     /// (`scene::water::light_field`, same a, b and phase function as the path-traced truth)
@@ -87,6 +89,10 @@ pub struct Options {
     pub tabulated_kd: bool,
     /// Photons per wavelength node and source of the light-field solver.
     pub photons: usize,
+    /// With `light_field`, close the column with the medium's sea floor
+    /// ([`WaterMedium::floor`], found under the camera) so the light it reflects back into the
+    /// water is in the table; off (or no floor found) = a bottomless column.
+    pub sea_floor: bool,
 }
 
 /// Default photons of the light-field solver (per wavelength node and source).
@@ -99,10 +105,11 @@ impl Default for Options {
             phase_g: PETZOLD_G,
             scalar_irradiance: false,
             split_beams: false,
-            surface: false,
+            surface: true,
             light_field: true,
             tabulated_kd: false,
             photons: LIGHT_FIELD_PHOTONS,
+            sea_floor: true,
         }
     }
 }
@@ -119,12 +126,12 @@ impl Options {
 
     /// The paper's model: analytic isotropic in-scattering only.
     pub fn paper() -> Self {
-        Options { steps: 0, light_field: false, ..Default::default() }
+        Options { steps: 0, light_field: false, surface: false, ..Default::default() }
     }
 
     /// The previous default: the paper's isotropic term plus the marched single scattering.
     pub fn isotropic() -> Self {
-        Options { light_field: false, ..Default::default() }
+        Options { light_field: false, surface: false, ..Default::default() }
     }
 
     /// Checks the values a user can set.
@@ -195,30 +202,61 @@ pub fn light_field_range(depth: f64) -> f64 {
     20.0 * ((depth + 20.0) / 20.0).ceil()
 }
 
-/// The solver's input for `medium` (its refracted sun, its sky) with `options`.
+/// The solver's input for `medium` (its refracted sun, its sky, its sea floor) with `options`.
+/// With a floor the table ends at the floor's depth.
 pub fn light_field_key(medium: &WaterMedium, options: &Options) -> light_field::LightFieldKey {
+    let floor = medium.floor.as_ref().filter(|_| options.sea_floor).map(|f| {
+        let albedo = (0..light_field::N_LAMBDA)
+            .map(|l| f.albedo.eval(light_field::lambda_node(l).min(830.0)).clamp(0.0, 1.0))
+            .collect();
+        (medium.depth + f.below_camera, light_field::Floor { albedo })
+    });
     light_field::LightFieldKey {
         properties: medium.properties.clone(),
         name: medium.water_type.map_or_else(|| "custom".to_string(), |t| t.to_string()),
         sun_mu: medium.sun_dir_underwater().y as f64,
         sky: medium.sky,
-        z_max: light_field_range(medium.depth),
+        z_max: floor.as_ref().map_or_else(|| light_field_range(medium.depth), |f| f.0.max(1e-3)),
         g: options.phase_g as f64,
         photons: options.photons,
+        floor: floor.map(|f| f.1),
     }
 }
 
-/// The light-field table for `medium`: from this process's memory, else the disk cache
-/// (`$SPECTRA_CACHE_DIR`, as the upsampling tables), else solved (with a progress bar on a
-/// terminal; a few seconds per water type and range) and cached.
+/// The two tables the real-time pass reads: the column closed by the medium's sea floor, and
+/// the bottomless column over the same depth range (for the parts of the view beyond the
+/// floor's extent). Without a floor both are the same table.
+pub fn light_field_tables(
+    medium: &WaterMedium,
+    options: &Options,
+) -> Result<[std::sync::Arc<LightFieldTable>; 2], WaterError> {
+    let key = light_field_key(medium, options);
+    let main = light_field_table_for(key.clone())?;
+    if key.floor.is_none() {
+        return Ok([main.clone(), main]);
+    }
+    let deep = light_field_table_for(light_field::LightFieldKey { floor: None, ..key })?;
+    Ok([main, deep])
+}
+
+/// The light-field table for `medium` (closed by its floor, if it has one and `options` wants
+/// it): see [`light_field_table_for`].
 pub fn light_field_table(
     medium: &WaterMedium,
     options: &Options,
 ) -> Result<std::sync::Arc<LightFieldTable>, WaterError> {
+    light_field_table_for(light_field_key(medium, options))
+}
+
+/// The light-field table for `key`: from this process's memory, else the disk cache
+/// (`$SPECTRA_CACHE_DIR`, as the upsampling tables), else solved (with a progress bar on a
+/// terminal; a few seconds per water type and range) and cached.
+pub fn light_field_table_for(
+    key: light_field::LightFieldKey,
+) -> Result<std::sync::Arc<LightFieldTable>, WaterError> {
     use std::sync::{Arc, Mutex, OnceLock};
     type Solved = Vec<(String, Arc<LightFieldTable>)>;
     static MEMORY: OnceLock<Mutex<Solved>> = OnceLock::new();
-    let key = light_field_key(medium, options);
     key.validate()?;
     let name = key.cache_name();
     let memory = MEMORY.get_or_init(Default::default);
@@ -241,30 +279,45 @@ pub fn light_field_table(
     Ok(t)
 }
 
-/// The table as custom spectra (indices from 4, see `underwater.wgsl`): J per cell and E_d per
-/// depth node as piecewise-linear spectra over the table's wavelength nodes (resampled by the
-/// renderer at the frame's wavelengths), then the same at [`RGB_WAVELENGTHS`] as three
-/// constants each for the RGB hook.
-fn table_spectra(t: &LightFieldTable) -> Vec<color::Spectrum> {
+/// The tables as custom spectra (indices from 4, see `underwater.wgsl`): for the floored table
+/// and then the bottomless one, J per cell, E_d per depth node and the surface's reflection of
+/// the water and of the floor per view node, as piecewise-linear spectra over the table's
+/// wavelength nodes (resampled by the renderer at the frame's wavelengths); then the same at
+/// [`RGB_WAVELENGTHS`] as three constants each for the RGB hook.
+fn table_spectra(tables: [&LightFieldTable; 2]) -> Vec<color::Spectrum> {
     use light_field::*;
     let lambda: Vec<f64> = (0..N_LAMBDA).map(lambda_node).collect();
-    let cells = N_DEPTH * N_ELEV * N_AZ;
+    let (cells, views) = (N_DEPTH * N_ELEV * N_AZ, N_ELEV * N_AZ);
     let row = |v: &[f32]| color::Spectrum::Piecewise {
         lambda: lambda.clone(),
         values: v.iter().map(|&x| x as f64).collect(),
     };
-    let mut out = Vec::with_capacity(4 * (cells + N_DEPTH));
-    out.extend((0..cells).map(|c| row(&t.j[c * N_LAMBDA..(c + 1) * N_LAMBDA])));
-    out.extend((0..N_DEPTH).map(|d| row(&t.e_d[d * N_LAMBDA..(d + 1) * N_LAMBDA])));
-    for c in 0..cells {
-        for l in RGB_WAVELENGTHS {
-            let (d, rest) = (c / (N_ELEV * N_AZ), c % (N_ELEV * N_AZ));
-            out.push(color::Spectrum::Constant(t.j_node(d, rest / N_AZ, rest % N_AZ, l)));
-        }
+    let rows =
+        |v: &[f32], n: usize| (0..n).map(|c| row(&v[c * N_LAMBDA..(c + 1) * N_LAMBDA])).collect::<Vec<_>>();
+    let mut out = Vec::new();
+    for t in tables {
+        out.extend(rows(&t.j, cells));
+        out.extend(rows(&t.e_d, N_DEPTH));
+        out.extend(rows(&t.surface, views));
+        out.extend(rows(&t.surface_floor, views));
     }
-    for d in 0..N_DEPTH {
-        for l in RGB_WAVELENGTHS {
-            out.push(color::Spectrum::Constant(t.e_d_node(d, l)));
+    for t in tables {
+        let mut push = |f: &dyn Fn(f64) -> f64| {
+            for l in RGB_WAVELENGTHS {
+                out.push(color::Spectrum::Constant(f(l)));
+            }
+        };
+        for c in 0..cells {
+            let (d, rest) = (c / views, c % views);
+            push(&|l| t.j_node(d, rest / N_AZ, rest % N_AZ, l));
+        }
+        for d in 0..N_DEPTH {
+            push(&|l| t.e_d_node(d, l));
+        }
+        for floor in [false, true] {
+            for v in 0..views {
+                push(&|l| t.surface_node(v / N_AZ, v % N_AZ, l, floor));
+            }
         }
     }
     out
@@ -281,7 +334,7 @@ pub fn shader(medium: &WaterMedium) -> Result<CustomShader, WaterError> {
 pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShader, WaterError> {
     use scene::water::{WATER_IOR, fresnel::mean_transmittance};
     options.validate().map_err(WaterError::BadQuery)?;
-    let table = if options.light_field { Some(light_field_table(medium, options)?) } else { None };
+    let tables = if options.light_field { Some(light_field_tables(medium, options)?) } else { None };
     let mut source = HOOKS.to_string();
     let mut set = |line: &str, value: String| {
         let (name, _) = line.split_once('=').expect("a const line");
@@ -298,10 +351,16 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
     set("const UW_TABLE: bool = true;", options.light_field.to_string());
     set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
     let mut spectra = spectra(medium);
-    if let Some(t) = &table {
+    if let Some([t, deep]) = &tables {
         set("const UW_ZMAX: f32 = 40.0;", format!("{:?}", t.z_max as f32));
+        // Where the mirrored view may show the floor: its mesh's extent (scene units).
+        let b = medium.floor.as_ref().and_then(|f| f.extent).unwrap_or([-1e30, -1e30, 1e30, 1e30]);
+        set(
+            "const UW_FLOOR_BOX: vec4<f32> = vec4<f32>(-1e30, -1e30, 1e30, 1e30);",
+            format!("vec4<f32>({:?}, {:?}, {:?}, {:?})", b[0], b[1], b[2], b[3]),
+        );
         spectra.push(color::Spectrum::Constant(0.0));
-        spectra.extend(table_spectra(t));
+        spectra.extend(table_spectra([t, deep]));
     }
     Ok(CustomShader { source, params: params_with(medium, options), spectra })
 }

@@ -40,11 +40,21 @@ const UW_ND: u32 = 16u;
 const UW_NE: u32 = 13u;
 const UW_NA: u32 = 9u;
 const UW_NC: u32 = UW_ND * UW_NE * UW_NA;
-// Spectrum indices (custom_spectra[s * n_groups + group]): J per cell, E_d per depth node, then
-// the RGB mode's copies, three constants each.
-const UW_T_J: u32 = 4u;
-const UW_T_ED: u32 = 4u + UW_NC;
-const UW_T_RGB: u32 = 4u + UW_NC + UW_ND;
+// Spectrum indices (custom_spectra[s * n_groups + group]): two tables of one block each — 0
+// the column closed by the sea floor, 1 the bottomless column (the same table twice when the
+// scene has no floor) — each J per cell, E_d per depth node, the surface's reflection of the
+// water and of the floor per view node; then the RGB mode's copies, three constants each.
+const UW_NV: u32 = UW_NE * UW_NA;
+const UW_L_J: u32 = 0u;
+const UW_L_ED: u32 = UW_NC;
+const UW_L_SURF: u32 = UW_NC + UW_ND;
+const UW_L_SURF_FLOOR: u32 = UW_NC + UW_ND + UW_NV;
+const UW_BLOCK: u32 = UW_NC + UW_ND + 2u * UW_NV;
+const UW_T_RGB: u32 = 4u + 2u * UW_BLOCK;
+// The sea floor's horizontal extent (scene units: min x, min z, max x, max z; written by
+// `underwater::shader_with`); the surface mirrors the floor only where the mirrored view lands
+// inside it.
+const UW_FLOOR_BOX: vec4<f32> = vec4<f32>(-1e30, -1e30, 1e30, 1e30);
 // Lights with single scattering, and march steps: must match underwater.rs.
 const UW_SS_LIGHTS: u32 = 4u;
 const UW_MAX_STEPS: u32 = 32u;
@@ -122,6 +132,41 @@ var<private> uw_pn: array<u32, 16>;
 var<private> uw_pt: array<f32, 16>;
 var<private> uw_pl: array<f32, 16>;
 var<private> uw_pz: array<f32, 16>;
+// Which table each piece reads: 1 (bottomless) where its midpoint lies beyond the floor.
+var<private> uw_pd: array<u32, 16>;
+var<private> uw_org: vec3<f32>;
+var<private> uw_view: vec3<f32>;
+
+// Distance (m) along the view from the camera at which it leaves the floor's extent or reaches
+// the table's deepest node (the floor), 0 if the camera is not over the floor, ≥ 1e30 if never.
+fn uw_floor_exit(w: vec3<f32>, z0: f32) -> f32 {
+    let scale = custom.params[0].y;
+    if (!uw_over_floor(uw_org)) { return 0.0; }
+    var te = 1e30;
+    if (w.y < -1e-6) { te = (UW_ZMAX - z0) / (-w.y); }
+    let o = uw_org.xz;
+    let d = w.xz;
+    for (var a = 0u; a < 2u; a++) {
+        if (d[a] > 1e-9) { te = min(te, (UW_FLOOR_BOX[a + 2u] - o[a]) / d[a] * scale); }
+        if (d[a] < -1e-9) { te = min(te, (UW_FLOOR_BOX[a] - o[a]) / d[a] * scale); }
+    }
+    return max(te, 0.0);
+}
+
+// Whether a scene point (scene units) lies over the sea floor's extent.
+fn uw_over_floor(p: vec3<f32>) -> bool {
+    return all(p.xz >= UW_FLOOR_BOX.xy) && all(p.xz <= UW_FLOOR_BOX.zw);
+}
+
+// Table `table`'s entry `local` at the group's wavelengths (rgb: at the RGB wavelengths).
+fn uw_tab(table: u32, local: u32, group: u32, rgb: bool) -> vec4<f32> {
+    let ng = frame.n_groups;
+    if (rgb) {
+        let s = UW_T_RGB + 3u * (table * UW_BLOCK + local);
+        return vec4<f32>(custom_spectra[s * ng].x, custom_spectra[(s + 1u) * ng].x, custom_spectra[(s + 2u) * ng].x, 0.0);
+    }
+    return custom_spectra[(4u + table * UW_BLOCK + local) * ng + group];
+}
 
 fn uw_depth_node(i: u32) -> f32 {
     let f = f32(i) / f32(UW_ND - 1u);
@@ -172,6 +217,9 @@ fn uw_add_piece(t0: f32, t1: f32, infinite: bool, z0: f32, wy: f32) {
     uw_pt[uw_np] = t0;
     uw_pl[uw_np] = select(t1 - t0, -1.0, infinite);
     uw_pz[uw_np] = max(z0 - t0 * wy, 0.0) - uw_depth_node(i);
+    // An endless piece runs below the floor's depth, where only the bottomless column makes
+    // sense (a view that misses the floor's mesh inside its extent).
+    uw_pd[uw_np] = select(1u, 0u, !infinite && uw_over_floor(uw_org + uw_view * (tm / custom.params[0].y)));
     uw_np++;
 }
 
@@ -202,54 +250,72 @@ fn uw_prepare_table(w: vec3<f32>, z0: f32) {
     uw_cell[2] = (e0 + 1u) * UW_NA + k0;
     uw_cell[3] = (e0 + 1u) * UW_NA + k0 + 1u;
     uw_cw = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
-    // Pieces between the node depths the ray crosses, in order along the ray.
+    // Pieces between the node depths the ray crosses, in order along the ray, also cut where
+    // the ray leaves the floored column (the floor's extent, or its depth): each piece reads
+    // one table, chosen at its midpoint.
     uw_np = 0u;
     var t = 0.0;
     let wy = w.y;
+    let t_exit = uw_floor_exit(w, z0);
     if (abs(wy) > 1e-6) {
         for (var n = 1u; n < UW_ND - 1u; n++) {
             // Going down the nodes come in increasing depth, going up in decreasing depth.
             let i = select(UW_ND - 1u - n, n, wy < 0.0);
             let tc = (z0 - uw_depth_node(i)) / wy;
             if (tc > t && (uw_infinite || tc < uw_d)) {
+                if (t_exit > t && t_exit < tc) {
+                    uw_add_piece(t, t_exit, false, z0, wy);
+                    t = t_exit;
+                }
                 uw_add_piece(t, tc, false, z0, wy);
                 t = tc;
             }
         }
     }
     if (uw_infinite) {
+        if (t_exit > t && t_exit < 1e30) {
+            uw_add_piece(t, t_exit, false, z0, wy);
+            t = t_exit;
+        }
         uw_add_piece(t, t, true, z0, wy);
     } else if (uw_d > t) {
+        if (t_exit > t && t_exit < uw_d) {
+            uw_add_piece(t, t_exit, false, z0, wy);
+            t = t_exit;
+        }
         uw_add_piece(t, uw_d, false, z0, wy);
     }
 }
 
 // J at depth node d for the pixel's view (bilinear in direction), at the group's wavelengths
 // or in rgb mode at the three RGB wavelengths.
-fn uw_j_node(d: u32, group: u32, rgb: bool) -> vec4<f32> {
-    let ng = frame.n_groups;
+fn uw_j_node(table: u32, d: u32, group: u32, rgb: bool) -> vec4<f32> {
     var j = vec4<f32>(0.0);
     for (var c = 0u; c < 4u; c++) {
-        let cell = d * UW_NE * UW_NA + uw_cell[c];
-        var v: vec4<f32>;
-        if (rgb) {
-            let s = UW_T_RGB + 3u * cell;
-            v = vec4<f32>(custom_spectra[s * ng].x, custom_spectra[(s + 1u) * ng].x, custom_spectra[(s + 2u) * ng].x, 0.0);
-        } else {
-            v = custom_spectra[(UW_T_J + cell) * ng + group];
-        }
-        j += uw_cw[c] * v;
+        j += uw_cw[c] * uw_tab(table, UW_L_J + d * UW_NV + uw_cell[c], group, rgb);
     }
     return j;
 }
 
-fn uw_ed_node(d: u32, group: u32, rgb: bool) -> vec4<f32> {
-    let ng = frame.n_groups;
-    if (rgb) {
-        let s = UW_T_RGB + 3u * UW_NC + 3u * d;
-        return vec4<f32>(custom_spectra[s * ng].x, custom_spectra[(s + 1u) * ng].x, custom_spectra[(s + 2u) * ng].x, 1.0);
+fn uw_ed_node(table: u32, d: u32, group: u32, rgb: bool) -> vec4<f32> {
+    return uw_tab(table, UW_L_ED + d, group, rgb);
+}
+
+// What the surface reflects towards the pixel's (upward) view, per unit sun irradiance
+// (light_field::LightFieldTable::surface: Fresnel × the light coming up the mirrored view,
+// the water's part, plus the sea floor's when `floor`), bilinear in direction like J.
+// Over the floor the floored table's water and floor parts; beyond it the bottomless table's
+// water, whose mirrored view runs forever.
+fn uw_surface_node(group: u32, rgb: bool, floor: bool) -> vec4<f32> {
+    var r = vec4<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        if (floor) {
+            r += uw_cw[c] * (uw_tab(0u, UW_L_SURF + uw_cell[c], group, rgb) + uw_tab(0u, UW_L_SURF_FLOOR + uw_cell[c], group, rgb));
+        } else {
+            r += uw_cw[c] * uw_tab(1u, UW_L_SURF + uw_cell[c], group, rgb);
+        }
     }
-    return custom_spectra[(UW_T_ED + d) * ng + group];
+    return r;
 }
 
 // Decay rate of a column between nodes i and i + 1 (ln-linear interpolation), 0 where either
@@ -266,8 +332,8 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
     var sum = vec4<f32>(0.0);
     for (var p = 0u; p < uw_np; p++) {
         let i = uw_pn[p];
-        let ja = uw_j_node(i, group, rgb);
-        let k = uw_rate(ja, uw_j_node(i + 1u, group, rgb), i);
+        let ja = uw_j_node(uw_pd[p], i, group, rgb);
+        let k = uw_rate(ja, uw_j_node(uw_pd[p], i + 1u, group, rgb), i);
         let j0 = ja * exp(-k * uw_pz[p]);
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
@@ -292,10 +358,10 @@ fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f
 }
 
 // E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
-fn uw_table_attenuation(z: f32, group: u32, rgb: bool) -> vec4<f32> {
+fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> {
     let i = uw_segment(z);
-    let a = uw_ed_node(i, group, rgb);
-    let k = uw_rate(a, uw_ed_node(i + 1u, group, rgb), i);
+    let a = uw_ed_node(table, i, group, rgb);
+    let k = uw_rate(a, uw_ed_node(table, i + 1u, group, rgb), i);
     return a * exp(-k * (z - uw_depth_node(i)));
 }
 
@@ -314,6 +380,8 @@ fn uw_prepare(ctx: SurfaceContext) {
         uw_d = ctx.distance * scale;
     }
     if (UW_TABLE) {
+        uw_org = ctx.origin;
+        uw_view = w;
         uw_prepare_table(w, z0);
     }
     let m = min(u32(custom.params[0].z), UW_MAX_STEPS);
@@ -463,7 +531,7 @@ fn uw_fresnel_up(cos_w: f32) -> f32 {
 // attenuation): the sky through Snell's window, L_air·T·n² with L_air = E_sky/(π·T̄) from the
 // sky stand-ins' irradiance, plus the reflected water below (the in-scattering of a downward
 // ray from the surface along the mirrored direction; no sea floor, no single scattering).
-fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f32> {
+fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32, floor: bool) -> mat3x4<f32> {
     let r = uw_fresnel_up(wy);
     var sky = UW_ZERO;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
@@ -473,6 +541,16 @@ fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, 
         }
     }
     let window = sky * ((1.0 - r) * UW_N * UW_N * UW_SKY_NORM);
+    if (UW_TABLE) {
+        var reflected = UW_ZERO;
+        let f = uw_surface_node(group, rgb, floor);
+        for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+            let l = lights[li].pos_kind;
+            if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
+            reflected += s3_scale(uw_emission(li, group, rgb), f);
+        }
+        return window + reflected;
+    }
     return window + uw_in_scatter(b, c, kd, group, rgb, -wy, 0.0, 0.0, true) * r;
 }
 
@@ -490,13 +568,19 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
         l += uw_single_scatter(b, c, group, rgb);
     }
     if (UW_SURFACE && ctx.background && wy > 0.0) {
-        l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy), exp(-c * uw_d));
+        // Where the mirrored view meets the floor's plane (the table ends at the floor, UW_ZMAX
+        // m deep): up z0/ω_y metres to the surface, down UW_ZMAX/ω_y to the floor.
+        let hw = vec2<f32>(ctx.view_dir.x, ctx.view_dir.z) * ((z0 + UW_ZMAX) / (wy * custom.params[0].y));
+        let p = vec2<f32>(ctx.origin.x, ctx.origin.z) + hw;
+        let on_floor = all(p >= UW_FLOOR_BOX.xy) && all(p <= UW_FLOOR_BOX.zw);
+        l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy, on_floor), exp(-c * uw_d));
     }
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
         var att = exp(-kd * zs);
         if (UW_TABLE_KD) {
-            att = uw_table_attenuation(zs, group, rgb);
+            let hit = ctx.origin + ctx.view_dir * ctx.distance;
+            att = uw_table_attenuation(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb);
         }
         l += s3_scale(radiance, att * exp(-c * uw_d));
     }

@@ -56,8 +56,10 @@ pub const N_AZ: usize = 9;
 pub const LAMBDA0: f64 = 360.0;
 pub const DLAMBDA: f64 = 20.0;
 pub const N_LAMBDA: usize = 25;
+/// Entries of [`LightFieldTable::surface`].
+const N_SURFACE: usize = N_ELEV * N_AZ * N_LAMBDA;
 /// Table format version (bump when the solver's output changes, so stale caches are refitted).
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// What a table is computed for (also its cache key).
 #[derive(Clone, Debug, PartialEq)]
@@ -76,6 +78,19 @@ pub struct LightFieldKey {
     pub g: f64,
     /// Photons per wavelength node and source (sun, sky).
     pub photons: usize,
+    /// A sea floor closing the column at `z_max` (then `z_max` is its depth), or none: a
+    /// bottomless column.
+    pub floor: Option<Floor>,
+}
+
+/// A flat Lambertian sea floor under the column. Near the bottom it dominates the light field
+/// in all but the clearest water: it reflects the downwelling light back up, the water scatters
+/// that light forward towards a camera looking down and back down onto the floor, and the
+/// surface reflects it down again (total internal reflection outside Snell's window).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Floor {
+    /// Diffuse albedo at the table's wavelength nodes ([`lambda_node`]), each in [0, 1].
+    pub albedo: Vec<f64>,
 }
 
 impl LightFieldKey {
@@ -100,6 +115,15 @@ impl LightFieldKey {
         if self.photons == 0 {
             return bad("light-field table: photons must be > 0".into());
         }
+        if let Some(f) = &self.floor
+            && (f.albedo.len() != N_LAMBDA
+                || !f.albedo.iter().all(|a| a.is_finite() && (0.0..=1.0).contains(a)))
+        {
+            return bad(format!(
+                "light-field table: the sea floor's albedo needs {N_LAMBDA} values in [0, 1], got {:?}",
+                f.albedo
+            ));
+        }
         self.properties.validate()?;
         Ok(())
     }
@@ -119,6 +143,10 @@ impl LightFieldKey {
         }
         for x in [self.sun_mu, self.sky, self.z_max, self.g, self.photons as f64] {
             eat(x);
+        }
+        if let Some(f) = &self.floor {
+            eat(-1.0);
+            f.albedo.iter().for_each(|&a| eat(a));
         }
         let safe: String =
             self.name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
@@ -164,6 +192,16 @@ pub struct LightFieldTable {
     pub j: Vec<f32>,
     /// `e_d[d·N_LAMBDA + l]`: downwelling plane irradiance over the source's μ·(1 + sky).
     pub e_d: Vec<f32>,
+    /// `surface[(e·N_AZ + k)·N_LAMBDA + l]`, per unit sun E⊥: what the surface reflects towards
+    /// a view looking up at node (e, k) (0 for views that do not look up): Fresnel reflectance
+    /// (1 outside Snell's window) × the radiance coming up along the mirrored, downward view
+    /// from the water — the column's diffuse light and the sun beam's single scattering, down
+    /// to the floor (or forever without one).
+    pub surface: Vec<f32>,
+    /// The same for the lit sea floor at the end of the mirrored view (Fresnel × ρ/π·E_d(floor)
+    /// × the path's attenuation); zero without a floor. Kept apart so that the real-time pass
+    /// can leave it out where the mirrored view passes beyond the floor's extent.
+    pub surface_floor: Vec<f32>,
     /// Seconds the solver took (0 when loaded from the cache).
     pub seconds: f64,
 }
@@ -220,6 +258,7 @@ fn simulate(
     photons: usize,
     seed: u64,
     views: &[DVec3],
+    floor_albedo: Option<f64>,
     cancel: &AtomicBool,
 ) -> Option<Scores> {
     let c = a + b;
@@ -227,11 +266,14 @@ fn simulate(
     let edges: Vec<f64> = (0..=N_DEPTH)
         .map(|i| match i {
             0 => 0.0,
+            // A floor ends the water at the last node: its bin is only the half above.
+            i if i == N_DEPTH && floor_albedo.is_some() => nodes[N_DEPTH - 1],
             i if i == N_DEPTH => nodes[N_DEPTH - 1] + 0.5 * (nodes[N_DEPTH - 1] - nodes[N_DEPTH - 2]),
             i => 0.5 * (nodes[i - 1] + nodes[i]),
         })
         .collect();
-    let z_cut = edges[N_DEPTH] + (3.0 / c).min(60.0);
+    // Without a floor, light below the deepest bin still scatters some back up into it.
+    let z_cut = if floor_albedo.is_some() { z_max } else { edges[N_DEPTH] + (3.0 / c).min(60.0) };
     let n = WATER_IOR;
     let t_mean = mean_transmittance(n);
     let nv = views.len();
@@ -282,7 +324,19 @@ fn simulate(
                 count_down(&edges, &nodes, z, z_new.min(z_cut), d, w, &mut e_d);
             }
             if z_new > z_cut {
-                break;
+                let Some(rho) = floor_albedo else { break };
+                // Lambertian reflection: the weight times the albedo, a cosine-weighted
+                // direction up. From here the light is diffuse.
+                w *= rho;
+                if w <= 0.0 {
+                    break;
+                }
+                let (u1, u2) = (rng.next(), rng.next());
+                let (r, phi) = (u1.sqrt(), 2.0 * PI * u2);
+                d = DVec3::new(r * phi.cos(), (1.0 - u1).sqrt(), r * phi.sin());
+                z = z_cut;
+                scattered = true;
+                continue;
             }
             z = z_new;
             if scattered && z < edges[N_DEPTH] {
@@ -364,6 +418,7 @@ impl LightFieldTable {
                     key.photons,
                     0x5eed_0000 + 2 * l as u64 + sky as u64,
                     &views,
+                    key.floor.as_ref().map(|f| f.albedo[l]),
                     cancel,
                 );
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
@@ -392,13 +447,61 @@ impl LightFieldTable {
                 e_d[d * N_LAMBDA + l] += (ed / (mu * (1.0 + key.sky))) as f32;
             }
         }
-        Ok(LightFieldTable {
+        let mut table = LightFieldTable {
             z_max: key.z_max,
             sun_mu: key.sun_mu,
             j,
             e_d,
-            seconds: t0.elapsed().as_secs_f64(),
-        })
+            surface: Vec::new(),
+            surface_floor: Vec::new(),
+            seconds: 0.0,
+        };
+        (table.surface, table.surface_floor) = table.surface_reflection(key);
+        table.seconds = t0.elapsed().as_secs_f64();
+        Ok(table)
+    }
+
+    /// [`LightFieldTable::surface`] from the solved J and E_d: for every view looking up, the
+    /// Fresnel reflectance of the surface times the radiance arriving from below along the
+    /// mirrored view — J integrated down the mirrored ray (to the floor, or forever), the sun
+    /// beam's single scattering along it (no shadows: the column is empty) and the floor's
+    /// Lambertian radiance ρ/π·E_d(floor), attenuated over the path.
+    fn surface_reflection(&self, key: &LightFieldKey) -> (Vec<f32>, Vec<f32>) {
+        let mu = key.sun_mu;
+        let sun_d = DVec3::new(-(1.0 - mu * mu).max(0.0).sqrt(), -mu, 0.0);
+        let mut out = vec![0.0f32; N_SURFACE];
+        let mut out_floor = vec![0.0f32; N_SURFACE];
+        for e in 0..N_ELEV {
+            for k in 0..N_AZ {
+                let v = view_node(e, k);
+                if v.y <= 1e-6 {
+                    continue;
+                }
+                let r = fresnel_reflectance(v.y, WATER_IOR, 1.0);
+                // The mirrored view looks down; its light travels up, along −m.
+                let m = DVec3::new(v.x, -v.y, v.z);
+                let len = if key.floor.is_some() { key.z_max / v.y } else { f64::INFINITY };
+                for l in 0..N_LAMBDA {
+                    let lambda = lambda_node(l);
+                    let [a, b, _, _] = key.properties.at(lambda.min(830.0));
+                    let c = a + b;
+                    let col: [f64; N_DEPTH] =
+                        std::array::from_fn(|d| self.j_node(d, N_ELEV - 1 - e, k, lambda));
+                    let diffuse = ray_integral(&col, self.z_max, c, 0.0, m.y, len);
+                    // Beam at depth z = t·v.y: e^{−c·z/μ}; along the ray e^{−c·t}.
+                    let rate = c * (1.0 + v.y / mu);
+                    let path = if len.is_finite() { super::path_integral(rate, len) } else { 1.0 / rate };
+                    let single = b * super::single::hg_phase(key.g, sun_d.dot(-m)) * path;
+                    let floor = key.floor.as_ref().map_or(0.0, |f| {
+                        let e_d = self.e_d_node(N_DEPTH - 1, lambda) * mu * (1.0 + key.sky);
+                        f.albedo[l] / PI * e_d * (-c * len).exp()
+                    });
+                    out[(e * N_AZ + k) * N_LAMBDA + l] = (r * (diffuse + single)) as f32;
+                    out_floor[(e * N_AZ + k) * N_LAMBDA + l] = (r * floor) as f32;
+                }
+            }
+        }
+        (out, out_floor)
     }
 
     /// The table for `key`, from `dir` if a valid copy is there, else computed and written
@@ -428,11 +531,11 @@ impl LightFieldTable {
     }
 
     fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(8 * 4 + 4 * (self.j.len() + self.e_d.len()));
+        let mut out = Vec::with_capacity(8 * 5 + 4 * (self.j.len() + self.e_d.len() + 2 * N_SURFACE));
         for x in [VERSION as f64, self.z_max, self.sun_mu, self.j.len() as f64, self.e_d.len() as f64] {
             out.extend_from_slice(&x.to_le_bytes());
         }
-        for x in self.j.iter().chain(&self.e_d) {
+        for x in self.j.iter().chain(&self.e_d).chain(&self.surface).chain(&self.surface_floor) {
             out.extend_from_slice(&x.to_le_bytes());
         }
         out
@@ -447,7 +550,7 @@ impl LightFieldTable {
             || mu != key.sun_mu
             || nj != N_DEPTH * N_ELEV * N_AZ * N_LAMBDA
             || ne != N_DEPTH * N_LAMBDA
-            || b.len() != 40 + 4 * (nj + ne)
+            || b.len() != 40 + 4 * (nj + ne + 2 * N_SURFACE)
         {
             return None;
         }
@@ -460,7 +563,9 @@ impl LightFieldTable {
             z_max,
             sun_mu: mu,
             j: floats[..nj].to_vec(),
-            e_d: floats[nj..].to_vec(),
+            e_d: floats[nj..nj + ne].to_vec(),
+            surface: floats[nj + ne..nj + ne + N_SURFACE].to_vec(),
+            surface_floor: floats[nj + ne + N_SURFACE..].to_vec(),
             seconds: 0.0,
         })
     }
@@ -470,6 +575,15 @@ impl LightFieldTable {
     pub fn j_node(&self, d: usize, e: usize, k: usize, lambda: f64) -> f64 {
         let base = ((d * N_ELEV + e) * N_AZ + k) * N_LAMBDA;
         lerp_lambda(&self.j[base..base + N_LAMBDA], lambda)
+    }
+
+    /// The surface's reflection seen by a view looking up at node (e, k) (see
+    /// [`LightFieldTable::surface`]).
+    /// `floor`: the floor's part ([`LightFieldTable::surface_floor`]) instead of the water's.
+    pub fn surface_node(&self, e: usize, k: usize, lambda: f64, floor: bool) -> f64 {
+        let base = (e * N_AZ + k) * N_LAMBDA;
+        let v = if floor { &self.surface_floor } else { &self.surface };
+        lerp_lambda(&v[base..base + N_LAMBDA], lambda)
     }
 
     /// E_d ratio at depth node `d`.
@@ -489,6 +603,21 @@ impl LightFieldTable {
                 + te * ((1.0 - tk) * self.j_node(d, e0 + 1, k0, lambda)
                     + tk * self.j_node(d, e0 + 1, k0 + 1, lambda))
         })
+    }
+
+    /// What the surface reflects towards an upward view `v` (world, unit), per unit sun E⊥,
+    /// bilinear in elevation and azimuth as the real-time pass reads it; 0 for views that do
+    /// not look up. `floor`: with the sea floor's part (the mirrored view reaches the floor).
+    pub fn surface_at(&self, v: DVec3, sun_h: DVec3, lambda: f64, floor: bool) -> f64 {
+        let (fe, fk) = view_coords(v, sun_h);
+        let (e0, k0) = ((fe.floor() as usize).min(N_ELEV - 2), (fk.floor() as usize).min(N_AZ - 2));
+        let (te, tk) = (fe - e0 as f64, fk - k0 as f64);
+        let at = |e, k| {
+            self.surface_node(e, k, lambda, false)
+                + if floor { self.surface_node(e, k, lambda, true) } else { 0.0 }
+        };
+        (1.0 - te) * ((1.0 - tk) * at(e0, k0) + tk * at(e0, k0 + 1))
+            + te * ((1.0 - tk) * at(e0 + 1, k0) + tk * at(e0 + 1, k0 + 1))
     }
 
     /// Downwelling attenuation at depth z (E_d(z)/E_d source), exponential between nodes and
@@ -534,6 +663,23 @@ pub fn log_interp(col: &[f64; N_DEPTH], z_max: f64, z: f64) -> f64 {
 /// (`f64::INFINITY`: forever; then c must exceed the deepest segment's growth), in closed form
 /// per depth segment: the CPU reference of the real-time pass's integral.
 pub fn ray_integral(col: &[f64; N_DEPTH], z_max: f64, c: f64, z0: f64, wy: f64, d: f64) -> f64 {
+    ray_integral_by(&|_, _| *col, z_max, c, z0, wy, d, None)
+}
+
+/// [`ray_integral`] with the column chosen per piece: `col_at(t, endless)` gives the column for
+/// the piece whose midpoint is at `t` metres along the ray (for the last piece of an endless
+/// ray, `endless`, one metre past its start) — the real-time pass picks the floored or the
+/// bottomless table there; `cut` is one more place (m) to split the ray at.
+#[allow(clippy::too_many_arguments)]
+pub fn ray_integral_by(
+    col_at: &dyn Fn(f64, bool) -> [f64; N_DEPTH],
+    z_max: f64,
+    c: f64,
+    z0: f64,
+    wy: f64,
+    d: f64,
+    cut: Option<f64>,
+) -> f64 {
     // Split [0, d] at the node depths the ray crosses; on each piece J is col[i]·e^{−k_i(z − z_i)}.
     let z_at = |t: f64| z0 - t * wy;
     let mut cuts: Vec<f64> = vec![0.0];
@@ -545,12 +691,17 @@ pub fn ray_integral(col: &[f64; N_DEPTH], z_max: f64, c: f64, z0: f64, wy: f64, 
             }
         }
     }
+    if let Some(t) = cut.filter(|&t| t > 0.0 && t < d) {
+        cuts.push(t);
+    }
     cuts.sort_by(|a, b| a.partial_cmp(b).unwrap());
     cuts.push(d);
     let mut sum = 0.0;
     for w in cuts.windows(2) {
         let (t0, t1) = (w[0], w[1]);
-        let zm = if t1.is_finite() { z_at(0.5 * (t0 + t1)) } else { z_at(t0 + 1.0) };
+        let tm = if t1.is_finite() { 0.5 * (t0 + t1) } else { t0 + 1.0 };
+        let zm = z_at(tm);
+        let col = &col_at(tm, !t1.is_finite());
         let mut i = 0;
         while i + 2 < N_DEPTH && depth_node(i + 1, z_max) < zm {
             i += 1;
@@ -570,6 +721,7 @@ pub fn ray_integral(col: &[f64; N_DEPTH], z_max: f64, c: f64, z0: f64, wy: f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use color::Spectrum;
     use color::water::{WaterSource, WaterType};
 
     fn key(ty: &str, mu: f64, photons: usize) -> LightFieldKey {
@@ -581,7 +733,53 @@ mod tests {
             z_max: 30.0,
             g: 0.924,
             photons,
+            floor: None,
         }
+    }
+
+    /// A sea floor under water that absorbs but does not scatter (b = 0), against closed forms:
+    /// the floor's downwelling irradiance is the beam plus the floor's own light sent back down
+    /// by the surface, E_f = μ·e^{−a·z_f/μ} / (1 − ρ·F) with F = 2∫R(μ')·e^{−2a·z_f/μ'}·μ'dμ'
+    /// (Lambertian up, Fresnel/total internal reflection, back down); the surface seen from
+    /// below shows R(v)·ρ/π·E_f·e^{−a·z_f/v_y}; J is zero.
+    #[test]
+    fn sea_floor_matches_closed_form_without_scattering() {
+        let (a, rho, z_f, mu) = (0.08, 0.6, 4.0, 0.8);
+        let k = |v: f64| Spectrum::Constant(v);
+        let key = LightFieldKey {
+            properties: WaterProperties { a: k(a), b: k(0.0), c: k(a), kd: k(a) },
+            name: "absorbing".into(),
+            sun_mu: mu,
+            sky: 0.0,
+            z_max: z_f,
+            g: 0.924,
+            photons: 60_000,
+            floor: Some(Floor { albedo: vec![rho; N_LAMBDA] }),
+        };
+        let t = LightFieldTable::compute(&key, &|_, _| {}, &AtomicBool::new(false)).unwrap();
+        let n = 20_000;
+        let f: f64 = (0..n)
+            .map(|i| {
+                let m = (i as f64 + 0.5) / n as f64;
+                2.0 * fresnel_reflectance(m, WATER_IOR, 1.0) * (-2.0 * a * z_f / m).exp() * m / n as f64
+            })
+            .sum();
+        let e_f = mu * (-a * z_f / mu).exp() / (1.0 - rho * f);
+        let got = t.e_d_node(N_DEPTH - 1, 550.0) * mu;
+        assert!((got / e_f - 1.0).abs() < 0.01, "floor irradiance {got} vs closed form {e_f} (F = {f})");
+        assert!(t.j.iter().all(|&x| x == 0.0), "no scattering, no source");
+        for e in 0..N_ELEV / 2 {
+            let v = view_node(e, 0);
+            let want = fresnel_reflectance(v.y, WATER_IOR, 1.0) * rho / PI * e_f * (-a * z_f / v.y).exp();
+            let got = t.surface_node(e, 0, 550.0, true) + t.surface_node(e, 0, 550.0, false);
+            assert!((got / want - 1.0).abs() < 0.01, "elevation node {e}: surface {got} vs {want}");
+        }
+        // A darker floor gives a darker bottom light field, and the cache key sees the floor.
+        let mut dark = key.clone();
+        dark.floor = Some(Floor { albedo: vec![0.1; N_LAMBDA] });
+        assert_ne!(dark.cache_name(), key.cache_name());
+        dark.floor = Some(Floor { albedo: vec![1.5; N_LAMBDA] });
+        assert!(dark.validate().unwrap_err().to_string().contains("albedo"));
     }
 
     #[test]

@@ -38,6 +38,7 @@ use thiserror::Error;
 
 use crate::WaterSettings;
 
+pub mod floor;
 pub mod fresnel;
 pub mod light_field;
 mod quadrature;
@@ -127,6 +128,9 @@ pub struct WaterMedium {
     /// Sky plane irradiance below the surface as a multiple of the sun's (`water.sky`, see
     /// `scene::sky`); 0 unless set from the scene's settings.
     pub sky: f64,
+    /// The sea floor under the camera, for the real-time light-field model ([`floor`]); `None`
+    /// = a bottomless column.
+    pub floor: Option<floor::SeaFloor>,
 }
 
 impl WaterMedium {
@@ -175,6 +179,7 @@ impl WaterMedium {
             sun_dir: s.normalize().as_vec3(),
             scale,
             sky: 0.0,
+            floor: None,
         })
     }
 

@@ -76,7 +76,7 @@ pub struct LookArgs {
     /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance
     /// attenuated by the tabulated Kd, no single scattering).
     #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface",
-          "isotropic", "tabulated_kd", "light_field_photons"])]
+          "isotropic", "tabulated_kd", "light_field_photons", "no_water_surface", "no_sea_floor"])]
     pub paper_model: bool,
     /// Under water: the paper's isotropic in-scattering term with the tabulated Kd plus the
     /// marched single scattering (the previous default) instead of the light-field source.
@@ -99,10 +99,19 @@ pub struct LookArgs {
     /// scattering on top of the paper's term.
     #[arg(long)]
     pub split_beams: bool,
-    /// Under water: draw the surface seen from below (Snell's window with the sky, Fresnel
-    /// reflection and total internal reflection of the water below, not of the sea floor).
+    /// Under water, isotropic model: draw the surface seen from below (Snell's window with the
+    /// sky, Fresnel reflection and total internal reflection of the water below, not of the sea
+    /// floor). The light-field model draws it by default, sea floor included.
     #[arg(long)]
     pub water_surface: bool,
+    /// Under water, light-field model: do not draw the surface seen from below (the view ray
+    /// ends in the water's own in-scattering, as in the paper).
+    #[arg(long, conflicts_with_all = ["isotropic", "water_surface"])]
+    pub no_water_surface: bool,
+    /// Under water, light-field model: solve the water column without the sea floor under the
+    /// camera (a bottomless column), i.e. without the light the floor sends back into the water.
+    #[arg(long, conflicts_with = "isotropic")]
+    pub no_sea_floor: bool,
     #[command(flatten)]
     pub env: super::EnvArgs,
     /// Lambert only: every surface reflects base colour / π, no specular (like `truth
@@ -142,8 +151,13 @@ impl LookArgs {
                 phase_g: self.phase_g,
                 scalar_irradiance: self.scalar_irradiance,
                 split_beams: self.split_beams,
-                surface: self.water_surface,
+                surface: if self.isotropic || self.scalar_irradiance || self.split_beams {
+                    self.water_surface
+                } else {
+                    !self.no_water_surface
+                },
                 light_field: !(self.isotropic || self.scalar_irradiance || self.split_beams),
+                sea_floor: !self.no_sea_floor,
                 tabulated_kd: self.tabulated_kd,
                 photons: self.light_field_photons,
             }
@@ -207,6 +221,10 @@ pub fn water_medium(
         Some(w) => anyhow!("--water '{w}': {e}"),
         None => anyhow!("scene {}: water settings: {e}", scene.source),
     })?;
+    let mut medium = medium;
+    // The floor under the camera closes the light-field model's water column.
+    medium.floor = scene::water::floor::below_camera(scene, medium.scale)
+        .map_err(|e| anyhow!("scene {}: {e}", scene.source))?;
     if let (Some(_), Some(to_sun)) = (&scene.water, sun) {
         let want = medium.sun_dir_underwater();
         let angle = to_sun.dot(want).clamp(-1.0, 1.0).acos().to_degrees();

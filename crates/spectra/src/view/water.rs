@@ -28,25 +28,38 @@ impl WaterControls {
         WaterControls { water_type, depth: medium.depth as f32, options }
     }
 
-    /// The medium these controls describe: `base` (sun, scale, data source) with this type and
-    /// depth.
+    /// The medium these controls describe: `base` (sun, scale, sky, sea floor) with this type
+    /// and depth. The floor keeps its distance below the camera: a depth change moves the
+    /// surface, not the scene.
     pub fn medium(&self, base: &WaterMedium) -> Result<WaterMedium, scene::water::WaterError> {
         let ty = color::water::WaterType::parse(&self.water_type)?;
-        WaterMedium::new(ty, self.depth as f64, base.sun_dir, base.scale)
+        let mut m = WaterMedium::new(ty, self.depth as f64, base.sun_dir, base.scale)?;
+        m.sky = base.sky;
+        m.floor = base.floor.clone();
+        Ok(m)
+    }
+
+    /// Deepest depth of the light-field table these controls need: the floor's depth when the
+    /// column is closed by one, else the rounded range.
+    fn table_depth(&self, base: &WaterMedium) -> f64 {
+        match &base.floor {
+            Some(f) if self.options.sea_floor => self.depth as f64 + f.below_camera,
+            _ => underwater::light_field_range(self.depth as f64),
+        }
     }
 
     /// Whether going from `applied` to `self` needs new pipelines (not just new parameters).
-    pub fn needs_recompile(&self, applied: &WaterControls) -> bool {
+    pub fn needs_recompile(&self, applied: &WaterControls, base: &WaterMedium) -> bool {
         self.water_type != applied.water_type
             || (self.options.steps > 0) != (applied.options.steps > 0)
             || self.options.surface != applied.options.surface
             || self.options.light_field != applied.options.light_field
             || self.options.tabulated_kd != applied.options.tabulated_kd
-            // The light-field table depends on g and on the depth range it covers.
+            // The light-field table depends on g, the floor and the depth range it covers.
             || (self.options.light_field
                 && (self.options.phase_g != applied.options.phase_g
-                    || underwater::light_field_range(self.depth as f64)
-                        != underwater::light_field_range(applied.depth as f64)))
+                    || self.options.sea_floor != applied.options.sea_floor
+                    || self.table_depth(base) != applied.table_depth(base)))
     }
 
     /// Applies `self` to `renderer`, coming from `applied`.
@@ -58,7 +71,7 @@ impl WaterControls {
     ) -> anyhow::Result<()> {
         let medium = self.medium(base)?;
         self.options.validate().map_err(|e| anyhow::anyhow!(e))?;
-        if self.needs_recompile(applied) {
+        if self.needs_recompile(applied, base) {
             renderer.set_custom_shader(underwater::shader_with(&medium, &self.options)?)?;
         } else {
             renderer.set_custom_params(underwater::params_with(&medium, &self.options));
@@ -77,6 +90,7 @@ impl WaterControls {
         let o = &mut self.options;
         ui.checkbox(&mut o.light_field, "light-field source (off: the paper's isotropic term)");
         ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.tabulated_kd, "tabulated Kd on surfaces"));
+        ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.sea_floor, "sea floor lights the water"));
         ui.add(egui::Slider::new(&mut o.steps, 0..=MAX_STEPS).text("march steps (0 = off)"));
         ui.add_enabled(o.steps > 0, egui::Slider::new(&mut o.phase_g, 0.0..=0.99).text("phase g"));
         ui.add_enabled(o.steps > 0, egui::Checkbox::new(&mut o.split_beams, "split sun beams out of L_ms"));
@@ -107,27 +121,39 @@ mod tests {
         let lf = WaterControls::new(&base(), Options::default());
         let mut e = lf.clone();
         e.depth = 3.0;
-        assert!(!e.needs_recompile(&lf), "same table range");
+        assert!(!e.needs_recompile(&lf, &base()), "same table range");
         e.depth = 30.0;
-        assert!(e.needs_recompile(&lf), "deeper table");
+        assert!(e.needs_recompile(&lf, &base()), "deeper table");
         let mut e = lf.clone();
         e.options.phase_g = 0.5;
-        assert!(e.needs_recompile(&lf), "the table depends on g");
-        assert!(a.needs_recompile(&lf), "light field on/off");
+        assert!(e.needs_recompile(&lf, &base()), "the table depends on g");
+        assert!(a.needs_recompile(&lf, &base()), "light field on/off");
+        // With a sea floor the table ends at the floor, so any depth change recompiles.
+        let mut floored = base();
+        floored.floor = Some(scene::water::floor::SeaFloor {
+            below_camera: 1.2,
+            rgb: [0.4; 3],
+            albedo: color::Spectrum::Constant(0.4),
+            extent: None,
+        });
+        let mut e = lf.clone();
+        e.depth = 10.5;
+        assert!(e.needs_recompile(&lf, &floored) && !e.needs_recompile(&lf, &base()));
+        assert_eq!(e.medium(&floored).unwrap().floor, floored.floor, "the floor follows the camera");
         let mut b = a.clone();
         b.depth = 3.0;
         b.options.steps = 8;
         b.options.phase_g = 0.5;
         b.options.split_beams = true;
-        assert!(!b.needs_recompile(&a), "parameters only");
+        assert!(!b.needs_recompile(&a, &base()), "parameters only");
         b.options.steps = 0;
-        assert!(b.needs_recompile(&a), "march off is compiled");
+        assert!(b.needs_recompile(&a, &base()), "march off is compiled");
         let mut c = a.clone();
         c.options.surface = true;
-        assert!(c.needs_recompile(&a));
+        assert!(c.needs_recompile(&a, &base()));
         let mut d = a.clone();
         d.water_type = "3C".into();
-        assert!(d.needs_recompile(&a));
+        assert!(d.needs_recompile(&a, &base()));
         let m = d.medium(&base()).unwrap();
         assert_eq!((m.water_type.unwrap().to_string(), m.depth, m.scale), ("3C".to_string(), 10.0, 0.5));
         assert_eq!(m.sun_dir, base().sun_dir);
