@@ -361,3 +361,36 @@ pub fn gamut_report(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u
         n_outside_solid: nc,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::upsample::roundtrip::roundtrip_table;
+
+    /// The shipping sRGB table (the cached fit + refinement every renderer loads) against the
+    /// adversarial search on the default seed. The old fetch (coefficients interpolated next to
+    /// white) fails the max: 1.22 at (0.985, 1, 0.987). The goal is max ≤ 0.1; what is
+    /// reached is ≈ 0.44, on the red edge (r, 0, ≈ r/120), where the face node's coefficients sit
+    /// far out (a zero channel) — see docs/upsampling.md. The bound is that figure with margin
+    /// for refits on another machine, so the test guards the near-white fix without claiming
+    /// the goal.
+    #[test]
+    fn default_srgb_table_survives_the_adversarial_search() {
+        let space = RgbColorSpace::srgb();
+        let t = crate::upsample::table("srgb").expect("the sRGB table");
+        let a = check(&t, &space, Domain::Own, &AdversarialOptions::default()).unwrap();
+        assert!(a.stats.max <= 0.5, "adversarial max ΔE2000 {} at {:?}", a.stats.max, a.worst[0]);
+        // Nothing near white (every channel ≥ 0.9) is among the bad ones any more.
+        for w in a.worst.iter().filter(|w| w.rgb.iter().all(|&c| c >= 0.9)) {
+            assert!(w.delta_e <= 0.1, "near-white {:?} at ΔE2000 {}", w.rgb, w.delta_e);
+        }
+        let near_white = structured_colours()
+            .into_iter()
+            .filter(|u| u.iter().all(|&c| c >= 0.97))
+            .map(|u| table_delta_e(&LabModel::new(&space).unwrap(), &t, u))
+            .fold(0.0, f64::max);
+        assert!(near_white <= 0.1, "near-white grid max ΔE2000 {near_white}");
+        let u = roundtrip_table(&t, &space, 100_000, 1).unwrap().stats;
+        assert!(u.mean <= 0.005, "uniform mean ΔE2000 {}", u.mean);
+    }
+}
