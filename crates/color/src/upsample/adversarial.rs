@@ -31,8 +31,9 @@ type Found = ([f64; 3], f64);
 pub enum Domain {
     /// The space's own unit cube.
     Own,
-    /// The sRGB unit cube expressed in the space (colours that land outside the space's cube,
-    /// possible for a space that does not contain sRGB, are skipped).
+    /// The sRGB unit cube expressed in the space (Bradford-adapted between different whites;
+    /// colours that land outside the space's cube, possible for a space that does not contain
+    /// sRGB, are skipped).
     Srgb,
 }
 
@@ -148,16 +149,8 @@ pub fn check(
     opt: &AdversarialOptions,
 ) -> Result<Adversarial> {
     let model = LabModel::new(space)?;
-    let srgb = RgbColorSpace::srgb();
-    if domain == Domain::Srgb
-        && srgb.white_xyz().iter().zip(space.white_xyz()).any(|(a, b)| (a - b).abs() > 1e-4)
-    {
-        return Err(ColorError::Table(format!(
-            "the sRGB domain needs a space with sRGB's white (D65); {} has another",
-            space.name
-        )));
-    }
-    let from_srgb = space.from_xyz * srgb.to_xyz;
+    // Bradford-adapted when the whites differ (ACEScg's D60), so sRGB white is the space's white.
+    let from_srgb = RgbColorSpace::srgb().conversion_to(space);
     let eval =
         |u: [f64; 3]| to_space(domain, &from_srgb, u).map(|rgb| (rgb, table_delta_e(&model, table, rgb)));
     let mut found: Vec<([f64; 3], f64)> = structured_colours().into_par_iter().filter_map(eval).collect();
@@ -330,7 +323,7 @@ pub fn gamut_report(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u
     let model = LabModel::new(space)?;
     let solid = ObjectSolid::new(&model);
     let srgb = RgbColorSpace::srgb();
-    let to_srgb = srgb.from_xyz * space.to_xyz;
+    let to_srgb = space.conversion_to(&srgb);
     let rows: Vec<(u8, f64)> = random_colours(n, seed)
         .into_par_iter()
         .map(|rgb| {
