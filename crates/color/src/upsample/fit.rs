@@ -269,38 +269,6 @@ impl LabModel {
     }
 }
 
-/// Lab residual (ΔE*ab) above which a node's colour counts as out of reach: outside the
-/// object-colour solid (wide-gamut primaries), where Newton ends at the coefficient clamp.
-const UNREACHABLE: f64 = 0.5;
-
-impl LabModel {
-    /// Coefficients for the most saturated colour on the line from `rgb`'s luminance-matched
-    /// grey to `rgb` that the model reaches (bisection on the saturation, 12 steps).
-    ///
-    /// A node outside the object-colour solid has no reflectance; left at whatever Newton ended
-    /// on (coefficients at the clamp), it poisons every cell it belongs to, including the
-    /// reachable colours in them: sRGB red inside the P3 and Rec.2020 tables came back at
-    /// ΔE2000 2–3. Fitted to the nearest reachable colour along its saturation line instead, it
-    /// interpolates with its neighbours like any other node.
-    pub fn solve_reachable(&self, rgb: [f64; 3], start: [f64; 3], opt: &FitOptions) -> [f64; 3] {
-        let y = self.space.rgb_to_xyz(rgb)[1].clamp(0.0, 1.0);
-        let (mut lo, mut hi) = (0.0, 1.0);
-        let mut best = [0.0, 0.0, crate::upsample::table::z_logit(y as f32) as f64];
-        for _ in 0..12 {
-            let s = 0.5 * (lo + hi);
-            let target = self.target_lab([0, 1, 2].map(|c| y + s * (rgb[c] - y)));
-            let mut a = start;
-            if self.solve(target, &mut a, opt) <= 0.05 {
-                lo = s;
-                best = a;
-            } else {
-                hi = s;
-            }
-        }
-        best
-    }
-}
-
 /// Solves the 3 × 3 system `j · x = r`; `None` when singular.
 pub fn solve3_pub(j: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
     solve3(j, r)
@@ -386,12 +354,8 @@ pub fn fit_table_with(
                     let mut k = if dir > 0 { start as i64 } else { start as i64 - 1 };
                     while (0..res as i64).contains(&k) {
                         let ku = k as usize;
-                        let rgb = node_rgb(res, &opt.scale, l, ku, j, i);
-                        let mut trial = a;
-                        if model.solve(model.target_lab(rgb), &mut trial, opt) > UNREACHABLE {
-                            trial = model.solve_reachable(rgb, a, opt);
-                        }
-                        a = trial;
+                        let target = model.target_lab(node_rgb(res, &opt.scale, l, ku, j, i));
+                        model.solve(target, &mut a, opt);
                         out[ku * res + i] = normalised_to_nm(a);
                         k += dir;
                     }
