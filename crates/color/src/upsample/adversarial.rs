@@ -31,8 +31,9 @@ type Found = ([f64; 3], f64);
 pub enum Domain {
     /// The space's own unit cube.
     Own,
-    /// The sRGB unit cube expressed in the space (colours that land outside the space's cube,
-    /// possible for a space that does not contain sRGB, are skipped).
+    /// The sRGB unit cube expressed in the space (Bradford-adapted between different whites;
+    /// colours that land outside the space's cube, possible for a space that does not contain
+    /// sRGB, are skipped).
     Srgb,
 }
 
@@ -148,16 +149,8 @@ pub fn check(
     opt: &AdversarialOptions,
 ) -> Result<Adversarial> {
     let model = LabModel::new(space)?;
-    let srgb = RgbColorSpace::srgb();
-    if domain == Domain::Srgb
-        && srgb.white_xyz().iter().zip(space.white_xyz()).any(|(a, b)| (a - b).abs() > 1e-4)
-    {
-        return Err(ColorError::Table(format!(
-            "the sRGB domain needs a space with sRGB's white (D65); {} has another",
-            space.name
-        )));
-    }
-    let from_srgb = space.from_xyz * srgb.to_xyz;
+    // Bradford-adapted when the whites differ (ACEScg's D60), so sRGB white is the space's white.
+    let from_srgb = RgbColorSpace::srgb().conversion_to(space);
     let eval =
         |u: [f64; 3]| to_space(domain, &from_srgb, u).map(|rgb| (rgb, table_delta_e(&model, table, rgb)));
     let mut found: Vec<([f64; 3], f64)> = structured_colours().into_par_iter().filter_map(eval).collect();
@@ -330,7 +323,7 @@ pub fn gamut_report(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u
     let model = LabModel::new(space)?;
     let solid = ObjectSolid::new(&model);
     let srgb = RgbColorSpace::srgb();
-    let to_srgb = srgb.from_xyz * space.to_xyz;
+    let to_srgb = space.conversion_to(&srgb);
     let rows: Vec<(u8, f64)> = random_colours(n, seed)
         .into_par_iter()
         .map(|rgb| {
@@ -360,4 +353,37 @@ pub fn gamut_report(table: &CoeffTable, space: &RgbColorSpace, n: usize, seed: u
         outside_solid: c,
         n_outside_solid: nc,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::upsample::roundtrip::roundtrip_table;
+
+    /// The shipping sRGB table (the cached fit + refinement every renderer loads) against the
+    /// adversarial search on the default seed. The old fetch (coefficients interpolated next to
+    /// white) fails the max: 1.22 at (0.985, 1, 0.987). The goal is max ≤ 0.1; what is
+    /// reached is ≈ 0.44, on the red edge (r, 0, ≈ r/120), where the face node's coefficients sit
+    /// far out (a zero channel) — see docs/upsampling.md. The bound is that figure with margin
+    /// for refits on another machine, so the test guards the near-white fix without claiming
+    /// the goal.
+    #[test]
+    fn default_srgb_table_survives_the_adversarial_search() {
+        let space = RgbColorSpace::srgb();
+        let t = crate::upsample::table("srgb").expect("the sRGB table");
+        let a = check(&t, &space, Domain::Own, &AdversarialOptions::default()).unwrap();
+        assert!(a.stats.max <= 0.5, "adversarial max ΔE2000 {} at {:?}", a.stats.max, a.worst[0]);
+        // Nothing near white (every channel ≥ 0.9) is among the bad ones any more.
+        for w in a.worst.iter().filter(|w| w.rgb.iter().all(|&c| c >= 0.9)) {
+            assert!(w.delta_e <= 0.1, "near-white {:?} at ΔE2000 {}", w.rgb, w.delta_e);
+        }
+        let near_white = structured_colours()
+            .into_iter()
+            .filter(|u| u.iter().all(|&c| c >= 0.97))
+            .map(|u| table_delta_e(&LabModel::new(&space).unwrap(), &t, u))
+            .fold(0.0, f64::max);
+        assert!(near_white <= 0.1, "near-white grid max ΔE2000 {near_white}");
+        let u = roundtrip_table(&t, &space, 100_000, 1).unwrap().stats;
+        assert!(u.mean <= 0.005, "uniform mean ΔE2000 {}", u.mean);
+    }
 }

@@ -9,8 +9,10 @@
 //!
 //! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
 //! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly — with
-//! one difference: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
-//! exact at every brightness. Because `scale` is stored in the file, a table may use any
+//! two differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
+//! exact at every brightness, and light colours (lowest channel above 0.5) are fetched through
+//! their complement 1 − rgb with negated coefficients ([`white_blend`]), which removes the
+//! near-white errors of coefficient interpolation. Because `scale` is stored in the file, a table may use any
 //! increasing brightness grid and stay readable by every rgb2spec-compatible renderer; such a
 //! renderer (linear `z` weight) gets the node colours exactly and greys to rgb2spec's accuracy
 //! (−3.9 % at 0.01) in between.
@@ -188,12 +190,30 @@ impl CoeffTable {
     }
 
     /// Coefficients for a linear RGB colour with components in [0, 1], as `rgb2spec_fetch`
-    /// computes them but with the σ⁻¹-space brightness weight ([`z_weight`]). This is the renderer's hot path: it does not validate;
+    /// computes them ([`Self::fetch_direct`], with the σ⁻¹-space brightness weight), except for
+    /// light colours, which are fetched as the negated complement `−fetch(1 − rgb)` (blended in
+    /// over a band of the lowest channel, [`white_blend`]). This is the renderer's hot path: it does not validate;
     /// NaN or negative inputs are clamped to 0 and components above 1 to 1 (use
     /// [`Self::fetch_checked`] for user input, or the unbounded variant for values above 1).
     #[inline]
     pub fn fetch(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
         let rgb = rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 });
+        let alpha = white_blend(rgb);
+        if alpha <= 0.0 {
+            return self.fetch_direct(rgb);
+        }
+        let comp = self.fetch_direct(rgb.map(|v| 1.0 - v)).c.map(|v| -v);
+        if alpha >= 1.0 {
+            return SigmoidPolynomial { c: comp };
+        }
+        let d = self.fetch_direct(rgb).c;
+        let a = alpha as f64;
+        SigmoidPolynomial { c: [0, 1, 2].map(|m| d[m] + a * (comp[m] - d[m])) }
+    }
+
+    /// rgb2spec's trilinear fetch (with [`z_weight`]) of a colour already clamped to [0, 1].
+    #[inline]
+    pub fn fetch_direct(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
         let res = self.res;
         // Largest channel; later channels win ties, as in rgb2spec.
         let mut l = 0;
@@ -286,6 +306,32 @@ pub fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     w.clamp(0.0, 1.0)
 }
 
+/// Lowest channel at which [`CoeffTable::fetch`] starts blending in the complement fetch.
+pub const WHITE_BLEND_LO: f32 = 0.5;
+/// Lowest channel from which on [`CoeffTable::fetch`] uses the complement fetch alone.
+pub const WHITE_BLEND_HI: f32 = 0.7;
+
+/// Weight of the complement fetch for a colour clamped to [0, 1]: smoothstep of its lowest
+/// channel between [`WHITE_BLEND_LO`] and [`WHITE_BLEND_HI`].
+///
+/// Near white, node spectra sit within a percent of 1 and their coefficients grow like
+/// 1/√(1 − channel), each node choosing its own shape (dips at 380 or 700 nm where the observer
+/// is blind); blending such coefficients linearly missed (0.985, 1, 0.987) by ΔE2000 1.22. The
+/// complement 1 − s of a reflectance s is a reflectance, its coefficients are −c (σ(−x) =
+/// 1 − σ(x)), and its colour is exactly (1, 1, 1) − rgb (colour is linear in the reflectance and
+/// reflectance 1 is RGB (1, 1, 1) by our conventions). So a light colour can be fetched as the
+/// negated dark colour 1 − rgb, where the table is smooth (σ⁻¹ brightness weight) and where an
+/// XYZ error weighs ~20× less in L* once mapped back next to white. Over [0.5, 1]³ the
+/// complement alone stays below ΔE2000 0.04 (sRGB 64³); the band 0.5…0.7 blends the two
+/// coefficient sets, whose spectra differ by < 0.1 in reflectance there, so the fetch stays
+/// continuous. Greys stay exact: the complement of the flat σ⁻¹(1 − g) is the flat σ⁻¹(g).
+#[inline]
+pub fn white_blend(rgb: [f32; 3]) -> f32 {
+    let u = ((rgb[0].min(rgb[1]).min(rgb[2]) - WHITE_BLEND_LO) / (WHITE_BLEND_HI - WHITE_BLEND_LO))
+        .clamp(0.0, 1.0);
+    u * u * (3.0 - 2.0 * u)
+}
+
 /// Refuses NaN, infinite and negative RGB components.
 pub fn check_rgb(rgb: [f64; 3]) -> Result<()> {
     if rgb.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
@@ -351,13 +397,37 @@ mod tests {
         let c = t.fetch([0.1, 0.2, 0.05]).c;
         assert!((c[2] - (1.0 + w)).abs() < 1e-5, "{c:?} vs {}", 1.0 + w);
         // Ties go to the later channel; black does not divide by zero.
-        assert!((t.fetch([0.7, 0.7, 0.7]).c[0] - 204.0).abs() < 1e-5);
+        assert!((t.fetch_direct([0.7, 0.7, 0.7]).c[0] - 204.0).abs() < 1e-5);
         assert_eq!(t.fetch([0.0, 0.0, 0.0]).c, [200.0, 0.0, 0.0]);
         // Hot path clamps instead of failing; the checked path refuses.
         assert!(t.fetch([f64::NAN, -1.0, 2.0]).c.iter().all(|v| v.is_finite()));
         assert!(t.fetch_checked([f64::NAN, 0.0, 0.0]).is_err());
         assert!(t.fetch_checked([-0.1, 0.0, 0.0]).is_err());
         assert!(t.fetch_checked([1.5, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn light_colours_are_fetched_through_their_complement() {
+        let t = synthetic(5);
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|m| (a[m] - b[m]).abs() < 1e-4);
+        let neg = |p: SigmoidPolynomial| p.c.map(|v| -v);
+        // Lowest channel ≥ 0.7: the negated fetch of 1 − rgb alone.
+        let rgb = [0.9f32, 0.75, 0.8];
+        let want = neg(t.fetch_direct(rgb.map(|v| 1.0 - v)));
+        assert!(close(t.fetch(rgb.map(f64::from)).c, want));
+        // Lowest channel ≤ 0.5: rgb2spec's fetch unchanged.
+        let rgb = [0.9f32, 0.5, 1.0];
+        assert!(close(t.fetch(rgb.map(f64::from)).c, t.fetch_direct(rgb).c));
+        // Halfway through the band: the smoothstep weight is ½.
+        let rgb = [0.6f32, 0.95, 0.8];
+        let (d, c) = (t.fetch_direct(rgb).c, neg(t.fetch_direct(rgb.map(|v| 1.0 - v))));
+        assert!(close(t.fetch(rgb.map(f64::from)).c, [0, 1, 2].map(|m| 0.5 * (d[m] + c[m]))));
+        // Continuous at both ends of the band.
+        for lo in [WHITE_BLEND_LO, WHITE_BLEND_HI] {
+            let a = t.fetch([f64::from(lo) - 1e-6, 0.9, 0.95]).c;
+            let b = t.fetch([f64::from(lo) + 1e-6, 0.9, 0.95]).c;
+            assert!(close(a, b), "jump at {lo}: {a:?} vs {b:?}");
+        }
     }
 
     #[test]

@@ -148,11 +148,30 @@ fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     return clamp(w, 0.0, 1.0);
 }
 
-// Jakob–Hanika coefficients of a reflectance in [0, 1]³: manual trilinear interpolation with
-// textureLoad (exact in f32; rgba32float is not filterable everywhere), brightness weight in
-// σ⁻¹ space (z_weight).
+// Jakob–Hanika coefficients of a reflectance in [0, 1]³: color::upsample::CoeffTable::fetch.
+// Light colours come from the negated complement fetch (σ(−x) = 1 − σ(x), colour (1,1,1) − rgb),
+// blended in by a smoothstep of the lowest channel over [0.5, 0.7] (table::white_blend, same
+// constants): coefficient interpolation next to white is poor, next to black it is smooth.
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
+    let lo = min(rgb.x, min(rgb.y, rgb.z));
+    let u = clamp((lo - 0.5) / (0.7 - 0.5), 0.0, 1.0);
+    let alpha = u * u * (3.0 - 2.0 * u);
+    if (alpha <= 0.0) {
+        return fetch_coeffs_direct(rgb, res);
+    }
+    let comp = -fetch_coeffs_direct(vec3<f32>(1.0) - rgb, res);
+    if (alpha >= 1.0) {
+        return comp;
+    }
+    let d = fetch_coeffs_direct(rgb, res);
+    return d + alpha * (comp - d);
+}
+
+// rgb2spec's fetch of a colour in [0, 1]³ (table::CoeffTable::fetch_direct): manual trilinear
+// interpolation with textureLoad (exact in f32; rgba32float is not filterable everywhere),
+// brightness weight in σ⁻¹ space (z_weight).
+fn fetch_coeffs_direct(rgb: vec3<f32>, res: u32) -> vec3<f32> {
     var l = 0u;
     if (rgb.y >= rgb[l]) { l = 1u; }
     if (rgb.z >= rgb[l]) { l = 2u; }
