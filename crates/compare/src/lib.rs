@@ -21,5 +21,5 @@ pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
-pub use spectral::{SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr};
 pub use io::{ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_image};
+pub use spectral::{SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr};

@@ -143,10 +143,7 @@ fn parse_channel(name: &str) -> Option<std::result::Result<(SpectralKind, f64), 
         _ => return None,
     };
     let Some(number) = rest.strip_suffix("nm") else {
-        return Some(Err(format!(
-            "expected the wavelength in nm, like {}",
-            channel_name(kind, 550.0)
-        )));
+        return Some(Err(format!("expected the wavelength in nm, like {}", channel_name(kind, 550.0))));
     };
     // A dot would be a layer separator, so a bi-spectral (re-radiation) channel lands here too.
     let ok = !number.is_empty()
@@ -180,7 +177,8 @@ pub fn is_spectral_exr(bytes: &[u8]) -> bool {
 /// Reads a spectral EXR file ([`decode_spectral_exr`]).
 pub fn read_spectral_exr(path: impl AsRef<Path>) -> Result<SpectralImage> {
     let path = path.as_ref();
-    let bytes = color::input::read_regular(path, crate::io::MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
+    let bytes = color::input::read_regular(path, crate::io::MAX_INPUT_BYTES)
+        .map_err(|e| CompareError::io(path, e))?;
     decode_spectral_exr(path, &bytes)
 }
 
@@ -191,7 +189,8 @@ pub fn read_spectral_exr(path: impl AsRef<Path>) -> Result<SpectralImage> {
 /// do not hold their channel's wavelength at their centre.
 pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<SpectralImage> {
     let path = path.as_ref();
-    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "spectral OpenEXR", reason };
+    let decode =
+        |reason: String| CompareError::Decode { path: path.into(), format: "spectral OpenEXR", reason };
     crate::io::check_exr_headers(path, bytes, MAX_BANDS as u64 + 8)?;
     let image = exr::prelude::read()
         .no_deep_data()
@@ -379,10 +378,8 @@ pub fn write_spectral_exr(path: impl AsRef<Path>, image: &SpectralImage, rgb: Op
     }
     let layer = Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(list.into()));
     let mut buf = Cursor::new(Vec::new());
-    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut buf).map_err(|e| CompareError::Encode {
-        path: path.into(),
-        format: "spectral OpenEXR",
-        reason: e.to_string(),
+    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut buf).map_err(|e| {
+        CompareError::Encode { path: path.into(), format: "spectral OpenEXR", reason: e.to_string() }
     })?;
     write_atomic(path, &buf.into_inner())
 }
@@ -433,7 +430,8 @@ mod tests {
             assert_eq!(back.to_linear_srgb(&obs, &d65).unwrap(), img.to_linear_srgb(&obs, &d65).unwrap());
         }
         let rgb_only = dir.path().join("rgb.exr");
-        crate::io::write_image(&rgb_only, &Image::filled(2, 2, [0.5; 3]).unwrap(), Default::default()).unwrap();
+        crate::io::write_image(&rgb_only, &Image::filled(2, 2, [0.5; 3]).unwrap(), Default::default())
+            .unwrap();
         assert!(!is_spectral_exr(&std::fs::read(&rgb_only).unwrap()));
     }
 
@@ -457,7 +455,12 @@ mod tests {
                 color::RgbColorSpace::srgb().xyz_to_rgb(xyz)
             };
             for k in 0..3 {
-                assert!((f64::from(rgb.data[4][k]) - want[k]).abs() < 1e-6, "{} {:?} {want:?}", obs.name, rgb.data[4]);
+                assert!(
+                    (f64::from(rgb.data[4][k]) - want[k]).abs() < 1e-6,
+                    "{} {:?} {want:?}",
+                    obs.name,
+                    rgb.data[4]
+                );
             }
         }
     }

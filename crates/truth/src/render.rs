@@ -184,7 +184,9 @@ pub fn render_world(
     let dropped = AtomicU64::new(0);
     let bins = settings.spectral_bands.as_deref().map(|e| Bins::new(e, settings.range));
     let nb = bins.as_ref().map_or(0, |b| b.len());
-    let rows: Vec<Option<(Vec<[f32; 3]>, Vec<f32>)>> = (0..h)
+    // A row's colours and, when binning, its bands.
+    type Row = (Vec<[f32; 3]>, Vec<f32>);
+    let rows: Vec<Option<Row>> = (0..h)
         .into_par_iter()
         .map(|y| {
             if cancel.load(Ordering::Relaxed) {
@@ -403,7 +405,8 @@ mod tests {
         let st = Settings { seed: 3, ..Settings::new(6, 4, 256).unwrap() };
         let edges = st.range.bin_edges(5.0).unwrap();
         let plain = pool_free_render(&scene, &st);
-        let binned = pool_free_render(&scene, &Settings { spectral_bands: Some(edges.clone()), ..st.clone() });
+        let binned =
+            pool_free_render(&scene, &Settings { spectral_bands: Some(edges.clone()), ..st.clone() });
         assert_eq!(plain.xyz, binned.xyz);
         assert!(plain.spectral.is_none());
         let spectral = binned.spectral.clone().unwrap();
@@ -440,8 +443,9 @@ mod tests {
         }
         for (b, e) in edges.windows(2).enumerate() {
             let m = 1000;
-            let exact: f64 = (0..m).map(|k| f11.eval(e[0] + (k as f64 + 0.5) * (e[1] - e[0]) / m as f64)).sum::<f64>()
-                / m as f64;
+            let exact: f64 =
+                (0..m).map(|k| f11.eval(e[0] + (k as f64 + 0.5) * (e[1] - e[0]) / m as f64)).sum::<f64>()
+                    / m as f64;
             let got = acc[b] / n as f64;
             assert!((got - exact).abs() < 2e-3 * exact.max(1.0), "band {e:?}: {got} vs {exact}");
         }

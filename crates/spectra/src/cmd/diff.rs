@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use compare::{ColorMap, DiffMaps, DiffOptions, DiffSummary, Heatmap, HeatmapOptions, read_image};
+use compare::{ColorMap, DiffMaps, DiffOptions, DiffSummary, Heatmap, HeatmapOptions, Image};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -37,6 +37,46 @@ pub struct Args {
     /// dropped): against a noisy Monte-Carlo reference this cuts its noise by N.
     #[arg(long, value_name = "N", default_value_t = 1)]
     block: u32,
+    /// Observer integrating a spectral EXR input (one with S0.<λ>nm or T.<λ>nm channels, e.g.
+    /// from `truth --spectral-out`, pbrt-v4 or Mitsuba): cie1931 (default), cie1964, a camera
+    /// (nikon_d5100, canon_5d_mark_ii, …; white balanced and shown as linear RGB) or any other
+    /// `--observer` name spectra knows.
+    #[arg(long)]
+    observer: Option<String>,
+    /// White of a spectral input: normalises radiance (a radiance equal to it has Y = 1) and
+    /// lights reflectance. Default: the file's `spectra.white` attribute, else D65.
+    #[arg(long)]
+    white: Option<String>,
+}
+
+/// Reads an input; a spectral EXR is integrated to linear sRGB with the chosen observer and
+/// white. Returns a note saying how, for spectral inputs.
+fn load(path: &std::path::Path, what: &str, args: &Args) -> anyhow::Result<(Image, Option<String>)> {
+    let bytes = color::input::read_regular(path, compare::io::MAX_INPUT_BYTES)
+        .with_context(|| format!("reading the {what} image {}", path.display()))?;
+    let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !(is_exr && compare::spectral::is_spectral_exr(&bytes)) {
+        let img = compare::decode_image(path, &bytes).with_context(|| format!("reading the {what} image"))?;
+        return Ok((img, None));
+    }
+    let spec = compare::spectral::decode_spectral_exr(path, &bytes)
+        .with_context(|| format!("reading the {what} image"))?;
+    let obs_name = args.observer.as_deref().unwrap_or("cie1931");
+    let observer = color::Observer::by_name(obs_name).context("--observer")?;
+    let white_name = args.white.clone().or(spec.white.clone()).unwrap_or_else(|| "D65".into());
+    let white = color::illuminant::by_name(&white_name).with_context(|| format!("white {white_name}"))?;
+    let img = spec
+        .to_linear_srgb(&observer, &white)
+        .with_context(|| format!("integrating the {what} image {}", path.display()))?;
+    let edges = &spec.edges;
+    let note = format!(
+        "spectral, {} bands {:.1}–{:.1} nm, integrated with {} against {white_name}",
+        spec.bands(),
+        edges[0],
+        edges[edges.len() - 1],
+        observer.name
+    );
+    Ok((img, Some(note)))
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -57,8 +97,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("--max-de must be a positive number, got {m}");
     }
 
-    let mut reference = read_image(&args.reference).context("reading the reference image")?;
-    let mut test = read_image(&args.test).context("reading the test image")?;
+    let (mut reference, ref_note) = load(&args.reference, "reference", &args)?;
+    let (mut test, test_note) = load(&args.test, "test", &args)?;
+    if (args.observer.is_some() || args.white.is_some()) && ref_note.is_none() && test_note.is_none() {
+        bail!("--observer and --white integrate spectral EXR inputs, and neither input is one");
+    }
     if args.block != 1 {
         // Blocks of two different sizes could coincide: compare sizes first.
         if reference.size() != test.size() {
@@ -89,6 +132,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let o = v.as_object_mut().expect("a struct serialises to an object");
         o.insert("reference".into(), args.reference.display().to_string().into());
         o.insert("test".into(), args.test.display().to_string().into());
+        o.insert("reference_spectral".into(), ref_note.clone().into());
+        o.insert("test_spectral".into(), test_note.clone().into());
         o.insert(
             "heatmap".into(),
             match heatmap {
@@ -99,14 +144,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         o.insert("per_pixel_out".into(), args.per_pixel_out.as_ref().map(|p| p.display().to_string()).into());
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_table(&args, &summary, heatmap);
+        print_table(&args, &summary, heatmap, [&ref_note, &test_note]);
     }
     Ok(())
 }
 
-fn print_table(args: &Args, s: &DiffSummary, heatmap: Option<(&PathBuf, f64)>) {
-    println!("reference  {}", args.reference.display());
-    println!("test       {}", args.test.display());
+fn print_table(args: &Args, s: &DiffSummary, heatmap: Option<(&PathBuf, f64)>, notes: [&Option<String>; 2]) {
+    let note = |n: &Option<String>| n.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
+    println!("reference  {}{}", args.reference.display(), note(notes[0]));
+    println!("test       {}{}", args.test.display(), note(notes[1]));
     println!(
         "size       {}×{} ({} pixels); CIELAB white: D65, Y = {}",
         s.width,
