@@ -1,5 +1,5 @@
-//! Image comparison for spectra: image I/O (EXR, PNG), per-pixel error metrics (CIEDE2000,
-//! MAE), and ΔE heat maps with a readable colour bar.
+//! Image comparison for spectra: image I/O (EXR, PNG, spectral EXR), per-pixel error metrics
+//! (CIEDE2000, MAE, FLIP), and ΔE heat maps with a readable colour bar.
 //!
 //! Everything here works on [`Image`], linear sRGB (Rec. 709 primaries, D65 white) pixels, the
 //! type the GPU renderer and the CPU ground-truth tracer both hand to the binary. The metric
@@ -11,6 +11,7 @@
 pub mod atomic;
 pub mod diff;
 pub mod error;
+pub mod flip;
 pub mod font;
 pub mod heatmap;
 pub mod image;
