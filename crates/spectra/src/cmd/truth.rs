@@ -77,7 +77,13 @@ pub struct Args {
     pub spectral_out: Option<PathBuf>,
     /// Width of the --spectral-out bins in nm, over the render range (the last bin is narrower
     /// when the width does not divide the range).
-    #[arg(long, value_name = "NM", default_value_t = 5.0, requires = "spectral_out")]
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 5.0,
+        requires = "spectral_out",
+        allow_negative_numbers = true
+    )]
     pub spectral_bin: f64,
 }
 
@@ -129,6 +135,9 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
 }
 
 pub fn run(a: Args) -> Result<()> {
+    if a.spectral_out.is_some() && a.out.is_none() {
+        bail!("--spectral-out needs --out as well (its R, G, B are the --out image)");
+    }
     if a.out.is_none() && a.export_mitsuba.is_none() {
         bail!("nothing to do: give --out FILE (.exr/.png) and/or --export-mitsuba DIR");
     }
@@ -146,9 +155,6 @@ pub fn run(a: Args) -> Result<()> {
         super::check_output("--out", out)?;
     }
     if let Some(sp) = &a.spectral_out {
-        if a.out.is_none() {
-            bail!("--spectral-out needs --out as well (its R, G, B are the --out image)");
-        }
         if !sp.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
             bail!(
                 "--spectral-out {}: a spectral image is an OpenEXR file; give it a .exr name",
