@@ -3,13 +3,13 @@
 //! The README's two commands are `cargo xtask demo` and `cargo xtask test`; CI runs
 //! `cargo xtask ci`. Each installs what it needs on a fresh Debian machine, so nothing has to be
 //! set up by hand: a Vulkan driver (Mesa's software rasteriser lavapipe when there is no GPU
-//! driver) and, for the test oracles, the `colour-science` and `mitsuba` Python packages.
+//! driver) and, for the test oracles, the `colour-science`, `mitsuba` and `OpenEXR` Python packages.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 const VULKAN_PACKAGES: &[&str] = &["mesa-vulkan-drivers", "libvulkan1"];
-const PYTHON_PACKAGES: &[&str] = &["colour-science==0.4.7", "scipy", "mitsuba"];
+const PYTHON_PACKAGES: &[&str] = &["colour-science==0.4.7", "scipy", "mitsuba", "OpenEXR==3.5.3"];
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -126,7 +126,7 @@ fn python() -> String {
 /// The oracle scripts in tools/ compare against colour-science; install it if missing.
 fn setup_python() -> Result {
     let ok = Command::new(python())
-        .args(["-c", "import colour, scipy, mitsuba"])
+        .args(["-c", "import colour, scipy, mitsuba, OpenEXR"])
         .output()
         .map(|o| o.status.success())
         .map_err(|e| format!("cannot run {}: {e} (install python3)", python()))?;

@@ -36,6 +36,19 @@ impl WavelengthRange {
         Ok(WavelengthRange { min, max })
     }
 
+    /// Edges of box bins `width` nm wide from `min` (the last bin ends at `max`, narrower when
+    /// `width` does not divide the range): the bins of a spectral image.
+    pub fn bin_edges(&self, width: f64) -> Result<Vec<f64>> {
+        if !(width.is_finite() && width > 0.0) {
+            return Err(ColorError::BadSpectrum(format!("bin width {width} nm: must be a positive number")));
+        }
+        // A bin narrower than 1 % of the width at the end is rounding, not a bin.
+        let n = ((self.width() / width) - 0.01).ceil().max(1.0) as usize;
+        let mut edges: Vec<f64> = (0..n).map(|i| self.min + i as f64 * width).collect();
+        edges.push(self.max);
+        Ok(edges)
+    }
+
     /// Parses `380:730` (also accepts `380-730` and `380..730`).
     pub fn parse(s: &str) -> Result<Self> {
         let parts: Vec<&str> = s.splitn(2, [':', '-']).collect();
@@ -103,6 +116,27 @@ impl SampledWavelengths {
         })
     }
 
+    /// Box bands given by their edges (N + 1 strictly increasing values, nm): one sample at each
+    /// band's centre, weighted by its width. This is how a spectral image's bins are integrated:
+    /// the midpoint rule on the bins, exact when the integrand is constant across each bin.
+    pub fn from_edges(edges: &[f64]) -> Result<Self> {
+        if edges.len() < 2 {
+            return Err(ColorError::NoSamples);
+        }
+        for (i, e) in edges.windows(2).enumerate() {
+            if !(e[0].is_finite() && e[1].is_finite()) || e[1] <= e[0] {
+                return Err(ColorError::BadSpectrum(format!(
+                    "band {i} spans {}–{} nm: band edges must be finite and strictly increasing",
+                    e[0], e[1]
+                )));
+            }
+        }
+        Ok(SampledWavelengths {
+            lambda: edges.windows(2).map(|e| 0.5 * (e[0] + e[1])).collect(),
+            weight: edges.windows(2).map(|e| e[1] - e[0]).collect(),
+        })
+    }
+
     pub fn len(&self) -> usize {
         self.lambda.len()
     }
@@ -130,6 +164,21 @@ mod tests {
         let sum: f64 = w.lambda.iter().zip(&w.weight).map(|(l, wt)| (2.0 * l + 1.0) * wt).sum();
         let exact = (730.0f64.powi(2) - 380.0f64.powi(2)) + 350.0;
         assert!((sum - exact).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bins_and_bands() {
+        let e = WavelengthRange::new(360.0, 830.0).unwrap().bin_edges(5.0).unwrap();
+        assert_eq!((e.len(), e[0], e[1], e[94]), (95, 360.0, 365.0, 830.0));
+        let e = WavelengthRange::new(400.0, 417.0).unwrap().bin_edges(5.0).unwrap();
+        assert_eq!(e, vec![400.0, 405.0, 410.0, 415.0, 417.0]);
+        assert!(WavelengthRange::VISIBLE.bin_edges(0.0).is_err());
+        assert!(WavelengthRange::VISIBLE.bin_edges(-5.0).is_err());
+        let w = SampledWavelengths::from_edges(&[400.0, 405.0, 415.0]).unwrap();
+        assert_eq!((w.lambda, w.weight), (vec![402.5, 410.0], vec![5.0, 10.0]));
+        let m = SampledWavelengths::from_edges(&[400.0, 410.0, 405.0]).unwrap_err().to_string();
+        assert!(m.contains("band 1") && m.contains("410–405"), "{m}");
+        assert!(SampledWavelengths::from_edges(&[400.0]).is_err());
     }
 
     #[test]

@@ -110,24 +110,7 @@ pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {
 
 fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
-    // The headers first: the reader allocates every layer's samples from its data window.
-    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
-        .map_err(|e| decode(e.to_string()))?;
-    for h in &meta.headers {
-        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
-        check_size(path, "OpenEXR", w, ht)?;
-        // Every channel is read (not only R, G, B), so the channels multiply the memory.
-        let n = h.channels.list.len() as u64;
-        if n > 64 || w * ht * n * 4 > MAX_DECODED_BYTES {
-            return Err(decode(format!(
-                "{w}×{ht} with {n} channels; at most 64 channels and {} MiB of samples are read",
-                MAX_DECODED_BYTES >> 20
-            )));
-        }
-    }
-    if meta.headers.len() > 64 {
-        return Err(decode(format!("{} layers; at most 64 are read", meta.headers.len())));
-    }
+    check_exr_headers(path, bytes, 64)?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -167,6 +150,29 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
     );
     let data = (0..w * h).map(|i| [r, g, b].map(|c| c.sample_data.value_by_flat_index(i).to_f32())).collect();
     Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+}
+
+/// Checks an EXR's headers against the size caps before any sample is decoded: the reader
+/// allocates every layer's samples from its data window, and reads every channel.
+pub(crate) fn check_exr_headers(path: &Path, bytes: &[u8], max_channels: u64) -> Result<()> {
+    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| decode(e.to_string()))?;
+    for h in &meta.headers {
+        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        check_size(path, "OpenEXR", w, ht)?;
+        let n = h.channels.list.len() as u64;
+        if n > max_channels || w * ht * n * 4 > MAX_DECODED_BYTES {
+            return Err(decode(format!(
+                "{w}×{ht} with {n} channels; at most {max_channels} channels and {} MiB of samples are read",
+                MAX_DECODED_BYTES >> 20
+            )));
+        }
+    }
+    if meta.headers.len() > 64 {
+        return Err(decode(format!("{} layers; at most 64 are read", meta.headers.len())));
+    }
+    Ok(())
 }
 
 fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {

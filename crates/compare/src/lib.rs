@@ -1,5 +1,5 @@
-//! Image comparison for spectra: image I/O (EXR, PNG), per-pixel error metrics (CIEDE2000,
-//! MAE), and ΔE heat maps with a readable colour bar.
+//! Image comparison for spectra: image I/O (EXR, PNG, spectral EXR), per-pixel error metrics
+//! (CIEDE2000, MAE, FLIP), and ΔE heat maps with a readable colour bar.
 //!
 //! Everything here works on [`Image`], linear sRGB (Rec. 709 primaries, D65 white) pixels, the
 //! type the GPU renderer and the CPU ground-truth tracer both hand to the binary. The metric
@@ -11,13 +11,16 @@
 pub mod atomic;
 pub mod diff;
 pub mod error;
+pub mod flip;
 pub mod font;
 pub mod heatmap;
 pub mod image;
 pub mod io;
+pub mod spectral;
 
 pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
 pub use io::{ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_image};
+pub use spectral::{SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr};

@@ -15,7 +15,7 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// The fuzzed parsers.
-pub const TARGETS: &[&str] = &["gltf", "coeff", "csv", "medium", "exr", "png", "env"];
+pub const TARGETS: &[&str] = &["gltf", "coeff", "csv", "medium", "exr", "spectral-exr", "png", "env"];
 
 /// Runs one input through `target`'s parser. `Err` is fine (refused input); a panic is not.
 pub fn run_one(target: &str, data: &[u8]) {
@@ -32,6 +32,7 @@ pub fn run_one(target: &str, data: &[u8]) {
             }
         }
         "exr" => drop(compare::decode_image("fuzz.exr", data)),
+        "spectral-exr" => drop(compare::spectral::decode_spectral_exr("fuzz.exr", data)),
         "png" => drop(compare::decode_image("fuzz.png", data)),
         // Environment maps: Radiance (starts with "#?") or OpenEXR.
         "env" => {

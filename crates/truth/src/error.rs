@@ -14,6 +14,8 @@ pub enum TruthError {
         max_px = crate::render::MAX_PIXELS
     )]
     TooLarge(u32, u32),
+    #[error("spectral output: {0}")]
+    BadBands(String),
     #[error("invalid medium: {0}")]
     BadMedium(String),
     #[error("scene '{scene}': {why}")]

@@ -6,7 +6,7 @@ use crate::error::{Result, TruthError};
 use crate::integrator::Integrator;
 use crate::medium::Medium;
 use crate::rng::Sampler;
-use crate::spectral::XyzSensor;
+use crate::spectral::{Wavelengths, XyzSensor};
 use crate::upsample::RgbToSpectrum;
 use crate::world::World;
 use color::{Observer, Spectrum, WavelengthRange};
@@ -29,6 +29,9 @@ pub const MAX_SIDE: u32 = 32_768;
 /// The most pixels `truth` renders: 8192² (the XYZ image alone is 12 bytes a pixel, 0.8 GB).
 pub const MAX_PIXELS: u64 = 1 << 26;
 
+/// Most memory the binned spectral image may take (f32 samples).
+pub const MAX_SPECTRAL_BYTES: u64 = 1 << 31;
+
 /// What to render and how.
 #[derive(Clone, Debug)]
 pub struct Settings {
@@ -47,6 +50,9 @@ pub struct Settings {
     pub environment: Option<Spectrum>,
     /// Lambertian BRDF instead of glTF's (for comparison with Mitsuba's `diffuse`).
     pub lambert: bool,
+    /// Also bin the radiance by wavelength ([`XyzImage::spectral`]): box bands with these
+    /// edges (nm, strictly increasing, from `range.min` to `range.max`).
+    pub spectral_bands: Option<Vec<f64>>,
 }
 
 impl Settings {
@@ -64,6 +70,7 @@ impl Settings {
             medium: None,
             environment: None,
             lambert: false,
+            spectral_bands: None,
         })
     }
 
@@ -84,6 +91,27 @@ impl Settings {
         if let Some(m) = &self.medium {
             m.validate(self.range)?;
         }
+        if let Some(edges) = &self.spectral_bands {
+            color::SampledWavelengths::from_edges(edges)?;
+            let (lo, hi) = (edges[0], edges[edges.len() - 1]);
+            if (lo - self.range.min).abs() > 1e-9 || (hi - self.range.max).abs() > 1e-9 {
+                return Err(TruthError::BadBands(format!(
+                    "the bands span {lo}–{hi} nm but the render range is {}–{} nm; they must cover it exactly",
+                    self.range.min, self.range.max
+                )));
+            }
+            let bytes = self.width as u64 * self.height as u64 * (edges.len() as u64 - 1) * 4;
+            if bytes > MAX_SPECTRAL_BYTES {
+                return Err(TruthError::BadBands(format!(
+                    "{}×{} pixels × {} bands is {} MiB of samples; at most {} MiB: use wider bands or a smaller image",
+                    self.width,
+                    self.height,
+                    edges.len() - 1,
+                    bytes >> 20,
+                    MAX_SPECTRAL_BYTES >> 20
+                )));
+            }
+        }
         Ok(())
     }
 }
@@ -96,6 +124,9 @@ pub struct XyzImage {
     pub xyz: Vec<[f32; 3]>,
     /// Samples whose estimate was not finite and were dropped (should be 0).
     pub dropped: u64,
+    /// With [`Settings::spectral_bands`]: per pixel (row-major), the mean radiance over each band,
+    /// `spectral[(y * width + x) * bands + b]`, estimated from the same samples as `xyz`.
+    pub spectral: Option<Vec<f32>>,
 }
 
 impl XyzImage {
@@ -151,16 +182,23 @@ pub fn render_world(
     };
     let rows_done = AtomicU64::new(0);
     let dropped = AtomicU64::new(0);
-    let rows: Vec<Option<Vec<[f32; 3]>>> = (0..h)
+    let bins = settings.spectral_bands.as_deref().map(|e| Bins::new(e, settings.range));
+    let nb = bins.as_ref().map_or(0, |b| b.len());
+    // A row's colours and, when binning, its bands.
+    type Row = (Vec<[f32; 3]>, Vec<f32>);
+    let rows: Vec<Option<Row>> = (0..h)
         .into_par_iter()
         .map(|y| {
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
             let mut row = Vec::with_capacity(w as usize);
+            let mut spectral_row = Vec::with_capacity(w as usize * nb);
+            let mut bin_acc = vec![0.0f64; nb];
             for x in 0..w {
                 let mut rng = Sampler::new(settings.seed, y as u64 * w as u64 + x as u64);
                 let mut acc = [0.0f64; 3];
+                bin_acc.iter_mut().for_each(|v| *v = 0.0);
                 // Pixel positions from the R2 rank-1 lattice (Roberts 2018) with a random
                 // per-pixel shift (Cranley–Patterson rotation): well spread over the pixel, and
                 // each sample still uniform, so the estimate stays unbiased.
@@ -185,25 +223,57 @@ pub fn render_world(
                     }
                     let xyz = sensor.to_xyz(&wl, l);
                     (0..3).for_each(|c| acc[c] += xyz[c]);
+                    if let Some(b) = &bins {
+                        b.add(&mut bin_acc, &wl, l);
+                    }
                 }
                 row.push(acc.map(|v| (v / settings.spp as f64) as f32));
+                spectral_row.extend(bin_acc.iter().map(|v| (v / settings.spp as f64) as f32));
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
             }
             progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1);
-            Some(row)
+            Some((row, spectral_row))
         })
         .collect();
     if cancel.load(Ordering::Relaxed) || rows.iter().any(Option::is_none) {
         return Err(TruthError::Cancelled);
     }
-    Ok(XyzImage {
-        width: w,
-        height: h,
-        xyz: rows.into_iter().flatten().flatten().collect(),
-        dropped: dropped.into_inner(),
-    })
+    let (mut xyz, mut spectral) = (Vec::with_capacity(w as usize * h as usize), Vec::new());
+    for (r, s) in rows.into_iter().flatten() {
+        xyz.extend(r);
+        spectral.extend(s);
+    }
+    Ok(XyzImage { width: w, height: h, xyz, dropped: dropped.into_inner(), spectral: bins.map(|_| spectral) })
+}
+
+/// Box bands over the render range, accumulating per-band mean radiance. With wavelengths drawn
+/// uniformly over the range (density 1/W), four per path, `L(λ)·W / (4·Δλ_b)` for each λ in band
+/// b is an unbiased estimate of the band's mean radiance.
+struct Bins {
+    edges: Vec<f64>,
+    /// W / (4·Δλ_b).
+    scale: Vec<f64>,
+}
+
+impl Bins {
+    fn new(edges: &[f64], range: WavelengthRange) -> Self {
+        let scale = edges.windows(2).map(|e| range.width() / (4.0 * (e[1] - e[0]))).collect();
+        Bins { edges: edges.to_vec(), scale }
+    }
+
+    fn len(&self) -> usize {
+        self.scale.len()
+    }
+
+    fn add(&self, acc: &mut [f64], wl: &Wavelengths, l: glam::Vec4) {
+        for (lambda, v) in wl.0.to_array().into_iter().zip(l.to_array()) {
+            // The upper edge belongs to the last band (the sampler stays below it anyway).
+            let b = self.edges.partition_point(|&e| e <= f64::from(lambda)).clamp(1, self.len()) - 1;
+            acc[b] += f64::from(v) * self.scale[b];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -325,6 +395,60 @@ mod tests {
         };
         let e = render(&scene, &GreyOnly, &bad, &AtomicBool::new(false), &|_| {}).unwrap_err();
         assert!(e.to_string().contains("sigma_a"), "{e}");
+    }
+
+    /// Binning leaves the colour estimate untouched (the same samples, the same XYZ), and the
+    /// bins, integrated by `color`'s integrator, land on it up to 5 nm quadrature and noise.
+    #[test]
+    fn spectral_bins_leave_xyz_alone() {
+        let scene = small_scene();
+        let st = Settings { seed: 3, ..Settings::new(6, 4, 256).unwrap() };
+        let edges = st.range.bin_edges(5.0).unwrap();
+        let plain = pool_free_render(&scene, &st);
+        let binned =
+            pool_free_render(&scene, &Settings { spectral_bands: Some(edges.clone()), ..st.clone() });
+        assert_eq!(plain.xyz, binned.xyz);
+        assert!(plain.spectral.is_none());
+        let spectral = binned.spectral.clone().unwrap();
+        let n = edges.len() - 1;
+        assert_eq!(spectral.len(), 6 * 4 * n);
+        let wl = color::SampledWavelengths::from_edges(&edges).unwrap();
+        let integ = color::SpectralIntegrator::emission(&st.observer, &st.white, &wl);
+        let mut mean = [0.0; 3];
+        for px in spectral.chunks_exact(n) {
+            let v: Vec<f64> = px.iter().map(|&x| f64::from(x)).collect();
+            let t = integ.integrate_samples(&v);
+            (0..3).for_each(|c| mean[c] += t[c] / 24.0);
+        }
+        let want = binned.mean();
+        for c in 0..3 {
+            assert!((mean[c] - want[c]).abs() < 0.01 * want[c], "{mean:?} vs {want:?}");
+        }
+    }
+
+    /// Fed a fine grid of hero wavelengths, the bins hold the band means of the spectrum.
+    #[test]
+    fn bins_estimate_band_means() {
+        let f11 = color::illuminant::by_name("F11").unwrap();
+        let range = WavelengthRange::VISIBLE;
+        let edges = range.bin_edges(5.0).unwrap();
+        let bins = Bins::new(&edges, range);
+        let sensor = XyzSensor::new(&Observer::cie1931(), &Spectrum::Constant(1.0), range);
+        let n = 70_000;
+        let mut acc = vec![0.0; bins.len()];
+        for i in 0..n {
+            let wl = sensor.sample((i as f32 + 0.5) / n as f32);
+            let l = glam::Vec4::from_array(wl.0.to_array().map(|x| f11.eval(f64::from(x)) as f32));
+            bins.add(&mut acc, &wl, l);
+        }
+        for (b, e) in edges.windows(2).enumerate() {
+            let m = 1000;
+            let exact: f64 =
+                (0..m).map(|k| f11.eval(e[0] + (k as f64 + 0.5) * (e[1] - e[0]) / m as f64)).sum::<f64>()
+                    / m as f64;
+            let got = acc[b] / n as f64;
+            assert!((got - exact).abs() < 2e-3 * exact.max(1.0), "band {e:?}: {got} vs {exact}");
+        }
     }
 
     /// Direct lighting never exceeds full transport, and both see the lamp.

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use compare::{ColorMap, DiffMaps, DiffOptions, DiffSummary, Heatmap, HeatmapOptions, read_image};
+use compare::{ColorMap, DiffMaps, DiffOptions, DiffSummary, Heatmap, HeatmapOptions, Image};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -37,10 +37,76 @@ pub struct Args {
     /// dropped): against a noisy Monte-Carlo reference this cuts its noise by N.
     #[arg(long, value_name = "N", default_value_t = 1)]
     block: u32,
+    /// Observer integrating a spectral EXR input (one with S0.<λ>nm or T.<λ>nm channels, e.g.
+    /// from `truth --spectral-out`, pbrt-v4 or Mitsuba): cie1931 (default), cie1964, a camera
+    /// (nikon_d5100, canon_5d_mark_ii, …; white balanced and shown as linear RGB) or any other
+    /// `--observer` name spectra knows.
+    #[arg(long)]
+    observer: Option<String>,
+    /// White of a spectral input: normalises radiance (a radiance equal to it has Y = 1) and
+    /// lights reflectance. Default: the file's `spectra.white` attribute, else D65.
+    #[arg(long)]
+    white: Option<String>,
+    /// An extra metric beside ΔE2000 and MAE: `flip` (LDR-FLIP, NVIDIA's perceptual difference
+    /// of the sRGB-encoded, clipped images, through its reference C++ code, FLIP v1.2).
+    #[arg(long, value_name = "NAME")]
+    metric: Option<String>,
+    /// Write the FLIP error map (magma colours, 0 black to 1 white-yellow) to this PNG.
+    #[arg(long, value_name = "FILE.png")]
+    flip_map: Option<PathBuf>,
+    /// FLIP's viewing condition in pixels per degree (67: a 0.7 m wide 4K screen at 0.7 m).
+    #[arg(long, value_name = "PPD", default_value_t = compare::flip::DEFAULT_PIXELS_PER_DEGREE)]
+    flip_ppd: f32,
+}
+
+/// Reads an input; a spectral EXR is integrated to linear sRGB with the chosen observer and
+/// white. Returns a note saying how, for spectral inputs.
+fn load(path: &std::path::Path, what: &str, args: &Args) -> anyhow::Result<(Image, Option<String>)> {
+    let bytes = color::input::read_regular(path, compare::io::MAX_INPUT_BYTES)
+        .with_context(|| format!("reading the {what} image {}", path.display()))?;
+    let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !(is_exr && compare::spectral::is_spectral_exr(&bytes)) {
+        let img = compare::decode_image(path, &bytes).with_context(|| format!("reading the {what} image"))?;
+        return Ok((img, None));
+    }
+    let spec = compare::spectral::decode_spectral_exr(path, &bytes)
+        .with_context(|| format!("reading the {what} image"))?;
+    let obs_name = args.observer.as_deref().unwrap_or("cie1931");
+    let observer = color::Observer::by_name(obs_name).context("--observer")?;
+    let white_name = args.white.clone().or(spec.white.clone()).unwrap_or_else(|| "D65".into());
+    let white = color::illuminant::by_name(&white_name).with_context(|| format!("white {white_name}"))?;
+    let img = spec
+        .to_linear_srgb(&observer, &white)
+        .with_context(|| format!("integrating the {what} image {}", path.display()))?;
+    let edges = &spec.edges;
+    let note = format!(
+        "spectral, {} bands {:.1}–{:.1} nm, integrated with {} against {white_name}",
+        spec.bands(),
+        edges[0],
+        edges[edges.len() - 1],
+        observer.name
+    );
+    Ok((img, Some(note)))
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     // Check cheap things before reading possibly large images.
+    let flip = match args.metric.as_deref() {
+        None => false,
+        Some(m) if m.eq_ignore_ascii_case("flip") => true,
+        Some(m) => bail!("--metric {m}: the extra metric can be: flip (ΔE2000 and MAE are always measured)"),
+    };
+    if args.flip_map.is_some() && !flip {
+        bail!("--flip-map needs --metric flip");
+    }
+    if let Some(p) = &args.flip_map
+        && !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        bail!("{}: the FLIP map is written as PNG; give it a .png name", p.display());
+    }
+    if !(args.flip_ppd.is_finite() && args.flip_ppd > 0.0) {
+        bail!("--flip-ppd must be a positive number, got {}", args.flip_ppd);
+    }
     let colormap = ColorMap::by_name(&args.colormap)?;
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
     if !(lo..=hi).contains(&args.white_y) {
@@ -57,8 +123,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("--max-de must be a positive number, got {m}");
     }
 
-    let mut reference = read_image(&args.reference).context("reading the reference image")?;
-    let mut test = read_image(&args.test).context("reading the test image")?;
+    let (mut reference, ref_note) = load(&args.reference, "reference", &args)?;
+    let (mut test, test_note) = load(&args.test, "test", &args)?;
+    if (args.observer.is_some() || args.white.is_some()) && ref_note.is_none() && test_note.is_none() {
+        bail!("--observer and --white integrate spectral EXR inputs, and neither input is one");
+    }
     if args.block != 1 {
         // Blocks of two different sizes could coincide: compare sizes first.
         if reference.size() != test.size() {
@@ -70,6 +139,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let maps = DiffMaps::compute(&reference, &test, DiffOptions { white_luminance: args.white_y })
         .with_context(|| format!("comparing {} with {}", args.reference.display(), args.test.display()))?;
     let summary = maps.summary();
+    let flip_stats = if flip {
+        let map = compare::flip::ldr_flip(&reference, &test, args.flip_ppd).context("FLIP")?;
+        if let Some(p) = &args.flip_map {
+            map.save_png(p).context("writing the FLIP map")?;
+        }
+        let v: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
+        color::metrics::Stats::of(&v)
+    } else {
+        None
+    };
 
     let heatmap = match &args.heatmap {
         Some(path) => {
@@ -89,6 +168,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let o = v.as_object_mut().expect("a struct serialises to an object");
         o.insert("reference".into(), args.reference.display().to_string().into());
         o.insert("test".into(), args.test.display().to_string().into());
+        o.insert("reference_spectral".into(), ref_note.clone().into());
+        if let Some(f) = &flip_stats {
+            o.insert("flip".into(), serde_json::to_value(f)?);
+            o.insert("flip_ppd".into(), args.flip_ppd.into());
+            o.insert("flip_map".into(), args.flip_map.as_ref().map(|p| p.display().to_string()).into());
+        }
+        o.insert("test_spectral".into(), test_note.clone().into());
         o.insert(
             "heatmap".into(),
             match heatmap {
@@ -99,14 +185,21 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         o.insert("per_pixel_out".into(), args.per_pixel_out.as_ref().map(|p| p.display().to_string()).into());
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_table(&args, &summary, heatmap);
+        print_table(&args, &summary, heatmap, [&ref_note, &test_note], flip_stats.as_ref());
     }
     Ok(())
 }
 
-fn print_table(args: &Args, s: &DiffSummary, heatmap: Option<(&PathBuf, f64)>) {
-    println!("reference  {}", args.reference.display());
-    println!("test       {}", args.test.display());
+fn print_table(
+    args: &Args,
+    s: &DiffSummary,
+    heatmap: Option<(&PathBuf, f64)>,
+    notes: [&Option<String>; 2],
+    flip: Option<&color::metrics::Stats>,
+) {
+    let note = |n: &Option<String>| n.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
+    println!("reference  {}{}", args.reference.display(), note(notes[0]));
+    println!("test       {}{}", args.test.display(), note(notes[1]));
     println!(
         "size       {}×{} ({} pixels); CIELAB white: D65, Y = {}",
         s.width,
@@ -128,11 +221,86 @@ fn print_table(args: &Args, s: &DiffSummary, heatmap: Option<(&PathBuf, f64)>) {
     row("ΔE2000", &s.delta_e2000, 4);
     row("MAE linear RGB", &s.mae_linear, 6);
     row("MAE sRGB-encoded", &s.mae_srgb, 6);
+    if let Some(f) = flip {
+        row(&format!("LDR-FLIP ({} ppd)", args.flip_ppd), f, 6);
+    }
     if let Some((p, max)) = heatmap {
         println!();
         println!("heat map   {} (ΔE00 scale 0 to {max})", p.display());
     }
     if let Some(p) = &args.per_pixel_out {
         println!("per-pixel  {}", p.display());
+    }
+    if let Some(p) = &args.flip_map {
+        println!("FLIP map   {}", p.display());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(extra: &[&str]) -> Args {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            a: Args,
+        }
+        Cli::parse_from(["diff"].iter().chain(extra)).a
+    }
+
+    fn run_with(extra: &[&str]) -> anyhow::Result<()> {
+        run(args(extra))
+    }
+
+    /// A spectral input is integrated (and a wrong observer changes the result); the options
+    /// that only make sense with spectral inputs or FLIP are refused otherwise.
+    #[test]
+    fn spectral_inputs_and_flip_options() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = |n: &str| dir.path().join(n).display().to_string();
+        let edges = color::WavelengthRange::VISIBLE.bin_edges(5.0).unwrap();
+        let n = edges.len() - 1;
+        // A D65-coloured emitter at half the white: sRGB (0.5, 0.5, 0.5) for CIE 1931.
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let wl = color::SampledWavelengths::from_edges(&edges).unwrap();
+        let data = (0..12).flat_map(|_| wl.lambda.iter().map(|&l| (0.5 * d65.eval(l)) as f32)).collect();
+        let spec = compare::SpectralImage {
+            width: 4,
+            height: 3,
+            kind: compare::SpectralKind::Emissive,
+            edges,
+            data,
+            white: Some("D65".into()),
+        };
+        compare::write_spectral_exr(p("s.exr"), &spec, None).unwrap();
+        let grey = Image::filled(4, 3, [0.5; 3]).unwrap();
+        compare::write_image(p("g.exr"), &grey, Default::default()).unwrap();
+        assert_eq!(spec.bands(), n);
+        let pixel = |obs: &str| {
+            let a = args(&[&p("g.exr"), &p("s.exr"), "--observer", obs]);
+            let (img, note) = load(std::path::Path::new(&p("s.exr")), "test", &a).unwrap();
+            assert!(note.unwrap().contains(obs), "the note names the observer");
+            img.data[5]
+        };
+        // CIE 1931: D65 is sRGB's white (to the 5 nm bands' quadrature); a camera is white
+        // balanced on D65 exactly; the 10° observer sees D65 away from sRGB's 2° white.
+        let (c31, nikon, c64) = (pixel("cie1931"), pixel("nikon_d5100"), pixel("cie1964"));
+        assert!(c31.iter().all(|v| (v - 0.5).abs() < 2e-3), "{c31:?}");
+        assert!(nikon.iter().all(|v| (v - 0.5).abs() < 1e-6), "{nikon:?}");
+        assert!(c64.iter().zip(c31).any(|(a, b)| (a - b).abs() > 5e-3), "{c64:?} vs {c31:?}");
+        run_with(&[&p("g.exr"), &p("s.exr"), "--metric", "flip", "--flip-map", &p("f.png")]).unwrap();
+        assert!(dir.path().join("f.png").exists());
+        run_with(&[&p("s.exr"), &p("g.exr"), "--observer", "nikon", "--json"]).unwrap();
+        let e = |x: &[&str]| format!("{:#}", run_with(x).unwrap_err());
+        assert!(e(&[&p("g.exr"), &p("g.exr"), "--observer", "cie1964"]).contains("neither input"));
+        assert!(e(&[&p("g.exr"), &p("s.exr"), "--observer", "martian"]).contains("martian"));
+        assert!(e(&[&p("g.exr"), &p("g.exr"), "--metric", "ssim"]).contains("flip"));
+        assert!(e(&[&p("g.exr"), &p("g.exr"), "--flip-map", &p("x.png")]).contains("--metric flip"));
+        assert!(
+            e(&[&p("g.exr"), &p("g.exr"), "--metric", "flip", "--flip-map", &p("x.jpg")]).contains(".png")
+        );
+        assert!(!dir.path().join("x.png").exists());
     }
 }

@@ -70,6 +70,21 @@ pub struct Args {
     /// Output image: .exr (linear) or .png (sRGB-encoded, clipped).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also write the radiance binned by wavelength as a spectral EXR (the OpenEXR layout of
+    /// Fichet et al. 2021, as pbrt-v4 writes it: channels S0.<λ>nm, with R, G, B beside them),
+    /// estimated from the same samples as --out, which it does not change.
+    #[arg(long, value_name = "FILE.exr")]
+    pub spectral_out: Option<PathBuf>,
+    /// Width of the --spectral-out bins in nm, over the render range (the last bin is narrower
+    /// when the width does not divide the range).
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 5.0,
+        requires = "spectral_out",
+        allow_negative_numbers = true
+    )]
+    pub spectral_bin: f64,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32)> {
@@ -112,11 +127,17 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
         }
         s.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
+    if a.spectral_out.is_some() {
+        s.spectral_bands = Some(s.range.bin_edges(a.spectral_bin).context("--spectral-bin")?);
+    }
     s.validate()?;
     Ok(s)
 }
 
 pub fn run(a: Args) -> Result<()> {
+    if a.spectral_out.is_some() && a.out.is_none() {
+        bail!("--spectral-out needs --out as well (its R, G, B are the --out image)");
+    }
     if a.out.is_none() && a.export_mitsuba.is_none() {
         bail!("nothing to do: give --out FILE (.exr/.png) and/or --export-mitsuba DIR");
     }
@@ -132,6 +153,18 @@ pub fn run(a: Args) -> Result<()> {
             bail!("--xyz needs an .exr output (PNG is display-encoded sRGB)");
         }
         super::check_output("--out", out)?;
+    }
+    if let Some(sp) = &a.spectral_out {
+        if !sp.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+            bail!(
+                "--spectral-out {}: a spectral image is an OpenEXR file; give it a .exr name",
+                sp.display()
+            );
+        }
+        if a.xyz {
+            bail!("--spectral-out stores linear sRGB beside the bands; it cannot be combined with --xyz");
+        }
+        super::check_output("--spectral-out", sp)?;
     }
     if let Some(dir) = &a.export_mitsuba {
         if std::fs::symlink_metadata(dir).is_ok() {
@@ -185,6 +218,22 @@ pub fn run(a: Args) -> Result<()> {
     }
     let data = if a.xyz { img.xyz.clone() } else { img.to_rgb(&RgbColorSpace::srgb()) };
     let image = compare::image::Image::new(st.width, st.height, data)?;
+    // The spectral file first: an interrupted run leaves neither complete, never a colour image
+    // without the spectral one it was asked to go with.
+    if let (Some(sp), Some(bands)) = (&a.spectral_out, img.spectral.clone()) {
+        let edges = st.spectral_bands.clone().expect("bands were asked for");
+        let white = a.white.clone().or(scene.spectral.white.clone()).unwrap_or_else(|| "D65".into());
+        let spec = compare::SpectralImage {
+            width: st.width,
+            height: st.height,
+            kind: compare::SpectralKind::Emissive,
+            edges,
+            data: bands,
+            white: Some(white),
+        };
+        compare::write_spectral_exr(sp, &spec, Some(&image))
+            .with_context(|| format!("writing {}", sp.display()))?;
+    }
     compare::io::write_image(out, &image, Default::default())
         .with_context(|| format!("writing {}", out.display()))?;
     let paths = st.width as f64 * st.height as f64 * st.spp as f64;
@@ -211,6 +260,16 @@ pub fn run(a: Args) -> Result<()> {
         y,
         if img.dropped > 0 { format!(", {} non-finite samples dropped", img.dropped) } else { String::new() }
     );
+    if let (Some(sp), Some(edges)) = (&a.spectral_out, &st.spectral_bands) {
+        eprintln!(
+            "{}: {} bands of {} nm, {:.0}–{:.0} nm (S0.<λ>nm channels, with R, G, B)",
+            sp.display(),
+            edges.len() - 1,
+            a.spectral_bin,
+            st.range.min,
+            st.range.max
+        );
+    }
     Ok(())
 }
 
@@ -235,6 +294,12 @@ mod tests {
         assert!(e(&["--spp", "0", "--out", "x.exr"]).contains("at least 1"));
         assert!(e(&["--out", "x.bmp"]).contains(".exr"));
         assert!(e(&["--xyz", "--out", "x.png"]).contains("--xyz"));
+        assert!(e(&["--spectral-out", "s.exr"]).contains("needs --out"));
+        assert!(e(&["--out", "x.exr", "--spectral-out", "s.png"]).contains(".exr name"));
+        assert!(e(&["--out", "x.exr", "--spectral-out", "s.exr", "--xyz"]).contains("--xyz"));
+        let m = e(&["--out", "x.exr", "--spectral-out", "s.exr", "--spectral-bin", "-5"]);
+        assert!(m.contains("--spectral-bin") && m.contains("positive"), "{m}");
+        assert!(!std::path::Path::new("s.exr").exists());
         assert!(e(&["--size", "0x4", "--out", "x.exr"]).contains("positive"));
         let m = e(&["--size", "4294967295x1", "--out", "x.exr"]);
         assert!(m.contains("too large") && m.contains("4294967295"), "{m}");

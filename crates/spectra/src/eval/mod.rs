@@ -56,6 +56,10 @@ pub struct ModeResult {
     pub image: String,
     pub heatmap: String,
     pub errors: Errors,
+    /// Mean LDR-FLIP against the truth (sRGB-encoded, clipped; 67 pixels per degree) and its
+    /// error map (magma PNG).
+    pub flip_mean: f64,
+    pub flip_map: String,
 }
 
 /// One case's results.
@@ -217,17 +221,20 @@ pub fn run(cfg: Config) -> Result<Results> {
             let img = measure::realtime(&mut r, &c.scene, &measure::settings(*mode, n, range))?;
             let png = format!("{}_{}.png", c.id, name);
             save_png(&cfg.out.join(&png), &img)?;
-            maps.push((*mode, *name, png, measure::diff(&t0, &img)?));
+            let flip = compare::flip::ldr_flip(&t0, &img, compare::flip::DEFAULT_PIXELS_PER_DEGREE)?;
+            maps.push((*mode, *name, png, measure::diff(&t0, &img)?, flip));
         }
         // One heat-map scale per case so the three modes are comparable at a glance.
         let scale = compare::heatmap::nice_ceil(
             maps.iter().map(|m| m.3.summary().delta_e2000.p99).fold(1.0, f64::max),
         );
         let mut modes = Vec::new();
-        for (mode, name, png, m) in maps {
+        for (mode, name, png, m, flip) in maps {
             let hm = format!("{}_{}_heat.png", c.id, name);
             Heatmap::of_delta_e(&m, &HeatmapOptions { max: Some(scale), ..Default::default() })?
                 .save_png(cfg.out.join(&hm))?;
+            let flip_map = format!("{}_{}_flip.png", c.id, name);
+            flip.save_png(&cfg.out.join(&flip_map))?;
             modes.push(ModeResult {
                 mode: name.into(),
                 wavelengths: (mode != Mode::Rgb).then_some(n),
@@ -235,6 +242,8 @@ pub fn run(cfg: Config) -> Result<Results> {
                 image: png,
                 heatmap: hm,
                 errors: Errors::of(&m, &mask)?,
+                flip_mean: flip.mean(),
+                flip_map,
             });
         }
         eprintln!(
@@ -479,6 +488,8 @@ mod tests {
             image: String::new(),
             heatmap: String::new(),
             errors: errors(de),
+            flip_mean: 0.0,
+            flip_map: String::new(),
         };
         let case = CaseResult {
             id: "c".into(),

@@ -565,6 +565,16 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
                 esc(&m.mode)
             );
         }
+        h.push_str("</div><div class=\"row\">");
+        for m in &c.modes {
+            let _ = write!(
+                h,
+                "<figure><img class=\"px\" src=\"{}\"><figcaption>{} LDR-FLIP map (magma, 0–1) — mean FLIP {:.4}</figcaption></figure>",
+                esc(&m.flip_map),
+                esc(&m.mode),
+                m.flip_mean
+            );
+        }
         h.push_str("</div>");
         sweep_html(&mut h, c);
     }

@@ -1,0 +1,515 @@
+//! Spectral images in the OpenEXR layout of Fichet, Pacanowski & Wilkie 2021 ("An OpenEXR Layout
+//! for Spectral Images", JCGT 10(3)), as pbrt-v4's `SpectralFilm` writes it.
+//!
+//! One channel per band, the band's wavelength spelled into the name with a comma for the decimal
+//! point (a dot separates OpenEXR layers): `S0.562,500nm` is the emissive (unpolarised, Stokes 0)
+//! radiance at 562.5 nm, `T.562,500nm` a reflectance (transmittance) at 562.5 nm. The header
+//! carries `spectralLayoutVersion` = "1.0" and, for emissive images, `emissiveUnits`. pbrt-v4
+//! writes its bucket centres with three decimals and R, G, B beside them; so does spectra.
+//!
+//! The layout does not store band widths. spectra writes its box bins' edges in an extra header
+//! attribute, [`BAND_EDGES_ATTRIBUTE`] (other readers ignore it); a file without it gets bands
+//! that meet half-way between neighbouring wavelengths, the outer two as wide as their
+//! neighbour's spacing, which is the bucket layout of pbrt-v4 and of any uniform sampling.
+//!
+//! Integration (observer, white, the convention for non-CIE observers) is `color`'s:
+//! [`color::SpectralIntegrator`] on [`color::SampledWavelengths::from_edges`].
+
+use std::io::Cursor;
+use std::path::Path;
+
+use color::{Observer, SampledWavelengths, SpectralIntegrator, Spectrum};
+use exr::meta::attribute::{AttributeValue, Text};
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, ReadChannels, ReadLayers, Vec2,
+    WritableImage,
+};
+
+use crate::atomic::write_atomic;
+use crate::error::{CompareError, Result};
+use crate::image::Image;
+
+/// Header attribute holding the band edges in nm, N + 1 numbers separated by spaces.
+pub const BAND_EDGES_ATTRIBUTE: &str = "spectra.bandEdgesNm";
+/// Header attribute naming the scene white the radiances are normalised against (informative).
+pub const WHITE_ATTRIBUTE: &str = "spectra.white";
+/// Most spectral channels read (1 nm over 360–830 nm is 471).
+pub const MAX_BANDS: usize = 2048;
+
+/// What the band values are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpectralKind {
+    /// Radiance (Stokes component 0): channels `S0.<λ>nm`.
+    Emissive,
+    /// Reflectance: channels `T.<λ>nm`.
+    Reflective,
+}
+
+impl SpectralKind {
+    fn prefix(self) -> &'static str {
+        match self {
+            SpectralKind::Emissive => "S0",
+            SpectralKind::Reflective => "T",
+        }
+    }
+}
+
+/// A spectral image: `data[(y * width + x) * bands + b]` is band `b` of pixel (x, y), the mean
+/// of the quantity over the band (for radiance: per nm, in the scene's units).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectralImage {
+    pub width: u32,
+    pub height: u32,
+    pub kind: SpectralKind,
+    /// Band edges in nm, strictly increasing, one more than there are bands.
+    pub edges: Vec<f64>,
+    pub data: Vec<f32>,
+    /// Name of the white the values are normalised against ([`WHITE_ATTRIBUTE`]), if known.
+    pub white: Option<String>,
+}
+
+impl SpectralImage {
+    pub fn bands(&self) -> usize {
+        self.edges.len().saturating_sub(1)
+    }
+
+    /// The wavelengths and widths of the bands.
+    pub fn wavelengths(&self) -> Result<SampledWavelengths> {
+        SampledWavelengths::from_edges(&self.edges).map_err(|e| CompareError::InvalidImage(e.to_string()))
+    }
+
+    fn validate(&self) -> Result<()> {
+        let n = self.bands();
+        self.wavelengths()?;
+        let want = self.width as usize * self.height as usize * n;
+        if self.width == 0 || self.height == 0 || self.data.len() != want {
+            return Err(CompareError::InvalidImage(format!(
+                "{}×{} with {n} bands needs {want} samples, got {}",
+                self.width,
+                self.height,
+                self.data.len()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Integrates every pixel with `observer` against `white` (for emissive images the white
+    /// normalises: a radiance equal to `white` has Y = 1; for reflective ones it is the
+    /// illuminant) and converts to linear sRGB by [`color::xyz::tristimulus_to_linear_srgb`].
+    pub fn to_linear_srgb(&self, observer: &Observer, white: &Spectrum) -> Result<Image> {
+        self.validate()?;
+        let wl = self.wavelengths()?;
+        let integ = match self.kind {
+            SpectralKind::Emissive => SpectralIntegrator::emission(observer, white, &wl),
+            SpectralKind::Reflective => SpectralIntegrator::reflectance(observer, white, &wl),
+        };
+        let white_response = match self.kind {
+            SpectralKind::Emissive => integ.integrate(|l| white.eval(l)),
+            SpectralKind::Reflective => integ.white(),
+        };
+        let m = color::xyz::tristimulus_to_linear_srgb(observer, white_response)
+            .map_err(|e| CompareError::InvalidOption(e.to_string()))?;
+        let n = self.bands();
+        let mut values = vec![0.0f64; n];
+        let data = self
+            .data
+            .chunks_exact(n)
+            .map(|px| {
+                values.iter_mut().zip(px).for_each(|(v, &p)| *v = f64::from(p));
+                let t = integ.integrate_samples(&values);
+                let rgb = m * glam::DVec3::from(t);
+                [rgb.x as f32, rgb.y as f32, rgb.z as f32]
+            })
+            .collect();
+        Image::new(self.width, self.height, data)
+    }
+}
+
+/// The channel name of a band at `lambda` nm, as pbrt-v4 spells it: three decimals, comma.
+pub fn channel_name(kind: SpectralKind, lambda: f64) -> String {
+    format!("{}.{}nm", kind.prefix(), format!("{lambda:.3}").replace('.', ","))
+}
+
+/// Parses a spectral channel name: `None` if the name is not in the layout's namespace (R, G, B,
+/// A, other layers), an error naming the channel if it is but cannot be read.
+fn parse_channel(name: &str) -> Option<std::result::Result<(SpectralKind, f64), String>> {
+    let (prefix, rest) = name.split_once('.')?;
+    let kind = match prefix {
+        "S0" => SpectralKind::Emissive,
+        "T" => SpectralKind::Reflective,
+        "S1" | "S2" | "S3" => {
+            return Some(Err("polarised (Stokes 1–3) channels are not supported".into()));
+        }
+        _ => return None,
+    };
+    let Some(number) = rest.strip_suffix("nm") else {
+        return Some(Err(format!("expected the wavelength in nm, like {}", channel_name(kind, 550.0))));
+    };
+    // A dot would be a layer separator, so a bi-spectral (re-radiation) channel lands here too.
+    let ok = !number.is_empty()
+        && number.chars().all(|c| c.is_ascii_digit() || c == ',')
+        && number.matches(',').count() <= 1
+        && !number.starts_with(',');
+    let lambda = if ok { number.replace(',', ".").parse::<f64>().ok() } else { None };
+    match lambda {
+        Some(l) if l.is_finite() && l > 0.0 => Some(Ok((kind, l))),
+        _ => Some(Err(format!("'{number}' is not a wavelength (digits with a comma decimal separator)"))),
+    }
+}
+
+fn is_layout_attribute(name: &Text) -> bool {
+    name.eq("spectralLayoutVersion")
+}
+
+/// Whether EXR bytes hold a spectral image (a channel named `S0.<λ>nm`/`T.<λ>nm`, or the
+/// layout's `spectralLayoutVersion` attribute). Reads the header only.
+pub fn is_spectral_exr(bytes: &[u8]) -> bool {
+    let Ok(meta) = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false) else {
+        return false;
+    };
+    meta.headers.iter().any(|h| {
+        h.own_attributes.other.keys().any(is_layout_attribute)
+            || h.shared_attributes.other.keys().any(is_layout_attribute)
+            || h.channels.list.iter().any(|c| parse_channel(&c.name.to_string()).is_some())
+    })
+}
+
+/// Reads a spectral EXR file ([`decode_spectral_exr`]).
+pub fn read_spectral_exr(path: impl AsRef<Path>) -> Result<SpectralImage> {
+    let path = path.as_ref();
+    let bytes = color::input::read_regular(path, crate::io::MAX_INPUT_BYTES)
+        .map_err(|e| CompareError::io(path, e))?;
+    decode_spectral_exr(path, &bytes)
+}
+
+/// Decodes a spectral EXR: the first valid layer's `S0.<λ>nm` or `T.<λ>nm` channels, sorted by
+/// wavelength (other channels are ignored). Errors name the offending channel: unreadable
+/// wavelengths, two channels at one wavelength, a mix of emissive and reflective channels,
+/// polarised or subsampled channels, band edges that are unsorted, of zero or negative width, or
+/// do not hold their channel's wavelength at their centre.
+pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<SpectralImage> {
+    let path = path.as_ref();
+    let decode =
+        |reason: String| CompareError::Decode { path: path.into(), format: "spectral OpenEXR", reason };
+    crate::io::check_exr_headers(path, bytes, MAX_BANDS as u64 + 8)?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| decode(e.to_string()))?;
+    let layer: Layer<AnyChannels<FlatSamples>> = image.layer_data;
+    let attr = |name: &str| {
+        layer
+            .attributes
+            .other
+            .iter()
+            .chain(image.attributes.other.iter())
+            .find(|(k, _)| (*k).eq(name))
+            .map(|(_, v)| v.clone())
+    };
+    let text = |name: &str| match attr(name) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+
+    let mut bands: Vec<(f64, &AnyChannel<FlatSamples>, String)> = Vec::new();
+    let mut kind: Option<(SpectralKind, String)> = None;
+    for c in &layer.channel_data.list {
+        let name = c.name.to_string();
+        let Some(parsed) = parse_channel(&name) else { continue };
+        let (k, lambda) = parsed.map_err(|why| decode(format!("channel {name}: {why}")))?;
+        match &kind {
+            None => kind = Some((k, name.clone())),
+            Some((k0, first)) if *k0 != k => {
+                return Err(decode(format!(
+                    "channel {name} and channel {first}: emissive (S0) and reflective (T) bands in one image \
+                     are not supported"
+                )));
+            }
+            _ => {}
+        }
+        if c.sampling != Vec2(1, 1) {
+            return Err(decode(format!("channel {name} is subsampled, which is not supported")));
+        }
+        bands.push((lambda, c, name));
+    }
+    let Some((kind, _)) = kind else {
+        let present: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+        return Err(decode(format!(
+            "no spectral channel (named like S0.550,000nm or T.550,000nm); the file has: {}",
+            if present.is_empty() { "none".into() } else { present.join(", ") }
+        )));
+    };
+    bands.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for w in bands.windows(2) {
+        // Wavelengths are written with three decimals: closer than that is the same band.
+        if (w[1].0 - w[0].0).abs() < 5e-4 {
+            return Err(decode(format!(
+                "channels {} and {} give the same wavelength ({} nm)",
+                w[0].2, w[1].2, w[0].0
+            )));
+        }
+    }
+    let edges = match text(BAND_EDGES_ATTRIBUTE) {
+        Some(s) => edges_from_attribute(&s, &bands, &decode)?,
+        None => edges_from_centres(&bands, &decode)?,
+    };
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let (width, height) = (
+        u32::try_from(w).map_err(|_| decode(format!("width {w} too large")))?,
+        u32::try_from(h).map_err(|_| decode(format!("height {h} too large")))?,
+    );
+    let n = bands.len();
+    let mut data = vec![0.0f32; w * h * n];
+    for (b, (_, c, _)) in bands.iter().enumerate() {
+        for i in 0..w * h {
+            data[i * n + b] = c.sample_data.value_by_flat_index(i).to_f32();
+        }
+    }
+    let img = SpectralImage { width, height, kind, edges, data, white: text(WHITE_ATTRIBUTE) };
+    img.validate().map_err(|e| decode(e.to_string()))?;
+    Ok(img)
+}
+
+fn edges_from_attribute(
+    s: &str,
+    bands: &[(f64, &AnyChannel<FlatSamples>, String)],
+    decode: &dyn Fn(String) -> CompareError,
+) -> Result<Vec<f64>> {
+    let edges: Vec<f64> = s
+        .split_whitespace()
+        .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| decode(format!("attribute {BAND_EDGES_ATTRIBUTE} '{s}': not a list of numbers")))?;
+    if edges.len() != bands.len() + 1 {
+        return Err(decode(format!(
+            "attribute {BAND_EDGES_ATTRIBUTE} has {} edges for {} spectral channels (want {}): a channel \
+             is missing or the edges are wrong",
+            edges.len(),
+            bands.len(),
+            bands.len() + 1
+        )));
+    }
+    for (i, (lambda, _, name)) in bands.iter().enumerate() {
+        let (lo, hi) = (edges[i], edges[i + 1]);
+        if hi <= lo {
+            return Err(decode(format!(
+                "channel {name}: its band {lo}–{hi} nm (attribute {BAND_EDGES_ATTRIBUTE}) has a width of {} nm; \
+                 edges must be sorted and widths positive",
+                hi - lo
+            )));
+        }
+        let centre = 0.5 * (lo + hi);
+        if (centre - lambda).abs() > 1e-3 {
+            return Err(decode(format!(
+                "channel {name}: its band {lo}–{hi} nm (attribute {BAND_EDGES_ATTRIBUTE}) is centred at \
+                 {centre} nm, not at the channel's wavelength"
+            )));
+        }
+    }
+    Ok(edges)
+}
+
+fn edges_from_centres(
+    bands: &[(f64, &AnyChannel<FlatSamples>, String)],
+    decode: &dyn Fn(String) -> CompareError,
+) -> Result<Vec<f64>> {
+    let l: Vec<f64> = bands.iter().map(|b| b.0).collect();
+    if l.len() < 2 {
+        return Err(decode(format!(
+            "channel {}: a single band without attribute {BAND_EDGES_ATTRIBUTE} has no known width",
+            bands[0].2
+        )));
+    }
+    let n = l.len();
+    let mut edges = Vec::with_capacity(n + 1);
+    edges.push(l[0] - 0.5 * (l[1] - l[0]));
+    edges.extend(l.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+    edges.push(l[n - 1] + 0.5 * (l[n - 1] - l[n - 2]));
+    Ok(edges)
+}
+
+/// Writes `image` as a spectral EXR, atomically, with `rgb` (linear sRGB, e.g. the same run's
+/// colour image) as R, G, B beside the bands so viewers without spectral support show it. f32
+/// samples, ZIP compression.
+pub fn write_spectral_exr(path: impl AsRef<Path>, image: &SpectralImage, rgb: Option<&Image>) -> Result<()> {
+    let path = path.as_ref();
+    image.validate()?;
+    let (w, h) = (image.width as usize, image.height as usize);
+    if let Some(rgb) = rgb
+        && rgb.size() != (image.width, image.height)
+    {
+        return Err(CompareError::SizeMismatch { reference: (image.width, image.height), test: rgb.size() });
+    }
+    let wl = image.wavelengths()?;
+    let n = image.bands();
+    let mut list: Vec<AnyChannel<FlatSamples>> = Vec::with_capacity(n + 3);
+    let mut names = std::collections::HashSet::new();
+    for (b, &lambda) in wl.lambda.iter().enumerate() {
+        let name = channel_name(image.kind, lambda);
+        if !names.insert(name.clone()) {
+            return Err(CompareError::InvalidImage(format!(
+                "two bands are named {name}: bands narrower than 0.002 nm cannot be told apart"
+            )));
+        }
+        let samples = (0..w * h).map(|i| image.data[i * n + b]).collect();
+        list.push(AnyChannel::new(name.as_str(), FlatSamples::F32(samples)));
+    }
+    if let Some(rgb) = rgb {
+        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+            list.push(AnyChannel::new(name, FlatSamples::F32(rgb.data.iter().map(|p| p[c]).collect())));
+        }
+    }
+    let mut attributes = LayerAttributes::default();
+    let mut set = |k: &str, v: &str| {
+        attributes.other.insert(Text::new_or_panic(k), AttributeValue::Text(Text::new_or_panic(v)));
+    };
+    set("spectralLayoutVersion", "1.0");
+    if image.kind == SpectralKind::Emissive {
+        set("emissiveUnits", "W.m^-2.sr^-1");
+    }
+    let edges: Vec<String> = image.edges.iter().map(|e| format!("{e}")).collect();
+    set(BAND_EDGES_ATTRIBUTE, &edges.join(" "));
+    if let Some(white) = &image.white {
+        set(WHITE_ATTRIBUTE, white);
+    }
+    let layer = Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(list.into()));
+    let mut buf = Cursor::new(Vec::new());
+    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut buf).map_err(|e| {
+        CompareError::Encode { path: path.into(), format: "spectral OpenEXR", reason: e.to_string() }
+    })?;
+    write_atomic(path, &buf.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(kind: SpectralKind) -> SpectralImage {
+        let edges = color::WavelengthRange::new(380.0, 730.0).unwrap().bin_edges(5.0).unwrap();
+        let n = edges.len() - 1;
+        let (w, h) = (5u32, 3u32);
+        let data = (0..w * h)
+            .flat_map(|p| (0..n).map(move |b| 0.1 + 0.8 * (((p as usize * 7 + b * 3) % 11) as f32 / 10.0)))
+            .collect();
+        SpectralImage { width: w, height: h, kind, edges, data, white: Some("D65".into()) }
+    }
+
+    #[test]
+    fn names_follow_pbrt() {
+        assert_eq!(channel_name(SpectralKind::Emissive, 562.5), "S0.562,500nm");
+        assert_eq!(channel_name(SpectralKind::Reflective, 400.0), "T.400,000nm");
+        assert_eq!(parse_channel("S0.562,500nm"), Some(Ok((SpectralKind::Emissive, 562.5))));
+        assert_eq!(parse_channel("S0.550nm"), Some(Ok((SpectralKind::Emissive, 550.0))));
+        assert_eq!(parse_channel("R"), None);
+        assert_eq!(parse_channel("diffuse.R"), None);
+        assert!(parse_channel("S0.550,5Hz").unwrap().is_err());
+        assert!(parse_channel("S0.55,0,1nm").unwrap().is_err());
+        assert!(parse_channel("S1.550nm").unwrap().is_err());
+    }
+
+    /// Written, read back: the same bands, values and metadata; integration of the file equals
+    /// integration of the image in memory.
+    #[test]
+    fn round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        for kind in [SpectralKind::Emissive, SpectralKind::Reflective] {
+            let img = sample(kind);
+            let p = dir.path().join("s.exr");
+            let rgb = Image::filled(5, 3, [0.25, 0.5, 0.75]).unwrap();
+            write_spectral_exr(&p, &img, Some(&rgb)).unwrap();
+            let bytes = std::fs::read(&p).unwrap();
+            assert!(is_spectral_exr(&bytes));
+            let back = read_spectral_exr(&p).unwrap();
+            assert_eq!(back, img);
+            let d65 = color::illuminant::by_name("D65").unwrap();
+            let obs = Observer::cie1931();
+            assert_eq!(back.to_linear_srgb(&obs, &d65).unwrap(), img.to_linear_srgb(&obs, &d65).unwrap());
+        }
+        let rgb_only = dir.path().join("rgb.exr");
+        crate::io::write_image(&rgb_only, &Image::filled(2, 2, [0.5; 3]).unwrap(), Default::default())
+            .unwrap();
+        assert!(!is_spectral_exr(&std::fs::read(&rgb_only).unwrap()));
+    }
+
+    /// A spectrally flat emitter equal to the white integrates to the white: sRGB (1, 1, 1) for
+    /// CIE observers, and for a camera (white balanced by the convention in `color`).
+    #[test]
+    fn white_integrates_to_white() {
+        let mut img = sample(SpectralKind::Emissive);
+        let wl = img.wavelengths().unwrap();
+        let e = Spectrum::Constant(1.0);
+        let n = img.bands();
+        for (i, v) in img.data.iter_mut().enumerate() {
+            *v = e.eval(wl.lambda[i % n]) as f32;
+        }
+        for obs in [Observer::cie1931(), Observer::cie1964(), Observer::nikon_d5100()] {
+            let rgb = img.to_linear_srgb(&obs, &e).unwrap();
+            let want = if obs.name == "nikon_d5100" {
+                [1.0; 3]
+            } else {
+                let xyz = SpectralIntegrator::emission(&obs, &e, &wl).integrate(|_| 1.0);
+                color::RgbColorSpace::srgb().xyz_to_rgb(xyz)
+            };
+            for k in 0..3 {
+                assert!(
+                    (f64::from(rgb.data[4][k]) - want[k]).abs() < 1e-6,
+                    "{} {:?} {want:?}",
+                    obs.name,
+                    rgb.data[4]
+                );
+            }
+        }
+    }
+
+    fn write_raw(path: &Path, names: &[&str], attrs: &[(&str, &str)]) {
+        let list: Vec<AnyChannel<FlatSamples>> =
+            names.iter().map(|n| AnyChannel::new(*n, FlatSamples::F32(vec![0.5; 4]))).collect();
+        let mut a = LayerAttributes::default();
+        for (k, v) in attrs {
+            a.other.insert(Text::new_or_panic(*k), AttributeValue::Text(Text::new_or_panic(*v)));
+        }
+        let layer = Layer::new((2, 2), a, Encoding::UNCOMPRESSED, AnyChannels::sort(list.into()));
+        exr::prelude::Image::from_layer(layer).write().to_file(path).unwrap();
+    }
+
+    #[test]
+    fn bad_layouts_name_the_channel() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("bad.exr");
+        let err = |names: &[&str], attrs: &[(&str, &str)]| {
+            write_raw(&p, names, attrs);
+            read_spectral_exr(&p).unwrap_err().to_string()
+        };
+        let e = err(&["R", "G", "B"], &[("spectralLayoutVersion", "1.0")]);
+        assert!(e.contains("bad.exr") && e.contains("no spectral channel") && e.contains("B, G, R"), "{e}");
+        let e = err(&["S0.500nm", "S0.510,abcnm"], &[]);
+        assert!(e.contains("channel S0.510,abcnm") && e.contains("not a wavelength"), "{e}");
+        let e = err(&["S0.500nm", "S0.500,000nm", "S0.510nm"], &[]);
+        assert!(e.contains("S0.500,000nm") && e.contains("S0.500nm") && e.contains("same wavelength"), "{e}");
+        let e = err(&["S0.500nm", "T.510nm"], &[]);
+        assert!(e.contains("T.510nm") && e.contains("S0.500nm") && e.contains("emissive"), "{e}");
+        let e = err(&["S0.500nm", "S1.500nm"], &[]);
+        assert!(e.contains("channel S1.500nm") && e.contains("polarised"), "{e}");
+        let e = err(&["S0.500nm"], &[]);
+        assert!(e.contains("channel S0.500nm") && e.contains("width"), "{e}");
+        // A missing channel against the written edges.
+        let e = err(&["S0.502,500nm", "S0.512,500nm"], &[(BAND_EDGES_ATTRIBUTE, "500 505 510 515")]);
+        assert!(e.contains("3 edges") || e.contains("4 edges"), "{e}");
+        assert!(e.contains("missing"), "{e}");
+        // Unsorted edges: a negative width, named by its channel.
+        let e = err(&["S0.502,500nm", "S0.507,500nm"], &[(BAND_EDGES_ATTRIBUTE, "500 505 500")]);
+        assert!(e.contains("channel S0.507,500nm") && e.contains("width of -5"), "{e}");
+        let e = err(&["S0.502,500nm", "S0.508,000nm"], &[(BAND_EDGES_ATTRIBUTE, "500 505 510")]);
+        assert!(e.contains("channel S0.508,000nm") && e.contains("centred at 507.5"), "{e}");
+        let e = err(&["S0.502,500nm", "S0.507,500nm"], &[(BAND_EDGES_ATTRIBUTE, "500 x 510")]);
+        assert!(e.contains(BAND_EDGES_ATTRIBUTE) && e.contains("not a list"), "{e}");
+        // Without edges, uneven spacing is legitimate (bands meet half-way).
+        write_raw(&p, &["S0.500nm", "S0.510nm", "S0.530nm"], &[]);
+        let ok = read_spectral_exr(&p).unwrap();
+        assert_eq!(ok.edges, vec![495.0, 505.0, 520.0, 540.0]);
+    }
+}

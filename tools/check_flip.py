@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""FLIP test data from NVIDIA's reference implementation (the `flip-evaluator` PyPI package, the
+C++ FLIP through nanobind): crates/compare/tests/data/flip_{reference,test}.rgb8 (raw 8-bit sRGB,
+64×48, row-major RGB) and flip_expected.json (LDR-FLIP at 67 pixels per degree: the mean and the
+whole error map, no magma), read by crates/compare/tests/flip_reference.rs.
+
+The FLIP repository's own example pair (images/reference.png, test.png; published LDR mean
+0.159691) is not used: the example images are 4 MB, too large for the test data.
+
+Run: python3 tools/check_flip.py (what `cargo xtask test` does) checks that a fresh run of the
+reference implementation reproduces the checked-in expectations (mean to 1e-6, map to 1e-6);
+with --write it regenerates them.
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+try:
+    import flip_evaluator as flip
+except ImportError:
+    print("check_flip: flip-evaluator missing, installing it with pip (test oracle only)")
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", "flip-evaluator"], check=True)
+    import flip_evaluator as flip
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DATA = os.path.join(ROOT, "crates", "compare", "tests", "data")
+W, H = 64, 48
+
+
+def images():
+    """A render-like reference (gradients, an edge, texture) and a test with noise, a colour
+    shift in one region and a blurred edge: errors of the kinds FLIP weighs differently."""
+    rng = np.random.default_rng(2020)
+    y, x = np.mgrid[0:H, 0:W].astype(np.float64)
+    ref = np.stack([x / W, y / H, 0.5 + 0.4 * np.sin(x / 5.0) * np.cos(y / 7.0)], axis=-1)
+    ref[:, 30:34] = [0.9, 0.9, 0.85]
+    test = ref.copy()
+    test += rng.normal(0, 0.03, test.shape)
+    test[5:20, 40:60] *= [1.0, 0.8, 1.1]
+    test[:, 29:35] = 0.5 * (test[:, 28:34] + test[:, 30:36])
+    to8 = lambda a: np.round(np.clip(a, 0, 1) * 255).astype(np.uint8)
+    return to8(ref), to8(test)
+
+
+def evaluate(ref8, test8):
+    err, mean, _ = flip.evaluate(ref8.astype(np.float32) / 255.0, test8.astype(np.float32) / 255.0, "LDR", applyMagma=False)
+    return np.asarray(err, np.float64).reshape(H, W), float(mean)
+
+
+def main():
+    ref8, test8 = images()
+    err, mean = evaluate(ref8, test8)
+    if "--write" in sys.argv:
+        os.makedirs(DATA, exist_ok=True)
+        ref8.tofile(os.path.join(DATA, "flip_reference.rgb8"))
+        test8.tofile(os.path.join(DATA, "flip_test.rgb8"))
+        with open(os.path.join(DATA, "flip_expected.json"), "w") as f:
+            json.dump({"width": W, "height": H, "ppd": 67.0, "implementation": f"flip-evaluator {flip.__version__ if hasattr(flip, '__version__') else ''}".strip(),
+                       "mean": mean, "map": [round(v, 7) for v in err.ravel().tolist()]}, f)
+            f.write("\n")
+        print(f"check_flip: wrote test data, LDR-FLIP mean {mean:.6f}")
+        return 0
+    exp = json.load(open(os.path.join(DATA, "flip_expected.json")))
+    same_inputs = np.array_equal(np.fromfile(os.path.join(DATA, "flip_reference.rgb8"), np.uint8), ref8.ravel()) and np.array_equal(
+        np.fromfile(os.path.join(DATA, "flip_test.rgb8"), np.uint8), test8.ravel())
+    ok = same_inputs and abs(exp["mean"] - mean) <= 1e-6 and np.max(np.abs(np.array(exp["map"]) - err.ravel())) <= 1e-6
+    print(f"check_flip: reference implementation mean {mean:.6f}, checked-in {exp['mean']:.6f}: {'ok' if ok else 'FAIL'}")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
