@@ -18,7 +18,8 @@
 //! table's angular interpolation plays no part; wavelengths are on its 20 nm nodes.
 //!
 //! `cargo run --release -p spectra --example lf_column -- --out lf.csv` (options: `--types`,
-//! `--depths`, `--paths`, `--photons-hi`, `--seed`); `tools/lf_column_plot.py` plots the CSV.
+//! `--depths`, `--paths`, `--photons-hi`, `--seed`, `--truth-csv`, `--z-max`);
+//! `tools/lf_column_plot.py` plots the CSV.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -56,6 +57,10 @@ struct Args {
     /// compare another table against the same truth).
     #[arg(long)]
     truth_csv: Option<PathBuf>,
+    /// Depth range of the tables (m) instead of the real-time pass's (`light_field_range`), to
+    /// see what the depth discretisation does (the nodes scale with it).
+    #[arg(long)]
+    z_max: Option<f64>,
     /// Output CSV.
     #[arg(long)]
     out: PathBuf,
@@ -107,11 +112,28 @@ fn main() -> Result<()> {
             let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000, lambert: false };
             let sun = &world.delta_lights[0];
             let opts = Options::default();
-            let table = underwater::light_field_table(&medium, &opts)?;
-            let hi = (args.photons_hi > 0)
-                .then(|| {
-                    underwater::light_field_table(&medium, &Options { photons: args.photons_hi, ..opts })
+            let solve = |o: &Options| -> Result<std::sync::Arc<LightFieldTable>> {
+                Ok(match args.z_max {
+                    None => underwater::light_field_table(&medium, o)?,
+                    Some(z) => {
+                        let key = scene::water::light_field::LightFieldKey {
+                            z_max: z,
+                            ..underwater::light_field_key(&medium, o)
+                        };
+                        let dir = color::upsample::cache::cache_dir().ok();
+                        let cancel = std::sync::atomic::AtomicBool::new(false);
+                        std::sync::Arc::new(LightFieldTable::cached(
+                            &key,
+                            dir.as_deref(),
+                            &|_, _| {},
+                            &cancel,
+                        )?)
+                    }
                 })
+            };
+            let table = solve(&opts)?;
+            let hi = (args.photons_hi > 0)
+                .then(|| solve(&Options { photons: args.photons_hi, ..opts }))
                 .transpose()?;
             let to_sun = medium.sun_dir_underwater().as_dvec3();
             let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
