@@ -28,6 +28,18 @@
 //! (collision estimator `w·(b/c)·p(d·(−v))`), so the phase function is evaluated exactly and
 //! never through an angular histogram of L.
 //!
+//! **Noise, and why the wavelength nodes share their random numbers.** The scoring direction
+//! meets the phase function's ≈ 4° forward peak only for the few photons travelling within a
+//! few degrees of it, so J is noisy where little light travels (level and downward views):
+//! with 8,000 photons, ±10–50 % per node in IB at 5 m against the path tracer
+//! (`tools/lf_column_plot.py`, docs/underwater.md). Every wavelength node therefore follows
+//! the same photons with the same random numbers (each photon's stream is seeded by its index;
+//! Russian roulette, whose odds depend on λ, draws from its own stream): all lengths scale with 1/c, so
+//! the directions, the surface crossings and the scattering sequence are the same at every
+//! node, and the remaining noise is shared by neighbouring wavelengths (a brightness error, not
+//! a colour one). The sky's field is symmetric about the vertical, so its J is averaged over the
+//! azimuth nodes.
+//!
 //! Discretisation (why): depth nodes `z_i = z_max·(i/(n−1))^1.5` (fine near the surface, where
 //! the diffuse field builds up from the sky alone); each node scores the events of the bin
 //! between its neighbours' midpoints (the bin average, a relative bias of (kΔ)²/24 ≈ 1 % for a
@@ -210,6 +222,16 @@ pub struct LightFieldTable {
 /// whatever the thread schedule.
 struct Rng(u64);
 impl Rng {
+    /// The stream of one photon for one purpose: the same at every wavelength node (common
+    /// random numbers), independent between photons and purposes.
+    fn stream(seed: u64, photon: u64, purpose: u64) -> Rng {
+        let mut h = Rng(seed
+            ^ photon.wrapping_mul(0xd1b5_4a32_d192_ed03)
+            ^ purpose.wrapping_mul(0x8cb9_2ba7_2f3d_8dd7));
+        let x = h.next();
+        Rng(x.to_bits())
+    }
+
     fn next(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e3779b97f4a7c15);
         let mut z = self.0;
@@ -279,13 +301,17 @@ fn simulate(
     let nv = views.len();
     let mut j = vec![0.0f64; N_DEPTH * nv];
     let mut e_d = vec![0.0f64; N_DEPTH];
-    let mut rng = Rng(seed);
     let albedo = b / c;
     let sun_d = DVec3::new(-(1.0 - sun_mu * sun_mu).max(0.0).sqrt(), -sun_mu, 0.0);
     for p in 0..photons {
         if p % 256 == 0 && cancel.load(Ordering::Relaxed) {
             return None;
         }
+        // Transport (free paths, directions) and the decisions whose odds depend on the
+        // wavelength (Russian roulette) draw from separate streams, so the first stays in step
+        // across wavelength nodes.
+        let mut rng = Rng::stream(seed, p as u64, 0);
+        let mut rr = Rng::stream(seed, p as u64, 1);
         let (mut d, mut w) = if sky_source {
             // Uniform sky above the surface: cosine-weighted in air, weighted by T/T̄ so the mean
             // weight is 1 (unit plane irradiance below), refracted by Snell's law.
@@ -354,7 +380,7 @@ fn simulate(
             // only a guess here: it steers the effort, the estimate stays unbiased).
             let t = 0.02 * (-kd_guess * z).exp();
             if w < t {
-                if rng.next() < w / t {
+                if rr.next() < w / t {
                     w = t;
                 } else {
                     break;
@@ -416,7 +442,8 @@ impl LightFieldTable {
                     sky,
                     key.z_max,
                     key.photons,
-                    0x5eed_0000 + 2 * l as u64 + sky as u64,
+                    // One seed per source, the same at every wavelength node (see the module doc).
+                    0x5eed_0000 + sky as u64,
                     &views,
                     key.floor.as_ref().map(|f| f.albedo[l]),
                     cancel,
@@ -436,8 +463,14 @@ impl LightFieldTable {
             // Per unit sun E⊥: the sky's plane irradiance is sky·μ.
             let f = if sky { key.sky * mu } else { 1.0 };
             for d in 0..N_DEPTH {
-                for v in 0..views.len() {
-                    j[(d * views.len() + v) * N_LAMBDA + l] += (f * r.j[d * views.len() + v]) as f32;
+                for e in 0..N_ELEV {
+                    let row = &r.j[(d * N_ELEV + e) * N_AZ..(d * N_ELEV + e + 1) * N_AZ];
+                    // The uniform sky's field does not depend on azimuth: average its nodes.
+                    let sky_mean = row.iter().sum::<f64>() / N_AZ as f64;
+                    for (k, &x) in row.iter().enumerate() {
+                        let x = if sky { sky_mean } else { x };
+                        j[((d * N_ELEV + e) * N_AZ + k) * N_LAMBDA + l] += (f * x) as f32;
+                    }
                 }
                 let mut ed = f * r.e_d[d];
                 if !sky {
@@ -817,6 +850,42 @@ mod tests {
             }
         }
         eprintln!("light-field ray integral vs quadrature: {n} cases, worst {worst:e}");
+    }
+
+    /// Every wavelength node follows the same photons: a water whose a and b do not depend on
+    /// the wavelength gets the same J and E_d at every node, to the last bit (with a seed per
+    /// node, as before table version 3, the nodes differed by the full Monte-Carlo noise). And
+    /// the sky's part is the same at every azimuth.
+    #[test]
+    fn wavelength_nodes_share_their_photons() {
+        use color::Spectrum;
+        let flat = WaterProperties {
+            a: Spectrum::Constant(0.08),
+            b: Spectrum::Constant(0.25),
+            c: Spectrum::Constant(0.33),
+            kd: Spectrum::Constant(0.12),
+        };
+        let k = LightFieldKey { properties: flat, name: "flat".into(), ..key("IB", 0.8, 300) };
+        let t = LightFieldTable::compute(&k, &|_, _| {}, &AtomicBool::new(false)).unwrap();
+        for cell in t.j.chunks_exact(N_LAMBDA).chain(t.e_d.chunks_exact(N_LAMBDA)) {
+            assert!(cell.iter().all(|&x| x == cell[0]), "{cell:?}");
+        }
+        let sky_only = LightFieldKey { sky: 1.0, ..k.clone() };
+        let no_sky = LightFieldKey { sky: 0.0, ..k };
+        let (a, b) = (
+            LightFieldTable::compute(&sky_only, &|_, _| {}, &AtomicBool::new(false)).unwrap(),
+            LightFieldTable::compute(&no_sky, &|_, _| {}, &AtomicBool::new(false)).unwrap(),
+        );
+        for d in [2, 9] {
+            for e in [3, 6, 10] {
+                let sky: Vec<f64> =
+                    (0..N_AZ).map(|az| a.j_node(d, e, az, 500.0) - b.j_node(d, e, az, 500.0)).collect();
+                // f32 storage: the rounding of the sum of the sun's and the sky's parts.
+                let tol = 1e-6 * (0..N_AZ).map(|az| a.j_node(d, e, az, 500.0)).fold(0.0, f64::max);
+                assert!(sky[0] > 100.0 * tol, "{d} {e}: no sky light {sky:?}");
+                assert!(sky.iter().all(|x| (x - sky[0]).abs() <= tol), "{d} {e}: {sky:?}");
+            }
+        }
     }
 
     #[test]
