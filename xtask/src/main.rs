@@ -119,6 +119,17 @@ fn setup_vulkan() -> Result {
     apt_install(VULKAN_PACKAGES)
 }
 
+/// `nv-flip` (FLIP in `compare`) compiles NVIDIA's C++ reference: install a C++ compiler when
+/// there is none.
+fn setup_cxx() -> Result {
+    let cxx = std::env::var("CXX").unwrap_or_else(|_| "c++".into());
+    if Command::new(&cxx).arg("--version").output().map(|o| o.status.success()).unwrap_or(false) {
+        return Ok(());
+    }
+    eprintln!("No C++ compiler ({cxx}) found: installing g++ (FLIP's reference implementation is C++).");
+    apt_install(&["g++"])
+}
+
 fn python() -> String {
     std::env::var("PYTHON").unwrap_or_else(|_| "python3".into())
 }
@@ -151,6 +162,7 @@ fn demo(extra: &[String]) -> Result {
 /// Every test: the Rust suite, then each `tools/check_*.py` oracle script.
 fn test(extra: &[String]) -> Result {
     setup_vulkan()?;
+    setup_cxx()?;
     setup_python()?;
     run(cargo().args(["test", "--workspace"]).args(extra))?;
     let mut checks: Vec<PathBuf> = std::fs::read_dir(root().join("tools"))
@@ -178,6 +190,7 @@ fn test(extra: &[String]) -> Result {
 }
 
 fn ci() -> Result {
+    setup_cxx()?;
     run(cargo().args(["fmt", "--all", "--", "--check"]))?;
     run(cargo().args(["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
     test(&[])

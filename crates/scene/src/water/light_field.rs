@@ -71,7 +71,7 @@ pub const N_LAMBDA: usize = 25;
 /// Entries of [`LightFieldTable::surface`].
 const N_SURFACE: usize = N_ELEV * N_AZ * N_LAMBDA;
 /// Table format version (bump when the solver's output changes, so stale caches are refitted).
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// What a table is computed for (also its cache key).
 #[derive(Clone, Debug, PartialEq)]
