@@ -51,11 +51,14 @@ impl Budget {
             sweep_counts: vec![4, 8, 16],
             jitter_per_frame: 6,
             jitter_frames: vec![1, 2, 4, 8],
-            // Clear ocean at the built-in's 10 m: ≈ 7 s per truth render here, truth noise
-            // ≈ 0.6 ΔE00 against mode differences of ≈ 1.2 (docs/evaluation.md).
+            // Clear ocean at the built-in's 10 m. Since the real-time model draws the surface
+            // from below and the lit sea floor (issue 13), ours and naive differ by ≈ 0.6 ΔE00
+            // per pixel there, the truth's per-pixel noise at 1024 spp (0.74) being larger:
+            // 4096 spp halves it, so the ranking the quick test asserts is one another seed
+            // could not overturn.
             water_width: 128,
             water_height: 96,
-            water_spp: 1024,
+            water_spp: 4096,
             water_types: vec!["I".into()],
             water_depths: vec![],
         }
