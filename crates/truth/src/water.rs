@@ -27,10 +27,8 @@
 
 use crate::medium::{Medium, Phase, Region};
 use glam::Vec3;
+pub use scene::water::PETZOLD_G;
 use scene::water::{WATER_IOR, WaterMedium};
-
-/// Mean cosine of Petzold's average-particle phase function.
-pub const PETZOLD_G: f32 = 0.924;
 
 /// Half the sideways extent of the water slab, and its depth below the camera, in metres.
 pub const HALF_WIDTH: f32 = 5000.0;

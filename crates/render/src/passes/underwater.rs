@@ -159,9 +159,7 @@ impl Options {
     }
 }
 
-/// Mean cosine of Petzold's average-particle phase function (Mobley 1994, *Light and Water*,
-/// §3.8), the g the path-traced water uses too.
-pub const PETZOLD_G: f32 = 0.924;
+pub use scene::water::PETZOLD_G;
 
 /// The custom-shader parameters for `medium`: `[z0, scale, steps, g]`, then c, Kd and b at
 /// [`RGB_WAVELENGTHS`] (and the smallest c over 360–830 nm). Use with

@@ -47,6 +47,11 @@ pub mod single;
 /// Refractive index of sea water used to bend the sun direction (visible band, ≈ 1.34).
 pub const WATER_IOR: f64 = 1.34;
 
+/// Mean cosine of Petzold's average-particle phase function (Mobley 1994, *Light and Water*,
+/// §3.8): the Henyey–Greenstein g of the path-traced water and the real-time model's default,
+/// one constant so that both renderers scatter alike.
+pub const PETZOLD_G: f32 = 0.924;
+
 impl From<ColorError> for WaterError {
     fn from(e: ColorError) -> Self {
         WaterError::Color(e)
