@@ -108,18 +108,25 @@ pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {
     }
 }
 
-fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
-    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
-    check_exr_headers(path, bytes, 64)?;
-    let image = exr::prelude::read()
+/// An EXR in memory as its first valid layer with every channel as flat samples, plus the
+/// image's attributes: what both the RGB and the spectral readers need (the caller has checked
+/// the headers with [`check_exr_headers`]).
+pub(crate) type FlatExr = exr::prelude::Image<Layer<AnyChannels<FlatSamples>>>;
+
+pub(crate) fn read_flat_exr(bytes: &[u8]) -> std::result::Result<FlatExr, exr::error::Error> {
+    exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
         .all_attributes()
         .from_buffered(Cursor::new(bytes))
-        .map_err(|e| decode(e.to_string()))?;
-    let layer: Layer<AnyChannels<FlatSamples>> = image.layer_data;
+}
+
+fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
+    let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
+    check_exr_headers(path, bytes, 64)?;
+    let layer = read_flat_exr(bytes).map_err(|e| decode(e.to_string()))?.layer_data;
     let channels = &layer.channel_data.list;
     let find = |name: &str| channels.iter().find(|c| c.name.eq(name));
     let (r, g, b) = match (find("R"), find("G"), find("B")) {

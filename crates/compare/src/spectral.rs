@@ -21,8 +21,7 @@ use std::path::Path;
 use color::{Observer, SampledWavelengths, SpectralIntegrator, Spectrum};
 use exr::meta::attribute::{AttributeValue, Text};
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, ReadChannels, ReadLayers, Vec2,
-    WritableImage,
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, Vec2, WritableImage,
 };
 
 use crate::atomic::write_atomic;
@@ -192,15 +191,8 @@ pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Spect
     let decode =
         |reason: String| CompareError::Decode { path: path.into(), format: "spectral OpenEXR", reason };
     crate::io::check_exr_headers(path, bytes, MAX_BANDS as u64 + 8)?;
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(Cursor::new(bytes))
-        .map_err(|e| decode(e.to_string()))?;
-    let layer: Layer<AnyChannels<FlatSamples>> = image.layer_data;
+    let image = crate::io::read_flat_exr(bytes).map_err(|e| decode(e.to_string()))?;
+    let layer = image.layer_data;
     let attr = |name: &str| {
         layer
             .attributes
