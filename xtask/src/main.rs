@@ -190,8 +190,26 @@ fn test(extra: &[String]) -> Result {
 }
 
 fn ci() -> Result {
+    // A clean clone builds once: incremental caches only cost disk there (GBs per profile).
+    // SAFETY: single-threaded at this point; children inherit the variable.
+    unsafe { std::env::set_var("CARGO_INCREMENTAL", "0") };
+    disk_report("before the build");
     setup_cxx()?;
     run(cargo().args(["fmt", "--all", "--", "--check"]))?;
     run(cargo().args(["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
-    test(&[])
+    let result = test(&[]);
+    disk_report("after the tests");
+    result
+}
+
+/// Prints free disk space and the target directory's size: a CI machine once ran out of disk
+/// mid-suite, and this makes the margin visible in every log.
+fn disk_report(when: &str) {
+    let target =
+        std::env::var("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|_| root().join("target"));
+    eprintln!("disk {when}:");
+    let _ = Command::new("df").args(["-h", "."]).current_dir(root()).status();
+    if target.exists() {
+        let _ = Command::new("du").args(["-sh"]).arg(&target).status();
+    }
 }
