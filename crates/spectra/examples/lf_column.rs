@@ -14,7 +14,7 @@
 //!   sky through Snell's window and the Fresnel-reflected (totally reflected outside the window)
 //!   downward radiance just below the surface, itself from the table, all attenuated by e^{−c·d}.
 //!
-//! Directions are on the table's nodes (every 15° of elevation, sun azimuth 0° or 180°), so the
+//! Directions are on the table's nodes (the nearest elevation node, sun azimuth 0° or 180°), so the
 //! table's angular interpolation plays no part; wavelengths are on its 20 nm nodes.
 //!
 //! `cargo run --release -p spectra --example lf_column -- --out lf.csv` (options: `--types`,
@@ -29,7 +29,7 @@ use clap::Parser;
 use glam::{DVec3, Vec3, Vec4};
 use render::passes::underwater::{self, Options};
 use scene::water::fresnel::{mean_transmittance, transmittance_up};
-use scene::water::light_field::{LightFieldTable, ray_integral};
+use scene::water::light_field::{self, LightFieldTable, ray_integral};
 use scene::water::{WATER_IOR, WaterMedium, single};
 use truth::World;
 use truth::integrator::Integrator;
@@ -61,6 +61,14 @@ struct Args {
     /// see what the depth discretisation does (the nodes scale with it).
     #[arg(long)]
     z_max: Option<f64>,
+    /// Close the column with an unbounded grey Lambertian sea floor this far below the camera
+    /// (m): the truth gets a 20 km floor quad, the tables are the floored ones (the real-time
+    /// pass's table over a sea floor). Not with `--z-max`.
+    #[arg(long, conflicts_with = "z_max")]
+    floor_below: Option<f64>,
+    /// The floor's albedo (with `--floor-below`).
+    #[arg(long, default_value_t = 0.3)]
+    floor_albedo: f64,
     /// Output CSV.
     #[arg(long)]
     out: PathBuf,
@@ -69,7 +77,8 @@ struct Args {
 /// Wavelength groups traced together (hero-wavelength MIS over the four), on the table's nodes.
 const GROUPS: [[f32; 4]; 2] = [[400.0, 480.0, 560.0, 640.0], [440.0, 520.0, 600.0, 680.0]];
 
-/// (name, angle from straight up in degrees, azimuth from the sun's in degrees).
+/// (name, angle from straight up in degrees — snapped to the nearest elevation node —, azimuth
+/// from the sun's in degrees).
 const DIRECTIONS: [(&str, f64, f64); 7] = [
     ("up", 0.0, 0.0),
     ("up60_anti", 60.0, 180.0),
@@ -96,20 +105,37 @@ fn main() -> Result<()> {
         for &depth in &args.depths {
             let settings =
                 scene::WaterSettings { water_type: ty.clone(), depth: depth as f32, ..settings0.clone() };
-            let medium =
+            let mut medium =
                 WaterMedium::from_settings(&settings).with_context(|| format!("water {ty} {depth} m"))?;
+            if let Some(below) = args.floor_below {
+                let r = args.floor_albedo;
+                if !(below > 0.0 && (0.0..=1.0).contains(&r)) {
+                    bail!("--floor-below must be > 0 and --floor-albedo in [0, 1]");
+                }
+                medium.floor = Some(scene::water::floor::SeaFloor {
+                    below_camera: below,
+                    rgb: [r; 3],
+                    albedo: color::Spectrum::Constant(r),
+                    extent: None,
+                });
+            }
             let mut sc = base.clone();
             sc.water = Some(settings);
             scene::sky::sync(&mut sc).map_err(anyhow::Error::msg)?;
             let cam = sc.camera.position();
-            sc.meshes = vec![tiny_quad(cam - Vec3::Y * 4000.0)];
+            sc.meshes = vec![match args.floor_below {
+                None => quad(cam - Vec3::Y * 4000.0, 0.01),
+                Some(below) => quad(cam - Vec3::Y * below as f32, 10_000.0),
+            }];
             sc.materials.truncate(1);
-            sc.materials[0].base_color = glam::Vec4::new(0.0, 0.0, 0.0, 1.0);
+            let r = if args.floor_below.is_some() { args.floor_albedo as f32 } else { 0.0 };
+            sc.materials[0].base_color = glam::Vec4::new(r, r, r, 1.0);
             let water = truth::water::medium(&medium, cam);
             let white = color::illuminant::by_name("D65")?;
             let up = truth::upsample::GreyOnly;
             let world = World::new(&sc, &up, &white, color::WavelengthRange::VISIBLE, Some(&water))?;
-            let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000, lambert: false };
+            // Lambertian, as the table's floor (the tiny black quad reflects nothing either way).
+            let integ = Integrator { world: &world, direct_only: false, max_depth: 100_000, lambert: true };
             let sun = &world.delta_lights[0];
             let opts = Options::default();
             let solve = |o: &Options| -> Result<std::sync::Arc<LightFieldTable>> {
@@ -139,7 +165,11 @@ fn main() -> Result<()> {
             let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
             let side = DVec3::Y.cross(sun_h);
             for (di, &(name, th, ph)) in DIRECTIONS.iter().enumerate() {
-                let (th, ph) = (th.to_radians(), ph.to_radians());
+                // Snapped to the nearest elevation node (the nodes are warped towards the horizon).
+                let th = light_field::elevation_angle(
+                    light_field::elevation_coord(th.to_radians()).round() as usize
+                );
+                let ph = ph.to_radians();
                 let v = (sun_h * (th.sin() * ph.cos()) + DVec3::Y * th.cos() + side * (th.sin() * ph.sin()))
                     .normalize();
                 for (gi, group) in GROUPS.iter().enumerate() {
@@ -212,9 +242,9 @@ fn read_truth(path: &std::path::Path) -> Result<std::collections::HashMap<String
     Ok(m)
 }
 
-/// A 2 cm quad facing up at `c`: the tracer's only triangle pair, out of every path's way.
-fn tiny_quad(c: Vec3) -> scene::Mesh {
-    let h = 0.01;
+/// A square quad facing up at `c`, half-width `h`: the tracer's only triangle pair — 2 cm and
+/// out of every path's way, or the sea floor.
+fn quad(c: Vec3, h: f32) -> scene::Mesh {
     scene::Mesh {
         positions: vec![
             c + Vec3::new(-h, 0.0, -h),
@@ -276,9 +306,22 @@ fn predict(t: &LightFieldTable, m: &WaterMedium, v: DVec3, sun_h: DVec3, lambda:
     let g = Options::default().phase_g as f64;
     let to_sun = m.sun_dir_underwater().as_dvec3();
     let z0 = m.depth;
-    let d = if v.y > 1e-9 { z0 / v.y } else { f64::INFINITY };
+    let floor = m.floor.as_ref();
+    let d = if v.y > 1e-9 {
+        z0 / v.y
+    } else if let Some(f) = floor.filter(|_| v.y < -1e-9) {
+        f.below_camera / -v.y
+    } else {
+        f64::INFINITY
+    };
     let diffuse = ray_integral(&t.j_column(v, sun_h, lambda), t.z_max, k.c, z0, v.y, d);
     let beam = single::beam(k.b, k.c, g, to_sun, 1.0, v, z0, d);
+    if let Some(f) = floor.filter(|_| v.y < -1e-9) {
+        // The Lambertian floor lit by the table's downwelling irradiance, per unit sun E⊥.
+        let e_d = t.attenuation(t.z_max, lambda) * to_sun.y * (1.0 + m.sky);
+        let seen = f.albedo.eval(lambda) / std::f64::consts::PI * e_d * (-k.c * d).exp();
+        return [diffuse, beam, seen];
+    }
     let surface = if d.is_finite() {
         let n = WATER_IOR;
         let tr = transmittance_up(v.y, n);
@@ -286,6 +329,10 @@ fn predict(t: &LightFieldTable, m: &WaterMedium, v: DVec3, sun_h: DVec3, lambda:
         // L_air·T·n² through the window (truth::water_surface).
         let sky = m.sky * to_sun.y / (std::f64::consts::PI * mean_transmittance(n)) * tr * n * n;
         let mirror = DVec3::new(v.x, -v.y, v.z);
+        if floor.is_some() {
+            // The floored table's own reflection (water and floor), as the real-time pass reads it.
+            return [diffuse, beam, (sky + t.surface_at(v, sun_h, lambda, true)) * (-k.c * d).exp()];
+        }
         let below =
             ray_integral(&t.j_column(mirror, sun_h, lambda), t.z_max, k.c, 0.0, mirror.y, f64::INFINITY)
                 + single::beam(k.b, k.c, g, to_sun, 1.0, mirror, 0.0, f64::INFINITY);

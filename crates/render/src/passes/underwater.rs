@@ -347,6 +347,13 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
         format!("{:?}", (1.0 / (std::f64::consts::PI * mean_transmittance(WATER_IOR))) as f32),
     );
     set("const UW_TABLE: bool = true;", options.light_field.to_string());
+    {
+        use scene::water::light_field::{ELEV_WARP, N_AZ, N_DEPTH, N_ELEV};
+        set("const UW_ND: u32 = 16u;", format!("{N_DEPTH}u"));
+        set("const UW_NE: u32 = 19u;", format!("{N_ELEV}u"));
+        set("const UW_NA: u32 = 9u;", format!("{N_AZ}u"));
+        set("const UW_ELEV_INV_WARP: f32 = 0.6666667;", format!("{:?}", (1.0 / ELEV_WARP) as f32));
+    }
     set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
     let mut spectra = spectra(medium);
     if let Some([t, deep]) = &tables {

@@ -36,9 +36,12 @@ const UW_SKY_NORM: f32 = 0.34;
 const UW_TABLE: bool = true;
 const UW_TABLE_KD: bool = true;
 const UW_ZMAX: f32 = 40.0;
+// The table's layout, written by `underwater::shader_with` from scene::water::light_field
+// (N_DEPTH, N_ELEV, N_AZ, 1/ELEV_WARP): one home for the numbers.
 const UW_ND: u32 = 16u;
-const UW_NE: u32 = 13u;
+const UW_NE: u32 = 19u;
 const UW_NA: u32 = 9u;
+const UW_ELEV_INV_WARP: f32 = 0.6666667;
 const UW_NC: u32 = UW_ND * UW_NE * UW_NA;
 // Spectrum indices (custom_spectra[s * n_groups + group]): two tables of one block each — 0
 // the column closed by the sea floor, 1 the bottomless column (the same table twice when the
@@ -199,6 +202,14 @@ fn uw_angle(s: f32, c: f32) -> f32 {
     return select(th, 3.14159265358979 - th, c < 0.0);
 }
 
+// Fractional elevation node of the polar angle th (light_field::elevation_coord): nodes are
+// denser near the horizon.
+fn uw_elev_coord(th: f32) -> f32 {
+    let u = clamp(th / 1.5707963 - 1.0, -1.0, 1.0);
+    let t = select(sign(u) * pow(abs(u), UW_ELEV_INV_WARP), 0.0, abs(u) < 1e-20);
+    return 0.5 * (t + 1.0) * f32(UW_NE - 1u);
+}
+
 // The segment [z_i, z_{i+1}] that holds depth z (the last one beyond the last node).
 fn uw_segment(z: f32) -> u32 {
     var i = 0u;
@@ -235,7 +246,7 @@ fn uw_prepare_table(w: vec3<f32>, z0: f32) {
         }
     }
     let hw = vec3<f32>(w.x, 0.0, w.z);
-    let fe = uw_angle(length(hw), w.y) / 3.14159265358979 * f32(UW_NE - 1u);
+    let fe = uw_elev_coord(uw_angle(length(hw), w.y));
     var ph = 0.0;
     if (length(hw) > 1e-6 && dot(sun_h, sun_h) > 0.5) {
         ph = uw_angle(abs(cross(sun_h, hw).y), dot(sun_h, hw));

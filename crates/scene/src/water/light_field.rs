@@ -46,7 +46,7 @@
 //! decay k = 0.3 /m over a 4 m bin). Between nodes the real-time pass interpolates ln J
 //! linearly in depth (exponential segments, integrated in closed form along the ray); below
 //! `z_max` it extrapolates the last segment's decay (a documented clamp: the field tends to the
-//! asymptotic one, whose magnitude decays exponentially). View elevations every 15°, relative
+//! asymptotic one, whose magnitude decays exponentially). View elevations from 3.3° apart at the horizon to 14.6° at the poles ([`ELEV_WARP`]), relative
 //! azimuths (to the sun, symmetric) every 22.5°, wavelengths every 20 nm over 360–830 nm.
 
 use std::f64::consts::PI;
@@ -60,8 +60,17 @@ use super::{WATER_IOR, WaterError};
 
 /// Depth nodes.
 pub const N_DEPTH: usize = 16;
-/// View elevation nodes, from straight up (0) to straight down, every 15°.
-pub const N_ELEV: usize = 13;
+/// View elevation nodes, from straight up (0) to straight down, denser near the horizon (see
+/// [`elevation_angle`]).
+pub const N_ELEV: usize = 19;
+/// Exponent of the elevation warp: node e sits at the polar angle π/2·(1 + t·|t|^(w−1)) for
+/// t = 2e/(N_ELEV − 1) − 1. With 19 nodes and w = 1.5 the spacing grows from 3.3° at the
+/// horizon to 14.6° at the poles. Why: most underwater views are near level, and there the
+/// field changes fastest — the bright water above meets the dark water below within the phase
+/// function's few-degree peak, and the surface seen from below at a few degrees' elevation
+/// mirrors the far water or the floor. A uniform 15° grid put the first upward node at 15°,
+/// so a camera looking level interpolated its whole upper frame from the horizon's zero.
+pub const ELEV_WARP: f64 = 1.5;
 /// Relative azimuth nodes, 0 (towards the sun) to 180°, every 22.5°.
 pub const N_AZ: usize = 9;
 /// Wavelength nodes: 360, 380, …, 840 nm (the last one stands in for 830 nm and beyond).
@@ -71,7 +80,7 @@ pub const N_LAMBDA: usize = 25;
 /// Entries of [`LightFieldTable::surface`].
 const N_SURFACE: usize = N_ELEV * N_AZ * N_LAMBDA;
 /// Table format version (bump when the solver's output changes, so stale caches are refitted).
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 /// What a table is computed for (also its cache key).
 #[derive(Clone, Debug, PartialEq)]
@@ -179,9 +188,23 @@ pub fn depth_node(i: usize, z_max: f64) -> f64 {
 /// The unit view direction of elevation node `e` and azimuth node `k`, in the sun's frame
 /// (+x horizontal towards the sun, +y up).
 pub fn view_node(e: usize, k: usize) -> DVec3 {
-    let th = PI * e as f64 / (N_ELEV - 1) as f64;
+    let th = elevation_angle(e);
     let ph = PI * k as f64 / (N_AZ - 1) as f64;
     DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+}
+
+/// Polar angle (from straight up, radians) of elevation node `e` (the warp: [`ELEV_WARP`]).
+pub fn elevation_angle(e: usize) -> f64 {
+    let t = 2.0 * e as f64 / (N_ELEV - 1) as f64 - 1.0;
+    0.5 * PI * (1.0 + t.signum() * t.abs().powf(ELEV_WARP))
+}
+
+/// Fractional elevation node of the polar angle `th` ∈ [0, π]: the inverse of
+/// [`elevation_angle`] (`uw_elev_coord` in underwater.wgsl is the same function).
+pub fn elevation_coord(th: f64) -> f64 {
+    let u = (th / (0.5 * PI) - 1.0).clamp(-1.0, 1.0);
+    let t = u.signum() * u.abs().powf(1.0 / ELEV_WARP);
+    0.5 * (t + 1.0) * (N_ELEV - 1) as f64
 }
 
 /// Fractional (elevation, azimuth) node coordinates of a view direction `v` (world, unit) for
@@ -192,7 +215,7 @@ pub fn view_coords(v: DVec3, sun_h: DVec3) -> (f64, f64) {
     let hl = h.length();
     let cos_ph =
         if hl > 1e-9 && sun_h.length_squared() > 0.5 { (h.dot(sun_h) / hl).clamp(-1.0, 1.0) } else { 1.0 };
-    (th / PI * (N_ELEV - 1) as f64, cos_ph.acos() / PI * (N_AZ - 1) as f64)
+    (elevation_coord(th), cos_ph.acos() / PI * (N_AZ - 1) as f64)
 }
 
 /// The precomputed field of one water, sun and depth range.
@@ -506,10 +529,14 @@ impl LightFieldTable {
         let mut out_floor = vec![0.0f32; N_SURFACE];
         for e in 0..N_ELEV {
             for k in 0..N_AZ {
-                let v = view_node(e, k);
-                if v.y <= 1e-6 {
+                let mut v = view_node(e, k);
+                if v.y < -1e-6 {
                     continue;
                 }
+                // The level node holds the limit of views just above the horizon (total
+                // reflection of the far water), not zero: the pass interpolates between it and
+                // the first upward node, and a zero there darkened every near-level view.
+                v.y = v.y.max(1e-3);
                 let r = fresnel_reflectance(v.y, WATER_IOR, 1.0);
                 // The mirrored view looks down; its light travels up, along −m.
                 let m = DVec3::new(v.x, -v.y, v.z);
