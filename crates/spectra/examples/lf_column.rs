@@ -127,9 +127,14 @@ fn main() -> Result<()> {
                 None => quad(cam - Vec3::Y * 4000.0, 0.01),
                 Some(below) => quad(cam - Vec3::Y * below as f32, 10_000.0),
             }];
-            sc.materials.truncate(1);
+            // A plain grey material: the scene's first one is the sand, whose texture would
+            // scale the floor's albedo.
             let r = if args.floor_below.is_some() { args.floor_albedo as f32 } else { 0.0 };
-            sc.materials[0].base_color = glam::Vec4::new(r, r, r, 1.0);
+            sc.materials = vec![scene::Material {
+                name: "floor".into(),
+                base_color: glam::Vec4::new(r, r, r, 1.0),
+                ..Default::default()
+            }];
             let water = truth::water::medium(&medium, cam);
             let white = color::illuminant::by_name("D65")?;
             let up = truth::upsample::GreyOnly;
