@@ -3,7 +3,7 @@
 //! `cargo run --release -p color --example fit -- SPACE RES OUT.coeff [SWEEPS]`
 //! Environment: `ZGRID` = rgb2spec (default: its double smoothstep and clamp 200) | ss1 (spectra)
 //! | uniform | pow2 | pow3 | mix; `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
-//! per axis and threshold.
+//! per axis and threshold, `RSTEPS` Gauss–Newton steps per node.
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
     let space = color::RgbColorSpace::by_name(&a[1])?;
@@ -50,6 +50,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         if let Ok(v) = std::env::var("RTHR") {
             opt.threshold = v.parse()?;
+        }
+        if let Ok(v) = std::env::var("RSTEPS") {
+            opt.steps = v.parse()?;
         }
         let n = color::upsample::refine::refine_table(
             &mut t,

@@ -211,9 +211,22 @@ impl CoeffTable {
         SigmoidPolynomial { c: [0, 1, 2].map(|m| d[m] + a * (comp[m] - d[m])) }
     }
 
-    /// rgb2spec's trilinear fetch (with [`z_weight`]) of a colour already clamped to [0, 1].
+    /// rgb2spec's trilinear fetch (with [`z_weight`] and [`chroma_weight`]) of a colour already
+    /// clamped to [0, 1].
     #[inline]
     pub fn fetch_direct(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
+        self.fetch_trilinear(rgb, false)
+    }
+
+    /// Exactly `rgb2spec_fetch` (linear weights on all three axes, no complement), as rgb2spec,
+    /// Mitsuba and pbrt read a table: for judging a table made for them (e.g. rgb2spec_opt's
+    /// output) on its own terms. Clamps like [`Self::fetch`].
+    pub fn fetch_rgb2spec(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
+        self.fetch_trilinear(rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 }), true)
+    }
+
+    #[inline]
+    fn fetch_trilinear(&self, rgb: [f32; 3], linear: bool) -> SigmoidPolynomial {
         let res = self.res;
         // Largest channel; later channels win ties, as in rgb2spec.
         let mut l = 0;
@@ -232,9 +245,16 @@ impl CoeffTable {
         let xi = (x as usize).min(res - 2);
         let yi = (y as usize).min(res - 2);
         let zi = self.scale.partition_point(|&s| s <= z).clamp(1, res - 1) - 1;
-        let x1 = x - xi as f32;
-        let y1 = y - yi as f32;
-        let z1 = z_weight(z, self.scale[zi], self.scale[zi + 1]);
+        let (x1, y1, z1) = if linear {
+            let (s0, s1) = (self.scale[zi], self.scale[zi + 1]);
+            (x - xi as f32, y - yi as f32, ((z - s0) / (s1 - s0)).clamp(0.0, 1.0))
+        } else {
+            (
+                chroma_weight(x, xi, y, res),
+                chroma_weight(y, yi, x, res),
+                z_weight(z, self.scale[zi], self.scale[zi + 1]),
+            )
+        };
         let (x0, y0, z0) = (1.0 - x1, 1.0 - y1, 1.0 - z1);
         let o = self.index(l, zi, yi, xi);
         let (dx, dy, dz) = (3, 3 * res, 3 * res * res);
@@ -304,6 +324,34 @@ pub fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     let (h0, h1) = (z_logit(s0), z_logit(s1));
     let w = if h1 > h0 && s1 <= 0.5 { (z_logit(z) - h0) / (h1 - h0) } else { (z - s0) / (s1 - s0) };
     w.clamp(0.0, 1.0)
+}
+
+/// Chroma warp scale on a zero channel's face ([`chroma_weight`]), as a channel ratio (≈ 2 cells
+/// at 64³).
+pub const CHROMA_WARP: f32 = 0.032;
+/// Growth of the chroma warp scale with the other chroma coordinate (both as channel ratios).
+pub const CHROMA_WARP_SLOPE: f32 = 0.2;
+
+/// Interpolation weight along a chroma axis: `x` = the channel ratio × (res − 1), in cell `xi`;
+/// `other` = the other chroma coordinate, in the same units. The weight is linear in the warped
+/// coordinate g(x) = x / (x + A), A = ([`CHROMA_WARP`] + [`CHROMA_WARP_SLOPE`] · other / (res − 1))
+/// · (res − 1): w = (g(x) − g(xi)) / (g(xi + 1) − g(xi)) = f · (xi + 1 + A) / (x + A), f = x − xi.
+///
+/// Next to a zero channel the node coefficients move non-uniformly with the channel: between the
+/// exact nodes (0.92, 0, 0) and (0.92, 0, 0.0146) the linear blend passes through the right
+/// colours but at the wrong place (the midpoint colour is at weight 0.62, not 0.5), missing the
+/// midpoint by ΔE2000 0.51, while the best weight misses it by < 0.02 (sRGB 64³, unrefined). The
+/// best weight at a cell's middle is 0.6 on a face (o = 0) and drifts towards 0.5 as the other
+/// chroma coordinate o grows (0.57 at o = 8, 0.53 at o = 30 cells), which A = 2 + 0.2·o cells
+/// follows. Measured on the unrefined sRGB table with `python3 tools/chroma_warp.py TABLE`: face
+/// colours max 0.57 → 0.17, uniform mean 0.0075 → 0.0050 (linear weight → this one). Each weight
+/// runs 0 → 1 across its cell and A is continuous, so the fetch stays continuous; the nodes are
+/// unchanged, so other rgb2spec readers (linear weights) still get every node colour exactly.
+#[inline]
+pub fn chroma_weight(x: f32, xi: usize, other: f32, res: usize) -> f32 {
+    let a = CHROMA_WARP * (res - 1) as f32 + CHROMA_WARP_SLOPE * other;
+    let f = x - xi as f32;
+    (f * (xi as f32 + 1.0 + a) / (x + a)).clamp(0.0, 1.0)
 }
 
 /// Lowest channel at which [`CoeffTable::fetch`] starts blending in the complement fetch.
@@ -384,9 +432,19 @@ mod tests {
     fn fetch_interpolates_like_rgb2spec() {
         let t = synthetic(5);
         // Green largest (l = 1): x = blue/green·4, y = red/green·4, z located in scale.
-        let c = t.fetch([0.2, 0.5, 0.3]).c;
+        // rgb2spec's own fetch: linear weights.
+        let c = t.fetch_rgb2spec([0.2, 0.5, 0.3]).c;
         assert!((c[0] - (100.0 + 0.3 / 0.5 * 4.0)).abs() < 1e-5, "{c:?}");
         assert!((c[1] - 0.2 / 0.5 * 4.0).abs() < 1e-5);
+        assert!((c[2] - (2.0 + (0.5 - 0.25) / (0.5625 - 0.25))).abs() < 1e-5);
+        // Ours: chroma weights f·(xi + 1 + A)/(x + A), A = 0.032·(res − 1) + 0.2·(other axis).
+        // x = 2.4 (cell 2, f = 0.4, other y = 1.6); y = 1.6 (cell 1, f = 0.6, other x = 2.4).
+        let c = t.fetch([0.2, 0.5, 0.3]).c;
+        let (ax, ay) = (0.128 + 0.2 * 1.6, 0.128 + 0.2 * 2.4);
+        let wx = 0.4 * (3.0 + ax) / (2.4 + ax);
+        let wy = 0.6 * (2.0 + ay) / (1.6 + ay);
+        assert!((c[0] - (102.0 + wx)).abs() < 1e-5, "{c:?} vs {}", 102.0 + wx);
+        assert!((c[1] - (1.0 + wy)).abs() < 1e-5, "{c:?} vs {}", 1.0 + wy);
         // scale = (k/4)²: 0.5 lies between k = 2 (0.25) and k = 3 (0.5625).
         // The cell 0.25…0.5625 reaches above 0.5: linear brightness weight.
         assert!((c[2] - (2.0 + (0.5 - 0.25) / (0.5625 - 0.25))).abs() < 1e-5);
@@ -404,6 +462,28 @@ mod tests {
         assert!(t.fetch_checked([f64::NAN, 0.0, 0.0]).is_err());
         assert!(t.fetch_checked([-0.1, 0.0, 0.0]).is_err());
         assert!(t.fetch_checked([1.5, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn chroma_weight_runs_from_0_to_1_across_each_cell() {
+        for res in [5, 64] {
+            for xi in 0..res - 1 {
+                for other in [0.0, 1.5, (res - 1) as f32] {
+                    let w = |f: f32| chroma_weight(xi as f32 + f, xi, other, res);
+                    assert_eq!(w(0.0), 0.0);
+                    assert!((w(1.0) - 1.0).abs() < 1e-6, "res {res} cell {xi}: {}", w(1.0));
+                    // Increasing, and above linear (the warp is concave).
+                    let mut prev = 0.0;
+                    for m in 1..=10 {
+                        let f = m as f32 / 10.0;
+                        assert!(w(f) > prev && w(f) >= f - 1e-6, "res {res} cell {xi} f {f}: {}", w(f));
+                        prev = w(f);
+                    }
+                }
+            }
+        }
+        // Far from a zero channel the weight is nearly linear: at x = 30.5 of 64³, 0.508.
+        assert!((chroma_weight(30.5, 30, 30.0, 64) - 0.5).abs() < 0.01);
     }
 
     #[test]
