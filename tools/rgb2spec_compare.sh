@@ -38,6 +38,6 @@ for line in sys.stdin:
         print("%.4f / %.4f / %.4f  (%d colours, worst %s)" % (s["max"], s["p99"], s["mean"], d["colours"], [round(v, 4) for v in d["worst"][0]["rgb"]]))'; }
 echo "rgb2spec_opt table, rgb2spec fetch : $("$bin/adversarial" "$space" "$out/rgb2spec.coeff" --rgb2spec-fetch | summ)"
 echo "rgb2spec_opt table, spectra fetch  : $("$bin/adversarial" "$space" "$out/rgb2spec.coeff" | summ)"
-echo "spectra rgb2spec-mode, rgb2spec fetch: $("$bin/adversarial" "$space" "$out/spectra-rgb2spec.coeff" --rgb2spec-fetch | summ)"
+echo "spectra rgb2spec grid+clamp, spectra fetch: $("$bin/adversarial" "$space" "$out/spectra-rgb2spec.coeff" | summ)"
 echo "spectra unrefined, spectra fetch   : $("$bin/adversarial" "$space" "$out/spectra-unrefined.coeff" | summ)"
 echo "spectra default, spectra fetch     : $("$bin/adversarial" "$space" "$out/spectra-default.coeff" | summ)"
