@@ -9,8 +9,9 @@
 //!
 //! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
 //! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly — with
-//! two differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
-//! exact at every brightness, and light colours (lowest channel above 0.5) are fetched through
+//! three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
+//! exact at every brightness, the weights along x and y are warped next to a zero channel
+//! ([`chroma_weight`]), where the coefficients move non-uniformly, and light colours (lowest channel above 0.3) are fetched through
 //! their complement 1 − rgb with negated coefficients ([`white_blend`]), which removes the
 //! near-white errors of coefficient interpolation. Because `scale` is stored in the file, a table may use any
 //! increasing brightness grid and stay readable by every rgb2spec-compatible renderer; such a
@@ -355,9 +356,9 @@ pub fn chroma_weight(x: f32, xi: usize, other: f32, res: usize) -> f32 {
 }
 
 /// Lowest channel at which [`CoeffTable::fetch`] starts blending in the complement fetch.
-pub const WHITE_BLEND_LO: f32 = 0.5;
+pub const WHITE_BLEND_LO: f32 = 0.3;
 /// Lowest channel from which on [`CoeffTable::fetch`] uses the complement fetch alone.
-pub const WHITE_BLEND_HI: f32 = 0.7;
+pub const WHITE_BLEND_HI: f32 = 0.5;
 
 /// Weight of the complement fetch for a colour clamped to [0, 1]: smoothstep of its lowest
 /// channel between [`WHITE_BLEND_LO`] and [`WHITE_BLEND_HI`].
@@ -369,10 +370,13 @@ pub const WHITE_BLEND_HI: f32 = 0.7;
 /// 1 − σ(x)), and its colour is exactly (1, 1, 1) − rgb (colour is linear in the reflectance and
 /// reflectance 1 is RGB (1, 1, 1) by our conventions). So a light colour can be fetched as the
 /// negated dark colour 1 − rgb, where the table is smooth (σ⁻¹ brightness weight) and where an
-/// XYZ error weighs ~20× less in L* once mapped back next to white. Over [0.5, 1]³ the
-/// complement alone stays below ΔE2000 0.04 (sRGB 64³); the band 0.5…0.7 blends the two
-/// coefficient sets, whose spectra differ by < 0.1 in reflectance there, so the fetch stays
-/// continuous. Greys stay exact: the complement of the flat σ⁻¹(1 − g) is the flat σ⁻¹(g).
+/// XYZ error weighs ~20× less in L* once mapped back next to white. The band 0.3…0.5 blends the
+/// two coefficient sets, so the fetch stays continuous. It was 0.5…0.7 until the wide-gamut
+/// tables showed light yellows such as (0.98, 0.99, 0.62) in the band, where the direct fetch is
+/// poor: with 0.3…0.5 the sRGB colours inside Rec.2020 / ACEScg went from ΔE2000 0.49 / 1.77 to
+/// 0.42 / 0.40 and the sRGB uniform mean from 0.0039 to 0.0034, the sRGB adversarial max stayed
+/// 0.161 (`cargo run --release -p color --example adversarial -- SPACE`;
+/// `… --example white_corner` prints the band figures). Greys stay exact: the complement of the flat σ⁻¹(1 − g) is the flat σ⁻¹(g).
 #[inline]
 pub fn white_blend(rgb: [f32; 3]) -> f32 {
     let u = ((rgb[0].min(rgb[1]).min(rgb[2]) - WHITE_BLEND_LO) / (WHITE_BLEND_HI - WHITE_BLEND_LO))
@@ -491,15 +495,15 @@ mod tests {
         let t = synthetic(5);
         let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|m| (a[m] - b[m]).abs() < 1e-4);
         let neg = |p: SigmoidPolynomial| p.c.map(|v| -v);
-        // Lowest channel ≥ 0.7: the negated fetch of 1 − rgb alone.
+        // Lowest channel ≥ 0.5: the negated fetch of 1 − rgb alone.
         let rgb = [0.9f32, 0.75, 0.8];
         let want = neg(t.fetch_direct(rgb.map(|v| 1.0 - v)));
         assert!(close(t.fetch(rgb.map(f64::from)).c, want));
-        // Lowest channel ≤ 0.5: rgb2spec's fetch unchanged.
-        let rgb = [0.9f32, 0.5, 1.0];
+        // Lowest channel ≤ 0.3: rgb2spec's fetch unchanged.
+        let rgb = [0.9f32, 0.3, 1.0];
         assert!(close(t.fetch(rgb.map(f64::from)).c, t.fetch_direct(rgb).c));
         // Halfway through the band: the smoothstep weight is ½.
-        let rgb = [0.6f32, 0.95, 0.8];
+        let rgb = [0.4f32, 0.95, 0.8];
         let (d, c) = (t.fetch_direct(rgb).c, neg(t.fetch_direct(rgb.map(|v| 1.0 - v))));
         assert!(close(t.fetch(rgb.map(f64::from)).c, [0, 1, 2].map(|m| 0.5 * (d[m] + c[m]))));
         // Continuous at both ends of the band.

@@ -161,12 +161,12 @@ fn chroma_weight(x: f32, xi: u32, other: f32, res: u32) -> f32 {
 
 // Jakob–Hanika coefficients of a reflectance in [0, 1]³: color::upsample::CoeffTable::fetch.
 // Light colours come from the negated complement fetch (σ(−x) = 1 − σ(x), colour (1,1,1) − rgb),
-// blended in by a smoothstep of the lowest channel over [0.5, 0.7] (table::white_blend, same
+// blended in by a smoothstep of the lowest channel over [0.3, 0.5] (table::white_blend, same
 // constants): coefficient interpolation next to white is poor, next to black it is smooth.
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
     let lo = min(rgb.x, min(rgb.y, rgb.z));
-    let u = clamp((lo - 0.5) / (0.7 - 0.5), 0.0, 1.0);
+    let u = clamp((lo - 0.3) / (0.5 - 0.3), 0.0, 1.0);
     let alpha = u * u * (3.0 - 2.0 * u);
     if (alpha <= 0.0) {
         return fetch_coeffs_direct(rgb, res);
