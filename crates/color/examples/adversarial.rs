@@ -1,11 +1,14 @@
 //! Fit (or load) a table and check it adversarially, as docs/upsampling.md reports:
-//! `cargo run --release -p color --example adversarial -- SPACE [FILE.coeff]`.
+//! `cargo run --release -p color --example adversarial -- SPACE [FILE.coeff] [--rgb2spec-fetch]`.
 //! Without FILE the default table (64³ fit + refinement) is fitted, timed and written to
-//! `/tmp/SPACE-64.coeff`.
+//! `/tmp/SPACE-64.coeff`. `--rgb2spec-fetch` reads the table as rgb2spec does (linear weights,
+//! no complement; for rgb2spec_opt's tables) and prints only the adversarial search.
 use color::upsample::{adversarial, roundtrip};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let a: Vec<String> = std::env::args().collect();
+    let mut a: Vec<String> = std::env::args().collect();
+    let rgb2spec_fetch = a.iter().any(|s| s == "--rgb2spec-fetch");
+    a.retain(|s| s != "--rgb2spec-fetch");
     let space = color::RgbColorSpace::by_name(a.get(1).map(|s| s.as_str()).unwrap_or("srgb"))?;
     let table = match a.get(2) {
         Some(p) => color::upsample::CoeffTable::read(std::path::Path::new(p))?,
@@ -17,7 +20,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             t
         }
     };
-    let opt = adversarial::AdversarialOptions::default();
+    let opt = adversarial::AdversarialOptions { rgb2spec_fetch, ..Default::default() };
+    if rgb2spec_fetch {
+        let adv = adversarial::check(&table, &space, adversarial::Domain::Own, &opt)?;
+        println!("adversarial (own cube, rgb2spec fetch): {}", serde_json::to_string(&adv)?);
+        return Ok(());
+    }
     let u = roundtrip::roundtrip_table(&table, &space, 100_000, 1)?;
     println!("uniform 1e5: {}", serde_json::to_string(&u)?);
     let adv = adversarial::check(&table, &space, adversarial::Domain::Own, &opt)?;

@@ -3,7 +3,8 @@
 //! `cargo run --release -p color --example fit -- SPACE RES OUT.coeff [SWEEPS]`
 //! Environment: `ZGRID` = rgb2spec (default: its double smoothstep and clamp 200) | ss1 (spectra)
 //! | uniform | pow2 | pow3 | mix; `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
-//! per axis and threshold.
+//! per axis and threshold, `RSTEPS` Gauss–Newton steps per node, `RGIVE` its `give_up`, `RSOLID` (set) keeps the refinement's
+//! samples inside the object-colour solid however far off (`RefineOptions::keep_solid`).
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
     let space = color::RgbColorSpace::by_name(&a[1])?;
@@ -50,6 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         if let Ok(v) = std::env::var("RTHR") {
             opt.threshold = v.parse()?;
+        }
+        if let Ok(v) = std::env::var("RSTEPS") {
+            opt.steps = v.parse()?;
+        }
+        opt.keep_solid = std::env::var_os("RSOLID").is_some();
+        if let Ok(v) = std::env::var("RGIVE") {
+            opt.give_up = v.parse()?;
         }
         let n = color::upsample::refine::refine_table(
             &mut t,

@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let m = LabModel::new(&space)?;
     let direct = |rgb: [f64; 3]| t.fetch(rgb).c;
     let comp = |rgb: [f64; 3]| t.fetch(rgb.map(|v| 1.0 - v)).c.map(|v| -v);
-    for thr in [0.5, 0.7, 0.8, 0.9, 0.95, 0.97] {
+    for thr in [0.3, 0.5, 0.7, 0.8, 0.9, 0.95, 0.97] {
         // Region min ≥ thr: errors of both fetches; on the boundary: spectral jump.
         let pts: Vec<[f64; 3]> =
             random_colours(20000, 7).into_iter().map(|u| u.map(|v| thr + (1.0 - thr) * v)).collect();
@@ -45,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     // Blended band: α = smoothstep((min − t0)/(t1 − t0)), coefficients blended.
-    for (t0, t1) in [(0.5, 0.7), (0.6, 0.8), (0.5, 0.8), (0.7, 0.9), (0.4, 0.7)] {
+    for (t0, t1) in [(0.3, 0.5), (0.2, 0.4), (0.5, 0.7), (0.6, 0.8), (0.5, 0.8), (0.7, 0.9), (0.4, 0.7)] {
         let blend = |rgb: [f64; 3]| {
             let mn = rgb.iter().cloned().fold(1.0, f64::min);
             let u = ((mn - t0) / (t1 - t0)).clamp(0.0, 1.0);

@@ -9,8 +9,9 @@
 //!
 //! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
 //! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly — with
-//! two differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
-//! exact at every brightness, and light colours (lowest channel above 0.5) are fetched through
+//! three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
+//! exact at every brightness, the weights along x and y are warped next to a zero channel
+//! ([`chroma_weight`]), where the coefficients move non-uniformly, and light colours (lowest channel above 0.3) are fetched through
 //! their complement 1 − rgb with negated coefficients ([`white_blend`]), which removes the
 //! near-white errors of coefficient interpolation. Because `scale` is stored in the file, a table may use any
 //! increasing brightness grid and stay readable by every rgb2spec-compatible renderer; such a
@@ -211,9 +212,22 @@ impl CoeffTable {
         SigmoidPolynomial { c: [0, 1, 2].map(|m| d[m] + a * (comp[m] - d[m])) }
     }
 
-    /// rgb2spec's trilinear fetch (with [`z_weight`]) of a colour already clamped to [0, 1].
+    /// rgb2spec's trilinear fetch (with [`z_weight`] and [`chroma_weight`]) of a colour already
+    /// clamped to [0, 1].
     #[inline]
     pub fn fetch_direct(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
+        self.fetch_trilinear(rgb, false)
+    }
+
+    /// Exactly `rgb2spec_fetch` (linear weights on all three axes, no complement), as rgb2spec,
+    /// Mitsuba and pbrt read a table: for judging a table made for them (e.g. rgb2spec_opt's
+    /// output) on its own terms. Clamps like [`Self::fetch`].
+    pub fn fetch_rgb2spec(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
+        self.fetch_trilinear(rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 }), true)
+    }
+
+    #[inline]
+    fn fetch_trilinear(&self, rgb: [f32; 3], linear: bool) -> SigmoidPolynomial {
         let res = self.res;
         // Largest channel; later channels win ties, as in rgb2spec.
         let mut l = 0;
@@ -232,9 +246,16 @@ impl CoeffTable {
         let xi = (x as usize).min(res - 2);
         let yi = (y as usize).min(res - 2);
         let zi = self.scale.partition_point(|&s| s <= z).clamp(1, res - 1) - 1;
-        let x1 = x - xi as f32;
-        let y1 = y - yi as f32;
-        let z1 = z_weight(z, self.scale[zi], self.scale[zi + 1]);
+        let (x1, y1, z1) = if linear {
+            let (s0, s1) = (self.scale[zi], self.scale[zi + 1]);
+            (x - xi as f32, y - yi as f32, ((z - s0) / (s1 - s0)).clamp(0.0, 1.0))
+        } else {
+            (
+                chroma_weight(x, xi, y, res),
+                chroma_weight(y, yi, x, res),
+                z_weight(z, self.scale[zi], self.scale[zi + 1]),
+            )
+        };
         let (x0, y0, z0) = (1.0 - x1, 1.0 - y1, 1.0 - z1);
         let o = self.index(l, zi, yi, xi);
         let (dx, dy, dz) = (3, 3 * res, 3 * res * res);
@@ -306,10 +327,38 @@ pub fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     w.clamp(0.0, 1.0)
 }
 
+/// Chroma warp scale on a zero channel's face ([`chroma_weight`]), as a channel ratio (≈ 2 cells
+/// at 64³).
+pub const CHROMA_WARP: f32 = 0.032;
+/// Growth of the chroma warp scale with the other chroma coordinate (both as channel ratios).
+pub const CHROMA_WARP_SLOPE: f32 = 0.2;
+
+/// Interpolation weight along a chroma axis: `x` = the channel ratio × (res − 1), in cell `xi`;
+/// `other` = the other chroma coordinate, in the same units. The weight is linear in the warped
+/// coordinate g(x) = x / (x + A), A = ([`CHROMA_WARP`] + [`CHROMA_WARP_SLOPE`] · other / (res − 1))
+/// · (res − 1): w = (g(x) − g(xi)) / (g(xi + 1) − g(xi)) = f · (xi + 1 + A) / (x + A), f = x − xi.
+///
+/// Next to a zero channel the node coefficients move non-uniformly with the channel: between the
+/// exact nodes (0.92, 0, 0) and (0.92, 0, 0.0146) the linear blend passes through the right
+/// colours but at the wrong place (the midpoint colour is at weight 0.62, not 0.5), missing the
+/// midpoint by ΔE2000 0.51, while the best weight misses it by < 0.02 (sRGB 64³, unrefined). The
+/// best weight at a cell's middle is 0.6 on a face (o = 0) and drifts towards 0.5 as the other
+/// chroma coordinate o grows (0.57 at o = 8, 0.53 at o = 30 cells), which A = 2 + 0.2·o cells
+/// follows. Measured on the unrefined sRGB table with `python3 tools/chroma_warp.py TABLE`: face
+/// colours max 0.57 → 0.17, uniform mean 0.0075 → 0.0050 (linear weight → this one). Each weight
+/// runs 0 → 1 across its cell and A is continuous, so the fetch stays continuous; the nodes are
+/// unchanged, so other rgb2spec readers (linear weights) still get every node colour exactly.
+#[inline]
+pub fn chroma_weight(x: f32, xi: usize, other: f32, res: usize) -> f32 {
+    let a = CHROMA_WARP * (res - 1) as f32 + CHROMA_WARP_SLOPE * other;
+    let f = x - xi as f32;
+    (f * (xi as f32 + 1.0 + a) / (x + a)).clamp(0.0, 1.0)
+}
+
 /// Lowest channel at which [`CoeffTable::fetch`] starts blending in the complement fetch.
-pub const WHITE_BLEND_LO: f32 = 0.5;
+pub const WHITE_BLEND_LO: f32 = 0.3;
 /// Lowest channel from which on [`CoeffTable::fetch`] uses the complement fetch alone.
-pub const WHITE_BLEND_HI: f32 = 0.7;
+pub const WHITE_BLEND_HI: f32 = 0.5;
 
 /// Weight of the complement fetch for a colour clamped to [0, 1]: smoothstep of its lowest
 /// channel between [`WHITE_BLEND_LO`] and [`WHITE_BLEND_HI`].
@@ -321,10 +370,13 @@ pub const WHITE_BLEND_HI: f32 = 0.7;
 /// 1 − σ(x)), and its colour is exactly (1, 1, 1) − rgb (colour is linear in the reflectance and
 /// reflectance 1 is RGB (1, 1, 1) by our conventions). So a light colour can be fetched as the
 /// negated dark colour 1 − rgb, where the table is smooth (σ⁻¹ brightness weight) and where an
-/// XYZ error weighs ~20× less in L* once mapped back next to white. Over [0.5, 1]³ the
-/// complement alone stays below ΔE2000 0.04 (sRGB 64³); the band 0.5…0.7 blends the two
-/// coefficient sets, whose spectra differ by < 0.1 in reflectance there, so the fetch stays
-/// continuous. Greys stay exact: the complement of the flat σ⁻¹(1 − g) is the flat σ⁻¹(g).
+/// XYZ error weighs ~20× less in L* once mapped back next to white. The band 0.3…0.5 blends the
+/// two coefficient sets, so the fetch stays continuous. It was 0.5…0.7 until the wide-gamut
+/// tables showed light yellows such as (0.98, 0.99, 0.62) in the band, where the direct fetch is
+/// poor: with 0.3…0.5 the sRGB colours inside Rec.2020 / ACEScg went from ΔE2000 0.49 / 1.77 to
+/// 0.42 / 0.40 and the sRGB uniform mean from 0.0039 to 0.0034, the sRGB adversarial max stayed
+/// 0.161 (`cargo run --release -p color --example adversarial -- SPACE`;
+/// `… --example white_corner` prints the band figures). Greys stay exact: the complement of the flat σ⁻¹(1 − g) is the flat σ⁻¹(g).
 #[inline]
 pub fn white_blend(rgb: [f32; 3]) -> f32 {
     let u = ((rgb[0].min(rgb[1]).min(rgb[2]) - WHITE_BLEND_LO) / (WHITE_BLEND_HI - WHITE_BLEND_LO))
@@ -384,9 +436,19 @@ mod tests {
     fn fetch_interpolates_like_rgb2spec() {
         let t = synthetic(5);
         // Green largest (l = 1): x = blue/green·4, y = red/green·4, z located in scale.
-        let c = t.fetch([0.2, 0.5, 0.3]).c;
+        // rgb2spec's own fetch: linear weights.
+        let c = t.fetch_rgb2spec([0.2, 0.5, 0.3]).c;
         assert!((c[0] - (100.0 + 0.3 / 0.5 * 4.0)).abs() < 1e-5, "{c:?}");
         assert!((c[1] - 0.2 / 0.5 * 4.0).abs() < 1e-5);
+        assert!((c[2] - (2.0 + (0.5 - 0.25) / (0.5625 - 0.25))).abs() < 1e-5);
+        // Ours: chroma weights f·(xi + 1 + A)/(x + A), A = 0.032·(res − 1) + 0.2·(other axis).
+        // x = 2.4 (cell 2, f = 0.4, other y = 1.6); y = 1.6 (cell 1, f = 0.6, other x = 2.4).
+        let c = t.fetch([0.2, 0.5, 0.3]).c;
+        let (ax, ay) = (0.128 + 0.2 * 1.6, 0.128 + 0.2 * 2.4);
+        let wx = 0.4 * (3.0 + ax) / (2.4 + ax);
+        let wy = 0.6 * (2.0 + ay) / (1.6 + ay);
+        assert!((c[0] - (102.0 + wx)).abs() < 1e-5, "{c:?} vs {}", 102.0 + wx);
+        assert!((c[1] - (1.0 + wy)).abs() < 1e-5, "{c:?} vs {}", 1.0 + wy);
         // scale = (k/4)²: 0.5 lies between k = 2 (0.25) and k = 3 (0.5625).
         // The cell 0.25…0.5625 reaches above 0.5: linear brightness weight.
         assert!((c[2] - (2.0 + (0.5 - 0.25) / (0.5625 - 0.25))).abs() < 1e-5);
@@ -407,19 +469,41 @@ mod tests {
     }
 
     #[test]
+    fn chroma_weight_runs_from_0_to_1_across_each_cell() {
+        for res in [5, 64] {
+            for xi in 0..res - 1 {
+                for other in [0.0, 1.5, (res - 1) as f32] {
+                    let w = |f: f32| chroma_weight(xi as f32 + f, xi, other, res);
+                    assert_eq!(w(0.0), 0.0);
+                    assert!((w(1.0) - 1.0).abs() < 1e-6, "res {res} cell {xi}: {}", w(1.0));
+                    // Increasing, and above linear (the warp is concave).
+                    let mut prev = 0.0;
+                    for m in 1..=10 {
+                        let f = m as f32 / 10.0;
+                        assert!(w(f) > prev && w(f) >= f - 1e-6, "res {res} cell {xi} f {f}: {}", w(f));
+                        prev = w(f);
+                    }
+                }
+            }
+        }
+        // Far from a zero channel the weight is nearly linear: at x = 30.5 of 64³, 0.508.
+        assert!((chroma_weight(30.5, 30, 30.0, 64) - 0.5).abs() < 0.01);
+    }
+
+    #[test]
     fn light_colours_are_fetched_through_their_complement() {
         let t = synthetic(5);
         let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|m| (a[m] - b[m]).abs() < 1e-4);
         let neg = |p: SigmoidPolynomial| p.c.map(|v| -v);
-        // Lowest channel ≥ 0.7: the negated fetch of 1 − rgb alone.
+        // Lowest channel ≥ 0.5: the negated fetch of 1 − rgb alone.
         let rgb = [0.9f32, 0.75, 0.8];
         let want = neg(t.fetch_direct(rgb.map(|v| 1.0 - v)));
         assert!(close(t.fetch(rgb.map(f64::from)).c, want));
-        // Lowest channel ≤ 0.5: rgb2spec's fetch unchanged.
-        let rgb = [0.9f32, 0.5, 1.0];
+        // Lowest channel ≤ 0.3: rgb2spec's fetch unchanged.
+        let rgb = [0.9f32, 0.3, 1.0];
         assert!(close(t.fetch(rgb.map(f64::from)).c, t.fetch_direct(rgb).c));
         // Halfway through the band: the smoothstep weight is ½.
-        let rgb = [0.6f32, 0.95, 0.8];
+        let rgb = [0.4f32, 0.95, 0.8];
         let (d, c) = (t.fetch_direct(rgb).c, neg(t.fetch_direct(rgb.map(|v| 1.0 - v))));
         assert!(close(t.fetch(rgb.map(f64::from)).c, [0, 1, 2].map(|m| 0.5 * (d[m] + c[m]))));
         // Continuous at both ends of the band.

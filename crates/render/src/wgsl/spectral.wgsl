@@ -148,14 +148,25 @@ fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     return clamp(w, 0.0, 1.0);
 }
 
+// Chroma weight, as color::upsample::table::chroma_weight: linear in x / (x + A), A = 2 + 0.2·other
+// cells at 64³, which follows how the coefficients move next to a zero channel (a linear weight
+// missed sRGB (0.92, 0, 0.0073) by ΔE2000 0.5 between two exact nodes). Same constants as there.
+const CHROMA_WARP: f32 = 0.032;
+const CHROMA_WARP_SLOPE: f32 = 0.2;
+fn chroma_weight(x: f32, xi: u32, other: f32, res: u32) -> f32 {
+    let a = CHROMA_WARP * f32(res - 1u) + CHROMA_WARP_SLOPE * other;
+    let f = x - f32(xi);
+    return clamp(f * (f32(xi) + 1.0 + a) / (x + a), 0.0, 1.0);
+}
+
 // Jakob–Hanika coefficients of a reflectance in [0, 1]³: color::upsample::CoeffTable::fetch.
 // Light colours come from the negated complement fetch (σ(−x) = 1 − σ(x), colour (1,1,1) − rgb),
-// blended in by a smoothstep of the lowest channel over [0.5, 0.7] (table::white_blend, same
+// blended in by a smoothstep of the lowest channel over [0.3, 0.5] (table::white_blend, same
 // constants): coefficient interpolation next to white is poor, next to black it is smooth.
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
     let lo = min(rgb.x, min(rgb.y, rgb.z));
-    let u = clamp((lo - 0.5) / (0.7 - 0.5), 0.0, 1.0);
+    let u = clamp((lo - 0.3) / (0.5 - 0.3), 0.0, 1.0);
     let alpha = u * u * (3.0 - 2.0 * u);
     if (alpha <= 0.0) {
         return fetch_coeffs_direct(rgb, res);
@@ -184,8 +195,8 @@ fn fetch_coeffs_direct(rgb: vec3<f32>, res: u32) -> vec3<f32> {
     let xi = min(u32(x), res - 2u);
     let yi = min(u32(y), res - 2u);
     let zi = find_interval(z, res);
-    let x1 = x - f32(xi);
-    let y1 = y - f32(yi);
+    let x1 = chroma_weight(x, xi, y, res);
+    let y1 = chroma_weight(y, yi, x, res);
     let z1 = z_weight(z, coeff_scale[zi], coeff_scale[zi + 1u]);
     let base = vec3<i32>(i32(xi), i32(yi), i32(l * res + zi));
     let c000 = textureLoad(coeff_table, base, 0).xyz;
