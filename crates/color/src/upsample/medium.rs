@@ -74,6 +74,16 @@ impl Attenuation {
         }
     }
 
+    /// The name [`Attenuation::parse`] reads back (the transmittance method's reference distance
+    /// is always [`Attenuation::TRANSMITTANCE`]'s there).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Attenuation::Unbounded => "unbounded",
+            Attenuation::Transmittance { .. } => "transmittance",
+            Attenuation::Box => "box",
+        }
+    }
+
     pub fn label(&self) -> String {
         match self {
             Attenuation::Unbounded => "unbounded (pbrt-v4)".into(),

@@ -55,6 +55,7 @@ pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
         spectral: SpectralSettings { white: Some("D65".into()), ..SpectralSettings::default() },
         water: None,
         environment: None,
+        medium: None,
     }
 }
 
