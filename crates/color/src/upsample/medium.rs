@@ -175,7 +175,9 @@ pub fn medium(
     let sigma_t = coefficient(table, t, method)?;
     let a = albedo(table, alb)?;
     match (&sigma_t, &a) {
-        (_, Spectrum::Constant(k)) => Ok((sigma_t.scaled(1.0 - k), sigma_t.scaled(*k))),
+        // Exact zeros for a pure absorber and a conservative medium (only 0 and 1 are constant).
+        (_, Spectrum::Constant(k)) if *k == 0.0 => Ok((sigma_t, Spectrum::Constant(0.0))),
+        (_, Spectrum::Constant(_)) => Ok((Spectrum::Constant(0.0), sigma_t)),
         (Spectrum::Constant(_), _) => Ok((sigma_t.clone(), sigma_t)),
         _ => {
             let st = |l: f64| sigma_t.eval(l);
