@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: super::SceneFileArgs,

@@ -14,7 +14,7 @@ pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra rend
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: super::SceneFileArgs,
