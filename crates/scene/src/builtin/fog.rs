@@ -22,10 +22,11 @@ pub const LANTERN: Vec3 = Vec3::new(-0.12, 0.40, 0.16);
 /// The lantern's luminous intensity, in the units of the Cornell lamp's stand-in (0.55).
 pub const LANTERN_INTENSITY: f32 = 0.12;
 
-/// The media, per metre: a mean free path of about 0.5 m, the size of the box.
+/// The media, per metre: mean free paths of 1.2–1.6 m, so the back wall (1.36 m from the
+/// camera) is seen through an optical depth of about one.
 pub fn medium(tinted: bool) -> RgbMedium {
     let (absorption, scattering, g) =
-        if tinted { ([0.15, 0.35, 0.8], [1.6, 1.6, 1.6], 0.4) } else { ([0.05; 3], [2.0; 3], 0.6) };
+        if tinted { ([0.1, 0.25, 0.6], [0.5, 0.5, 0.5], 0.4) } else { ([0.02; 3], [0.6; 3], 0.6) };
     RgbMedium::new(absorption, scattering, g, 1.0, Attenuation::DEFAULT).expect("valid built-in medium")
 }
 
