@@ -193,6 +193,16 @@ pub fn transmittance_error(model: &LabModel, sigma_rgb: [f64; 3], sigma: &Spectr
     ciede2000(model.target_lab(target), model.lab_of_xyz(model.xyz_of(|l| (-sigma.eval(l) * d).exp())))
 }
 
+/// The RGB projection of a coefficient spectrum: its colour as if it were a reflectance under
+/// the space's white (linear in σ; what a renderer that only keeps RGB would store for a
+/// measured coefficient). The grid's white is mapped onto the space's per XYZ component, as
+/// the Lab comparisons do.
+pub fn project(model: &LabModel, sigma: &Spectrum) -> [f64; 3] {
+    let xyz = model.xyz_of(|l| sigma.eval(l));
+    let w = model.space.white_xyz();
+    model.space.xyz_to_rgb(std::array::from_fn(|c| xyz[c] * w[c] / model.white[c]))
+}
+
 /// A named RGB extinction for the study.
 #[derive(Clone, Debug)]
 pub struct NamedMedium {
@@ -304,6 +314,14 @@ mod tests {
         assert!(a.max_value(360.0, 830.0) > 0.0);
         let (a, _) = medium(&t, [0.0; 3], [0.3, 0.4, 0.5], Attenuation::DEFAULT).unwrap();
         assert_eq!(a.max_value(360.0, 830.0), 0.0, "a conservative medium absorbs nothing");
+    }
+
+    /// A flat spectrum projects to the grey of its value.
+    #[test]
+    fn projection_of_a_constant_is_grey() {
+        let model = LabModel::new(&crate::RgbColorSpace::srgb()).unwrap();
+        let p = project(&model, &Spectrum::Constant(0.3));
+        assert!(p.iter().all(|&v| (v - 0.3).abs() < 1e-3), "{p:?}");
     }
 
     #[test]
