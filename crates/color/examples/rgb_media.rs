@@ -69,21 +69,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for r in (550..=630).step_by(5) {
             let (b, r) = (b as f64, r as f64);
             let e = color::upsample::medium::study_with(&model, &media, &depths, |s| {
-                Ok(color::Spectrum::Piecewise {
-                    lambda: (360..=830).map(f64::from).collect(),
-                    values: (360..=830)
-                        .map(|l| {
-                            let l = l as f64;
-                            if l < b {
-                                s[2]
-                            } else if l < r {
-                                s[1]
-                            } else {
-                                s[0]
-                            }
-                        })
-                        .collect(),
-                })
+                // Steps 1e-6 nm wide, as color::upsample::medium's box spectrum.
+                let lambda = vec![360.0, b - 1e-6, b, r - 1e-6, r, 830.0];
+                let values = vec![s[2], s[2], s[1], s[1], s[0], s[0]];
+                Ok(color::Spectrum::Piecewise { lambda, values })
             })?;
             let (am, _, ax) = stats(e.iter().flatten().copied());
             if am < best.0 {
