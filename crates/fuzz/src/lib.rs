@@ -15,7 +15,8 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// The fuzzed parsers.
-pub const TARGETS: &[&str] = &["gltf", "coeff", "csv", "medium", "exr", "spectral-exr", "png", "env"];
+pub const TARGETS: &[&str] =
+    &["gltf", "coeff", "csv", "medium", "rgb-medium", "exr", "spectral-exr", "png", "env"];
 
 /// Runs one input through `target`'s parser. `Err` is fine (refused input); a panic is not.
 pub fn run_one(target: &str, data: &[u8]) {
@@ -29,6 +30,11 @@ pub fn run_one(target: &str, data: &[u8]) {
                 && let Ok(m) = truth::Medium::from_json(text, "fuzz.json")
             {
                 let _ = m.validate(color::WavelengthRange::VISIBLE);
+            }
+        }
+        "rgb-medium" => {
+            if let Ok(text) = std::str::from_utf8(data) {
+                drop(scene::medium::RgbMedium::from_json_str(text));
             }
         }
         "exr" => drop(compare::decode_image("fuzz.exr", data)),

@@ -1,6 +1,6 @@
 //! `cargo run --release -p fuzz -- TARGET [--execs N] [--seconds S] [--seed K]`
 //!
-//! Fuzzes one parser (gltf, coeff, csv, medium, exr, png; `all` for each in turn) and prints
+//! Fuzzes one parser (gltf, coeff, csv, medium, rgb-medium, exr, png; `all` for each in turn) and prints
 //! executions, time, crashes and the process's peak resident memory. Crashing inputs are
 //! written to `crates/fuzz/crashes/<target>-<n>.bin` and the exit status is 1; each belongs in
 //! a regression test once fixed; `TARGET --replay FILE` runs one input uncaught, for a backtrace.

@@ -31,6 +31,7 @@ fn each_corpus_has_a_valid_seed() {
             "coeff" => color::upsample::CoeffTable::from_bytes(s, "s").is_ok(),
             "csv" => scene::spectrum_desc::csv_spectrum("s.csv", s).is_ok(),
             "medium" => truth::Medium::from_json(std::str::from_utf8(s).unwrap(), "m").is_ok(),
+            "rgb-medium" => scene::medium::RgbMedium::from_json_str(std::str::from_utf8(s).unwrap()).is_ok(),
             "exr" => compare::decode_image("s.exr", s).is_ok(),
             "spectral-exr" => compare::spectral::decode_spectral_exr("s.exr", s).is_ok(),
             "png" => compare::decode_image("s.png", s).is_ok(),

@@ -81,6 +81,7 @@ fn scene(meshes: Vec<Mesh>, materials: Vec<Material>, textures: Vec<Texture>, li
         water: None,
         warnings: vec![],
         environment: None,
+        medium: None,
     }
 }
 

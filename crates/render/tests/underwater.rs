@@ -64,6 +64,7 @@ fn floor_scene() -> Scene {
         spectral: SpectralSettings::default(),
         water: None,
         environment: None,
+        medium: None,
     }
 }
 

@@ -300,6 +300,18 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
             }),
         );
     }
+    if let Some(m) = &scene.medium {
+        scene_extras.insert(
+            "medium".into(),
+            json!({
+                "absorption": m.absorption,
+                "scattering": m.scattering,
+                "g": m.g,
+                "scale": m.scale,
+                "upsampling": m.upsampling.name(),
+            }),
+        );
+    }
 
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},

@@ -147,16 +147,17 @@ pub(crate) fn light(ctx: &Ctx, at: &str, map: &Map<String, Value>) -> Result<Lig
     Ok(LightExtras { spectrum, stands_in_for_node })
 }
 
-/// Scene-level extras (root, asset or scene): `spectra`, `water` and `environment`.
+/// Scene-level extras (root, asset or scene): `spectra`, `water`, `environment` and `medium`.
 #[derive(Default)]
 pub(crate) struct SceneExtras {
     pub spectral: SpectralSettings,
     pub water: Option<WaterSettings>,
     pub environment: Option<crate::Environment>,
+    pub medium: Option<crate::medium::RgbMedium>,
 }
 
 /// The keys [`scene`] reads.
-pub(crate) const SCENE_KEYS: &[&str] = &["spectra", "water", "environment"];
+pub(crate) const SCENE_KEYS: &[&str] = &["spectra", "water", "environment", "medium"];
 
 /// Edit distance, for telling a misspelt key from someone else's metadata.
 fn distance(a: &str, b: &str) -> usize {
@@ -202,6 +203,14 @@ pub(crate) fn scene(
     }
     if let Some(v) = map.get("environment") {
         out.environment = environment(ctx, &format!("{at}.environment"), v)?;
+    }
+    if let Some(v) = map.get("medium") {
+        let m = crate::medium::RgbMedium::from_json(v).map_err(|e| {
+            let field =
+                if e.field == "medium" { format!("{at}.medium") } else { format!("{at}.medium.{}", e.field) };
+            ctx.extras(field, e.why)
+        })?;
+        out.medium = Some(m);
     }
     Ok(())
 }

@@ -256,7 +256,14 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         spectral: sx.spectral,
         water: sx.water,
         environment: sx.environment,
+        medium: sx.medium,
     };
+    if scene.water.is_some() && scene.medium.is_some() {
+        return Err(ctx.extras(
+            "extras.medium",
+            "a scene has either water (extras.water) or an RGB medium (extras.medium), not both",
+        ));
+    }
     crate::sky::sync(&mut scene).map_err(|m| ctx.extras("water.sky", m))?;
     Ok(scene)
 }

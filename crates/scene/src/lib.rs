@@ -18,6 +18,7 @@ pub mod framing;
 mod gltf_ext;
 mod gltf_file;
 mod instancing;
+pub mod medium;
 mod meshopt_decode;
 mod primitive;
 pub mod sky;
@@ -77,6 +78,9 @@ pub struct Scene {
     /// Light arriving from infinitely far away ([`environment`]); from the file's
     /// `extras.environment` or the command line. `None`: no environment light.
     pub environment: Option<Environment>,
+    /// A homogeneous medium in RGB filling the scene (`extras.medium`, [`medium::RgbMedium`]);
+    /// `None`: clear air. Never together with [`Self::water`].
+    pub medium: Option<medium::RgbMedium>,
 }
 
 /// A triangle mesh in world space.

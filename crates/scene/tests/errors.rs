@@ -356,3 +356,38 @@ fn pointer_mut<'a>(v: &'a mut Value, path: &[String]) -> &'a mut Value {
     }
     cur
 }
+
+/// `extras.medium` (an RGB medium, issue 18): loads; each bad field is named with its place;
+/// water and a medium together are refused.
+#[test]
+fn rgb_medium_extras() {
+    let with_medium = |m: Value| {
+        mutate(|d| {
+            d["scenes"][0]["extras"].as_object_mut().unwrap().remove("water");
+            d["scenes"][0]["extras"]["medium"] = m;
+        })
+    };
+    let doc = with_medium(json!({"absorption": [0.1, 0.2, 0.3], "scattering": [0.5, 0.5, 0.5], "g": 0.4}));
+    let s = scene::load_slice("ok.gltf", doc.to_string().as_bytes(), Some(&data(""))).unwrap();
+    let m = s.medium.expect("the medium");
+    assert_eq!((m.absorption, m.scattering, m.g), ([0.1, 0.2, 0.3], [0.5; 3], 0.4));
+    expect(
+        &with_medium(json!({"absorption": [0.1, -0.2, 0.3]})),
+        &["scenes[0].extras.medium.absorption", "green"],
+    );
+    expect(
+        &with_medium(json!({"absorption": [0.1, 0.2, 0.3], "g": 1.0})),
+        &["scenes[0].extras.medium.g", "−1 and 1"],
+    );
+    expect(
+        &with_medium(
+            json!({"attenuation_color": [1, 0.5, 0.5], "attenuation_distance": 2, "albedo": [0.8, 0.8, 0.8]}),
+        ),
+        &["scenes[0].extras.medium.albedo", "extinction is zero"],
+    );
+    expect(&with_medium(json!("fog")), &["scenes[0].extras.medium", "object"]);
+    expect(
+        &mutate(|d| d["extras"]["medium"] = json!({"absorption": [1, 1, 1]})),
+        &["extras.medium", "not both"],
+    );
+}

@@ -102,6 +102,27 @@ fn compare(a: &Scene, b: &Scene) {
     // Water, including the sky (whose stand-in light is not written but made again on load).
     let w = |s: &Scene| s.water.as_ref().map(|w| (w.water_type.clone(), w.depth, w.scale, w.sky));
     assert_eq!(w(a), w(b));
+    assert_eq!(a.medium, b.medium);
+}
+
+#[test]
+fn an_rgb_medium_survives_a_round_trip() {
+    let dir = std::env::temp_dir().join(format!("spectra-scene-medium-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut a = builtin("cornell").unwrap();
+    a.medium = Some(
+        scene::medium::RgbMedium::from_json_str(
+            r#"{"absorption": [0.1, 0.25, 0.3], "scattering": [0.7, 0.6, 0.5], "g": -0.3, "scale": 0.01,
+                "upsampling": "unbounded"}"#,
+        )
+        .unwrap(),
+    );
+    let path = dir.join("fog.gltf");
+    scene::write_gltf(&a, &path).unwrap();
+    let b = scene::load(&path).unwrap();
+    assert!(b.medium.is_some());
+    compare(&a, &b);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

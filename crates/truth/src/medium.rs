@@ -90,6 +90,23 @@ impl Medium {
     }
 }
 
+impl Medium {
+    /// A scene's RGB medium ([`scene::medium::RgbMedium`]) as the tracer's spectral medium,
+    /// filling the scene: σ_a(λ), σ_s(λ) per scene unit upsampled through `table` (the scene
+    /// colour space's Jakob–Hanika table) by the medium's own method (docs/rgb-media.md).
+    pub fn from_rgb(m: &scene::medium::RgbMedium, table: &color::upsample::CoeffTable) -> Result<Medium> {
+        let (sigma_a, sigma_s) =
+            m.spectra(table).map_err(|e| TruthError::BadMedium(format!("upsampling the RGB medium: {e}")))?;
+        Ok(Medium {
+            sigma_a,
+            sigma_s,
+            phase: if m.g == 0.0 { Phase::Isotropic } else { Phase::HenyeyGreenstein { g: m.g as f32 } },
+            region: Region::Everywhere,
+            surface_ior: None,
+        })
+    }
+}
+
 /// A validated medium prepared for the inner loop.
 #[derive(Clone, Debug)]
 pub struct PreparedMedium {

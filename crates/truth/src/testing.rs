@@ -22,6 +22,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         spectral: SpectralSettings::default(),
         water: None,
         environment: None,
+        medium: None,
     }
 }
 

@@ -9,6 +9,7 @@
 //! - [`variants`]: unbounded RGB and illuminant spectra (pbrt-v4); [`smits`], [`boxes`]:
 //!   baselines; [`Upsampler`] / [`Method`]: one interface over all three methods.
 //! - [`roundtrip`]: RGB → spectrum → Lab accuracy, as measured for the acceptance figures.
+//! - [`medium`]: RGB participating-medium coefficients → spectra (attenuation round trip).
 
 // Numeric kernels index several parallel arrays with one counter, and `!(a > b)` is how the
 // validation code makes NaN fail a check; both lints would make this code harder to read.
@@ -18,6 +19,7 @@ pub mod adversarial;
 pub mod boxes;
 pub mod cache;
 pub mod fit;
+pub mod medium;
 pub mod method;
 pub mod refine;
 pub mod roundtrip;

@@ -128,6 +128,7 @@ impl Chart {
             spectral: SpectralSettings::default(),
             water: None,
             environment: None,
+            medium: None,
         }
     }
 }

@@ -7,6 +7,7 @@
 mod colorchecker;
 mod cornell;
 mod dense;
+pub mod fog;
 mod metamerism;
 pub(crate) mod shapes;
 mod underwater;
@@ -20,7 +21,8 @@ use crate::{Emission, Material, Scene, SpectralReflectance, SpectralSettings, sr
 
 /// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
 /// about N triangles, for large-mesh measurements).
-pub const BUILTIN_NAMES: &[&str] = &["cornell", "colorchecker", "metamerism", "underwater"];
+pub const BUILTIN_NAMES: &[&str] =
+    &["cornell", "colorchecker", "metamerism", "underwater", "fog", "tinted-fog"];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
@@ -30,6 +32,8 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "colorchecker" => colorchecker::build(&ctx),
         "metamerism" => metamerism::build(&ctx),
         "underwater" => underwater::build(&ctx),
+        "fog" => fog::build(&ctx, false),
+        "tinted-fog" => fog::build(&ctx, true),
         other if other.starts_with("dense:") => dense::build(&ctx, &other["dense:".len()..]),
         _ => {
             return Err(SceneError::UnknownBuiltin {
@@ -55,6 +59,7 @@ pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
         spectral: SpectralSettings { white: Some("D65".into()), ..SpectralSettings::default() },
         water: None,
         environment: None,
+        medium: None,
     }
 }
 

@@ -277,6 +277,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
+    super::warn_no_realtime_medium(&scene);
     args.env.apply(&mut scene)?;
     let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
     r.set_scene(&scene)?;

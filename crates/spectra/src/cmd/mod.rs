@@ -25,6 +25,17 @@ pub fn print_warnings(scene: &scene::Scene) {
     }
 }
 
+/// The real-time renderer does not draw an RGB medium yet (issue 18's later step); say so
+/// rather than silently render clear air.
+pub fn warn_no_realtime_medium(scene: &scene::Scene) {
+    if scene.medium.is_some() {
+        eprintln!(
+            "warning: {}: extras.medium (an RGB medium) is drawn only by `spectra truth` so far; this real-time image shows clear air",
+            scene.source
+        );
+    }
+}
+
 /// How a scene file is loaded, shared by every command that takes a scene (`render`, `view`,
 /// `truth`, `bench`).
 #[derive(clap::Args, Debug, Clone, Default)]

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: super::SceneFileArgs,
@@ -374,6 +374,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     super::check_output("--out", &args.out)?;
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
+    super::warn_no_realtime_medium(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = settings(&args, &scene)?;
     let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;

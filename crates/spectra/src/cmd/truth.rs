@@ -11,7 +11,7 @@ use truth::{Medium, Settings, TruthError, World};
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: super::SceneFileArgs,
@@ -47,6 +47,12 @@ pub struct Args {
     /// A homogeneous participating medium, as JSON (see `truth::medium_file`).
     #[arg(long)]
     pub medium: Option<PathBuf>,
+    /// A homogeneous medium filling the scene, given in RGB: inline JSON or a JSON file, e.g.
+    /// '{"absorption": [0.02, 0.05, 0.1], "scattering": [0.3, 0.3, 0.3], "g": 0.3}' or
+    /// '{"attenuation_color": [0.8, 0.6, 0.5], "attenuation_distance": 4, "albedo": [0.9, 0.9, 0.9]}'
+    /// (per metre / metres; docs/rgb-media.md). Replaces the scene's extras.medium.
+    #[arg(long, value_name = "JSON|FILE", conflicts_with = "medium")]
+    pub rgb_medium: Option<String>,
     /// Render under water: a Jerlov type (I … III, 1C … 9C, blends like II.5); default: the
     /// scene's water settings, if any. The water becomes a participating medium with a
     /// forward-peaked phase function (see `truth::water`).
@@ -96,7 +102,20 @@ fn parse_size(s: &str) -> Result<(u32, u32)> {
     }
 }
 
-fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
+/// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it.
+fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
+    let (text, origin) = if arg.trim_start().starts_with('{') {
+        (arg.to_string(), "--rgb-medium".to_string())
+    } else {
+        let p = std::path::Path::new(arg);
+        let t = color::input::read_regular_string(p, truth::medium_file::MAX_MEDIUM_FILE_BYTES)
+            .with_context(|| format!("--rgb-medium {arg}: cannot read"))?;
+        (t, format!("--rgb-medium {arg}"))
+    };
+    scene::medium::RgbMedium::from_json_str(&text).map_err(|e| anyhow!("{origin}: {e}"))
+}
+
+fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
     let (width, height) = parse_size(&a.size)?;
     let mut s = Settings::new(width, height, a.spp)?;
     s.seed = a.seed;
@@ -121,9 +140,24 @@ fn settings(a: &Args, scene: &scene::Scene) -> Result<Settings> {
         m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
         s.medium = Some(m);
     }
+    // An explicit --medium / --rgb-medium replaces the scene's own RGB medium.
+    let rgb = match (&a.rgb_medium, &scene.medium) {
+        (Some(arg), _) => Some((rgb_medium_arg(arg)?, "--rgb-medium".to_string())),
+        (None, Some(m)) if a.medium.is_none() => {
+            Some((m.clone(), format!("{}: extras.medium", scene.source)))
+        }
+        _ => None,
+    };
+    if let Some((m, origin)) = &rgb {
+        let m = Medium::from_rgb(m, table).with_context(|| origin.clone())?;
+        m.validate(s.range).with_context(|| origin.clone())?;
+        s.medium = Some(m);
+    }
     if let Some(w) = super::render::water_medium(scene, a.water.as_deref(), a.depth)? {
-        if a.medium.is_some() {
-            bail!("--medium and water (from --water or the scene) cannot be combined: pick one medium");
+        if a.medium.is_some() || rgb.is_some() {
+            bail!(
+                "--medium / --rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
+            );
         }
         s.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
@@ -175,13 +209,13 @@ pub fn run(a: Args) -> Result<()> {
     let mut scene = a.files.load(&a.scene)?;
     super::print_warnings(&scene);
     a.env.apply(&mut scene)?;
-    let st = settings(&a, &scene)?;
     let table = match &a.table {
         Some(p) => std::sync::Arc::new(
             color::upsample::CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?,
         ),
         None => color::upsample::table("srgb").context("loading the sRGB upsampling table")?,
     };
+    let st = settings(&a, &scene, &table)?;
     let t0 = Instant::now();
     let mut world = World::new(&scene, table.as_ref(), &st.white, st.range, st.medium.as_ref())?;
     if let Some(env) = &st.environment {
@@ -287,6 +321,50 @@ mod tests {
         Cli::parse_from(["truth", "cornell"].iter().chain(extra)).a
     }
 
+    fn srgb_table() -> std::sync::Arc<color::upsample::CoeffTable> {
+        color::upsample::table("srgb").expect("the sRGB table")
+    }
+
+    /// `--rgb-medium` inline or from a file reaches the tracer as a medium filling the scene;
+    /// bad input is an error naming the flag and the field; it cannot be combined with water or
+    /// `--medium`.
+    #[test]
+    fn rgb_medium_flag() {
+        let scene = scene::builtin("cornell").unwrap();
+        let tab = srgb_table();
+        let a = args(&[
+            "--rgb-medium",
+            r#"{"absorption": [0.5, 0.2, 0.1], "scattering": [0.1, 0.1, 0.1], "g": 0.5}"#,
+        ]);
+        let m = settings(&a, &scene, &tab).unwrap().medium.expect("a medium");
+        assert_eq!(m.region, truth::Region::Everywhere);
+        assert_eq!(m.phase, truth::Phase::HenyeyGreenstein { g: 0.5 });
+        // Box upsampling of the extinction: the red channel's at 650 nm, the blue one's at 450 nm.
+        let t = |l: f64| m.sigma_a.eval(l) + m.sigma_s.eval(l);
+        assert!((t(650.0) - 0.6).abs() < 1e-9 && (t(450.0) - 0.2).abs() < 1e-9, "{} {}", t(650.0), t(450.0));
+        let dir = std::env::temp_dir().join(format!("spectra-rgb-medium-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("fog.json");
+        std::fs::write(
+            &f,
+            r#"{"attenuation_color": [0.5, 0.5, 0.5], "attenuation_distance": 2, "albedo": [1, 1, 1]}"#,
+        )
+        .unwrap();
+        let m =
+            settings(&args(&["--rgb-medium", f.to_str().unwrap()]), &scene, &tab).unwrap().medium.unwrap();
+        assert_eq!(m.sigma_a, color::Spectrum::Constant(0.0));
+        let e = |x: &[&str]| format!("{:#}", settings(&args(x), &scene, &tab).unwrap_err());
+        let m = e(&["--rgb-medium", r#"{"absorption": [0.5, 0.2, 0.1], "g": 2}"#]);
+        assert!(m.contains("--rgb-medium") && m.contains("g:") && m.contains("−1 and 1"), "{m}");
+        let m = e(&["--rgb-medium", r#"{"absorption": [0.5, -0.2, 0.1]}"#]);
+        assert!(m.contains("absorption") && m.contains("green"), "{m}");
+        let m = e(&["--rgb-medium", "no-such-medium.json"]);
+        assert!(m.contains("no-such-medium.json"), "{m}");
+        let m = e(&["--rgb-medium", r#"{"absorption": [1, 1, 1]}"#, "--water", "II"]);
+        assert!(m.contains("cannot be combined"), "{m}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
     #[test]
     fn refuses_bad_requests_before_any_work() {
         let e = |x: &[&str]| format!("{:#}", run(args(x)).unwrap_err());
@@ -349,7 +427,7 @@ mod tests {
             let a = args(flags);
             let mut scene = scene::builtin("cornell").unwrap();
             a.env.apply(&mut scene).unwrap();
-            let st = settings(&a, &scene).unwrap();
+            let st = settings(&a, &scene, &srgb_table()).unwrap();
             let w = World::new(&scene, &up, &st.white, st.range, None).unwrap();
             assert_eq!(w.env_map.is_some(), want, "{flags:?}");
         }
@@ -357,7 +435,7 @@ mod tests {
         a.scene = "underwater".into();
         let mut scene = scene::builtin("underwater").unwrap();
         a.env.apply(&mut scene).unwrap();
-        let st = settings(&a, &scene).unwrap();
+        let st = settings(&a, &scene, &srgb_table()).unwrap();
         let e = World::new(&scene, &up, &st.white, st.range, st.medium.as_ref()).err().unwrap();
         assert!(e.to_string().contains("environment map"), "{e}");
     }
@@ -370,7 +448,7 @@ mod tests {
         for extra in [&[][..], &["--water", "II"][..]] {
             let mut a = args(extra);
             a.scene = "underwater".into();
-            let st = settings(&a, &scene).unwrap();
+            let st = settings(&a, &scene, &srgb_table()).unwrap();
             let m = st.medium.as_ref().unwrap();
             assert_eq!(m.surface_ior, Some(scene::water::WATER_IOR as f32));
             let w = World::new(&scene, &truth::upsample::GreyOnly, &st.white, st.range, Some(m)).unwrap();

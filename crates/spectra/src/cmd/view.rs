@@ -14,7 +14,7 @@ pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra rend
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: super::SceneFileArgs,
@@ -60,6 +60,7 @@ pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
+    super::warn_no_realtime_medium(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = initial_settings(&args, &scene)?;
     let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
