@@ -177,6 +177,12 @@ impl RgbColorSpace {
         }
     }
 
+    /// Relative luminance Y of a linear RGB colour in this space (the Y row of its RGB → XYZ
+    /// matrix): the one definition both renderers and the evaluation use (issue 16).
+    pub fn luminance(&self, rgb: [f64; 3]) -> f64 {
+        self.to_xyz.row(1).dot(DVec3::from(rgb))
+    }
+
     pub fn rgb_to_xyz(&self, rgb: [f64; 3]) -> [f64; 3] {
         (self.to_xyz * DVec3::from(rgb)).into()
     }
@@ -271,6 +277,18 @@ mod tests {
             ],
             1e-6,
         );
+    }
+
+    #[test]
+    fn srgb_luminance_is_the_published_y_row() {
+        // IEC 61966-2-1 / ITU-R BT.709: Y = 0.2126 R + 0.7152 G + 0.0722 B (4 decimals).
+        let s = RgbColorSpace::srgb();
+        for (rgb, want) in [([1.0, 0.0, 0.0], 0.2126), ([0.0, 1.0, 0.0], 0.7152), ([0.0, 0.0, 1.0], 0.0722)] {
+            assert!((s.luminance(rgb) - want).abs() < 1e-4, "{rgb:?}: {}", s.luminance(rgb));
+        }
+        assert!((s.luminance([1.0; 3]) - 1.0).abs() < 1e-12);
+        // Another space's own row, not sRGB's: Rec.2020 green is 0.6780.
+        assert!((RgbColorSpace::rec2020().luminance([0.0, 1.0, 0.0]) - 0.6780).abs() < 1e-4);
     }
 
     #[test]

@@ -287,7 +287,7 @@ impl SpectralSetup {
 
     /// Y of a linear RGB colour in the output colour space.
     pub fn luminance(&self, rgb: [f64; 3]) -> f64 {
-        self.space.rgb_to_xyz(rgb)[1]
+        self.space.luminance(rgb)
     }
 }
 

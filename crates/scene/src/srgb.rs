@@ -22,10 +22,9 @@ pub fn xyz_to_linear(xyz: [f64; 3]) -> DVec3 {
     xyz_to_rgb_matrix() * DVec3::from_array(xyz)
 }
 
-/// Relative luminance Y of a linear sRGB colour: the middle row of [`rgb_to_xyz_matrix`].
+/// Relative luminance Y of a linear sRGB colour ([`RgbColorSpace::luminance`]).
 pub fn luminance(rgb: Vec3) -> f64 {
-    let m = rgb_to_xyz_matrix();
-    m.row(1).dot(rgb.as_dvec3())
+    RgbColorSpace::srgb().luminance(rgb.as_dvec3().to_array())
 }
 
 /// The sRGB transfer function (linear → encoded).

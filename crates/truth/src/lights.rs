@@ -12,10 +12,9 @@ use color::{Observer, Spectrum, WavelengthRange};
 use glam::{Vec3, Vec4};
 use scene::{Emission, Light, LightKind};
 
-/// CIE 1931 luminance weights of linear sRGB (the Y row of its RGB→XYZ matrix).
+/// Relative luminance of a linear sRGB colour (`scene::srgb::luminance`, the one definition).
 pub fn luminance(rgb: Vec3) -> f32 {
-    let cs = color::colorspace::RgbColorSpace::srgb();
-    cs.rgb_to_xyz([rgb.x as f64, rgb.y as f64, rgb.z as f64])[1] as f32
+    scene::srgb::luminance(rgb) as f32
 }
 
 /// ∫ ȳ(λ)·s(λ) dλ over the range (CIE 1931, 0.1 nm midpoint rule).

@@ -99,7 +99,8 @@ pub fn settings(mode: Mode, n: usize, range: WavelengthRange) -> RenderSettings 
 /// pixels from every mode (shadow-map and silhouette mismatches, but also texture edges).
 pub fn edge_mask(truth: &Image) -> Vec<bool> {
     let (w, h) = (truth.width as i64, truth.height as i64);
-    let y: Vec<f32> = truth.data.iter().map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect();
+    let srgb = color::colorspace::RgbColorSpace::srgb();
+    let y: Vec<f32> = truth.data.iter().map(|p| srgb.luminance(p.map(f64::from)) as f32).collect();
     let mut mask = vec![false; y.len()];
     for py in 0..h {
         for px in 0..w {

@@ -230,7 +230,7 @@ fn relight(s: &mut Scene, illum: &str) -> Result<()> {
 }
 
 fn luminance(rgb: Vec3) -> f32 {
-    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+    scene::srgb::luminance(rgb) as f32
 }
 
 #[cfg(test)]
