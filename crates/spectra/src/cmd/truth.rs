@@ -93,15 +93,6 @@ pub struct Args {
     pub spectral_bin: f64,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32)> {
-    let (w, h) =
-        s.split_once(['x', 'X']).ok_or_else(|| anyhow!("--size '{s}' must look like WIDTHxHEIGHT"))?;
-    match (w.trim().parse::<u32>(), h.trim().parse::<u32>()) {
-        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
-        _ => bail!("--size '{s}': width and height must be positive integers"),
-    }
-}
-
 /// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it.
 fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
     let (text, origin) = if arg.trim_start().starts_with('{') {
@@ -116,7 +107,8 @@ fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
 }
 
 fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
-    let (width, height) = parse_size(&a.size)?;
+    // One size syntax for every command (issue 16): render's parser.
+    let (width, height) = crate::cmd::render::parse_size(&a.size)?;
     let mut s = Settings::new(width, height, a.spp)?;
     s.seed = a.seed;
     s.direct_only = a.direct_only;
@@ -459,7 +451,9 @@ mod tests {
 
     #[test]
     fn sizes() {
+        use crate::cmd::render::parse_size;
         assert_eq!(parse_size("64x32").unwrap(), (64, 32));
+        assert_eq!(parse_size("64*32").unwrap(), (64, 32), "the same separators as render");
         assert!(parse_size("0x3").is_err());
         assert!(parse_size("64").is_err());
     }
