@@ -532,9 +532,14 @@ fn light_field_hook_matches_cpu_to_1e_3() {
     r.resize(W, H).unwrap();
     let table = common::table();
     let mut tally = Tally::default();
-    for (ty, depth, scale, floor) in
-        [("IB", 5.0, 1.0, false), ("3C", 12.0, 0.5, true), ("II", 30.0, 8.0, false)]
-    {
+    // The last case: surfaces attenuated by the column's E_d (the option without the
+    // irradiance term).
+    for (ty, depth, scale, floor, irradiance) in [
+        ("IB", 5.0, 1.0, false, true),
+        ("3C", 12.0, 0.5, true, true),
+        ("II", 30.0, 8.0, false, true),
+        ("IB", 5.0, 1.0, false, false),
+    ] {
         let mut medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         if floor {
             // A sea floor closes the column (the table ends at its depth).
@@ -545,11 +550,13 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                 extent: Some([-FX, -FZ, FX, 2.0]),
             });
         }
-        let options = underwater::Options { photons: 400, ..Default::default() };
+        let options = underwater::Options { photons: 400, irradiance, ..Default::default() };
         let [lf, deep] = underwater::light_field_tables(&medium, &options).unwrap();
         assert_eq!(lf.z_max, deep.z_max, "both tables share the depth nodes");
         for lambda in [430.0, 500.0, 575.0, 640.0] {
-            let settings = one_wavelength(lambda, true);
+            // Lambert only, so that the dry render is ρ/π·E·cos and gives ρ·E/π for the
+            // column's irradiance term.
+            let settings = RenderSettings { lambert: true, ..one_wavelength(lambda, true) };
             let dry = render(&mut r, &scene, &settings, CustomShader::default());
             let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
@@ -623,10 +630,18 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                     }
                     let surface = match hit {
                         Some(_) => {
+                            // The sun's unscattered beam on the floor plus the column's diffuse
+                            // irradiance on its normal (up), both seen through d metres.
                             let zs = depth - d * w.y;
                             let t = if over(end.x, end.z) { &lf } else { &deep };
-                            DVec3::from(common::rgb_of(&dry[i]))
-                                * (log_interp(&ed(t), lf.z_max, zs) * (-k.c * d).exp())
+                            let dry = DVec3::from(common::rgb_of(&dry[i]));
+                            let mu = -light_dir().y as f64;
+                            if irradiance {
+                                let diffuse = t.irradiance_at(zs, DVec3::Y, sun_h, lambda) / mu;
+                                dry * (((-k.c * zs / mu).exp() + diffuse) * (-k.c * d).exp())
+                            } else {
+                                dry * (log_interp(&ed(t), lf.z_max, zs) * (-k.c * d).exp())
+                            }
                         }
                         // Looking up at the surface: what it reflects (the table's), attenuated
                         // over the path; no sky in this scene, so nothing through the window.
@@ -644,7 +659,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                     let want = surface + unit * scatter;
                     let what = || {
                         format!(
-                            "light field {ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py}) (table part \
+                            "light field {ty} z0={depth} scale={scale} irradiance={irradiance} λ={lambda} pixel ({px},{py}) (table part \
                              {table_part:.6}, beam part {beam_part:.6}, cut {cut:?})"
                         )
                     };

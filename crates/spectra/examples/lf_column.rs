@@ -69,10 +69,27 @@ struct Args {
     /// The floor's albedo (with `--floor-below`).
     #[arg(long, default_value_t = 0.3)]
     floor_albedo: f64,
+    /// Instead of radiance along directions: the diffuse irradiance (everything but the sun's
+    /// unscattered beam) on small surfaces at the camera's depth facing up, sideways (towards,
+    /// away from and across the sun) and down — the truth as π × the mean radiance over
+    /// cosine-distributed directions around the normal, the table's
+    /// `LightFieldTable::irradiance_at` (what the real-time pass lights surfaces with).
+    #[arg(long)]
+    irradiance: bool,
     /// Output CSV.
     #[arg(long)]
     out: PathBuf,
 }
+
+/// (name, angle of the normal from straight up in degrees, azimuth from the sun's in degrees).
+const NORMALS: [(&str, f64, f64); 6] = [
+    ("up", 0.0, 0.0),
+    ("side_sun", 90.0, 0.0),
+    ("side_across", 90.0, 90.0),
+    ("side_anti", 90.0, 180.0),
+    ("down45_sun", 135.0, 0.0),
+    ("down", 180.0, 0.0),
+];
 
 /// Wavelength groups traced together (hero-wavelength MIS over the four), on the table's nodes.
 const GROUPS: [[f32; 4]; 2] = [[400.0, 480.0, 560.0, 640.0], [440.0, 520.0, 600.0, 680.0]];
@@ -97,10 +114,12 @@ fn main() -> Result<()> {
     let reuse = args.truth_csv.as_deref().map(read_truth).transpose()?;
     let base = scene::builtin("underwater").context("the built-in underwater scene")?;
     let settings0 = base.water.clone().context("the underwater scene has water settings")?;
-    let mut out = String::from(
+    let mut out = String::from(if args.irradiance {
+        "type,depth_m,normal,theta_deg,phi_deg,lambda_nm,truth,truth_se,table,table_hi,ratio,ratio_se,ratio_hi\n"
+    } else {
         "type,depth_m,direction,theta_deg,phi_deg,lambda_nm,truth,truth_se,table,table_hi,\
-         table_diffuse,table_beam,table_surface,ratio,ratio_se,ratio_hi\n",
-    );
+         table_diffuse,table_beam,table_surface,ratio,ratio_se,ratio_hi\n"
+    });
     for ty in &args.types {
         for &depth in &args.depths {
             let settings =
@@ -169,6 +188,37 @@ fn main() -> Result<()> {
             let to_sun = medium.sun_dir_underwater().as_dvec3();
             let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
             let side = DVec3::Y.cross(sun_h);
+            if args.irradiance {
+                for (ni, &(name, th, ph)) in NORMALS.iter().enumerate() {
+                    let (th, ph) = (th.to_radians(), ph.to_radians());
+                    let n =
+                        (sun_h * (th.sin() * ph.cos()) + DVec3::Y * th.cos() + side * (th.sin() * ph.sin()))
+                            .normalize();
+                    for (gi, group) in GROUPS.iter().enumerate() {
+                        let seed = args.seed.wrapping_mul(1_000_003) ^ ((gi as u64) << 8 | (64 + ni) as u64);
+                        let (mean, se) = trace_irradiance(&integ, cam, n, *group, args.paths, seed);
+                        for (lane, &lambda) in group.iter().enumerate() {
+                            let lambda = lambda as f64;
+                            let s = sun.spectrum.eval(lambda as f32) as f64;
+                            let t = s * table.irradiance_at(depth, n, sun_h, lambda);
+                            let t_hi = hi.as_ref().map(|h| s * h.irradiance_at(depth, n, sun_h, lambda));
+                            let truth = mean[lane];
+                            out += &format!(
+                                "{ty},{depth},{name},{:.0},{:.0},{lambda:.0},{truth:.6e},{:.3e},{t:.6e},{},{:.5},{:.5},{}\n",
+                                th.to_degrees(),
+                                ph.to_degrees(),
+                                se[lane],
+                                t_hi.map_or(String::new(), |x| format!("{x:.6e}")),
+                                t / truth,
+                                t / truth * se[lane] / truth,
+                                t_hi.map_or(String::new(), |x| format!("{:.5}", x / truth)),
+                            );
+                        }
+                    }
+                    eprintln!("{ty} {depth} m irradiance {name}: done");
+                }
+                continue;
+            }
             for (di, &(name, th, ph)) in DIRECTIONS.iter().enumerate() {
                 // Snapped to the nearest elevation node (the nodes are warped towards the horizon).
                 let th = light_field::elevation_angle(
@@ -294,6 +344,60 @@ fn trace(integ: &Integrator, o: Vec3, v: Vec3, wl: [f32; 4], n: u64, seed: u64) 
         hs.into_iter().map(|h| h.join().expect("tracing thread")).collect()
     });
     let nf = n as f64;
+    let mut mean = [0.0; 4];
+    let mut se = [0.0; 4];
+    for j in 0..4 {
+        let (s, q): (f64, f64) = parts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0[j], b + p.1[j]));
+        mean[j] = s / nf;
+        se[j] = ((q / nf - mean[j] * mean[j]).max(0.0) / (nf - 1.0).max(1.0)).sqrt();
+    }
+    (mean, se)
+}
+
+/// Diffuse irradiance on a surface at `o` facing `n`: π × the mean radiance arriving along
+/// cosine-distributed directions around n (the integrator's radiance excludes the sun's delta
+/// beam at `o` itself, as the table does), per lane with its standard error.
+fn trace_irradiance(
+    integ: &Integrator,
+    o: Vec3,
+    n: DVec3,
+    wl: [f32; 4],
+    paths: u64,
+    seed: u64,
+) -> ([f64; 4], [f64; 4]) {
+    let threads = std::thread::available_parallelism().map_or(2, |x| x.get()) as u64;
+    let a = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let t = n.cross(a).normalize();
+    let b = n.cross(t);
+    let parts: Vec<([f64; 4], [f64; 4])> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..threads)
+            .map(|th| {
+                s.spawn(move || {
+                    let (mut sum, mut sq) = ([0.0f64; 4], [0.0f64; 4]);
+                    let mut i = th;
+                    while i < paths {
+                        let mut rng = Sampler::new(seed, i);
+                        let (u1, u2) = (rng.uniform() as f64, rng.uniform() as f64);
+                        let (r, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
+                        let v = (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
+                            .normalize();
+                        let k = ((rng.uniform() * 4.0) as usize).min(3);
+                        let rot = Wavelengths(Vec4::from_array(std::array::from_fn(|j| wl[(j + k) % 4])));
+                        let l = integ.radiance(o, v.as_vec3(), &rot, &mut rng);
+                        for j in 0..4 {
+                            let x = std::f64::consts::PI * l[(j + 4 - k) % 4] as f64;
+                            sum[j] += x;
+                            sq[j] += x * x;
+                        }
+                        i += threads;
+                    }
+                    (sum, sq)
+                })
+            })
+            .collect();
+        hs.into_iter().map(|h| h.join().expect("tracing thread")).collect()
+    });
+    let nf = paths as f64;
     let mut mean = [0.0; 4];
     let mut se = [0.0; 4];
     for j in 0..4 {

@@ -1,6 +1,6 @@
 //! Pass 3 and the custom-shader extension point.
 //!
-//! A [`CustomShader`] is WGSL source that defines any of three hooks (each one it leaves out is
+//! A [`CustomShader`] is WGSL source that defines any of these hooks (each one it leaves out is
 //! the identity from `custom_hooks.wgsl`):
 //!
 //! ```wgsl
@@ -11,6 +11,12 @@
 //! fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32>
 //! // Pass 3, every mode, once per pixel on the HDR linear-sRGB colour:
 //! fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32>
+//! // Pass 2, every mode, per light on a lit surface: a factor on the light's direct light:
+//! fn custom_light_surface(li: u32, ctx: SurfaceContext) -> f32
+//! // Pass 2, irradiance a medium brings to the surface (weighted form; rgb: linear sRGB), as
+//! // seen from the camera; reflected with the diffuse lobe and added after the hooks above:
+//! fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32>
+//! fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32>
 //! ```
 //!
 //! Inputs available to the hooks (see `wgsl/custom_api.wgsl` and `wgsl/spectral.wgsl`):
@@ -46,8 +52,15 @@ use color::Spectrum;
 /// Identity hooks.
 pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
 
-/// The three hook names, in the order `custom_hooks.wgsl` defines them.
-const HOOKS: [&str; 3] = ["custom_spectral", "custom_rgb", "custom_pixel"];
+/// The hook names, in the order `custom_hooks.wgsl` defines them.
+const HOOKS: [&str; 6] = [
+    "custom_spectral",
+    "custom_rgb",
+    "custom_pixel",
+    "custom_light_surface",
+    "custom_irradiance",
+    "custom_irradiance_rgb",
+];
 
 /// User code for the extension point.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +105,9 @@ impl CustomShader {
             }
         }
         out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {};\n", self.defines("custom_spectral")));
+        // The irradiance hooks come as a pair; either one turns on the diffuse term's code.
+        let irradiance = self.defines("custom_irradiance") || self.defines("custom_irradiance_rgb");
+        out.push_str(&format!("const CUSTOM_IRRADIANCE: bool = {irradiance};\n"));
         out
     }
 

@@ -1,4 +1,4 @@
-// Default custom hooks: identity. A custom shader defines any of these three functions (it
+// Default custom hooks: identity. A custom shader defines any of these functions (it
 // may declare helpers too); the renderer adds this file's definition of each one it leaves out
 // (`CustomShader::assembled`).
 
@@ -21,4 +21,24 @@ fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> {
 // Pass 3, every mode: the HDR linear-sRGB colour after shading. Return the new colour.
 fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {
     return hdr;
+}
+
+// Pass 2, every mode, once per light and pixel on a lit surface: a factor on light `li`'s
+// direct light at the surface (before `custom_spectral`/`custom_rgb`) — 0 for a light whose
+// effect the hooks account for themselves.
+fn custom_light_surface(li: u32, ctx: SurfaceContext) -> f32 {
+    return 1.0;
+}
+
+// Pass 2, spectral and naive modes, once per group on a lit surface: irradiance the medium
+// brings to the surface, in weighted form (like a light's `light_w` times its irradiance),
+// as it reaches the camera (the hook applies the medium's attenuation along the view). The
+// renderer reflects it with the surface's diffuse lobe and adds it after `custom_spectral`.
+fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
+    return mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+}
+
+// Pass 2, rgb mode: the same as linear-sRGB irradiance.
+fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
+    return vec3<f32>(0.0);
 }

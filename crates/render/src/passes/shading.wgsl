@@ -307,6 +307,16 @@ fn load_surface(px: vec2<i32>) -> GSurface {
     return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0);
 }
 
+// Diffuse radiance per unit irradiance arriving from all sides (the hooks' medium
+// irradiance): the Lambertian layer under the dielectric coat, (1 − metallic)·(1 − F̄)/π with
+// F̄ = 0.04 + 0.96/21 the cosine-weighted hemispherical mean of Schlick's Fresnel (the
+// per-light term uses the Fresnel of its own half vector instead). Unlit surfaces: 0.
+fn diffuse_lobe(s: GSurface) -> f32 {
+    if (s.unlit) { return 0.0; }
+    if (lambert_only()) { return 1.0 / PI; }
+    return (1.0 - s.metallic) * (1.0 - (0.04 + 0.96 / 21.0)) / PI;
+}
+
 // RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
 // own), so that RGB pays only for what RGB needs.
 @fragment
@@ -321,7 +331,8 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         var sum_b = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lit; li++) {
-            let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness);
+            let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness)
+                * custom_light_surface(li, ctx);
             let e = lights[li].rgb.rgb;
             sum_a = fma(vec3<f32>(f.x), e, sum_a);
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
@@ -335,7 +346,12 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
-    return vec4<f32>(custom_rgb(rgb, ctx), 1.0);
+    var out = custom_rgb(rgb, ctx);
+    if (CUSTOM_IRRADIANCE && !ctx.background) {
+        let s = load_surface(px);
+        out += s.base * diffuse_lobe(s) * custom_irradiance_rgb(ctx);
+    }
+    return vec4<f32>(out, 1.0);
 }
 
 // Spectral and naive modes.
@@ -349,6 +365,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     var base = vec3<f32>(0.0);
     var emission = vec3<f32>(0.0);
     var n_lights = 0u;
+    var lobe = 0.0;
     // The spectral loop reads each light's factors once per wavelength group.
     var fa: array<f32, MAX_LIGHTS>;
     var fb: array<f32, MAX_LIGHTS>;
@@ -367,8 +384,10 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         emission = s.emission;
         ctx.normal = s.normal;
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+        lobe = diffuse_lobe(s);
         for (var li = 0u; li < n_lights; li++) {
-            let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness);
+            let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness)
+                * custom_light_surface(li, ctx);
             fa[li] = f.x;
             fb[li] = f.y;
         }
@@ -451,6 +470,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             if (has_em) {
                 xyz += em * white_weights(g);
             }
+        }
+        if (CUSTOM_IRRADIANCE && lobe > 0.0) {
+            xyz += s3_xyz(s3_scale(custom_irradiance(lambda, g, ctx), rho * lobe));
         }
     }
     return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);

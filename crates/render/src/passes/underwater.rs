@@ -87,6 +87,12 @@ pub struct Options {
     /// With `light_field`, attenuate surfaces by the tabulated Kd anyway (the documented
     /// option; the default derives the attenuation from a, b and the phase function).
     pub tabulated_kd: bool,
+    /// With `light_field`, light G-buffer surfaces with the column's diffuse irradiance for
+    /// their normal (`LightFieldTable::irradiance`: the sky's and all scattered light, from
+    /// every side) and the sun's unscattered beam, instead of the scene's lights attenuated by
+    /// the downwelling E_d with the sky stand-in straight down (which leaves vertical and
+    /// downward faces without the water's sideways and upwelling light).
+    pub irradiance: bool,
     /// Photons per wavelength node and source of the light-field solver.
     pub photons: usize,
     /// With `light_field`, close the column with the medium's sea floor
@@ -108,6 +114,7 @@ impl Default for Options {
             surface: true,
             light_field: true,
             tabulated_kd: false,
+            irradiance: true,
             photons: LIGHT_FIELD_PHOTONS,
             sea_floor: true,
         }
@@ -298,6 +305,7 @@ fn table_spectra(tables: [&LightFieldTable; 2]) -> Vec<color::Spectrum> {
         out.extend(rows(&t.e_d, N_DEPTH));
         out.extend(rows(&t.surface, views));
         out.extend(rows(&t.surface_floor, views));
+        out.extend(rows(&t.irradiance, N_DEPTH * N_NORMAL_ELEV * N_NORMAL_AZ));
     }
     for t in tables {
         let mut push = |f: &dyn Fn(f64) -> f64| {
@@ -316,6 +324,11 @@ fn table_spectra(tables: [&LightFieldTable; 2]) -> Vec<color::Spectrum> {
             for v in 0..views {
                 push(&|l| t.surface_node(v / N_AZ, v % N_AZ, l, floor));
             }
+        }
+        let normals = N_NORMAL_ELEV * N_NORMAL_AZ;
+        for c in 0..N_DEPTH * normals {
+            let (d, rest) = (c / normals, c % normals);
+            push(&|l| t.irradiance_node(d, rest / N_NORMAL_AZ, rest % N_NORMAL_AZ, l));
         }
     }
     out
@@ -348,13 +361,19 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
     );
     set("const UW_TABLE: bool = true;", options.light_field.to_string());
     {
-        use scene::water::light_field::{ELEV_WARP, N_AZ, N_DEPTH, N_ELEV};
+        use scene::water::light_field::{ELEV_WARP, N_AZ, N_DEPTH, N_ELEV, N_NORMAL_AZ, N_NORMAL_ELEV};
         set("const UW_ND: u32 = 16u;", format!("{N_DEPTH}u"));
+        set("const UW_NNE: u32 = 9u;", format!("{N_NORMAL_ELEV}u"));
+        set("const UW_NNA: u32 = 5u;", format!("{N_NORMAL_AZ}u"));
         set("const UW_NE: u32 = 19u;", format!("{N_ELEV}u"));
         set("const UW_NA: u32 = 9u;", format!("{N_AZ}u"));
         set("const UW_ELEV_INV_WARP: f32 = 0.6666667;", format!("{:?}", (1.0 / ELEV_WARP) as f32));
     }
     set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
+    set(
+        "const UW_IRRADIANCE: bool = true;",
+        (options.light_field && options.irradiance && !options.tabulated_kd).to_string(),
+    );
     let mut spectra = spectra(medium);
     if let Some([t, deep]) = &tables {
         set("const UW_ZMAX: f32 = 40.0;", format!("{:?}", t.z_max as f32));

@@ -35,6 +35,10 @@ const UW_SKY_NORM: f32 = 0.34;
 // the table's depth range; the table's layout must match scene::water::light_field.
 const UW_TABLE: bool = true;
 const UW_TABLE_KD: bool = true;
+// Surfaces lit by the sun's unscattered beam (e^{−c·z/μ}, shadowed) plus the column's diffuse
+// irradiance for their normal (light_field::LightFieldTable::irradiance), the sky stand-ins
+// left out (their light is in the table): `Options::irradiance`.
+const UW_IRRADIANCE: bool = true;
 const UW_ZMAX: f32 = 40.0;
 // The table's layout, written by `underwater::shader_with` from scene::water::light_field
 // (N_DEPTH, N_ELEV, N_AZ, 1/ELEV_WARP): one home for the numbers.
@@ -42,17 +46,21 @@ const UW_ND: u32 = 16u;
 const UW_NE: u32 = 19u;
 const UW_NA: u32 = 9u;
 const UW_ELEV_INV_WARP: f32 = 0.6666667;
+const UW_NNE: u32 = 9u;
+const UW_NNA: u32 = 5u;
 const UW_NC: u32 = UW_ND * UW_NE * UW_NA;
 // Spectrum indices (custom_spectra[s * n_groups + group]): two tables of one block each — 0
 // the column closed by the sea floor, 1 the bottomless column (the same table twice when the
 // scene has no floor) — each J per cell, E_d per depth node, the surface's reflection of the
-// water and of the floor per view node; then the RGB mode's copies, three constants each.
+// water and of the floor per view node, the irradiance per depth and normal node; then the RGB
+// mode's copies, three constants each.
 const UW_NV: u32 = UW_NE * UW_NA;
 const UW_L_J: u32 = 0u;
 const UW_L_ED: u32 = UW_NC;
 const UW_L_SURF: u32 = UW_NC + UW_ND;
 const UW_L_SURF_FLOOR: u32 = UW_NC + UW_ND + UW_NV;
-const UW_BLOCK: u32 = UW_NC + UW_ND + 2u * UW_NV;
+const UW_L_IRR: u32 = UW_NC + UW_ND + 2u * UW_NV;
+const UW_BLOCK: u32 = UW_L_IRR + UW_ND * UW_NNE * UW_NNA;
 const UW_T_RGB: u32 = 4u + 2u * UW_BLOCK;
 // The sea floor's horizontal extent (scene units: min x, min z, max x, max z; written by
 // `underwater::shader_with`); the surface mirrors the floor only where the mirrored view lands
@@ -139,6 +147,10 @@ var<private> uw_pz: array<f32, 16>;
 var<private> uw_pd: array<u32, 16>;
 var<private> uw_org: vec3<f32>;
 var<private> uw_view: vec3<f32>;
+// The first sun's horizontal direction (towards it; zero for a zenith sun or none) and the
+// cosine of its beam to the downward vertical (1 without a sun).
+var<private> uw_sun_h: vec3<f32>;
+var<private> uw_sun_mu: f32 = 1.0;
 
 // Distance (m) along the view from the camera at which it leaves the floor's extent or reaches
 // the table's deepest node (the floor), 0 if the camera is not over the floor, ≥ 1e30 if never.
@@ -242,9 +254,11 @@ fn uw_prepare_table(w: vec3<f32>, z0: f32) {
         if (u32(l.w) == 0u && lights[li].cone.z < 0.5 && l.y < 0.0) {
             let h = vec2<f32>(-l.x, -l.z);
             if (dot(h, h) > 1e-12) { sun_h = vec3<f32>(normalize(h).x, 0.0, normalize(h).y); }
+            uw_sun_mu = -l.y;
             break;
         }
     }
+    uw_sun_h = sun_h;
     let hw = vec3<f32>(w.x, 0.0, w.z);
     let fe = uw_elev_coord(uw_angle(length(hw), w.y));
     var ph = 0.0;
@@ -366,6 +380,65 @@ fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f
         total += s3_scale(uw_emission(li, group, rgb), f);
     }
     return total;
+}
+
+// The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
+// normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
+// light_field::LightFieldTable::irradiance_at).
+fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec4<f32> {
+    let hn = vec3<f32>(n.x, 0.0, n.z);
+    let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
+    var ph = 0.0;
+    if (length(hn) > 1e-6 && dot(uw_sun_h, uw_sun_h) > 0.5) {
+        ph = uw_angle(abs(cross(uw_sun_h, hn).y), dot(uw_sun_h, hn));
+    }
+    let fk = ph / 3.14159265358979 * f32(UW_NNA - 1u);
+    let e0 = min(u32(floor(fe)), UW_NNE - 2u);
+    let k0 = min(u32(floor(fk)), UW_NNA - 2u);
+    let te = fe - f32(e0);
+    let tk = fk - f32(k0);
+    let cells = vec4<u32>(e0 * UW_NNA + k0, e0 * UW_NNA + k0 + 1u, (e0 + 1u) * UW_NNA + k0, (e0 + 1u) * UW_NNA + k0 + 1u);
+    let w = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
+    let i = uw_segment(z);
+    var a = vec4<f32>(0.0);
+    var b = vec4<f32>(0.0);
+    for (var c = 0u; c < 4u; c++) {
+        a += w[c] * uw_tab(table, UW_L_IRR + i * UW_NNE * UW_NNA + cells[c], group, rgb);
+        b += w[c] * uw_tab(table, UW_L_IRR + (i + 1u) * UW_NNE * UW_NNA + cells[c], group, rgb);
+    }
+    return a * exp(-uw_rate(a, b, i) * (z - uw_depth_node(i)));
+}
+
+// The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
+// camera (× e^{−c·d}), in weighted form.
+fn uw_surface_irradiance(c: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
+    uw_prepare(ctx);
+    let z0 = custom.params[0].x;
+    let zs = max(z0 - uw_d * ctx.view_dir.y, 0.0);
+    let hit = ctx.origin + ctx.view_dir * ctx.distance;
+    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb) * exp(-c * uw_d);
+    var total = UW_ZERO;
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
+        total += s3_scale(uw_emission(li, group, rgb), e);
+    }
+    return total;
+}
+
+fn custom_light_surface(li: u32, ctx: SurfaceContext) -> f32 {
+    // The sky stand-ins' light is in the column's irradiance.
+    return select(1.0, 0.0, UW_IRRADIANCE && lights[li].cone.z > 0.5);
+}
+
+fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
+    if (!UW_IRRADIANCE) { return UW_ZERO; }
+    return uw_surface_irradiance(custom_spectra[group * 4u + 1u], group, false, ctx);
+}
+
+fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
+    if (!UW_IRRADIANCE) { return vec3<f32>(0.0); }
+    return uw_surface_irradiance(vec4<f32>(custom.params[1].xyz, 1.0), 0u, true, ctx)[0].rgb;
 }
 
 // E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
@@ -589,7 +662,11 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
         var att = exp(-kd * zs);
-        if (UW_TABLE_KD) {
+        if (UW_IRRADIANCE) {
+            // The lights' direct light: the sun's unscattered beam (other lights get the same
+            // factor, as they got Kd's before). The diffuse light comes from `custom_irradiance`.
+            att = exp(-c * (zs / max(uw_sun_mu, 1e-3)));
+        } else if (UW_TABLE_KD) {
             let hit = ctx.origin + ctx.view_dir * ctx.distance;
             att = uw_table_attenuation(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb);
         }

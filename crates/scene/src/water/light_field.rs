@@ -79,8 +79,15 @@ pub const DLAMBDA: f64 = 20.0;
 pub const N_LAMBDA: usize = 25;
 /// Entries of [`LightFieldTable::surface`].
 const N_SURFACE: usize = N_ELEV * N_AZ * N_LAMBDA;
+/// Surface-normal nodes of [`LightFieldTable::irradiance`]: polar angles from straight up every
+/// 22.5° (irradiance is the field convolved with a cosine lobe, smooth enough that linear
+/// interpolation over 22.5° is within ≈ 2 %), relative azimuths every 45°.
+pub const N_NORMAL_ELEV: usize = 9;
+pub const N_NORMAL_AZ: usize = 5;
+/// Entries of [`LightFieldTable::irradiance`].
+const N_IRRADIANCE: usize = N_DEPTH * N_NORMAL_ELEV * N_NORMAL_AZ * N_LAMBDA;
 /// Table format version (bump when the solver's output changes, so stale caches are refitted).
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 /// What a table is computed for (also its cache key).
 #[derive(Clone, Debug, PartialEq)]
@@ -193,6 +200,24 @@ pub fn view_node(e: usize, k: usize) -> DVec3 {
     DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
 }
 
+/// The unit surface normal of irradiance node (polar `e`, azimuth `k`), in the sun's frame.
+pub fn normal_node(e: usize, k: usize) -> DVec3 {
+    let th = PI * e as f64 / (N_NORMAL_ELEV - 1) as f64;
+    let ph = PI * k as f64 / (N_NORMAL_AZ - 1) as f64;
+    DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+}
+
+/// Fractional (polar, azimuth) irradiance-node coordinates of a surface normal `n` (world,
+/// unit) for a sun whose horizontal direction is `sun_h` (as [`view_coords`]).
+pub fn normal_coords(n: DVec3, sun_h: DVec3) -> (f64, f64) {
+    let th = n.y.clamp(-1.0, 1.0).acos();
+    let h = DVec3::new(n.x, 0.0, n.z);
+    let hl = h.length();
+    let cos_ph =
+        if hl > 1e-9 && sun_h.length_squared() > 0.5 { (h.dot(sun_h) / hl).clamp(-1.0, 1.0) } else { 1.0 };
+    (th / PI * (N_NORMAL_ELEV - 1) as f64, cos_ph.acos() / PI * (N_NORMAL_AZ - 1) as f64)
+}
+
 /// Polar angle (from straight up, radians) of elevation node `e` (the warp: [`ELEV_WARP`]).
 pub fn elevation_angle(e: usize) -> f64 {
     let t = 2.0 * e as f64 / (N_ELEV - 1) as f64 - 1.0;
@@ -237,6 +262,13 @@ pub struct LightFieldTable {
     /// × the path's attenuation); zero without a floor. Kept apart so that the real-time pass
     /// can leave it out where the mirrored view passes beyond the floor's extent.
     pub surface_floor: Vec<f32>,
+    /// `irradiance[((d·N_NORMAL_ELEV + e)·N_NORMAL_AZ + k)·N_LAMBDA + l]`, per unit sun E⊥:
+    /// the diffuse light's irradiance on a surface at depth node d facing normal node (e, k)
+    /// ([`normal_node`]) — everything but the unscattered sun beam, i.e. the sky's light and
+    /// all scattered light, from every side including below (no occluders: the column is
+    /// empty). The real-time pass lights G-buffer surfaces with it instead of the sky
+    /// stand-in, which reaches only faces turned up (`scene::sky`).
+    pub irradiance: Vec<f32>,
     /// Seconds the solver took (0 when loaded from the cache).
     pub seconds: f64,
 }
@@ -289,6 +321,7 @@ fn basis(n: DVec3) -> (DVec3, DVec3) {
 struct Scores {
     j: Vec<f64>,
     e_d: Vec<f64>,
+    irradiance: Vec<f64>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -303,6 +336,7 @@ fn simulate(
     photons: usize,
     seed: u64,
     views: &[DVec3],
+    normals: &[DVec3],
     floor_albedo: Option<f64>,
     cancel: &AtomicBool,
 ) -> Option<Scores> {
@@ -324,6 +358,7 @@ fn simulate(
     let nv = views.len();
     let mut j = vec![0.0f64; N_DEPTH * nv];
     let mut e_d = vec![0.0f64; N_DEPTH];
+    let mut irr = vec![0.0f64; N_DEPTH * normals.len()];
     let albedo = b / c;
     let sun_d = DVec3::new(-(1.0 - sun_mu * sun_mu).max(0.0).sqrt(), -sun_mu, 0.0);
     for p in 0..photons {
@@ -360,6 +395,7 @@ fn simulate(
                 z_new = 0.0;
                 if scattered {
                     count_down(&edges, &nodes, z, z_new, d, w, &mut e_d);
+                    track(&edges, z, z_new, z / d.y, d, w, normals, &mut irr);
                 }
                 let r = fresnel_reflectance(d.y, n, 1.0);
                 if rng.next() >= r {
@@ -371,6 +407,8 @@ fn simulate(
             }
             if scattered {
                 count_down(&edges, &nodes, z, z_new.min(z_cut), d, w, &mut e_d);
+                let len = if z_new > z_cut { (z_cut - z) / -d.y } else { s };
+                track(&edges, z, z_new.min(z_cut), len, d, w, normals, &mut irr);
             }
             if z_new > z_cut {
                 let Some(rho) = floor_albedo else { break };
@@ -412,14 +450,58 @@ fn simulate(
         }
     }
     let norm = if sky_source { 1.0 } else { sun_mu } / photons as f64;
+    let nn = normals.len();
     for bin in 0..N_DEPTH {
         let dz = edges[bin + 1] - edges[bin];
         for x in &mut j[bin * nv..(bin + 1) * nv] {
             *x *= norm / dz;
         }
+        for x in &mut irr[bin * nn..(bin + 1) * nn] {
+            *x *= norm / dz;
+        }
         e_d[bin] *= norm;
     }
-    Some(Scores { j, e_d })
+    Some(Scores { j, e_d, irradiance: irr })
+}
+
+/// Track-length estimate of the irradiance on every normal node: a path of length `len` from
+/// depth `z0` to `z1` along `d` with weight `w` adds w·ℓ·max(0, −d·n)/Δz to each depth bin it
+/// crosses (ℓ its length inside the bin; the division by Δz happens with the normalisation).
+/// The expectation of w·ℓ/Δz per unit area is the fluence ∫L dω; the cosine turns it into the
+/// irradiance of a surface facing n. Unlike a collision estimator it scores every photon in
+/// flight, so the sky's unscattered light is counted too.
+#[allow(clippy::too_many_arguments)]
+fn track(edges: &[f64], z0: f64, z1: f64, len: f64, d: DVec3, w: f64, normals: &[DVec3], irr: &mut [f64]) {
+    if len <= 0.0 || !len.is_finite() {
+        return;
+    }
+    let (lo, hi) = (z0.min(z1), z0.max(z1));
+    let nn = normals.len();
+    let mut add = |bin: usize, l: f64| {
+        for (x, n) in irr[bin * nn..(bin + 1) * nn].iter_mut().zip(normals) {
+            let cos = -d.dot(*n);
+            if cos > 0.0 {
+                *x += w * l * cos;
+            }
+        }
+    };
+    if hi - lo < 1e-12 {
+        if lo < edges[N_DEPTH] {
+            add(edges.partition_point(|&e| e <= lo).saturating_sub(1).min(N_DEPTH - 1), len);
+        }
+        return;
+    }
+    let first = edges.partition_point(|&e| e <= lo).saturating_sub(1);
+    for bin in first..N_DEPTH {
+        let (a, b) = (edges[bin].max(lo), edges[bin + 1].min(hi));
+        if b <= a {
+            if edges[bin] >= hi {
+                break;
+            }
+            continue;
+        }
+        add(bin, len * (b - a) / (hi - lo));
+    }
 }
 
 /// Adds a downward segment's crossings of the depth nodes' planes (plane irradiance: the
@@ -449,6 +531,8 @@ impl LightFieldTable {
         key.validate()?;
         let t0 = std::time::Instant::now();
         let views: Vec<DVec3> = (0..N_ELEV).flat_map(|e| (0..N_AZ).map(move |k| view_node(e, k))).collect();
+        let normals: Vec<DVec3> =
+            (0..N_NORMAL_ELEV).flat_map(|e| (0..N_NORMAL_AZ).map(move |k| normal_node(e, k))).collect();
         let done = AtomicUsize::new(0);
         let total = 2 * N_LAMBDA;
         let jobs: Vec<(usize, bool)> = (0..N_LAMBDA).flat_map(|l| [(l, false), (l, true)]).collect();
@@ -468,6 +552,7 @@ impl LightFieldTable {
                     // One seed per source, the same at every wavelength node (see the module doc).
                     0x5eed_0000 + sky as u64,
                     &views,
+                    &normals,
                     key.floor.as_ref().map(|f| f.albedo[l]),
                     cancel,
                 );
@@ -477,6 +562,7 @@ impl LightFieldTable {
             .collect();
         let mut j = vec![0.0f32; N_DEPTH * views.len() * N_LAMBDA];
         let mut e_d = vec![0.0f32; N_DEPTH * N_LAMBDA];
+        let mut irradiance = vec![0.0f32; N_IRRADIANCE];
         let mu = key.sun_mu;
         for (&(l, sky), r) in jobs.iter().zip(&results) {
             let Some(r) = r else {
@@ -495,6 +581,16 @@ impl LightFieldTable {
                         j[((d * N_ELEV + e) * N_AZ + k) * N_LAMBDA + l] += (f * x) as f32;
                     }
                 }
+                for e in 0..N_NORMAL_ELEV {
+                    let row = &r.irradiance
+                        [(d * N_NORMAL_ELEV + e) * N_NORMAL_AZ..(d * N_NORMAL_ELEV + e + 1) * N_NORMAL_AZ];
+                    let sky_mean = row.iter().sum::<f64>() / N_NORMAL_AZ as f64;
+                    for (k, &x) in row.iter().enumerate() {
+                        let x = if sky { sky_mean } else { x };
+                        irradiance[((d * N_NORMAL_ELEV + e) * N_NORMAL_AZ + k) * N_LAMBDA + l] +=
+                            (f * x) as f32;
+                    }
+                }
                 let mut ed = f * r.e_d[d];
                 if !sky {
                     // The unscattered beam, in closed form.
@@ -510,6 +606,7 @@ impl LightFieldTable {
             e_d,
             surface: Vec::new(),
             surface_floor: Vec::new(),
+            irradiance,
             seconds: 0.0,
         };
         (table.surface, table.surface_floor) = table.surface_reflection(key);
@@ -591,11 +688,19 @@ impl LightFieldTable {
     }
 
     fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(8 * 5 + 4 * (self.j.len() + self.e_d.len() + 2 * N_SURFACE));
+        let mut out =
+            Vec::with_capacity(8 * 5 + 4 * (self.j.len() + self.e_d.len() + 2 * N_SURFACE + N_IRRADIANCE));
         for x in [VERSION as f64, self.z_max, self.sun_mu, self.j.len() as f64, self.e_d.len() as f64] {
             out.extend_from_slice(&x.to_le_bytes());
         }
-        for x in self.j.iter().chain(&self.e_d).chain(&self.surface).chain(&self.surface_floor) {
+        for x in self
+            .j
+            .iter()
+            .chain(&self.e_d)
+            .chain(&self.surface)
+            .chain(&self.surface_floor)
+            .chain(&self.irradiance)
+        {
             out.extend_from_slice(&x.to_le_bytes());
         }
         out
@@ -610,7 +715,7 @@ impl LightFieldTable {
             || mu != key.sun_mu
             || nj != N_DEPTH * N_ELEV * N_AZ * N_LAMBDA
             || ne != N_DEPTH * N_LAMBDA
-            || b.len() != 40 + 4 * (nj + ne + 2 * N_SURFACE)
+            || b.len() != 40 + 4 * (nj + ne + 2 * N_SURFACE + N_IRRADIANCE)
         {
             return None;
         }
@@ -625,7 +730,8 @@ impl LightFieldTable {
             j: floats[..nj].to_vec(),
             e_d: floats[nj..nj + ne].to_vec(),
             surface: floats[nj + ne..nj + ne + N_SURFACE].to_vec(),
-            surface_floor: floats[nj + ne + N_SURFACE..].to_vec(),
+            surface_floor: floats[nj + ne + N_SURFACE..nj + ne + 2 * N_SURFACE].to_vec(),
+            irradiance: floats[nj + ne + 2 * N_SURFACE..].to_vec(),
             seconds: 0.0,
         })
     }
@@ -644,6 +750,31 @@ impl LightFieldTable {
         let base = (e * N_AZ + k) * N_LAMBDA;
         let v = if floor { &self.surface_floor } else { &self.surface };
         lerp_lambda(&v[base..base + N_LAMBDA], lambda)
+    }
+
+    /// The diffuse irradiance at depth node `d` on normal node (e, k) (see
+    /// [`LightFieldTable::irradiance`]).
+    pub fn irradiance_node(&self, d: usize, e: usize, k: usize, lambda: f64) -> f64 {
+        let base = ((d * N_NORMAL_ELEV + e) * N_NORMAL_AZ + k) * N_LAMBDA;
+        lerp_lambda(&self.irradiance[base..base + N_LAMBDA], lambda)
+    }
+
+    /// The diffuse irradiance per unit sun E⊥ on a surface at depth `z` facing `n` (world,
+    /// unit): bilinear in the normal's polar angle and azimuth, exponential in depth between
+    /// nodes (as E_d) — what the real-time pass reads (`uw_irradiance` in underwater.wgsl).
+    pub fn irradiance_at(&self, z: f64, n: DVec3, sun_h: DVec3, lambda: f64) -> f64 {
+        let (fe, fk) = normal_coords(n, sun_h);
+        let (e0, k0) =
+            ((fe.floor() as usize).min(N_NORMAL_ELEV - 2), (fk.floor() as usize).min(N_NORMAL_AZ - 2));
+        let (te, tk) = (fe - e0 as f64, fk - k0 as f64);
+        let col: [f64; N_DEPTH] = std::array::from_fn(|d| {
+            (1.0 - te)
+                * ((1.0 - tk) * self.irradiance_node(d, e0, k0, lambda)
+                    + tk * self.irradiance_node(d, e0, k0 + 1, lambda))
+                + te * ((1.0 - tk) * self.irradiance_node(d, e0 + 1, k0, lambda)
+                    + tk * self.irradiance_node(d, e0 + 1, k0 + 1, lambda))
+        });
+        log_interp(&col, self.z_max, z)
     }
 
     /// E_d ratio at depth node `d`.
@@ -912,6 +1043,68 @@ mod tests {
                 assert!(sky[0] > 100.0 * tol, "{d} {e}: no sky light {sky:?}");
                 assert!(sky.iter().all(|x| (x - sky[0]).abs() <= tol), "{d} {e}: {sky:?}");
             }
+        }
+    }
+
+    /// The irradiance's track-length estimate against closed forms: water that absorbs but
+    /// does not scatter under a uniform sky, no floor. Below the surface the sky's light
+    /// travels down at the refracted angle θ_w, so a surface facing up at depth z gets
+    /// E = sky·μ·⟨T/T̄·e^{−a·z/cos θ_w}⟩ and one facing sideways ⟨T/T̄·e^{−a·z/cos θ_w}·tan θ_w/π⟩
+    /// (the azimuth mean of max(0, sin θ_w·cos φ) is sin θ_w/π, per unit plane irradiance),
+    /// ⟨·⟩ over the cosine-weighted sky in air; one facing down gets nothing.
+    #[test]
+    fn irradiance_matches_closed_form_without_scattering() {
+        let (a, mu, sky) = (0.08, 0.8, 0.5);
+        let k = |v: f64| Spectrum::Constant(v);
+        let key = LightFieldKey {
+            properties: WaterProperties { a: k(a), b: k(0.0), c: k(a), kd: k(a) },
+            name: "absorbing".into(),
+            sun_mu: mu,
+            sky,
+            z_max: 20.0,
+            g: 0.924,
+            photons: 60_000,
+            floor: None,
+        };
+        let t = LightFieldTable::compute(&key, &|_, _| {}, &AtomicBool::new(false)).unwrap();
+        let n_air = 4000;
+        let t_mean = mean_transmittance(WATER_IOR);
+        let closed = |z: f64, sideways: bool| -> f64 {
+            (0..n_air)
+                .map(|i| {
+                    let cos_a = (i as f64 + 0.5) / n_air as f64;
+                    let tr = 1.0 - fresnel_reflectance(cos_a, 1.0, WATER_IOR);
+                    let sin_w = (1.0 - cos_a * cos_a).sqrt() / WATER_IOR;
+                    let cos_w = (1.0 - sin_w * sin_w).sqrt();
+                    let f = if sideways { sin_w / cos_w / PI } else { 1.0 };
+                    2.0 * cos_a / n_air as f64 * tr / t_mean * (-a * z / cos_w).exp() * f
+                })
+                .sum::<f64>()
+                * sky
+                * mu
+        };
+        let mid = (N_NORMAL_ELEV - 1) / 2;
+        for d in 1..N_DEPTH - 1 {
+            // The table holds the depth bin's mean; compare with the closed form's mean over
+            // the bin (Simpson over its edges and the node).
+            let z = depth_node(d, key.z_max);
+            let (lo, hi) =
+                (0.5 * (depth_node(d - 1, key.z_max) + z), 0.5 * (z + depth_node(d + 1, key.z_max)));
+            let mean = |side| {
+                let m = 0.5 * (lo + hi);
+                (closed(lo, side) + 4.0 * closed(m, side) + closed(hi, side)) / 6.0
+            };
+            let (up, side, down) = (
+                t.irradiance_node(d, 0, 0, 550.0),
+                t.irradiance_node(d, mid, 2, 550.0),
+                t.irradiance_node(d, N_NORMAL_ELEV - 1, 0, 550.0),
+            );
+            assert!((up / mean(false) - 1.0).abs() < 0.01, "depth {z}: up {up} vs {}", mean(false));
+            assert!((side / mean(true) - 1.0).abs() < 0.02, "depth {z}: sideways {side} vs {}", mean(true));
+            assert_eq!(down, 0.0, "nothing travels up");
+            // The lookup between nodes: at a node it is the node.
+            let n = DVec3::new(0.0, 1.0, 0.0);
+            assert!((t.irradiance_at(z, n, DVec3::X, 550.0) / up - 1.0).abs() < 1e-6);
         }
     }
 

@@ -76,16 +76,22 @@ pub struct LookArgs {
     /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance
     /// attenuated by the tabulated Kd, no single scattering).
     #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface",
-          "isotropic", "tabulated_kd", "light_field_photons", "no_water_surface", "no_sea_floor"])]
+          "isotropic", "tabulated_kd", "light_field_photons", "no_water_surface", "no_sea_floor",
+          "no_surface_irradiance"])]
     pub paper_model: bool,
     /// Under water: the paper's isotropic in-scattering term with the tabulated Kd plus the
     /// marched single scattering (the previous default) instead of the light-field source.
-    #[arg(long, conflicts_with_all = ["tabulated_kd", "light_field_photons"])]
+    #[arg(long, conflicts_with_all = ["tabulated_kd", "light_field_photons", "no_surface_irradiance"])]
     pub isotropic: bool,
     /// Under water, light-field model: attenuate surfaces by the type's tabulated Kd instead
     /// of the downwelling irradiance derived from a, b and the phase function.
     #[arg(long)]
     pub tabulated_kd: bool,
+    /// Under water, light-field model: light surfaces as the paper does (the scene's lights
+    /// attenuated by the downwelling irradiance, the sky straight down) instead of with the
+    /// sun's beam plus the water column's diffuse irradiance for each surface's normal.
+    #[arg(long)]
+    pub no_surface_irradiance: bool,
     /// Under water, light-field model: photons per wavelength node and source for the
     /// table's solver (solved once per water type, sun, sky and depth range, then cached).
     #[arg(long, value_name = "N", default_value_t = render::passes::underwater::LIGHT_FIELD_PHOTONS)]
@@ -159,6 +165,7 @@ impl LookArgs {
                 light_field: !(self.isotropic || self.scalar_irradiance || self.split_beams),
                 sea_floor: !self.no_sea_floor,
                 tabulated_kd: self.tabulated_kd,
+                irradiance: !(self.no_surface_irradiance || self.tabulated_kd),
                 photons: self.light_field_photons,
             }
         };

@@ -55,6 +55,7 @@ impl WaterControls {
             || self.options.surface != applied.options.surface
             || self.options.light_field != applied.options.light_field
             || self.options.tabulated_kd != applied.options.tabulated_kd
+            || self.options.irradiance != applied.options.irradiance
             // The light-field table depends on g, the floor and the depth range it covers.
             || (self.options.light_field
                 && (self.options.phase_g != applied.options.phase_g
@@ -90,6 +91,10 @@ impl WaterControls {
         let o = &mut self.options;
         ui.checkbox(&mut o.light_field, "light-field source (off: the paper's isotropic term)");
         ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.tabulated_kd, "tabulated Kd on surfaces"));
+        ui.add_enabled(
+            o.light_field && !o.tabulated_kd,
+            egui::Checkbox::new(&mut o.irradiance, "surfaces lit by the column's irradiance"),
+        );
         ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.sea_floor, "sea floor lights the water"));
         ui.add(egui::Slider::new(&mut o.steps, 0..=MAX_STEPS).text("march steps (0 = off)"));
         ui.add_enabled(o.steps > 0, egui::Slider::new(&mut o.phase_g, 0.0..=0.99).text("phase g"));
