@@ -533,7 +533,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
     let table = common::table();
     let mut tally = Tally::default();
     // The last case: surfaces attenuated by the column's E_d (the option without the
-    // irradiance term).
+    // irradiance term), no forward cone.
     for (ty, depth, scale, floor, irradiance) in [
         ("IB", 5.0, 1.0, false, true),
         ("3C", 12.0, 0.5, true, true),
@@ -550,7 +550,10 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                 extent: Some([-FX, -FZ, FX, 2.0]),
             });
         }
-        let options = underwater::Options { photons: 400, irradiance, ..Default::default() };
+        // The last case also without the forward cone (view rays attenuated by c itself).
+        let forward_cone_deg = if irradiance { underwater::FORWARD_CONE_DEG } else { 0.0 };
+        let options =
+            underwater::Options { photons: 400, irradiance, forward_cone_deg, ..Default::default() };
         let [lf, deep] = underwater::light_field_tables(&medium, &options).unwrap();
         assert_eq!(lf.z_max, deep.z_max, "both tables share the depth nodes");
         for lambda in [430.0, 500.0, 575.0, 640.0] {
@@ -563,6 +566,9 @@ fn light_field_hook_matches_cpu_to_1e_3() {
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
             let k = medium.coefficients(lambda);
+            // Along view rays the light-field model attenuates by c minus the forward cone's
+            // scattering (the table's key says how much).
+            let cv = underwater::light_field_key(&medium, &options).view_attenuation(k.a, k.b);
             let to_sun = -light_dir().as_dvec3();
             let sun_h = DVec3::new(to_sun.x, 0.0, to_sun.z).normalize();
             let ed = |t: &scene::water::light_field::LightFieldTable| -> [f64; scene::water::light_field::N_DEPTH] {
@@ -613,9 +619,9 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                         }
                         te
                     });
-                    let table_part = e_sun * ray_integral_by(&col_at, lf.z_max, k.c, depth, w.y, d, cut);
+                    let table_part = e_sun * ray_integral_by(&col_at, lf.z_max, cv, depth, w.y, d, cut);
                     let beam_part =
-                        single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
+                        single::beam_view(k.b, k.c, cv, options.phase_g as f64, to_sun, e_sun, w, depth, d);
                     let scatter = table_part + beam_part;
                     let i = (py * W + px) as usize;
                     let reach = if hit.is_none() && w.y > 0.0 {
@@ -638,9 +644,9 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                             let mu = -light_dir().y as f64;
                             if irradiance {
                                 let diffuse = t.irradiance_at(zs, DVec3::Y, sun_h, lambda) / mu;
-                                dry * (((-k.c * zs / mu).exp() + diffuse) * (-k.c * d).exp())
+                                dry * (((-k.c * zs / mu).exp() + diffuse) * (-cv * d).exp())
                             } else {
-                                dry * (log_interp(&ed(t), lf.z_max, zs) * (-k.c * d).exp())
+                                dry * (log_interp(&ed(t), lf.z_max, zs) * (-cv * d).exp())
                             }
                         }
                         // Looking up at the surface: what it reflects (the table's), attenuated
@@ -652,7 +658,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                             } else {
                                 deep.surface_at(w, sun_h, lambda, false)
                             };
-                            unit * (e_sun * r * (-k.c * d).exp())
+                            unit * (e_sun * r * (-cv * d).exp())
                         }
                         None => DVec3::ZERO,
                     };

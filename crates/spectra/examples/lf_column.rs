@@ -423,12 +423,14 @@ fn predict(t: &LightFieldTable, m: &WaterMedium, v: DVec3, sun_h: DVec3, lambda:
     } else {
         f64::INFINITY
     };
-    let diffuse = ray_integral(&t.j_column(v, sun_h, lambda), t.z_max, k.c, z0, v.y, d);
-    let beam = single::beam(k.b, k.c, g, to_sun, 1.0, v, z0, d);
+    // View rays: c minus the forward cone's scattering, as the real-time pass.
+    let cv = underwater::light_field_key(m, &Options::default()).view_attenuation(k.a, k.b);
+    let diffuse = ray_integral(&t.j_column(v, sun_h, lambda), t.z_max, cv, z0, v.y, d);
+    let beam = single::beam_view(k.b, k.c, cv, g, to_sun, 1.0, v, z0, d);
     if let Some(f) = floor.filter(|_| v.y < -1e-9) {
         // The Lambertian floor lit by the table's downwelling irradiance, per unit sun E⊥.
         let e_d = t.attenuation(t.z_max, lambda) * to_sun.y * (1.0 + m.sky);
-        let seen = f.albedo.eval(lambda) / std::f64::consts::PI * e_d * (-k.c * d).exp();
+        let seen = f.albedo.eval(lambda) / std::f64::consts::PI * e_d * (-cv * d).exp();
         return [diffuse, beam, seen];
     }
     let surface = if d.is_finite() {
@@ -440,12 +442,12 @@ fn predict(t: &LightFieldTable, m: &WaterMedium, v: DVec3, sun_h: DVec3, lambda:
         let mirror = DVec3::new(v.x, -v.y, v.z);
         if floor.is_some() {
             // The floored table's own reflection (water and floor), as the real-time pass reads it.
-            return [diffuse, beam, (sky + t.surface_at(v, sun_h, lambda, true)) * (-k.c * d).exp()];
+            return [diffuse, beam, (sky + t.surface_at(v, sun_h, lambda, true)) * (-cv * d).exp()];
         }
         let below =
-            ray_integral(&t.j_column(mirror, sun_h, lambda), t.z_max, k.c, 0.0, mirror.y, f64::INFINITY)
-                + single::beam(k.b, k.c, g, to_sun, 1.0, mirror, 0.0, f64::INFINITY);
-        (sky + (1.0 - tr) * below) * (-k.c * d).exp()
+            ray_integral(&t.j_column(mirror, sun_h, lambda), t.z_max, cv, 0.0, mirror.y, f64::INFINITY)
+                + single::beam_view(k.b, k.c, cv, g, to_sun, 1.0, mirror, 0.0, f64::INFINITY);
+        (sky + (1.0 - tr) * below) * (-cv * d).exp()
     } else {
         0.0
     };

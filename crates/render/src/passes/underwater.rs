@@ -93,6 +93,11 @@ pub struct Options {
     /// the downwelling E_d with the sky stand-in straight down (which leaves vertical and
     /// downward faces without the water's sideways and upwelling light).
     pub irradiance: bool,
+    /// With `light_field`: half-angle (degrees) of the forward cone whose scattering the table
+    /// leaves out of its source term and view rays treat as not scattering (attenuation
+    /// c − f·b): objects seen through turbid water keep their image instead of washing out
+    /// into the open water's light (`light_field::LightFieldKey::forward_cone`). 0 = off.
+    pub forward_cone_deg: f32,
     /// Photons per wavelength node and source of the light-field solver.
     pub photons: usize,
     /// With `light_field`, close the column with the medium's sea floor
@@ -100,6 +105,13 @@ pub struct Options {
     /// water is in the table; off (or no floor found) = a bottomless column.
     pub sea_floor: bool,
 }
+
+/// Default forward cone of the light-field model (degrees). Why 10°: light a view ray gathers
+/// from within 10° of its own direction comes, on average, from within 5° of where the ray
+/// looks (the scattering point lies anywhere between camera and object), which is inside the
+/// image of any object larger than ~10° on screen; with the truth's phase function (HG 0.924)
+/// the cone holds 61 % of the scattering. `docs/underwater.md` sweeps it (0, 5, 10, 20°).
+pub const FORWARD_CONE_DEG: f32 = 10.0;
 
 /// Default photons of the light-field solver (per wavelength node and source).
 pub const LIGHT_FIELD_PHOTONS: usize = 8000;
@@ -115,6 +127,7 @@ impl Default for Options {
             light_field: true,
             tabulated_kd: false,
             irradiance: true,
+            forward_cone_deg: FORWARD_CONE_DEG,
             photons: LIGHT_FIELD_PHOTONS,
             sea_floor: true,
         }
@@ -158,6 +171,9 @@ impl Options {
             return Err("split beams and scalar irradiance change the paper's isotropic term; \
                         they need the isotropic model (--isotropic)"
                 .into());
+        }
+        if !(self.forward_cone_deg.is_finite() && (0.0..=45.0).contains(&self.forward_cone_deg)) {
+            return Err(format!("forward cone must be 0…45°, got {}", self.forward_cone_deg));
         }
         if self.light_field && !(1..=10_000_000).contains(&self.photons) {
             return Err(format!("light-field photons must be 1..=10000000, got {}", self.photons));
@@ -225,6 +241,7 @@ pub fn light_field_key(medium: &WaterMedium, options: &Options) -> light_field::
         g: options.phase_g as f64,
         photons: options.photons,
         floor: floor.map(|f| f.1),
+        forward_cone: if options.light_field { (options.forward_cone_deg as f64).to_radians() } else { 0.0 },
     }
 }
 
@@ -370,6 +387,16 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
         set("const UW_ELEV_INV_WARP: f32 = 0.6666667;", format!("{:?}", (1.0 / ELEV_WARP) as f32));
     }
     set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
+    {
+        // The forward-scattered fraction along view rays (light-field model only).
+        let f = if options.light_field {
+            let cone = (options.forward_cone_deg as f64).to_radians();
+            scene::water::single::forward_fraction(options.phase_g as f64, cone)
+        } else {
+            0.0
+        };
+        set("const UW_FWD: f32 = 0.0;", format!("{:?}", f as f32));
+    }
     set(
         "const UW_IRRADIANCE: bool = true;",
         (options.light_field && options.irradiance && !options.tabulated_kd).to_string(),

@@ -39,6 +39,10 @@ const UW_TABLE_KD: bool = true;
 // irradiance for their normal (light_field::LightFieldTable::irradiance), the sky stand-ins
 // left out (their light is in the table): `Options::irradiance`.
 const UW_IRRADIANCE: bool = true;
+// Fraction f of the scattering within the light-field model's forward cone
+// (light_field::LightFieldKey::forward_cone; 0 for the other models): view rays are attenuated
+// by c − f·b, and the table's J leaves that scattering out.
+const UW_FWD: f32 = 0.0;
 const UW_ZMAX: f32 = 40.0;
 // The table's layout, written by `underwater::shader_with` from scene::water::light_field
 // (N_DEPTH, N_ELEV, N_AZ, 1/ELEV_WARP): one home for the numbers.
@@ -90,6 +94,9 @@ var<private> uw_w: array<f32, 128>;
 // Directional slots whose every march sample is lit: their sum has a closed form.
 var<private> uw_lit: array<bool, UW_SS_LIGHTS>;
 var<private> uw_s: array<f32, 128>;
+// Point/spot slots: the view part of `uw_s` (metres from the camera), attenuated by c − f·b
+// instead of c.
+var<private> uw_tv: array<f32, 128>;
 // Path length (m) to the hit or the surface, and whether the ray runs forever.
 var<private> uw_d: f32 = 0.0;
 var<private> uw_infinite: bool = false;
@@ -411,12 +418,13 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
 
 // The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
 // camera (× e^{−c·d}), in weighted form.
-fn uw_surface_irradiance(c: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
+fn uw_surface_irradiance(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
     uw_prepare(ctx);
     let z0 = custom.params[0].x;
     let zs = max(z0 - uw_d * ctx.view_dir.y, 0.0);
     let hit = ctx.origin + ctx.view_dir * ctx.distance;
-    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb) * exp(-c * uw_d);
+    let cv = c - UW_FWD * b;
+    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb) * exp(-cv * uw_d);
     var total = UW_ZERO;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         let l = lights[li].pos_kind;
@@ -433,12 +441,13 @@ fn custom_light_surface(li: u32, ctx: SurfaceContext) -> f32 {
 
 fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
     if (!UW_IRRADIANCE) { return UW_ZERO; }
-    return uw_surface_irradiance(custom_spectra[group * 4u + 1u], group, false, ctx);
+    return uw_surface_irradiance(custom_spectra[group * 4u + 0u], custom_spectra[group * 4u + 1u], group, false, ctx);
 }
 
 fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
     if (!UW_IRRADIANCE) { return vec3<f32>(0.0); }
-    return uw_surface_irradiance(vec4<f32>(custom.params[1].xyz, 1.0), 0u, true, ctx)[0].rgb;
+    let b = vec4<f32>(custom.params[3].xyz, 1.0);
+    return uw_surface_irradiance(b, vec4<f32>(custom.params[1].xyz, 1.0), 0u, true, ctx)[0].rgb;
 }
 
 // E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
@@ -519,6 +528,7 @@ fn uw_prepare(ctx: SurfaceContext) {
                 let v = light_visibility(li, x, vec3<f32>(0.0));
                 uw_w[n * UW_MAX_STEPS + k] = scale * uw_hg(g, dot(inc.xyz, w)) * v * inc.w * r * r * dth / h;
                 uw_s[n * UW_MAX_STEPS + k] = scale * (r + t);
+                uw_tv[n * UW_MAX_STEPS + k] = scale * t;
             }
             uw_dir[n] = vec4<f32>(0.0);
         }
@@ -528,22 +538,24 @@ fn uw_prepare(ctx: SurfaceContext) {
     uw_n = n;
 }
 
-// Single scattering of every marched light, at the wavelengths of `c`.
-fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> mat3x4<f32> {
+// Single scattering of every marched light, at the wavelengths of `c`; the scattered light
+// travels to the camera with `cv` (c − f·b), the light to the scattering point with c.
+fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb: bool) -> mat3x4<f32> {
     var total = UW_ZERO;
+    let dc = c - cv;
     for (var j = 0u; j < uw_n; j++) {
         var sum = vec4<f32>(0.0);
         let dir = uw_dir[j];
         let base = j * UW_MAX_STEPS;
         if (dir.y > 0.0 && uw_lit[j]) {
             // Directional, nothing in the way: the whole ray in closed form.
-            let cq = c * dir.x;
+            let cq = c * dir.x - dc;
             sum = uw_w[base] * exp(-c * uw_s[base]) * uw_ray_integral(cq);
         } else if (dir.y > 0.0) {
             // Directional: the optical path grows by dt·q per segment, so the attenuations
             // form a geometric sequence (two exponentials per group instead of one per step);
             // each segment's exponential is integrated exactly, the tail unshadowed.
-            let cq = c * dir.x;
+            let cq = c * dir.x - dc;
             let ratio = exp(-cq * dir.y);
             var att = exp(-c * uw_s[base]);
             for (var k = 0u; k < uw_steps; k++) {
@@ -552,11 +564,12 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool) -> mat3x
             }
             sum = sum * uw_path_integral(cq, dir.y);
             if (dir.z > 0.0) {
-                sum += dir.z * exp(-c * dir.w) / cq;
+                // The tail starts dir.y·steps metres along the view.
+                sum += dir.z * exp(-c * dir.w + dc * (dir.y * f32(uw_steps))) / cq;
             }
         } else {
             for (var k = 0u; k < uw_steps; k++) {
-                sum = fma(vec4<f32>(uw_w[base + k]), exp(-c * uw_s[base + k]), sum);
+                sum = fma(vec4<f32>(uw_w[base + k]), exp(-c * uw_s[base + k] + dc * uw_tv[base + k]), sum);
             }
         }
         total += s3_scale(uw_emission(uw_light[j], group, rgb), b * sum);
@@ -642,14 +655,16 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
     let z0 = custom.params[0].x;
+    // Along the view: c minus the forward cone's scattering (light-field model; = c otherwise).
+    let cv = c - UW_FWD * b;
     var l: mat3x4<f32>;
     if (UW_TABLE) {
-        l = uw_table_in_scatter(c, group, rgb, wy);
+        l = uw_table_in_scatter(cv, group, rgb, wy);
     } else {
         l = uw_in_scatter(b, c, kd, group, rgb, wy, z0, uw_d, uw_infinite);
     }
     if (UW_MARCH) {
-        l += uw_single_scatter(b, c, group, rgb);
+        l += uw_single_scatter(b, c, cv, group, rgb);
     }
     if (UW_SURFACE && ctx.background && wy > 0.0) {
         // Where the mirrored view meets the floor's plane (the table ends at the floor, UW_ZMAX
@@ -657,7 +672,7 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
         let hw = vec2<f32>(ctx.view_dir.x, ctx.view_dir.z) * ((z0 + UW_ZMAX) / (wy * custom.params[0].y));
         let p = vec2<f32>(ctx.origin.x, ctx.origin.z) + hw;
         let on_floor = all(p >= UW_FLOOR_BOX.xy) && all(p <= UW_FLOOR_BOX.zw);
-        l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy, on_floor), exp(-c * uw_d));
+        l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy, on_floor), exp(-cv * uw_d));
     }
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
@@ -670,7 +685,7 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
             let hit = ctx.origin + ctx.view_dir * ctx.distance;
             att = uw_table_attenuation(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb);
         }
-        l += s3_scale(radiance, att * exp(-c * uw_d));
+        l += s3_scale(radiance, att * exp(-cv * uw_d));
     }
     return l;
 }

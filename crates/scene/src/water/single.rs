@@ -35,6 +35,40 @@ fn ray_integral(k: f64, d: f64) -> f64 {
     if d.is_infinite() { 1.0 / k } else { path_integral(k, d) }
 }
 
+/// Fraction of Henyey–Greenstein scattering (asymmetry `g`) within `cone` radians of the
+/// forward direction: ∫ p dω over the cap, (1 − g²)/(2g)·[1/(1 − g) − 1/√(1 + g² − 2g·cos cone)]
+/// (cone/π-free closed form of the HG cumulative; isotropic limit (1 − cos cone)/2).
+pub fn forward_fraction(g: f64, cone: f64) -> f64 {
+    if cone <= 0.0 {
+        return 0.0;
+    }
+    let mc = cone.cos();
+    if g.abs() < 1e-6 {
+        return 0.5 * (1.0 - mc);
+    }
+    ((1.0 - g * g) / (2.0 * g) * (1.0 / (1.0 - g) - 1.0 / (1.0 + g * g - 2.0 * g * mc).sqrt()))
+        .clamp(0.0, 1.0)
+}
+
+/// [`beam`] with the scattered light attenuated towards the camera by `c_view` instead of c
+/// (the light-field model's view attenuation, c minus the forward-scattered part: see
+/// `light_field::LightFieldKey::forward_cone`); the beam itself still decays with c.
+#[allow(clippy::too_many_arguments)]
+pub fn beam_view(
+    b: f64,
+    c: f64,
+    c_view: f64,
+    g: f64,
+    to_light: DVec3,
+    e_perp: f64,
+    w: DVec3,
+    z0: f64,
+    d: f64,
+) -> f64 {
+    let mu = to_light.y;
+    b * hg_phase(g, to_light.dot(w)) * e_perp * (-c * z0 / mu).exp() * ray_integral(c_view - c * w.y / mu, d)
+}
+
 /// Single scattering of a directional beam, unshadowed, in closed form:
 /// `∫₀ᵈ b·p(l·ω)·E·e^{−c·(z0 − t·ω_y)/μ}·e^{−c·t} dt = b·p·E·e^{−c·z0/μ}·I(c·(1 − ω_y/μ))`.
 /// `to_light` is the unit direction towards the light under water (μ = y > 0), `e_perp` its

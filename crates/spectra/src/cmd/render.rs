@@ -77,7 +77,7 @@ pub struct LookArgs {
     /// attenuated by the tabulated Kd, no single scattering).
     #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface",
           "isotropic", "tabulated_kd", "light_field_photons", "no_water_surface", "no_sea_floor",
-          "no_surface_irradiance"])]
+          "no_surface_irradiance", "forward_cone"])]
     pub paper_model: bool,
     /// Under water: the paper's isotropic in-scattering term with the tabulated Kd plus the
     /// marched single scattering (the previous default) instead of the light-field source.
@@ -92,6 +92,11 @@ pub struct LookArgs {
     /// sun's beam plus the water column's diffuse irradiance for each surface's normal.
     #[arg(long)]
     pub no_surface_irradiance: bool,
+    /// Under water, light-field model: half-angle (degrees, 0–45) of the forward cone whose
+    /// scattering view rays treat as not scattering (objects keep their image through turbid
+    /// water); 0 = the plain source term.
+    #[arg(long, value_name = "DEG", default_value_t = render::passes::underwater::FORWARD_CONE_DEG)]
+    pub forward_cone: f32,
     /// Under water, light-field model: photons per wavelength node and source for the
     /// table's solver (solved once per water type, sun, sky and depth range, then cached).
     #[arg(long, value_name = "N", default_value_t = render::passes::underwater::LIGHT_FIELD_PHOTONS)]
@@ -166,6 +171,7 @@ impl LookArgs {
                 sea_floor: !self.no_sea_floor,
                 tabulated_kd: self.tabulated_kd,
                 irradiance: !(self.no_surface_irradiance || self.tabulated_kd),
+                forward_cone_deg: self.forward_cone,
                 photons: self.light_field_photons,
             }
         };

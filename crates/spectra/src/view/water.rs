@@ -56,6 +56,7 @@ impl WaterControls {
             || self.options.light_field != applied.options.light_field
             || self.options.tabulated_kd != applied.options.tabulated_kd
             || self.options.irradiance != applied.options.irradiance
+            || self.options.forward_cone_deg != applied.options.forward_cone_deg
             // The light-field table depends on g, the floor and the depth range it covers.
             || (self.options.light_field
                 && (self.options.phase_g != applied.options.phase_g
@@ -94,6 +95,10 @@ impl WaterControls {
         ui.add_enabled(
             o.light_field && !o.tabulated_kd,
             egui::Checkbox::new(&mut o.irradiance, "surfaces lit by the column's irradiance"),
+        );
+        ui.add_enabled(
+            o.light_field,
+            egui::Slider::new(&mut o.forward_cone_deg, 0.0..=45.0).step_by(1.0).text("forward cone °"),
         );
         ui.add_enabled(o.light_field, egui::Checkbox::new(&mut o.sea_floor, "sea floor lights the water"));
         ui.add(egui::Slider::new(&mut o.steps, 0..=MAX_STEPS).text("march steps (0 = off)"));
