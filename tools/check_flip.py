@@ -11,6 +11,10 @@ C++ FLIP through nanobind), read by crates/compare/tests/flip_reference.rs:
 The FLIP repository's own example pair (images/reference.png, test.png; published LDR mean
 0.159691) is not used: the example images are 4 MB, too large for the test data.
 
+With --large SPECTRA (the path of a built `spectra` binary), it also compares `spectra diff
+--metric flip` with the reference on a 1280×720 pair it writes to a temporary directory (EXR
+for HDR-FLIP, 8-bit PNG for LDR-FLIP), means to 1e-6, and prints both times.
+
 Run: python3 tools/check_flip.py (what `cargo xtask test` does) checks that a fresh run of the
 reference implementation reproduces the checked-in expectations (mean to 1e-6, map to 1e-6);
 with --write it regenerates them.
@@ -76,7 +80,49 @@ def evaluate(ref8, test8):
     return np.asarray(err, np.float64).reshape(H, W), float(mean)
 
 
+def large(spectra):
+    """1280×720: a render-sized pair through the whole command line, files and all."""
+    import tempfile
+    import time
+    import OpenEXR
+    from PIL import Image
+
+    h, w = 720, 1280
+    rng = np.random.default_rng(7)
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    ref = np.stack([0.2 + 0.6 * x / w, 0.1 + 0.5 * y / h, 0.3 + 0.2 * np.sin(x / 13) * np.cos(y / 17)], -1).astype(np.float32)
+    ref += (6 * np.exp(-((x - 400) ** 2 + (y - 300) ** 2) / 2000.0))[..., None] * np.array([1, 0.9, 0.8], np.float32)
+    test = np.clip(ref * (1 + rng.normal(0, 0.05, ref.shape)), 0, None).astype(np.float32)
+
+    def srgb8(a):
+        a = np.clip(a, 0, 1)
+        return np.round(np.where(a <= 0.0031308, 12.92 * a, 1.055 * a ** (1 / 2.4) - 0.055) * 255).astype(np.uint8)
+
+    ok = True
+    with tempfile.TemporaryDirectory() as d:
+        p = lambda n: os.path.join(d, n)
+        for n, a in (("r", ref), ("t", test)):
+            with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": a}) as f:
+                f.write(p(n + ".exr"))
+            Image.fromarray(srgb8(a)).save(p(n + ".png"))
+        for kind, ext in (("HDR", "exr"), ("LDR", "png")):
+            t0 = time.time()
+            _, want, _ = flip.evaluate(p("r." + ext), p("t." + ext), kind, applyMagma=False)
+            t1 = time.time()
+            out = subprocess.run([spectra, "diff", p("r." + ext), p("t." + ext), "--metric", "flip", "--json"],
+                                 check=True, capture_output=True, text=True).stdout
+            t2 = time.time()
+            got = json.loads(out)["flip"]["mean"]
+            good = abs(got - want) <= 1e-6
+            ok &= good
+            print(f"check_flip: 1280×720 {kind}-FLIP mean: spectra {got:.6f} ({t2 - t1:.1f} s with ΔE2000), "
+                  f"reference {want:.6f} ({t1 - t0:.1f} s): {'ok' if good else 'FAIL'}")
+    return ok
+
+
 def main():
+    if "--large" in sys.argv:
+        return 0 if large(sys.argv[sys.argv.index("--large") + 1]) else 1
     ref8, test8 = images()
     err, mean = evaluate(ref8, test8)
     href, htest = hdr_images()
