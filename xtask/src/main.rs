@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 const VULKAN_PACKAGES: &[&str] = &["mesa-vulkan-drivers", "libvulkan1"];
-const PYTHON_PACKAGES: &[&str] = &["colour-science==0.4.7", "scipy", "mitsuba", "OpenEXR==3.5.3"];
+const PYTHON_PACKAGES: &[&str] =
+    &["colour-science==0.4.7", "scipy", "mitsuba", "OpenEXR==3.5.3", "flip-evaluator==1.7"];
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -119,8 +120,8 @@ fn setup_vulkan() -> Result {
     apt_install(VULKAN_PACKAGES)
 }
 
-/// `nv-flip` (FLIP in `compare`) compiles NVIDIA's C++ reference: install a C++ compiler when
-/// there is none.
+/// `compare`'s build compiles NVIDIA's FLIP reference implementation (C++, vendored in
+/// crates/compare/flip): install a C++ compiler when there is none.
 fn setup_cxx() -> Result {
     let cxx = std::env::var("CXX").unwrap_or_else(|_| "c++".into());
     if Command::new(&cxx).arg("--version").output().map(|o| o.status.success()).unwrap_or(false) {

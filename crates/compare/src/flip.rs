@@ -1,18 +1,113 @@
-//! FLIP (Andersson et al. 2020, "FLIP: A Difference Evaluator for Alternating Images"):
-//! NVIDIA's perceptual difference of rendered images, as LDR-FLIP, through the `nv-flip` crate,
-//! which compiles the reference C++ implementation (BSD-3-Clause) it vendors.
+//! FLIP (Andersson et al. 2020, "FLIP: A Difference Evaluator for Alternating Images"; HDR-FLIP,
+//! Andersson et al. 2021): NVIDIA's perceptual difference of rendered images, computed by NVIDIA's
+//! own reference implementation (flip/FLIP.h of `flip-evaluator` 1.7, BSD-3-Clause, compiled by
+//! build.rs) through the small C ABI in flip/flip_capi.cpp. Nothing of FLIP is re-implemented
+//! here: this module only validates inputs and prepares them the way the reference's Python
+//! `evaluate` does, so the maps and means are the reference's.
 //!
-//! LDR-FLIP compares display-encoded sRGB images in [0, 1]: our linear images are clamped and
-//! encoded to 8-bit sRGB exactly as a PNG output is ([`crate::io::to_display`]), so FLIP of two
-//! images read from PNG sees the files' own codes. HDR-FLIP (tone mapping over a range of
-//! exposures) is not offered: `nv-flip` wraps LDR-FLIP only.
+//! - LDR-FLIP compares display-encoded sRGB images in [0, 1]: our linear images are clamped and
+//!   encoded to 8-bit sRGB exactly as a PNG output is ([`crate::io::to_display`]), so FLIP of two
+//!   images read from PNG sees the files' own codes, and FLIP decodes them with its own function.
+//! - HDR-FLIP takes linear images, exposes them over a range of exposures, tone maps each (ACES
+//!   by default), and keeps each pixel's worst LDR-FLIP. Without user exposures the range comes
+//!   from the reference image as in the reference tool: from its brightest pixel to its median
+//!   luminance.
 
 use crate::error::{CompareError, Result};
 use crate::image::Image;
 
+unsafe extern "C" {
+    fn spectra_flip_exposures(
+        reference: *const f32,
+        width: i32,
+        height: i32,
+        tonemapper: i32,
+        start: *mut f32,
+        stop: *mut f32,
+    ) -> i32;
+    fn spectra_flip_evaluate(
+        reference: *const f32,
+        test: *const f32,
+        width: i32,
+        height: i32,
+        use_hdr: i32,
+        srgb_input: i32,
+        ppd: f32,
+        start_exposure: f32,
+        stop_exposure: f32,
+        num_exposures: i32,
+        tonemapper: i32,
+        map_out: *mut f32,
+        mean_out: *mut f32,
+        num_exposures_used: *mut i32,
+    ) -> i32;
+    fn spectra_flip_magma(values: *const f32, count: i32, rgb_out: *mut f32);
+}
+
 /// Pixels per degree of visual angle of the reference implementation's default viewing setup
-/// (a 0.7 m wide 4K monitor at 0.7 m).
-pub const DEFAULT_PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+/// (a 0.7 m wide 4K monitor at 0.7 m): 0.7 · 3840 / 0.7 · π / 180, in f32 as FLIP.h computes it
+/// (its π, 3.14159265358979f, is the same f32).
+pub const DEFAULT_PIXELS_PER_DEGREE: f32 = 0.7 * (3840.0 / 0.7) * (std::f32::consts::PI / 180.0);
+
+/// HDR-FLIP's tone mapper (the reference's `--tone-mapper`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ToneMapper {
+    Reinhard,
+    #[default]
+    Aces,
+    Hable,
+}
+
+impl ToneMapper {
+    /// By the reference tool's names: `aces`, `reinhard`, `hable`.
+    pub fn by_name(name: &str) -> Result<ToneMapper> {
+        match name.to_ascii_lowercase().as_str() {
+            "aces" => Ok(ToneMapper::Aces),
+            "reinhard" => Ok(ToneMapper::Reinhard),
+            "hable" => Ok(ToneMapper::Hable),
+            _ => Err(CompareError::InvalidOption(format!(
+                "tone mapper {name:?}: FLIP has aces (default), reinhard and hable"
+            ))),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMapper::Reinhard => "reinhard",
+            ToneMapper::Aces => "aces",
+            ToneMapper::Hable => "hable",
+        }
+    }
+
+    fn code(self) -> i32 {
+        match self {
+            ToneMapper::Reinhard => 0,
+            ToneMapper::Aces => 1,
+            ToneMapper::Hable => 2,
+        }
+    }
+}
+
+/// HDR-FLIP settings; `None` means the reference implementation's default.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HdrOptions {
+    /// First exposure (log2 stops); default from the reference image's brightest pixel.
+    pub start_exposure: Option<f32>,
+    /// Last exposure; default from the reference image's median luminance.
+    pub stop_exposure: Option<f32>,
+    /// Number of exposures; default ⌈stop − start⌉, at least 2.
+    pub exposures: Option<u32>,
+    pub tone_mapper: ToneMapper,
+}
+
+/// The exposures HDR-FLIP used.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Exposures {
+    pub start: f32,
+    pub stop: f32,
+    pub count: u32,
+    pub tone_mapper: &'static str,
+}
 
 /// A per-pixel FLIP error map, values in [0, 1], row-major from the top-left.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,18 +115,27 @@ pub struct FlipMap {
     pub width: u32,
     pub height: u32,
     pub values: Vec<f32>,
+    /// The mean as the reference computes it (a running f32 sum), so it equals the number the
+    /// reference tool prints.
+    mean: f32,
+    /// For HDR-FLIP, the exposures used; `None` for LDR-FLIP.
+    pub exposures: Option<Exposures>,
 }
 
 impl FlipMap {
     /// Mean FLIP over the image, the number the reference tool reports as "Mean".
     pub fn mean(&self) -> f64 {
-        self.values.iter().map(|&v| f64::from(v)).sum::<f64>() / self.values.len().max(1) as f64
+        f64::from(self.mean)
     }
 
-    /// The map coloured with the reference implementation's magma lookup table, as RGB8.
+    /// The map coloured with the reference implementation's magma lookup table, as RGB8 (the
+    /// reference tool's PNG rounding).
     pub fn magma(&self) -> Vec<u8> {
-        let map = nv_flip::FlipImageFloat::with_data(self.width, self.height, &self.values);
-        map.apply_color_lut(&nv_flip::magma_lut()).to_vec()
+        let mut rgb = vec![0f32; self.values.len() * 3];
+        // SAFETY: `values` has `len` floats and `rgb` three times as many, as the callee reads
+        // and writes; the count fits an i32 (checked when the map was made).
+        unsafe { spectra_flip_magma(self.values.as_ptr(), self.values.len() as i32, rgb.as_mut_ptr()) };
+        rgb.iter().map(|&c| (255.0 * c.clamp(0.0, 1.0) + 0.5) as u8).collect()
     }
 
     /// Writes the magma-coloured map as PNG, atomically.
@@ -48,12 +152,8 @@ impl FlipMap {
     }
 }
 
-fn srgb8(image: &Image) -> Vec<u8> {
-    image.data.iter().flat_map(|p| p.map(|v| (crate::io::to_display(v) * 255.0).round() as u8)).collect()
-}
-
-/// LDR-FLIP of `test` against `reference` (same size, finite pixels) at `pixels_per_degree`.
-pub fn ldr_flip(reference: &Image, test: &Image, pixels_per_degree: f32) -> Result<FlipMap> {
+/// Checks what FLIP needs of a pair and returns the size as the C side's ints.
+fn check_pair(reference: &Image, test: &Image, pixels_per_degree: f32) -> Result<(i32, i32)> {
     reference.validate()?;
     test.validate()?;
     if reference.size() != test.size() {
@@ -67,10 +167,123 @@ pub fn ldr_flip(reference: &Image, test: &Image, pixels_per_degree: f32) -> Resu
         )));
     }
     let (w, h) = reference.size();
-    let r = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(reference));
-    let t = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(test));
-    let map = nv_flip::flip(r, t, pixels_per_degree);
-    Ok(FlipMap { width: w, height: h, values: map.to_vec() })
+    // FLIP.h indexes with int: keep 3 · pixels within i32.
+    if u64::from(w) * u64::from(h) * 3 > i32::MAX as u64 {
+        return Err(CompareError::InvalidImage(format!("{w}×{h} is too large for FLIP")));
+    }
+    Ok((w as i32, h as i32))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn evaluate(
+    reference: &[f32],
+    test: &[f32],
+    (w, h): (i32, i32),
+    hdr: bool,
+    srgb: bool,
+    ppd: f32,
+    (start, stop, count): (f32, f32, i32),
+    tone_mapper: ToneMapper,
+) -> Result<FlipMap> {
+    let mut values = vec![0f32; (w as usize) * (h as usize)];
+    let (mut mean, mut used) = (0f32, 0i32);
+    // SAFETY: both inputs hold 3·w·h floats and `values` w·h, as the callee reads and writes;
+    // the callee catches every C++ exception, and the exposures were validated so FLIP.h never
+    // reaches its exit() on start > stop.
+    let rc = unsafe {
+        spectra_flip_evaluate(
+            reference.as_ptr(),
+            test.as_ptr(),
+            w,
+            h,
+            i32::from(hdr),
+            i32::from(srgb),
+            ppd,
+            start,
+            stop,
+            count,
+            tone_mapper.code(),
+            values.as_mut_ptr(),
+            &mut mean,
+            &mut used,
+        )
+    };
+    if rc != 0 {
+        return Err(CompareError::InvalidImage(format!("FLIP failed on a {w}×{h} image (out of memory?)")));
+    }
+    let exposures =
+        hdr.then(|| Exposures { start, stop, count: used as u32, tone_mapper: tone_mapper.name() });
+    Ok(FlipMap { width: w as u32, height: h as u32, values, mean, exposures })
+}
+
+/// LDR-FLIP of `test` against `reference` (same size, finite pixels) at `pixels_per_degree`.
+pub fn ldr_flip(reference: &Image, test: &Image, pixels_per_degree: f32) -> Result<FlipMap> {
+    let size = check_pair(reference, test, pixels_per_degree)?;
+    // 8-bit codes as a PNG holds them, given to FLIP as code / 255 like the reference's loader.
+    let codes = |img: &Image| -> Vec<f32> {
+        img.data
+            .iter()
+            .flat_map(|p| p.map(|v| ((crate::io::to_display(v) * 255.0).round() as u8) as f32 / 255.0))
+            .collect()
+    };
+    evaluate(
+        &codes(reference),
+        &codes(test),
+        size,
+        false,
+        true,
+        pixels_per_degree,
+        (0.0, 0.0, -1),
+        ToneMapper::Aces,
+    )
+}
+
+/// HDR-FLIP of the linear images `test` against `reference` (same size, finite pixels).
+/// Negative values (linear sRGB outside the gamut) are taken as 0: FLIP expects non-negative
+/// radiance, and a display cannot show less than black.
+pub fn hdr_flip(
+    reference: &Image,
+    test: &Image,
+    pixels_per_degree: f32,
+    opts: &HdrOptions,
+) -> Result<FlipMap> {
+    let size = check_pair(reference, test, pixels_per_degree)?;
+    let linear = |img: &Image| -> Vec<f32> { img.data.iter().flat_map(|p| p.map(|v| v.max(0.0))).collect() };
+    let (r, t) = (linear(reference), linear(test));
+    let (mut start, mut stop) = (f32::INFINITY, f32::INFINITY);
+    if opts.start_exposure.is_none() || opts.stop_exposure.is_none() {
+        // SAFETY: `r` holds 3·w·h floats; the callee catches every C++ exception.
+        let rc = unsafe {
+            spectra_flip_exposures(r.as_ptr(), size.0, size.1, opts.tone_mapper.code(), &mut start, &mut stop)
+        };
+        if rc != 0 {
+            return Err(CompareError::InvalidImage("FLIP could not compute the exposure range".into()));
+        }
+        if !(start.is_finite() && stop.is_finite()) {
+            return Err(CompareError::InvalidOption(
+                "HDR-FLIP: the reference image is black, so FLIP cannot choose its exposure range; \
+                 give the start and stop exposures"
+                    .into(),
+            ));
+        }
+    }
+    let start = opts.start_exposure.unwrap_or(start);
+    let stop = opts.stop_exposure.unwrap_or(stop);
+    if !(start.is_finite() && stop.is_finite() && start <= stop) {
+        return Err(CompareError::InvalidOption(format!(
+            "HDR-FLIP exposures: the start ({start}) must not exceed the stop ({stop}), both finite"
+        )));
+    }
+    let count = match opts.exposures {
+        None => -1,
+        Some(n) if (2..=1000).contains(&n) => n as i32,
+        Some(n) => {
+            return Err(CompareError::InvalidOption(format!(
+                "HDR-FLIP: the number of exposures must be 2 to 1000, got {n}"
+            )));
+        }
+    };
+    evaluate(&r, &t, size, true, false, pixels_per_degree, (start, stop, count), opts.tone_mapper)
 }
 
 #[cfg(test)]
@@ -83,6 +296,9 @@ mod tests {
         let m = ldr_flip(&a, &a, DEFAULT_PIXELS_PER_DEGREE).unwrap();
         assert_eq!(m.mean(), 0.0);
         assert_eq!(m.magma().len(), 16 * 8 * 3);
+        let h = hdr_flip(&a, &a, DEFAULT_PIXELS_PER_DEGREE, &HdrOptions::default()).unwrap();
+        assert_eq!(h.mean(), 0.0);
+        assert!(h.exposures.unwrap().count >= 2);
         let b = Image::filled(8, 8, [0.5; 3]).unwrap();
         assert!(matches!(ldr_flip(&a, &b, 67.0), Err(CompareError::SizeMismatch { .. })));
         let mut c = a.clone();
@@ -90,5 +306,27 @@ mod tests {
         let e = ldr_flip(&a, &c, 67.0).unwrap_err().to_string();
         assert!(e.contains("test image") && e.contains("(3, 2)"), "{e}");
         assert!(ldr_flip(&a, &a, 0.0).is_err());
+        assert!(hdr_flip(&a, &c, 67.0, &HdrOptions::default()).is_err());
+    }
+
+    #[test]
+    fn hdr_options_that_would_stop_flip_are_refused() {
+        let a = Image::from_fn(16, 8, |x, _| [x as f32, 0.5, 0.2]).unwrap();
+        let b = Image::from_fn(16, 8, |x, _| [x as f32 * 1.1, 0.5, 0.2]).unwrap();
+        let backwards =
+            HdrOptions { start_exposure: Some(1.0), stop_exposure: Some(-1.0), ..Default::default() };
+        let e = hdr_flip(&a, &b, 67.0, &backwards).unwrap_err().to_string();
+        assert!(e.contains("start") && e.contains("stop"), "{e}");
+        let one = HdrOptions { exposures: Some(1), ..Default::default() };
+        assert!(hdr_flip(&a, &b, 67.0, &one).unwrap_err().to_string().contains("number of exposures"));
+        let black = Image::filled(16, 8, [0.0; 3]).unwrap();
+        let e = hdr_flip(&black, &b, 67.0, &HdrOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("black"), "{e}");
+        // With exposures given, a black reference is measurable.
+        let given = HdrOptions { start_exposure: Some(-2.0), stop_exposure: Some(1.0), ..Default::default() };
+        let m = hdr_flip(&black, &b, 67.0, &given).unwrap();
+        assert!(m.mean() > 0.0);
+        assert_eq!(m.exposures.unwrap().count, 3);
+        assert!(ToneMapper::by_name("filmic").is_err());
     }
 }

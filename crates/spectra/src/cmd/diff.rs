@@ -47,10 +47,29 @@ pub struct Args {
     /// lights reflectance. Default: the file's `spectra.white` attribute, else D65.
     #[arg(long)]
     white: Option<String>,
-    /// An extra metric beside ΔE2000 and MAE: `flip` (LDR-FLIP, NVIDIA's perceptual difference
-    /// of the sRGB-encoded, clipped images, through its reference C++ code, FLIP v1.2).
+    /// An extra metric beside ΔE2000 and MAE: `flip` (NVIDIA's perceptual difference, computed
+    /// by its reference C++ code, FLIP 1.7; LDR- or HDR-FLIP, see --flip).
     #[arg(long, value_name = "NAME")]
     metric: Option<String>,
+    /// Which FLIP: `ldr` (the sRGB-encoded images clipped to [0, 1], what a display shows),
+    /// `hdr` (HDR-FLIP: the linear images over a range of exposures, tone mapped), or `auto`:
+    /// HDR-FLIP when both inputs are EXR (linear, possibly above 1), LDR-FLIP otherwise.
+    #[arg(long, value_name = "MODE", default_value = "auto", requires = "metric")]
+    flip: String,
+    /// HDR-FLIP's first exposure in stops (default, as FLIP's tool: from the reference's
+    /// brightest pixel).
+    #[arg(long, value_name = "EV", allow_negative_numbers = true, requires = "metric")]
+    flip_start_exposure: Option<f32>,
+    /// HDR-FLIP's last exposure in stops (default, as FLIP's tool: from the reference's median
+    /// luminance).
+    #[arg(long, value_name = "EV", allow_negative_numbers = true, requires = "metric")]
+    flip_stop_exposure: Option<f32>,
+    /// HDR-FLIP's number of exposures (default, as FLIP's tool: ⌈stop − start⌉, at least 2).
+    #[arg(long, value_name = "N", requires = "metric")]
+    flip_exposures: Option<u32>,
+    /// HDR-FLIP's tone mapper: aces (default, as FLIP's tool), reinhard or hable.
+    #[arg(long, value_name = "NAME", default_value = "aces", requires = "metric")]
+    flip_tone_mapper: String,
     /// Write the FLIP error map (magma colours, 0 black to 1 white-yellow) to this PNG.
     #[arg(long, value_name = "FILE.png")]
     flip_map: Option<PathBuf>,
@@ -99,6 +118,31 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.flip_map.is_some() && !flip {
         bail!("--flip-map needs --metric flip");
     }
+    let both_exr = [&args.reference, &args.test]
+        .iter()
+        .all(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")));
+    let hdr_flip = match args.flip.to_ascii_lowercase().as_str() {
+        "auto" => both_exr,
+        "hdr" => true,
+        "ldr" => false,
+        other => bail!("--flip {other}: FLIP can be ldr, hdr or auto (hdr when both inputs are EXR)"),
+    };
+    let hdr_opts = compare::flip::HdrOptions {
+        start_exposure: args.flip_start_exposure,
+        stop_exposure: args.flip_stop_exposure,
+        exposures: args.flip_exposures,
+        tone_mapper: compare::flip::ToneMapper::by_name(&args.flip_tone_mapper)
+            .context("--flip-tone-mapper")?,
+    };
+    let hdr_only = args.flip_start_exposure.is_some()
+        || args.flip_stop_exposure.is_some()
+        || args.flip_exposures.is_some()
+        || !args.flip_tone_mapper.eq_ignore_ascii_case("aces");
+    if flip && !hdr_flip && hdr_only {
+        bail!(
+            "the --flip-*exposure*/--flip-tone-mapper options set HDR-FLIP, and LDR-FLIP was chosen (--flip)"
+        );
+    }
     if let Some(p) = &args.flip_map
         && !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
     {
@@ -140,12 +184,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("comparing {} with {}", args.reference.display(), args.test.display()))?;
     let summary = maps.summary();
     let flip_stats = if flip {
-        let map = compare::flip::ldr_flip(&reference, &test, args.flip_ppd).context("FLIP")?;
+        let map = if hdr_flip {
+            compare::flip::hdr_flip(&reference, &test, args.flip_ppd, &hdr_opts).context("HDR-FLIP")?
+        } else {
+            compare::flip::ldr_flip(&reference, &test, args.flip_ppd).context("LDR-FLIP")?
+        };
         if let Some(p) = &args.flip_map {
             map.save_png(p).context("writing the FLIP map")?;
         }
         let v: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
+        // The mean as FLIP's own tool computes and prints it.
         color::metrics::Stats::of(&v)
+            .map(|st| (color::metrics::Stats { mean: map.mean(), ..st }, map.exposures))
     } else {
         None
     };
@@ -169,8 +219,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         o.insert("reference".into(), args.reference.display().to_string().into());
         o.insert("test".into(), args.test.display().to_string().into());
         o.insert("reference_spectral".into(), ref_note.clone().into());
-        if let Some(f) = &flip_stats {
+        if let Some((f, exposures)) = &flip_stats {
             o.insert("flip".into(), serde_json::to_value(f)?);
+            o.insert("flip_kind".into(), if exposures.is_some() { "hdr" } else { "ldr" }.into());
+            o.insert("flip_exposures".into(), serde_json::to_value(exposures)?);
             o.insert("flip_ppd".into(), args.flip_ppd.into());
             o.insert("flip_map".into(), args.flip_map.as_ref().map(|p| p.display().to_string()).into());
         }
@@ -195,7 +247,7 @@ fn print_table(
     s: &DiffSummary,
     heatmap: Option<(&PathBuf, f64)>,
     notes: [&Option<String>; 2],
-    flip: Option<&color::metrics::Stats>,
+    flip: Option<&(color::metrics::Stats, Option<compare::flip::Exposures>)>,
 ) {
     let note = |n: &Option<String>| n.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
     println!("reference  {}{}", args.reference.display(), note(notes[0]));
@@ -221,8 +273,10 @@ fn print_table(
     row("ΔE2000", &s.delta_e2000, 4);
     row("MAE linear RGB", &s.mae_linear, 6);
     row("MAE sRGB-encoded", &s.mae_srgb, 6);
-    if let Some(f) = flip {
-        row(&format!("LDR-FLIP ({} ppd)", args.flip_ppd), f, 6);
+    match flip {
+        Some((f, None)) => row(&format!("LDR-FLIP ({:.0} ppd)", args.flip_ppd), f, 6),
+        Some((f, Some(_))) => row(&format!("HDR-FLIP ({:.0} ppd)", args.flip_ppd), f, 6),
+        None => {}
     }
     if let Some((p, max)) = heatmap {
         println!();
@@ -230,6 +284,12 @@ fn print_table(
     }
     if let Some(p) = &args.per_pixel_out {
         println!("per-pixel  {}", p.display());
+    }
+    if let Some((_, Some(e))) = flip {
+        println!(
+            "HDR-FLIP   exposures {:+.4} to {:+.4} EV, {} of them, {} tone mapping",
+            e.start, e.stop, e.count, e.tone_mapper
+        );
     }
     if let Some(p) = &args.flip_map {
         println!("FLIP map   {}", p.display());
@@ -292,6 +352,10 @@ mod tests {
         assert!(c64.iter().zip(c31).any(|(a, b)| (a - b).abs() > 5e-3), "{c64:?} vs {c31:?}");
         run_with(&[&p("g.exr"), &p("s.exr"), "--metric", "flip", "--flip-map", &p("f.png")]).unwrap();
         assert!(dir.path().join("f.png").exists());
+        run_with(&[&p("g.exr"), &p("s.exr"), "--metric", "flip", "--flip", "ldr"]).unwrap();
+        let (g, sp) = (p("g.exr"), p("s.exr"));
+        let ev = ["--flip-start-exposure", "-1", "--flip-stop-exposure", "1"];
+        run_with(&[&[g.as_str(), &sp, "--metric", "flip"][..], &ev].concat()).unwrap();
         run_with(&[&p("s.exr"), &p("g.exr"), "--observer", "nikon", "--json"]).unwrap();
         let e = |x: &[&str]| format!("{:#}", run_with(x).unwrap_err());
         assert!(e(&[&p("g.exr"), &p("g.exr"), "--observer", "cie1964"]).contains("neither input"));
@@ -302,5 +366,16 @@ mod tests {
             e(&[&p("g.exr"), &p("g.exr"), "--metric", "flip", "--flip-map", &p("x.jpg")]).contains(".png")
         );
         assert!(!dir.path().join("x.png").exists());
+        assert!(
+            e(&[&p("g.exr"), &p("g.exr"), "--metric", "flip", "--flip", "hd"]).contains("ldr, hdr or auto")
+        );
+        let ldr_ev = [&[g.as_str(), &g, "--metric", "flip", "--flip", "ldr"][..], &ev].concat();
+        assert!(e(&ldr_ev).contains("HDR-FLIP"));
+        let backwards = ["--flip-start-exposure", "2", "--flip-stop-exposure", "1"];
+        assert!(e(&[&[g.as_str(), &sp, "--metric", "flip"][..], &backwards].concat()).contains("start"));
+        assert!(
+            e(&[&p("g.exr"), &p("g.exr"), "--metric", "flip", "--flip-tone-mapper", "filmic"])
+                .contains("filmic")
+        );
     }
 }

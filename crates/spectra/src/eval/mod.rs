@@ -60,6 +60,9 @@ pub struct ModeResult {
     /// error map (magma PNG).
     pub flip_mean: f64,
     pub flip_map: String,
+    /// Mean HDR-FLIP against the truth (the linear images, FLIP's default exposure range taken
+    /// from the truth, ACES tone mapping): what LDR-FLIP misses above 1 (highlights, lights).
+    pub flip_hdr_mean: f64,
 }
 
 /// One case's results.
@@ -221,15 +224,17 @@ pub fn run(cfg: Config) -> Result<Results> {
             let img = measure::realtime(&mut r, &c.scene, &measure::settings(*mode, n, range))?;
             let png = format!("{}_{}.png", c.id, name);
             save_png(&cfg.out.join(&png), &img)?;
-            let flip = compare::flip::ldr_flip(&t0, &img, compare::flip::DEFAULT_PIXELS_PER_DEGREE)?;
-            maps.push((*mode, *name, png, measure::diff(&t0, &img)?, flip));
+            let ppd = compare::flip::DEFAULT_PIXELS_PER_DEGREE;
+            let flip = compare::flip::ldr_flip(&t0, &img, ppd)?;
+            let flip_hdr = compare::flip::hdr_flip(&t0, &img, ppd, &Default::default())?.mean();
+            maps.push((*mode, *name, png, measure::diff(&t0, &img)?, (flip, flip_hdr)));
         }
         // One heat-map scale per case so the three modes are comparable at a glance.
         let scale = compare::heatmap::nice_ceil(
             maps.iter().map(|m| m.3.summary().delta_e2000.p99).fold(1.0, f64::max),
         );
         let mut modes = Vec::new();
-        for (mode, name, png, m, flip) in maps {
+        for (mode, name, png, m, (flip, flip_hdr_mean)) in maps {
             let hm = format!("{}_{}_heat.png", c.id, name);
             Heatmap::of_delta_e(&m, &HeatmapOptions { max: Some(scale), ..Default::default() })?
                 .save_png(cfg.out.join(&hm))?;
@@ -244,6 +249,7 @@ pub fn run(cfg: Config) -> Result<Results> {
                 errors: Errors::of(&m, &mask)?,
                 flip_mean: flip.mean(),
                 flip_map,
+                flip_hdr_mean,
             });
         }
         eprintln!(
@@ -490,6 +496,7 @@ mod tests {
             errors: errors(de),
             flip_mean: 0.0,
             flip_map: String::new(),
+            flip_hdr_mean: 0.0,
         };
         let case = CaseResult {
             id: "c".into(),

@@ -569,10 +569,11 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
         for m in &c.modes {
             let _ = write!(
                 h,
-                "<figure><img class=\"px\" src=\"{}\"><figcaption>{} LDR-FLIP map (magma, 0–1) — mean FLIP {:.4}</figcaption></figure>",
+                "<figure><img class=\"px\" src=\"{}\"><figcaption>{} LDR-FLIP map (magma, 0–1) — mean LDR-FLIP {:.4}, HDR-FLIP {:.4}</figcaption></figure>",
                 esc(&m.flip_map),
                 esc(&m.mode),
-                m.flip_mean
+                m.flip_mean,
+                m.flip_hdr_mean
             );
         }
         h.push_str("</div>");
