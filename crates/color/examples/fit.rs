@@ -2,7 +2,8 @@
 //! (10⁵ colours) before and after each refinement sweep.
 //! `cargo run --release -p color --example fit -- SPACE RES OUT.coeff [SWEEPS]`
 //! Environment: `ZGRID` = rgb2spec (default: its double smoothstep and clamp 200) | ss1 (spectra)
-//! | uniform | pow2 | pow3 | mix; `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
+//! | uniform | pow2 | pow3 | mix; `XGRID` = uniform (default, rgb2spec's chroma grid) | spectra
+//! (`fit::spectra_chroma`, the default tables'); `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
 //! per axis and threshold, `RSTEPS` Gauss–Newton steps per node, `RGIVE` its `give_up`, `RSOLID` (set) keeps the refinement's
 //! samples inside the object-colour solid however far off (`RefineOptions::keep_solid`).
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -28,6 +29,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect()
         }
         _ => {}
+    }
+    if std::env::var("XGRID").is_ok_and(|x| x == "spectra") {
+        opt.chroma = color::upsample::fit::spectra_chroma(res);
     }
     if let Ok(m) = std::env::var("MAXC") {
         opt.max_coeff = m.parse()?;

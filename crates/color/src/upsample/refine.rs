@@ -75,6 +75,8 @@ struct Grid<'a> {
     res: usize,
     scale: &'a [f64],
     scale32: &'a [f32],
+    chroma: &'a [f64],
+    chroma32: &'a [f32],
     /// Interior sample fractions per axis.
     offs: Vec<f64>,
 }
@@ -116,10 +118,11 @@ impl Grid<'_> {
     /// and [`z_weight`], exactly as [`CoeffTable::fetch`] blends the corners.
     fn wf(&self, k: usize, j: usize, i: usize, f: [f64; 3]) -> [f64; 3] {
         let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
-        let (x, y) = ((i as f64 + f[0]) as f32, (j as f64 + f[1]) as f32);
+        let (x, y) = (self.ratio(i, f[0]) as f32, self.ratio(j, f[1]) as f32);
+        let c = self.chroma32;
         [
-            chroma_weight(x, i, y, self.res) as f64,
-            chroma_weight(y, j, x, self.res) as f64,
+            chroma_weight(x, c[i], c[i + 1], y) as f64,
+            chroma_weight(y, c[j], c[j + 1], x) as f64,
             z_weight(z as f32, self.scale32[k], self.scale32[k + 1]) as f64,
         ]
     }
@@ -127,12 +130,16 @@ impl Grid<'_> {
     /// RGB at fractional grid coordinates inside cell (l, k, j, i).
     fn rgb(&self, l: usize, k: usize, j: usize, i: usize, f: [f64; 3]) -> [f64; 3] {
         let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
-        let n = (self.res - 1) as f64;
         let mut rgb = [0.0; 3];
         rgb[l] = z;
-        rgb[(l + 1) % 3] = (i as f64 + f[0]) / n * z;
-        rgb[(l + 2) % 3] = (j as f64 + f[1]) / n * z;
+        rgb[(l + 1) % 3] = self.ratio(i, f[0]) * z;
+        rgb[(l + 2) % 3] = self.ratio(j, f[1]) * z;
         rgb
+    }
+
+    /// Channel ratio at fraction `f` of chroma cell `i`.
+    fn ratio(&self, i: usize, f: f64) -> f64 {
+        self.chroma[i] + (self.chroma[i + 1] - self.chroma[i]) * f
     }
 }
 
@@ -195,7 +202,9 @@ pub fn refine_table(
     let scale: Vec<f64> = table.scale.iter().map(|&s| s as f64).collect();
     let n_off = opt.samples_per_axis.clamp(1, 2);
     let offs: Vec<f64> = (0..n_off).map(|m| (m as f64 + 0.5) / n_off as f64).collect();
-    let grid = Grid { res, scale: &scale, scale32: &table.scale, offs };
+    let chroma: Vec<f64> = table.chroma.iter().map(|&c| c as f64).collect();
+    let grid =
+        Grid { res, scale: &scale, scale32: &table.scale, chroma: &chroma, chroma32: &table.chroma, offs };
     let solid = opt.keep_solid.then(|| ObjectSolid::new(model));
     // A colour is in the objective if the table already comes within `give_up` of it (or, with
     // `keep_solid`, if a reflectance in [0, 1] can have it at all; the membership test — 110 k
@@ -269,7 +278,7 @@ pub fn refine_table(
                     let me = node_index(res, l, k, j, i);
                     // Samples: (target Lab, weight of this node, the other corners' blend).
                     let mut samples: Vec<([f64; 3], f64, [f64; 3])> = Vec::with_capacity(8 * 8 + 1);
-                    let own = crate::upsample::fit::node_rgb(res, &scale, l, k, j, i);
+                    let own = crate::upsample::fit::node_rgb(&scale, &chroma, l, k, j, i);
                     let own_lab = model.target_lab(own);
                     // An unreachable node's own colour would pull it back to where Newton gave
                     // up; without it the node serves the reachable colours of its cells.
