@@ -23,7 +23,7 @@ use crate::upsample::table::CoeffTable;
 pub const TABLE_RES: usize = 64;
 
 /// Bumped whenever the fitter changes its output, so stale caches are not reused.
-pub const TABLE_VERSION: u32 = 7;
+pub const TABLE_VERSION: u32 = 8;
 
 /// Environment variable overriding the cache directory.
 pub const CACHE_ENV: &str = "SPECTRA_CACHE_DIR";

@@ -55,24 +55,24 @@ pub fn spectra_scale(res: usize) -> Vec<f64> {
     (0..res).map(|k| smoothstep(k as f64 / (res - 1) as f64)).collect()
 }
 
-/// How far [`spectra_chroma`] pulls the chroma nodes towards 0: the first cell is 1 − this of
-/// a uniform cell.
+/// How far [`spectra_chroma`] pulls the chroma nodes towards 0 and towards 1: the first and the
+/// last cell are 1 − this of a uniform cell.
 pub const CHROMA_PULL: f64 = 0.5;
 
-/// spectra's chroma grid: node i at the channel ratio t − [`CHROMA_PULL`] · t(1 − t)³, t = i/(res − 1).
-/// Cells next to a zero channel are half as wide as rgb2spec's uniform ones, those at t = ½ 12.5 %
-/// wider, those next to the grey axis as wide (slope 1 − p(1 − t)²(1 − 4t) in t, 0.5 … 1.125). The interpolation error concentrates next to
-/// zero channels, where the spectra are extreme and the coefficients move fastest: on the sRGB
-/// 64³ table, the uniform grid's worst colours were all in the corner cell of the red table,
-/// (0.839, 0.0055, 0.0060) at ΔE2000 0.161; with this grid the adversarial max is 0.081 and the
-/// uniform max 0.108 → 0.038, at the same memory (`cargo run --release -p color --example
-/// adversarial -- srgb`). A quadratic pull (t − 0.5·t(1 − t)) reached 0.085 next to the red but
-/// made the cells next to the grey axis 1.5× wider and lost there (light cyans: 0.219).
+/// spectra's chroma grid: node i at the channel ratio t − p·t(1 − t)³ + p·t³(1 − t),
+/// p = [`CHROMA_PULL`], t = i/(res − 1). The cells next to a zero channel (ratio 0) and next to a
+/// second largest channel (ratio 1) are half as wide as rgb2spec's uniform ones, those in the
+/// middle 25 % wider (slope 1 − p(1 − t)²(1 − 4t) + p·t²(3 − 4t), 0.5 … 1.25). The interpolation
+/// error concentrates at both ends, where the spectra are extreme and the coefficients move
+/// fastest: on the sRGB 64³ table with the uniform grid the worst colours were all in the corner
+/// cell of the red table, (0.839, 0.0055, 0.0060) at ΔE2000 0.161; pulled towards 0 only
+/// (t − p·t(1 − t)³) they were light yellows with red ≈ green, (0.984, 1, 0.336) at 0.081; with
+/// both ends 0.059 (docs/upsampling.md, "Chroma grid"). Same memory: only the node positions move.
 pub fn spectra_chroma(res: usize) -> Vec<f64> {
     (0..res)
         .map(|i| {
             let t = i as f64 / (res - 1) as f64;
-            t - CHROMA_PULL * t * (1.0 - t).powi(3)
+            t - CHROMA_PULL * t * (1.0 - t).powi(3) + CHROMA_PULL * t.powi(3) * (1.0 - t)
         })
         .collect()
 }
@@ -296,7 +296,8 @@ impl LabModel {
     }
 
     /// Newton iterations from `a` (normalised coefficients) towards `target` Lab. Returns the
-    /// final residual norm (ΔE*ab).
+    /// last residual norm computed (ΔE*ab): after an unchecked last step ([`EARLY_STOP`]) the one
+    /// before it, an upper bound.
     pub fn solve(&self, target: [f64; 3], a: &mut [f64; 3], opt: &FitOptions) -> f64 {
         let mut best = f64::INFINITY;
         for _ in 0..opt.max_iter {
@@ -310,6 +311,12 @@ impl LabModel {
             let Some(step) = solve3(j, r) else { break };
             for m in 0..3 {
                 a[m] -= step[m];
+            }
+            // Newton converges quadratically: from a residual this small the step lands far
+            // below `tolerance`, so checking that would cost one more XYZ + Jacobian pass (a
+            // third of a node's work with warm starts) for nothing.
+            if norm < EARLY_STOP * opt.tolerance.sqrt() {
+                break;
             }
             let mx = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             if !mx.is_finite() {
@@ -325,6 +332,10 @@ impl LabModel {
         best
     }
 }
+
+/// [`LabModel::solve`] takes a last step without checking it once the residual is below this
+/// times √tolerance (10⁻⁴ at the default 10⁻⁶).
+const EARLY_STOP: f64 = 0.1;
 
 /// Solves the 3 × 3 system `j · x = r`; `None` when singular.
 pub fn solve3_pub(j: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
@@ -539,7 +550,9 @@ mod tests {
         let opt = FitOptions::new(8);
         for rgb in [[0.5, 0.5, 0.5], [0.8, 0.2, 0.1], [0.05, 0.3, 0.9], [0.9, 0.9, 0.2]] {
             let mut a = [0.0; 3];
-            let r = m.solve(m.target_lab(rgb), &mut a, &opt);
+            m.solve(m.target_lab(rgb), &mut a, &opt);
+            let (lab, t) = (m.lab_of_xyz(m.xyz(a)), m.target_lab(rgb));
+            let r = ((lab[0] - t[0]).powi(2) + (lab[1] - t[1]).powi(2) + (lab[2] - t[2]).powi(2)).sqrt();
             assert!(r < 1e-6, "{rgb:?}: residual {r}");
         }
     }

@@ -428,7 +428,8 @@ pub const CHROMA_WARP_SLOPE: f32 = 0.2;
 /// 0.5 as the other chroma coordinate o grows (0.57 at o = 8, 0.53 at o = 30 cells of 1/63),
 /// which A = 2 + 0.2·o cells follows (`python3 tools/chroma_warp.py TABLE`, on a uniform grid).
 /// With the default tables' denser nodes near 0 (`fit::spectra_chroma`) the warp still pays:
-/// a linear weight there gives an sRGB adversarial max of 0.138 instead of 0.081 (docs/upsampling.md).
+/// on a similar grid (t − 0.5·t(1 − t)²) a linear weight gave an sRGB adversarial max of 0.138
+/// instead of 0.085 (a development build with the constants as parameters).
 /// Each weight runs 0 → 1 across its cell and A is continuous, so the fetch stays continuous; the
 /// nodes are unchanged, so every node colour comes back exactly whatever the weight.
 #[inline]
