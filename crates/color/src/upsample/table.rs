@@ -4,12 +4,15 @@
 //! `data` is indexed `((l·res + k)·res + j)·res + i`, times 3 coefficients, where `l` is the
 //! largest RGB channel, `k` the brightness index (the largest channel's value is `scale[k]`),
 //! and `i`, `j` the two other channels (`(l+1) % 3` and `(l+2) % 3`) divided by the largest and
-//! multiplied by `res − 1`. Files written here load in rgb2spec, Mitsuba and pbrt, and Mitsuba's
-//! shipped `srgb.coeff` (which appends a trailer after the payload) loads here.
+//! located on the chroma grid ([`CoeffTable::chroma`]): rgb2spec's is uniform (ratio × (res − 1)),
+//! spectra's default tables are denser next to 0 and 1 and store their grid in a block after the
+//! payload ([`CHROMA_TAG`]). Uniform-grid files written here load in rgb2spec, Mitsuba and pbrt;
+//! those readers skip the block of the others and would misread them. Mitsuba's shipped
+//! `srgb.coeff` (which appends a trailer after the payload) loads here.
 //!
 //! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
-//! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly — with
-//! three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
+//! find `z` in `scale` and the two ratios in `chroma` by binary search, then interpolate the
+//! coefficients trilinearly — with three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
 //! exact at every brightness, the weights along x and y are warped next to a zero channel
 //! ([`chroma_weight`]), where the coefficients move non-uniformly, and light colours (lowest channel above 0.3) are fetched through
 //! their complement 1 − rgb with negated coefficients ([`white_blend`]), which removes the
@@ -296,7 +299,8 @@ impl CoeffTable {
 
     /// Exactly `rgb2spec_fetch` (linear weights on all three axes, no complement), as rgb2spec,
     /// Mitsuba and pbrt read a table: for judging a table made for them (e.g. rgb2spec_opt's
-    /// output) on its own terms. Clamps like [`Self::fetch`].
+    /// output) on its own terms. Like them it assumes the uniform chroma grid, whatever
+    /// [`Self::chroma`] says. Clamps like [`Self::fetch`].
     pub fn fetch_rgb2spec(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
         self.fetch_trilinear(rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 }), true)
     }
