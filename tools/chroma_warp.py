@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Why the chroma weight (color::upsample::table::chroma_weight) is what it is.
 
-Reads an *unrefined* sRGB table (node-exact, so only the interpolation is judged):
+Reads an *unrefined* sRGB table on rgb2spec's uniform chroma grid (node-exact, so only the
+interpolation is judged; the default tables' grid is denser next to 0 and 1, which this script
+does not model, and it refuses them):
 
-    cargo run --release -p color --example fit_time -- srgb 64 /tmp/unrefined.coeff unrefined
+    ZGRID=ss1 MAXC=10000 cargo run --release -p color --example fit -- srgb 64 /tmp/unrefined.coeff 0
     python3 tools/chroma_warp.py /tmp/unrefined.coeff
 
 and evaluates the direct fetch (trilinear, σ⁻¹ brightness weight; no complement, so only colours
@@ -28,6 +30,8 @@ b = open(fn, "rb").read()
 if b[:4] != b"SPEC":
     sys.exit(f"{fn}: not an rgb2spec .coeff table")
 res = struct.unpack("<I", b[4:8])[0]
+if b[8 + 4 * res + 36 * res**3 :].startswith(b"\nspectra-chroma-nodes\n"):
+    sys.exit(f"{fn}: has a non-uniform chroma grid (spectra's default); this script needs the uniform one (see its usage)")
 scale = np.frombuffer(b[8 : 8 + 4 * res], dtype="<f4").astype(float)
 data = np.frombuffer(b[8 + 4 * res : 8 + 4 * res + 36 * res**3], dtype="<f4").reshape(3, res, res, res, 3).astype(float)
 shape = colour.SpectralShape(360, 830, 1)

@@ -52,6 +52,15 @@ def main():
     ours = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
     s_ours = sigmoid_spectrum(ours, lam)
 
+    # colour-science, like rgb2spec, assumes the uniform chroma grid; spectra's default tables
+    # carry another one after the payload (color::upsample::table::CHROMA_TAG).
+    with open(path, "rb") as f:
+        b = f.read()
+    res = int.from_bytes(b[4:8], "little")
+    if b[8 + 4 * res + 36 * res**3 :].startswith(b"\nspectra-chroma-nodes\n"):
+        print("1. skipped: the table has spectra's non-uniform chroma grid, which colour-science cannot read")
+        compare_fit(rgb, s_ours, lam, n)
+        return
     lut = LUT3D_Jakob2019()
     lut.read(path)
     theirs = np.array([lut.RGB_to_coefficients(c) for c in rgb])
@@ -60,7 +69,10 @@ def main():
     print(f"1. same table, colour-science LUT3D_Jakob2019 interpolation vs spectra fetch, {n} colours:")
     print(f"   largest spectral difference {d1.max():.3e} (mean {d1.mean():.3e}), "
           f"worst RGB {np.array2string(rgb[d1.argmax()], precision=4)}")
+    compare_fit(rgb, s_ours, lam, n)
 
+
+def compare_fit(rgb, s_ours, lam, n):
     srgb = colour.RGB_COLOURSPACES["sRGB"]
     xyz = colour.RGB_to_XYZ(rgb, srgb, apply_cctf_decoding=False)
     d2 = np.zeros(n)

@@ -53,7 +53,7 @@ fn fetch(c: &mut Criterion) {
     let res = 64;
     let scale = (0..res).map(|k| k as f32 / (res - 1) as f32).collect();
     let data = (0..CoeffTable::data_len(res)).map(|i| (i % 97) as f32 * 1e-3).collect();
-    let t = CoeffTable { res, scale, data };
+    let t = CoeffTable { res, scale, chroma: color::upsample::table::uniform_chroma(res), data };
     let colours: Vec<[f64; 3]> =
         (0..N).map(|i| [(i % 13) as f64 / 13.0, (i % 7) as f64 / 7.0, (i % 31) as f64 / 31.0]).collect();
     let mut g = c.benchmark_group("table_fetch");

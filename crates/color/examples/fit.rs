@@ -2,9 +2,13 @@
 //! (10⁵ colours) before and after each refinement sweep.
 //! `cargo run --release -p color --example fit -- SPACE RES OUT.coeff [SWEEPS]`
 //! Environment: `ZGRID` = rgb2spec (default: its double smoothstep and clamp 200) | ss1 (spectra)
-//! | uniform | pow2 | pow3 | mix; `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
+//! | uniform | pow2 | pow3 | mix; `XGRID` = uniform (default, rgb2spec's chroma grid) | spectra
+//! (`fit::spectra_chroma`, the default tables') | pull:C:P[:C1] (node i at t − C·t(1 − t)^P + C1·t^P(1 − t),
+//! t = i/(res − 1); spectra is pull:0.5:3:0.5); `MAXC` coefficient clamp; `RSAMP`, `RTHR` refinement samples
 //! per axis and threshold, `RSTEPS` Gauss–Newton steps per node, `RGIVE` its `give_up`, `RSOLID` (set) keeps the refinement's
-//! samples inside the object-colour solid however far off (`RefineOptions::keep_solid`).
+//! samples inside the object-colour solid however far off (`RefineOptions::keep_solid`), `RROBUST` σ of
+//! the robust loss (`RefineOptions::robust`), `RSELF` the weight of a node's own colour
+//! (`RefineOptions::own_weight`), `RCAP` its cap (`RefineOptions::own_cap`).
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
     let space = color::RgbColorSpace::by_name(&a[1])?;
@@ -26,6 +30,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     0.5 * ss(ss(t)) + 0.5 * t.powi(2)
                 })
                 .collect()
+        }
+        _ => {}
+    }
+    match std::env::var("XGRID").unwrap_or_default().split(':').collect::<Vec<_>>()[..] {
+        ["spectra"] => opt.chroma = color::upsample::fit::spectra_chroma(res),
+        ["pull", c, p] | ["pull", c, p, _] => {
+            let (c, p): (f64, i32) = (c.parse()?, p.parse()?);
+            let c1: f64 = std::env::var("XGRID").unwrap().split(':').nth(3).unwrap_or("0").parse()?;
+            opt.chroma = (0..res)
+                .map(|i| i as f64 / n)
+                .map(|t| t - c * t * (1.0 - t).powi(p) + c1 * t.powi(p) * (1.0 - t))
+                .collect();
         }
         _ => {}
     }
@@ -56,6 +72,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             opt.steps = v.parse()?;
         }
         opt.keep_solid = std::env::var_os("RSOLID").is_some();
+        if let Ok(v) = std::env::var("RCAP") {
+            opt.own_cap = v.parse()?;
+        }
+        if let Ok(v) = std::env::var("RSELF") {
+            opt.own_weight = v.parse()?;
+        }
+        if let Ok(v) = std::env::var("RROBUST") {
+            opt.robust = v.parse()?;
+        }
         if let Ok(v) = std::env::var("RGIVE") {
             opt.give_up = v.parse()?;
         }

@@ -1,6 +1,6 @@
 //! The Jakob–Hanika coefficient table on the GPU: one `rgba32float` 3D texture of
 //! res × res × 3·res texels (x = i, y = j, z = l·res + k; rgb = c0, c1, c2) and a storage
-//! buffer with the table's non-uniform z axis.
+//! buffer with the table's axes and the chroma weight's constants ([`GpuCoeffTable::axes`]).
 //!
 //! The shader interpolates by hand with `textureLoad` (8 loads, once per pixel): exact in
 //! f32 and identical to the CPU `CoeffTable::fetch`, and independent of
@@ -12,6 +12,7 @@ use wgpu::util::DeviceExt;
 pub struct GpuCoeffTable {
     pub res: u32,
     pub view: wgpu::TextureView,
+    /// `coeff_scale` in WGSL, from [`GpuCoeffTable::axes`].
     pub scale: wgpu::Buffer,
 }
 
@@ -40,11 +41,26 @@ impl GpuCoeffTable {
             bytemuck::cast_slice(&texels),
         );
         let scale = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("coefficient scale"),
-            contents: bytemuck::cast_slice(&table.scale),
+            label: Some("coefficient table axes"),
+            contents: bytemuck::cast_slice(&Self::axes(table)),
             usage: wgpu::BufferUsages::STORAGE,
         });
         GpuCoeffTable { res: res as u32, view: texture.create_view(&Default::default()), scale }
+    }
+
+    /// What the shader's `coeff_scale` holds: the brightness levels (`res`), the chroma nodes
+    /// (`res`), then the chroma weight's [`CHROMA_WARP`] and [`CHROMA_WARP_SLOPE`], so the WGSL
+    /// fetch takes the table's grids and the weight's constants from the CPU side and cannot
+    /// drift from `CoeffTable::fetch`.
+    ///
+    /// [`CHROMA_WARP`]: color::upsample::table::CHROMA_WARP
+    /// [`CHROMA_WARP_SLOPE`]: color::upsample::table::CHROMA_WARP_SLOPE
+    pub fn axes(table: &CoeffTable) -> Vec<f32> {
+        use color::upsample::table::{CHROMA_WARP, CHROMA_WARP_SLOPE};
+        let mut v = table.scale.clone();
+        v.extend_from_slice(&table.chroma);
+        v.extend_from_slice(&[CHROMA_WARP, CHROMA_WARP_SLOPE]);
+        v
     }
 }
 

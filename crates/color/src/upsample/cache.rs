@@ -23,7 +23,7 @@ use crate::upsample::table::CoeffTable;
 pub const TABLE_RES: usize = 64;
 
 /// Bumped whenever the fitter changes its output, so stale caches are not reused.
-pub const TABLE_VERSION: u32 = 6;
+pub const TABLE_VERSION: u32 = 8;
 
 /// Environment variable overriding the cache directory.
 pub const CACHE_ENV: &str = "SPECTRA_CACHE_DIR";
@@ -78,13 +78,13 @@ fn write_cached(t: &CoeffTable, path: &std::path::Path) -> Result<()> {
 /// else (missing, truncated, damaged, unsigned, or well-formed but wrong) is `None`, to be
 /// refitted.
 pub fn read_cached(path: &std::path::Path, space: &RgbColorSpace, res: usize) -> Option<CoeffTable> {
-    let cap = CoeffTable::file_len(res) as u64 + 64;
+    let cap = (CoeffTable::file_len(res) + crate::upsample::table::CHROMA_TAG.len() + 4 * res) as u64 + 64;
     let bytes = crate::input::read_regular(path, cap).ok()?;
     let t = CoeffTable::from_bytes(&bytes, &path.display().to_string()).ok()?;
     if t.res != res {
         return None;
     }
-    let (payload, trailer) = bytes.split_at(CoeffTable::file_len(res));
+    let (payload, trailer) = bytes.split_at(t.encoded_len());
     let hex = trailer.strip_prefix(SIGNATURE_TAG)?.strip_suffix(b"\n")?;
     let sum = u64::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?;
     if sum != fnv1a64(payload) {
@@ -192,7 +192,12 @@ mod tests {
         let fitted = load_or_fit(&path, &space, 8).unwrap();
         let good = std::fs::read(&path).unwrap();
         assert!(read_cached(&path, &space, 8).is_some());
-        let zeros = CoeffTable { res: 8, scale: fitted.scale.clone(), data: vec![0.0; fitted.data.len()] };
+        let zeros = CoeffTable {
+            res: 8,
+            scale: fitted.scale.clone(),
+            chroma: fitted.chroma.clone(),
+            data: vec![0.0; fitted.data.len()],
+        };
         // All zeros, plainly written (as the old cache did, or another tool): no signature.
         zeros.write(&path).unwrap();
         assert!(read_cached(&path, &space, 8).is_none());

@@ -294,7 +294,12 @@ mod tests {
     fn grey_table() -> CoeffTable {
         let res = 64;
         let scale = crate::upsample::fit::spectra_scale(res).iter().map(|&s| s as f32).collect();
-        let mut t = CoeffTable { res, scale, data: vec![0.0; CoeffTable::data_len(res)] };
+        let mut t = CoeffTable {
+            res,
+            scale,
+            chroma: crate::upsample::table::uniform_chroma(res),
+            data: vec![0.0; CoeffTable::data_len(res)],
+        };
         crate::upsample::fit::pin_grey_nodes(&mut t);
         t
     }

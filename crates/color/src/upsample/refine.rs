@@ -53,6 +53,24 @@ pub struct RefineOptions {
     /// Gauss–Newton steps per node per sweep. One: a second step changed the sRGB 64³ table's
     /// adversarial max from 0.161 to 0.159 and its uniform mean not at all, for 50 % more time.
     pub steps: usize,
+    /// Scale σ (ΔE*ab) of the robust (Cauchy) loss σ²·ln(1 + e²/σ²) that replaces e², so that
+    /// samples off by much more than σ (colours next to the object-colour solid's boundary, in
+    /// wide gamuts) stop dominating a node's objective; `f64::INFINITY` is least squares. 1:
+    /// the sRGB colours inside P3 / Rec.2020 / ACEScg went from ΔE2000 0.209 / 0.306 / 0.300 to
+    /// 0.117 / 0.287 / 0.267, sRGB's own adversarial max stayed 0.059; σ = 0.3 gave P3 0.151 but
+    /// sRGB 0.093 (docs/upsampling.md).
+    pub robust: f64,
+    /// Weight of a node's own colour in its objective, relative to one sample point. 1: a
+    /// weight of 4 made both sRGB (0.059 → 0.063) and the sRGB colours in P3 (0.117 → 0.166) worse.
+    pub own_weight: f64,
+    /// A step is refused if it leaves the node's own colour off by more than this (ΔE*ab) and
+    /// by more than before. The objective trades a node's own colour for its cells' samples, and
+    /// next to black in wide gamuts (coefficients in the hundreds, colours at the solid's
+    /// boundary) that went far: Rec.2020 nodes at z = 0.003 ended 0.39 off, and sRGB
+    /// (0.0016, 0.0002, 0.00004) between them at 0.287, where the unrefined table gave 0.078.
+    /// 0.3: Rec.2020 0.287 → 0.132, sRGB unchanged; 0.1: Rec.2020 0.180, but sRGB 0.128 (its
+    /// darkest corner cells need the move). `f64::INFINITY`: no cap.
+    pub own_cap: f64,
     /// Sample points per axis inside each cell (at (m + ½)/n), 1 or 2 (larger values are
     /// taken as 2); boundary cells add their boundary face ([`Grid::cell_points`]).
     pub samples_per_axis: usize,
@@ -67,6 +85,9 @@ impl Default for RefineOptions {
             steps: 1,
             samples_per_axis: 1,
             keep_solid: false,
+            robust: 1.0,
+            own_weight: 1.0,
+            own_cap: 0.3,
         }
     }
 }
@@ -75,6 +96,8 @@ struct Grid<'a> {
     res: usize,
     scale: &'a [f64],
     scale32: &'a [f32],
+    chroma: &'a [f64],
+    chroma32: &'a [f32],
     /// Interior sample fractions per axis.
     offs: Vec<f64>,
 }
@@ -116,10 +139,11 @@ impl Grid<'_> {
     /// and [`z_weight`], exactly as [`CoeffTable::fetch`] blends the corners.
     fn wf(&self, k: usize, j: usize, i: usize, f: [f64; 3]) -> [f64; 3] {
         let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
-        let (x, y) = ((i as f64 + f[0]) as f32, (j as f64 + f[1]) as f32);
+        let (x, y) = (self.ratio(i, f[0]) as f32, self.ratio(j, f[1]) as f32);
+        let c = self.chroma32;
         [
-            chroma_weight(x, i, y, self.res) as f64,
-            chroma_weight(y, j, x, self.res) as f64,
+            chroma_weight(x, c[i], c[i + 1], y) as f64,
+            chroma_weight(y, c[j], c[j + 1], x) as f64,
             z_weight(z as f32, self.scale32[k], self.scale32[k + 1]) as f64,
         ]
     }
@@ -127,12 +151,16 @@ impl Grid<'_> {
     /// RGB at fractional grid coordinates inside cell (l, k, j, i).
     fn rgb(&self, l: usize, k: usize, j: usize, i: usize, f: [f64; 3]) -> [f64; 3] {
         let z = self.scale[k] + (self.scale[k + 1] - self.scale[k]) * f[2];
-        let n = (self.res - 1) as f64;
         let mut rgb = [0.0; 3];
         rgb[l] = z;
-        rgb[(l + 1) % 3] = (i as f64 + f[0]) / n * z;
-        rgb[(l + 2) % 3] = (j as f64 + f[1]) / n * z;
+        rgb[(l + 1) % 3] = self.ratio(i, f[0]) * z;
+        rgb[(l + 2) % 3] = self.ratio(j, f[1]) * z;
         rgb
+    }
+
+    /// Channel ratio at fraction `f` of chroma cell `i`.
+    fn ratio(&self, i: usize, f: f64) -> f64 {
+        self.chroma[i] + (self.chroma[i + 1] - self.chroma[i]) * f
     }
 }
 
@@ -195,7 +223,9 @@ pub fn refine_table(
     let scale: Vec<f64> = table.scale.iter().map(|&s| s as f64).collect();
     let n_off = opt.samples_per_axis.clamp(1, 2);
     let offs: Vec<f64> = (0..n_off).map(|m| (m as f64 + 0.5) / n_off as f64).collect();
-    let grid = Grid { res, scale: &scale, scale32: &table.scale, offs };
+    let chroma: Vec<f64> = table.chroma.iter().map(|&c| c as f64).collect();
+    let grid =
+        Grid { res, scale: &scale, scale32: &table.scale, chroma: &chroma, chroma32: &table.chroma, offs };
     let solid = opt.keep_solid.then(|| ObjectSolid::new(model));
     // A colour is in the objective if the table already comes within `give_up` of it (or, with
     // `keep_solid`, if a reflectance in [0, 1] can have it at all; the membership test — 110 k
@@ -267,14 +297,15 @@ pub fn refine_table(
                 .par_iter()
                 .map(|&(l, k, j, i)| {
                     let me = node_index(res, l, k, j, i);
-                    // Samples: (target Lab, weight of this node, the other corners' blend).
-                    let mut samples: Vec<([f64; 3], f64, [f64; 3])> = Vec::with_capacity(8 * 8 + 1);
-                    let own = crate::upsample::fit::node_rgb(res, &scale, l, k, j, i);
+                    // Samples: (target Lab, weight of this node, the other corners' blend, weight
+                    // of the sample in the objective).
+                    let mut samples: Vec<([f64; 3], f64, [f64; 3], f64)> = Vec::with_capacity(8 * 8 + 1);
+                    let own = crate::upsample::fit::node_rgb(&scale, &chroma, l, k, j, i);
                     let own_lab = model.target_lab(own);
                     // An unreachable node's own colour would pull it back to where Newton gave
                     // up; without it the node serves the reachable colours of its cells.
                     if reachable(own, lab_err(model, own_lab, a[me])) {
-                        samples.push((own_lab, 1.0, [0.0; 3]));
+                        samples.push((own_lab, 1.0, [0.0; 3], opt.own_weight));
                     }
                     for c in 0..8 {
                         let (di, dj, dk) = (c & 1, (c >> 1) & 1, (c >> 2) & 1);
@@ -290,18 +321,23 @@ pub fn refine_table(
                             let w = weights(grid.wf(ck, cj, ci, f));
                             let (rest, wme) = blend_without(&a, res, (l, ck, cj, ci), &w, Some(me));
                             if wme > 0.0 {
-                                samples.push((model.target_lab(grid.rgb(l, ck, cj, ci, f)), wme, rest));
+                                samples.push((model.target_lab(grid.rgb(l, ck, cj, ci, f)), wme, rest, 1.0));
                             }
                         }
                     }
                     if samples.is_empty() {
                         return (me, a[me]);
                     }
-                    let blend = |x: [f64; 3], s: &([f64; 3], f64, [f64; 3])| {
+                    let blend = |x: [f64; 3], s: &([f64; 3], f64, [f64; 3], f64)| {
                         [s.2[0] + s.1 * x[0], s.2[1] + s.1 * x[1], s.2[2] + s.1 * x[2]]
                     };
+                    let sigma2 = opt.robust * opt.robust;
+                    let loss = |e2: f64| if sigma2.is_finite() { sigma2 * (e2 / sigma2).ln_1p() } else { e2 };
                     let objective = |x: [f64; 3]| {
-                        samples.iter().map(|s| lab_err(model, s.0, blend(x, s)).powi(2)).sum::<f64>()
+                        samples
+                            .iter()
+                            .map(|s| s.3 * loss(lab_err(model, s.0, blend(x, s)).powi(2)))
+                            .sum::<f64>()
                     };
                     let mut x = a[me];
                     for _ in 0..opt.steps {
@@ -312,20 +348,23 @@ pub fn refine_table(
                         for s in &samples {
                             let (lab, jac) = model.lab_jac_pub(blend(x, s));
                             let r = [lab[0] - s.0[0], lab[1] - s.0[1], lab[2] - s.0[2]];
-                            fx += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                            let e2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                            fx += s.3 * loss(e2);
+                            // Iteratively reweighted: the loss's slope at e² scales the sample.
+                            let om = s.3 * if sigma2.is_finite() { 1.0 / (1.0 + e2 / sigma2) } else { 1.0 };
                             for p in 0..3 {
                                 for q in 0..3 {
                                     let mut acc = 0.0;
                                     for row in 0..3 {
                                         acc += jac[row][p] * jac[row][q];
                                     }
-                                    h[p][q] += s.1 * s.1 * acc;
+                                    h[p][q] += om * s.1 * s.1 * acc;
                                 }
                                 let mut acc = 0.0;
                                 for row in 0..3 {
                                     acc += jac[row][p] * r[row];
                                 }
-                                g[p] += s.1 * acc;
+                                g[p] += om * s.1 * acc;
                             }
                         }
                         let mut damping = 1e-9;
@@ -338,7 +377,11 @@ pub fn refine_table(
                             let Some(step) = crate::upsample::fit::solve3_pub(hd, g) else { break };
                             let cand = [x[0] - step[0], x[1] - step[1], x[2] - step[2]];
                             let fc = objective(cand);
-                            if fc < fx {
+                            let own_ok = !opt.own_cap.is_finite() || {
+                                let e = lab_err(model, own_lab, cand);
+                                e <= opt.own_cap || e <= lab_err(model, own_lab, x)
+                            };
+                            if fc < fx && own_ok {
                                 x = cand;
                                 accepted = true;
                                 break;

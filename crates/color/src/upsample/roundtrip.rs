@@ -166,13 +166,14 @@ mod tests {
         let t = srgb_table();
         let model = LabModel::new(&space).unwrap();
         let scale: Vec<f64> = t.scale.iter().map(|&s| s as f64).collect();
+        let chroma: Vec<f64> = t.chroma.iter().map(|&c| c as f64).collect();
         let mut worst: f64 = 0.0;
         // Every 7th node of every table except black (k = 0), which no reflectance reaches.
         for l in 0..3 {
             for k in (1..t.res).step_by(7) {
                 for j in (0..t.res).step_by(7) {
                     for i in (0..t.res).step_by(7) {
-                        let rgb = crate::upsample::fit::node_rgb(t.res, &scale, l, k, j, i);
+                        let rgb = crate::upsample::fit::node_rgb(&scale, &chroma, l, k, j, i);
                         let c = t.node(l, k, j, i).map(|v| v as f64);
                         let de = ciede2000(model.target_lab(rgb), model.lab_of_nm(c));
                         if de > 1e-3 {

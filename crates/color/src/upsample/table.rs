@@ -4,12 +4,15 @@
 //! `data` is indexed `((l·res + k)·res + j)·res + i`, times 3 coefficients, where `l` is the
 //! largest RGB channel, `k` the brightness index (the largest channel's value is `scale[k]`),
 //! and `i`, `j` the two other channels (`(l+1) % 3` and `(l+2) % 3`) divided by the largest and
-//! multiplied by `res − 1`. Files written here load in rgb2spec, Mitsuba and pbrt, and Mitsuba's
-//! shipped `srgb.coeff` (which appends a trailer after the payload) loads here.
+//! located on the chroma grid ([`CoeffTable::chroma`]): rgb2spec's is uniform (ratio × (res − 1)),
+//! spectra's default tables are denser next to 0 and 1 and store their grid in a block after the
+//! payload ([`CHROMA_TAG`]). Uniform-grid files written here load in rgb2spec, Mitsuba and pbrt;
+//! those readers skip the block of the others and would misread them. Mitsuba's shipped
+//! `srgb.coeff` (which appends a trailer after the payload) loads here.
 //!
 //! [`CoeffTable::fetch`] is rgb2spec's `rgb2spec_fetch`: pick the table of the largest channel,
-//! find `z` in `scale` by binary search, then interpolate the coefficients trilinearly — with
-//! three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
+//! find `z` in `scale` and the two ratios in `chroma` by binary search, then interpolate the
+//! coefficients trilinearly — with three differences: the weight along `z` is taken in σ⁻¹ space ([`z_weight`]), which makes greys
 //! exact at every brightness, the weights along x and y are warped next to a zero channel
 //! ([`chroma_weight`]), where the coefficients move non-uniformly, and light colours (lowest channel above 0.3) are fetched through
 //! their complement 1 − rgb with negated coefficients ([`white_blend`]), which removes the
@@ -28,6 +31,17 @@ pub const MAX_RES: usize = 256;
 
 const MAGIC: &[u8; 4] = b"SPEC";
 
+/// Starts the block after a `.coeff` payload that holds a non-uniform chroma grid
+/// ([`CoeffTable::chroma`]): the tag, then `res` little-endian f32. rgb2spec, Mitsuba and pbrt
+/// ignore bytes after the payload (Mitsuba's own table carries a trailer), but they also assume
+/// a uniform grid, so they read such a table with every non-grey node in the wrong place.
+pub const CHROMA_TAG: &[u8] = b"\nspectra-chroma-nodes\n";
+
+/// rgb2spec's chroma grid: i/(res − 1).
+pub fn uniform_chroma(res: usize) -> Vec<f32> {
+    (0..res).map(|i| i as f32 / (res - 1) as f32).collect()
+}
+
 /// A 3 × res³ table of sigmoid-polynomial coefficients, exactly as in a `.coeff` file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CoeffTable {
@@ -35,6 +49,11 @@ pub struct CoeffTable {
     pub res: usize,
     /// The largest channel's value at brightness index k, strictly increasing.
     pub scale: Vec<f32>,
+    /// The channel ratio (other channel ÷ largest) at chroma index i (or j): 0 to 1, strictly
+    /// increasing. rgb2spec's grid is uniform, i/(res − 1) ([`uniform_chroma`]); spectra's
+    /// default tables put more nodes next to 0 (`fit::spectra_chroma`). `.coeff` files have no
+    /// field for it, so a non-uniform grid travels in a block after the payload ([`CHROMA_TAG`]).
+    pub chroma: Vec<f32>,
     /// `3·res³·3` coefficients in rgb2spec order (see the module docs).
     pub data: Vec<f32>,
 }
@@ -53,6 +72,17 @@ impl CoeffTable {
     /// Size in bytes of the `.coeff` payload (without any trailer).
     pub fn file_len(res: usize) -> usize {
         8 + 4 * res + 4 * Self::data_len(res)
+    }
+
+    /// Size in bytes of [`Self::to_bytes`]: the payload plus the chroma block if the grid is not
+    /// uniform.
+    pub fn encoded_len(&self) -> usize {
+        Self::file_len(self.res) + if self.has_uniform_chroma() { 0 } else { CHROMA_TAG.len() + 4 * self.res }
+    }
+
+    /// Whether the chroma grid is rgb2spec's (then the file is exactly what rgb2spec reads).
+    pub fn has_uniform_chroma(&self) -> bool {
+        self.chroma == uniform_chroma(self.res)
     }
 
     /// Index of the first coefficient of node (l, k, j, i) in [`Self::data`].
@@ -99,6 +129,33 @@ impl CoeffTable {
                     self.scale[k],
                     k + 1,
                     self.scale[k + 1]
+                ),
+            ));
+        }
+        if self.chroma.len() != self.res {
+            return Err(table_err(
+                origin,
+                format!("{} chroma nodes for resolution {}", self.chroma.len(), self.res),
+            ));
+        }
+        if self.chroma[0] != 0.0 || self.chroma[self.res - 1] != 1.0 {
+            return Err(table_err(
+                origin,
+                format!(
+                    "chroma nodes must run from 0 to 1, but they run from {} to {}",
+                    self.chroma[0],
+                    self.chroma[self.res - 1]
+                ),
+            ));
+        }
+        if let Some(i) = self.chroma.windows(2).position(|w| !(w[1] > w[0])) {
+            return Err(table_err(
+                origin,
+                format!(
+                    "chroma nodes must increase strictly, but node {i} is {} and node {} is {}",
+                    self.chroma[i],
+                    i + 1,
+                    self.chroma[i + 1]
                 ),
             ));
         }
@@ -156,7 +213,21 @@ impl CoeffTable {
         };
         let scale = floats(&bytes[8..8 + 4 * res]);
         let data = floats(&bytes[8 + 4 * res..need]);
-        let t = CoeffTable { res, scale, data };
+        let chroma = match bytes[need..].strip_prefix(CHROMA_TAG) {
+            Some(rest) if rest.len() >= 4 * res => floats(&rest[..4 * res]),
+            Some(rest) => {
+                return Err(table_err(
+                    origin,
+                    format!(
+                        "chroma block is truncated: {} bytes, resolution {res} needs {}",
+                        rest.len(),
+                        4 * res
+                    ),
+                ));
+            }
+            None => uniform_chroma(res),
+        };
+        let t = CoeffTable { res, scale, chroma, data };
         t.validate(origin)?;
         Ok(t)
     }
@@ -171,13 +242,20 @@ impl CoeffTable {
         Self::from_bytes(&bytes, &origin)
     }
 
-    /// The `.coeff` payload.
+    /// The `.coeff` payload, followed by the chroma block ([`CHROMA_TAG`]) unless the chroma
+    /// grid is uniform.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(Self::file_len(self.res));
+        let mut out = Vec::with_capacity(self.encoded_len());
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&(self.res as u32).to_le_bytes());
         for v in self.scale.iter().chain(&self.data) {
             out.extend_from_slice(&v.to_le_bytes());
+        }
+        if !self.has_uniform_chroma() {
+            out.extend_from_slice(CHROMA_TAG);
+            for v in &self.chroma {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
         }
         out
     }
@@ -221,7 +299,8 @@ impl CoeffTable {
 
     /// Exactly `rgb2spec_fetch` (linear weights on all three axes, no complement), as rgb2spec,
     /// Mitsuba and pbrt read a table: for judging a table made for them (e.g. rgb2spec_opt's
-    /// output) on its own terms. Clamps like [`Self::fetch`].
+    /// output) on its own terms. Like them it assumes the uniform chroma grid, whatever
+    /// [`Self::chroma`] says. Clamps like [`Self::fetch`].
     pub fn fetch_rgb2spec(&self, rgb: [f64; 3]) -> SigmoidPolynomial {
         self.fetch_trilinear(rgb.map(|v| if v > 0.0 { v.min(1.0) as f32 } else { 0.0 }), true)
     }
@@ -237,22 +316,28 @@ impl CoeffTable {
             }
         }
         let z = rgb[l];
-        let (x, y) = if z > 0.0 {
-            let s = (res - 1) as f32 / z;
-            (rgb[(l + 1) % 3] * s, rgb[(l + 2) % 3] * s)
-        } else {
-            (0.0, 0.0)
-        };
-        let xi = (x as usize).min(res - 2);
-        let yi = (y as usize).min(res - 2);
         let zi = self.scale.partition_point(|&s| s <= z).clamp(1, res - 1) - 1;
-        let (x1, y1, z1) = if linear {
+        let (xi, yi, x1, y1, z1) = if linear {
+            let (x, y) = if z > 0.0 {
+                let s = (res - 1) as f32 / z;
+                (rgb[(l + 1) % 3] * s, rgb[(l + 2) % 3] * s)
+            } else {
+                (0.0, 0.0)
+            };
+            let xi = (x as usize).min(res - 2);
+            let yi = (y as usize).min(res - 2);
             let (s0, s1) = (self.scale[zi], self.scale[zi + 1]);
-            (x - xi as f32, y - yi as f32, ((z - s0) / (s1 - s0)).clamp(0.0, 1.0))
+            (xi, yi, x - xi as f32, y - yi as f32, ((z - s0) / (s1 - s0)).clamp(0.0, 1.0))
         } else {
+            let (x, y) = if z > 0.0 { (rgb[(l + 1) % 3] / z, rgb[(l + 2) % 3] / z) } else { (0.0, 0.0) };
+            let cell = |r: f32| self.chroma.partition_point(|&c| c <= r).clamp(1, res - 1) - 1;
+            let (xi, yi) = (cell(x), cell(y));
+            let ch = &self.chroma;
             (
-                chroma_weight(x, xi, y, res),
-                chroma_weight(y, yi, x, res),
+                xi,
+                yi,
+                chroma_weight(x, ch[xi], ch[xi + 1], y),
+                chroma_weight(y, ch[yi], ch[yi + 1], x),
                 z_weight(z, self.scale[zi], self.scale[zi + 1]),
             )
         };
@@ -284,9 +369,9 @@ impl CoeffTable {
         Ok(self.fetch(rgb))
     }
 
-    /// Bytes of memory the coefficients and scale occupy.
+    /// Bytes of memory the coefficients, scale and chroma grid occupy.
     pub fn memory_bytes(&self) -> usize {
-        4 * (self.scale.len() + self.data.len())
+        4 * (self.scale.len() + self.chroma.len() + self.data.len())
     }
 }
 
@@ -333,26 +418,28 @@ pub const CHROMA_WARP: f32 = 0.032;
 /// Growth of the chroma warp scale with the other chroma coordinate (both as channel ratios).
 pub const CHROMA_WARP_SLOPE: f32 = 0.2;
 
-/// Interpolation weight along a chroma axis: `x` = the channel ratio × (res − 1), in cell `xi`;
-/// `other` = the other chroma coordinate, in the same units. The weight is linear in the warped
-/// coordinate g(x) = x / (x + A), A = ([`CHROMA_WARP`] + [`CHROMA_WARP_SLOPE`] · other / (res − 1))
-/// · (res − 1): w = (g(x) − g(xi)) / (g(xi + 1) − g(xi)) = f · (xi + 1 + A) / (x + A), f = x − xi.
+/// Interpolation weight along a chroma axis at the channel ratio `x`, in the cell between the
+/// chroma nodes `r0` and `r1`; `other` = the other chroma coordinate (also a ratio). The weight
+/// is linear in the warped coordinate g(x) = x / (x + A), A = [`CHROMA_WARP`] +
+/// [`CHROMA_WARP_SLOPE`] · other: w = (g(x) − g(r0)) / (g(r1) − g(r0)) = (x − r0)(r1 + A) /
+/// ((r1 − r0)(x + A)).
 ///
 /// Next to a zero channel the node coefficients move non-uniformly with the channel: between the
 /// exact nodes (0.92, 0, 0) and (0.92, 0, 0.0146) the linear blend passes through the right
 /// colours but at the wrong place (the midpoint colour is at weight 0.62, not 0.5), missing the
-/// midpoint by ΔE2000 0.51, while the best weight misses it by < 0.02 (sRGB 64³, unrefined). The
-/// best weight at a cell's middle is 0.6 on a face (o = 0) and drifts towards 0.5 as the other
-/// chroma coordinate o grows (0.57 at o = 8, 0.53 at o = 30 cells), which A = 2 + 0.2·o cells
-/// follows. Measured on the unrefined sRGB table with `python3 tools/chroma_warp.py TABLE`: face
-/// colours max 0.57 → 0.17, uniform mean 0.0075 → 0.0050 (linear weight → this one). Each weight
-/// runs 0 → 1 across its cell and A is continuous, so the fetch stays continuous; the nodes are
-/// unchanged, so other rgb2spec readers (linear weights) still get every node colour exactly.
+/// midpoint by ΔE2000 0.51, while the best weight misses it by < 0.02 (sRGB 64³, uniform grid,
+/// unrefined). The best weight at a cell's middle is 0.6 on a face (o = 0) and drifts towards
+/// 0.5 as the other chroma coordinate o grows (0.57 at o = 8, 0.53 at o = 30 cells of 1/63),
+/// which A = 2 + 0.2·o cells follows (`python3 tools/chroma_warp.py TABLE`, on a uniform grid).
+/// With the default tables' denser nodes near 0 (`fit::spectra_chroma`) the warp still pays:
+/// on a similar grid (t − 0.5·t(1 − t)²) a linear weight gave an sRGB adversarial max of 0.138
+/// instead of 0.085 (a development build with the constants as parameters).
+/// Each weight runs 0 → 1 across its cell and A is continuous, so the fetch stays continuous; the
+/// nodes are unchanged, so every node colour comes back exactly whatever the weight.
 #[inline]
-pub fn chroma_weight(x: f32, xi: usize, other: f32, res: usize) -> f32 {
-    let a = CHROMA_WARP * (res - 1) as f32 + CHROMA_WARP_SLOPE * other;
-    let f = x - xi as f32;
-    (f * (xi as f32 + 1.0 + a) / (x + a)).clamp(0.0, 1.0)
+pub fn chroma_weight(x: f32, r0: f32, r1: f32, other: f32) -> f32 {
+    let a = CHROMA_WARP + CHROMA_WARP_SLOPE * other;
+    ((x - r0) * (r1 + a) / ((r1 - r0) * (x + a))).clamp(0.0, 1.0)
 }
 
 /// Lowest channel at which [`CoeffTable::fetch`] starts blending in the complement fetch.
@@ -406,7 +493,12 @@ mod tests {
     /// A small table whose coefficients encode their own node, so fetch can be checked exactly.
     fn synthetic(res: usize) -> CoeffTable {
         let scale: Vec<f32> = (0..res).map(|k| (k as f32 / (res - 1) as f32).powi(2)).collect();
-        let mut t = CoeffTable { res, scale, data: vec![0.0; CoeffTable::data_len(res)] };
+        let mut t = CoeffTable {
+            res,
+            scale,
+            chroma: uniform_chroma(res),
+            data: vec![0.0; CoeffTable::data_len(res)],
+        };
         for l in 0..3 {
             for k in 0..res {
                 for j in 0..res {
@@ -471,23 +563,58 @@ mod tests {
     #[test]
     fn chroma_weight_runs_from_0_to_1_across_each_cell() {
         for res in [5, 64] {
-            for xi in 0..res - 1 {
-                for other in [0.0, 1.5, (res - 1) as f32] {
-                    let w = |f: f32| chroma_weight(xi as f32 + f, xi, other, res);
-                    assert_eq!(w(0.0), 0.0);
-                    assert!((w(1.0) - 1.0).abs() < 1e-6, "res {res} cell {xi}: {}", w(1.0));
-                    // Increasing, and above linear (the warp is concave).
-                    let mut prev = 0.0;
-                    for m in 1..=10 {
-                        let f = m as f32 / 10.0;
-                        assert!(w(f) > prev && w(f) >= f - 1e-6, "res {res} cell {xi} f {f}: {}", w(f));
-                        prev = w(f);
+            let spectra: Vec<f32> =
+                crate::upsample::fit::spectra_chroma(res).iter().map(|&c| c as f32).collect();
+            for nodes in [uniform_chroma(res), spectra] {
+                for xi in 0..res - 1 {
+                    let (r0, r1) = (nodes[xi], nodes[xi + 1]);
+                    for other in [0.0, 0.02, 1.0] {
+                        let w = |f: f32| chroma_weight(r0 + f * (r1 - r0), r0, r1, other);
+                        assert_eq!(w(0.0), 0.0);
+                        assert!((w(1.0) - 1.0).abs() < 1e-5, "res {res} cell {xi}: {}", w(1.0));
+                        // Increasing, and above linear (the warp is concave).
+                        let mut prev = 0.0;
+                        for m in 1..=10 {
+                            let f = m as f32 / 10.0;
+                            assert!(w(f) > prev && w(f) >= f - 1e-5, "res {res} cell {xi} f {f}: {}", w(f));
+                            prev = w(f);
+                        }
                     }
                 }
             }
         }
-        // Far from a zero channel the weight is nearly linear: at x = 30.5 of 64³, 0.508.
-        assert!((chroma_weight(30.5, 30, 30.0, 64) - 0.5).abs() < 0.01);
+        // Far from a zero channel the weight is nearly linear: mid-cell at x = 30.5/63, 0.508.
+        let r = |x: f32| x / 63.0;
+        assert!((chroma_weight(r(30.5), r(30.0), r(31.0), r(30.0)) - 0.5).abs() < 0.01);
+    }
+
+    #[test]
+    fn non_uniform_chroma_grid_is_stored_and_fetched() {
+        let mut t = synthetic(5);
+        t.chroma = vec![0.0, 0.1, 0.3, 0.6, 1.0];
+        // Written after the payload, read back; a uniform grid writes no block.
+        let b = t.to_bytes();
+        assert_eq!(b.len(), t.encoded_len());
+        assert_eq!(b.len(), CoeffTable::file_len(5) + CHROMA_TAG.len() + 20);
+        assert_eq!(CoeffTable::from_bytes(&b, "x").unwrap(), t);
+        assert_eq!(synthetic(5).to_bytes().len(), CoeffTable::file_len(5));
+        // A node's colour fetches exactly that node: red table (l = 0), x = green/red on node 1
+        // (0.1), y = blue/red on node 3 (0.6); z = 0.5625 is level 3.
+        let c = t.fetch_direct([0.5625, 0.05625, 0.3375]).c;
+        assert!((c[0] - 1.0).abs() < 1e-5 && (c[1] - 3.0).abs() < 1e-5 && (c[2] - 3.0).abs() < 1e-5, "{c:?}");
+        // Between nodes the weight uses the node ratios: x = 0.2 is cell 1 (0.1…0.3).
+        let c = t.fetch_direct([0.5625, 0.1125, 0.3375]).c;
+        let w = chroma_weight(0.2, 0.1, 0.3, 0.6);
+        assert!((c[0] - (1.0 + w as f64)).abs() < 1e-5, "{c:?} vs {}", 1.0 + w);
+        // Bad grids are refused with the reason.
+        let mut b2 = b.clone();
+        b2.truncate(b.len() - 3);
+        assert!(err(&b2).contains("chroma block is truncated"));
+        let mut bad = t.clone();
+        bad.chroma[2] = 0.05;
+        assert!(err(&bad.to_bytes()).contains("chroma nodes must increase"));
+        bad.chroma = vec![0.0, 0.1, 0.3, 0.6, 0.9];
+        assert!(err(&bad.to_bytes()).contains("from 0 to 1"));
     }
 
     #[test]

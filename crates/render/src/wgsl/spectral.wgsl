@@ -113,16 +113,19 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
 @group(2) @binding(2) var<storage, read> light_weights: array<mat3x4<f32>>;
 // The coefficient table as one 3D texture: x = i, y = j, z = l·res + k; rgb = (c0, c1, c2).
 @group(2) @binding(3) var coeff_table: texture_3d<f32>;
-// The table's non-uniform z axis (values of the largest channel at each k).
+// The table's axes (render::coeff_table::GpuCoeffTable::axes): [0, res) the brightness levels
+// (the largest channel at each k), [res, 2·res) the chroma nodes (channel ratio at each i or j),
+// then CHROMA_WARP and CHROMA_WARP_SLOPE of color::upsample::table::chroma_weight.
 @group(2) @binding(4) var<storage, read> coeff_scale: array<f32>;
 
-// Largest k with scale[k] <= z, clamped to [0, res - 2] (binary search over the z axis).
-fn find_interval(z: f32, res: u32) -> u32 {
+// Largest n with coeff_scale[first + n] <= v, clamped to [0, res - 2] (binary search over the
+// axis that starts at `first`: 0 for z, res for the chroma nodes).
+fn find_interval(v: f32, first: u32, res: u32) -> u32 {
     var lo = 0u;
     var hi = res - 1u;
     while (hi - lo > 1u) {
         let mid = (lo + hi) / 2u;
-        if (coeff_scale[mid] <= z) { lo = mid; } else { hi = mid; }
+        if (coeff_scale[first + mid] <= v) { lo = mid; } else { hi = mid; }
     }
     return min(lo, res - 2u);
 }
@@ -148,15 +151,13 @@ fn z_weight(z: f32, s0: f32, s1: f32) -> f32 {
     return clamp(w, 0.0, 1.0);
 }
 
-// Chroma weight, as color::upsample::table::chroma_weight: linear in x / (x + A), A = 2 + 0.2·other
-// cells at 64³, which follows how the coefficients move next to a zero channel (a linear weight
-// missed sRGB (0.92, 0, 0.0073) by ΔE2000 0.5 between two exact nodes). Same constants as there.
-const CHROMA_WARP: f32 = 0.032;
-const CHROMA_WARP_SLOPE: f32 = 0.2;
-fn chroma_weight(x: f32, xi: u32, other: f32, res: u32) -> f32 {
-    let a = CHROMA_WARP * f32(res - 1u) + CHROMA_WARP_SLOPE * other;
-    let f = x - f32(xi);
-    return clamp(f * (f32(xi) + 1.0 + a) / (x + a), 0.0, 1.0);
+// Chroma weight at the channel ratio x in the cell between the chroma nodes r0 and r1, as
+// color::upsample::table::chroma_weight: linear in x / (x + A), A = CHROMA_WARP + CHROMA_WARP_SLOPE·other
+// (constants at the end of coeff_scale), which follows how the coefficients move next to a
+// zero channel (a linear weight missed sRGB (0.92, 0, 0.0073) by ΔE2000 0.5 between two exact nodes).
+fn chroma_weight(x: f32, r0: f32, r1: f32, other: f32, res: u32) -> f32 {
+    let a = coeff_scale[2u * res] + coeff_scale[2u * res + 1u] * other;
+    return clamp((x - r0) * (r1 + a) / ((r1 - r0) * (x + a)), 0.0, 1.0);
 }
 
 // Jakob–Hanika coefficients of a reflectance in [0, 1]³: color::upsample::CoeffTable::fetch.
@@ -187,16 +188,15 @@ fn fetch_coeffs_direct(rgb: vec3<f32>, res: u32) -> vec3<f32> {
     if (rgb.y >= rgb[l]) { l = 1u; }
     if (rgb.z >= rgb[l]) { l = 2u; }
     let z = rgb[l];
-    let rm1 = f32(res - 1u);
     // Black: any (x, y) on the z = 0 slice gives the same spectrum; use the corner.
-    let inv = select(0.0, rm1 / z, z > 0.0);
-    let x = rgb[(l + 1u) % 3u] * inv;
-    let y = rgb[(l + 2u) % 3u] * inv;
-    let xi = min(u32(x), res - 2u);
-    let yi = min(u32(y), res - 2u);
-    let zi = find_interval(z, res);
-    let x1 = chroma_weight(x, xi, y, res);
-    let y1 = chroma_weight(y, yi, x, res);
+    // Channel ratios (divided as on the CPU), located on the table's chroma nodes.
+    let x = select(0.0, rgb[(l + 1u) % 3u] / z, z > 0.0);
+    let y = select(0.0, rgb[(l + 2u) % 3u] / z, z > 0.0);
+    let xi = find_interval(x, res, res);
+    let yi = find_interval(y, res, res);
+    let zi = find_interval(z, 0u, res);
+    let x1 = chroma_weight(x, coeff_scale[res + xi], coeff_scale[res + xi + 1u], y, res);
+    let y1 = chroma_weight(y, coeff_scale[res + yi], coeff_scale[res + yi + 1u], x, res);
     let z1 = z_weight(z, coeff_scale[zi], coeff_scale[zi + 1u]);
     let base = vec3<i32>(i32(xi), i32(yi), i32(l * res + zi));
     let c000 = textureLoad(coeff_table, base, 0).xyz;
