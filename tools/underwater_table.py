@@ -13,6 +13,7 @@ measured the same way for the rows in --noise-depths.
 Usage: tools/underwater_table.py [--bin target/release/spectra] [--size 72x48] [--spp 4096]
        [--block 8] [--wavelengths 16] [--types I,IB] [--depths 2,10] [--noise-depths all]
        [--truth-cache DIR] [--models ours,naive] [--out FILE.md] [--json FILE.json]
+       [--render-args '--forward-cone 5']
 
 --truth-cache keeps the path-traced images (keyed by type, depth, size, spp, seed) so a
 second run with a changed real-time model reuses them.
@@ -66,6 +67,8 @@ def main():
     ap.add_argument("--models", default=DEFAULT_MODELS)
     ap.add_argument("--out")
     ap.add_argument("--json")
+    ap.add_argument("--render-args", default="",
+                    help="extra flags for every real-time render, e.g. '--forward-cone 5' (a sweep)")
     a = ap.parse_args()
     noise_depths = set(a.depths.split(",")) if a.noise_depths == "all" else (
         set(a.noise_depths.split(",")) if a.noise_depths else set())
@@ -93,7 +96,7 @@ def main():
                 for col, mode, flags in MODELS:
                     img = os.path.join(tmp, f"{col}.exr")
                     run([a.bin, "render", *common, "--mode", mode, "--wavelengths", str(a.wavelengths), *flags,
-                         "--out", img])
+                         *a.render_args.split(), "--out", img])
                     row[col] = diff(a.bin, truth, img, a.block)
                 if depth in noise_depths:
                     second = truth_image(tmp, ty, depth, 2)
@@ -145,7 +148,8 @@ def main():
     text += (f"{a.size} px, truth {a.spp} spp (seed 1; noise = seed 1 vs seed 2), real time N = {a.wavelengths}, "
              f"scene `underwater`; {elapsed / 60:.0f} min. `tools/underwater_table.py --size {a.size} --spp {a.spp} "
              f"--block {a.block} --wavelengths {a.wavelengths} --types {a.types} --depths {a.depths} "
-             f"--noise-depths {a.noise_depths} --models {a.models}`\n")
+             f"--noise-depths {a.noise_depths} --models {a.models}"
+             + (f" --render-args '{a.render_args}'" if a.render_args else "") + "`\n")
     print(text)
     if a.out:
         with open(a.out, "w") as f:
