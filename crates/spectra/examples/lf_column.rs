@@ -314,10 +314,17 @@ fn quad(c: Vec3, h: f32) -> scene::Mesh {
     }
 }
 
-/// Mean radiance and its standard error per lane over `n` independent paths along `v`, the
-/// hero wavelength rotated over the four lanes (as `truth::water`'s closed-form test does) so
-/// that every lane's estimate is unbiased.
-fn trace(integ: &Integrator, o: Vec3, v: Vec3, wl: [f32; 4], n: u64, seed: u64) -> ([f64; 4], [f64; 4]) {
+/// Mean and standard error per lane of `n` independent samples, each drawn on its own stream
+/// over the available threads: `pre` draws what the sample needs before the hero rotation,
+/// `post` evaluates it for the four wavelengths rotated so the hero takes every lane in turn
+/// (as `truth::water`'s closed-form test does), which keeps every lane's estimate unbiased.
+fn lane_means<T>(
+    wl: [f32; 4],
+    n: u64,
+    seed: u64,
+    pre: &(dyn Fn(&mut Sampler) -> T + Sync),
+    post: &(dyn Fn(&mut Sampler, T, &Wavelengths) -> [f64; 4] + Sync),
+) -> ([f64; 4], [f64; 4]) {
     let threads = std::thread::available_parallelism().map_or(2, |x| x.get()) as u64;
     let parts: Vec<([f64; 4], [f64; 4])> = std::thread::scope(|s| {
         let hs: Vec<_> = (0..threads)
@@ -327,11 +334,12 @@ fn trace(integ: &Integrator, o: Vec3, v: Vec3, wl: [f32; 4], n: u64, seed: u64) 
                     let mut i = t;
                     while i < n {
                         let mut rng = Sampler::new(seed, i);
+                        let x0 = pre(&mut rng);
                         let k = ((rng.uniform() * 4.0) as usize).min(3);
                         let rot = Wavelengths(Vec4::from_array(std::array::from_fn(|j| wl[(j + k) % 4])));
-                        let r = integ.radiance(o, v, &rot, &mut rng);
+                        let r = post(&mut rng, x0, &rot);
                         for j in 0..4 {
-                            let x = r[(j + 4 - k) % 4] as f64;
+                            let x = r[(j + 4 - k) % 4];
                             sum[j] += x;
                             sq[j] += x * x;
                         }
@@ -354,6 +362,13 @@ fn trace(integ: &Integrator, o: Vec3, v: Vec3, wl: [f32; 4], n: u64, seed: u64) 
     (mean, se)
 }
 
+/// Mean radiance and its standard error per lane over `n` independent paths along `v`.
+fn trace(integ: &Integrator, o: Vec3, v: Vec3, wl: [f32; 4], n: u64, seed: u64) -> ([f64; 4], [f64; 4]) {
+    lane_means(wl, n, seed, &|_| (), &|rng, (), rot| {
+        integ.radiance(o, v, rot, rng).to_array().map(|x| x as f64)
+    })
+}
+
 /// Diffuse irradiance on a surface at `o` facing `n`: π × the mean radiance arriving along
 /// cosine-distributed directions around n (the integrator's radiance excludes the sun's delta
 /// beam at `o` itself, as the table does), per lane with its standard error.
@@ -365,47 +380,17 @@ fn trace_irradiance(
     paths: u64,
     seed: u64,
 ) -> ([f64; 4], [f64; 4]) {
-    let threads = std::thread::available_parallelism().map_or(2, |x| x.get()) as u64;
     let a = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
     let t = n.cross(a).normalize();
     let b = n.cross(t);
-    let parts: Vec<([f64; 4], [f64; 4])> = std::thread::scope(|s| {
-        let hs: Vec<_> = (0..threads)
-            .map(|th| {
-                s.spawn(move || {
-                    let (mut sum, mut sq) = ([0.0f64; 4], [0.0f64; 4]);
-                    let mut i = th;
-                    while i < paths {
-                        let mut rng = Sampler::new(seed, i);
-                        let (u1, u2) = (rng.uniform() as f64, rng.uniform() as f64);
-                        let (r, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
-                        let v = (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
-                            .normalize();
-                        let k = ((rng.uniform() * 4.0) as usize).min(3);
-                        let rot = Wavelengths(Vec4::from_array(std::array::from_fn(|j| wl[(j + k) % 4])));
-                        let l = integ.radiance(o, v.as_vec3(), &rot, &mut rng);
-                        for j in 0..4 {
-                            let x = std::f64::consts::PI * l[(j + 4 - k) % 4] as f64;
-                            sum[j] += x;
-                            sq[j] += x * x;
-                        }
-                        i += threads;
-                    }
-                    (sum, sq)
-                })
-            })
-            .collect();
-        hs.into_iter().map(|h| h.join().expect("tracing thread")).collect()
-    });
-    let nf = paths as f64;
-    let mut mean = [0.0; 4];
-    let mut se = [0.0; 4];
-    for j in 0..4 {
-        let (s, q): (f64, f64) = parts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0[j], b + p.1[j]));
-        mean[j] = s / nf;
-        se[j] = ((q / nf - mean[j] * mean[j]).max(0.0) / (nf - 1.0).max(1.0)).sqrt();
-    }
-    (mean, se)
+    let direction = |rng: &mut Sampler| {
+        let (u1, u2) = (rng.uniform() as f64, rng.uniform() as f64);
+        let (r, phi) = (u1.sqrt(), 2.0 * std::f64::consts::PI * u2);
+        (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+    };
+    lane_means(wl, paths, seed, &direction, &|rng, v, rot| {
+        integ.radiance(o, v.as_vec3(), rot, rng).to_array().map(|x| std::f64::consts::PI * x as f64)
+    })
 }
 
 /// The table's radiance along `v` from the camera's depth, per unit sun irradiance E⊥:
