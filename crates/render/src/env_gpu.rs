@@ -145,7 +145,11 @@ impl GpuEnvironment {
     /// The frame's uniforms for `totals` (XYZ per basis spectrum) and an occlusion search radius
     /// in world units (0 = no screen-space occlusion).
     pub fn uniforms(&self, totals: [[f32; 4]; 4], spectral: bool, occlusion_radius: f32) -> EnvUniforms {
-        let Some(env) = &self.source else { return EnvUniforms::default() };
+        // Without an environment the radius still serves the other ambient term, a medium's
+        // diffuse irradiance (the underwater hook), which the same horizons occlude.
+        let Some(env) = &self.source else {
+            return EnvUniforms { params: [0.0, 0.0, 0.0, occlusion_radius], ..EnvUniforms::default() };
+        };
         let max_lod = match (&self.spectral, spectral) {
             (Some((_, t)), true) => t.max_lod,
             _ => self.rgb.max_lod,

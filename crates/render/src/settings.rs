@@ -121,8 +121,9 @@ pub struct RenderSettings {
     /// light, as the path tracer's `lambert` does: for comparisons with renderers that lack the
     /// glTF BRDF, and the white furnace.
     pub lambert: bool,
-    /// Screen-space occlusion of the environment light (horizon-based, from the depth buffer;
-    /// `wgsl/environment.wgsl`): concave parts and contact regions see less of the sky.
+    /// Screen-space occlusion of ambient light, the environment and a custom hook's diffuse
+    /// irradiance (the water column's; horizon-based, from the depth buffer; `shading.wgsl`):
+    /// concave parts and contact regions see less of the sky or the water around them.
     pub env_occlusion: bool,
 }
 

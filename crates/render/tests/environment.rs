@@ -213,6 +213,46 @@ fn the_occlusion_texture_darkens_the_environment_only() {
     assert!((img[0][1] - 1.0).abs() < 0.01, "background {:?}", img[0]);
 }
 
+#[test]
+fn a_hooks_irradiance_is_occluded_like_the_environment() {
+    // A white Lambertian sphere lit only by a custom hook's irradiance π (radiance 1, as in the
+    // furnace), then with the occlusion texture of the test above: the hook's diffuse light is
+    // ambient light, scaled by the same 1 + 0.8·(0.5 − 1) = 0.6 as the environment.
+    let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    scene.environment = None;
+    let hook = "fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
+        return s3_scale(white_weights(group), vec4<f32>(PI));
+    }
+    fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> { return vec3<f32>(PI); }";
+    let center = (SIZE / 2 * SIZE + SIZE / 2) as usize;
+    let want = 1.0 + 0.8 * (128.0 / 255.0 - 1.0);
+    for textured in [false, true] {
+        if textured {
+            scene.textures.push(scene::Texture {
+                sampler: Default::default(),
+                name: "ao".into(),
+                width: 2,
+                height: 2,
+                rgba8: [128u8, 128, 128, 255].repeat(4),
+                srgb: false,
+            });
+            scene.materials[0].occlusion_texture =
+                Some(scene::TextureRef { transform: None, index: 0, tex_coord: 0 });
+            scene.materials[0].occlusion_strength = 0.8;
+        }
+        for mode in [Mode::Rgb, Mode::Spectral] {
+            let mut r = renderer();
+            r.set_scene(&scene).unwrap();
+            r.set_custom_shader(render::CustomShader::new(hook)).unwrap();
+            r.resize(SIZE, SIZE).unwrap();
+            r.render(&scene.camera, &settings(mode, 16)).unwrap();
+            let c = r.read_hdr().unwrap()[center];
+            let want = if textured { want } else { 1.0 };
+            assert!((c[1] - want).abs() < 0.01, "{mode:?} occlusion texture {textured}: {c:?} vs {want}");
+        }
+    }
+}
+
 /// The spectral mode's K-term basis reproduces each shipped HDR environment as the RGB mode
 /// shows it (the background is the unfiltered map: any basis error is seen there directly).
 #[test]

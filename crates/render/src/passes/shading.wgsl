@@ -287,6 +287,12 @@ fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return 1.0 - hidden / f32(dirs);
 }
 
+// How much of the ambient light (the environment, a medium's diffuse irradiance) reaches the
+// surface: the material's occlusion texture times the screen-space horizons.
+fn ambient_visibility(pix: vec2<f32>, p: vec3<f32>, s: GSurface) -> f32 {
+    return s.occlusion * env_occlusion(pix, p, s.normal);
+}
+
 // What the G-buffer holds for one pixel.
 struct GSurface {
     base: vec3<f32>,
@@ -294,7 +300,7 @@ struct GSurface {
     normal: vec3<f32>,
     metallic: f32,
     roughness: f32,
-    // The material's ambient occlusion (glTF occlusionTexture), for the environment only.
+    // The material's ambient occlusion (glTF occlusionTexture), for ambient light only (the environment, a medium's irradiance).
     occlusion: f32,
     // KHR_materials_unlit: only `emission` (its base colour) leaves the surface.
     unlit: bool,
@@ -340,8 +346,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (shading_env() && !s.unlit) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
-            let vis = s.occlusion * env_occlusion(in.pos.xy, ctx.world_pos, s.normal);
-            rgb += (s.base * et.a.rgb + et.b.rgb) * vis;
+            rgb += (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
         }
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
@@ -349,7 +354,10 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     var out = custom_rgb(rgb, ctx);
     if (CUSTOM_IRRADIANCE && !ctx.background) {
         let s = load_surface(px);
-        out += s.base * diffuse_lobe(s) * custom_irradiance_rgb(ctx);
+        let lobe = diffuse_lobe(s);
+        if (lobe > 0.0) {
+            out += s.base * (lobe * ambient_visibility(in.pos.xy, ctx.world_pos, s)) * custom_irradiance_rgb(ctx);
+        }
     }
     return vec4<f32>(out, 1.0);
 }
@@ -374,9 +382,12 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let has_env = shading_env();
     if (!background) {
         let s = load_surface(px);
+        var vis = 1.0;
+        if ((has_env || CUSTOM_IRRADIANCE) && !s.unlit) {
+            vis = ambient_visibility(in.pos.xy, p, s);
+        }
         if (has_env && !s.unlit) {
             et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
-            let vis = s.occlusion * env_occlusion(in.pos.xy, p, s.normal);
             et.a *= vis;
             et.b *= vis;
         }
@@ -384,7 +395,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         emission = s.emission;
         ctx.normal = s.normal;
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
-        lobe = diffuse_lobe(s);
+        // The hook's irradiance is ambient light too: occluded like the environment.
+        lobe = diffuse_lobe(s) * vis;
         for (var li = 0u; li < n_lights; li++) {
             let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness)
                 * custom_light_surface(li, ctx);

@@ -129,8 +129,8 @@ pub struct LookArgs {
     /// --lambert`; for comparisons with renderers without the glTF BRDF, and the white furnace).
     #[arg(long)]
     pub lambert: bool,
-    /// Turn off the screen-space occlusion of the environment light (then every point sees the
-    /// whole environment).
+    /// Turn off the screen-space occlusion of ambient light: the environment and the water's
+    /// diffuse irradiance (then every point sees the whole environment or water column).
     #[arg(long)]
     pub no_env_occlusion: bool,
 }
