@@ -25,15 +25,43 @@ pub fn print_warnings(scene: &scene::Scene) {
     }
 }
 
-/// The real-time renderer does not draw an RGB medium yet (issue 18's later step); say so
-/// rather than silently render clear air.
-pub fn warn_no_realtime_medium(scene: &scene::Scene) {
-    if scene.medium.is_some() {
-        eprintln!(
-            "warning: {}: extras.medium (an RGB medium) is drawn only by `spectra truth` so far; this real-time image shows clear air",
-            scene.source
+/// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it (`render`, `view`,
+/// `bench`, `truth`).
+pub fn rgb_medium_arg(arg: &str) -> anyhow::Result<scene::medium::RgbMedium> {
+    use anyhow::Context;
+    let (text, origin) = if arg.trim_start().starts_with('{') {
+        (arg.to_string(), "--rgb-medium".to_string())
+    } else {
+        let p = std::path::Path::new(arg);
+        let t = color::input::read_regular_string(p, ::truth::medium_file::MAX_MEDIUM_FILE_BYTES)
+            .with_context(|| format!("--rgb-medium {arg}: cannot read"))?;
+        (t, format!("--rgb-medium {arg}"))
+    };
+    scene::medium::RgbMedium::from_json_str(&text).map_err(|e| anyhow::anyhow!("{origin}: {e}"))
+}
+
+/// The real-time renderer's RGB medium: `--rgb-medium`, else the scene's `extras.medium`;
+/// with water (which is a medium of its own) it is an error, as for `spectra truth`. As a
+/// custom shader with `steps` march steps, upsampled through `table`.
+pub fn realtime_medium(
+    scene: &scene::Scene,
+    arg: Option<&str>,
+    water: bool,
+    table: &color::upsample::CoeffTable,
+    steps: u32,
+) -> anyhow::Result<Option<::render::CustomShader>> {
+    let m = match (arg, &scene.medium) {
+        (Some(a), _) => rgb_medium_arg(a)?,
+        (None, Some(m)) => m.clone(),
+        (None, None) => return Ok(None),
+    };
+    if water {
+        anyhow::bail!(
+            "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
         );
     }
+    let opts = ::render::passes::rgb_medium::Options { steps };
+    Ok(Some(::render::passes::rgb_medium::shader(&m, table, &opts)?))
 }
 
 /// How a scene file is loaded, shared by every command that takes a scene (`render`, `view`,
