@@ -115,3 +115,34 @@ impl EnvArgs {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod rgb_medium_tests {
+    use super::realtime_medium;
+
+    /// `render`/`view`/`bench` take the medium from `--rgb-medium` or the scene, refuse it with
+    /// water, and name the flag in every error.
+    #[test]
+    fn realtime_rgb_medium_comes_from_the_flag_or_the_scene() {
+        let table = color::upsample::table("srgb").unwrap();
+        let fog = scene::builtin("fog").unwrap();
+        let cornell = scene::builtin("cornell").unwrap();
+        assert!(realtime_medium(&cornell, None, false, &table, 16).unwrap().is_none());
+        let s = realtime_medium(&fog, None, false, &table, 16).unwrap().expect("the scene's medium");
+        assert_eq!(s.params[0], 16.0);
+        let m = r#"{"absorption": [0.5, 0.2, 0.1], "g": 0.5}"#;
+        let s = realtime_medium(&cornell, Some(m), false, &table, 8).unwrap().expect("the flag's medium");
+        assert_eq!((s.params[0], s.params[1], &s.params[8..11]), (8.0, 0.5, &[0.5f32, 0.2, 0.1][..]));
+        let e = |scene: &scene::Scene, arg: Option<&str>, water: bool, steps: u32| {
+            format!("{:#}", realtime_medium(scene, arg, water, &table, steps).unwrap_err())
+        };
+        let msg = e(&fog, None, true, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("water"), "{msg}");
+        let msg = e(&cornell, Some(r#"{"absorption": [0.5, 0.2, 0.1], "g": 1}"#), false, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("g:"), "{msg}");
+        let msg = e(&cornell, Some("no-such-medium.json"), false, 16);
+        assert!(msg.contains("--rgb-medium no-such-medium.json"), "{msg}");
+        let msg = e(&cornell, Some(m), false, 33);
+        assert!(msg.contains("march steps") && msg.contains("33"), "{msg}");
+    }
+}
