@@ -9,7 +9,9 @@ spectra. The real-time images come from `cargo run --release -p spectra --exampl
 
 fog: the built-in `fog` and `tinted-fog` scenes (an RGB medium with lights inside it), real time
 (spectral, naive, rgb; and spectral without in-scattering, --scatter-steps 0) against
-`spectra truth` of the same scene (the same upsampled medium, full multiple scattering).
+`spectra truth` of the same scene (the same upsampled medium): the full tracer, and its direct
+light only (--direct-only), which is the real-time model (no global illumination, single
+scattering); and the same scene in clear air, for what the renderers differ by without a medium.
 
 Two figures per cell, mean ΔE2000 per pixel and on BLOCK×BLOCK block means (`spectra diff
 --block`); the truth's noise floor is a second truth seed measured the same way.
@@ -105,21 +107,34 @@ def main():
         if "fog" in parts:
             modes = [("spectral", ["--mode", "spectral"]), ("naive", ["--mode", "naive"]), ("rgb", ["--mode", "rgb"]),
                      ("spectral, no in-scattering", ["--mode", "spectral", "--scatter-steps", "0"])]
-            lines = ["| scene | " + " | ".join(m for m, _ in modes) + " | truth noise |",
-                     "|" + "---|" * (len(modes) + 2)]
-            for sc in ["fog", "tinted-fog"]:
-                ref = truth(sc, [sc], 1, a.fog_size, a.fog_spp)
-                noise = diff(a.bin, ref, truth(sc, [sc], 2, a.fog_size, a.fog_spp), a.block)
-                ds = []
+            # The real-time renderer has no global illumination and single scattering only: the
+            # tracer's direct light (--direct-only: light sampled at the camera ray's first
+            # vertex, in the medium or on a surface) is its model; the full tracer is the truth.
+            # "clear" is the fog scene in (practically) clear air: what the renderers differ by
+            # without a medium.
+            clear = ["--rgb-medium", '{"absorption": [1e-9, 1e-9, 1e-9]}']
+            lines = ["| scene | reference | " + " | ".join(m for m, _ in modes) + " | truth noise |",
+                     "|" + "---|" * (len(modes) + 3)]
+            for sc, extra in [("fog", []), ("tinted-fog", []), ("clear", clear)]:
+                scene_name = "fog" if sc == "clear" else sc
+                imgs = []
                 for m, flags in modes:
                     img = os.path.join(tmp, f"{sc}-{m.replace(' ', '').replace(',', '')}.exr")
-                    run([a.bin, "render", sc, "--size", a.fog_size, *flags, "--out", img])
-                    ds.append(diff(a.bin, ref, img, a.block))
-                lines.append(f"| {sc} | " + " | ".join(cell(d, a.block) for d in ds) + f" | {cell(noise, a.block)} |")
-                print(f"{sc}: " + ", ".join(f"{m} {cell(d, a.block)}" for (m, _), d in zip(modes, ds))
-                      + f", noise {cell(noise, a.block)}", file=sys.stderr)
+                    run([a.bin, "render", scene_name, *extra, "--size", a.fog_size, *flags, "--out", img])
+                    imgs.append(img)
+                for ref_name, ref_flags in [("full", []), ("direct only", ["--direct-only"])]:
+                    tag = f"{sc}{'-direct' if ref_flags else ''}"
+                    targs = [scene_name, *extra, *ref_flags]
+                    ref = truth(tag, targs, 1, a.fog_size, a.fog_spp)
+                    noise = diff(a.bin, ref, truth(tag, targs, 2, a.fog_size, a.fog_spp), a.block)
+                    ds = [diff(a.bin, ref, img, a.block) for img in imgs]
+                    lines.append(f"| {sc} | {ref_name} | " + " | ".join(cell(d, a.block) for d in ds)
+                                 + f" | {cell(noise, a.block)} |")
+                    print(f"{sc} vs {ref_name}: " + ", ".join(f"{m} {cell(d, a.block)}" for (m, _), d in zip(modes, ds))
+                          + f", noise {cell(noise, a.block)}", file=sys.stderr)
             text += ("**Fog scenes** (RGB media with lights inside): mean ΔE2000 per pixel / on "
-                     f"{a.block}×{a.block} block means against `spectra truth` of the same scene\n\n"
+                     f"{a.block}×{a.block} block means against `spectra truth` of the same scene, full and "
+                     "--direct-only\n\n"
                      + "\n".join(lines) + f"\n\n{a.fog_size} px, truth {a.fog_spp} spp (noise: seed 1 vs 2), "
                      "real time N = 16, 16 march steps.\n\n")
     text += (f"{(time.time() - t_start) / 60:.0f} min. `tools/rgb_media_study.py --parts {a.parts} --size {a.size} "
