@@ -17,6 +17,11 @@
 //! // seen from the camera; reflected with the diffuse lobe and added after the hooks above:
 //! fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32>
 //! fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32>
+//! // Pass 2, a wavelength-dependent factor on light li's direct light at the surface (a
+//! // medium's transmittance between the light and the surface): per group of four node
+//! // wavelengths in spectral & naive modes, per channel in rgb mode:
+//! fn custom_light_transmittance(li: u32, lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32>
+//! fn custom_light_transmittance_rgb(li: u32, ctx: SurfaceContext) -> vec3<f32>
 //! ```
 //!
 //! Inputs available to the hooks (see `wgsl/custom_api.wgsl` and `wgsl/spectral.wgsl`):
@@ -52,14 +57,21 @@ use color::Spectrum;
 /// Identity hooks.
 pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
 
+/// WGSL shared by the media hooks (`underwater`, `rgb_medium`): the Henyey–Greenstein phase
+/// function, the path integral (1 − e^{−k·d})/k and equiangular steps for point lights. Each
+/// medium's shader source starts with it.
+pub const MEDIUM_COMMON: &str = include_str!("medium_common.wgsl");
+
 /// The hook names, in the order `custom_hooks.wgsl` defines them.
-const HOOKS: [&str; 6] = [
+const HOOKS: [&str; 8] = [
     "custom_spectral",
     "custom_rgb",
     "custom_pixel",
     "custom_light_surface",
     "custom_irradiance",
     "custom_irradiance_rgb",
+    "custom_light_transmittance",
+    "custom_light_transmittance_rgb",
 ];
 
 /// User code for the extension point.
@@ -94,8 +106,10 @@ impl CustomShader {
     }
 
     /// The source as the passes compile it: the user's code, the identity definition of each
-    /// hook it leaves out, and `CUSTOM_SPECTRAL` (whether the spectral hook is the user's: the
-    /// shading loop skips the hook, and carries the specular term outside the nodes, when not).
+    /// hook it leaves out, `CUSTOM_SPECTRAL` (whether the spectral hook or the light
+    /// transmittance is the user's: the shading loop skips the hook, and carries the specular
+    /// term outside the nodes, when neither is) and `CUSTOM_LIGHT_T` (whether the shading loop
+    /// calls the light-transmittance hooks).
     pub fn assembled(&self) -> String {
         let mut out = self.source.clone();
         for name in HOOKS {
@@ -104,7 +118,12 @@ impl CustomShader {
                 out.push_str(default_hook(name));
             }
         }
-        out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {};\n", self.defines("custom_spectral")));
+        // A per-light spectral factor needs the specular term inside the nodes too.
+        let transmittance =
+            self.defines("custom_light_transmittance") || self.defines("custom_light_transmittance_rgb");
+        let spectral = self.defines("custom_spectral") || transmittance;
+        out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {spectral};\n"));
+        out.push_str(&format!("const CUSTOM_LIGHT_T: bool = {transmittance};\n"));
         // The irradiance hooks come as a pair; either one turns on the diffuse term's code.
         let irradiance = self.defines("custom_irradiance") || self.defines("custom_irradiance_rgb");
         out.push_str(&format!("const CUSTOM_IRRADIANCE: bool = {irradiance};\n"));

@@ -42,3 +42,15 @@ fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3
 fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
+
+// Pass 2, spectral and naive modes, per light and group on a lit surface: a factor per node
+// wavelength on light `li`'s direct light at the surface (a medium's transmittance between
+// the light and the surface), applied to its diffuse and specular terms.
+fn custom_light_transmittance(li: u32, lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+    return vec4<f32>(1.0);
+}
+
+// Pass 2, rgb mode: the same per linear-sRGB channel.
+fn custom_light_transmittance_rgb(li: u32, ctx: SurfaceContext) -> vec3<f32> {
+    return vec3<f32>(1.0);
+}

@@ -9,6 +9,7 @@ pub mod accumulate;
 pub mod custom;
 pub mod gbuffer;
 pub mod post;
+pub mod rgb_medium;
 pub mod shading;
 pub mod shadow;
 pub mod underwater;

@@ -339,7 +339,10 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         for (var li = 0u; li < n_lit; li++) {
             let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness)
                 * custom_light_surface(li, ctx);
-            let e = lights[li].rgb.rgb;
+            var e = lights[li].rgb.rgb;
+            if (CUSTOM_LIGHT_T) {
+                e *= custom_light_transmittance_rgb(li, ctx);
+            }
             sum_a = fma(vec3<f32>(f.x), e, sum_a);
             sum_b = fma(vec3<f32>(f.y), e, sum_b);
         }
@@ -451,7 +454,10 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         var acc_a = zero;
         var acc_b = zero;
         for (var li = 0u; li < n_lights; li++) {
-            let w = light_w(li, g, ng);
+            var w = light_w(li, g, ng);
+            if (CUSTOM_LIGHT_T) {
+                w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
+            }
             acc_a += w * fa[li];
             if (CUSTOM_SPECTRAL) {
                 acc_b += w * fb[li];

@@ -43,7 +43,7 @@ use super::custom::CustomShader;
 use scene::water::light_field::{self, LightFieldTable};
 use scene::water::{WaterError, WaterMedium};
 
-/// The WGSL hooks.
+/// The WGSL hooks (after [`super::custom::MEDIUM_COMMON`], which they use).
 pub const HOOKS: &str = include_str!("underwater.wgsl");
 
 /// Wavelengths (nm) at which the RGB mode takes c, Kd and b for its R, G, B channels: the
@@ -363,7 +363,7 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
     use scene::water::{WATER_IOR, fresnel::mean_transmittance};
     options.validate().map_err(WaterError::BadQuery)?;
     let tables = if options.light_field { Some(light_field_tables(medium, options)?) } else { None };
-    let mut source = HOOKS.to_string();
+    let mut source = format!("{}\n{HOOKS}", super::custom::MEDIUM_COMMON);
     let mut set = |line: &str, value: String| {
         let (name, _) = line.split_once('=').expect("a const line");
         assert!(source.contains(line), "underwater.wgsl lost `{line}`");

@@ -15,7 +15,8 @@
 // light's lines are integrated by the renderer's quadrature and the water's smooth factors
 // multiply node by node; in rgb mode column 0 holds (R, G, B, 0) and the others are zero.
 
-const UW_INV_4PI: f32 = 0.0795774715459476;
+// The phase function, the path integral and the equiangular steps: medium_common.wgsl.
+const UW_INV_4PI: f32 = MEDIUM_INV_4PI;
 // Must match MAX_LIGHTS in src/scene_gpu.rs.
 const UW_MAX_LIGHTS: u32 = 32u;
 // Whether the shader marches at all: `underwater::shader_with` writes `false` here when the
@@ -101,15 +102,6 @@ var<private> uw_tv: array<f32, 128>;
 var<private> uw_d: f32 = 0.0;
 var<private> uw_infinite: bool = false;
 
-// (1 − e^{−k·d})/k, continuous through k = 0 (where it is d). The series is used where the
-// subtraction would lose f32 digits; its truncation error is below (k·d)³/24·d < 1e-10·d.
-fn uw_path_integral(k: vec4<f32>, d: f32) -> vec4<f32> {
-    let x = k * d;
-    let series = d * (1.0 - 0.5 * x + x * x / 6.0);
-    let exact = (1.0 - exp(-x)) / k;
-    return select(exact, series, abs(x) < vec4<f32>(1e-3));
-}
-
 // The same over the whole view ray: to the hit or surface, or to infinity (k > 0 there).
 fn uw_ray_integral(k: vec4<f32>) -> vec4<f32> {
     return uw_integral_to(k, uw_d, uw_infinite);
@@ -119,13 +111,7 @@ fn uw_integral_to(k: vec4<f32>, d: f32, infinite: bool) -> vec4<f32> {
     if (infinite) {
         return 1.0 / k;
     }
-    return uw_path_integral(k, d);
-}
-
-fn uw_hg(g: f32, cos_t: f32) -> f32 {
-    let g2 = g * g;
-    let den = max(1.0 + g2 - 2.0 * g * cos_t, 1e-6);
-    return UW_INV_4PI * (1.0 - g2) / (den * sqrt(den));
+    return medium_path_integral(k, d);
 }
 
 // Light `li` in weighted form: its node weights for the group, or in rgb mode its linear-sRGB
@@ -494,7 +480,7 @@ fn uw_prepare(ctx: SurfaceContext) {
             let q = 1.0 - w.y / mu;
             let dm = select(uw_d, UW_CAP / custom.params[1].w, uw_infinite);
             let dt = dm / fm;
-            let p = uw_hg(g, dot(-l.xyz, w));
+            let p = medium_hg(g, dot(-l.xyz, w));
             var lit = true;
             for (var k = 0u; k < m; k++) {
                 let x = cam + w * ((f32(k) + 0.5) * dt / scale);
@@ -507,27 +493,20 @@ fn uw_prepare(ctx: SurfaceContext) {
             let tail = select(0.0, p, uw_infinite);
             uw_dir[n] = vec4<f32>(q, dt, tail, z0 / mu + dm * q);
         } else {
-            // Equiangular steps (Kulla & Fajardo 2012): with t − t0 = h·tan θ the 1/r² of
-            // the light cancels the Jacobian, leaving a smooth integrand in θ.
-            let rel = l.xyz - cam;
-            let t0 = dot(rel, w);
-            let h = max(length(rel - w * t0), 1e-4);
+            // Equiangular steps (medium_common.wgsl).
             // The march ends after UW_CAP optical depths of the clearest wavelength; what
             // lies beyond is lost (< e^{−6} of the light's scattering there).
             let cap = UW_CAP / custom.params[1].w;
             let dm = select(min(uw_d, cap), cap, uw_infinite);
-            let ta = atan2(-t0, h);
-            let tb = atan2(dm / scale - t0, h);
-            let dth = (tb - ta) / fm;
+            let eq = medium_equiangular(l.xyz - cam, w, dm / scale, m);
             for (var k = 0u; k < m; k++) {
-                let th = ta + (f32(k) + 0.5) * dth;
-                let t = t0 + h * tan(th);
-                let r = h / cos(th);
+                let st = medium_equiangular_step(eq, k);
+                let t = st.x;
                 let x = cam + w * t;
                 let inc = light_incidence(li, x);
                 let v = light_visibility(li, x, vec3<f32>(0.0));
-                uw_w[n * UW_MAX_STEPS + k] = scale * uw_hg(g, dot(inc.xyz, w)) * v * inc.w * r * r * dth / h;
-                uw_s[n * UW_MAX_STEPS + k] = scale * (r + t);
+                uw_w[n * UW_MAX_STEPS + k] = scale * medium_hg(g, dot(inc.xyz, w)) * v * inc.w * st.z;
+                uw_s[n * UW_MAX_STEPS + k] = scale * (st.y + t);
                 uw_tv[n * UW_MAX_STEPS + k] = scale * t;
             }
             uw_dir[n] = vec4<f32>(0.0);
@@ -562,7 +541,7 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb:
                 sum = fma(vec4<f32>(uw_w[base + k]), att, sum);
                 att *= ratio;
             }
-            sum = sum * uw_path_integral(cq, dir.y);
+            sum = sum * medium_path_integral(cq, dir.y);
             if (dir.z > 0.0) {
                 // The tail starts dir.y·steps metres along the view.
                 sum += dir.z * exp(-c * dir.w + dc * (dir.y * f32(uw_steps))) / cq;

@@ -1,7 +1,7 @@
 //! `fog` and `tinted-fog`: the Cornell box filled with an RGB medium ([`crate::medium`]), with
 //! a lantern (a 2700 K point light) hanging in the fog beside the ceiling lamp, so that light
 //! scattered around a source inside the medium can be seen. For the RGB-media work (issue 18):
-//! ground truth renders the medium spectrally now; the real-time renderer does not draw it yet.
+//! both renderers draw the medium (`spectra truth`, `spectra render`; docs/rgb-media.md).
 //!
 //! `fog` is a white fog (grey coefficients: every upsampling gives a flat spectrum, so RGB and
 //! spectral rendering agree on its colour); `tinted-fog` a smoky fog that absorbs blue more

@@ -35,6 +35,10 @@ pub struct Args {
     pub files: super::SceneFileArgs,
     #[command(flatten)]
     pub env: super::EnvArgs,
+    /// A homogeneous medium filling the scene, given in RGB (inline JSON or a JSON file;
+    /// docs/rgb-media.md); default: the scene's extras.medium. Drawn with 16 march steps.
+    #[arg(long, value_name = "JSON|FILE")]
+    pub rgb_medium: Option<String>,
     /// Frame size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720")]
     pub size: String,
@@ -277,10 +281,15 @@ pub fn run(args: Args) -> Result<()> {
     }
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
-    super::warn_no_realtime_medium(&scene);
     args.env.apply(&mut scene)?;
-    let mut r = Renderer::with_table(load_table(args.table.as_deref())?)?;
+    let coeffs = load_table(args.table.as_deref())?;
+    let steps = render::passes::rgb_medium::Options::default().steps;
+    let medium = super::realtime_medium(&scene, args.rgb_medium.as_deref(), false, &coeffs, steps)?;
+    let mut r = Renderer::with_table(coeffs)?;
     r.set_scene(&scene)?;
+    if let Some(m) = medium {
+        r.set_custom_shader(m)?;
+    }
     r.resize(width, height)?;
     let load_before = load_average();
     let has_ts = r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY);

@@ -25,15 +25,43 @@ pub fn print_warnings(scene: &scene::Scene) {
     }
 }
 
-/// The real-time renderer does not draw an RGB medium yet (issue 18's later step); say so
-/// rather than silently render clear air.
-pub fn warn_no_realtime_medium(scene: &scene::Scene) {
-    if scene.medium.is_some() {
-        eprintln!(
-            "warning: {}: extras.medium (an RGB medium) is drawn only by `spectra truth` so far; this real-time image shows clear air",
-            scene.source
+/// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it (`render`, `view`,
+/// `bench`, `truth`).
+pub fn rgb_medium_arg(arg: &str) -> anyhow::Result<scene::medium::RgbMedium> {
+    use anyhow::Context;
+    let (text, origin) = if arg.trim_start().starts_with('{') {
+        (arg.to_string(), "--rgb-medium".to_string())
+    } else {
+        let p = std::path::Path::new(arg);
+        let t = color::input::read_regular_string(p, ::truth::medium_file::MAX_MEDIUM_FILE_BYTES)
+            .with_context(|| format!("--rgb-medium {arg}: cannot read"))?;
+        (t, format!("--rgb-medium {arg}"))
+    };
+    scene::medium::RgbMedium::from_json_str(&text).map_err(|e| anyhow::anyhow!("{origin}: {e}"))
+}
+
+/// The real-time renderer's RGB medium: `--rgb-medium`, else the scene's `extras.medium`;
+/// with water (which is a medium of its own) it is an error, as for `spectra truth`. As a
+/// custom shader with `steps` march steps, upsampled through `table`.
+pub fn realtime_medium(
+    scene: &scene::Scene,
+    arg: Option<&str>,
+    water: bool,
+    table: &color::upsample::CoeffTable,
+    steps: u32,
+) -> anyhow::Result<Option<::render::CustomShader>> {
+    let m = match (arg, &scene.medium) {
+        (Some(a), _) => rgb_medium_arg(a)?,
+        (None, Some(m)) => m.clone(),
+        (None, None) => return Ok(None),
+    };
+    if water {
+        anyhow::bail!(
+            "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
         );
     }
+    let opts = ::render::passes::rgb_medium::Options { steps };
+    Ok(Some(::render::passes::rgb_medium::shader(&m, table, &opts)?))
 }
 
 /// How a scene file is loaded, shared by every command that takes a scene (`render`, `view`,
@@ -85,5 +113,36 @@ impl EnvArgs {
             eprintln!("{note}");
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod rgb_medium_tests {
+    use super::realtime_medium;
+
+    /// `render`/`view`/`bench` take the medium from `--rgb-medium` or the scene, refuse it with
+    /// water, and name the flag in every error.
+    #[test]
+    fn realtime_rgb_medium_comes_from_the_flag_or_the_scene() {
+        let table = color::upsample::table("srgb").unwrap();
+        let fog = scene::builtin("fog").unwrap();
+        let cornell = scene::builtin("cornell").unwrap();
+        assert!(realtime_medium(&cornell, None, false, &table, 16).unwrap().is_none());
+        let s = realtime_medium(&fog, None, false, &table, 16).unwrap().expect("the scene's medium");
+        assert_eq!(s.params[0], 16.0);
+        let m = r#"{"absorption": [0.5, 0.2, 0.1], "g": 0.5}"#;
+        let s = realtime_medium(&cornell, Some(m), false, &table, 8).unwrap().expect("the flag's medium");
+        assert_eq!((s.params[0], s.params[1], &s.params[8..11]), (8.0, 0.5, &[0.5f32, 0.2, 0.1][..]));
+        let e = |scene: &scene::Scene, arg: Option<&str>, water: bool, steps: u32| {
+            format!("{:#}", realtime_medium(scene, arg, water, &table, steps).unwrap_err())
+        };
+        let msg = e(&fog, None, true, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("water"), "{msg}");
+        let msg = e(&cornell, Some(r#"{"absorption": [0.5, 0.2, 0.1], "g": 1}"#), false, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("g:"), "{msg}");
+        let msg = e(&cornell, Some("no-such-medium.json"), false, 16);
+        assert!(msg.contains("--rgb-medium no-such-medium.json"), "{msg}");
+        let msg = e(&cornell, Some(m), false, 33);
+        assert!(msg.contains("march steps") && msg.contains("33"), "{msg}");
     }
 }

@@ -65,8 +65,13 @@ pub struct LookArgs {
     /// Camera depth below the water surface, metres (default: the scene's, else 10).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub depth: Option<f64>,
-    /// Under water: ray-march steps for single scattering of the scene's lights (0–32; 0 =
-    /// the paper's analytic in-scattering alone).
+    /// A homogeneous medium filling the scene, given in RGB (inline JSON or a JSON file, as for
+    /// `spectra truth --rgb-medium`; docs/rgb-media.md). Replaces the scene's extras.medium.
+    #[arg(long, value_name = "JSON|FILE")]
+    pub rgb_medium: Option<String>,
+    /// Under water or in an RGB medium: ray-march steps for single scattering of the scene's
+    /// lights (0–32; under water 0 = the paper's analytic in-scattering alone, in an RGB
+    /// medium attenuation alone).
     #[arg(long, value_name = "STEPS", default_value_t = render::passes::underwater::Options::default().steps)]
     pub scatter_steps: u32,
     /// Under water: Henyey–Greenstein asymmetry g of single scattering (default: Petzold's 0.924).
@@ -342,7 +347,7 @@ fn render_frame(
     args: &RenderArgs,
     scene: &scene::Scene,
     settings: &RenderSettings,
-    water: Option<&scene::water::WaterMedium>,
+    custom: Option<render::CustomShader>,
     format: OutFormat,
     (width, height): (u32, u32),
 ) -> Result<()> {
@@ -350,8 +355,9 @@ fn render_frame(
     for w in r.scene_warnings() {
         eprintln!("warning: {}: {w}", scene.source);
     }
-    if let Some(m) = water {
-        r.set_custom_shader(render::passes::underwater::shader_with(m, &args.look.underwater()?)?)?;
+    // The water's or the RGB medium's hooks.
+    if let Some(c) = custom {
+        r.set_custom_shader(c)?;
     }
     r.resize(width, height)?;
     r.render(&scene.camera, settings)?;
@@ -387,13 +393,23 @@ pub fn run(args: RenderArgs) -> Result<()> {
     super::check_output("--out", &args.out)?;
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
-    super::warn_no_realtime_medium(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = settings(&args, &scene)?;
     let water = water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
     let table = load_table(args.look.table.as_deref())?;
+    let medium = super::realtime_medium(
+        &scene,
+        args.look.rgb_medium.as_deref(),
+        water.is_some(),
+        &table,
+        args.look.scatter_steps,
+    )?;
     let mut r = Renderer::with_table(table)?;
-    let frame = render_frame(&mut r, &args, &scene, &settings, water.as_ref(), format, (width, height));
+    let custom = match &water {
+        Some(m) => Some(render::passes::underwater::shader_with(m, &args.look.underwater()?)?),
+        None => medium,
+    };
+    let frame = render_frame(&mut r, &args, &scene, &settings, custom, format, (width, height));
     if let Err(e) = frame {
         if color::cancel::is_cancelled() {
             // Dropping the device waits for the frame in flight (28 s at 4096² on lavapipe):

@@ -1,6 +1,6 @@
 //! `spectra truth`: the CPU spectral path tracer's ground-truth image of a scene.
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
 use color::{Observer, RgbColorSpace, WavelengthRange};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -95,19 +95,6 @@ pub struct Args {
     pub spectral_bin: f64,
 }
 
-/// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it.
-fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
-    let (text, origin) = if arg.trim_start().starts_with('{') {
-        (arg.to_string(), "--rgb-medium".to_string())
-    } else {
-        let p = std::path::Path::new(arg);
-        let t = color::input::read_regular_string(p, truth::medium_file::MAX_MEDIUM_FILE_BYTES)
-            .with_context(|| format!("--rgb-medium {arg}: cannot read"))?;
-        (t, format!("--rgb-medium {arg}"))
-    };
-    scene::medium::RgbMedium::from_json_str(&text).map_err(|e| anyhow!("{origin}: {e}"))
-}
-
 fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
     // One size syntax for every command (issue 16): render's parser.
     let (width, height) = crate::cmd::render::parse_size(&a.size)?;
@@ -136,7 +123,7 @@ fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable)
     }
     // An explicit --medium / --rgb-medium replaces the scene's own RGB medium.
     let rgb = match (&a.rgb_medium, &scene.medium) {
-        (Some(arg), _) => Some((rgb_medium_arg(arg)?, "--rgb-medium".to_string())),
+        (Some(arg), _) => Some((super::rgb_medium_arg(arg)?, "--rgb-medium".to_string())),
         (None, Some(m)) if a.medium.is_none() => {
             Some((m.clone(), format!("{}: extras.medium", scene.source)))
         }

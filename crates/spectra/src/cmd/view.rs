@@ -60,7 +60,6 @@ pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
-    super::warn_no_realtime_medium(&scene);
     args.look.env.apply(&mut scene)?;
     let settings = initial_settings(&args, &scene)?;
     let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
@@ -71,7 +70,14 @@ pub fn run(args: Args) -> Result<()> {
     // The event loop connects to the X server; a named but unreachable display fails here.
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
     let table = load_table(args.look.table.as_deref())?;
-    run_window(event_loop, ViewOptions { scene, settings, size, table, water, water_options })
+    let medium = super::realtime_medium(
+        &scene,
+        args.look.rgb_medium.as_deref(),
+        water.is_some(),
+        &table,
+        args.look.scatter_steps,
+    )?;
+    run_window(event_loop, ViewOptions { scene, settings, size, table, water, water_options, medium })
 }
 
 #[cfg(test)]

@@ -32,6 +32,8 @@ pub struct ViewOptions {
     pub water: Option<scene::water::WaterMedium>,
     /// The underwater model's choices (`--scatter-steps`, `--phase-g`).
     pub water_options: render::passes::underwater::Options,
+    /// The RGB medium filling the scene (`--rgb-medium` or the scene's), as its hooks.
+    pub medium: Option<render::CustomShader>,
 }
 
 /// Radians of orbit per pixel of drag.
@@ -149,6 +151,9 @@ impl Running {
         renderer.set_scene(&opts.scene)?;
         if let Some(w) = &opts.water {
             renderer.set_custom_shader(render::passes::underwater::shader_with(w, &opts.water_options)?)?;
+        }
+        if let Some(m) = &opts.medium {
+            renderer.set_custom_shader(m.clone())?;
         }
         let water = opts.water.as_ref().map(|w| {
             let c = WaterControls::new(w, opts.water_options);
