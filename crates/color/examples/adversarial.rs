@@ -14,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(p) => color::upsample::CoeffTable::read(std::path::Path::new(p))?,
         None => {
             let t0 = std::time::Instant::now();
-            let t = color::upsample::fit_default(&space, &indicatif::ProgressBar::hidden())?;
+            let t = color::upsample::fit_default(&space, &color::progress::Silent)?;
             println!("fit + refine {}: {:.1} s", space.name, t0.elapsed().as_secs_f64());
             t.write(std::path::Path::new(&format!("/tmp/{}-64.coeff", space.name)))?;
             t

@@ -51,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut t = color::upsample::fit_table_with(
         &space,
         &opt,
-        &indicatif::ProgressBar::hidden(),
+        &color::progress::Silent,
         color::upsample::interrupt_flag(),
     )?;
     eprintln!("fit {res}^3 {}: {:.2} s", space.name, t0.elapsed().as_secs_f64());
@@ -88,7 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &mut t,
             &model,
             &opt,
-            &indicatif::ProgressBar::hidden(),
+            &color::progress::Silent,
             color::upsample::interrupt_flag(),
         )?;
         let r = color::upsample::roundtrip::roundtrip_table(&t, &space, 100_000, 1)?;

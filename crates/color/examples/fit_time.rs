@@ -10,7 +10,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let space = color::RgbColorSpace::by_name(&a[1])?;
     let res: usize = a[2].parse().map_err(|e| format!("RES {:?}: {e}", a[2]))?;
-    let bar = indicatif::ProgressBar::hidden();
+    let bar = color::progress::Silent;
     let flag = color::upsample::interrupt_flag();
     let table = match a.get(4).map(|s| s.as_str()).unwrap_or("default") {
         "default" => color::upsample::fit_default_res(&space, res, &bar)?,

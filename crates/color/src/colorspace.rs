@@ -201,6 +201,20 @@ impl RgbColorSpace {
         illuminant::by_name(&self.illuminant_name).expect("built-in spaces name built-in illuminants")
     }
 
+    /// What RGB white (1, 1, 1) emits in a scene whose reference white is `scene_white`: this
+    /// space's illuminant scaled to the scene white's luminance, `y` being the caller's
+    /// luminance integral (its observer, quadrature and range). The scene white sets the units
+    /// (XYZ is normalised by ∫ȳ·white, so a light of the white's own spectrum has Y = 1) and
+    /// RGB emission follows it, so RGB lights and emissive colours keep the luminance and the
+    /// colour they have under D65: there is no chromatic adaptation, the output colours are
+    /// this space's. The one statement of the convention; both renderers build their white
+    /// with it (`spectra.white`, `--white`).
+    pub fn emission_white(&self, scene_white: &Spectrum, y: impl Fn(&Spectrum) -> f64) -> Spectrum {
+        let ill = self.illuminant();
+        let (k_white, k_ill) = (y(scene_white), y(&ill));
+        if k_ill > 0.0 { ill.scaled(k_white / k_ill) } else { ill }
+    }
+
     /// Linear → encoded with this space's transfer function.
     pub fn encode(&self, rgb: [f64; 3]) -> [f64; 3] {
         rgb.map(|v| self.transfer.encode(v))

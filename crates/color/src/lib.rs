@@ -13,6 +13,7 @@ pub mod lab;
 pub mod metrics;
 pub mod observer;
 pub mod outfile;
+pub mod progress;
 pub mod quadrature;
 pub mod spectrum;
 pub mod upsample;

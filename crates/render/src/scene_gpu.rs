@@ -391,6 +391,10 @@ impl GpuScene {
         max_buffer_bytes: u64,
     ) -> Result<Self> {
         let max_buffer_bytes = max_buffer_bytes.min(device.limits().max_buffer_size);
+        // Normals and tangents as the scene's convention has them (flat normals when a mesh
+        // has none, MikkTSpace tangents for normal maps), the same the path tracer reads.
+        let completed = s.completed();
+        let s: &Scene = &completed;
         let bad = |problem: String| RenderError::Scene { source_name: s.source.clone(), problem };
         if s.lights.len() > MAX_LIGHTS {
             return Err(bad(format!(
@@ -428,20 +432,6 @@ impl GpuScene {
                 }
             }
             let mat = &s.materials[m.material];
-            let normals = if m.normals.is_empty() { flat_normals(m) } else { m.normals.clone() };
-            // Generated tangents follow the normal map's UV set (its KHR_texture_transform
-            // rotation is not applied to the tangent frame).
-            let normal_uvs = match mat.normal_texture {
-                Some(r) if r.tex_coord == 1 => &m.uvs1,
-                _ => &m.uvs,
-            };
-            let tangents = if !m.tangents.is_empty() {
-                m.tangents.clone()
-            } else if mat.normal_texture.is_some() && !normal_uvs.is_empty() {
-                generate_tangents(&m.positions, &normals, normal_uvs, &m.indices)
-            } else {
-                vec![Vec4::ZERO; n]
-            };
             let mut vertices = Vec::with_capacity(n);
             for i in 0..n {
                 let p = m.positions[i];
@@ -449,14 +439,15 @@ impl GpuScene {
                 hi = hi.max(p);
                 vertices.push(Vertex {
                     position: p.to_array(),
-                    normal: normals[i].to_array(),
+                    normal: m.normals.get(i).copied().unwrap_or(Vec3::Z).to_array(),
                     uv: m.uvs.get(i).copied().unwrap_or(Vec2::ZERO).to_array(),
-                    tangent: tangents[i].to_array(),
+                    // Zero without a normal map (or one lacking the UV set to orient it): the
+                    // shader leaves the normal unmapped.
+                    tangent: m.tangents.get(i).copied().unwrap_or(Vec4::ZERO).to_array(),
                     color: m.colors.get(i).copied().unwrap_or(Vec4::ONE).to_array(),
                     uv1: m.uvs1.get(i).copied().unwrap_or(Vec2::ZERO).to_array(),
                 });
             }
-            drop((normals, tangents));
             let template = Draw {
                 chunk: 0,
                 mesh: mi,
@@ -915,49 +906,6 @@ impl DefaultTextures {
             ),
         }
     }
-}
-
-/// Per-vertex normals from face normals (area-weighted), for meshes that come without.
-fn flat_normals(m: &scene::Mesh) -> Vec<Vec3> {
-    let mut n = vec![Vec3::ZERO; m.positions.len()];
-    for t in m.indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| m.positions[i as usize]);
-        let f = (b - a).cross(c - a);
-        for &i in t {
-            n[i as usize] += f;
-        }
-    }
-    n.into_iter().map(|v| v.normalize_or(Vec3::Y)).collect()
-}
-
-/// Tangents from UV derivatives, accumulated per vertex and Gram–Schmidt orthogonalised, for
-/// normal-mapped meshes that come without tangents.
-fn generate_tangents(p: &[Vec3], n: &[Vec3], uv: &[Vec2], indices: &[u32]) -> Vec<Vec4> {
-    let mut t = vec![Vec3::ZERO; p.len()];
-    let mut b = vec![Vec3::ZERO; p.len()];
-    for tri in indices.chunks_exact(3) {
-        let [i0, i1, i2] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
-        let (e1, e2) = (p[i1] - p[i0], p[i2] - p[i0]);
-        let (d1, d2) = (uv[i1] - uv[i0], uv[i2] - uv[i0]);
-        let det = d1.x * d2.y - d2.x * d1.y;
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let r = 1.0 / det;
-        let tu = (e1 * d2.y - e2 * d1.y) * r;
-        let tv = (e2 * d1.x - e1 * d2.x) * r;
-        for i in [i0, i1, i2] {
-            t[i] += tu;
-            b[i] += tv;
-        }
-    }
-    (0..p.len())
-        .map(|i| {
-            let ortho = (t[i] - n[i] * n[i].dot(t[i])).normalize_or_zero();
-            let w = if n[i].cross(ortho).dot(b[i]) < 0.0 { -1.0 } else { 1.0 };
-            ortho.extend(w)
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -98,6 +98,10 @@ pub struct RenderSettings {
     pub range: WavelengthRange,
     /// Observer name for `color::Observer::by_name`.
     pub observer: String,
+    /// The scene's reference white, an illuminant name for `color::illuminant::by_name`
+    /// (`spectra.white`, default D65): the units of the XYZ normalisation, with RGB emission
+    /// following it ([`color::RgbColorSpace::emission_white`], as in the path tracer).
+    pub white: String,
     /// Exposure in stops: the HDR colour is multiplied by 2^EV before tone mapping.
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
@@ -135,6 +139,7 @@ impl Default for RenderSettings {
             quadrature: Quadrature::Prefiltered,
             range: WavelengthRange::VISIBLE,
             observer: "cie1931".into(),
+            white: scene::DEFAULT_WHITE.into(),
             exposure_ev: 0.0,
             tonemap: Tonemap::None,
             shadows: true,
@@ -172,6 +177,7 @@ impl RenderSettings {
             return Err(RenderError::Settings(format!("the wavelength jitter must be in [0, 1) (got {u})")));
         }
         color::Observer::by_name(&self.observer)?;
+        color::illuminant::by_name(&self.white)?;
         Ok(())
     }
 }

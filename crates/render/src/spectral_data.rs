@@ -51,7 +51,8 @@ pub struct SpectralSetup {
     /// midpoint rule's weights for a light of radiance 1. Kept for per-wavelength tests; the
     /// renderer uploads [`Self::light_weights`].
     pub integrator: SpectralIntegrator,
-    /// The white illuminant (the colour space's, D65 for sRGB), unnormalised.
+    /// RGB white's emission: the colour space's illuminant (D65 for sRGB) at the luminance of
+    /// the scene white ([`color::RgbColorSpace::emission_white`]), unnormalised.
     pub white: Spectrum,
     /// The white illuminant at each node.
     pub white_samples: Vec<f64>,
@@ -79,7 +80,7 @@ impl SpectralSetup {
     pub fn new(settings: &RenderSettings) -> Result<Self> {
         let observer = Observer::by_name(&settings.observer)?;
         let space = RgbColorSpace::srgb();
-        let white = space.illuminant();
+        let scene_white = color::illuminant::by_name(&settings.white)?;
         let offset = settings.jitter.map_or(0.5, f64::from);
         let nodes = Nodes::new(settings.range, settings.wavelengths, offset)?;
         let quad = NodeQuadrature::new(settings.quadrature, nodes, &observer);
@@ -87,17 +88,15 @@ impl SpectralSetup {
             lambda: quad.nodes.lambda.clone(),
             weight: vec![quad.nodes.spacing; quad.len()],
         };
-        let quad_white = quad.total(|l| white.eval(l));
-        let (k, sampled_white, norm) = match settings.jitter {
-            None => (quad_white[1], quad_white, None),
+        // With jitter, normalise with the dense integral over the render range, not these
+        // nodes: a ratio of two N-node estimates is biased, so frame averages would not
+        // converge (see `RenderSettings::jitter`).
+        let raw = match settings.jitter {
+            None => None,
             Some(_) => {
-                // Normalise with the dense integral over the render range, not these nodes:
-                // a ratio of two N-node estimates is biased, so frame averages would not
-                // converge (see `RenderSettings::jitter`).
                 let n_dense = settings.range.width().round().max(1.0) as usize;
                 let dense_wl = SampledWavelengths::midpoint(settings.range, n_dense)?;
-                let norm = SpectralIntegrator::emission(&observer, &white, &dense_wl);
-                let raw = SpectralIntegrator {
+                Some(SpectralIntegrator {
                     lambda: dense_wl.lambda.clone(),
                     weights: dense_wl
                         .lambda
@@ -105,12 +104,22 @@ impl SpectralSetup {
                         .zip(&dense_wl.weight)
                         .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl))
                         .collect(),
-                };
-                let dense_white = raw.integrate(|l| white.eval(l));
-                (dense_white[1], dense_white, Some(norm))
+                })
             }
         };
-        let k = if k > 0.0 { k } else { 1.0 };
+        let integrate = |s: &Spectrum| match &raw {
+            None => quad.total(|l| s.eval(l)),
+            Some(raw) => raw.integrate(|l| s.eval(l)),
+        };
+        // RGB white as the scene white has it: the colour space's illuminant at the scene
+        // white's luminance, so the normalisation below is the scene white's (as in truth).
+        let white = space.emission_white(&scene_white, |s| integrate(s)[1]);
+        let sampled_white = integrate(&white);
+        let k = if sampled_white[1] > 0.0 { sampled_white[1] } else { 1.0 };
+        let norm = raw.map(|raw| SpectralIntegrator {
+            weights: raw.weights.iter().map(|w| w.map(|c| c / k)).collect(),
+            ..raw
+        });
         let sampled_white = sampled_white.map(|c| c / k);
         let weights = wavelengths
             .lambda
@@ -292,15 +301,11 @@ impl SpectralSetup {
 }
 
 /// pbrt-style "illuminant" upsampling of an emission colour: the coefficients of `rgb / s` and
-/// the scale `s = 2·max(rgb)`, so that the sigmoid works in its comfortable middle range and
-/// RGB (1, 1, 1) becomes exactly the white illuminant (ρ ≡ ½, times s = 2).
+/// the scale `s = 2·max(rgb)` ([`color::upsample::variants::unbounded_split`]), so that RGB
+/// (1, 1, 1) becomes exactly the white illuminant (ρ ≡ ½, times s = 2).
 pub fn illuminant_coeffs(rgb: [f64; 3], table: &CoeffTable) -> (f64, color::upsample::SigmoidPolynomial) {
-    let m = rgb[0].max(rgb[1]).max(rgb[2]);
-    if m <= 0.0 {
-        return (0.0, table.fetch([0.0; 3]));
-    }
-    let s = 2.0 * m;
-    (s, table.fetch(rgb.map(|c| c.max(0.0) / s)))
+    let u = color::upsample::variants::UnboundedSpectrum::clamped(table, rgb);
+    (u.scale, u.poly)
 }
 
 /// Band edges (nm) of the naive box upsampling: below `blue_max` is blue, below `green_max`

@@ -78,6 +78,19 @@ impl Emission {
         Ok(Emission { rgb, intensity, spectrum })
     }
 
+    /// A light of spectral `shape` and luminance `luminance`, with the shape's own linear sRGB
+    /// chromaticity (negative components of out-of-gamut lights clipped) at luminance 1 as its
+    /// glTF colour, so that `rgb × intensity` and the scaled spectrum describe the same light as
+    /// closely as RGB can. The built-in scenes and the evaluation's relit charts use it.
+    pub fn of_shape(shape: &Spectrum, luminance: f32) -> Result<Self, String> {
+        let xyz = spectrum_xyz(shape);
+        if !(xyz[1] > 0.0 && xyz[1].is_finite()) {
+            return Err("the spectrum has no luminance, so it has no colour to give the light".into());
+        }
+        let rgb = srgb::xyz_to_linear(xyz.map(|c| c / xyz[1])).max(glam::DVec3::ZERO).as_vec3();
+        Emission::new(rgb / srgb::luminance(rgb) as f32, luminance, Some(shape))
+    }
+
     /// CIE XYZ of the emission: `∫ S x̄ȳz̄ dλ` for a spectral light, else `rgb × intensity`
     /// converted from linear sRGB.
     pub fn xyz(&self) -> [f64; 3] {

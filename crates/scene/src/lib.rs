@@ -27,6 +27,7 @@ pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
 mod uri;
+pub mod vertex;
 pub mod water;
 
 use std::path::Path;
@@ -362,6 +363,9 @@ impl Camera {
     }
 }
 
+/// The reference white of a scene that names none (`spectra.white`).
+pub const DEFAULT_WHITE: &str = "D65";
+
 /// Spectral rendering defaults carried by the scene (the CLI overrides them).
 #[derive(Clone, Debug, Default)]
 pub struct SpectralSettings {
@@ -373,6 +377,14 @@ pub struct SpectralSettings {
     pub wavelengths: Option<u32>,
     /// The illuminant whose white is the reference white for XYZ → RGB (default D65).
     pub white: Option<String>,
+}
+
+impl SpectralSettings {
+    /// The reference white's name: `spectra.white`, else [`DEFAULT_WHITE`]. Both renderers
+    /// take the scene's white from here (the loader checked that the name resolves).
+    pub fn white_name(&self) -> &str {
+        self.white.as_deref().unwrap_or(DEFAULT_WHITE)
+    }
 }
 
 /// Underwater settings, validated by the underwater work.

@@ -1,14 +1,15 @@
-//! One glTF primitive → one [`Mesh`]: attributes read and dequantized, triangulation, flat
-//! normals when the file has none, MikkTSpace tangents when a normal map needs them; then
-//! [`to_world`] applies a node (or instance) transform.
+//! One glTF primitive → one [`Mesh`]: attributes read and dequantized, triangulation, then the
+//! scene's vertex convention ([`Mesh::complete`]: flat normals when the file has none,
+//! MikkTSpace tangents when a normal map needs them); [`to_world`] applies a node (or
+//! instance) transform.
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
+use crate::Mesh;
 use crate::accessors::{self, Expect};
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Mesh, tangents};
 
 /// Triangle list indices for `mode`, from the primitive's indices (or 0..n when unindexed).
 fn triangulate(ctx: &Ctx, at: &str, mode: Mode, idx: Vec<u32>) -> Result<Vec<u32>, SceneError> {
@@ -45,10 +46,6 @@ pub(crate) struct Needs {
 /// Whether a primitive mode has area (the others are points and lines).
 pub(crate) fn is_triangles(mode: Mode) -> bool {
     matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
-}
-
-fn corners<T: Copy>(v: &[T], idx: &[u32]) -> Vec<T> {
-    if v.is_empty() { Vec::new() } else { idx.iter().map(|&i| v[i as usize]).collect() }
 }
 
 /// Builds the mesh of `prim` in its node's local space (see [`to_world`]). `material` is the
@@ -127,64 +124,17 @@ pub(crate) fn build(
     }
     let indices = triangulate(ctx, at, prim.mode(), raw_idx)?;
 
-    let mut mesh = match normals {
-        Some(normals) => {
-            Mesh { colors, uvs1, positions, normals, tangents: file_tangents, uvs, indices, material }
-        }
-        None => {
-            // glTF: without normals, flat normals. Each triangle needs its own vertices.
-            let p = corners(&positions, &indices);
-            let nrm: Vec<Vec3> = p
-                .chunks_exact(3)
-                .flat_map(|t| {
-                    let f = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-                    // A degenerate triangle has no area to shade; any unit normal will do.
-                    [if f == Vec3::ZERO { Vec3::Z } else { f }; 3]
-                })
-                .collect();
-            // File tangents were per original vertex; flat shading re-indexed, so regenerate.
-            Mesh {
-                colors: corners(&colors, &indices),
-                uvs1: corners(&uvs1, &indices),
-                uvs: corners(&uvs, &indices),
-                positions: p,
-                normals: nrm,
-                tangents: Vec::new(),
-                indices: (0..indices.len() as u32).collect(),
-                material,
-            }
-        }
+    let mesh = Mesh {
+        colors,
+        uvs1,
+        positions,
+        normals: normals.unwrap_or_default(),
+        tangents: file_tangents,
+        uvs,
+        indices,
+        material,
     };
-    for nrm in &mut mesh.normals {
-        // Files carry un-normalised or zero normals surprisingly often.
-        *nrm = nrm.try_normalize().unwrap_or(Vec3::Z);
-    }
-    match needs.normal_map_set {
-        Some(set) if mesh.tangents.is_empty() => {
-            let uv = if set == 1 { &mesh.uvs1 } else { &mesh.uvs };
-            if uv.is_empty() {
-                return Err(ctx.invalid(
-                    at,
-                    format!("its material has a normal map on TEXCOORD_{set} but the primitive has no TEXCOORD_{set} to orient it"),
-                ));
-            }
-            let t = tangents::generate(&mesh.positions, &mesh.normals, uv, &mesh.indices);
-            let idx = std::mem::take(&mut mesh.indices);
-            mesh = Mesh {
-                positions: corners(&mesh.positions, &idx),
-                normals: corners(&mesh.normals, &idx),
-                uvs: corners(&mesh.uvs, &idx),
-                uvs1: corners(&mesh.uvs1, &idx),
-                colors: corners(&mesh.colors, &idx),
-                tangents: t,
-                indices: (0..idx.len() as u32).collect(),
-                material,
-            };
-        }
-        Some(_) => {}
-        None => mesh.tangents.clear(),
-    }
-    Ok(mesh)
+    mesh.complete(needs.normal_map_set).map_err(|m| ctx.invalid(at, m))
 }
 
 /// Applies a node transform: positions by the matrix, normals by its inverse transpose,

@@ -4,6 +4,7 @@
 
 mod cmd;
 mod eval;
+mod progress;
 mod view;
 
 use clap::{Parser, Subcommand};
@@ -121,6 +122,7 @@ fn main() {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     install_interrupt_handler();
+    progress::install();
     let unwritten = match cli.command {
         // The suite keeps the cases it finished; the summary is what is missing.
         Command::Eval(_) => "results.json and index.html not written",

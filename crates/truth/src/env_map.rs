@@ -84,16 +84,9 @@ impl<'s> EnvMap<'s> {
         let texels: Vec<[f32; 4]> = env
             .texels
             .par_iter()
-            .map(|t| {
-                // As `upsample::emission_shape`: rgb = s·(rgb/s), s = 2·max(rgb).
-                let rgb = *t * k;
-                let m = rgb.max_element();
-                if m <= 0.0 {
-                    return [0.0; 4];
-                }
-                let s = 2.0 * m;
-                let c = up.coefficients((rgb / s).max(Vec3::ZERO).to_array());
-                [c[0], c[1], c[2], s]
+            .map(|t| match upsample::emission_coeffs(up, (*t * k).to_array()) {
+                Some((s, c)) => [c[0], c[1], c[2], s],
+                None => [0.0; 4],
             })
             .collect();
 

@@ -10,7 +10,7 @@
 use crate::error::{Result, TruthError};
 use crate::world::World;
 use glam::{Vec3, Vec4};
-use scene::{LightKind, SpectralReflectance};
+use scene::{LightKind, Scene, SpectralReflectance};
 use serde_json::{Value, json};
 use std::fs;
 use std::path::Path;
@@ -86,7 +86,7 @@ pub fn export(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<
 }
 
 fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<String>> {
-    let scene = world.scene;
+    let scene: &Scene = &world.scene;
     let mut unsupported = Vec::new();
 
     let cam = &scene.camera;

@@ -42,10 +42,9 @@ pub struct EmissionUnits {
 impl EmissionUnits {
     pub fn new(white: &Spectrum, range: WavelengthRange) -> Self {
         let k_white = y_integral(&|l| white.eval(l), range);
-        let ill = color::colorspace::RgbColorSpace::srgb().illuminant();
-        let k_ill = y_integral(&|l| ill.eval(l), range);
-        let s = if k_ill > 0.0 { k_white / k_ill } else { 1.0 };
-        EmissionUnits { range, rgb_illuminant: DenseSpectrum::new(&ill, range).scaled(s as f32), k_white }
+        let ill = color::colorspace::RgbColorSpace::srgb()
+            .emission_white(white, |s| y_integral(&|l| s.eval(l), range));
+        EmissionUnits { range, rgb_illuminant: DenseSpectrum::new(&ill, range), k_white }
     }
 
     /// The emitted spectrum of a light. With a measured spectrum: its shape, scaled so its
@@ -62,14 +61,11 @@ impl EmissionUnits {
             }
             None => {
                 // One table fetch; the shape is then a closed form in λ.
-                let rgb = rgb.to_array();
-                let m = rgb[0].max(rgb[1]).max(rgb[2]);
-                if m.is_nan() || m <= 0.0 {
+                let Some((scale, c)) = upsample::emission_coeffs(up, rgb.to_array()) else {
                     return DenseSpectrum::from_fn(self.range, |_| 0.0);
-                }
-                let c = up.coefficients(rgb.map(|v| (v / (2.0 * m)).clamp(0.0, 1.0)));
+                };
                 DenseSpectrum::from_fn(self.range, |l| {
-                    let s = upsample::eval4(c, Vec4::splat(l as f32)).x * 2.0 * m;
+                    let s = upsample::eval4(c, Vec4::splat(l as f32)).x * scale;
                     (s * self.rgb_illuminant.eval(l as f32)) as f64
                 })
             }

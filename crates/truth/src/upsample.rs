@@ -40,15 +40,20 @@ pub fn reflectance(up: &dyn RgbToSpectrum, rgb: [f32; 3], l: Vec4) -> Vec4 {
 
 /// The spectral shape of an RGB emitter, before multiplication by the colour space's
 /// illuminant: an RGB of any magnitude is written scale·s(λ) with s the reflectance fit of
-/// rgb/scale and scale = 2·max(rgb) (the "unbounded" form pbrt-v4 also uses), so (1,1,1)
-/// becomes exactly the illuminant itself.
+/// rgb/scale ([`color::upsample::variants::unbounded_split`], the "unbounded" form pbrt-v4
+/// also uses), so (1,1,1) becomes exactly the illuminant itself.
 pub fn emission_shape(up: &dyn RgbToSpectrum, rgb: [f32; 3], l: Vec4) -> Vec4 {
-    let m = rgb[0].max(rgb[1]).max(rgb[2]);
-    if m.is_nan() || m <= 0.0 {
-        return Vec4::ZERO;
+    match emission_coeffs(up, rgb) {
+        Some((scale, c)) => eval4(c, l) * scale,
+        None => Vec4::ZERO,
     }
-    let scale = 2.0 * m;
-    eval4(up.coefficients(rgb.map(|c| (c / scale).max(0.0))), l) * scale
+}
+
+/// The scale and sigmoid coefficients of [`emission_shape`], for callers that evaluate the
+/// shape many times; `None` for black.
+pub fn emission_coeffs(up: &dyn RgbToSpectrum, rgb: [f32; 3]) -> Option<(f32, [f32; 3])> {
+    let (scale, c) = color::upsample::variants::unbounded_split(rgb.map(f64::from))?;
+    Some((scale as f32, up.coefficients(c.map(|v| v as f32))))
 }
 
 /// An exact upsampler for greys only (a flat spectrum is a constant sigmoid), used by tests

@@ -14,6 +14,7 @@ use crate::water_surface::Surface;
 use color::{Spectrum, WavelengthRange};
 use glam::{Vec2, Vec3, Vec4};
 use scene::{AlphaMode, Scene};
+use std::borrow::Cow;
 
 /// Everything about a surface point the integrator needs.
 #[derive(Clone, Copy, Debug)]
@@ -33,7 +34,9 @@ pub struct SurfacePoint {
 }
 
 pub struct World<'s> {
-    pub scene: &'s Scene,
+    /// The scene with the vertex convention applied ([`Scene::completed`]: normals and
+    /// tangents as the real-time renderer and the glTF loader have them).
+    pub scene: Cow<'s, Scene>,
     pub geometry: Geometry,
     pub upsampler: &'s dyn RgbToSpectrum,
     pub units: EmissionUnits,
@@ -67,8 +70,12 @@ impl<'s> World<'s> {
         range: WavelengthRange,
         medium: Option<&Medium>,
     ) -> Result<Self> {
+        // The environment is borrowed from the caller's scene (completion leaves it alone), so
+        // the environment map may outlive this function.
+        let original = scene;
+        let scene = original.completed();
         let bad = |why: String| TruthError::BadScene { scene: scene.source.clone(), why };
-        let geometry = Geometry::new(scene).map_err(bad)?;
+        let geometry = Geometry::new(&scene).map_err(bad)?;
         for (i, t) in scene.textures.iter().enumerate() {
             if t.rgba8.len() != 4 * t.width as usize * t.height as usize {
                 return Err(bad(format!(
@@ -122,8 +129,8 @@ impl<'s> World<'s> {
             }),
             geometry.len(),
         );
-        let surface = water_surface(scene, medium, &units, upsampler, range).map_err(bad)?;
-        let env_map = match &scene.environment {
+        let surface = water_surface(&scene, medium, &units, upsampler, range).map_err(bad)?;
+        let env_map = match &original.environment {
             Some(env) if !env.is_black() => {
                 if surface.is_some() {
                     // Its light would have to come in through the water surface (Fresnel, Snell's
@@ -184,29 +191,8 @@ impl<'s> World<'s> {
             lerp(&m.uvs1, idx, b).unwrap_or(Vec2::ZERO),
         ]);
         let color = lerp(&m.colors, idx, b).unwrap_or(Vec4::ONE);
-        let tangent = lerp(&m.tangents, idx, b).or_else(|| self.uv_tangent(tri, n));
+        let tangent = lerp(&m.tangents, idx, b);
         (n, tc, color, tangent)
-    }
-
-    /// A tangent from the triangle's UV gradients (the normal map's UV set and transform), for
-    /// normal-mapped meshes without tangents.
-    fn uv_tangent(&self, tri: u32, n: Vec3) -> Option<Vec4> {
-        let (m, idx) = self.corners(tri);
-        let r = self.scene.materials.get(m.material)?.normal_texture?;
-        let set = if r.tex_coord == 1 { &m.uvs1 } else { &m.uvs };
-        let uv = idx.map(|i| set.get(i).map(|&uv| r.transform.map_or(uv, |t| t.apply(uv))));
-        let [Some(uv0), Some(uv1), Some(uv2)] = uv else { return None };
-        let v = &self.geometry.verts[tri as usize];
-        let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-        let (d1, d2) = (uv1 - uv0, uv2 - uv0);
-        let det = d1.x * d2.y - d2.x * d1.y;
-        if det.abs() < 1e-12 {
-            return None;
-        }
-        let t = (e1 * d2.y - e2 * d1.y) / det;
-        let b = (e2 * d1.x - e1 * d2.x) / det;
-        let w = if n.cross(t).dot(b) < 0.0 { -1.0 } else { 1.0 };
-        Some(t.extend(w))
     }
 
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {

@@ -13,8 +13,6 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use indicatif::{ProgressBar, ProgressStyle};
-
 use crate::colorspace::RgbColorSpace;
 use crate::error::{ColorError, Result};
 use crate::upsample::table::CoeffTable;
@@ -94,18 +92,6 @@ pub fn read_cached(path: &std::path::Path, space: &RgbColorSpace, res: usize) ->
     (rt.stats.mean <= MAX_CACHED_MEAN_DE).then_some(t)
 }
 
-/// A progress bar on stderr (hidden automatically when stderr is not a terminal).
-pub fn fit_progress(what: &str) -> ProgressBar {
-    let pb = ProgressBar::new(0);
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} rows, {elapsed} (eta {eta})")
-    {
-        pb.set_style(style.progress_chars("=> "));
-    }
-    pb.set_message(what.to_string());
-    pb
-}
-
 /// The table cached at `path` if it loads and has resolution `res`; otherwise a fresh
 /// [`crate::upsample::fit_default_res`] fit, written atomically to `path` (a failed write is
 /// not an error: the table is still good, it only costs a refit next time).
@@ -113,12 +99,12 @@ pub fn load_or_fit(path: &std::path::Path, space: &RgbColorSpace, res: usize) ->
     if let Some(t) = read_cached(path, space, res) {
         return Ok(t);
     }
-    let pb = fit_progress(&format!(
+    let pb = crate::progress::reporter(&format!(
         "fitting the {} spectral table (once; cached in {})",
         space.name,
         path.display()
     ));
-    let t = crate::upsample::fit_default_res(space, res, &pb)?;
+    let t = crate::upsample::fit_default_res(space, res, pb.as_ref())?;
     if let Some(dir) = path.parent() {
         let _ = std::fs::create_dir_all(dir);
     }
@@ -134,7 +120,7 @@ pub fn table(space_name: &str) -> Result<Arc<CoeffTable>> {
 }
 
 /// The default table of `space`: from this process's memory, else the cache file, else
-/// fitted (with a progress bar on stderr) and cached. Ctrl-C during the fit (once
+/// fitted (reporting through [`crate::progress::reporter`]) and cached. Ctrl-C during the fit (once
 /// the program installed a handler that calls [`crate::cancel::cancel`]) returns an error and writes nothing.
 pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
     if let Some(t) = MEMO.lock().ok().and_then(|m| m.as_ref().and_then(|m| m.get(&space.name).cloned())) {
@@ -144,12 +130,12 @@ pub fn table_for(space: &RgbColorSpace) -> Result<Arc<CoeffTable>> {
     let table = match read_cached(&path, space, TABLE_RES) {
         Some(t) => t,
         None => {
-            let pb = fit_progress(&format!(
+            let pb = crate::progress::reporter(&format!(
                 "fitting the {} spectral table (once; cached in {})",
                 space.name,
                 path.display()
             ));
-            let t = crate::upsample::fit_default(space, &pb)?;
+            let t = crate::upsample::fit_default(space, pb.as_ref())?;
             if let Some(dir) = path.parent() {
                 let _ = std::fs::create_dir_all(dir);
             }

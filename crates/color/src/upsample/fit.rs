@@ -20,7 +20,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use indicatif::ProgressBar;
+use crate::progress::Progress;
 use rayon::prelude::*;
 use wide::f64x4;
 
@@ -377,7 +377,7 @@ pub fn node_rgb(scale: &[f64], chroma: &[f64], l: usize, k: usize, j: usize, i: 
 /// Fits a `res`³ table for `space` with rgb2spec's grid, showing progress on `progress`.
 /// Stops early when [`crate::upsample::interrupt_flag`] is set (Ctrl-C once
 /// the program installed a handler that calls [`crate::cancel::cancel`]).
-pub fn fit_table(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
+pub fn fit_table(space: &RgbColorSpace, res: usize, progress: &dyn Progress) -> Result<CoeffTable> {
     fit_table_with(space, &FitOptions::new(res), progress, crate::upsample::interrupt_flag())
 }
 
@@ -386,7 +386,7 @@ pub fn fit_table(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> R
 pub fn fit_table_with(
     space: &RgbColorSpace,
     opt: &FitOptions,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
     cancel: &AtomicBool,
 ) -> Result<CoeffTable> {
     let res = opt.res;
@@ -411,7 +411,7 @@ pub fn fit_table_with(
         return Err(ColorError::Table(format!("chroma grid must be {res} increasing values from 0 to 1")));
     }
     let model = LabModel::new(space)?;
-    progress.set_length((3 * res) as u64);
+    progress.stage(None, (3 * res) as u64);
     let start = res / 5;
     // One task per (l, j) row: sweeps every i column in k from `start` up, then down, each
     // node warm-started from the previous one.

@@ -31,7 +31,7 @@ pub mod variants;
 
 use std::sync::atomic::AtomicBool;
 
-use indicatif::ProgressBar;
+use crate::progress::Progress;
 
 pub use cache::{TABLE_RES, table, table_for};
 pub use fit::{FitOptions, fit_table, fit_table_with};
@@ -51,16 +51,15 @@ pub fn interrupt_flag() -> &'static AtomicBool {
 /// The fit behind the default tables: [`TABLE_RES`]³ nodes on [`fit::spectra_scale`]'s
 /// brightness grid, then one sweep of [`refine`] (interpolation-aware). This is what [`table()`]
 /// caches and `spectra lut` writes.
-pub fn fit_default(space: &RgbColorSpace, progress: &ProgressBar) -> Result<CoeffTable> {
+pub fn fit_default(space: &RgbColorSpace, progress: &dyn Progress) -> Result<CoeffTable> {
     fit_default_res(space, TABLE_RES, progress)
 }
 
 /// [`fit_default`] at another resolution.
-pub fn fit_default_res(space: &RgbColorSpace, res: usize, progress: &ProgressBar) -> Result<CoeffTable> {
+pub fn fit_default_res(space: &RgbColorSpace, res: usize, progress: &dyn Progress) -> Result<CoeffTable> {
     let mut t = fit_table_with(space, &FitOptions::spectra(res), progress, interrupt_flag())?;
     let model = fit::LabModel::new(space)?;
-    progress.set_position(0);
-    progress.set_message(format!("refining the {} table for interpolation", space.name));
+    progress.stage(Some(&format!("refining the {} table for interpolation", space.name)), 0);
     refine::refine_table(&mut t, &model, &refine::RefineOptions::default(), progress, interrupt_flag())?;
     Ok(t)
 }

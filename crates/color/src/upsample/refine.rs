@@ -22,7 +22,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use indicatif::ProgressBar;
+use crate::progress::Progress;
 use rayon::prelude::*;
 
 use crate::error::{ColorError, Result};
@@ -216,7 +216,7 @@ pub fn refine_table(
     table: &mut CoeffTable,
     model: &LabModel,
     opt: &RefineOptions,
-    progress: &ProgressBar,
+    progress: &dyn Progress,
     cancel: &AtomicBool,
 ) -> Result<usize> {
     let res = table.res;
@@ -241,7 +241,7 @@ pub fn refine_table(
     let r1 = res - 1;
     let ncell = 3 * r1.pow(3);
     let mut updates = 0;
-    progress.set_length((opt.sweeps * 9) as u64);
+    progress.stage(None, (opt.sweeps * 9) as u64);
     for _ in 0..opt.sweeps {
         // 1. Probe every cell at its sample points: which points are reachable (a bit mask over
         //    `cell_points`) and whether any reachable one is poor.

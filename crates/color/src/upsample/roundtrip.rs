@@ -114,7 +114,6 @@ mod tests {
     use crate::upsample::{FitOptions, Method, fit_table_with};
     use crate::xyz::SpectralIntegrator;
     use crate::{Observer, SampledWavelengths, WavelengthRange, xyz_to_lab};
-    use indicatif::ProgressBar;
     use std::sync::OnceLock;
 
     /// The shipping sRGB table (64³, spectra grid) before refinement, fitted once per test binary
@@ -123,7 +122,7 @@ mod tests {
         static T: OnceLock<CoeffTable> = OnceLock::new();
         T.get_or_init(|| {
             let never = std::sync::atomic::AtomicBool::new(false);
-            fit_table_with(&RgbColorSpace::srgb(), &FitOptions::spectra(64), &ProgressBar::hidden(), &never)
+            fit_table_with(&RgbColorSpace::srgb(), &FitOptions::spectra(64), &crate::progress::Silent, &never)
                 .unwrap()
         })
     }
@@ -132,18 +131,20 @@ mod tests {
     fn refinement_lowers_interpolation_error() {
         let space = RgbColorSpace::srgb();
         let never = std::sync::atomic::AtomicBool::new(false);
-        let mut t = fit_table_with(&space, &FitOptions::spectra(20), &ProgressBar::hidden(), &never).unwrap();
+        let mut t =
+            fit_table_with(&space, &FitOptions::spectra(20), &crate::progress::Silent, &never).unwrap();
         let before = roundtrip_table(&t, &space, 10_000, 11).unwrap().stats;
         let model = LabModel::new(&space).unwrap();
         let opt = crate::upsample::refine::RefineOptions::default();
-        crate::upsample::refine::refine_table(&mut t, &model, &opt, &ProgressBar::hidden(), &never).unwrap();
+        crate::upsample::refine::refine_table(&mut t, &model, &opt, &crate::progress::Silent, &never)
+            .unwrap();
         let after = roundtrip_table(&t, &space, 10_000, 11).unwrap().stats;
         // Measured at res 20 (10⁴ colours, seed 11): mean 0.088 → 0.040, p99 0.45 → 0.27.
         assert!(after.mean < 0.6 * before.mean, "{before:?} → {after:?}");
         assert!(after.p99 < 0.7 * before.p99, "{before:?} → {after:?}");
         let cancelled = std::sync::atomic::AtomicBool::new(true);
         assert!(
-            crate::upsample::refine::refine_table(&mut t, &model, &opt, &ProgressBar::hidden(), &cancelled)
+            crate::upsample::refine::refine_table(&mut t, &model, &opt, &crate::progress::Silent, &cancelled)
                 .is_err()
         );
     }
@@ -253,8 +254,8 @@ mod tests {
             let t = if space.name == "srgb" {
                 srgb_table()
             } else {
-                other =
-                    fit_table_with(&space, &FitOptions::spectra(64), &ProgressBar::hidden(), &never).unwrap();
+                other = fit_table_with(&space, &FitOptions::spectra(64), &crate::progress::Silent, &never)
+                    .unwrap();
                 &other
             };
             let black = ciede2000(model.target_lab([0.0; 3]), model.lab_of_nm(t.fetch([0.0; 3]).c));

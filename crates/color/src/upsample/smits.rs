@@ -2,8 +2,8 @@
 //! a reflectance is built from seven basis spectra (white, cyan, magenta, yellow, red, green,
 //! blue) sampled in 10 equal bins over 380–720 nm, choosing the basis by channel ordering.
 //!
-//! The values are Table 1 of the paper (checked against colour-science's
-//! `colour.recovery.datasets.smits1999` by `tools/roundtrip_baselines.py`). Spectra are
+//! The values are Table 1 of the paper, the table colour-science ships as
+//! `colour.recovery.datasets.smits1999` (no script here compares the two yet). Spectra are
 //! piecewise constant over the bins and keep their edge value outside 380–720 nm, so white stays
 //! white over the whole observer range. The basis was derived for sRGB-like primaries; it is
 //! applied to the RGB of any space as given.

@@ -12,6 +12,20 @@ use crate::spectrum::Spectrum;
 use crate::upsample::sigmoid::SigmoidPolynomial;
 use crate::upsample::table::{CoeffTable, check_rgb};
 
+/// pbrt-v4's split of a colour of any magnitude into `scale · rgb'`: `scale = 2·max(rgb)` and
+/// `rgb' = rgb / scale` (largest channel ½, negative channels clamped to 0), so a reflectance
+/// table looked up at `rgb'` times `scale` is the colour's spectrum. `None` for black (and an
+/// all-NaN colour): the spectrum is 0. The one place this convention is written; the
+/// real-time renderer, the path tracer and the environment maps all split emission with it.
+pub fn unbounded_split(rgb: [f64; 3]) -> Option<(f64, [f64; 3])> {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m.is_nan() || m <= 0.0 {
+        return None;
+    }
+    let scale = 2.0 * m;
+    Some((scale, rgb.map(|c| (c / scale).max(0.0))))
+}
+
 /// `scale · s(λ)`: any non-negative RGB, including values above 1.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct UnboundedSpectrum {
@@ -23,10 +37,16 @@ impl UnboundedSpectrum {
     /// pbrt-v4's construction; black gets scale 0 (the spectrum is exactly 0).
     pub fn new(table: &CoeffTable, rgb: [f64; 3]) -> Result<Self> {
         check_rgb(rgb)?;
-        let m = rgb[0].max(rgb[1]).max(rgb[2]);
-        let scale = 2.0 * m;
-        let poly = if scale > 0.0 { table.fetch(rgb.map(|v| v / scale)) } else { table.fetch([0.0; 3]) };
-        Ok(UnboundedSpectrum { poly, scale })
+        Ok(Self::clamped(table, rgb))
+    }
+
+    /// As [`Self::new`] for emission, which is not validated here: negative channels count as
+    /// 0 and black or NaN gives the zero spectrum.
+    pub fn clamped(table: &CoeffTable, rgb: [f64; 3]) -> Self {
+        match unbounded_split(rgb) {
+            Some((scale, c)) => UnboundedSpectrum { poly: table.fetch(c), scale },
+            None => UnboundedSpectrum { poly: table.fetch([0.0; 3]), scale: 0.0 },
+        }
     }
 
     #[inline]

@@ -84,19 +84,14 @@ pub(crate) fn measured_material(name: &str, s: &Spectrum) -> Material {
     }
 }
 
-/// A light colour in the glTF sense for a spectral shape: its own linear sRGB chromaticity at
-/// luminance 1 (negative components of out-of-gamut lights clipped), so that `rgb × intensity`
-/// and the scaled spectrum describe the same light as closely as RGB can.
+/// A light of spectral `shape` ([`Emission::of_shape`]), errors placed at `what`.
 pub(crate) fn light_emission(
     ctx: &Ctx,
     what: &str,
     shape: &Spectrum,
     intensity: f32,
 ) -> Result<Emission, SceneError> {
-    let xyz = crate::emission::spectrum_xyz(shape);
-    let rgb = srgb::xyz_to_linear(xyz.map(|c| c / xyz[1])).max(DVec3::ZERO).as_vec3();
-    let rgb = rgb / srgb::luminance(rgb) as f32;
-    Emission::new(rgb, intensity, Some(shape)).map_err(|m| ctx.invalid(what, m))
+    Emission::of_shape(shape, intensity).map_err(|m| ctx.invalid(what, m))
 }
 
 /// The ColorChecker patch spectrum by 0-based chart index.

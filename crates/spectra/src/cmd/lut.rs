@@ -51,7 +51,7 @@ pub fn run(a: Args) -> Result<()> {
         opt.chroma = fit::uniform_chroma(a.res);
     }
     let t0 = Instant::now();
-    let pb = cache::fit_progress(&format!("fitting {} {}³", space.name, a.res));
+    let pb = crate::progress::fit_bar(&format!("fitting {} {}³", space.name, a.res));
     let mut table = upsample::fit_table_with(&space, &opt, &pb, upsample::interrupt_flag())
         .with_context(|| format!("fitting the {} table", space.name))?;
     let fit_s = t0.elapsed().as_secs_f64();
@@ -59,7 +59,7 @@ pub fn run(a: Args) -> Result<()> {
     if !(a.rgb2spec || a.no_refine) {
         let t1 = Instant::now();
         let model = fit::LabModel::new(&space)?;
-        let pb = cache::fit_progress("refining for interpolation");
+        let pb = crate::progress::fit_bar("refining for interpolation");
         refine::refine_table(
             &mut table,
             &model,

@@ -317,6 +317,7 @@ fn settings(args: &RenderArgs, scene: &scene::Scene) -> Result<RenderSettings> {
         wavelengths,
         range,
         observer,
+        white: scene.spectral.white_name().into(),
         exposure_ev: args.look.exposure,
         tonemap: Tonemap::parse(&args.look.tonemap)?,
         shadows: !args.no_shadows,

@@ -38,6 +38,7 @@ pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSetti
         wavelengths,
         range,
         observer,
+        white: scene.spectral.white_name().into(),
         exposure_ev: args.look.exposure,
         tonemap: Tonemap::parse(&args.look.tonemap).context("--tonemap")?,
         shadows: true,

@@ -67,9 +67,7 @@ pub fn truth(
         st.direct_only = false;
         st.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
-    if let Some(w) = &scene.spectral.white {
-        st.white = color::illuminant::by_name(w)?;
-    }
+    st.white = color::illuminant::by_name(scene.spectral.white_name())?;
     let world = truth::World::new(scene, table, &st.white, st.range, st.medium.as_ref())?;
     let img = match truth::render_world(&world, &st, cancel, progress) {
         Err(truth::TruthError::Cancelled) => bail!("interrupted"),

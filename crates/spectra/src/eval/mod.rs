@@ -15,6 +15,9 @@ pub mod plot;
 pub mod report;
 pub mod suite;
 
+#[cfg(test)]
+mod conventions_tests;
+
 use anyhow::{Context, Result};
 use color::{Quadrature, WavelengthRange};
 use compare::{Heatmap, HeatmapOptions, Image, WriteOptions};

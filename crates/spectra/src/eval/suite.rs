@@ -5,7 +5,6 @@
 //! with the shadow-mapped real-time image.
 
 use anyhow::{Context, Result, bail};
-use glam::Vec3;
 use scene::{Emission, Scene};
 
 /// Sizes and sample counts of one run.
@@ -219,18 +218,12 @@ pub fn case(id: &str) -> Result<Case> {
 /// RGB renderers that illuminant's own chromaticity (what an artist would pick for the lamp).
 fn relight(s: &mut Scene, illum: &str) -> Result<()> {
     let shape = color::illuminant::by_name(illum)?;
-    let xyz = scene::emission::spectrum_xyz(&shape);
-    let rgb = scene::srgb::xyz_to_linear(xyz.map(|v| v / xyz[1])).max(glam::DVec3::ZERO).as_vec3();
     for l in &mut s.lights {
         // Keep the luminance the scene gave the light; only its spectrum changes.
         let y = l.emission.xyz()[1] as f32;
-        l.emission = Emission::new(rgb, y / luminance(rgb), Some(&shape)).map_err(|e| anyhow::anyhow!(e))?;
+        l.emission = Emission::of_shape(&shape, y).map_err(|e| anyhow::anyhow!(e))?;
     }
     Ok(())
-}
-
-fn luminance(rgb: Vec3) -> f32 {
-    scene::srgb::luminance(rgb) as f32
 }
 
 #[cfg(test)]

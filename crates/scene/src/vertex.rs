@@ -1,0 +1,128 @@
+//! The scene's vertex convention, written once for the loader and both renderers: every mesh
+//! has unit normals, and a normal-mapped mesh has tangents. glTF 2.0 (§3.7.2.1, "Meshes"):
+//! "When normals are not specified, client implementations MUST calculate flat normals and the
+//! provided tangents (if present) MUST be ignored"; "When tangents are not specified, client
+//! implementations SHOULD calculate tangents using default MikkTSpace algorithms". The loader
+//! applies it to every primitive; the renderers take [`Scene::completed`], so a scene built in
+//! code without normals is drawn faceted by both, exactly as the same mesh loaded from glTF.
+
+use std::borrow::Cow;
+
+use glam::Vec3;
+
+use crate::{Mesh, Scene, tangents};
+
+fn corners<T: Copy>(v: &[T], idx: &[u32]) -> Vec<T> {
+    if v.is_empty() { Vec::new() } else { idx.iter().map(|&i| v[i as usize]).collect() }
+}
+
+impl Mesh {
+    /// Un-indexed: one vertex per triangle corner (what flat normals and MikkTSpace's
+    /// per-corner tangents need).
+    fn unindexed(self) -> Mesh {
+        let idx = &self.indices;
+        Mesh {
+            positions: corners(&self.positions, idx),
+            normals: corners(&self.normals, idx),
+            tangents: corners(&self.tangents, idx),
+            uvs: corners(&self.uvs, idx),
+            uvs1: corners(&self.uvs1, idx),
+            colors: corners(&self.colors, idx),
+            indices: (0..idx.len() as u32).collect(),
+            material: self.material,
+        }
+    }
+
+    /// The mesh with the vertex convention of this module applied: flat normals when it has
+    /// none (its tangents dropped), normals made unit length, and MikkTSpace tangents on the
+    /// UV set `normal_map_set` when its material has a normal map and the mesh no tangents
+    /// (tangents are dropped when there is no normal map). Indices must be in range. The error
+    /// is a message for the caller to place: a normal map whose UV set the mesh lacks.
+    pub fn complete(self, normal_map_set: Option<u32>) -> Result<Mesh, String> {
+        let mut mesh = if self.normals.is_empty() {
+            let mut m = Mesh { tangents: Vec::new(), ..self }.unindexed();
+            m.normals = m
+                .positions
+                .chunks_exact(3)
+                .flat_map(|t| {
+                    let f = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                    // A degenerate triangle has no area to shade; any unit normal will do.
+                    [if f == Vec3::ZERO { Vec3::Z } else { f }; 3]
+                })
+                .collect();
+            m
+        } else {
+            self
+        };
+        for nrm in &mut mesh.normals {
+            // Files carry un-normalised or zero normals surprisingly often.
+            *nrm = nrm.try_normalize().unwrap_or(Vec3::Z);
+        }
+        match normal_map_set {
+            Some(set) if mesh.tangents.is_empty() => {
+                let uv = if set == 1 { &mesh.uvs1 } else { &mesh.uvs };
+                if uv.is_empty() {
+                    return Err(format!(
+                        "its material has a normal map on TEXCOORD_{set} but the primitive has no TEXCOORD_{set} to orient it"
+                    ));
+                }
+                let t = tangents::generate(&mesh.positions, &mesh.normals, uv, &mesh.indices);
+                mesh = mesh.unindexed();
+                mesh.tangents = t;
+            }
+            Some(_) => {}
+            None => mesh.tangents.clear(),
+        }
+        Ok(mesh)
+    }
+
+    /// Whether the renderers could read this mesh at all (indices in range, whole triangles,
+    /// one attribute per position); the renderers report the problem when it cannot.
+    fn is_well_formed(&self, materials: usize) -> bool {
+        let n = self.positions.len();
+        self.material < materials
+            && self.indices.len().is_multiple_of(3)
+            && self.indices.iter().all(|&i| (i as usize) < n)
+            && [self.normals.len(), self.tangents.len(), self.uvs.len(), self.uvs1.len(), self.colors.len()]
+                .iter()
+                .all(|&l| l == 0 || l == n)
+    }
+}
+
+impl Scene {
+    /// The UV set a mesh's normal map reads, when the mesh has it (without it the normal map
+    /// cannot be oriented; the loader refuses such a file, a scene built in code keeps it
+    /// unoriented as before).
+    fn normal_map_set(&self, m: &Mesh) -> Option<u32> {
+        let set = self.materials.get(m.material)?.normal_texture?.tex_coord;
+        let uv = if set == 1 { &m.uvs1 } else { &m.uvs };
+        (!uv.is_empty()).then_some(set)
+    }
+
+    /// The scene with the vertex convention ([`Mesh::complete`]) applied to every mesh that
+    /// lacks normals or the tangents its normal map needs; borrowed when none does (every
+    /// loaded scene). What both renderers draw, so neither repairs meshes its own way.
+    pub fn completed(&self) -> Cow<'_, Scene> {
+        let needs = |m: &Mesh| {
+            m.is_well_formed(self.materials.len())
+                && (m.normals.is_empty() || (m.tangents.is_empty() && self.normal_map_set(m).is_some()))
+        };
+        if !self.meshes.iter().any(needs) {
+            return Cow::Borrowed(self);
+        }
+        let mut s = self.clone();
+        s.meshes = self
+            .meshes
+            .iter()
+            .map(|m| {
+                if !needs(m) {
+                    return m.clone();
+                }
+                // `complete` fails only for a normal map whose UV set is missing, which
+                // `normal_map_set` rules out; the mesh is kept as it is should that change.
+                m.clone().complete(self.normal_map_set(m)).unwrap_or_else(|_| m.clone())
+            })
+            .collect();
+        Cow::Owned(s)
+    }
+}
