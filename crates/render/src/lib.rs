@@ -43,7 +43,7 @@ pub mod uniforms;
 pub use error::{NO_ADAPTER_HELP, RenderError, Result};
 pub use gpu::Gpu;
 pub use passes::custom::CustomShader;
-pub use renderer::Renderer;
+pub use renderer::{Renderer, SpectralCapture};
 pub use settings::{Mode, RenderSettings, Tonemap};
 pub use spectral_data::SpectralSetup;
 pub use timing::PassTimings;

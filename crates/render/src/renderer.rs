@@ -72,6 +72,54 @@ struct TargetBindings {
     post_accumulated: wgpu::BindGroup,
 }
 
+/// The spectral capture of one frame (see [`Renderer::set_spectral_capture`]).
+struct Capture {
+    buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    width: u32,
+    height: u32,
+    /// The frame's wavelength settings, read back with it.
+    settings: RenderSettings,
+}
+
+/// The node radiances of one frame ([`Renderer::read_spectral_capture`]).
+#[derive(Clone, Debug)]
+pub struct SpectralCapture {
+    pub width: u32,
+    pub height: u32,
+    /// The node wavelengths in nm: the centres of N equal bins over the render range.
+    pub lambda: Vec<f64>,
+    /// The bins' edges, N + 1 (range.min + k·Δλ).
+    pub edges: Vec<f64>,
+    pub quadrature: color::Quadrature,
+    /// `data[(y · width + x) · N + k]`: node k's radiance in the scene's relative units (a
+    /// radiance equal to the scene white has Y = 1), before exposure: L(λₖ) exactly with the
+    /// midpoint rule, the node's share of the integral as a radiance with the prefiltered rule
+    /// (see [`Renderer::set_spectral_capture`]).
+    pub data: Vec<f32>,
+}
+
+/// Bytes the GPU needs to capture a `width`×`height` frame with `groups` groups of four nodes.
+pub fn spectral_capture_bytes(width: u32, height: u32, groups: usize) -> u64 {
+    width as u64 * height as u64 * groups as u64 * 16
+}
+
+/// Refuses a capture larger than the device's storage-buffer and buffer limits.
+fn check_capture_size(limits: &wgpu::Limits, width: u32, height: u32, n: usize) -> Result<u64> {
+    let bytes = spectral_capture_bytes(width, height, n.div_ceil(4));
+    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if bytes > limit {
+        let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+        return Err(RenderError::Settings(format!(
+            "a spectral capture of {width}×{height} pixels with {n} wavelengths needs {:.0} MiB in one GPU \
+             buffer, more than this device allows ({:.0} MiB); use a smaller image or fewer wavelengths",
+            mib(bytes),
+            mib(limit)
+        )));
+    }
+    Ok(bytes)
+}
+
 /// A real-time spectral deferred renderer.
 ///
 /// Typical use: [`Renderer::new`] once, [`Renderer::set_scene`], [`Renderer::resize`], then
@@ -103,6 +151,11 @@ pub struct Renderer {
     spectral: Option<SpectralState>,
     targets: Option<(Targets, TargetBindings)>,
     timer: Option<Timer>,
+    /// Whether frames write the spectral capture.
+    capture_on: bool,
+    /// Bound in place of the capture buffer when not capturing.
+    capture_dummy: wgpu::Buffer,
+    capture: Option<Capture>,
 }
 
 impl Renderer {
@@ -151,7 +204,16 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let capture_dummy = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("spectral capture (unused)"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         Ok(Renderer {
+            capture_on: false,
+            capture_dummy,
+            capture: None,
             gpu,
             shared,
             gbuffer,
@@ -377,6 +439,88 @@ impl Renderer {
         self.spectral.as_ref().map(|s| &s.setup)
     }
 
+    /// Makes the next frames also write the radiance at each of the N wavelength nodes of every
+    /// pixel, read back by [`Self::read_spectral_capture`] (`spectra render --spectral-out`).
+    ///
+    /// The shading pass accumulates each node's radiance in weighted form, its X, Y and Z
+    /// weights (light × observer × quadrature, `color::quadrature`); the capture stores their
+    /// sum over X, Y and Z and divides it by the point-sampled observer's sum at the node,
+    /// s̄(λₖ)·Δλ (s̄ = x̄ + ȳ + z̄, normalised like the weights). With the midpoint rule every
+    /// weight of node k is the radiance at λₖ times x̄(λₖ)·Δλ, so this is L(λₖ) exactly, and the
+    /// N bins of width Δλ around the nodes integrate back (midpoint rule, the same observer) to
+    /// the frame's XYZ. With the prefiltered rule it is ∫L·s̄·φₖ dλ / (s̄(λₖ)·Δλ), φₖ the node's
+    /// cardinal function: the node's share of ∫L·s̄ expressed as a radiance at λₖ (L itself
+    /// where L and s̄ are flat around λₖ). Integrated back the same way the bins keep the
+    /// frame's X + Y + Z exactly, but not how it splits into X, Y and Z (docs/spectral-exr.md).
+    /// What the custom hooks add in the shading pass is included (they return weighted form);
+    /// pass 3's `custom_pixel` is not (an RGB step, the identity for the built-in hooks). RGB
+    /// mode and jittered nodes are refused; frames cost one more storage write per group and
+    /// pixel.
+    pub fn set_spectral_capture(&mut self, on: bool) {
+        self.capture_on = on;
+        if !on {
+            self.capture = None;
+        }
+    }
+
+    /// Refuses a spectral capture of a `width`×`height` frame with `wavelengths` nodes larger
+    /// than this device's buffer limits; otherwise its size on the GPU in bytes.
+    pub fn check_spectral_capture(&self, width: u32, height: u32, wavelengths: usize) -> Result<u64> {
+        check_capture_size(&self.gpu.device.limits(), width, height, wavelengths)
+    }
+
+    /// The last frame's spectral capture (see [`Self::set_spectral_capture`]); waits for it.
+    pub fn read_spectral_capture(&self) -> Result<SpectralCapture> {
+        let c = self.capture.as_ref().ok_or_else(|| {
+            RenderError::Settings("no spectral capture: call set_spectral_capture(true) and render".into())
+        })?;
+        let setup = SpectralSetup::new(&c.settings)?;
+        let n = setup.len();
+        let groups = setup.groups();
+        // The point-sampled observer at each node, (x̄ + ȳ + z̄)(λₖ)·Δλ / k: the midpoint rule's
+        // weights of a radiance of one, whichever rule rendered. (The prefiltered rule's own
+        // weights of a radiance of one are not usable: the first node's is negative, -9e-6 at
+        // N = 15 over 380–730 nm, since the observer is nearly zero where its cardinal function
+        // is positive.)
+        let divisor: Vec<f64> = setup.integrator.weights.iter().map(|w| w[0] + w[1] + w[2]).collect();
+        let device = &self.gpu.device;
+        readback::wait(device)?;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("spectral capture readback"),
+            size: c.buffer.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&c.buffer, 0, &staging, 0, c.buffer.size());
+        self.gpu.queue.submit([encoder.finish()]);
+        let pixels = c.width as usize * c.height as usize;
+        let data = readback::map_buffer(device, &staging, |bytes| {
+            let values: &[f32] = bytemuck::cast_slice(bytes);
+            let mut out = Vec::with_capacity(pixels * n);
+            for px in values.chunks_exact(groups * 4).take(pixels) {
+                out.extend(
+                    px[..n]
+                        .iter()
+                        .zip(&divisor)
+                        .map(|(&v, &d)| if d > 0.0 { (v as f64 / d) as f32 } else { 0.0 }),
+                );
+            }
+            out
+        })?;
+        let range = c.settings.range;
+        let step = range.width() / n as f64;
+        let edges = (0..=n).map(|k| if k == n { range.max } else { range.min + k as f64 * step }).collect();
+        Ok(SpectralCapture {
+            width: c.width,
+            height: c.height,
+            lambda: setup.wavelengths.lambda.clone(),
+            edges,
+            quadrature: c.settings.quadrature,
+            data,
+        })
+    }
+
     /// Renders one frame from `camera`. Requires [`Self::set_scene`] and [`Self::resize`].
     pub fn render(&mut self, camera: &scene::Camera, settings: &RenderSettings) -> Result<()> {
         if color::cancel::is_cancelled() {
@@ -398,6 +542,31 @@ impl Renderer {
                  magnifications must be finite and non-zero and zfar > znear",
                 camera.znear, camera.zfar
             )));
+        }
+        self.capture = None;
+        if self.capture_on {
+            if settings.mode == Mode::Rgb {
+                return Err(RenderError::Settings(
+                    "a spectral capture needs the spectral or naive mode: RGB mode has no wavelengths".into(),
+                ));
+            }
+            if settings.jitter.is_some() {
+                return Err(RenderError::Settings(
+                    "a spectral capture needs fixed nodes (jitter moves them off the bin centres)".into(),
+                ));
+            }
+            let bytes = check_capture_size(&self.gpu.device.limits(), width, height, settings.wavelengths)?;
+            let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("spectral capture"),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let (targets, _) = self.targets.as_ref().expect("checked above");
+            let bind_group = self.shading_bind_group(targets, &buffer);
+            self.capture = Some(Capture { buffer, bind_group, width, height, settings: settings.clone() });
         }
         self.update_spectral(settings)?;
         let spectral = self.spectral.as_ref().expect("update_spectral sets it");
@@ -424,7 +593,9 @@ impl Renderer {
             exposure: settings.exposure_ev.exp2(),
             tonemap: settings.tonemap.gpu(),
             table_res: self.gpu_table.res,
-            flags: if settings.lambert { 1 } else { 0 } | if camera.ortho.is_some() { 2 } else { 0 },
+            flags: if settings.lambert { 1 } else { 0 }
+                | if camera.ortho.is_some() { 2 } else { 0 }
+                | if self.capture.is_some() { 4 } else { 0 },
             frame_index,
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
@@ -453,11 +624,15 @@ impl Renderer {
             scene,
             ts(1),
         );
+        if let Some(c) = &self.capture {
+            // Background pixels without an environment write nothing.
+            encoder.clear_buffer(&c.buffer, 0, None);
+        }
         self.shading.record(
             &mut encoder,
             &targets.hdr_shaded_view,
             &self.frame_bind_group,
-            &bindings.shading,
+            self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group),
             &spectral.bind_group,
             &spectral.custom_bind_group,
             settings.mode == Mode::Rgb,
@@ -554,13 +729,13 @@ impl Renderer {
             .collect())
     }
 
-    fn target_bindings(&self, t: &Targets) -> TargetBindings {
-        let device = &self.gpu.device;
+    /// The shading pass's inputs, with `capture` as the spectral capture buffer.
+    fn shading_bind_group(&self, t: &Targets, capture: &wgpu::Buffer) -> wgpu::BindGroup {
         fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
         }
         let g = &t.gbuffer_views;
-        let shading = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shading inputs"),
             layout: &self.shading.input_layout,
             entries: &[
@@ -574,8 +749,18 @@ impl Renderer {
                     resource: wgpu::BindingResource::Sampler(&self.shadow.sampler),
                 },
                 wgpu::BindGroupEntry { binding: 6, resource: self.shadow.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: capture.as_entire_binding() },
             ],
-        });
+        })
+    }
+
+    fn target_bindings(&self, t: &Targets) -> TargetBindings {
+        let device = &self.gpu.device;
+        fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
+        }
+        let shading = self.shading_bind_group(t, &self.capture_dummy);
+        let g = &t.gbuffer_views;
         let custom = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("custom inputs"),
             layout: &self.custom_pass.input_layout,

@@ -124,6 +124,17 @@ impl ShadingPass {
                     count: None,
                 },
                 uniform_entry(6, wgpu::ShaderStages::FRAGMENT),
+                // The spectral capture (`capture` in shading.wgsl).
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
         let module = shader::compile(device, "shading", sources)?;

@@ -37,6 +37,18 @@ struct ShadowUniforms {
 };
 @group(1) @binding(6) var<uniform> shadows: ShadowUniforms;
 
+// The spectral capture (`Renderer::set_spectral_capture`, `spectra render --spectral-out`): per
+// pixel and group of four nodes, each node's radiance in weighted form summed over X, Y and Z
+// (`capture[pixel * n_groups + group]`); the host divides by the observer's sum at the node.
+// Written only while FLAG_CAPTURE is set; otherwise a dummy buffer is bound.
+@group(1) @binding(7) var<storage, read_write> capture: array<vec4<f32>>;
+const FLAG_CAPTURE: u32 = 4u;
+
+fn capture_group(px: vec2<i32>, g: u32, m: mat3x4<f32>) {
+    let pixel = u32(px.y) * u32(frame.viewport.x) + u32(px.x);
+    capture[pixel * frame.n_groups + g] = m[0] + m[1] + m[2];
+}
+
 // Fraction of a light that reaches `p` according to its shadow map `layer` (1 outside the
 // light's frustum): one hardware 2×2 comparison sample.
 fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
@@ -423,10 +435,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             c_em = fetch_coeffs(emission / em_scale, res);
         }
     }
+    // The capture needs every term per node, the specular one included.
+    let capturing = (frame.flags & FLAG_CAPTURE) != 0u;
     if (background && !CUSTOM_SPECTRAL) {
         if (has_env && env.flags.y != 0u) {
-            return vec4<f32>(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)), 1.0);
+            let bg = env_background(ctx.view_dir);
+            if (capturing) {
+                for (var g = 0u; g < frame.n_groups; g++) {
+                    capture_group(px, g, env_w(bg, g, frame.n_groups));
+                }
+            }
+            return vec4<f32>(frame.xyz_to_rgb * env_xyz(bg), 1.0);
         }
+        // The capture buffer is cleared before the frame: nothing to write.
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let ng = frame.n_groups;
@@ -459,13 +480,13 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
                 w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
             }
             acc_a += w * fa[li];
-            if (CUSTOM_SPECTRAL) {
+            if (CUSTOM_SPECTRAL || capturing) {
                 acc_b += w * fb[li];
             }
         }
         if (has_env && !background) {
             acc_a += env_w(et.a, g, ng);
-            if (CUSTOM_SPECTRAL) {
+            if (CUSTOM_SPECTRAL || capturing) {
                 acc_b += env_w(et.b, g, ng);
             }
         }
@@ -477,20 +498,34 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
                 em = box4(emission, g);
             }
         }
+        // This group's whole contribution in weighted form, for the capture.
+        var part = zero;
         if (CUSTOM_SPECTRAL) {
             var radiance = s3_scale(acc_a, rho) + acc_b;
             if (has_em) {
                 radiance += s3_scale(white_weights(g), em);
             }
-            xyz += s3_xyz(custom_spectral(lambda, radiance, g, ctx));
+            part = custom_spectral(lambda, radiance, g, ctx);
+            xyz += s3_xyz(part);
         } else {
             xyz += rho * acc_a;
             if (has_em) {
                 xyz += em * white_weights(g);
             }
+            if (capturing) {
+                part = s3_scale(acc_a, rho) + acc_b;
+                if (has_em) {
+                    part += s3_scale(white_weights(g), em);
+                }
+            }
         }
         if (CUSTOM_IRRADIANCE && lobe > 0.0) {
-            xyz += s3_xyz(s3_scale(custom_irradiance(lambda, g, ctx), rho * lobe));
+            let irr = s3_scale(custom_irradiance(lambda, g, ctx), rho * lobe);
+            xyz += s3_xyz(irr);
+            part += irr;
+        }
+        if (capturing) {
+            capture_group(px, g, part);
         }
     }
     return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);

@@ -26,6 +26,14 @@ pub struct RenderArgs {
     /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
     #[arg(long)]
     pub out: PathBuf,
+    /// Also write the radiance at the N wavelength nodes as a spectral EXR (the OpenEXR layout
+    /// of Fichet et al. 2021, as `truth --spectral-out` writes it: channels S0.<λ>nm for the N
+    /// equal bins around the nodes, with the linear R, G, B beside them). With --quadrature
+    /// midpoint the bins integrate back to the frame's XYZ; with the default prefiltered rule
+    /// they hold the radiance averaged around each node (docs/spectral-exr.md). Spectral or
+    /// naive mode.
+    #[arg(long, value_name = "FILE.exr")]
+    pub spectral_out: Option<PathBuf>,
 }
 
 /// What the picture looks like: shared by `spectra render` and `spectra view`.
@@ -352,6 +360,11 @@ fn render_frame(
     format: OutFormat,
     (width, height): (u32, u32),
 ) -> Result<()> {
+    // Before anything is allocated for the frame.
+    if let Some(sp) = &args.spectral_out {
+        r.check_spectral_capture(width, height, settings.wavelengths)
+            .map_err(|e| anyhow!("--spectral-out {}: {e}", sp.display()))?;
+    }
     r.set_scene(scene)?;
     for w in r.scene_warnings() {
         eprintln!("warning: {}: {w}", scene.source);
@@ -361,10 +374,32 @@ fn render_frame(
         r.set_custom_shader(c)?;
     }
     r.resize(width, height)?;
+    if args.spectral_out.is_some() {
+        r.set_spectral_capture(true);
+    }
     r.render(&scene.camera, settings)?;
     // Encoding a large image takes seconds; Ctrl-C meanwhile must not be followed by a write.
     let interrupted =
         || if color::cancel::is_cancelled() { Err(render::RenderError::Cancelled) } else { Ok(()) };
+    let k = settings.exposure_ev.exp2();
+    // The spectral file first: an interrupted run leaves neither complete, never a colour image
+    // without the spectral one it was asked to go with.
+    if let Some(sp) = &args.spectral_out {
+        let cap = r.read_spectral_capture()?;
+        let rgb = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+        let rgb = compare::image::Image::new(width, height, rgb)?;
+        let spec = compare::SpectralImage {
+            width,
+            height,
+            kind: compare::SpectralKind::Emissive,
+            edges: cap.edges,
+            data: cap.data.into_iter().map(|v| v * k).collect(),
+            white: Some(settings.white.clone()),
+        };
+        interrupted()?;
+        compare::write_spectral_exr(sp, &spec, Some(&rgb))
+            .with_context(|| format!("writing {}", sp.display()))?;
+    }
     match format {
         OutFormat::Png => {
             let rgba = r.read_ldr()?;
@@ -377,7 +412,6 @@ fn render_frame(
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
         OutFormat::Exr => {
-            let k = settings.exposure_ev.exp2();
             let data = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
             let img = compare::image::Image::new(width, height, data)?;
             interrupted()?;
@@ -392,6 +426,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let format = out_format(&args.out)?;
     let (width, height) = parse_size(&args.size)?;
     super::check_output("--out", &args.out)?;
+    if let Some(sp) = &args.spectral_out {
+        if !sp.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+            bail!(
+                "--spectral-out {}: a spectral image is an OpenEXR file; give it a .exr name",
+                sp.display()
+            );
+        }
+        if Mode::parse(&args.look.mode)? == Mode::Rgb {
+            bail!(
+                "--spectral-out needs --mode spectral (or naive): --mode rgb shades in RGB and has no wavelengths to write"
+            );
+        }
+        super::check_output("--spectral-out", sp)?;
+    }
     let mut scene = args.files.load(&args.scene)?;
     super::print_warnings(&scene);
     args.look.env.apply(&mut scene)?;
@@ -438,6 +486,21 @@ pub fn run(args: RenderArgs) -> Result<()> {
         ),
         _ => under,
     };
+    if let Some(sp) = &args.spectral_out {
+        eprintln!(
+            "{}: {} bands of {:.3} nm over {:.0}–{:.0} nm, the {} quadrature's node radiances{} (S0.<λ>nm channels, with R, G, B)",
+            sp.display(),
+            settings.wavelengths,
+            settings.range.width() / settings.wavelengths as f64,
+            settings.range.min,
+            settings.range.max,
+            settings.quadrature.name(),
+            match settings.quadrature {
+                color::Quadrature::Midpoint => "",
+                _ => ", band means that integrate back only approximately (docs/spectral-exr.md)",
+            }
+        );
+    }
     eprintln!(
         "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
         args.out.display(),
