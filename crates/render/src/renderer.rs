@@ -952,3 +952,21 @@ impl Renderer {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 16 bytes per group of four nodes and pixel, against wgpu's default storage-buffer limit
+    /// (128 MiB): 1920×1080 fits at N = 16 (4 groups), not at N = 20 (5), and the error says
+    /// how much was asked and what to change.
+    #[test]
+    fn capture_size_is_checked_against_the_device_limits() {
+        let limits = wgpu::Limits::default();
+        assert_eq!(check_capture_size(&limits, 1920, 1080, 16).unwrap(), 1920 * 1080 * 64);
+        assert_eq!(check_capture_size(&limits, 1920, 1080, 13).unwrap(), 1920 * 1080 * 64);
+        let e = check_capture_size(&limits, 1920, 1080, 20).unwrap_err().to_string();
+        assert!(e.contains("1920×1080") && e.contains("20 wavelengths") && e.contains("158 MiB"), "{e}");
+        assert!(e.contains("128 MiB") && e.contains("smaller image"), "{e}");
+    }
+}

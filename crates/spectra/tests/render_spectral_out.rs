@@ -102,10 +102,14 @@ fn round_trip(scene: &str, out: &Path, spec: &Path, quadrature: color::Quadratur
 fn midpoint_node_radiances_reintegrate_to_the_frame() {
     let dir = tempfile::tempdir().unwrap();
     // metamerism: spectral (F11, LED) lights; cornell: an emissive polygon light and specular
-    // terms; colorchecker under the default environment drawn as the background.
-    for (scene, extra) in
-        [("metamerism", &[][..]), ("cornell", &[][..]), ("colorchecker", &["--env", "default"][..])]
-    {
+    // terms; colorchecker under the default environment drawn as the background; underwater:
+    // the water's spectral hooks (attenuation, in-scattering, the surface seen from below).
+    for (scene, extra) in [
+        ("metamerism", &[][..]),
+        ("cornell", &[][..]),
+        ("colorchecker", &["--env", "default"][..]),
+        ("underwater", &[][..]),
+    ] {
         let args: Vec<&str> = [&["--quadrature", "midpoint"][..], extra].concat();
         let (out, spec) = render(dir.path(), scene, &args);
         let t = round_trip(scene, &out, &spec, color::Quadrature::Midpoint);
