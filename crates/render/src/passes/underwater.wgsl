@@ -130,14 +130,19 @@ const UW_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f3
 // weights; the ray cut at the depth nodes it crosses into pieces, each with its segment i,
 // start t0 (m), length (m, < 0 for a piece that runs forever) and depth offset z(t0) − z_i.
 var<private> uw_cell: array<u32, 4>;
+// At most one piece per depth node the ray crosses, one where it leaves the floored column and
+// the last one.
+const UW_MAX_PIECES: u32 = UW_ND + 2u;
 var<private> uw_cw: vec4<f32>;
 var<private> uw_np: u32 = 0u;
-var<private> uw_pn: array<u32, 16>;
-var<private> uw_pt: array<f32, 16>;
-var<private> uw_pl: array<f32, 16>;
-var<private> uw_pz: array<f32, 16>;
+var<private> uw_pn: array<u32, UW_MAX_PIECES>;
+var<private> uw_pt: array<f32, UW_MAX_PIECES>;
+var<private> uw_pl: array<f32, UW_MAX_PIECES>;
+var<private> uw_pz: array<f32, UW_MAX_PIECES>;
 // Which table each piece reads: 1 (bottomless) where its midpoint lies beyond the floor.
-var<private> uw_pd: array<u32, 16>;
+var<private> uw_pd: array<u32, UW_MAX_PIECES>;
+// Bit p set: piece p lies below the table's last node (extrapolated; light_field::ray_integral_by).
+var<private> uw_beyond: u32 = 0u;
 var<private> uw_org: vec3<f32>;
 var<private> uw_view: vec3<f32>;
 // The first sun's horizontal direction (towards it; zero for a zenith sun or none) and the
@@ -226,9 +231,11 @@ fn uw_segment(z: f32) -> u32 {
 }
 
 fn uw_add_piece(t0: f32, t1: f32, infinite: bool, z0: f32, wy: f32) {
-    if (uw_np >= 16u) { return; }
+    if (uw_np >= UW_MAX_PIECES) { return; }
     let tm = select(0.5 * (t0 + t1), t0 + 1.0, infinite);
-    let i = uw_segment(max(z0 - tm * wy, 0.0));
+    let zm = max(z0 - tm * wy, 0.0);
+    let i = uw_segment(zm);
+    if (zm > UW_ZMAX) { uw_beyond |= 1u << uw_np; }
     uw_pn[uw_np] = i;
     uw_pt[uw_np] = t0;
     uw_pl[uw_np] = select(t1 - t0, -1.0, infinite);
@@ -272,13 +279,16 @@ fn uw_prepare_table(w: vec3<f32>, z0: f32) {
     // the ray leaves the floored column (the floor's extent, or its depth): each piece reads
     // one table, chosen at its midpoint.
     uw_np = 0u;
+    uw_beyond = 0u;
     var t = 0.0;
     let wy = w.y;
     let t_exit = uw_floor_exit(w, z0);
     if (abs(wy) > 1e-6) {
-        for (var n = 1u; n < UW_ND - 1u; n++) {
-            // Going down the nodes come in increasing depth, going up in decreasing depth.
+        for (var n = 1u; n < UW_ND; n++) {
+            // Going down the nodes come in increasing depth, going up in decreasing depth; the
+            // last node too (below it the column is extrapolated), never the surface.
             let i = select(UW_ND - 1u - n, n, wy < 0.0);
+            if (i == 0u) { continue; }
             let tc = (z0 - uw_depth_node(i)) / wy;
             if (tc > t && (uw_infinite || tc < uw_d)) {
                 if (t_exit > t && t_exit < tc) {
@@ -351,8 +361,15 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
     for (var p = 0u; p < uw_np; p++) {
         let i = uw_pn[p];
         let ja = uw_j_node(uw_pd[p], i, group, rgb);
-        let k = uw_rate(ja, uw_j_node(uw_pd[p], i + 1u, group, rgb), i);
-        let j0 = ja * exp(-k * uw_pz[p]);
+        let jb = uw_j_node(uw_pd[p], i + 1u, group, rgb);
+        var k = uw_rate(ja, jb, i);
+        var j0 = ja * exp(-k * uw_pz[p]);
+        // Below the table the field never grows with depth, from the last node on
+        // (light_field::beyond_rate).
+        if (((uw_beyond >> p) & 1u) != 0u) {
+            k = max(k, vec4<f32>(0.0));
+            j0 = jb * exp(-k * (uw_pz[p] - (uw_depth_node(i + 1u) - uw_depth_node(i))));
+        }
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
         let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
@@ -399,7 +416,9 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
         a += w[c] * uw_tab(table, UW_L_IRR + i * UW_NNE * UW_NNA + cells[c], group, rgb);
         b += w[c] * uw_tab(table, UW_L_IRR + (i + 1u) * UW_NNE * UW_NNA + cells[c], group, rgb);
     }
-    return a * exp(-uw_rate(a, b, i) * (z - uw_depth_node(i)));
+    let k = uw_rate(a, b, i);
+    if (z > UW_ZMAX) { return b * exp(-max(k, vec4<f32>(0.0)) * (z - UW_ZMAX)); }
+    return a * exp(-k * (z - uw_depth_node(i)));
 }
 
 // The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
@@ -440,7 +459,10 @@ fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
 fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> {
     let i = uw_segment(z);
     let a = uw_ed_node(table, i, group, rgb);
-    let k = uw_rate(a, uw_ed_node(table, i + 1u, group, rgb), i);
+    let b = uw_ed_node(table, i + 1u, group, rgb);
+    let k = uw_rate(a, b, i);
+    // Below the table: never growing, from the last node on (light_field::log_interp).
+    if (z > UW_ZMAX) { return b * exp(-max(k, vec4<f32>(0.0)) * (z - UW_ZMAX)); }
     return a * exp(-k * (z - uw_depth_node(i)));
 }
 

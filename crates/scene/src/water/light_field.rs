@@ -868,14 +868,28 @@ pub fn segment_rate(col: &[f64; N_DEPTH], z_max: f64, i: usize) -> f64 {
 }
 
 /// A column's value at depth z: exponential between nodes (ln linear), the last segment's rate
-/// beyond the last node.
+/// beyond the last node, clamped so that the column never grows below the table
+/// ([`beyond_rate`]).
 pub fn log_interp(col: &[f64; N_DEPTH], z_max: f64, z: f64) -> f64 {
     let z = z.max(0.0);
     let mut i = 0;
     while i + 2 < N_DEPTH && depth_node(i + 1, z_max) < z {
         i += 1;
     }
-    col[i] * (-segment_rate(col, z_max, i) * (z - depth_node(i, z_max))).exp()
+    let k = segment_rate(col, z_max, i);
+    if z > z_max {
+        return col[N_DEPTH - 1] * (-beyond_rate(k) * (z - z_max)).exp();
+    }
+    col[i] * (-k * (z - depth_node(i, z_max))).exp()
+}
+
+/// The decay rate used below a table's last node, from the last segment's rate `k`: never
+/// negative. Near the surface or the floor the last segment can grow with depth (or look so
+/// through noise), and extrapolated the column would then grow without bound — an endless view
+/// below the table would gather infinite light; the deep field decays (its asymptotic rate K∞
+/// lies between a and c).
+pub fn beyond_rate(k: f64) -> f64 {
+    k.max(0.0)
 }
 
 /// `∫₀ᵈ J(z0 − t·ω_y)·e^{−c·t} dt` for a column J over depth (interpolated as in
@@ -904,7 +918,8 @@ pub fn ray_integral_by(
     let z_at = |t: f64| z0 - t * wy;
     let mut cuts: Vec<f64> = vec![0.0];
     if wy.abs() > 1e-12 {
-        for i in 1..N_DEPTH - 1 {
+        // The last node too: below it the column is extrapolated (see the clamp below).
+        for i in 1..N_DEPTH {
             let t = (z0 - depth_node(i, z_max)) / wy;
             if t > 0.0 && t < d {
                 cuts.push(t);
@@ -926,9 +941,15 @@ pub fn ray_integral_by(
         while i + 2 < N_DEPTH && depth_node(i + 1, z_max) < zm {
             i += 1;
         }
-        let k = segment_rate(col, z_max, i);
-        // J(t) = col[i]·e^{−k(z0 − t·wy − z_i)}, times e^{−c·t}.
-        let j0 = col[i] * (-k * (z_at(t0) - depth_node(i, z_max))).exp();
+        // J(t) = col[i]·e^{−k(z0 − t·wy − z_i)}, times e^{−c·t}; below the table from the
+        // last node on (the same J without the clamp).
+        let (k, j0) = if zm > z_max {
+            let k = beyond_rate(segment_rate(col, z_max, i));
+            (k, col[N_DEPTH - 1] * (-k * (z_at(t0) - z_max)).exp())
+        } else {
+            let k = segment_rate(col, z_max, i);
+            (k, col[i] * (-k * (z_at(t0) - depth_node(i, z_max))).exp())
+        };
         let rate = c - k * wy;
         let len = t1 - t0;
         sum += j0
@@ -1039,6 +1060,26 @@ mod tests {
             }
         }
         eprintln!("light-field ray integral vs quadrature: {n} cases, worst {worst:e}");
+    }
+
+    /// A column that grows with depth (as near the floor, or through noise in the last
+    /// segment): inside the table the closed form follows it, below it the column stays at its
+    /// last value. Analytic: J = e^{z/2}, c = 0.1, a view 30° down from z0 = 2 to infinity.
+    /// Before the clamp the endless piece's rate c − k·ω_y was negative and so was the result.
+    #[test]
+    fn ray_integral_below_the_table_never_grows() {
+        let z_max = 10.0;
+        let col: [f64; N_DEPTH] = std::array::from_fn(|i| (0.5 * depth_node(i, z_max)).exp());
+        let (c, z0, wy) = (0.1, 2.0, -0.5);
+        let got = ray_integral(&col, z_max, c, z0, wy, f64::INFINITY);
+        // Inside: e^{z0/2}·∫₀^{t_max} e^{(0.25 − c)t} dt; below: J(z_max)·e^{−c·t_max}/c.
+        let t_max = (z_max - z0) / -wy;
+        let inside = (0.5 * z0).exp() * ((0.15 * t_max).exp() - 1.0) / 0.15;
+        let below = (0.5 * z_max).exp() * (-c * t_max).exp() / c;
+        let want = inside + below;
+        assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+        // The same convention for a point value below the table.
+        assert!((log_interp(&col, z_max, 25.0) - (0.5 * z_max).exp()).abs() < 1e-9 * (0.5 * z_max).exp());
     }
 
     /// Every wavelength node follows the same photons: a water whose a and b do not depend on
