@@ -164,7 +164,8 @@ fn rgb_medium_hooks_match_the_cpu_model_to_1e_3() {
         ("scattering, box", medium([0.05, 0.1, 0.4], [0.3, 0.2, 0.1], Attenuation::Box), 24),
     ];
     for (name, m, steps) in &media {
-        let shader = rgb_medium::shader(m, &table, &rgb_medium::Options { steps: *steps }).unwrap();
+        let shader =
+            rgb_medium::shader(m, &table, &rgb_medium::Options { steps: *steps, multiple: false }).unwrap();
         let (sa, ss) = m.spectra(&table).unwrap();
         let boxed = RgbMedium { upsampling: Attenuation::Box, ..m.clone() };
         let (sa_box, ss_box) = boxed.spectra(&table).unwrap();
