@@ -12,6 +12,7 @@ Truth images are cached in --work (they do not depend on the real-time code), ke
 medium, size, spp and seed.
 
     tools/rgb_media_ms_sweep.py --bin target/release/spectra --spp 4096 [--json out.json]
+    tools/rgb_media_ms_sweep.py --spp 4096 --rt-args=--single-scattering   # the model without the term
 """
 import argparse
 import base64
