@@ -8,7 +8,8 @@ the RGB mode's three wavelengths), all against `spectra truth underwater` with t
 spectra. The real-time images come from `cargo run --release -p spectra --example rgb_water`.
 
 fog: the built-in `fog` and `tinted-fog` scenes (an RGB medium with lights inside it), real time
-(spectral, naive, rgb; and spectral without in-scattering, --scatter-steps 0) against
+(spectral, naive, rgb, with multiple scattering; spectral without in-scattering, --scatter-steps 0;
+spectral with single scattering only, --single-scattering) against
 `spectra truth` of the same scene (the same upsampled medium): the full tracer, and its direct
 light only (--direct-only), which is the real-time model (no global illumination, single
 scattering); and the same scene in clear air, for what the renderers differ by without a medium.
@@ -106,8 +107,9 @@ def main():
                      "N = 16, default underwater model.\n\n")
         if "fog" in parts:
             modes = [("spectral", ["--mode", "spectral"]), ("naive", ["--mode", "naive"]), ("rgb", ["--mode", "rgb"]),
-                     ("spectral, no in-scattering", ["--mode", "spectral", "--scatter-steps", "0"])]
-            # The real-time renderer has no global illumination and single scattering only: the
+                     ("spectral, no in-scattering", ["--mode", "spectral", "--scatter-steps", "0"]),
+                     ("spectral, single scattering", ["--mode", "spectral", "--single-scattering"])]
+            # The real-time renderer has no global illumination; with --single-scattering the
             # tracer's direct light (--direct-only: light sampled at the camera ray's first
             # vertex, in the medium or on a surface) is its model; the full tracer is the truth.
             # "clear" is the fog scene in (practically) clear air: what the renderers differ by

@@ -27,7 +27,13 @@
 //! node's footprint, since a step sampled at the nodes would move to the nearest node
 //! (docs/rgb-media.md); the albedo σ_s/σ_t, smooth, is sampled at the nodes.
 //!
-//! Left out (docs/rgb-media.md): multiple scattering, the environment light's extinction (an
+//! Multiple scattering ([`Options::multiple`], on by default): the fluence of the light that
+//! has collided at least once around each marched light, in closed form per wavelength
+//! (the once-collided term exactly, the higher orders with their exact total and the transport
+//! solution's far-field decay; the model is derived at the end of `rgb_medium.wgsl`),
+//! scattered once more along the view ray and falling on surfaces (`custom_irradiance`).
+//!
+//! Left out (docs/rgb-media.md): light reflected by surfaces and scattered back by the medium, the environment light's extinction (an
 //! environment map still lights surfaces, attenuated only along the view), attenuation of a
 //! polygon light over its extent (its centroid stands for it).
 
@@ -55,11 +61,15 @@ pub const MAX_MARCH: f64 = 1e4;
 pub struct Options {
     /// Equiangular steps per light for the in-scattering (0 = attenuation only).
     pub steps: u32,
+    /// The multiple-scattering term (the collided light's fluence around each marched light,
+    /// scattered along the view and onto surfaces; docs/rgb-media.md); off = single scattering
+    /// only, which is what the path tracer computes with `--direct-only`.
+    pub multiple: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { steps: 16 }
+        Options { steps: 16, multiple: true }
     }
 }
 
@@ -109,6 +119,7 @@ pub fn shader(medium: &RgbMedium, table: &CoeffTable, options: &Options) -> Resu
     params[12] = blue_green as f32;
     params[13] = green_red as f32;
     params[4..7].copy_from_slice(&sigma_s);
+    params[7] = if options.multiple { 1.0 } else { 0.0 };
     params[8..11].copy_from_slice(&sigma_t);
     Ok(CustomShader { source: format!("{MEDIUM_COMMON}\n{HOOKS}"), params, spectra: spectra.to_vec() })
 }
@@ -124,7 +135,9 @@ mod tests {
         let s = shader(&m, &table, &Options::default()).unwrap();
         assert_eq!(&s.params[..3], &[16.0, 0.3, s.params[2]]);
         // Per scene unit: 2 m per unit doubles the coefficients.
-        assert_eq!(&s.params[4..7], &[1.0, 1.0, 1.0]);
+        assert_eq!(&s.params[4..8], &[1.0, 1.0, 1.0, 1.0]);
+        let single = shader(&m, &table, &Options { multiple: false, ..Default::default() }).unwrap();
+        assert_eq!(single.params[7], 0.0);
         assert_eq!(&s.params[8..11], &[1.2, 1.4, 1.8]);
         // One home: the truth's spectra, per scene unit.
         let (a, sc) = m.spectra(&table).unwrap();
@@ -140,7 +153,8 @@ mod tests {
         assert!(
             s.defines("custom_light_transmittance") && s.assembled().contains("CUSTOM_LIGHT_T: bool = true")
         );
-        let e = shader(&m, &table, &Options { steps: 33 }).unwrap_err().to_string();
+        assert!(s.defines("custom_irradiance") && s.assembled().contains("CUSTOM_IRRADIANCE: bool = true"));
+        let e = shader(&m, &table, &Options { steps: 33, ..Default::default() }).unwrap_err().to_string();
         assert!(e.contains("march steps") && e.contains("33"), "{e}");
     }
 }

@@ -283,8 +283,8 @@ pub fn run(args: Args) -> Result<()> {
     super::print_warnings(&scene);
     args.env.apply(&mut scene)?;
     let coeffs = load_table(args.table.as_deref())?;
-    let steps = render::passes::rgb_medium::Options::default().steps;
-    let medium = super::realtime_medium(&scene, args.rgb_medium.as_deref(), false, &coeffs, steps)?;
+    let medium =
+        super::realtime_medium(&scene, args.rgb_medium.as_deref(), false, &coeffs, Default::default())?;
     let mut r = Renderer::with_table(coeffs)?;
     r.set_scene(&scene)?;
     if let Some(m) = medium {

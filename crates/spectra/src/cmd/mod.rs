@@ -42,13 +42,13 @@ pub fn rgb_medium_arg(arg: &str) -> anyhow::Result<scene::medium::RgbMedium> {
 
 /// The real-time renderer's RGB medium: `--rgb-medium`, else the scene's `extras.medium`;
 /// with water (which is a medium of its own) it is an error, as for `spectra truth`. As a
-/// custom shader with `steps` march steps, upsampled through `table`.
+/// custom shader with `opts`, upsampled through `table`.
 pub fn realtime_medium(
     scene: &scene::Scene,
     arg: Option<&str>,
     water: bool,
     table: &color::upsample::CoeffTable,
-    steps: u32,
+    opts: ::render::passes::rgb_medium::Options,
 ) -> anyhow::Result<Option<::render::CustomShader>> {
     let m = match (arg, &scene.medium) {
         (Some(a), _) => rgb_medium_arg(a)?,
@@ -60,7 +60,6 @@ pub fn realtime_medium(
             "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
         );
     }
-    let opts = ::render::passes::rgb_medium::Options { steps };
     Ok(Some(::render::passes::rgb_medium::shader(&m, table, &opts)?))
 }
 
@@ -119,6 +118,7 @@ impl EnvArgs {
 #[cfg(test)]
 mod rgb_medium_tests {
     use super::realtime_medium;
+    use render::passes::rgb_medium::Options;
 
     /// `render`/`view`/`bench` take the medium from `--rgb-medium` or the scene, refuse it with
     /// water, and name the flag in every error.
@@ -127,14 +127,22 @@ mod rgb_medium_tests {
         let table = color::upsample::table("srgb").unwrap();
         let fog = scene::builtin("fog").unwrap();
         let cornell = scene::builtin("cornell").unwrap();
-        assert!(realtime_medium(&cornell, None, false, &table, 16).unwrap().is_none());
-        let s = realtime_medium(&fog, None, false, &table, 16).unwrap().expect("the scene's medium");
+        assert!(realtime_medium(&cornell, None, false, &table, Default::default()).unwrap().is_none());
+        let s = realtime_medium(&fog, None, false, &table, Default::default())
+            .unwrap()
+            .expect("the scene's medium");
         assert_eq!(s.params[0], 16.0);
         let m = r#"{"absorption": [0.5, 0.2, 0.1], "g": 0.5}"#;
-        let s = realtime_medium(&cornell, Some(m), false, &table, 8).unwrap().expect("the flag's medium");
+        let s = realtime_medium(&cornell, Some(m), false, &table, Options { steps: 8, multiple: true })
+            .unwrap()
+            .expect("the flag's medium");
         assert_eq!((s.params[0], s.params[1], &s.params[8..11]), (8.0, 0.5, &[0.5f32, 0.2, 0.1][..]));
         let e = |scene: &scene::Scene, arg: Option<&str>, water: bool, steps: u32| {
-            format!("{:#}", realtime_medium(scene, arg, water, &table, steps).unwrap_err())
+            format!(
+                "{:#}",
+                realtime_medium(scene, arg, water, &table, Options { steps, ..Default::default() })
+                    .unwrap_err()
+            )
         };
         let msg = e(&fog, None, true, 16);
         assert!(msg.contains("--rgb-medium") && msg.contains("water"), "{msg}");

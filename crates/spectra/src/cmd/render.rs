@@ -82,6 +82,10 @@ pub struct LookArgs {
     /// medium attenuation alone).
     #[arg(long, value_name = "STEPS", default_value_t = render::passes::underwater::Options::default().steps)]
     pub scatter_steps: u32,
+    /// In an RGB medium: single scattering only, without the multiple-scattering term (what
+    /// `spectra truth --direct-only` computes; docs/rgb-media.md).
+    #[arg(long)]
+    pub single_scattering: bool,
     /// Under water: Henyey–Greenstein asymmetry g of single scattering (default: Petzold's 0.924).
     #[arg(long, value_name = "G", allow_negative_numbers = true,
           default_value_t = render::passes::underwater::Options::default().phase_g)]
@@ -166,6 +170,11 @@ impl LookArgs {
     }
 
     /// The underwater model's options from `--scatter-steps` and `--phase-g`.
+    /// The RGB medium's real-time options.
+    pub fn rgb_medium_options(&self) -> render::passes::rgb_medium::Options {
+        render::passes::rgb_medium::Options { steps: self.scatter_steps, multiple: !self.single_scattering }
+    }
+
     pub fn underwater(&self) -> Result<render::passes::underwater::Options> {
         let o = if self.paper_model {
             render::passes::underwater::Options::paper()
@@ -451,7 +460,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         args.look.rgb_medium.as_deref(),
         water.is_some(),
         &table,
-        args.look.scatter_steps,
+        args.look.rgb_medium_options(),
     )?;
     let mut r = Renderer::with_table(table)?;
     let custom = match &water {

@@ -76,7 +76,7 @@ pub fn run(args: Args) -> Result<()> {
         args.look.rgb_medium.as_deref(),
         water.is_some(),
         &table,
-        args.look.scatter_steps,
+        args.look.rgb_medium_options(),
     )?;
     run_window(event_loop, ViewOptions { scene, settings, size, table, water, water_options, medium })
 }
