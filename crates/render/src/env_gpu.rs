@@ -8,7 +8,8 @@ use glam::Vec4;
 use half::f16;
 use wgpu::util::DeviceExt;
 
-/// Per-frame environment parameters. Matches `EnvUniforms` in `wgsl/environment.wgsl`.
+/// Per-frame environment parameters. `EnvUniforms` in `wgsl/environment.wgsl` (checked by
+/// `layout_tests`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct EnvUniforms {

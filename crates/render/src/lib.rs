@@ -29,6 +29,8 @@ pub mod env_gpu;
 pub mod environment;
 pub mod error;
 pub mod gpu;
+#[cfg(test)]
+mod layout_tests;
 pub mod passes;
 mod readback;
 pub mod renderer;

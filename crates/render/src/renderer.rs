@@ -5,13 +5,13 @@ use crate::coeff_table::GpuCoeffTable;
 use crate::env_gpu::{EnvUniforms, GpuEnvironment};
 use crate::error::{RenderError, Result};
 use crate::gpu::Gpu;
-use crate::passes::SharedLayouts;
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::post::PostPass;
 use crate::passes::shading::{ShadingPass, Variant};
 use crate::passes::shadow::ShadowPass;
+use crate::passes::{Draw, SharedGroups, SharedLayouts, SpectralInputs};
 use crate::readback;
 use crate::scene_gpu::{GpuLight, GpuScene};
 use crate::settings::{Mode, RenderSettings};
@@ -179,8 +179,8 @@ impl Renderer {
         let custom = CustomShader::default();
         let gbuffer = GBufferPass::new(device, &shared)?;
         let shadow = ShadowPass::new(device, &gbuffer.material_layout)?;
-        let shading = ShadingPass::new(device, &shared, &custom.assembled())?;
-        let custom_pass = CustomPass::new(device, &shared, &custom.assembled())?;
+        let shading = ShadingPass::new(device, &shared, &custom)?;
+        let custom_pass = CustomPass::new(device, &shared, &custom)?;
         let post = PostPass::new(device, &shared)?;
         let accumulate = AccumulatePass::new(device)?;
         let gpu_table = GpuCoeffTable::upload(device, &gpu.queue, &table);
@@ -190,11 +190,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &shared.frame,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame_buffer.as_entire_binding() }],
-        });
+        let frame_bind_group = shared.frame_group(device, &frame_buffer);
         let timer =
             gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Timer::new(device, &gpu.queue));
         let environment = GpuEnvironment::new(device, &gpu.queue, None);
@@ -325,8 +321,8 @@ impl Renderer {
     pub fn set_custom_shader(&mut self, custom: CustomShader) -> Result<()> {
         custom.validate()?;
         let device = &self.gpu.device;
-        let shading = ShadingPass::new(device, &self.shared, &custom.assembled())?;
-        let custom_pass = CustomPass::new(device, &self.shared, &custom.assembled())?;
+        let shading = ShadingPass::new(device, &self.shared, &custom)?;
+        let custom_pass = CustomPass::new(device, &self.shared, &custom)?;
         self.shading = shading;
         self.custom_pass = custom_pass;
         self.custom = custom;
@@ -343,7 +339,7 @@ impl Renderer {
         self.shading = if on {
             ShadingPass::reference(device, &self.shared)?
         } else {
-            ShadingPass::new(device, &self.shared, &self.custom.assembled())?
+            ShadingPass::new(device, &self.shared, &self.custom)?
         };
         Ok(())
     }
@@ -565,7 +561,7 @@ impl Renderer {
                 mapped_at_creation: false,
             });
             let (targets, _) = self.targets.as_ref().expect("checked above");
-            let bind_group = self.shading_bind_group(targets, &buffer);
+            let bind_group = self.shading.bind_inputs(&self.gpu.device, targets, &self.shadow, &buffer);
             self.capture = Some(Capture { buffer, bind_group, width, height, settings: settings.clone() });
         }
         self.update_spectral(settings)?;
@@ -628,41 +624,26 @@ impl Renderer {
             // Background pixels without an environment write nothing.
             encoder.clear_buffer(&c.buffer, 0, None);
         }
-        self.shading.record(
-            &mut encoder,
-            &targets.hdr_shaded_view,
-            &self.frame_bind_group,
-            self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group),
-            &spectral.bind_group,
-            &spectral.custom_bind_group,
-            settings.mode == Mode::Rgb,
-            ts(2),
-        );
-        self.custom_pass.record(
-            &mut encoder,
-            &targets.hdr_view,
-            &self.frame_bind_group,
-            &bindings.custom,
-            &spectral.bind_group,
-            &spectral.custom_bind_group,
-            ts(3),
-        );
+        let shared = SharedGroups {
+            frame: &self.frame_bind_group,
+            spectral: &spectral.bind_group,
+            custom: &spectral.custom_bind_group,
+        };
+        let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
+        let draw = Draw { target: &targets.hdr_shaded_view, inputs, timestamps: ts(2) };
+        self.shading.record(&mut encoder, &shared, draw, settings.mode == Mode::Rgb);
+        let draw = Draw { target: &targets.hdr_view, inputs: &bindings.custom, timestamps: ts(3) };
+        self.custom_pass.record(&mut encoder, &shared, draw);
         let post_inputs = if self.accumulating {
             self.accumulated = self.accumulated.saturating_add(1);
             self.accumulate.set_frame(&self.gpu.queue, self.accumulated);
-            self.accumulate.record(
-                &mut encoder,
-                &targets.accum,
-                &targets.accum_prev,
-                &targets.accum_view,
-                &targets.accum_display_view,
-                &bindings.accumulate,
-            );
+            self.accumulate.record(&mut encoder, targets, &bindings.accumulate);
             &bindings.post_accumulated
         } else {
             &bindings.post
         };
-        self.post.record(&mut encoder, &targets.ldr_view, &self.frame_bind_group, post_inputs, ts(4));
+        let draw = Draw { target: &targets.ldr_view, inputs: post_inputs, timestamps: ts(4) };
+        self.post.record(&mut encoder, &self.frame_bind_group, draw);
         if let Some(t) = timer {
             t.resolve(&mut encoder);
         }
@@ -729,63 +710,19 @@ impl Renderer {
             .collect())
     }
 
-    /// The shading pass's inputs, with `capture` as the spectral capture buffer.
-    fn shading_bind_group(&self, t: &Targets, capture: &wgpu::Buffer) -> wgpu::BindGroup {
-        fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
-        }
-        let g = &t.gbuffer_views;
-        self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shading inputs"),
-            layout: &self.shading.input_layout,
-            entries: &[
-                view(0, &g[0]),
-                view(1, &g[1]),
-                view(2, &g[2]),
-                view(3, &t.depth_view),
-                view(4, &self.shadow.view),
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::Sampler(&self.shadow.sampler),
-                },
-                wgpu::BindGroupEntry { binding: 6, resource: self.shadow.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: capture.as_entire_binding() },
-            ],
-        })
-    }
-
     fn target_bindings(&self, t: &Targets) -> TargetBindings {
         let device = &self.gpu.device;
-        fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
+        TargetBindings {
+            shading: self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy),
+            custom: self.custom_pass.bind_inputs(device, t),
+            post: self.post.bind_inputs(device, &t.hdr_view, "post inputs"),
+            accumulate: self.accumulate.bind_inputs(device, t),
+            post_accumulated: self.post.bind_inputs(
+                device,
+                &t.accum_display_view,
+                "post inputs (accumulated)",
+            ),
         }
-        let shading = self.shading_bind_group(t, &self.capture_dummy);
-        let g = &t.gbuffer_views;
-        let custom = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("custom inputs"),
-            layout: &self.custom_pass.input_layout,
-            entries: &[view(0, &t.hdr_shaded_view), view(1, &g[1]), view(2, &t.depth_view)],
-        });
-        let post = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("post inputs"),
-            layout: &self.post.input_layout,
-            entries: &[view(0, &t.hdr_view)],
-        });
-        let accumulate = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("accumulate inputs"),
-            layout: &self.accumulate.input_layout,
-            entries: &[
-                view(0, &t.hdr_view),
-                view(1, &t.accum_prev_view),
-                wgpu::BindGroupEntry { binding: 2, resource: self.accumulate.uniforms.as_entire_binding() },
-            ],
-        });
-        let post_accumulated = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("post inputs (accumulated)"),
-            layout: &self.post.input_layout,
-            entries: &[view(0, &t.accum_display_view)],
-        });
-        TargetBindings { shading, custom, post, accumulate, post_accumulated }
     }
 
     /// Rebuilds the per-wavelength buffers when the wavelengths, observer, mode, scene or custom
@@ -882,38 +819,22 @@ impl Renderer {
         let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
         let light_buf = storage("lights", bytemuck::cast_slice(&lights));
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("spectral"),
-            layout: &self.shared.spectral,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wl_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: light_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: light_spec_buf.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&self.gpu_table.view),
-                },
-                wgpu::BindGroupEntry { binding: 4, resource: self.gpu_table.scale.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: env_weight_buf.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&env_tex.radiance),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: wgpu::BindingResource::TextureView(&env_tex.irradiance),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: wgpu::BindingResource::TextureView(&self.environment.lut),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 9,
-                    resource: wgpu::BindingResource::Sampler(&self.environment.sampler),
-                },
-                wgpu::BindGroupEntry { binding: 10, resource: self.env_buffer.as_entire_binding() },
-            ],
-        });
+        let bind_group = self.shared.spectral_group(
+            device,
+            &SpectralInputs {
+                wavelengths: &wl_buf,
+                lights: &light_buf,
+                light_weights: &light_spec_buf,
+                table: &self.gpu_table.view,
+                table_scale: &self.gpu_table.scale,
+                env_weights: &env_weight_buf,
+                env_radiance: &env_tex.radiance,
+                env_irradiance: &env_tex.irradiance,
+                env_lut: &self.environment.lut,
+                env_sampler: &self.environment.sampler,
+                env_uniforms: &self.env_buffer,
+            },
+        );
 
         // custom_spectra[group * 4 + s] = spectrum s < 4 at the group's four wavelengths; the
         // spectra beyond the fourth (tables) follow at [s * n_groups + group].
@@ -939,14 +860,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let custom_spec_buf = storage("custom spectra", bytemuck::cast_slice(&custom_spectra));
-        let custom_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("custom"),
-            layout: &self.shared.custom,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: custom_uniform_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: custom_spec_buf.as_entire_binding() },
-            ],
-        });
+        let custom_bind_group = self.shared.custom_group(device, &custom_uniform_buf, &custom_spec_buf);
         self.spectral =
             Some(SpectralState { key, setup, bind_group, custom_bind_group, n_lights, env_totals });
         Ok(())

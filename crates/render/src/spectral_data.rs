@@ -20,8 +20,8 @@ use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spe
 use glam::{DMat3, DVec3};
 use scene::Emission;
 
-/// Four node wavelengths and what the shader needs at them. Matches `WavelengthGroup` in
-/// `wgsl/spectral.wgsl`.
+/// Four node wavelengths and what the shader needs at them. `WavelengthGroup` in
+/// `wgsl/spectral.wgsl` (checked by `layout_tests`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct WavelengthGroup {

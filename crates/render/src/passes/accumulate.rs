@@ -4,9 +4,13 @@
 //! then tone-maps the mean. With jittered wavelengths (`RenderSettings::jitter`) each frame is an
 //! unbiased estimate, so the mean converges to the dense spectral integral.
 
-use super::{HDR_FORMAT, texture_entry, uniform_entry};
+use super::{
+    FullscreenPipeline, HDR_FORMAT, buffer_entry, draw_fullscreen, pipeline_layout, texture_entry,
+    uniform_entry, view_entry,
+};
 use crate::error::Result;
 use crate::shader;
+use crate::targets::Targets;
 
 /// The accumulated mean's format: f32 so that rounding does not build up over many frames.
 pub const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -34,35 +38,12 @@ impl AccumulatePass {
         let module =
             shader::compile(device, "accumulate", &[shader::COMMON, include_str!("accumulate.wgsl")])?;
         let pipeline = shader::checked(device, "accumulate pipeline", || {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("accumulate"),
-                bind_group_layouts: &[Some(&input_layout)],
-                immediate_size: 0,
-            });
-            let target = |format| {
-                Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
-            };
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("accumulate"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_fullscreen"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[target(ACCUM_FORMAT), target(HDR_FORMAT)],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let layout = pipeline_layout(device, "accumulate", &[&input_layout]);
+            FullscreenPipeline {
+                targets: &[ACCUM_FORMAT, HDR_FORMAT],
+                ..FullscreenPipeline::simple("accumulate", &module, &layout, &[HDR_FORMAT])
+            }
+            .build(device)
         })?;
         Ok(AccumulatePass { input_layout, uniforms, pipeline })
     }
@@ -73,44 +54,29 @@ impl AccumulatePass {
         queue.write_buffer(&self.uniforms, 0, bytemuck::cast_slice(&[w, 0.0, 0.0, 0.0]));
     }
 
-    /// Copies the current mean aside (`mean` → `prev`, read by `inputs`), then writes the new
-    /// mean to `mean` and to `display` (HDR format, post's input).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        mean: &wgpu::Texture,
-        prev: &wgpu::Texture,
-        mean_view: &wgpu::TextureView,
-        display_view: &wgpu::TextureView,
-        inputs: &wgpu::BindGroup,
-    ) {
+    /// Group 0: the current frame, the previous mean and the weight.
+    pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("accumulate inputs"),
+            layout: &self.input_layout,
+            entries: &[
+                view_entry(0, &t.hdr_view),
+                view_entry(1, &t.accum_prev_view),
+                buffer_entry(2, &self.uniforms),
+            ],
+        })
+    }
+
+    /// Copies the current mean aside (`accum` → `accum_prev`, read by `inputs`, from
+    /// [`Self::bind_inputs`]), then writes the new mean to `accum` and to `accum_display` (HDR
+    /// format, post's input).
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, t: &Targets, inputs: &wgpu::BindGroup) {
         encoder.copy_texture_to_texture(
-            mean.as_image_copy(),
-            prev.as_image_copy(),
-            wgpu::Extent3d { width: mean.width(), height: mean.height(), depth_or_array_layers: 1 },
+            t.accum.as_image_copy(),
+            t.accum_prev.as_image_copy(),
+            wgpu::Extent3d { width: t.accum.width(), height: t.accum.height(), depth_or_array_layers: 1 },
         );
-        let attachment = |view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("accumulate"),
-            color_attachments: &[attachment(mean_view), attachment(display_view)],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, inputs, &[]);
-        pass.draw(0..3, 0..1);
+        let targets = [&t.accum_view, &t.accum_display_view];
+        draw_fullscreen(encoder, "accumulate", &targets, &self.pipeline, &[inputs], None);
     }
 }

@@ -49,9 +49,13 @@
 //! Radiance units: the HDR values are linear sRGB where a white diffuse surface under a
 //! 1-lux white directional light at normal incidence is 1/π.
 
-use super::{HDR_FORMAT, SharedLayouts, depth_entry, draw_fullscreen, fullscreen_pipeline, texture_entry};
+use super::{
+    Draw, FullscreenPipeline, HDR_FORMAT, SharedGroups, SharedLayouts, depth_entry, draw_fullscreen,
+    pipeline_layout, texture_entry, view_entry,
+};
 use crate::error::{RenderError, Result};
 use crate::shader;
+use crate::targets::Targets;
 use color::Spectrum;
 
 /// Identity hooks.
@@ -83,6 +87,9 @@ pub struct CustomShader {
     pub params: [f32; 16],
     /// Up to four spectra the hooks need per wavelength (absorption, scattering, …).
     pub spectra: Vec<Spectrum>,
+    /// Values of the source's pipeline-overridable constants (`override NAME: T;`) by name:
+    /// fixed per shader, unlike `params`, so the driver compiles untaken branches away.
+    pub constants: Vec<(String, f64)>,
 }
 
 /// Most spectra a custom shader can ask for: the first four at `custom_spectra[group * 4 + s]`,
@@ -91,7 +98,7 @@ pub const MAX_CUSTOM_SPECTRA: usize = 32768;
 
 impl Default for CustomShader {
     fn default() -> Self {
-        CustomShader { source: String::new(), params: [0.0; 16], spectra: Vec::new() }
+        CustomShader { source: String::new(), params: [0.0; 16], spectra: Vec::new(), constants: Vec::new() }
     }
 }
 
@@ -130,6 +137,11 @@ impl CustomShader {
         out
     }
 
+    /// [`Self::constants`] as wgpu takes them.
+    pub(crate) fn constant_pairs(&self) -> Vec<(&str, f64)> {
+        self.constants.iter().map(|(name, value)| (name.as_str(), *value)).collect()
+    }
+
     pub(crate) fn validate(&self) -> Result<()> {
         if self.spectra.len() > MAX_CUSTOM_SPECTRA {
             return Err(RenderError::CustomShader(format!(
@@ -154,7 +166,7 @@ fn default_hook(name: &str) -> &'static str {
     &DEFAULT_HOOKS[start..start + len]
 }
 
-/// Matches `CustomUniforms` in `wgsl/custom_api.wgsl`.
+/// `CustomUniforms` in `wgsl/custom_api.wgsl` (checked by `layout_tests`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CustomUniforms {
@@ -169,7 +181,8 @@ pub struct CustomPass {
 }
 
 impl CustomPass {
-    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom_source: &str) -> Result<Self> {
+    /// Builds the pipeline with `custom` (the hooks) compiled in.
+    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom: &CustomShader) -> Result<Self> {
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("custom inputs"),
             entries: &[texture_entry(0), texture_entry(1), depth_entry(2)],
@@ -181,40 +194,41 @@ impl CustomPass {
                 shader::COMMON,
                 shader::SPECTRAL,
                 shader::CUSTOM_API,
-                custom_source,
+                &custom.assembled(),
                 include_str!("custom.wgsl"),
             ],
         )?;
         let pipeline = shader::checked(device, "custom pipeline", || {
-            fullscreen_pipeline(
+            let layout = pipeline_layout(
                 device,
                 "custom",
-                &module,
-                &[Some(&shared.frame), Some(&input_layout), Some(&shared.spectral), Some(&shared.custom)],
-                HDR_FORMAT,
-            )
+                &[&shared.frame, &input_layout, &shared.spectral, &shared.custom],
+            );
+            let constants = custom.constant_pairs();
+            FullscreenPipeline {
+                constants: &constants,
+                ..FullscreenPipeline::simple("custom", &module, &layout, &[HDR_FORMAT])
+            }
+            .build(device)
         })?;
         Ok(CustomPass { input_layout, pipeline })
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        frame: &wgpu::BindGroup,
-        inputs: &wgpu::BindGroup,
-        spectral: &wgpu::BindGroup,
-        custom: &wgpu::BindGroup,
-        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        draw_fullscreen(
-            encoder,
-            "custom",
-            target,
-            &self.pipeline,
-            &[frame, inputs, spectral, custom],
-            timestamps,
-        );
+    /// Group 1: the shading pass's output, the G-buffer normals and the depth.
+    pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("custom inputs"),
+            layout: &self.input_layout,
+            entries: &[
+                view_entry(0, &t.hdr_shaded_view),
+                view_entry(1, &t.gbuffer_views[1]),
+                view_entry(2, &t.depth_view),
+            ],
+        })
+    }
+
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw) {
+        let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
+        draw_fullscreen(encoder, "custom", &[draw.target], &self.pipeline, &groups, draw.timestamps);
     }
 }

@@ -76,6 +76,66 @@ impl SharedLayouts {
         });
         SharedLayouts { frame, spectral, custom }
     }
+
+    /// Group 0 over the frame-uniform buffer.
+    pub fn frame_group(&self, device: &wgpu::Device, uniforms: &wgpu::Buffer) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame"),
+            layout: &self.frame,
+            entries: &[buffer_entry(0, uniforms)],
+        })
+    }
+
+    /// Group 2.
+    pub fn spectral_group(&self, device: &wgpu::Device, i: &SpectralInputs) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("spectral"),
+            layout: &self.spectral,
+            entries: &[
+                buffer_entry(0, i.wavelengths),
+                buffer_entry(1, i.lights),
+                buffer_entry(2, i.light_weights),
+                view_entry(3, i.table),
+                buffer_entry(4, i.table_scale),
+                buffer_entry(5, i.env_weights),
+                view_entry(6, i.env_radiance),
+                view_entry(7, i.env_irradiance),
+                view_entry(8, i.env_lut),
+                wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(i.env_sampler) },
+                buffer_entry(10, i.env_uniforms),
+            ],
+        })
+    }
+
+    /// Group 3: the custom uniforms (`CustomUniforms`) and the sampled custom spectra.
+    pub fn custom_group(
+        &self,
+        device: &wgpu::Device,
+        uniforms: &wgpu::Buffer,
+        spectra: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("custom"),
+            layout: &self.custom,
+            entries: &[buffer_entry(0, uniforms), buffer_entry(1, spectra)],
+        })
+    }
+}
+
+/// What group 2 binds (`wgsl/spectral.wgsl`, `wgsl/environment.wgsl`).
+pub struct SpectralInputs<'a> {
+    pub wavelengths: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
+    pub light_weights: &'a wgpu::Buffer,
+    /// The coefficient table (3D texture) and its scale.
+    pub table: &'a wgpu::TextureView,
+    pub table_scale: &'a wgpu::Buffer,
+    pub env_weights: &'a wgpu::Buffer,
+    pub env_radiance: &'a wgpu::TextureView,
+    pub env_irradiance: &'a wgpu::TextureView,
+    pub env_lut: &'a wgpu::TextureView,
+    pub env_sampler: &'a wgpu::Sampler,
+    pub env_uniforms: &'a wgpu::Buffer,
 }
 
 pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -105,7 +165,7 @@ pub(crate) fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// A non-filterable 2D float texture (G-buffer inputs are read with textureLoad).
-pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -144,83 +204,137 @@ pub(crate) fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// A pipeline that draws one fullscreen triangle from `module` into `format`.
-pub(crate) fn fullscreen_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layouts: &[Option<&wgpu::BindGroupLayout>],
-    format: wgpu::TextureFormat,
-) -> wgpu::RenderPipeline {
-    fullscreen_pipeline_entry(device, label, module, layouts, format, "fs_main")
+/// The bind groups the fullscreen passes of one frame share: group 0 (frame uniforms), 2
+/// (per-wavelength data) and 3 (the custom shader's parameters and spectra).
+pub struct SharedGroups<'a> {
+    pub frame: &'a wgpu::BindGroup,
+    pub spectral: &'a wgpu::BindGroup,
+    pub custom: &'a wgpu::BindGroup,
 }
 
-/// [`fullscreen_pipeline`] with the fragment entry point `entry`.
-pub(crate) fn fullscreen_pipeline_entry(
+/// Where a fullscreen pass draws, with its own inputs (group 1, built by the pass's
+/// `bind_inputs`) and optional timestamps.
+pub struct Draw<'a, 'q> {
+    pub target: &'a wgpu::TextureView,
+    pub inputs: &'a wgpu::BindGroup,
+    pub timestamps: Option<wgpu::RenderPassTimestampWrites<'q>>,
+}
+
+/// A pipeline that draws one fullscreen triangle without vertex buffers: the shading, custom,
+/// post and accumulation passes, and the viewer's blit.
+pub struct FullscreenPipeline<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    pub layout: &'a wgpu::PipelineLayout,
+    /// Vertex entry point: `vs_fullscreen` (`wgsl/common.wgsl`) unless the module has its own.
+    pub vertex: &'a str,
+    pub fragment: &'a str,
+    /// One colour target per format, written without blending.
+    pub targets: &'a [wgpu::TextureFormat],
+    /// Values of the fragment shader's pipeline-overridable constants.
+    pub constants: &'a [(&'a str, f64)],
+}
+
+impl FullscreenPipeline<'_> {
+    /// `module`'s `fs_main` into one `format` target, with the vertex shader of `common.wgsl`.
+    pub fn simple<'a>(
+        label: &'a str,
+        module: &'a wgpu::ShaderModule,
+        layout: &'a wgpu::PipelineLayout,
+        format: &'a [wgpu::TextureFormat; 1],
+    ) -> FullscreenPipeline<'a> {
+        FullscreenPipeline {
+            label,
+            module,
+            layout,
+            vertex: "vs_fullscreen",
+            fragment: "fs_main",
+            targets: format,
+            constants: &[],
+        }
+    }
+
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let targets: Vec<_> = self
+            .targets
+            .iter()
+            .map(|&format| {
+                Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+            })
+            .collect();
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(self.layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some(self.vertex),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: self.constants,
+                    ..Default::default()
+                },
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
+/// The pipeline layout of bind groups `layouts` (group i at index i).
+pub fn pipeline_layout(
     device: &wgpu::Device,
     label: &str,
-    module: &wgpu::ShaderModule,
-    layouts: &[Option<&wgpu::BindGroupLayout>],
-    format: wgpu::TextureFormat,
-    entry: &str,
-) -> wgpu::RenderPipeline {
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let layouts: Vec<_> = layouts.iter().map(|l| Some(*l)).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
-        bind_group_layouts: layouts,
+        bind_group_layouts: &layouts,
         immediate_size: 0,
-    });
-    fullscreen_pipeline_with(device, label, module, &layout, format, entry, &[])
-}
-
-/// [`fullscreen_pipeline_entry`] with a pipeline layout and values for the fragment shader's
-/// pipeline-overridable constants.
-pub(crate) fn fullscreen_pipeline_with(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    format: wgpu::TextureFormat,
-    entry: &str,
-    constants: &[(&str, f64)],
-) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
     })
 }
 
-/// Records one full-screen triangle into `target` with `groups` bound in order (group i at
-/// index i): the whole of the shading, custom and post passes' recording.
-pub(crate) fn draw_fullscreen(
+/// Records one full-screen triangle that overwrites `targets` (cleared to black first) with
+/// `groups` bound in order (group i at index i).
+pub fn draw_fullscreen(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
-    target: &wgpu::TextureView,
+    targets: &[&wgpu::TextureView],
     pipeline: &wgpu::RenderPipeline,
     groups: &[&wgpu::BindGroup],
     timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
 ) {
-    let mut pass = fullscreen_pass(encoder, label, target, timestamps);
+    let attachments: Vec<_> = targets
+        .iter()
+        .map(|&view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
     pass.set_pipeline(pipeline);
     for (index, group) in groups.iter().enumerate() {
         pass.set_bind_group(index as u32, *group, &[]);
@@ -228,27 +342,12 @@ pub(crate) fn draw_fullscreen(
     pass.draw(0..3, 0..1);
 }
 
-/// Begins a render pass that overwrites one colour target, with optional timestamps.
-pub(crate) fn fullscreen_pass<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
-    label: &str,
-    target: &wgpu::TextureView,
-    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-) -> wgpu::RenderPass<'e> {
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: None,
-        timestamp_writes: timestamps,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
+/// A bind-group entry for a texture view.
+pub(crate) fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }
+}
+
+/// A bind-group entry for a whole buffer.
+pub(crate) fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
 }

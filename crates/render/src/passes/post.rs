@@ -2,7 +2,10 @@
 //! (by the `Rgba8UnormSrgb` target's store). EXR output skips this pass's result and reads the
 //! linear HDR target instead.
 
-use super::{LDR_FORMAT, SharedLayouts, draw_fullscreen, fullscreen_pipeline, texture_entry};
+use super::{
+    Draw, FullscreenPipeline, LDR_FORMAT, SharedLayouts, draw_fullscreen, pipeline_layout, texture_entry,
+    view_entry,
+};
 use crate::error::Result;
 use crate::shader;
 
@@ -19,25 +22,28 @@ impl PostPass {
         });
         let module = shader::compile(device, "post", &[shader::COMMON, include_str!("post.wgsl")])?;
         let pipeline = shader::checked(device, "post pipeline", || {
-            fullscreen_pipeline(
-                device,
-                "post",
-                &module,
-                &[Some(&shared.frame), Some(&input_layout)],
-                LDR_FORMAT,
-            )
+            let layout = pipeline_layout(device, "post", &[&shared.frame, &input_layout]);
+            FullscreenPipeline::simple("post", &module, &layout, &[LDR_FORMAT]).build(device)
         })?;
         Ok(PostPass { input_layout, pipeline })
     }
 
-    pub fn record(
+    /// Group 1: the linear HDR image to tone-map.
+    pub fn bind_inputs(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        frame: &wgpu::BindGroup,
-        inputs: &wgpu::BindGroup,
-        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        draw_fullscreen(encoder, "post", target, &self.pipeline, &[frame, inputs], timestamps);
+        device: &wgpu::Device,
+        hdr: &wgpu::TextureView,
+        label: &str,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout: &self.input_layout,
+            entries: &[view_entry(0, hdr)],
+        })
+    }
+
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, frame: &wgpu::BindGroup, draw: Draw) {
+        let groups = [frame, draw.inputs];
+        draw_fullscreen(encoder, "post", &[draw.target], &self.pipeline, &groups, draw.timestamps);
     }
 }

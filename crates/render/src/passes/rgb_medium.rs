@@ -46,9 +46,10 @@ use scene::medium::RgbMedium;
 /// The WGSL hooks (after [`MEDIUM_COMMON`]).
 pub const HOOKS: &str = include_str!("rgb_medium.wgsl");
 
-/// Lights that get in-scattering (the first non-directional ones); must match the WGSL.
+/// Lights that get in-scattering (the first non-directional ones); `RM_SS_LIGHTS` in the WGSL
+/// (checked by `layout_tests`).
 pub const SS_LIGHTS: usize = 4;
-/// Most march steps; must match the WGSL.
+/// Most march steps; `RM_MAX_STEPS` in the WGSL (checked by `layout_tests`).
 pub const MAX_STEPS: u32 = 32;
 /// How far background rays are marched: this many optical depths of the clearest wavelength
 /// (what lies beyond contributes < e^{−6}); never more than [`MAX_MARCH`] scene units.
@@ -121,7 +122,12 @@ pub fn shader(medium: &RgbMedium, table: &CoeffTable, options: &Options) -> Resu
     params[4..7].copy_from_slice(&sigma_s);
     params[7] = if options.multiple { 1.0 } else { 0.0 };
     params[8..11].copy_from_slice(&sigma_t);
-    Ok(CustomShader { source: format!("{MEDIUM_COMMON}\n{HOOKS}"), params, spectra: spectra.to_vec() })
+    Ok(CustomShader {
+        source: format!("{MEDIUM_COMMON}\n{HOOKS}"),
+        params,
+        spectra: spectra.to_vec(),
+        ..Default::default()
+    })
 }
 
 #[cfg(test)]

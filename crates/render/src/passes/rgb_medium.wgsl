@@ -20,10 +20,10 @@
 // as the mean of the box spectrum over the node's footprint (its share of each band, `rm_box`)
 // and compute the exponentials per channel.
 
-// Must match MAX_LIGHTS in src/scene_gpu.rs.
+// MAX_LIGHTS in src/scene_gpu.rs (checked by src/layout_tests.rs).
 const RM_MAX_LIGHTS: u32 = 32u;
-// Lights with in-scattering (the first non-directional ones) and march steps: must match
-// rgb_medium.rs.
+// Lights with in-scattering (the first non-directional ones) and march steps: SS_LIGHTS and
+// MAX_STEPS in rgb_medium.rs (checked by src/layout_tests.rs).
 const RM_SS_LIGHTS: u32 = 4u;
 const RM_MAX_STEPS: u32 = 32u;
 const RM_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));

@@ -22,12 +22,15 @@
 //! the BRDF and the shadow lookup (once per light) are per pixel, not per node. RGB mode skips
 //! all of it: one pass over the lights, no per-light arrays.
 
+use super::custom::CustomShader;
+use super::shadow::ShadowPass;
 use super::{
-    HDR_FORMAT, SharedLayouts, depth_entry, draw_fullscreen, fullscreen_pipeline_with, texture_entry,
-    uniform_entry,
+    Draw, FullscreenPipeline, HDR_FORMAT, SharedGroups, SharedLayouts, buffer_entry, depth_entry,
+    draw_fullscreen, texture_entry, uniform_entry, view_entry,
 };
 use crate::error::Result;
 use crate::shader;
+use crate::targets::Targets;
 use std::collections::HashMap;
 
 pub struct ShadingPass {
@@ -43,6 +46,8 @@ pub struct ShadingPass {
     /// skipped them).
     pipelines: HashMap<Variant, (wgpu::RenderPipeline, wgpu::RenderPipeline)>,
     current: Variant,
+    /// The custom hooks' pipeline-overridable constants ([`CustomShader::constants`]).
+    hook_constants: Vec<(String, f64)>,
 }
 
 /// What a scene needs of the shading pass beyond punctual lights: each feature is a
@@ -63,8 +68,8 @@ impl Variant {
 }
 
 impl ShadingPass {
-    /// Builds the pipeline with `custom_source` (the custom hooks) compiled in.
-    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom_source: &str) -> Result<Self> {
+    /// Builds the pipeline with `custom` (the custom hooks) compiled in.
+    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom: &CustomShader) -> Result<Self> {
         Self::build(
             device,
             shared,
@@ -73,11 +78,12 @@ impl ShadingPass {
                 shader::SPECTRAL,
                 shader::ENVIRONMENT,
                 shader::CUSTOM_API,
-                custom_source,
+                &custom.assembled(),
                 include_str!("shading.wgsl"),
             ],
             "fs_rgb",
             true,
+            custom.constants.clone(),
         )
     }
 
@@ -90,6 +96,7 @@ impl ShadingPass {
             &[shader::COMMON, shader::SPECTRAL, include_str!("shading_reference.wgsl")],
             "fs_main",
             false,
+            Vec::new(),
         )
     }
 
@@ -99,6 +106,7 @@ impl ShadingPass {
         sources: &[&str],
         rgb_entry: &'static str,
         has_variants: bool,
+        hook_constants: Vec<(String, f64)>,
     ) -> Result<Self> {
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shading inputs"),
@@ -156,6 +164,7 @@ impl ShadingPass {
             has_variants,
             pipelines: HashMap::new(),
             current: Variant::ALL,
+            hook_constants,
         };
         // Built now so that a shader error shows when the pass is made, not at the first frame.
         pass.select(device, Variant::ALL)?;
@@ -170,18 +179,23 @@ impl ShadingPass {
                 ("HAS_POLYGONS", f64::from(u8::from(variant.polygons))),
                 ("HAS_ENV", f64::from(u8::from(variant.environment))),
             ];
-            let constants: &[(&str, f64)] = if self.has_variants { &constants } else { &[] };
+            let constants: Vec<(&str, f64)> = if self.has_variants { constants.to_vec() } else { Vec::new() }
+                .into_iter()
+                .chain(self.hook_constants.iter().map(|(name, value)| (name.as_str(), *value)))
+                .collect();
             let build = |label: &str, entry: &str| {
                 shader::checked(device, label, || {
-                    fullscreen_pipeline_with(
-                        device,
-                        label,
-                        &self.module,
-                        &self.pipeline_layout,
-                        HDR_FORMAT,
-                        entry,
-                        constants,
-                    )
+                    FullscreenPipeline {
+                        fragment: entry,
+                        constants: &constants,
+                        ..FullscreenPipeline::simple(
+                            label,
+                            &self.module,
+                            &self.pipeline_layout,
+                            &[HDR_FORMAT],
+                        )
+                    }
+                    .build(device)
                 })
             };
             let spectral = build("shading pipeline", "fs_main")?;
@@ -192,28 +206,40 @@ impl ShadingPass {
         Ok(())
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+    /// Group 1: the G-buffer, its depth, the shadow maps and `capture` as the spectral capture
+    /// buffer (a dummy when not capturing).
+    pub fn bind_inputs(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        frame: &wgpu::BindGroup,
-        inputs: &wgpu::BindGroup,
-        spectral: &wgpu::BindGroup,
-        custom: &wgpu::BindGroup,
-        rgb: bool,
-        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        draw_fullscreen(
-            encoder,
-            "shading",
-            target,
-            {
-                let (spectral, rgb_pipeline) = &self.pipelines[&self.current];
-                if rgb { rgb_pipeline } else { spectral }
-            },
-            &[frame, inputs, spectral, custom],
-            timestamps,
-        );
+        device: &wgpu::Device,
+        t: &Targets,
+        shadow: &ShadowPass,
+        capture: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let g = &t.gbuffer_views;
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shading inputs"),
+            layout: &self.input_layout,
+            entries: &[
+                view_entry(0, &g[0]),
+                view_entry(1, &g[1]),
+                view_entry(2, &g[2]),
+                view_entry(3, &t.depth_view),
+                view_entry(4, &shadow.view),
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(&shadow.sampler),
+                },
+                buffer_entry(6, &shadow.uniforms),
+                buffer_entry(7, capture),
+            ],
+        })
+    }
+
+    /// Records the pass with the RGB-mode entry point when `rgb`.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw, rgb: bool) {
+        let (spectral, rgb_pipeline) = &self.pipelines[&self.current];
+        let pipeline = if rgb { rgb_pipeline } else { spectral };
+        let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
+        draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
     }
 }

@@ -11,9 +11,9 @@
 @group(1) @binding(4) var shadow_maps: texture_depth_2d_array;
 @group(1) @binding(5) var shadow_sampler: sampler_comparison;
 
-// Must match MAX_LIGHTS in src/scene_gpu.rs.
+// MAX_LIGHTS, MAX_SHADOWS and NO_SHADOW are the Rust constants of src/scene_gpu.rs and
+// src/passes/shadow.rs; src/layout_tests.rs checks them and the structs below.
 const MAX_LIGHTS: u32 = 32u;
-// Must match MAX_SHADOWS in src/passes/shadow.rs.
 const MAX_SHADOWS: u32 = 8u;
 // Value of `layer_of_light` for a light without a shadow map.
 const NO_SHADOW: u32 = 0xffffffffu;
@@ -27,7 +27,7 @@ fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
 }
 
-// Layout must match `ShadowUniforms` in src/passes/shadow.rs.
+// Byte for byte `ShadowUniforms` in src/passes/shadow.rs.
 struct ShadowUniforms {
     view_proj: array<mat4x4<f32>, MAX_SHADOWS>,
     // x: normal-offset bias in world units.

@@ -50,9 +50,10 @@ pub const HOOKS: &str = include_str!("underwater.wgsl");
 /// dominant wavelengths of the sRGB primaries under D65.
 pub const RGB_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 
-/// Lights that get single scattering (the first ones in the scene); must match the WGSL.
+/// Lights that get single scattering (the first ones in the scene); `UW_SS_LIGHTS` in the
+/// WGSL, checked by `layout_tests`.
 pub const SS_LIGHTS: usize = 4;
-/// Most march steps; must match the WGSL.
+/// Most march steps; `UW_MAX_STEPS` in the WGSL, checked by `layout_tests`.
 pub const MAX_STEPS: u32 = 32;
 
 /// Choices of the real-time model beyond the water itself.
@@ -184,30 +185,69 @@ impl Options {
 
 pub use scene::water::PETZOLD_G;
 
-/// The custom-shader parameters for `medium`: `[z0, scale, steps, g]`, then c, Kd and b at
-/// [`RGB_WAVELENGTHS`] (and the smallest c over 360–830 nm). Use with
-/// `Renderer::set_custom_params` to move the camera's depth without recompiling.
+/// The hooks' parameters, byte for byte `UwParams` in `underwater.wgsl` (the reflection test
+/// `layout_tests` checks the offsets); the renderer hands them over as the custom shader's
+/// sixteen floats.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct WaterParams {
+    /// Camera depth z0 (m).
+    pub depth: f32,
+    /// Metres per scene unit.
+    pub scale: f32,
+    /// March steps M (0 = the paper's model alone), as a float.
+    pub steps: f32,
+    /// Henyey–Greenstein g.
+    pub phase_g: f32,
+    /// c at [`RGB_WAVELENGTHS`].
+    pub c_rgb: [f32; 3],
+    /// The smallest c over 360–830 nm.
+    pub c_min: f32,
+    /// Kd at [`RGB_WAVELENGTHS`].
+    pub kd_rgb: [f32; 3],
+    /// 1 = scalar irradiance by Gershun's law ([`Options::scalar_irradiance`]).
+    pub gershun: f32,
+    /// b at [`RGB_WAVELENGTHS`].
+    pub b_rgb: [f32; 3],
+    /// 1 = take the beams out of L_ms ([`Options::split_beams`]).
+    pub split_beams: f32,
+}
+
+impl WaterParams {
+    /// The parameters of `medium` with `options`.
+    pub fn new(medium: &WaterMedium, options: &Options) -> Self {
+        let at = |f: fn(&scene::water::WaterCoefficients) -> f64| {
+            RGB_WAVELENGTHS.map(|l| f(&medium.coefficients(l)) as f32)
+        };
+        WaterParams {
+            depth: medium.depth as f32,
+            scale: medium.scale as f32,
+            steps: options.steps.min(MAX_STEPS) as f32,
+            phase_g: options.phase_g,
+            c_rgb: at(|k| k.c),
+            c_min: (360..=830).map(|l| medium.coefficients(l as f64).c).fold(f64::INFINITY, f64::min) as f32,
+            kd_rgb: at(|k| k.kd),
+            gershun: if options.scalar_irradiance { 1.0 } else { 0.0 },
+            b_rgb: at(|k| k.b),
+            split_beams: if options.split_beams { 1.0 } else { 0.0 },
+        }
+    }
+
+    /// As the custom shader's parameters.
+    pub fn to_array(self) -> [f32; 16] {
+        bytemuck::cast(self)
+    }
+}
+
+/// The custom-shader parameters for `medium` ([`WaterParams`] with the default [`Options`]).
+/// Use with `Renderer::set_custom_params` to move the camera's depth without recompiling.
 pub fn params(medium: &WaterMedium) -> [f32; 16] {
     params_with(medium, &Options::default())
 }
 
 /// [`params`] with explicit [`Options`].
 pub fn params_with(medium: &WaterMedium, options: &Options) -> [f32; 16] {
-    let mut p = [0.0f32; 16];
-    p[0] = medium.depth as f32;
-    p[1] = medium.scale as f32;
-    p[2] = options.steps.min(MAX_STEPS) as f32;
-    p[3] = options.phase_g;
-    for (ch, &l) in RGB_WAVELENGTHS.iter().enumerate() {
-        let k = medium.coefficients(l);
-        p[4 + ch] = k.c as f32;
-        p[8 + ch] = k.kd as f32;
-        p[12 + ch] = k.b as f32;
-    }
-    p[11] = if options.scalar_irradiance { 1.0 } else { 0.0 };
-    p[15] = if options.split_beams { 1.0 } else { 0.0 };
-    p[7] = (360..=830).map(|l| medium.coefficients(l as f64).c).fold(f64::INFINITY, f64::min) as f32;
-    p
+    WaterParams::new(medium, options).to_array()
 }
 
 /// The spectra the hooks read: b, c, Kd.
@@ -363,30 +403,26 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
     use scene::water::{WATER_IOR, fresnel::mean_transmittance};
     options.validate().map_err(WaterError::BadQuery)?;
     let tables = if options.light_field { Some(light_field_tables(medium, options)?) } else { None };
-    let mut source = format!("{}\n{HOOKS}", super::custom::MEDIUM_COMMON);
-    let mut set = |line: &str, value: String| {
-        let (name, _) = line.split_once('=').expect("a const line");
-        assert!(source.contains(line), "underwater.wgsl lost `{line}`");
-        source = source.replacen(line, &format!("{name}= {value};"), 1);
-    };
-    set("const UW_MARCH: bool = true;", (options.steps > 0).to_string());
-    set("const UW_SURFACE: bool = true;", options.surface.to_string());
-    set("const UW_N: f32 = 1.34;", format!("{WATER_IOR:?}"));
-    set(
-        "const UW_SKY_NORM: f32 = 0.34;",
-        format!("{:?}", (1.0 / (std::f64::consts::PI * mean_transmittance(WATER_IOR))) as f32),
-    );
-    set("const UW_TABLE: bool = true;", options.light_field.to_string());
+    let source = format!("{}\n{HOOKS}", super::custom::MEDIUM_COMMON);
+    // Values of the hooks' pipeline-overridable constants (`override UW_…` in underwater.wgsl).
+    let mut constants: Vec<(String, f64)> = Vec::new();
+    let mut set = |name: &str, value: f64| constants.push((name.to_string(), value));
+    let flag = |on: bool| f64::from(u8::from(on));
+    set("UW_MARCH", flag(options.steps > 0));
+    set("UW_SURFACE", flag(options.surface));
+    set("UW_N", WATER_IOR);
+    set("UW_SKY_NORM", f64::from((1.0 / (std::f64::consts::PI * mean_transmittance(WATER_IOR))) as f32));
+    set("UW_TABLE", flag(options.light_field));
     {
         use scene::water::light_field::{ELEV_WARP, N_AZ, N_DEPTH, N_ELEV, N_NORMAL_AZ, N_NORMAL_ELEV};
-        set("const UW_ND: u32 = 16u;", format!("{N_DEPTH}u"));
-        set("const UW_NNE: u32 = 9u;", format!("{N_NORMAL_ELEV}u"));
-        set("const UW_NNA: u32 = 5u;", format!("{N_NORMAL_AZ}u"));
-        set("const UW_NE: u32 = 19u;", format!("{N_ELEV}u"));
-        set("const UW_NA: u32 = 9u;", format!("{N_AZ}u"));
-        set("const UW_ELEV_INV_WARP: f32 = 0.6666667;", format!("{:?}", (1.0 / ELEV_WARP) as f32));
+        set("UW_ND", N_DEPTH as f64);
+        set("UW_NNE", N_NORMAL_ELEV as f64);
+        set("UW_NNA", N_NORMAL_AZ as f64);
+        set("UW_NE", N_ELEV as f64);
+        set("UW_NA", N_AZ as f64);
+        set("UW_ELEV_INV_WARP", f64::from((1.0 / ELEV_WARP) as f32));
     }
-    set("const UW_TABLE_KD: bool = true;", (options.light_field && !options.tabulated_kd).to_string());
+    set("UW_TABLE_KD", flag(options.light_field && !options.tabulated_kd));
     {
         // The forward-scattered fraction along view rays (light-field model only).
         let f = if options.light_field {
@@ -395,25 +431,23 @@ pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShad
         } else {
             0.0
         };
-        set("const UW_FWD: f32 = 0.0;", format!("{:?}", f as f32));
+        set("UW_FWD", f64::from(f as f32));
     }
-    set(
-        "const UW_IRRADIANCE: bool = true;",
-        (options.light_field && options.irradiance && !options.tabulated_kd).to_string(),
-    );
+    set("UW_IRRADIANCE", flag(options.light_field && options.irradiance && !options.tabulated_kd));
     let mut spectra = spectra(medium);
     if let Some([t, deep]) = &tables {
-        set("const UW_ZMAX: f32 = 40.0;", format!("{:?}", t.z_max as f32));
+        set("UW_ZMAX", f64::from(t.z_max as f32));
         // Where the mirrored view may show the floor: its mesh's extent (scene units).
         let b = medium.floor.as_ref().and_then(|f| f.extent).unwrap_or([-1e30, -1e30, 1e30, 1e30]);
-        set(
-            "const UW_FLOOR_BOX: vec4<f32> = vec4<f32>(-1e30, -1e30, 1e30, 1e30);",
-            format!("vec4<f32>({:?}, {:?}, {:?}, {:?})", b[0], b[1], b[2], b[3]),
-        );
+        for (name, v) in
+            ["UW_FLOOR_MIN_X", "UW_FLOOR_MIN_Z", "UW_FLOOR_MAX_X", "UW_FLOOR_MAX_Z"].iter().zip(b)
+        {
+            set(name, f64::from(v));
+        }
         spectra.push(color::Spectrum::Constant(0.0));
         spectra.extend(table_spectra([t, deep]));
     }
-    Ok(CustomShader { source, params: params_with(medium, options), spectra })
+    Ok(CustomShader { source, params: params_with(medium, options), spectra, constants })
 }
 
 #[cfg(test)]
@@ -435,13 +469,9 @@ mod tests {
         assert!(p[4] > p[6] && p[8] > 3.0 * p[10], "{p:?}");
         let s = shader_with(&m, &Options::paper()).unwrap();
         assert_eq!(s.params[2], 0.0);
-        assert!(
-            s.source.contains("const UW_MARCH: bool = false;"),
-            "the paper's model compiles without the march"
-        );
-        assert!(
-            shader_with(&m, &Options::isotropic()).unwrap().source.contains("const UW_MARCH: bool = true;")
-        );
+        let march = |s: &CustomShader| s.constants.iter().find(|(n, _)| n == "UW_MARCH").map(|c| c.1);
+        assert_eq!(march(&s), Some(0.0), "the paper's model compiles without the march");
+        assert_eq!(march(&shader_with(&m, &Options::isotropic()).unwrap()), Some(1.0));
         assert_eq!(s.spectra.len(), 3);
         assert_eq!(s.spectra[2].eval(500.0), m.coefficients(500.0).kd);
     }

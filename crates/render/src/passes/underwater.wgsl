@@ -2,11 +2,7 @@
 // `underwater::shader`. See src/passes/underwater.rs for the model, the parameter layout and the
 // assumptions; the CPU reference of every formula is `scene::water` (`single` for the march).
 //
-// custom.params[0] = (camera depth z0 m, metres per scene unit, march steps M (0 = the paper's
-//                     model alone), Henyey–Greenstein g)
-// custom.params[1] = (c at the RGB mode's three wavelengths, smallest c over the range)
-// custom.params[2] = (Kd at the RGB mode's three wavelengths, 1 = scalar irradiance by Gershun's law)
-// custom.params[3] = (b at the RGB mode's three wavelengths, 1 = take the beams out of L_ms)
+// custom.params = `UwParams` below (`underwater::WaterParams`)
 // custom_spectra[g * 4 + 0..3] = b, c, Kd at the group's wavelengths
 //
 // Water coefficients are vec4: four node wavelengths in spectral/naive modes, (R, G, B, unused)
@@ -17,63 +13,96 @@
 
 // The phase function, the path integral and the equiangular steps: medium_common.wgsl.
 const UW_INV_4PI: f32 = MEDIUM_INV_4PI;
-// Must match MAX_LIGHTS in src/scene_gpu.rs.
+// MAX_LIGHTS in src/scene_gpu.rs (src/layout_tests.rs checks it).
 const UW_MAX_LIGHTS: u32 = 32u;
-// Whether the shader marches at all: `underwater::shader_with` writes `false` here when the
-// steps are 0, so the paper's model compiles without the march (its code and private arrays
-// cost about 2× the hook on a CPU driver even when skipped at run time).
-const UW_MARCH: bool = true;
+// Pipeline-overridable constants, set by `underwater::shader_with` (`CustomShader::constants`).
+// Whether the shader marches at all: `false` when the steps are 0, so that the paper's model
+// runs without the march (its code and private arrays cost about 2× the hook on a CPU driver
+// even when skipped at run time; the override is a constant by the time the driver compiles).
+override UW_MARCH: bool = true;
 // Whether upward rays that reach the surface see it (Snell's window, Fresnel reflection, total
 // internal reflection); `false` for the paper's model. The refractive index and the sky's
-// normalisation 1/(π·T̄) are written by `underwater::shader_with` (scene::water::fresnel).
-const UW_SURFACE: bool = true;
-const UW_N: f32 = 1.34;
-const UW_SKY_NORM: f32 = 0.34;
+// normalisation 1/(π·T̄) come from scene::water (WATER_IOR, fresnel).
+override UW_SURFACE: bool = true;
+override UW_N: f32;
+override UW_SKY_NORM: f32;
 // The light-field model (`underwater::Options::light_field`, scene::water::light_field): the
 // in-scattering source J(z, view, λ) of the water's own diffuse light field replaces the
 // paper's isotropic term, and surfaces are attenuated by the field's downwelling irradiance
-// E_d(z) (UW_TABLE_KD) instead of the tabulated Kd. `underwater::shader_with` writes these and
-// the table's depth range; the table's layout must match scene::water::light_field.
-const UW_TABLE: bool = true;
-const UW_TABLE_KD: bool = true;
+// E_d(z) (UW_TABLE_KD) instead of the tabulated Kd. `underwater::shader_with` sets these and
+// the table's depth range; the table's layout is scene::water::light_field's.
+override UW_TABLE: bool = true;
+override UW_TABLE_KD: bool = true;
 // Surfaces lit by the sun's unscattered beam (e^{−c·z/μ}, shadowed) plus the column's diffuse
 // irradiance for their normal (light_field::LightFieldTable::irradiance), the sky stand-ins
 // left out (their light is in the table): `Options::irradiance`.
-const UW_IRRADIANCE: bool = true;
+override UW_IRRADIANCE: bool = true;
 // Fraction f of the scattering within the light-field model's forward cone
 // (light_field::LightFieldKey::forward_cone; 0 for the other models): view rays are attenuated
 // by c − f·b, and the table's J leaves that scattering out.
-const UW_FWD: f32 = 0.0;
-const UW_ZMAX: f32 = 40.0;
-// The table's layout, written by `underwater::shader_with` from scene::water::light_field
-// (N_DEPTH, N_ELEV, N_AZ, 1/ELEV_WARP): one home for the numbers.
-const UW_ND: u32 = 16u;
-const UW_NE: u32 = 19u;
-const UW_NA: u32 = 9u;
-const UW_ELEV_INV_WARP: f32 = 0.6666667;
-const UW_NNE: u32 = 9u;
-const UW_NNA: u32 = 5u;
-const UW_NC: u32 = UW_ND * UW_NE * UW_NA;
+override UW_FWD: f32 = 0.0;
+override UW_ZMAX: f32 = 40.0;
+// The table's layout, set by `underwater::shader_with` from scene::water::light_field
+// (N_DEPTH, N_ELEV, N_AZ, 1/ELEV_WARP, N_NORMAL_ELEV, N_NORMAL_AZ): one home for the numbers.
+override UW_ND: u32;
+override UW_NE: u32;
+override UW_NA: u32;
+override UW_ELEV_INV_WARP: f32;
+override UW_NNE: u32;
+override UW_NNA: u32;
+override UW_NC: u32 = UW_ND * UW_NE * UW_NA;
 // Spectrum indices (custom_spectra[s * n_groups + group]): two tables of one block each — 0
 // the column closed by the sea floor, 1 the bottomless column (the same table twice when the
 // scene has no floor) — each J per cell, E_d per depth node, the surface's reflection of the
 // water and of the floor per view node, the irradiance per depth and normal node; then the RGB
 // mode's copies, three constants each.
-const UW_NV: u32 = UW_NE * UW_NA;
-const UW_L_J: u32 = 0u;
-const UW_L_ED: u32 = UW_NC;
-const UW_L_SURF: u32 = UW_NC + UW_ND;
-const UW_L_SURF_FLOOR: u32 = UW_NC + UW_ND + UW_NV;
-const UW_L_IRR: u32 = UW_NC + UW_ND + 2u * UW_NV;
-const UW_BLOCK: u32 = UW_L_IRR + UW_ND * UW_NNE * UW_NNA;
-const UW_T_RGB: u32 = 4u + 2u * UW_BLOCK;
-// The sea floor's horizontal extent (scene units: min x, min z, max x, max z; written by
+override UW_NV: u32 = UW_NE * UW_NA;
+override UW_L_J: u32 = 0u;
+override UW_L_ED: u32 = UW_NC;
+override UW_L_SURF: u32 = UW_NC + UW_ND;
+override UW_L_SURF_FLOOR: u32 = UW_NC + UW_ND + UW_NV;
+override UW_L_IRR: u32 = UW_NC + UW_ND + 2u * UW_NV;
+override UW_BLOCK: u32 = UW_L_IRR + UW_ND * UW_NNE * UW_NNA;
+override UW_T_RGB: u32 = 4u + 2u * UW_BLOCK;
+// The sea floor's horizontal extent (scene units: min x, min z, max x, max z; set by
 // `underwater::shader_with`); the surface mirrors the floor only where the mirrored view lands
 // inside it.
-const UW_FLOOR_BOX: vec4<f32> = vec4<f32>(-1e30, -1e30, 1e30, 1e30);
-// Lights with single scattering, and march steps: must match underwater.rs.
+override UW_FLOOR_MIN_X: f32 = -1e30;
+override UW_FLOOR_MIN_Z: f32 = -1e30;
+override UW_FLOOR_MAX_X: f32 = 1e30;
+override UW_FLOOR_MAX_Z: f32 = 1e30;
+fn uw_floor_box() -> vec4<f32> {
+    return vec4<f32>(UW_FLOOR_MIN_X, UW_FLOOR_MIN_Z, UW_FLOOR_MAX_X, UW_FLOOR_MAX_Z);
+}
+// Lights with single scattering, and march steps: SS_LIGHTS and MAX_STEPS in underwater.rs
+// (src/layout_tests.rs checks them; they size private arrays, so they cannot be overrides).
 const UW_SS_LIGHTS: u32 = 4u;
 const UW_MAX_STEPS: u32 = 32u;
+// The hooks' parameters: byte for byte `underwater::WaterParams` (src/layout_tests.rs checks the
+// layout), read from the custom shader's sixteen floats in field order.
+struct UwParams {
+    // Camera depth z0 (m), metres per scene unit, march steps M (0 = the paper's model alone),
+    // Henyey–Greenstein g.
+    depth: f32,
+    scale: f32,
+    steps: f32,
+    g: f32,
+    // c at the RGB mode's three wavelengths, smallest c over the range.
+    c_rgb: vec3<f32>,
+    c_min: f32,
+    // Kd at the RGB mode's three wavelengths, 1 = scalar irradiance by Gershun's law.
+    kd_rgb: vec3<f32>,
+    gershun: f32,
+    // b at the RGB mode's three wavelengths, 1 = take the beams out of L_ms.
+    b_rgb: vec3<f32>,
+    split_beams: f32,
+}
+
+fn uw_params() -> UwParams {
+    let p = custom.params;
+    return UwParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].xyz, p[1].w, p[2].xyz, p[2].w, p[3].xyz, p[3].w);
+}
+
 // A downward or level ray has no end: directional lights are marched (for shadows) over the
 // first UW_CAP optical depths of the clearest wavelength, the rest is integrated unshadowed;
 // point and spot lights are marched over at most that length.
@@ -153,22 +182,22 @@ var<private> uw_sun_mu: f32 = 1.0;
 // Distance (m) along the view from the camera at which it leaves the floor's extent or reaches
 // the table's deepest node (the floor), 0 if the camera is not over the floor, ≥ 1e30 if never.
 fn uw_floor_exit(w: vec3<f32>, z0: f32) -> f32 {
-    let scale = custom.params[0].y;
+    let scale = uw_params().scale;
     if (!uw_over_floor(uw_org)) { return 0.0; }
     var te = 1e30;
     if (w.y < -1e-6) { te = (UW_ZMAX - z0) / (-w.y); }
     let o = uw_org.xz;
     let d = w.xz;
     for (var a = 0u; a < 2u; a++) {
-        if (d[a] > 1e-9) { te = min(te, (UW_FLOOR_BOX[a + 2u] - o[a]) / d[a] * scale); }
-        if (d[a] < -1e-9) { te = min(te, (UW_FLOOR_BOX[a] - o[a]) / d[a] * scale); }
+        if (d[a] > 1e-9) { te = min(te, (uw_floor_box()[a + 2u] - o[a]) / d[a] * scale); }
+        if (d[a] < -1e-9) { te = min(te, (uw_floor_box()[a] - o[a]) / d[a] * scale); }
     }
     return max(te, 0.0);
 }
 
 // Whether a scene point (scene units) lies over the sea floor's extent.
 fn uw_over_floor(p: vec3<f32>) -> bool {
-    return all(p.xz >= UW_FLOOR_BOX.xy) && all(p.xz <= UW_FLOOR_BOX.zw);
+    return all(p.xz >= uw_floor_box().xy) && all(p.xz <= uw_floor_box().zw);
 }
 
 // Table `table`'s entry `local` at the group's wavelengths (rgb: at the RGB wavelengths).
@@ -242,7 +271,7 @@ fn uw_add_piece(t0: f32, t1: f32, infinite: bool, z0: f32, wy: f32) {
     uw_pz[uw_np] = max(z0 - t0 * wy, 0.0) - uw_depth_node(i);
     // An endless piece runs below the floor's depth, where only the bottomless column makes
     // sense (a view that misses the floor's mesh inside its extent).
-    uw_pd[uw_np] = select(1u, 0u, !infinite && uw_over_floor(uw_org + uw_view * (tm / custom.params[0].y)));
+    uw_pd[uw_np] = select(1u, 0u, !infinite && uw_over_floor(uw_org + uw_view * (tm / uw_params().scale)));
     uw_np++;
 }
 
@@ -425,7 +454,7 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
 // camera (× e^{−c·d}), in weighted form.
 fn uw_surface_irradiance(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
     uw_prepare(ctx);
-    let z0 = custom.params[0].x;
+    let z0 = uw_params().depth;
     let zs = max(z0 - uw_d * ctx.view_dir.y, 0.0);
     let hit = ctx.origin + ctx.view_dir * ctx.distance;
     let cv = c - UW_FWD * b;
@@ -451,8 +480,8 @@ fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3
 
 fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
     if (!UW_IRRADIANCE) { return vec3<f32>(0.0); }
-    let b = vec4<f32>(custom.params[3].xyz, 1.0);
-    return uw_surface_irradiance(b, vec4<f32>(custom.params[1].xyz, 1.0), 0u, true, ctx)[0].rgb;
+    let b = vec4<f32>(uw_params().b_rgb, 1.0);
+    return uw_surface_irradiance(b, vec4<f32>(uw_params().c_rgb, 1.0), 0u, true, ctx)[0].rgb;
 }
 
 // E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
@@ -469,9 +498,9 @@ fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> 
 fn uw_prepare(ctx: SurfaceContext) {
     if (uw_ready) { return; }
     uw_ready = true;
-    let z0 = custom.params[0].x;
-    let scale = custom.params[0].y;
-    let g = custom.params[0].w;
+    let z0 = uw_params().depth;
+    let scale = uw_params().scale;
+    let g = uw_params().g;
     let w = ctx.view_dir;
     uw_infinite = ctx.background && w.y <= 0.0;
     if (ctx.background) {
@@ -485,7 +514,7 @@ fn uw_prepare(ctx: SurfaceContext) {
         uw_view = w;
         uw_prepare_table(w, z0);
     }
-    let m = min(u32(custom.params[0].z), UW_MAX_STEPS);
+    let m = min(u32(uw_params().steps), UW_MAX_STEPS);
     uw_steps = m;
     if (!UW_MARCH || m == 0u) { return; }
     let fm = f32(m);
@@ -500,7 +529,7 @@ fn uw_prepare(ctx: SurfaceContext) {
             let mu = -l.y;
             if (mu <= 0.0 || lights[li].cone.z > 0.5) { continue; }
             let q = 1.0 - w.y / mu;
-            let dm = select(uw_d, UW_CAP / custom.params[1].w, uw_infinite);
+            let dm = select(uw_d, UW_CAP / uw_params().c_min, uw_infinite);
             let dt = dm / fm;
             let p = medium_hg(g, dot(-l.xyz, w));
             var lit = true;
@@ -518,7 +547,7 @@ fn uw_prepare(ctx: SurfaceContext) {
             // Equiangular steps (medium_common.wgsl).
             // The march ends after UW_CAP optical depths of the clearest wavelength; what
             // lies beyond is lost (< e^{−6} of the light's scattering there).
-            let cap = UW_CAP / custom.params[1].w;
+            let cap = UW_CAP / uw_params().c_min;
             let dm = select(min(uw_d, cap), cap, uw_infinite);
             let eq = medium_equiangular(l.xyz - cam, w, dm / scale, m);
             for (var k = 0u; k < m; k++) {
@@ -579,9 +608,9 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb:
 }
 
 // Isotropic in-scattering of the downwelling field E0·e^{−Kd·z} (the paper's L_ms, whose
-// source is the plane irradiance). With `custom.params[2].w` = 1 the source is the scalar
+// source is the plane irradiance). With `uw_params().gershun` = 1 the source is the scalar
 // irradiance instead, from Gershun's law a·E_o = Kd·E_net: E_o = (Kd/a)·E0·e^{−Kd·z}
-// (upwelling light neglected, Kd/a ≥ 1). With `custom.params[3].w` = 1 (and single
+// (upwelling light neglected, Kd/a ≥ 1). With `uw_params().split_beams` = 1 (and single
 // scattering on) the unscattered sun beams inside the field (scalar irradiance
 // E_j·e^{−c·z/μ_j}, plane E_j·μ_j·e^{−c·z/μ_j}) are taken out, since `uw_single_scatter`
 // counts them with the real phase function; by default single scattering is added on top,
@@ -589,8 +618,8 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb:
 // and are never taken out.
 // For a ray with vertical component `wy` from depth `z0` over `d` metres (or forever).
 fn uw_in_scatter(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, wy: f32, z0: f32, d: f32, infinite: bool) -> mat3x4<f32> {
-    let gershun = custom.params[2].w > 0.5;
-    let split = uw_steps > 0u && custom.params[3].w > 0.5;
+    let gershun = uw_params().gershun > 0.5;
+    let split = uw_steps > 0u && uw_params().split_beams > 0.5;
     // k = c + Kd·cosθ with cosθ = −ω_y: the field's decay along the ray, the same for every
     // light; Gershun's factor likewise.
     var field = b * UW_INV_4PI * exp(-kd * z0) * uw_integral_to(c - kd * wy, d, infinite);
@@ -655,7 +684,7 @@ fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, 
 fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
     uw_prepare(ctx);
     let wy = ctx.view_dir.y;
-    let z0 = custom.params[0].x;
+    let z0 = uw_params().depth;
     // Along the view: c minus the forward cone's scattering (light-field model; = c otherwise).
     let cv = c - UW_FWD * b;
     var l: mat3x4<f32>;
@@ -670,9 +699,9 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     if (UW_SURFACE && ctx.background && wy > 0.0) {
         // Where the mirrored view meets the floor's plane (the table ends at the floor, UW_ZMAX
         // m deep): up z0/ω_y metres to the surface, down UW_ZMAX/ω_y to the floor.
-        let hw = vec2<f32>(ctx.view_dir.x, ctx.view_dir.z) * ((z0 + UW_ZMAX) / (wy * custom.params[0].y));
+        let hw = vec2<f32>(ctx.view_dir.x, ctx.view_dir.z) * ((z0 + UW_ZMAX) / (wy * uw_params().scale));
         let p = vec2<f32>(ctx.origin.x, ctx.origin.z) + hw;
-        let on_floor = all(p >= UW_FLOOR_BOX.xy) && all(p <= UW_FLOOR_BOX.zw);
+        let on_floor = all(p >= uw_floor_box().xy) && all(p <= uw_floor_box().zw);
         l += s3_scale(uw_surface_from_below(b, c, kd, group, rgb, wy, on_floor), exp(-cv * uw_d));
     }
     if (!ctx.background) {
@@ -700,9 +729,9 @@ fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: Su
 
 fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> {
     // The unused fourth lane gets harmless positive coefficients.
-    let c = vec4<f32>(custom.params[1].xyz, 1.0);
-    let kd = vec4<f32>(custom.params[2].xyz, 1.0);
-    let b = vec4<f32>(custom.params[3].xyz, 1.0);
+    let c = vec4<f32>(uw_params().c_rgb, 1.0);
+    let kd = vec4<f32>(uw_params().kd_rgb, 1.0);
+    let b = vec4<f32>(uw_params().b_rgb, 1.0);
     let r = mat3x4<f32>(vec4<f32>(radiance, 0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     return uw_shade(r, b, c, kd, 0u, true, ctx)[0].rgb;
 }

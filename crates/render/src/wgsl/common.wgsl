@@ -1,5 +1,5 @@
 // Shared declarations, prepended to every pass's WGSL (naga has no #include).
-// Layout must match `FrameUniforms` in src/uniforms.rs byte for byte.
+// `FrameUniforms` is byte for byte `uniforms::FrameUniforms` (src/layout_tests.rs checks it).
 
 struct FrameUniforms {
     view_proj: mat4x4<f32>,

@@ -1,7 +1,7 @@
 // The environment light (src/environment.rs, src/env_gpu.rs): K = 4 coefficient maps whose
 // coefficients multiply the basis spectra's node weights. Bind group 2, after the spectral data.
 
-// Layout must match `EnvUniforms` in src/env_gpu.rs.
+// `EnvUniforms` is byte for byte `env_gpu::EnvUniforms` (src/layout_tests.rs checks it).
 struct EnvUniforms {
     // XYZ of each basis spectrum seen by a reflectance of one (spectral and naive modes).
     totals: array<vec4<f32>, 4>,
