@@ -158,6 +158,7 @@ fn shared_constants_match_the_rust_constants() {
     assert_eq!(const_u32(&water, "UW_MAX_LIGHTS") as usize, MAX_LIGHTS);
     assert_eq!(const_u32(&water, "UW_SS_LIGHTS") as usize, underwater::SS_LIGHTS);
     assert_eq!(const_u32(&water, "UW_MAX_STEPS"), underwater::MAX_STEPS);
+    assert_eq!(const_u32(&water, "UW_MAX_PIECES") as usize, scene::water::light_field::N_DEPTH + 2);
 
     let hooks = format!("{MEDIUM_COMMON}\n{}", rgb_medium::HOOKS);
     let medium = shading_module(&CustomShader::new(hooks));

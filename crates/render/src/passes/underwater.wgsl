@@ -160,8 +160,8 @@ const UW_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f3
 // start t0 (m), length (m, < 0 for a piece that runs forever) and depth offset z(t0) − z_i.
 var<private> uw_cell: array<u32, 4>;
 // At most one piece per depth node the ray crosses, one where it leaves the floored column and
-// the last one.
-const UW_MAX_PIECES: u32 = UW_ND + 2u;
+// the last one: N_DEPTH + 2 (a constant, as private arrays need one; layout_tests checks it).
+const UW_MAX_PIECES: u32 = 18u;
 var<private> uw_cw: vec4<f32>;
 var<private> uw_np: u32 = 0u;
 var<private> uw_pn: array<u32, UW_MAX_PIECES>;
