@@ -93,6 +93,27 @@ mod tests {
         assert!(s.timestamps, "the viewer always asks for GPU timings");
     }
 
+    /// `--mode`/`--tonemap` take the library's names and aliases in any case (clap
+    /// `ValueEnum`s over `Mode::ALL`/`Tonemap::ALL`); `--white` reaches the settings, else the
+    /// scene's white does.
+    #[test]
+    fn enum_spellings_and_the_white() {
+        let s = parse(&["cornell", "--mode", "JH", "--tonemap", "Clamp", "--white", "D50"]).unwrap();
+        assert_eq!((s.mode, s.tonemap, s.white.as_str()), (Mode::Spectral, Tonemap::None, "D50"));
+        let s = parse(&["cornell", "--mode", "box"]).unwrap();
+        assert_eq!((s.mode, s.white.as_str()), (Mode::Naive, scene::DEFAULT_WHITE));
+        for m in Mode::ALL {
+            assert_eq!(parse(&["cornell", "--mode", m.name()]).unwrap().mode, m);
+        }
+        for t in Tonemap::ALL {
+            assert_eq!(parse(&["cornell", "--tonemap", t.name()]).unwrap().tonemap, t);
+        }
+        let e = format!("{:#}", parse(&["cornell", "--mode", "hsv"]).unwrap_err());
+        assert!(e.contains("hsv") && e.contains("rgb, naive, spectral"), "{e}");
+        let e = format!("{:#}", parse(&["cornell", "--white", "1K"]).unwrap_err());
+        assert!(e.contains("--white '1K'") && e.contains("500–1000000 K"), "{e}");
+    }
+
     #[test]
     fn bad_arguments_are_named() {
         let e = |argv: &[&str]| format!("{:#}", parse(argv).unwrap_err());
