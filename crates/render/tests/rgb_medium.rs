@@ -11,9 +11,10 @@ mod common;
 
 use color::upsample::medium::Attenuation;
 use color::{Quadrature, Spectrum, WavelengthRange};
+use common::{rel_err, render_custom as render};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::rgb_medium;
-use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
+use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
 use scene::medium::RgbMedium;
 use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 
@@ -86,22 +87,6 @@ fn in_scatter(w: DVec3, len: f64, light: DVec3, g: f64, sigma_t: f64, m: u32) ->
             hg(g, wi.dot(w)) * (-sigma_t * (t + r)).exp() * dth / h
         })
         .sum()
-}
-
-fn render(r: &mut Renderer, scene: &Scene, settings: &RenderSettings, custom: CustomShader) -> Vec<[f32; 4]> {
-    r.set_custom_shader(custom).unwrap();
-    r.render(&scene.camera, settings).unwrap();
-    r.read_hdr().unwrap()
-}
-
-/// One step of the HDR target's f16 below its smallest normal value.
-const F16_SUBNORMAL_STEP: f64 = 5.960464477539063e-8;
-
-/// Error relative to the largest channel, after one f16 subnormal step of quantisation.
-fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
-    let scale = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = (0..3).fold(0.0f64, |m, c| m.max((gpu[c] - cpu[c]).abs()));
-    (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }
 
 fn medium(absorption: [f64; 3], scattering: [f64; 3], method: Attenuation) -> RgbMedium {

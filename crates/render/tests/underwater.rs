@@ -8,9 +8,10 @@ mod common;
 
 use color::water::WaterType;
 use color::{Quadrature, WavelengthRange};
+use common::{rel_err, render_custom as render};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
-use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
+use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
 use scene::water::{WATER_IOR, WaterMedium};
 use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 
@@ -88,24 +89,6 @@ fn one_wavelength(lambda: f64, shadows: bool) -> RenderSettings {
         env_occlusion: false,
         ..Default::default()
     }
-}
-
-fn render(r: &mut Renderer, scene: &Scene, settings: &RenderSettings, custom: CustomShader) -> Vec<[f32; 4]> {
-    r.set_custom_shader(custom).unwrap();
-    r.render(&scene.camera, settings).unwrap();
-    r.read_hdr().unwrap()
-}
-
-/// One step of the HDR target's f16 below its smallest normal value (6.1e-5): the storage
-/// cannot resolve differences smaller than this, whatever the shader computes.
-const F16_SUBNORMAL_STEP: f64 = 5.960464477539063e-8;
-
-/// Error of `gpu` against `cpu` relative to the largest channel (max over channels), after
-/// discounting one f16 subnormal step of storage quantisation.
-fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
-    let scale = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = (0..3).fold(0.0f64, |m, c| m.max((gpu[c] - cpu[c]).abs()));
-    (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }
 
 /// The worst error of a GPU-vs-CPU comparison and how many pixel-wavelengths of each kind it
