@@ -17,14 +17,21 @@ pub enum Mode {
 
 impl Mode {
     pub const NAMES: &'static [&'static str] = &["rgb", "naive", "spectral"];
+    pub const ALL: [Mode; 3] = [Mode::Rgb, Mode::Naive, Mode::Spectral];
 
-    pub fn parse(s: &str) -> Result<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "rgb" => Ok(Mode::Rgb),
-            "naive" | "box" => Ok(Mode::Naive),
-            "spectral" | "jh" => Ok(Mode::Spectral),
-            _ => Err(RenderError::Settings(format!("unknown mode '{s}'; known: rgb, naive, spectral"))),
+    /// Other spellings `parse` (and the command line) accept.
+    fn aliases(self) -> &'static [&'static str] {
+        match self {
+            Mode::Rgb => &[],
+            Mode::Naive => &["box"],
+            Mode::Spectral => &["jh"],
         }
+    }
+
+    /// A name or alias, any case.
+    pub fn parse(s: &str) -> Result<Self> {
+        by_name(&Self::ALL, s, Self::name, Self::aliases)
+            .ok_or_else(|| RenderError::Settings(format!("unknown mode '{s}'; known: rgb, naive, spectral")))
     }
 
     pub fn name(self) -> &'static str {
@@ -58,12 +65,28 @@ pub enum Tonemap {
 }
 
 impl Tonemap {
+    pub const ALL: [Tonemap; 3] = [Tonemap::None, Tonemap::Reinhard, Tonemap::Aces];
+
+    /// Other spellings `parse` (and the command line) accept.
+    fn aliases(self) -> &'static [&'static str] {
+        match self {
+            Tonemap::None => &["clamp"],
+            Tonemap::Reinhard | Tonemap::Aces => &[],
+        }
+    }
+
+    /// A name or alias, any case.
     pub fn parse(s: &str) -> Result<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "none" | "clamp" => Ok(Tonemap::None),
-            "reinhard" => Ok(Tonemap::Reinhard),
-            "aces" => Ok(Tonemap::Aces),
-            _ => Err(RenderError::Settings(format!("unknown tone map '{s}'; known: none, reinhard, aces"))),
+        by_name(&Self::ALL, s, Self::name, Self::aliases).ok_or_else(|| {
+            RenderError::Settings(format!("unknown tone map '{s}'; known: none, reinhard, aces"))
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::None => "none",
+            Tonemap::Reinhard => "reinhard",
+            Tonemap::Aces => "aces",
         }
     }
 
@@ -72,6 +95,45 @@ impl Tonemap {
             Tonemap::None => 0,
             Tonemap::Reinhard => 1,
             Tonemap::Aces => 2,
+        }
+    }
+}
+
+/// The value of `all` whose name or one of whose aliases is `s`, ignoring case: one lookup for
+/// `parse` and the command line's `ValueEnum`, so both accept the same spellings.
+fn by_name<T: Copy>(
+    all: &[T],
+    s: &str,
+    name: fn(T) -> &'static str,
+    aliases: fn(T) -> &'static [&'static str],
+) -> Option<T> {
+    all.iter()
+        .copied()
+        .find(|&v| name(v).eq_ignore_ascii_case(s) || aliases(v).iter().any(|a| a.eq_ignore_ascii_case(s)))
+}
+
+/// `--mode`/`--tonemap` for clap (feature `clap`, which the `spectra` binary turns on): the
+/// names and aliases of `parse`; callers set `ignore_case` to accept any case as `parse` does.
+#[cfg(feature = "clap")]
+mod cli {
+    use super::{Mode, Tonemap};
+    use clap::builder::PossibleValue;
+
+    impl clap::ValueEnum for Mode {
+        fn value_variants<'a>() -> &'a [Self] {
+            &Self::ALL
+        }
+        fn to_possible_value(&self) -> Option<PossibleValue> {
+            Some(PossibleValue::new(self.name()).aliases(self.aliases().iter().copied()))
+        }
+    }
+
+    impl clap::ValueEnum for Tonemap {
+        fn value_variants<'a>() -> &'a [Self] {
+            &Self::ALL
+        }
+        fn to_possible_value(&self) -> Option<PossibleValue> {
+            Some(PossibleValue::new(self.name()).aliases(self.aliases().iter().copied()))
         }
     }
 }

@@ -190,11 +190,9 @@ fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
     }
 }
 
-#[test]
-fn the_occlusion_texture_darkens_the_environment_only() {
-    // A white sphere in the furnace with a uniform occlusion texture of 0.5 at strength 0.8:
-    // the environment term is scaled by 1 + 0.8·(0.5 − 1) = 0.6 (the background stays 1).
-    let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
+/// Gives the sphere's material a uniform occlusion texture of 128/255 ≈ 0.5 at strength 0.8:
+/// ambient light × 1 + 0.8·(0.5 − 1) = 0.6.
+fn occlude(scene: &mut Scene) {
     scene.textures.push(scene::Texture {
         sampler: Default::default(),
         name: "ao".into(),
@@ -206,6 +204,14 @@ fn the_occlusion_texture_darkens_the_environment_only() {
     scene.materials[0].occlusion_texture =
         Some(scene::TextureRef { transform: None, index: 0, tex_coord: 0 });
     scene.materials[0].occlusion_strength = 0.8;
+}
+
+#[test]
+fn the_occlusion_texture_darkens_the_environment_only() {
+    // A white sphere in the furnace with a uniform occlusion texture of 0.5 at strength 0.8:
+    // the environment term is scaled by 1 + 0.8·(0.5 − 1) = 0.6 (the background stays 1).
+    let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    occlude(&mut scene);
     let img = render(&scene, &settings(Mode::Spectral, 16));
     let c = img[(SIZE / 2 * SIZE + SIZE / 2) as usize];
     let want = 1.0 + 0.8 * (128.0 / 255.0 - 1.0);
@@ -228,17 +234,7 @@ fn a_hooks_irradiance_is_occluded_like_the_environment() {
     let want = 1.0 + 0.8 * (128.0 / 255.0 - 1.0);
     for textured in [false, true] {
         if textured {
-            scene.textures.push(scene::Texture {
-                sampler: Default::default(),
-                name: "ao".into(),
-                width: 2,
-                height: 2,
-                rgba8: [128u8, 128, 128, 255].repeat(4),
-                srgb: false,
-            });
-            scene.materials[0].occlusion_texture =
-                Some(scene::TextureRef { transform: None, index: 0, tex_coord: 0 });
-            scene.materials[0].occlusion_strength = 0.8;
+            occlude(&mut scene);
         }
         for mode in [Mode::Rgb, Mode::Spectral] {
             let mut r = renderer();

@@ -11,11 +11,12 @@ mod common;
 
 use color::upsample::medium::Attenuation;
 use color::{Quadrature, Spectrum, WavelengthRange};
+use common::{rel_err, render_custom as render};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::rgb_medium;
-use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
+use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
 use scene::medium::RgbMedium;
-use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
+use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 
 const W: u32 = 24;
 const H: u32 = 16;
@@ -29,44 +30,26 @@ fn light_pos() -> Vec3 {
 
 fn wall_scene() -> Scene {
     let s = 20.0;
-    let p =
-        [Vec3::new(-s, -s, -WALL), Vec3::new(s, -s, -WALL), Vec3::new(s, s, -WALL), Vec3::new(-s, s, -WALL)];
     let mut camera = Camera::look_at(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 1.0);
     camera.yfov = 0.8;
     camera.znear = 0.05;
     camera.zfar = 100.0;
-    Scene {
-        warnings: vec![],
-        source: "test:rgb-medium-wall".into(),
-        meshes: vec![Mesh {
-            colors: vec![],
-            uvs1: vec![],
-            positions: p.to_vec(),
-            normals: vec![Vec3::Z; 4],
-            tangents: vec![],
-            uvs: vec![Vec2::ZERO; 4],
-            indices: vec![0, 1, 2, 0, 2, 3],
-            material: 0,
-        }],
-        materials: vec![Material {
-            name: "white".into(),
-            base_color: Vec4::ONE,
-            roughness: 1.0,
-            ..Default::default()
-        }],
-        textures: vec![],
-        lights: vec![Light {
-            name: "lamp".into(),
-            kind: LightKind::Point { position: light_pos(), range: None },
-            emission: Emission { rgb: Vec3::ONE, intensity: INTENSITY, spectrum: None },
-            stands_in_for: None,
-        }],
-        camera,
-        spectral: SpectralSettings::default(),
-        water: None,
-        environment: None,
-        medium: None,
-    }
+    let mut scene = Scene::empty("test:rgb-medium-wall", camera);
+    // Facing +z, at z = −WALL.
+    scene.meshes.push(Mesh::quad(Vec3::new(-s, -s, -WALL), Vec3::X * 2.0 * s, Vec3::Y * 2.0 * s, 0));
+    scene.materials.push(Material {
+        name: "white".into(),
+        base_color: Vec4::ONE,
+        roughness: 1.0,
+        ..Default::default()
+    });
+    scene.lights.push(Light {
+        name: "lamp".into(),
+        kind: LightKind::Point { position: light_pos(), range: None },
+        emission: Emission { rgb: Vec3::ONE, intensity: INTENSITY, spectrum: None },
+        stands_in_for: None,
+    });
+    scene
 }
 
 /// Unit view direction through pixel (px, py) and the distance to the wall.
@@ -104,22 +87,6 @@ fn in_scatter(w: DVec3, len: f64, light: DVec3, g: f64, sigma_t: f64, m: u32) ->
             hg(g, wi.dot(w)) * (-sigma_t * (t + r)).exp() * dth / h
         })
         .sum()
-}
-
-fn render(r: &mut Renderer, scene: &Scene, settings: &RenderSettings, custom: CustomShader) -> Vec<[f32; 4]> {
-    r.set_custom_shader(custom).unwrap();
-    r.render(&scene.camera, settings).unwrap();
-    r.read_hdr().unwrap()
-}
-
-/// One step of the HDR target's f16 below its smallest normal value.
-const F16_SUBNORMAL_STEP: f64 = 5.960464477539063e-8;
-
-/// Error relative to the largest channel, after one f16 subnormal step of quantisation.
-fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
-    let scale = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = (0..3).fold(0.0f64, |m, c| m.max((gpu[c] - cpu[c]).abs()));
-    (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }
 
 fn medium(absorption: [f64; 3], scattering: [f64; 3], method: Attenuation) -> RgbMedium {

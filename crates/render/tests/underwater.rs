@@ -8,11 +8,12 @@ mod common;
 
 use color::water::WaterType;
 use color::{Quadrature, WavelengthRange};
+use common::{rel_err, render_custom as render};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
-use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
+use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
 use scene::water::{WATER_IOR, WaterMedium};
-use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
+use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 
 const W: u32 = 40;
 const H: u32 = 30;
@@ -25,47 +26,25 @@ fn light_dir() -> Vec3 {
 }
 
 fn floor_scene() -> Scene {
-    let p = [
-        Vec3::new(-FX, 0.0, 2.0),
-        Vec3::new(FX, 0.0, 2.0),
-        Vec3::new(FX, 0.0, -FZ),
-        Vec3::new(-FX, 0.0, -FZ),
-    ];
     let mut camera = Camera::look_at(Vec3::new(0.0, 1.5, 0.0), Vec3::new(0.0, 1.0, -10.0), Vec3::Y, 1.0);
     camera.znear = 0.05;
     camera.zfar = 500.0;
-    Scene {
-        warnings: vec![],
-        source: "test:underwater-floor".into(),
-        meshes: vec![Mesh {
-            colors: vec![],
-            uvs1: vec![],
-            positions: p.to_vec(),
-            normals: vec![Vec3::Y; 4],
-            tangents: vec![],
-            uvs: vec![Vec2::ZERO; 4],
-            indices: vec![0, 1, 2, 0, 2, 3],
-            material: 0,
-        }],
-        materials: vec![Material {
-            name: "sand".into(),
-            base_color: Vec4::new(0.55, 0.45, 0.3, 1.0),
-            roughness: 1.0,
-            ..Default::default()
-        }],
-        textures: vec![],
-        lights: vec![Light {
-            name: "sun".into(),
-            kind: LightKind::Directional { direction: light_dir() },
-            emission: Emission { rgb: Vec3::ONE, intensity: 3.0, spectrum: None },
-            stands_in_for: None,
-        }],
-        camera,
-        spectral: SpectralSettings::default(),
-        water: None,
-        environment: None,
-        medium: None,
-    }
+    let mut scene = Scene::empty("test:underwater-floor", camera);
+    // Facing +y: x ∈ [−FX, FX], z from 2 to −FZ.
+    scene.meshes.push(Mesh::quad(Vec3::new(-FX, 0.0, 2.0), Vec3::X * 2.0 * FX, Vec3::NEG_Z * (FZ + 2.0), 0));
+    scene.materials.push(Material {
+        name: "sand".into(),
+        base_color: Vec4::new(0.55, 0.45, 0.3, 1.0),
+        roughness: 1.0,
+        ..Default::default()
+    });
+    scene.lights.push(Light {
+        name: "sun".into(),
+        kind: LightKind::Directional { direction: light_dir() },
+        emission: Emission { rgb: Vec3::ONE, intensity: 3.0, spectrum: None },
+        stands_in_for: None,
+    });
+    scene
 }
 
 /// Unit view direction through pixel (px, py) and the distance (scene units) to the floor, or
@@ -110,24 +89,6 @@ fn one_wavelength(lambda: f64, shadows: bool) -> RenderSettings {
         env_occlusion: false,
         ..Default::default()
     }
-}
-
-fn render(r: &mut Renderer, scene: &Scene, settings: &RenderSettings, custom: CustomShader) -> Vec<[f32; 4]> {
-    r.set_custom_shader(custom).unwrap();
-    r.render(&scene.camera, settings).unwrap();
-    r.read_hdr().unwrap()
-}
-
-/// One step of the HDR target's f16 below its smallest normal value (6.1e-5): the storage
-/// cannot resolve differences smaller than this, whatever the shader computes.
-const F16_SUBNORMAL_STEP: f64 = 5.960464477539063e-8;
-
-/// Error of `gpu` against `cpu` relative to the largest channel (max over channels), after
-/// discounting one f16 subnormal step of storage quantisation.
-fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
-    let scale = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let diff = (0..3).fold(0.0f64, |m, c| m.max((gpu[c] - cpu[c]).abs()));
-    (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }
 
 /// The worst error of a GPU-vs-CPU comparison and how many pixel-wavelengths of each kind it
@@ -399,22 +360,8 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
 fn single_scattering_is_shadowed_under_a_roof() {
     use scene::water::single;
     let mut scene = floor_scene();
-    let roof = [
-        Vec3::new(-30.0, 3.5, 10.0),
-        Vec3::new(-30.0, 3.5, -60.0),
-        Vec3::new(30.0, 3.5, -60.0),
-        Vec3::new(30.0, 3.5, 10.0),
-    ];
-    scene.meshes.push(Mesh {
-        colors: vec![],
-        uvs1: vec![],
-        positions: roof.to_vec(),
-        normals: vec![Vec3::NEG_Y; 4],
-        tangents: vec![],
-        uvs: vec![Vec2::ZERO; 4],
-        indices: vec![0, 1, 2, 0, 2, 3],
-        material: 0,
-    });
+    // Facing −y at y = 3.5: x ∈ [−30, 30], z ∈ [−60, 10].
+    scene.meshes.push(Mesh::quad(Vec3::new(-30.0, 3.5, 10.0), Vec3::NEG_Z * 70.0, Vec3::X * 60.0, 0));
     let mut r = common::renderer();
     r.set_scene(&scene).unwrap();
     r.resize(W, H).unwrap();

@@ -26,12 +26,12 @@ impl Ctx {
         Ctx { path: PathBuf::from(format!("builtin:{name}")), dir: None, allow_outside: false }
     }
 
-    pub fn extras(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Extras { path: self.path.clone(), field: field.into(), message: message.into() }
+    pub fn extras(&self, field: impl Into<String>, message: impl std::fmt::Display) -> SceneError {
+        SceneError::Extras { path: self.path.clone(), field: field.into(), message: message.to_string() }
     }
 
-    pub fn invalid(&self, at: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid { path: self.path.clone(), at: at.into(), message: message.into() }
+    pub fn invalid(&self, at: impl Into<String>, message: impl std::fmt::Display) -> SceneError {
+        SceneError::Invalid { path: self.path.clone(), at: at.into(), message: message.to_string() }
     }
 
     pub fn io(&self, file: &Path, source: std::io::Error) -> SceneError {

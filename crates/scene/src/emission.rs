@@ -46,34 +46,45 @@ pub fn spectrum_luminance(s: &Spectrum) -> f64 {
     spectrum_xyz(s)[1]
 }
 
+/// Why a spectrum cannot be a light's; the caller places it at the field it came from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EmissionError {
+    #[error("an emission spectrum cannot be negative (minimum {min} over {lo}–{hi} nm)")]
+    Negative { min: f64, lo: f64, hi: f64 },
+    #[error("the spectrum has no luminance over {lo}–{hi} nm, so it cannot be scaled to the light's")]
+    NoLuminance { lo: f64, hi: f64 },
+    #[error("the RGB colour × intensity has invalid luminance {0}")]
+    BadTarget(f64),
+    #[error("the spectrum has no luminance, so it has no colour to give the light")]
+    NoColour,
+}
+
 /// Scales `shape` so that its luminance equals that of `rgb × intensity`.
 ///
-/// Errors (as a message for the caller to place) when the shape has no luminance to scale or a
-/// negative value somewhere, since neither can be a light.
-pub fn normalise(shape: &Spectrum, rgb: Vec3, intensity: f32) -> Result<Spectrum, String> {
+/// Errors when the shape has no luminance to scale or a negative value somewhere, since
+/// neither can be a light.
+pub fn normalise(shape: &Spectrum, rgb: Vec3, intensity: f32) -> Result<Spectrum, EmissionError> {
     let lo = color::spectrum::LAMBDA_MIN;
     let hi = color::spectrum::LAMBDA_MAX;
     let min = -Spectrum::max_value(&shape.scaled(-1.0), lo, hi);
     if min < 0.0 {
-        return Err(format!("an emission spectrum cannot be negative (minimum {min} over {lo}–{hi} nm)"));
+        return Err(EmissionError::Negative { min, lo, hi });
     }
     let y = spectrum_luminance(shape);
     if !(y > 0.0 && y.is_finite()) {
-        return Err(format!(
-            "the spectrum has no luminance over {lo}–{hi} nm, so it cannot be scaled to the light's"
-        ));
+        return Err(EmissionError::NoLuminance { lo, hi });
     }
     let target = srgb::luminance(rgb) * intensity as f64;
     if !(target.is_finite() && target >= 0.0) {
-        return Err(format!("the RGB colour × intensity has invalid luminance {target}"));
+        return Err(EmissionError::BadTarget(target));
     }
     Ok(shape.scaled(target / y))
 }
 
 impl Emission {
     /// An emission from RGB and intensity, with an optional spectral *shape* that is scaled
-    /// per the module convention. Errors are messages for the caller to attach to a field.
-    pub fn new(rgb: Vec3, intensity: f32, shape: Option<&Spectrum>) -> Result<Self, String> {
+    /// per the module convention. The caller attaches errors to a field.
+    pub fn new(rgb: Vec3, intensity: f32, shape: Option<&Spectrum>) -> Result<Self, EmissionError> {
         let spectrum = shape.map(|s| normalise(s, rgb, intensity)).transpose()?;
         Ok(Emission { rgb, intensity, spectrum })
     }
@@ -82,10 +93,10 @@ impl Emission {
     /// chromaticity (negative components of out-of-gamut lights clipped) at luminance 1 as its
     /// glTF colour, so that `rgb × intensity` and the scaled spectrum describe the same light as
     /// closely as RGB can. The built-in scenes and the evaluation's relit charts use it.
-    pub fn of_shape(shape: &Spectrum, luminance: f32) -> Result<Self, String> {
+    pub fn of_shape(shape: &Spectrum, luminance: f32) -> Result<Self, EmissionError> {
         let xyz = spectrum_xyz(shape);
         if !(xyz[1] > 0.0 && xyz[1].is_finite()) {
-            return Err("the spectrum has no luminance, so it has no colour to give the light".into());
+            return Err(EmissionError::NoColour);
         }
         let rgb = srgb::xyz_to_linear(xyz.map(|c| c / xyz[1])).max(glam::DVec3::ZERO).as_vec3();
         Emission::new(rgb / srgb::luminance(rgb) as f32, luminance, Some(shape))
@@ -140,8 +151,8 @@ mod tests {
     #[test]
     fn refuses_dark_and_negative_shapes() {
         let dark = Spectrum::piecewise(vec![900.0, 1000.0], vec![1.0, 1.0]).unwrap();
-        assert!(Emission::new(Vec3::ONE, 1.0, Some(&dark)).unwrap_err().contains("no luminance"));
+        assert!(Emission::new(Vec3::ONE, 1.0, Some(&dark)).unwrap_err().to_string().contains("no luminance"));
         let neg = Spectrum::piecewise(vec![400.0, 700.0], vec![1.0, -1.0]).unwrap();
-        assert!(Emission::new(Vec3::ONE, 1.0, Some(&neg)).unwrap_err().contains("negative"));
+        assert!(Emission::new(Vec3::ONE, 1.0, Some(&neg)).unwrap_err().to_string().contains("negative"));
     }
 }

@@ -53,17 +53,34 @@ fn data_uri(mime: &str, bytes: &[u8]) -> String {
     format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
 }
 
-fn png(t: &Texture) -> Result<Vec<u8>, String> {
+/// Why a scene cannot be written as glTF.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("mesh {0} is empty")]
+    EmptyMesh(usize),
+    #[error("texture '{name}' has {bytes} bytes for {width}×{height}")]
+    TextureSize { name: String, bytes: usize, width: u32, height: u32 },
+    #[error("texture '{name}': encoding PNG: {cause}")]
+    Png { name: String, cause: image::ImageError },
+}
+
+fn png(t: &Texture) -> Result<Vec<u8>, ExportError> {
     let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone()).ok_or_else(|| {
-        format!("texture '{}' has {} bytes for {}×{}", t.name, t.rgba8.len(), t.width, t.height)
+        ExportError::TextureSize {
+            name: t.name.clone(),
+            bytes: t.rgba8.len(),
+            width: t.width,
+            height: t.height,
+        }
     })?;
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .map_err(|cause| ExportError::Png { name: t.name.clone(), cause })?;
     Ok(out.into_inner())
 }
 
 /// Builds the glTF JSON document for `scene`.
-pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
+pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
     let mut accessors = Vec::new();
@@ -93,7 +110,7 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
     let mut nodes = Vec::new();
     for (i, m) in scene.meshes.iter().enumerate() {
         if m.positions.is_empty() || m.indices.is_empty() {
-            return Err(format!("mesh {i} is empty"));
+            return Err(ExportError::EmptyMesh(i));
         }
         let (lo, hi) = crate::framing::bounds(std::slice::from_ref(m)).expect("non-empty");
         let n = m.positions.len();
@@ -346,7 +363,7 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, String> {
 pub fn write_gltf(scene: &Scene, path: &Path) -> Result<(), SceneError> {
     let invalid =
         |m: String| SceneError::Invalid { path: path.to_path_buf(), at: "export".into(), message: m };
-    let doc = to_gltf_json(scene).map_err(invalid)?;
+    let doc = to_gltf_json(scene).map_err(|e| invalid(e.to_string()))?;
     let text = serde_json::to_string_pretty(&doc).map_err(|e| invalid(e.to_string()))?;
     let io = |e| SceneError::Io { path: path.to_path_buf(), file: path.to_path_buf(), cause: e };
     color::outfile::write_atomic_with(path, |f| {

@@ -84,6 +84,35 @@ pub struct Scene {
     pub medium: Option<medium::RgbMedium>,
 }
 
+impl Scene {
+    /// A scene with nothing in it yet but the camera, in air, with the default spectral
+    /// settings: for scenes built in code (built-ins, tests), which push meshes, materials
+    /// and lights into it.
+    pub fn empty(source: impl Into<String>, camera: Camera) -> Scene {
+        Scene {
+            warnings: vec![],
+            source: source.into(),
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            lights: Vec::new(),
+            camera,
+            spectral: SpectralSettings::default(),
+            water: None,
+            environment: None,
+            medium: None,
+        }
+    }
+}
+
+impl Mesh {
+    /// A parallelogram with corners `o`, `o+u`, `o+u+v`, `o+v`, facing `u × v`, UVs upright
+    /// when `u` points right and `v` up (glTF's top-left origin).
+    pub fn quad(o: Vec3, u: Vec3, v: Vec3, material: usize) -> Mesh {
+        builtin::shapes::quad(o, u, v, material)
+    }
+}
+
 /// A triangle mesh in world space.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {

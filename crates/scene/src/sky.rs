@@ -64,18 +64,24 @@ pub fn stand_ins(lights: &[Light], sky: f32) -> Vec<Light> {
         .collect()
 }
 
+/// A sky asked for with no sun to scale it by; the caller places it at `water.sky`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "sky = {sky} is a multiple of the sun's irradiance, but no directional light shines down into the water"
+)]
+pub struct NoSunError {
+    pub sky: f32,
+}
+
 /// Replaces the scene's sky stand-ins by those its water settings call for (idempotent).
-/// Errors, as a message for the caller to place, when a sky is asked for but no sun lights the
-/// water from above (there would be nothing to scale).
-pub fn sync(scene: &mut Scene) -> Result<(), String> {
+/// Errors when a sky is asked for but no sun lights the water from above (there would be
+/// nothing to scale).
+pub fn sync(scene: &mut Scene) -> Result<(), NoSunError> {
     scene.lights.retain(|l| !is_stand_in(l));
     let sky = scene.water.as_ref().map_or(0.0, |w| w.sky);
     let new = stand_ins(&scene.lights, sky);
     if sky > 0.0 && new.is_empty() {
-        return Err(format!(
-            "sky = {sky} is a multiple of the sun's irradiance, but no directional light shines down \
-             into the water"
-        ));
+        return Err(NoSunError { sky });
     }
     scene.lights.extend(new);
     Ok(())
@@ -118,7 +124,7 @@ mod tests {
     fn a_sky_without_a_sun_is_an_error() {
         let mut s = crate::builtin("underwater").unwrap();
         s.lights.clear();
-        let e = sync(&mut s).unwrap_err();
+        let e = sync(&mut s).unwrap_err().to_string();
         assert!(e.contains("no directional light"), "{e}");
     }
 }

@@ -65,7 +65,7 @@ fn resolve_unchecked(ctx: &Ctx, field: &str, v: &Value) -> Result<Spectrum, Scen
                     read_csv(ctx, &sub, &file)
                 }
                 "colorchecker" => {
-                    let i = colorchecker_index(inner).map_err(|m| err(&sub, m))?;
+                    let i = colorchecker_index(inner).map_err(|m| err(&sub, m.to_string()))?;
                     Ok(Spectrum::from_table(&colorchecker::SPECTRA[i]))
                 }
                 other => Err(err(
@@ -119,18 +119,26 @@ fn check_increasing(lambda: &[f64]) -> Result<(), String> {
     }
 }
 
+/// A ColorChecker patch reference that names no patch.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PatchError {
+    #[error("patch number {0} is outside 1–24")]
+    OutOfRange(u64),
+    #[error("expected a patch name or number 1–24, got {0}")]
+    NotAPatch(Value),
+    #[error("unknown ColorChecker patch '{0}'; patches are: {names}", names = colorchecker::NAMES.join(", "))]
+    Unknown(String),
+    #[error("'{name}' matches several ColorChecker patches ({}); be more specific", matches.join(", "))]
+    Ambiguous { name: String, matches: Vec<&'static str> },
+}
+
 /// Index (0-based) of a ColorChecker patch given as a name or a 1-based number.
-pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
-    let names = || colorchecker::NAMES.join(", ");
+pub fn colorchecker_index(v: &Value) -> Result<usize, PatchError> {
     if let Some(n) = v.as_u64() {
-        return if (1..=24).contains(&n) {
-            Ok(n as usize - 1)
-        } else {
-            Err(format!("patch number {n} is outside 1–24"))
-        };
+        return if (1..=24).contains(&n) { Ok(n as usize - 1) } else { Err(PatchError::OutOfRange(n)) };
     }
     let Some(name) = v.as_str() else {
-        return Err(format!("expected a patch name or number 1–24, got {v}"));
+        return Err(PatchError::NotAPatch(v.clone()));
     };
     let want = name.trim().to_ascii_lowercase();
     if let Some(i) = colorchecker::NAMES.iter().position(|n| n.eq_ignore_ascii_case(&want)) {
@@ -140,11 +148,11 @@ pub fn colorchecker_index(v: &Value) -> Result<usize, String> {
         (0..24).filter(|&i| colorchecker::NAMES[i].to_ascii_lowercase().starts_with(&want)).collect();
     match hits.as_slice() {
         [i] if !want.is_empty() => Ok(*i),
-        [] | [_] => Err(format!("unknown ColorChecker patch '{name}'; patches are: {}", names())),
-        many => Err(format!(
-            "'{name}' matches several ColorChecker patches ({}); be more specific",
-            many.iter().map(|&i| colorchecker::NAMES[i]).collect::<Vec<_>>().join(", ")
-        )),
+        [] | [_] => Err(PatchError::Unknown(name.to_string())),
+        many => Err(PatchError::Ambiguous {
+            name: name.to_string(),
+            matches: many.iter().map(|&i| colorchecker::NAMES[i]).collect(),
+        }),
     }
 }
 

@@ -12,6 +12,15 @@ use glam::Vec3;
 
 use crate::{Mesh, Scene, tangents};
 
+/// A normal map on a UV set the mesh does not have (nothing to orient its tangents by).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "its material has a normal map on TEXCOORD_{set} but the primitive has no TEXCOORD_{set} to orient it"
+)]
+pub struct MissingUvError {
+    pub set: u32,
+}
+
 fn corners<T: Copy>(v: &[T], idx: &[u32]) -> Vec<T> {
     if v.is_empty() { Vec::new() } else { idx.iter().map(|&i| v[i as usize]).collect() }
 }
@@ -37,8 +46,8 @@ impl Mesh {
     /// none (its tangents dropped), normals made unit length, and MikkTSpace tangents on the
     /// UV set `normal_map_set` when its material has a normal map and the mesh no tangents
     /// (tangents are dropped when there is no normal map). Indices must be in range. The error
-    /// is a message for the caller to place: a normal map whose UV set the mesh lacks.
-    pub fn complete(self, normal_map_set: Option<u32>) -> Result<Mesh, String> {
+    /// is for the caller to place: a normal map whose UV set the mesh lacks.
+    pub fn complete(self, normal_map_set: Option<u32>) -> Result<Mesh, MissingUvError> {
         let mut mesh = if self.normals.is_empty() {
             let mut m = Mesh { tangents: Vec::new(), ..self }.unindexed();
             m.normals = m
@@ -62,9 +71,7 @@ impl Mesh {
             Some(set) if mesh.tangents.is_empty() => {
                 let uv = if set == 1 { &mesh.uvs1 } else { &mesh.uvs };
                 if uv.is_empty() {
-                    return Err(format!(
-                        "its material has a normal map on TEXCOORD_{set} but the primitive has no TEXCOORD_{set} to orient it"
-                    ));
+                    return Err(MissingUvError { set });
                 }
                 let t = tangents::generate(&mesh.positions, &mesh.normals, uv, &mesh.indices);
                 mesh = mesh.unindexed();

@@ -3,8 +3,8 @@
 //! --rgb-medium`, the same upsampled medium). Figures and the accuracy they support are in
 //! docs/rgb-media.md ("Real time against the path tracer").
 
-use glam::{Vec2, Vec3, Vec4};
-use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
+use glam::{Vec3, Vec4};
+use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -31,42 +31,24 @@ const WALL: f32 = 2.0;
 
 fn wall_scene() -> Scene {
     let s = 5.0;
-    let q =
-        [Vec3::new(-s, -s, -WALL), Vec3::new(s, -s, -WALL), Vec3::new(s, s, -WALL), Vec3::new(-s, s, -WALL)];
     let mut camera = Camera::look_at(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 0.15);
     camera.yfov = 0.15;
-    Scene {
-        warnings: vec![],
-        source: "test:rgb-medium-wall".into(),
-        meshes: vec![Mesh {
-            colors: vec![],
-            uvs1: vec![],
-            positions: q.to_vec(),
-            normals: vec![Vec3::Z; 4],
-            tangents: vec![],
-            uvs: vec![Vec2::ZERO; 4],
-            indices: vec![0, 1, 2, 0, 2, 3],
-            material: 0,
-        }],
-        materials: vec![Material {
-            name: "white".into(),
-            base_color: Vec4::ONE,
-            roughness: 1.0,
-            ..Default::default()
-        }],
-        textures: vec![],
-        lights: vec![Light {
-            name: "lamp".into(),
-            kind: LightKind::Point { position: Vec3::new(0.1, 0.0, 0.0), range: None },
-            emission: Emission { rgb: Vec3::ONE, intensity: 10.0, spectrum: None },
-            stands_in_for: None,
-        }],
-        camera,
-        spectral: SpectralSettings::default(),
-        water: None,
-        environment: None,
-        medium: None,
-    }
+    let mut scene = Scene::empty("test:rgb-medium-wall", camera);
+    // Facing +z, at z = −WALL.
+    scene.meshes.push(Mesh::quad(Vec3::new(-s, -s, -WALL), Vec3::X * 2.0 * s, Vec3::Y * 2.0 * s, 0));
+    scene.materials.push(Material {
+        name: "white".into(),
+        base_color: Vec4::ONE,
+        roughness: 1.0,
+        ..Default::default()
+    });
+    scene.lights.push(Light {
+        name: "lamp".into(),
+        kind: LightKind::Point { position: Vec3::new(0.1, 0.0, 0.0), range: None },
+        emission: Emission { rgb: Vec3::ONE, intensity: 10.0, spectrum: None },
+        stands_in_for: None,
+    });
+    scene
 }
 
 /// Mean linear sRGB of an image.

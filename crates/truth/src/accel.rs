@@ -78,19 +78,34 @@ pub fn intersect_triangle(v: &[Vec3; 3], o: Vec3, d: Vec3, tmax: f32) -> Option<
     (t > 0.0 && t < tmax).then_some((t, b1, b2))
 }
 
+/// A mesh the tracer cannot build triangles from, named by its index in the scene.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GeometryError {
+    #[error("mesh {mesh} has {count} indices, not a multiple of 3")]
+    Indices { mesh: usize, count: usize },
+    #[error("mesh {mesh} uses material {material} of {count}")]
+    Material { mesh: usize, material: usize, count: usize },
+    #[error("mesh {mesh} triangle {triangle} indexes past its {vertices} vertices")]
+    Index { mesh: usize, triangle: usize, vertices: usize },
+}
+
 impl Geometry {
     /// Flattens every mesh's triangles and builds the BVH. Triangles referring to vertices a
     /// mesh does not have are an error naming the mesh, not a panic.
-    pub fn new(scene: &Scene) -> Result<Self, String> {
+    pub fn new(scene: &Scene) -> Result<Self, GeometryError> {
         let mut refs = Vec::new();
         let mut verts = Vec::new();
         let mut filter = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
             if m.indices.len() % 3 != 0 {
-                return Err(format!("mesh {mi} has {} indices, not a multiple of 3", m.indices.len()));
+                return Err(GeometryError::Indices { mesh: mi, count: m.indices.len() });
             }
             if m.material >= scene.materials.len() {
-                return Err(format!("mesh {mi} uses material {} of {}", m.material, scene.materials.len()));
+                return Err(GeometryError::Material {
+                    mesh: mi,
+                    material: m.material,
+                    count: scene.materials.len(),
+                });
             }
             let mat = &scene.materials[m.material];
             let flags = if mat.double_sided { 0 } else { SINGLE_SIDED }
@@ -98,10 +113,7 @@ impl Geometry {
             for (k, c) in m.indices.chunks_exact(3).enumerate() {
                 let p = |i: u32| m.positions.get(i as usize).copied();
                 let (Some(a), Some(b), Some(cc)) = (p(c[0]), p(c[1]), p(c[2])) else {
-                    return Err(format!(
-                        "mesh {mi} triangle {k} indexes past its {} vertices",
-                        m.positions.len()
-                    ));
+                    return Err(GeometryError::Index { mesh: mi, triangle: k, vertices: m.positions.len() });
                 };
                 // Zero-area triangles can never be hit; dropping them keeps light sampling valid.
                 if (b - a).cross(cc - a).length_squared() == 0.0 {
@@ -293,6 +305,6 @@ mod tests {
         let mesh =
             scene::Mesh { positions: vec![Vec3::ZERO; 3], indices: vec![0, 1, 7], ..Default::default() };
         let s = crate::testing::scene_with(vec![mesh], vec![scene::Material::default()], vec![]);
-        assert!(Geometry::new(&s).err().unwrap().contains("indexes past"));
+        assert!(Geometry::new(&s).err().unwrap().to_string().contains("indexes past"));
     }
 }

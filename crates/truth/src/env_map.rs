@@ -55,29 +55,43 @@ pub struct EnvSample {
     pub texel: usize,
 }
 
+/// An environment map the tracer cannot sample, naming its file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EnvMapError {
+    #[error("environment {file}: {texels} texels for {width}×{height}")]
+    Size { file: String, texels: usize, width: u32, height: u32 },
+    #[error(
+        "environment {file}: texel ({x}, {y}) = {value} × intensity {intensity} is not a finite, non-negative radiance"
+    )]
+    Texel { file: String, x: usize, y: usize, value: Vec3, intensity: f32 },
+}
+
 impl<'s> EnvMap<'s> {
     /// Fits every texel and builds the sampling distribution. Fails only when a texel's
     /// radiance × intensity overflows f32.
-    pub fn new(env: &'s Environment, units: &EmissionUnits, up: &dyn RgbToSpectrum) -> Result<Self, String> {
+    pub fn new(
+        env: &'s Environment,
+        units: &EmissionUnits,
+        up: &dyn RgbToSpectrum,
+    ) -> Result<Self, EnvMapError> {
         let (w, h) = (env.width as usize, env.height as usize);
         if w == 0 || h == 0 || env.texels.len() != w * h {
-            return Err(format!(
-                "environment {}: {} texels for {}×{}",
-                env.source,
-                env.texels.len(),
-                env.width,
-                env.height
-            ));
+            return Err(EnvMapError::Size {
+                file: env.source.clone(),
+                texels: env.texels.len(),
+                width: env.width,
+                height: env.height,
+            });
         }
         let k = env.intensity;
         if let Some(i) = env.texels.iter().position(|t| !(*t * k).is_finite() || t.min_element() < 0.0) {
-            return Err(format!(
-                "environment {}: texel ({}, {}) = {} × intensity {k} is not a finite, non-negative radiance",
-                env.source,
-                i % w,
-                i / w,
-                env.texels[i]
-            ));
+            return Err(EnvMapError::Texel {
+                file: env.source.clone(),
+                x: i % w,
+                y: i / w,
+                value: env.texels[i],
+                intensity: k,
+            });
         }
         // Luminance is linear: its weights once, not a colour-space construction per texel.
         let y_weights = Vec3::new(luminance(Vec3::X), luminance(Vec3::Y), luminance(Vec3::Z));
@@ -432,6 +446,6 @@ mod tests {
         assert!(map.is_empty() && map.sample([0.5; 6]).is_none() && map.pdf(Vec3::Y) == 0.0);
         let mut huge = Environment::from_rgb("huge", 4, 2, vec![Vec3::splat(1e38); 8]).unwrap();
         huge.intensity = 1e6;
-        assert!(EnvMap::new(&huge, &units(), &GreyOnly).err().unwrap().contains("huge"));
+        assert!(EnvMap::new(&huge, &units(), &GreyOnly).err().unwrap().to_string().contains("huge"));
     }
 }

@@ -75,7 +75,7 @@ impl<'s> World<'s> {
         let original = scene;
         let scene = original.completed();
         let bad = |why: String| TruthError::BadScene { scene: scene.source.clone(), why };
-        let geometry = Geometry::new(&scene).map_err(bad)?;
+        let geometry = Geometry::new(&scene).map_err(|e| bad(e.to_string()))?;
         for (i, t) in scene.textures.iter().enumerate() {
             if t.rgba8.len() != 4 * t.width as usize * t.height as usize {
                 return Err(bad(format!(
@@ -141,7 +141,7 @@ impl<'s> World<'s> {
                         env.source
                     )));
                 }
-                Some(EnvMap::new(env, &units, upsampler).map_err(bad)?)
+                Some(EnvMap::new(env, &units, upsampler).map_err(|e| bad(e.to_string()))?)
             }
             _ => None,
         };

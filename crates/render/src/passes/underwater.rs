@@ -158,31 +158,50 @@ impl Options {
     }
 
     /// Checks the values a user can set.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), OptionsError> {
         if self.steps > MAX_STEPS {
-            return Err(format!("underwater march steps must be 0..={MAX_STEPS}, got {}", self.steps));
+            return Err(OptionsError::Steps(self.steps));
         }
         if !(self.phase_g.is_finite() && self.phase_g.abs() < 1.0) {
-            return Err(format!("phase function g must be in (−1, 1), got {}", self.phase_g));
+            return Err(OptionsError::PhaseG(self.phase_g));
         }
         if self.light_field && self.steps == 0 {
-            return Err("the light-field model needs march steps ≥ 1 (the table leaves the sun's \
-                        unscattered beam to the march); use the paper's model for no march"
-                .into());
+            return Err(OptionsError::LightFieldNoMarch);
         }
         if self.light_field && (self.split_beams || self.scalar_irradiance) {
-            return Err("split beams and scalar irradiance change the paper's isotropic term; \
-                        they need the isotropic model (--isotropic)"
-                .into());
+            return Err(OptionsError::NeedsIsotropic);
         }
         if !(self.forward_cone_deg.is_finite() && (0.0..=45.0).contains(&self.forward_cone_deg)) {
-            return Err(format!("forward cone must be 0…45°, got {}", self.forward_cone_deg));
+            return Err(OptionsError::ForwardCone(self.forward_cone_deg));
         }
         if self.light_field && !(1..=10_000_000).contains(&self.photons) {
-            return Err(format!("light-field photons must be 1..=10000000, got {}", self.photons));
+            return Err(OptionsError::Photons(self.photons));
         }
         Ok(())
     }
+}
+
+/// An [`Options`] value the model cannot run with.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptionsError {
+    #[error("underwater march steps must be 0..={MAX_STEPS}, got {0}")]
+    Steps(u32),
+    #[error("phase function g must be in (−1, 1), got {0}")]
+    PhaseG(f32),
+    #[error(
+        "the light-field model needs march steps ≥ 1 (the table leaves the sun's unscattered beam to the \
+         march); use the paper's model for no march"
+    )]
+    LightFieldNoMarch,
+    #[error(
+        "split beams and scalar irradiance change the paper's isotropic term; they need the isotropic model \
+         (--isotropic)"
+    )]
+    NeedsIsotropic,
+    #[error("forward cone must be 0…45°, got {0}")]
+    ForwardCone(f32),
+    #[error("light-field photons must be 1..=10000000, got {0}")]
+    Photons(usize),
 }
 
 pub use scene::water::PETZOLD_G;
@@ -403,7 +422,7 @@ pub fn shader(medium: &WaterMedium) -> Result<CustomShader, WaterError> {
 /// light-field model solves (or loads) its table here; bad options or a bad sun are errors.
 pub fn shader_with(medium: &WaterMedium, options: &Options) -> Result<CustomShader, WaterError> {
     use scene::water::{WATER_IOR, fresnel::mean_transmittance};
-    options.validate().map_err(WaterError::BadQuery)?;
+    options.validate().map_err(|e| WaterError::BadQuery(e.to_string()))?;
     let tables = if options.light_field { Some(light_field_tables(medium, options)?) } else { None };
     let source = format!("{}\n{HOOKS}", super::custom::MEDIUM_COMMON);
     // Values of the hooks' pipeline-overridable constants (`override UW_…` in underwater.wgsl).

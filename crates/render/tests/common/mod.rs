@@ -7,7 +7,7 @@
 use color::upsample::CoeffTable;
 use color::{RgbColorSpace, Spectrum};
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use render::{RenderError, Renderer};
+use render::{CustomShader, RenderError, RenderSettings, Renderer};
 use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene, SpectralSettings};
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
@@ -249,4 +249,29 @@ pub fn rgb_of(px: &[f32; 4]) -> [f64; 3] {
 /// A white light (linear sRGB (1, 1, 1)) of `intensity` lux, optionally with a spectrum.
 pub fn white_light(intensity: f32, spectrum: Option<Spectrum>) -> Emission {
     Emission { rgb: Vec3::ONE, intensity, spectrum }
+}
+
+/// One frame of `scene` (already set, at the renderer's size) with `custom`'s hooks, as read
+/// back from the HDR target.
+pub fn render_custom(
+    r: &mut Renderer,
+    scene: &Scene,
+    settings: &RenderSettings,
+    custom: CustomShader,
+) -> Vec<[f32; 4]> {
+    r.set_custom_shader(custom).unwrap();
+    r.render(&scene.camera, settings).unwrap();
+    r.read_hdr().unwrap()
+}
+
+/// One step of the HDR target's f16 below its smallest normal value (6.1e-5): the storage
+/// cannot resolve differences smaller than this, whatever the shader computes.
+pub const F16_SUBNORMAL_STEP: f64 = 5.960464477539063e-8;
+
+/// Error of `gpu` against `cpu` relative to the largest channel (max over channels), after
+/// discounting one f16 subnormal step of storage quantisation.
+pub fn rel_err(gpu: [f64; 3], cpu: [f64; 3]) -> f64 {
+    let scale = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = (0..3).fold(0.0f64, |m, c| m.max((gpu[c] - cpu[c]).abs()));
+    (diff - F16_SUBNORMAL_STEP).max(0.0) / scale.max(1e-12)
 }

@@ -17,7 +17,7 @@ use glam::{DVec3, Vec3, Vec4};
 
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Emission, Material, Scene, SpectralReflectance, SpectralSettings, srgb};
+use crate::{Emission, Material, Scene, SpectralReflectance, srgb};
 
 /// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
 /// about N triangles, for large-mesh measurements).
@@ -48,19 +48,9 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
 /// An empty scene to fill in, with D65 as the white and the paper's spectral defaults left to
 /// the CLI.
 pub(crate) fn empty(ctx: &Ctx, camera: crate::Camera) -> Scene {
-    Scene {
-        warnings: vec![],
-        source: ctx.path.display().to_string(),
-        meshes: Vec::new(),
-        materials: Vec::new(),
-        textures: Vec::new(),
-        lights: Vec::new(),
-        camera,
-        spectral: SpectralSettings { white: Some("D65".into()), ..SpectralSettings::default() },
-        water: None,
-        environment: None,
-        medium: None,
-    }
+    let mut s = Scene::empty(ctx.path.display().to_string(), camera);
+    s.spectral.white = Some("D65".into());
+    s
 }
 
 /// Linear sRGB of a reflectance under D65 with the CIE 1931 observer (1 nm, 360–830 nm): the

@@ -90,9 +90,14 @@ fn texture_mean(scene: &Scene, index: usize) -> Option<[f64; 3]> {
     Some(sum.map(|s| s / n as f64))
 }
 
+/// The sea floor's albedo needs the sRGB upsampling table, which could not be had.
+#[derive(Debug, thiserror::Error)]
+#[error("sea floor albedo: the sRGB upsampling table: {0}")]
+pub struct FloorTableError(pub color::ColorError);
+
 /// The floor straight below the scene's camera, or `None` when nothing is below it (or the
 /// camera has no finite position). `scale` is metres per scene unit.
-pub fn below_camera(scene: &Scene, scale: f64) -> Result<Option<SeaFloor>, String> {
+pub fn below_camera(scene: &Scene, scale: f64) -> Result<Option<SeaFloor>, FloorTableError> {
     let origin = scene.camera.transform.w_axis.truncate();
     if !origin.is_finite() {
         return Ok(None);
@@ -107,8 +112,7 @@ pub fn below_camera(scene: &Scene, scale: f64) -> Result<Option<SeaFloor>, Strin
     let albedo = match &material.spectral {
         Some(SpectralReflectance::Uniform(s)) => s.clone(),
         _ => {
-            let table = color::upsample::cache::table("srgb")
-                .map_err(|e| format!("sea floor albedo: the sRGB upsampling table: {e}"))?;
+            let table = color::upsample::cache::table("srgb").map_err(FloorTableError)?;
             let poly = table.fetch(rgb);
             Spectrum::Piecewise {
                 lambda: (0..=47).map(|i| 360.0 + 10.0 * i as f64).collect(),

@@ -15,7 +15,7 @@
 
 pub mod stats;
 
-use crate::cmd::render::{load_table, parse_size};
+use super::setup::{RgbMediumArgs, SceneArgs, TableArgs, parse_size};
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
 use color::Quadrature;
@@ -29,17 +29,12 @@ use std::time::Instant;
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism) or a .gltf/.glb file.
-    pub scene: String,
     #[command(flatten)]
-    pub files: super::SceneFileArgs,
+    pub scene: SceneArgs,
+    // Drawn with the RGB medium pass's default march steps (16).
     #[command(flatten)]
-    pub env: super::EnvArgs,
-    /// A homogeneous medium filling the scene, given in RGB (inline JSON or a JSON file;
-    /// docs/rgb-media.md); default: the scene's extras.medium. Drawn with 16 march steps.
-    #[arg(long, value_name = "JSON|FILE")]
-    pub rgb_medium: Option<String>,
-    /// Frame size WIDTHxHEIGHT.
+    pub rgb_medium: RgbMediumArgs,
+    /// Frame size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT).
     #[arg(long, default_value = "1280x720")]
     pub size: String,
     /// Measured frames per configuration.
@@ -57,9 +52,8 @@ pub struct Args {
     /// Write the table as CSV to this file (atomically).
     #[arg(long)]
     pub csv: Option<PathBuf>,
-    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
-    #[arg(long)]
-    pub table: Option<PathBuf>,
+    #[command(flatten)]
+    pub table: TableArgs,
     /// Quadrature rules to measure the spectral rows with, comma-separated (midpoint,
     /// prefiltered).
     #[arg(long, default_value = "prefiltered")]
@@ -279,12 +273,10 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.csv {
         super::check_output("--csv", path)?;
     }
-    let mut scene = args.files.load(&args.scene)?;
-    super::print_warnings(&scene);
-    args.env.apply(&mut scene)?;
-    let coeffs = load_table(args.table.as_deref())?;
+    let scene = args.scene.load()?;
+    let coeffs = args.table.load()?;
     let medium =
-        super::realtime_medium(&scene, args.rgb_medium.as_deref(), false, &coeffs, Default::default())?;
+        super::setup::realtime_medium(&scene, args.rgb_medium.arg(), false, &coeffs, Default::default())?;
     let mut r = Renderer::with_table(coeffs)?;
     r.set_scene(&scene)?;
     if let Some(m) = medium {

@@ -23,7 +23,7 @@ pub struct Args {
     #[arg(long, default_value = "metamerism")]
     pub scene: String,
     #[command(flatten)]
-    pub files: super::SceneFileArgs,
+    pub files: super::setup::SceneFileArgs,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "480x360")]
     pub size: String,
@@ -58,7 +58,7 @@ pub fn run(a: Args) -> Result<()> {
         let argv =
             ["truth", &a.scene, "--direct-only", "--spp", &spp, "--size", &a.size, "--out", path_str(out)?];
         let mut args: super::truth::Args = parse(&argv)?;
-        args.files = a.files.clone();
+        args.scene.files = a.files.clone();
         super::truth::run(args)?;
     }
 
@@ -69,7 +69,7 @@ pub fn run(a: Args) -> Result<()> {
             let out = file(&format!("{mode}.{ext}"));
             let argv = ["render", &a.scene, "--mode", mode, "--size", &a.size, "--out", path_str(&out)?];
             let mut args: super::render::RenderArgs = parse(&argv)?;
-            args.files = a.files.clone();
+            args.scene.files = a.files.clone();
             super::render::run(args)?;
         }
     }

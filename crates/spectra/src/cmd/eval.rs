@@ -19,7 +19,8 @@ pub struct Args {
     /// Override the ground-truth samples per pixel (every case, underwater included).
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Override the image size WIDTHxHEIGHT of the error measurements (every case).
+    /// Override the image size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT) of the error
+    /// measurements (every case).
     #[arg(long)]
     pub size: Option<String>,
     /// Wavelength counts N of the error sweep (ours and naive, midpoint and prefiltered
@@ -28,9 +29,8 @@ pub struct Args {
     /// (1,2,4,8,16,32 with --quick, up to 64 in the full run).
     #[arg(long, value_name = "N,N,...")]
     pub sweep: Option<String>,
-    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
-    #[arg(long)]
-    pub table: Option<PathBuf>,
+    #[command(flatten)]
+    pub table: crate::cmd::setup::TableArgs,
     /// Output directory (created); gets index.html, results.json, results.csv, images, charts.
     #[arg(long)]
     pub out: PathBuf,
@@ -41,7 +41,7 @@ pub fn run(a: Args) -> Result<()> {
     if a.spp == Some(0) {
         bail!("--spp must be at least 1");
     }
-    let size = a.size.as_deref().map(crate::cmd::render::parse_size).transpose()?;
+    let size = a.size.as_deref().map(crate::cmd::setup::parse_size).transpose()?;
     budget.override_with(size, a.spp);
     if let Some(s) = &a.sweep {
         budget.sweep_counts = parse_sweep(s)?;
@@ -56,7 +56,7 @@ pub fn run(a: Args) -> Result<()> {
     };
     let notes = suite::notes(&ids);
     let out = a.out.clone();
-    let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table })?;
+    let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table.table })?;
     println!("{}", eval::report::markdown_table(&r));
     println!("{}", eval::report::markdown_sweep(&r));
     println!("report: {}  ({:.0} s)", out.join("index.html").display(), r.seconds);

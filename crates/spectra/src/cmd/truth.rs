@@ -1,8 +1,9 @@
 //! `spectra truth`: the CPU spectral path tracer's ground-truth image of a scene.
 
+use super::setup::{RgbMediumArgs, SceneArgs, SpectrumArgs, TableArgs, WaterArgs, parse_size};
 use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
-use color::{Observer, RgbColorSpace, WavelengthRange};
+use color::{Observer, RgbColorSpace};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -11,10 +12,11 @@ use truth::{Medium, Settings, TruthError, World};
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
-    pub scene: String,
+    // The scene, how it is loaded, and the environment light (--env, --env-intensity,
+    // --env-rotation), shared with `render`; the environment is importance-sampled ∝ luminance
+    // with MIS against the BRDF (truth::env_map).
     #[command(flatten)]
-    pub files: super::SceneFileArgs,
+    pub scene: SceneArgs,
     /// Samples (paths) per pixel; each path carries four wavelengths.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
@@ -25,51 +27,29 @@ pub struct Args {
     /// Random seed; the image depends on it alone (not on threads).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Image size WIDTHxHEIGHT.
+    /// Image size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT).
     #[arg(long, default_value = "256x256")]
     pub size: String,
-    // The environment light (--env, --env-intensity, --env-rotation), shared with `render`;
-    // importance-sampled ∝ luminance with MIS against the BRDF (truth::env_map).
     #[command(flatten)]
-    pub env: super::EnvArgs,
-    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
-    #[arg(long)]
-    pub range: Option<String>,
-    /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
-    #[arg(long)]
-    pub observer: Option<String>,
-    /// Scene white, the reference of the XYZ normalisation (default: the scene's, else D65).
-    #[arg(long)]
-    pub white: Option<String>,
+    pub spectrum: SpectrumArgs,
     /// Longest path, in scattering events (Russian roulette ends most paths long before).
     #[arg(long, default_value_t = 1024)]
     pub max_depth: u32,
     /// A homogeneous participating medium, as JSON (see `truth::medium_file`).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "rgb_medium")]
     pub medium: Option<PathBuf>,
-    /// A homogeneous medium filling the scene, given in RGB: inline JSON or a JSON file, e.g.
-    /// '{"absorption": [0.02, 0.05, 0.1], "scattering": [0.3, 0.3, 0.3], "g": 0.3}' or
-    /// '{"attenuation_color": [0.8, 0.6, 0.5], "attenuation_distance": 4, "albedo": [0.9, 0.9, 0.9]}'
-    /// (per metre / metres; docs/rgb-media.md). Replaces the scene's extras.medium.
-    #[arg(long, value_name = "JSON|FILE", conflicts_with = "medium")]
-    pub rgb_medium: Option<String>,
-    /// Render under water: a Jerlov type (I … III, 1C … 9C, blends like II.5); default: the
-    /// scene's water settings, if any. The water becomes a participating medium with a
-    /// forward-peaked phase function (see `truth::water`).
-    #[arg(long, value_name = "TYPE")]
-    pub water: Option<String>,
-    /// Camera depth below the water surface, metres (default: the scene's, else 10).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
-    pub depth: Option<f64>,
+    #[command(flatten)]
+    pub rgb_medium: RgbMediumArgs,
+    #[command(flatten)]
+    pub water: WaterArgs,
     /// Lambertian BRDF instead of glTF's (only for comparisons with Mitsuba's `diffuse`).
     #[arg(long)]
     pub lambert: bool,
     /// Write CIE XYZ into the EXR's three channels instead of linear sRGB.
     #[arg(long)]
     pub xyz: bool,
-    /// Jakob–Hanika coefficient table (.coeff); default: the cached sRGB table.
-    #[arg(long)]
-    pub table: Option<PathBuf>,
+    #[command(flatten)]
+    pub table: TableArgs,
     /// Also (or only, without --out) export the scene for Mitsuba 3 into this new directory.
     #[arg(long)]
     pub export_mitsuba: Option<PathBuf>,
@@ -96,34 +76,24 @@ pub struct Args {
 }
 
 fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
-    // One size syntax for every command (issue 16): render's parser.
-    let (width, height) = crate::cmd::render::parse_size(&a.size)?;
+    let (width, height) = parse_size(&a.size)?;
     let mut s = Settings::new(width, height, a.spp)?;
     s.seed = a.seed;
     s.direct_only = a.direct_only;
     s.max_depth = a.max_depth;
     s.lambert = a.lambert;
-    s.range = match (&a.range, scene.spectral.range) {
-        (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range {r}"))?,
-        (None, Some((lo, hi))) => {
-            WavelengthRange::new(lo as f64, hi as f64).context("the scene's wavelength range")?
-        }
-        (None, None) => WavelengthRange::VISIBLE,
-    };
-    if let Some(o) = a.observer.as_ref().or(scene.spectral.observer.as_ref()) {
-        s.observer = Observer::by_name(o)?;
-    }
-    if let Some(w) = a.white.as_ref().or(scene.spectral.white.as_ref()) {
-        s.white = color::illuminant::by_name(w)?;
-    }
+    let sp = a.spectrum.resolve(scene)?;
+    s.range = sp.range;
+    s.observer = Observer::by_name(&sp.observer)?;
+    s.white = color::illuminant::by_name(&sp.white)?;
     if let Some(p) = &a.medium {
         let m = Medium::read(p)?;
         m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
         s.medium = Some(m);
     }
     // An explicit --medium / --rgb-medium replaces the scene's own RGB medium.
-    let rgb = match (&a.rgb_medium, &scene.medium) {
-        (Some(arg), _) => Some((super::rgb_medium_arg(arg)?, "--rgb-medium".to_string())),
+    let rgb = match (a.rgb_medium.arg(), &scene.medium) {
+        (Some(arg), _) => Some((super::setup::rgb_medium_arg(arg)?, "--rgb-medium".to_string())),
         (None, Some(m)) if a.medium.is_none() => {
             Some((m.clone(), format!("{}: extras.medium", scene.source)))
         }
@@ -134,7 +104,7 @@ fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable)
         m.validate(s.range).with_context(|| origin.clone())?;
         s.medium = Some(m);
     }
-    if let Some(w) = super::render::water_medium(scene, a.water.as_deref(), a.depth)? {
+    if let Some(w) = a.water.medium(scene)? {
         if a.medium.is_some() || rgb.is_some() {
             bail!(
                 "--medium / --rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
@@ -187,15 +157,8 @@ pub fn run(a: Args) -> Result<()> {
         }
         super::check_output("--export-mitsuba", dir)?;
     }
-    let mut scene = a.files.load(&a.scene)?;
-    super::print_warnings(&scene);
-    a.env.apply(&mut scene)?;
-    let table = match &a.table {
-        Some(p) => std::sync::Arc::new(
-            color::upsample::CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?,
-        ),
-        None => color::upsample::table("srgb").context("loading the sRGB upsampling table")?,
-    };
+    let scene = a.scene.load()?;
+    let table = a.table.load()?;
     let st = settings(&a, &scene, &table)?;
     let t0 = Instant::now();
     let mut world = World::new(&scene, table.as_ref(), &st.white, st.range, st.medium.as_ref())?;
@@ -237,7 +200,7 @@ pub fn run(a: Args) -> Result<()> {
     // without the spectral one it was asked to go with.
     if let (Some(sp), Some(bands)) = (&a.spectral_out, img.spectral.clone()) {
         let edges = st.spectral_bands.clone().expect("bands were asked for");
-        let white = a.white.clone().or(scene.spectral.white.clone()).unwrap_or_else(|| "D65".into());
+        let white = a.spectrum.resolve(&scene)?.white;
         let spec = compare::SpectralImage {
             width: st.width,
             height: st.height,
@@ -407,15 +370,15 @@ mod tests {
         {
             let a = args(flags);
             let mut scene = scene::builtin("cornell").unwrap();
-            a.env.apply(&mut scene).unwrap();
+            a.scene.env.apply(&mut scene).unwrap();
             let st = settings(&a, &scene, &srgb_table()).unwrap();
             let w = World::new(&scene, &up, &st.white, st.range, None).unwrap();
             assert_eq!(w.env_map.is_some(), want, "{flags:?}");
         }
         let mut a = args(&["--env", "default"]);
-        a.scene = "underwater".into();
+        a.scene.scene = "underwater".into();
         let mut scene = scene::builtin("underwater").unwrap();
-        a.env.apply(&mut scene).unwrap();
+        a.scene.env.apply(&mut scene).unwrap();
         let st = settings(&a, &scene, &srgb_table()).unwrap();
         let e = World::new(&scene, &up, &st.white, st.range, st.medium.as_ref()).err().unwrap();
         assert!(e.to_string().contains("environment map"), "{e}");
@@ -428,7 +391,7 @@ mod tests {
         let scene = scene::builtin("underwater").unwrap();
         for extra in [&[][..], &["--water", "II"][..]] {
             let mut a = args(extra);
-            a.scene = "underwater".into();
+            a.scene.scene = "underwater".into();
             let st = settings(&a, &scene, &srgb_table()).unwrap();
             let m = st.medium.as_ref().unwrap();
             assert_eq!(m.surface_ior, Some(scene::water::WATER_IOR as f32));
@@ -436,14 +399,5 @@ mod tests {
             let sky = w.surface.as_ref().and_then(|s| s.sky.as_ref()).expect("a sky");
             assert!(sky.eval(550.0) > 0.0);
         }
-    }
-
-    #[test]
-    fn sizes() {
-        use crate::cmd::render::parse_size;
-        assert_eq!(parse_size("64x32").unwrap(), (64, 32));
-        assert_eq!(parse_size("64*32").unwrap(), (64, 32), "the same separators as render");
-        assert!(parse_size("0x3").is_err());
-        assert!(parse_size("64").is_err());
     }
 }

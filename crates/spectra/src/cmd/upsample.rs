@@ -20,9 +20,10 @@ pub struct Args {
     /// Colour space of the RGB: srgb, p3, rec2020, acescg, aces2065-1.
     #[arg(long, default_value = "srgb")]
     pub space: String,
-    /// Upsampling method: jakob, smits, box.
+    /// Upsampling method: jakob, smits, box (parsed by `color::upsample::Method`, aliases and any
+    /// case included).
     #[arg(long, default_value = "jakob")]
-    pub method: String,
+    pub method: Method,
     /// Use this `.coeff` table for the jakob method instead of the cached default.
     #[arg(long)]
     pub table: Option<PathBuf>,
@@ -57,7 +58,7 @@ fn emit(text: &str) -> Result<()> {
 }
 
 fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
-    let m: Method = a.method.parse()?;
+    let m = a.method;
     match (&a.table, m) {
         (Some(p), Method::Jakob) => {
             let t = CoeffTable::read(p)?;

@@ -2,23 +2,22 @@
 //! exposure, tone map, accumulation at jittered wavelengths), an orbit/fly camera, a CPU/GPU
 //! frame-time readout and screenshots.
 
-use crate::cmd::render::{LookArgs, load_table, parse_size};
+use super::setup::{LookArgs, SceneArgs, parse_size};
 use crate::view::app::{ViewOptions, run as run_window};
 use crate::view::controls::MAX_VIEW_WAVELENGTHS;
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow, bail};
 use clap::Args as ClapArgs;
-use render::{Mode, RenderSettings, Tonemap};
+use render::RenderSettings;
 
 /// What to say when there is nowhere to open a window.
 pub const NO_DISPLAY: &str = "no window system: set DISPLAY or use `spectra render`";
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
-    pub scene: String,
     #[command(flatten)]
-    pub files: super::SceneFileArgs,
-    /// Initial window size WIDTHxHEIGHT (the renderer follows the window).
+    pub scene: SceneArgs,
+    /// Initial window size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT; the renderer follows
+    /// the window).
     #[arg(long, default_value = "960x640")]
     pub size: String,
     #[command(flatten)]
@@ -28,27 +27,17 @@ pub struct Args {
 /// The initial settings: arguments first, then the scene's spectral defaults, then the
 /// renderer's. Refuses what the viewer cannot show, naming the argument.
 pub fn initial_settings(args: &Args, scene: &scene::Scene) -> Result<RenderSettings> {
-    let (range, wavelengths, observer) = args.look.spectral(scene)?;
-    if !(1..=MAX_VIEW_WAVELENGTHS).contains(&wavelengths) {
-        bail!("--wavelengths {wavelengths}: the viewer shows 1 to {MAX_VIEW_WAVELENGTHS} wavelengths");
+    if let Some(n) = args.look.wavelengths.filter(|n| !(1..=MAX_VIEW_WAVELENGTHS).contains(n)) {
+        bail!("--wavelengths {n}: the viewer shows 1 to {MAX_VIEW_WAVELENGTHS} wavelengths");
     }
-    color::Observer::by_name(&observer).with_context(|| format!("--observer '{observer}'"))?;
-    let s = RenderSettings {
-        mode: Mode::parse(&args.look.mode).context("--mode")?,
-        wavelengths,
-        range,
-        observer,
-        white: scene.spectral.white_name().into(),
-        exposure_ev: args.look.exposure,
-        tonemap: Tonemap::parse(&args.look.tonemap).context("--tonemap")?,
-        shadows: true,
-        timestamps: true,
-        jitter: None,
-        quadrature: args.look.quadrature,
-        lambert: args.look.lambert,
-        env_occlusion: !args.look.no_env_occlusion,
-    };
-    s.validate().map_err(|e| anyhow!("{e}"))?;
+    let s = args.look.settings(scene, true, true)?;
+    if !(1..=MAX_VIEW_WAVELENGTHS).contains(&s.wavelengths) {
+        bail!(
+            "scene {}: {} wavelengths; the viewer shows 1 to {MAX_VIEW_WAVELENGTHS} (give --wavelengths)",
+            scene.source,
+            s.wavelengths
+        );
+    }
     Ok(s)
 }
 
@@ -59,25 +48,18 @@ fn display_named(display: Option<std::ffi::OsString>) -> bool {
 
 pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
-    let mut scene = args.files.load(&args.scene)?;
-    super::print_warnings(&scene);
-    args.look.env.apply(&mut scene)?;
+    let scene = args.scene.load()?;
     let settings = initial_settings(&args, &scene)?;
-    let water = super::render::water_medium(&scene, args.look.water.as_deref(), args.look.depth)?;
-    let water_options = args.look.underwater()?;
+    // Bad water is refused before looking for a display (the media are built after it).
+    args.look.water.medium(&scene)?;
     if !display_named(std::env::var_os("DISPLAY")) {
         bail!("{NO_DISPLAY}");
     }
     // The event loop connects to the X server; a named but unreachable display fails here.
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| anyhow!("{NO_DISPLAY} ({e})"))?;
-    let table = load_table(args.look.table.as_deref())?;
-    let medium = super::realtime_medium(
-        &scene,
-        args.look.rgb_medium.as_deref(),
-        water.is_some(),
-        &table,
-        args.look.rgb_medium_options(),
-    )?;
+    let table = args.look.table.load()?;
+    let super::setup::RealtimeMedia { water, water_options, rgb: medium } =
+        args.look.media(&scene, &table)?;
     run_window(event_loop, ViewOptions { scene, settings, size, table, water, water_options, medium })
 }
 
@@ -85,6 +67,7 @@ pub fn run(args: Args) -> Result<()> {
 mod tests {
     use super::*;
     use clap::Parser;
+    use render::{Mode, Tonemap};
 
     #[derive(Parser)]
     struct Cli {
@@ -96,7 +79,7 @@ mod tests {
         let mut full = vec!["view"];
         full.extend_from_slice(argv);
         let args = Cli::try_parse_from(full).map_err(|e| anyhow!("{e}"))?.args;
-        let scene = scene::load_any(&args.scene)?;
+        let scene = scene::load_any(&args.scene.scene)?;
         initial_settings(&args, &scene)
     }
 
@@ -108,6 +91,27 @@ mod tests {
             parse(&["cornell", "--observer", "cie1964", "--exposure", "-1.5", "--tonemap", "aces"]).unwrap();
         assert_eq!((s.observer.as_str(), s.exposure_ev, s.tonemap), ("cie1964", -1.5, Tonemap::Aces));
         assert!(s.timestamps, "the viewer always asks for GPU timings");
+    }
+
+    /// `--mode`/`--tonemap` take the library's names and aliases in any case (clap
+    /// `ValueEnum`s over `Mode::ALL`/`Tonemap::ALL`); `--white` reaches the settings, else the
+    /// scene's white does.
+    #[test]
+    fn enum_spellings_and_the_white() {
+        let s = parse(&["cornell", "--mode", "JH", "--tonemap", "Clamp", "--white", "D50"]).unwrap();
+        assert_eq!((s.mode, s.tonemap, s.white.as_str()), (Mode::Spectral, Tonemap::None, "D50"));
+        let s = parse(&["cornell", "--mode", "box"]).unwrap();
+        assert_eq!((s.mode, s.white.as_str()), (Mode::Naive, scene::DEFAULT_WHITE));
+        for m in Mode::ALL {
+            assert_eq!(parse(&["cornell", "--mode", m.name()]).unwrap().mode, m);
+        }
+        for t in Tonemap::ALL {
+            assert_eq!(parse(&["cornell", "--tonemap", t.name()]).unwrap().tonemap, t);
+        }
+        let e = format!("{:#}", parse(&["cornell", "--mode", "hsv"]).unwrap_err());
+        assert!(e.contains("hsv") && e.contains("rgb, naive, spectral"), "{e}");
+        let e = format!("{:#}", parse(&["cornell", "--white", "1K"]).unwrap_err());
+        assert!(e.contains("--white '1K'") && e.contains("500–1000000 K"), "{e}");
     }
 
     #[test]

@@ -46,7 +46,7 @@ pub struct TruthJob {
 
 /// The scene's water as the renderer and the tracer need it, if it has any.
 pub fn water(scene: &scene::Scene) -> Result<Option<scene::water::WaterMedium>> {
-    crate::cmd::render::water_medium(scene, None, None)
+    crate::cmd::setup::water_medium(scene, None, None)
 }
 
 /// Ground truth of a scene: direct lighting only, linear sRGB.

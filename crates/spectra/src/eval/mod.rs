@@ -182,7 +182,7 @@ pub fn run(cfg: Config) -> Result<Results> {
             std::fs::remove_file(&p).with_context(|| format!("removing stale {}", p.display()))?;
         }
     }
-    let table = crate::cmd::render::load_table(cfg.table.as_deref())?;
+    let table = crate::cmd::setup::load_table(cfg.table.as_deref())?;
     let cancel = color::upsample::interrupt_flag();
     let check = || -> Result<()> {
         if cancel.load(Ordering::Relaxed) {

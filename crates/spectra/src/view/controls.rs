@@ -10,9 +10,8 @@ use std::path::{Path, PathBuf};
 /// Most wavelengths the viewer offers (the renderer allows more; beyond 64 lavapipe crawls).
 pub const MAX_VIEW_WAVELENGTHS: usize = 64;
 
-const MODES: [Mode; 3] = [Mode::Rgb, Mode::Naive, Mode::Spectral];
-const TONEMAPS: [(Tonemap, &str); 3] =
-    [(Tonemap::None, "none"), (Tonemap::Reinhard, "reinhard"), (Tonemap::Aces, "aces")];
+const MODES: [Mode; 3] = Mode::ALL;
+const TONEMAPS: [Tonemap; 3] = Tonemap::ALL;
 
 /// Shortcuts, shown in the panel and printed at start.
 pub const HELP: &str = "left drag: orbit · right drag: look · wheel: zoom · WASD/QE: fly (Shift ×4) · \
@@ -113,8 +112,8 @@ impl Controls {
     }
 
     pub fn cycle_tonemap(&mut self) {
-        let i = TONEMAPS.iter().position(|t| t.0 == self.wanted.tonemap).unwrap_or(0);
-        self.wanted.tonemap = TONEMAPS[(i + 1) % TONEMAPS.len()].0;
+        let i = TONEMAPS.iter().position(|t| *t == self.wanted.tonemap).unwrap_or(0);
+        self.wanted.tonemap = TONEMAPS[(i + 1) % TONEMAPS.len()];
     }
 
     pub fn cycle_observer(&mut self) {
@@ -163,8 +162,8 @@ impl Controls {
         ui.add(egui::Slider::new(&mut w.exposure_ev, -8.0..=8.0).step_by(0.25).text("exposure EV"));
         ui.horizontal(|ui| {
             ui.label("tone map");
-            for (t, name) in TONEMAPS {
-                ui.radio_value(&mut w.tonemap, t, name);
+            for t in TONEMAPS {
+                ui.radio_value(&mut w.tonemap, t, t.name());
             }
         });
         ui.checkbox(&mut w.shadows, "shadow maps");

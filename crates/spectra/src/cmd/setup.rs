@@ -1,0 +1,676 @@
+//! What the commands that render a scene share on the command line, and how it becomes a
+//! scene, settings and media: the scene and how it is loaded (`SceneArgs`: `render`, `view`,
+//! `truth`, `bench`), the spectral settings (`SpectrumArgs`: range, observer, white), the
+//! water (`WaterArgs`), the RGB medium (`RgbMediumArgs`), the upsampling table (`TableArgs`,
+//! also `eval`), the real-time picture (`LookArgs`: `render`, `view`) and `--size`. Each
+//! default that falls back to the scene is resolved here, once.
+
+use anyhow::{Context, Result, anyhow, bail};
+use clap::Args;
+use color::WavelengthRange;
+use color::upsample::CoeffTable;
+use render::passes::underwater;
+use render::settings::MAX_WAVELENGTHS;
+use render::{CustomShader, Mode, RenderSettings, Tonemap};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The scene on the command line: a built-in or a file, how it is loaded, and the
+/// environment light put into it.
+#[derive(Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a .gltf/.glb file.
+    pub scene: String,
+    #[command(flatten)]
+    pub files: SceneFileArgs,
+    #[command(flatten)]
+    pub env: EnvArgs,
+}
+
+impl SceneArgs {
+    /// Loads the scene, prints the loader's warnings and applies the environment flags.
+    pub fn load(&self) -> Result<scene::Scene> {
+        let mut scene = self.files.load(&self.scene)?;
+        print_warnings(&scene);
+        self.env.apply(&mut scene)?;
+        Ok(scene)
+    }
+}
+
+/// What the picture looks like: shared by `spectra render` and `spectra view`.
+#[derive(Args, Debug, Clone)]
+pub struct LookArgs {
+    /// rgb (classic), naive (box upsampling) or spectral (Jakob–Hanika); any case.
+    #[arg(long, value_enum, ignore_case = true, default_value_t = Mode::Spectral)]
+    pub mode: Mode,
+    /// Number of wavelength samples (default: the scene's, else 16; the viewer shows 1–64).
+    #[arg(long)]
+    pub wavelengths: Option<usize>,
+    #[command(flatten)]
+    pub spectrum: SpectrumArgs,
+    /// How the N wavelength nodes are integrated: prefiltered (light × observer integrated
+    /// densely against the nodes' cubic interpolant, so line spectra never alias) or midpoint
+    /// (the paper's point-sampled sum).
+    #[arg(long, default_value = "prefiltered", value_parser = parse_quadrature)]
+    pub quadrature: color::Quadrature,
+    /// Exposure in stops (the image is multiplied by 2^EV).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone mapping (PNG output and the window): none, reinhard or aces; any case.
+    #[arg(long, value_enum, ignore_case = true, default_value_t = Tonemap::None)]
+    pub tonemap: Tonemap,
+    #[command(flatten)]
+    pub table: TableArgs,
+    #[command(flatten)]
+    pub water: WaterArgs,
+    #[command(flatten)]
+    pub rgb_medium: RgbMediumArgs,
+    /// Under water or in an RGB medium: ray-march steps for single scattering of the scene's
+    /// lights (0–32; under water 0 = the paper's analytic in-scattering alone, in an RGB
+    /// medium attenuation alone).
+    #[arg(long, value_name = "STEPS", default_value_t = underwater::Options::default().steps)]
+    pub scatter_steps: u32,
+    /// In an RGB medium: single scattering only, without the multiple-scattering term (what
+    /// `spectra truth --direct-only` computes; docs/rgb-media.md).
+    #[arg(long)]
+    pub single_scattering: bool,
+    /// Under water: Henyey–Greenstein asymmetry g of single scattering (default: Petzold's 0.924).
+    #[arg(long, value_name = "G", allow_negative_numbers = true,
+          default_value_t = underwater::Options::default().phase_g)]
+    pub phase_g: f32,
+    /// Under water: the paper's model exactly (isotropic scattering of the plane irradiance
+    /// attenuated by the tabulated Kd, no single scattering).
+    #[arg(long, conflicts_with_all = ["scatter_steps", "phase_g", "scalar_irradiance", "split_beams", "water_surface",
+          "isotropic", "tabulated_kd", "light_field_photons", "no_water_surface", "no_sea_floor",
+          "no_surface_irradiance", "forward_cone"])]
+    pub paper_model: bool,
+    /// Under water: the paper's isotropic in-scattering term with the tabulated Kd plus the
+    /// marched single scattering (the previous default) instead of the light-field source.
+    #[arg(long, conflicts_with_all = ["tabulated_kd", "light_field_photons", "no_surface_irradiance"])]
+    pub isotropic: bool,
+    /// Under water, light-field model: attenuate surfaces by the type's tabulated Kd instead
+    /// of the downwelling irradiance derived from a, b and the phase function.
+    #[arg(long)]
+    pub tabulated_kd: bool,
+    /// Under water, light-field model: light surfaces as the paper does (the scene's lights
+    /// attenuated by the downwelling irradiance, the sky straight down) instead of with the
+    /// sun's beam plus the water column's diffuse irradiance for each surface's normal.
+    #[arg(long)]
+    pub no_surface_irradiance: bool,
+    /// Under water, light-field model: half-angle (degrees, 0–45) of the forward cone whose
+    /// scattering view rays treat as not scattering (objects keep their image through turbid
+    /// water); 0 = the plain source term.
+    #[arg(long, value_name = "DEG", default_value_t = underwater::FORWARD_CONE_DEG)]
+    pub forward_cone: f32,
+    /// Under water, light-field model: photons per wavelength node and source for the
+    /// table's solver (solved once per water type, sun, sky and depth range, then cached).
+    #[arg(long, value_name = "N", default_value_t = underwater::LIGHT_FIELD_PHOTONS)]
+    pub light_field_photons: usize,
+    /// Under water: scatter the diffuse light's scalar irradiance (Kd/a)·E_d (Gershun's law)
+    /// instead of the paper's plane irradiance E_d.
+    #[arg(long)]
+    pub scalar_irradiance: bool,
+    /// Under water: take the unscattered sun beams out of the isotropic term (single
+    /// scattering counts them with the real phase function) instead of adding single
+    /// scattering on top of the paper's term.
+    #[arg(long)]
+    pub split_beams: bool,
+    /// Under water, isotropic model: draw the surface seen from below (Snell's window with the
+    /// sky, Fresnel reflection and total internal reflection of the water below, not of the sea
+    /// floor). The light-field model draws it by default, sea floor included.
+    #[arg(long)]
+    pub water_surface: bool,
+    /// Under water, light-field model: do not draw the surface seen from below (the view ray
+    /// ends in the water's own in-scattering, as in the paper).
+    #[arg(long, conflicts_with_all = ["isotropic", "water_surface"])]
+    pub no_water_surface: bool,
+    /// Under water, light-field model: solve the water column without the sea floor under the
+    /// camera (a bottomless column), i.e. without the light the floor sends back into the water.
+    #[arg(long, conflicts_with = "isotropic")]
+    pub no_sea_floor: bool,
+    /// Lambert only: every surface reflects base colour / π, no specular (like `truth
+    /// --lambert`; for comparisons with renderers without the glTF BRDF, and the white furnace).
+    #[arg(long)]
+    pub lambert: bool,
+    /// Turn off the screen-space occlusion of ambient light: the environment and the water's
+    /// diffuse irradiance (then every point sees the whole environment or water column).
+    #[arg(long)]
+    pub no_env_occlusion: bool,
+}
+
+impl LookArgs {
+    /// The frame's settings: the arguments first, then the scene's spectral defaults, then
+    /// the renderer's. `shadows` and `timestamps` are the command's own choices. Errors name
+    /// the argument.
+    pub fn settings(&self, scene: &scene::Scene, shadows: bool, timestamps: bool) -> Result<RenderSettings> {
+        let sp = self.spectrum.resolve(scene)?;
+        let wavelengths = self
+            .wavelengths
+            .or(scene.spectral.wavelengths.map(|n| n as usize))
+            .unwrap_or(RenderSettings::default().wavelengths);
+        let s = RenderSettings {
+            mode: self.mode,
+            wavelengths,
+            range: sp.range,
+            observer: sp.observer,
+            white: sp.white,
+            exposure_ev: self.exposure,
+            tonemap: self.tonemap,
+            shadows,
+            timestamps,
+            jitter: None,
+            quadrature: self.quadrature,
+            lambert: self.lambert,
+            env_occlusion: !self.no_env_occlusion,
+        };
+        s.validate().map_err(|e| match self.wavelengths {
+            Some(n) if n == s.wavelengths && !(1..=MAX_WAVELENGTHS).contains(&n) => {
+                anyhow!("--wavelengths {n}: {e}")
+            }
+            _ => anyhow!("{e}"),
+        })?;
+        Ok(s)
+    }
+
+    /// The underwater model's options from `--scatter-steps`, `--phase-g` and the model flags.
+    pub fn underwater(&self) -> Result<underwater::Options> {
+        let o = if self.paper_model {
+            underwater::Options::paper()
+        } else {
+            underwater::Options {
+                steps: self.scatter_steps,
+                phase_g: self.phase_g,
+                scalar_irradiance: self.scalar_irradiance,
+                split_beams: self.split_beams,
+                surface: if self.isotropic || self.scalar_irradiance || self.split_beams {
+                    self.water_surface
+                } else {
+                    !self.no_water_surface
+                },
+                light_field: !(self.isotropic || self.scalar_irradiance || self.split_beams),
+                sea_floor: !self.no_sea_floor,
+                tabulated_kd: self.tabulated_kd,
+                irradiance: !(self.no_surface_irradiance || self.tabulated_kd),
+                forward_cone_deg: self.forward_cone,
+                photons: self.light_field_photons,
+            }
+        };
+        o.validate().map_err(|e| anyhow!("underwater model options: {e}"))?;
+        Ok(o)
+    }
+
+    /// The RGB medium's real-time options (`--scatter-steps`, `--single-scattering`).
+    pub fn rgb_medium_options(&self) -> ::render::passes::rgb_medium::Options {
+        ::render::passes::rgb_medium::Options { steps: self.scatter_steps, multiple: !self.single_scattering }
+    }
+
+    /// The media of a real-time frame: the water (`--water`/`--depth` or the scene's) with
+    /// its model options, or the RGB medium (`--rgb-medium` or the scene's) as its hooks;
+    /// both at once is an error.
+    pub fn media(&self, scene: &scene::Scene, table: &CoeffTable) -> Result<RealtimeMedia> {
+        let water = self.water.medium(scene)?;
+        // The model's options matter only under water (as before, bad ones are refused there).
+        let water_options = if water.is_some() { self.underwater()? } else { underwater::Options::default() };
+        let rgb =
+            realtime_medium(scene, self.rgb_medium.arg(), water.is_some(), table, self.rgb_medium_options())?;
+        Ok(RealtimeMedia { water, water_options, rgb })
+    }
+}
+
+/// What fills the space between the camera and the surfaces in a real-time frame
+/// ([`LookArgs::media`]); at most one of `water` and `rgb` is set.
+pub struct RealtimeMedia {
+    /// The water the camera is in.
+    pub water: Option<scene::water::WaterMedium>,
+    /// The underwater model's choices (used when `water` is set).
+    pub water_options: underwater::Options,
+    /// The RGB medium filling the scene, as its hooks.
+    pub rgb: Option<CustomShader>,
+}
+
+impl RealtimeMedia {
+    /// The custom shader that draws them: the underwater pass, or the RGB medium's.
+    pub fn shader(&self) -> Result<Option<CustomShader>> {
+        Ok(match &self.water {
+            Some(m) => Some(underwater::shader_with(m, &self.water_options)?),
+            None => self.rgb.clone(),
+        })
+    }
+}
+
+/// The spectral settings both renderers share (the real-time one adds `--wavelengths`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct SpectrumArgs {
+    /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
+    #[arg(long, value_name = "MIN:MAX")]
+    pub range: Option<String>,
+    /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
+    #[arg(long)]
+    pub observer: Option<String>,
+    /// Scene white, the reference of the XYZ normalisation and of RGB emission: an illuminant
+    /// name (D65, D50, A, F11, …, or a temperature such as 5000K; default: the scene's
+    /// spectra.white, else D65).
+    #[arg(long)]
+    pub white: Option<String>,
+}
+
+/// [`SpectrumArgs`] with the scene's defaults and the renderers' filled in, checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spectrum {
+    pub range: WavelengthRange,
+    /// A name `color::Observer::by_name` knows.
+    pub observer: String,
+    /// A name `color::illuminant::by_name` knows.
+    pub white: String,
+}
+
+impl SpectrumArgs {
+    /// The arguments first, then the scene's `spectra` settings, then the defaults; an
+    /// unknown name is an error naming the flag or the scene.
+    pub fn resolve(&self, scene: &scene::Scene) -> Result<Spectrum> {
+        let d = RenderSettings::default();
+        let range = match (&self.range, scene.spectral.range) {
+            (Some(r), _) => WavelengthRange::parse(r).with_context(|| format!("--range '{r}'"))?,
+            (None, Some((a, b))) => WavelengthRange::new(a as f64, b as f64)
+                .with_context(|| format!("scene {}: spectral range", scene.source))?,
+            (None, None) => d.range,
+        };
+        let from = |flag: &str, given: &Option<String>| match given {
+            Some(v) => format!("{flag} '{v}'"),
+            None => format!("scene {}: spectra {}", scene.source, &flag[2..]),
+        };
+        let observer = self.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
+        color::Observer::by_name(&observer).with_context(|| from("--observer", &self.observer))?;
+        let white = self.white.clone().unwrap_or_else(|| scene.spectral.white_name().to_string());
+        color::illuminant::by_name(&white).with_context(|| from("--white", &self.white))?;
+        Ok(Spectrum { range, observer, white })
+    }
+}
+
+/// Water on the command line (`render`, `view`, `truth`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct WaterArgs {
+    /// Render under water: a Jerlov type (I, IA, IB, II, III, 1C … 9C, or a blend such as
+    /// II.5). Default: the scene's own water settings, if it has any. (The path tracer makes
+    /// it a participating medium with a forward-peaked phase function, see `truth::water`.)
+    #[arg(long, value_name = "TYPE")]
+    pub water: Option<String>,
+    /// Camera depth below the water surface, metres (default: the scene's, else 10).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub depth: Option<f64>,
+}
+
+impl WaterArgs {
+    /// The water the camera is in, if any: [`water_medium`] with these flags.
+    pub fn medium(&self, scene: &scene::Scene) -> Result<Option<scene::water::WaterMedium>> {
+        water_medium(scene, self.water.as_deref(), self.depth)
+    }
+}
+
+/// `--rgb-medium` (`render`, `view`, `bench`, `truth`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct RgbMediumArgs {
+    /// A homogeneous medium filling the scene, given in RGB: inline JSON or a JSON file, e.g.
+    /// '{"absorption": [0.02, 0.05, 0.1], "scattering": [0.3, 0.3, 0.3], "g": 0.3}' or
+    /// '{"attenuation_color": [0.8, 0.6, 0.5], "attenuation_distance": 4, "albedo": [0.9, 0.9, 0.9]}'
+    /// (per metre / metres; docs/rgb-media.md). Replaces the scene's extras.medium.
+    #[arg(long, value_name = "JSON|FILE")]
+    pub rgb_medium: Option<String>,
+}
+
+impl RgbMediumArgs {
+    pub fn arg(&self) -> Option<&str> {
+        self.rgb_medium.as_deref()
+    }
+}
+
+/// `--table` (`render`, `view`, `bench`, `truth`, `eval`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct TableArgs {
+    /// Jakob–Hanika coefficient table (.coeff). Default: the sRGB 64³ table, fitted once per
+    /// machine and cached (see `spectra lut`, $SPECTRA_CACHE_DIR).
+    #[arg(long)]
+    pub table: Option<PathBuf>,
+}
+
+impl TableArgs {
+    /// The table: `--table`, else the colour crate's cached sRGB fit (fitted on first use).
+    pub fn load(&self) -> Result<Arc<CoeffTable>> {
+        load_table(self.table.as_deref())
+    }
+}
+
+/// `--table FILE` or, without one, the colour crate's cached sRGB fit (fitted on first use).
+pub fn load_table(explicit: Option<&std::path::Path>) -> Result<Arc<CoeffTable>> {
+    match explicit {
+        Some(p) => {
+            Ok(Arc::new(CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?))
+        }
+        None => color::upsample::table("srgb").context("the sRGB coefficient table"),
+    }
+}
+
+/// `--size` of every command: `WIDTHxHEIGHT`, the separator `x`, `X` or `*` (every spelling
+/// `render` or `truth` ever accepted), blanks around the numbers allowed; both positive.
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) = s
+        .split_once(['x', 'X', '*'])
+        .ok_or_else(|| anyhow!("--size '{s}' must look like WIDTHxHEIGHT, e.g. 640x480"))?;
+    let num = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    match (num(w), num(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--size '{s}': width and height must be positive integers"),
+    }
+}
+
+/// `--quadrature NAME`.
+pub fn parse_quadrature(s: &str) -> std::result::Result<color::Quadrature, String> {
+    color::Quadrature::parse(s).map_err(|e| e.to_string())
+}
+
+/// Camera depth used when `--water` is given for a scene without water settings.
+pub const DEFAULT_WATER_DEPTH: f64 = 10.0;
+
+/// The water the camera is in: the scene's `WaterSettings` with `--water`/`--depth` applied on
+/// top, or `None` when neither the scene nor the flags ask for water. Unknown types, negative
+/// or non-finite depths and `--depth` without any water are clear errors.
+pub fn water_medium(
+    scene: &scene::Scene,
+    water: Option<&str>,
+    depth: Option<f64>,
+) -> Result<Option<scene::water::WaterMedium>> {
+    let mut settings = scene.water.clone();
+    if let Some(ty) = water {
+        let base = settings.unwrap_or(scene::WaterSettings {
+            water_type: String::new(),
+            depth: DEFAULT_WATER_DEPTH as f32,
+            sun_direction: glam::Vec3::Y,
+            scale: 1.0,
+            sky: 0.0,
+        });
+        settings = Some(scene::WaterSettings { water_type: ty.to_string(), ..base });
+    }
+    let Some(mut settings) = settings else {
+        if let Some(d) = depth {
+            bail!("--depth {d}: scene {} has no water; add --water TYPE (e.g. --water II)", scene.source);
+        }
+        return Ok(None);
+    };
+    if let Some(d) = depth {
+        if !(d.is_finite() && d >= 0.0) {
+            bail!("--depth {d}: the camera depth must be a finite number of metres ≥ 0 below the surface");
+        }
+        settings.depth = d as f32;
+    }
+    // `water.sun_direction` drives the light-field table: a dry scene given --water takes it
+    // from the scene's sun (undoing the refraction), and a scene whose sun disagrees with its
+    // own setting is refused rather than rendered with a table for another sun.
+    let sun = scene.lights.iter().find_map(|l| match l.kind {
+        scene::LightKind::Directional { direction } if l.stands_in_for.is_none() && direction.y < 0.0 => {
+            Some(-direction.normalize())
+        }
+        _ => None,
+    });
+    if let (None, Some(to_sun)) = (&scene.water, sun) {
+        let h = glam::Vec3::new(to_sun.x, 0.0, to_sun.z) * scene::water::WATER_IOR as f32;
+        if h.length() < 1.0 {
+            settings.sun_direction = glam::Vec3::new(h.x, (1.0 - h.length_squared()).sqrt(), h.z);
+        }
+    }
+    // The message already includes its cause; anyhow's chain would print it twice.
+    let medium = scene::water::WaterMedium::from_settings(&settings).map_err(|e| match water {
+        Some(w) => anyhow!("--water '{w}': {e}"),
+        None => anyhow!("scene {}: water settings: {e}", scene.source),
+    })?;
+    let mut medium = medium;
+    // The floor under the camera closes the light-field model's water column.
+    medium.floor = scene::water::floor::below_camera(scene, medium.scale)
+        .map_err(|e| anyhow!("scene {}: {e}", scene.source))?;
+    if let (Some(_), Some(to_sun)) = (&scene.water, sun) {
+        let want = medium.sun_dir_underwater();
+        let angle = to_sun.dot(want).clamp(-1.0, 1.0).acos().to_degrees();
+        if angle > 0.5 {
+            bail!(
+                "scene {}: its sun shines from {to_sun:?} under water, but water.sun_direction {:?} refracts \
+                 to {want:?} ({angle:.1}° apart); make the light's direction the refracted water.sun_direction \
+                 (the underwater light-field table is computed for water.sun_direction)",
+                scene.source,
+                medium.sun_dir
+            );
+        }
+    }
+    // Both renderers put the whole scene under a flat surface `depth` above the camera: geometry
+    // above it would be lit and seen as if under water by the rasteriser and as in air by the
+    // path tracer.
+    if let Some((_, hi)) = scene.bounds() {
+        let above = (hi.y - scene.camera.position().y) as f64 * medium.scale;
+        if above > medium.depth + 1e-6 {
+            bail!(
+                "scene {}: its geometry reaches {above:.2} m above the camera, above the water surface {:.2} m \
+                 up; use --depth {:.2} or more (or a larger water scale)",
+                scene.source,
+                medium.depth,
+                above
+            );
+        }
+    }
+    Ok(Some(medium))
+}
+
+/// Prints what the loader skipped or approximated, one `warning: <scene>: <text>` line each on
+/// stderr (unsupported optional glTF extensions, points and lines, …).
+pub fn print_warnings(scene: &scene::Scene) {
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.source);
+    }
+}
+
+/// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it (`render`, `view`,
+/// `bench`, `truth`).
+pub fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
+    let (text, origin) = if arg.trim_start().starts_with('{') {
+        (arg.to_string(), "--rgb-medium".to_string())
+    } else {
+        let p = std::path::Path::new(arg);
+        let t = color::input::read_regular_string(p, ::truth::medium_file::MAX_MEDIUM_FILE_BYTES)
+            .with_context(|| format!("--rgb-medium {arg}: cannot read"))?;
+        (t, format!("--rgb-medium {arg}"))
+    };
+    scene::medium::RgbMedium::from_json_str(&text).map_err(|e| anyhow!("{origin}: {e}"))
+}
+
+/// The real-time renderer's RGB medium: `--rgb-medium`, else the scene's `extras.medium`;
+/// with water (which is a medium of its own) it is an error, as for `spectra truth`. As a
+/// custom shader with `steps` march steps, upsampled through `table`.
+pub fn realtime_medium(
+    scene: &scene::Scene,
+    arg: Option<&str>,
+    water: bool,
+    table: &color::upsample::CoeffTable,
+    opts: ::render::passes::rgb_medium::Options,
+) -> Result<Option<CustomShader>> {
+    let m = match (arg, &scene.medium) {
+        (Some(a), _) => rgb_medium_arg(a)?,
+        (None, Some(m)) => m.clone(),
+        (None, None) => return Ok(None),
+    };
+    if water {
+        bail!(
+            "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
+        );
+    }
+    Ok(Some(::render::passes::rgb_medium::shader(&m, table, &opts)?))
+}
+
+/// How a scene file is loaded, shared by every command that takes a scene (`render`, `view`,
+/// `truth`, `bench`).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct SceneFileArgs {
+    /// Let the scene's file references (buffers, images, CSV spectra, environment maps) leave
+    /// its folder: absolute paths, `..`, symlinks to elsewhere. Off by default so that a scene
+    /// from elsewhere cannot read your other files (docs/scene-format.md, "File references").
+    #[arg(long)]
+    pub allow_outside_scene_dir: bool,
+}
+
+impl SceneFileArgs {
+    /// Loads a built-in scene or a .gltf/.glb file, with these options.
+    pub fn load(&self, name: &str) -> Result<scene::Scene> {
+        let opts = scene::LoadOptions { allow_outside_scene_dir: self.allow_outside_scene_dir };
+        scene::load_any_with(name, &opts).with_context(|| format!("loading scene '{name}'"))
+    }
+}
+
+/// The environment light on the command line, shared by `render`, `view` and `truth`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct EnvArgs {
+    /// Environment light: an equirectangular .hdr or .exr of linear radiance, `default` (a
+    /// uniform white D65 sky over a grey ground) or `none`. Default: the scene's own
+    /// (extras.environment), else the default environment when the scene has no lights at all.
+    #[arg(long, value_name = "FILE|default|none")]
+    pub env: Option<String>,
+    /// Multiplies the environment's radiance.
+    #[arg(long, value_name = "K")]
+    pub env_intensity: Option<f32>,
+    /// Turns the environment about +Y, degrees.
+    #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
+    pub env_rotation: Option<f32>,
+}
+
+impl EnvArgs {
+    /// Sets the scene's environment as asked; prints the note (default environment chosen) or
+    /// warning (nothing lights the scene) on stderr.
+    pub fn apply(&self, scene: &mut scene::Scene) -> Result<()> {
+        let choice = scene::environment::EnvironmentChoice {
+            env: self.env.clone(),
+            intensity: self.env_intensity,
+            rotation: self.env_rotation,
+        };
+        if let Some(note) = choice.apply(scene)? {
+            eprintln!("{note}");
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("64x48").unwrap(), (64, 48));
+        assert_eq!(parse_size("64X48").unwrap(), (64, 48));
+        assert_eq!(parse_size("64*32").unwrap(), (64, 32));
+        assert_eq!(parse_size(" 64 x 32 ").unwrap(), (64, 32));
+        assert!(parse_size("64").unwrap_err().to_string().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x10").unwrap_err().to_string().contains("positive"));
+        assert!(parse_size("64,32").is_err());
+    }
+
+    /// The flags win over the scene's `spectra` settings, which win over the defaults; an
+    /// unknown name is refused naming where it came from.
+    #[test]
+    fn spectrum_flags_then_scene_then_defaults() {
+        let mut scene = scene::builtin("cornell").unwrap();
+        let none = SpectrumArgs::default();
+        let s = none.resolve(&scene).unwrap();
+        assert_eq!((s.observer.as_str(), s.white.as_str()), ("cie1931", scene::DEFAULT_WHITE));
+        assert_eq!(s.range, RenderSettings::default().range);
+        scene.spectral.white = Some("D50".into());
+        scene.spectral.observer = Some("cie1964".into());
+        scene.spectral.range = Some((400.0, 700.0));
+        let s = none.resolve(&scene).unwrap();
+        assert_eq!(
+            (s.observer.as_str(), s.white.as_str(), s.range.min, s.range.max),
+            ("cie1964", "D50", 400.0, 700.0)
+        );
+        let flags = SpectrumArgs {
+            range: Some("390:720".into()),
+            observer: Some("cie1931".into()),
+            white: Some("A".into()),
+        };
+        let s = flags.resolve(&scene).unwrap();
+        assert_eq!(
+            (s.observer.as_str(), s.white.as_str(), s.range.min, s.range.max),
+            ("cie1931", "A", 390.0, 720.0)
+        );
+        let e = |a: SpectrumArgs, sc: &scene::Scene| format!("{:#}", a.resolve(sc).unwrap_err());
+        let m = e(SpectrumArgs { white: Some("1K".into()), ..Default::default() }, &scene);
+        assert!(m.contains("--white '1K'") && m.contains("500–1000000 K"), "{m}");
+        let m = e(SpectrumArgs { observer: Some("cat".into()), ..Default::default() }, &scene);
+        assert!(m.contains("--observer 'cat'"), "{m}");
+        scene.spectral.white = Some("Z99".into());
+        let m = e(SpectrumArgs::default(), &scene);
+        assert!(m.contains("spectra white") && m.contains("Z99"), "{m}");
+    }
+
+    /// `render`/`view`/`bench` take the medium from `--rgb-medium` or the scene, refuse it with
+    /// water, and name the flag in every error.
+    #[test]
+    fn realtime_rgb_medium_comes_from_the_flag_or_the_scene() {
+        let table = color::upsample::table("srgb").unwrap();
+        let fog = scene::builtin("fog").unwrap();
+        let cornell = scene::builtin("cornell").unwrap();
+        use render::passes::rgb_medium::Options;
+        assert!(realtime_medium(&cornell, None, false, &table, Default::default()).unwrap().is_none());
+        let s = realtime_medium(&fog, None, false, &table, Default::default())
+            .unwrap()
+            .expect("the scene's medium");
+        assert_eq!(s.params[0], 16.0);
+        let m = r#"{"absorption": [0.5, 0.2, 0.1], "g": 0.5}"#;
+        let s = realtime_medium(&cornell, Some(m), false, &table, Options { steps: 8, multiple: true })
+            .unwrap()
+            .expect("the flag's medium");
+        assert_eq!((s.params[0], s.params[1], &s.params[8..11]), (8.0, 0.5, &[0.5f32, 0.2, 0.1][..]));
+        let e = |scene: &scene::Scene, arg: Option<&str>, water: bool, steps: u32| {
+            format!(
+                "{:#}",
+                realtime_medium(scene, arg, water, &table, Options { steps, ..Default::default() })
+                    .unwrap_err()
+            )
+        };
+        let msg = e(&fog, None, true, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("water"), "{msg}");
+        let msg = e(&cornell, Some(r#"{"absorption": [0.5, 0.2, 0.1], "g": 1}"#), false, 16);
+        assert!(msg.contains("--rgb-medium") && msg.contains("g:"), "{msg}");
+        let msg = e(&cornell, Some("no-such-medium.json"), false, 16);
+        assert!(msg.contains("--rgb-medium no-such-medium.json"), "{msg}");
+        let msg = e(&cornell, Some(m), false, 33);
+        assert!(msg.contains("march steps") && msg.contains("33"), "{msg}");
+    }
+
+    #[test]
+    fn geometry_above_the_surface_is_refused() {
+        let cornell = scene::builtin("cornell").unwrap();
+        let e = format!("{:#}", water_medium(&cornell, Some("II"), Some(0.0)).unwrap_err());
+        assert!(e.contains("above the water surface") && e.contains("--depth"), "{e}");
+        assert!(water_medium(&cornell, Some("II"), Some(50.0)).unwrap().is_some());
+    }
+
+    #[test]
+    fn water_flags_override_the_scene_and_reject_bad_input() {
+        let dry = scene::builtin("colorchecker").unwrap();
+        assert!(water_medium(&dry, None, None).unwrap().is_none());
+        let m = water_medium(&dry, Some("3C"), None).unwrap().unwrap();
+        assert_eq!((m.water_type.unwrap().to_string(), m.depth), ("3C".to_string(), DEFAULT_WATER_DEPTH));
+        let e = format!("{:#}", water_medium(&dry, None, Some(5.0)).unwrap_err());
+        assert!(e.contains("--water"), "{e}");
+        let e = format!("{:#}", water_medium(&dry, Some("XIV"), None).unwrap_err());
+        assert!(e.contains("XIV"), "{e}");
+        let e = format!("{:#}", water_medium(&dry, Some("II"), Some(-2.0)).unwrap_err());
+        assert!(e.contains("-2") && e.contains("depth"), "{e}");
+        let wet = scene::builtin("underwater").unwrap();
+        let m = water_medium(&wet, None, Some(20.0)).unwrap().unwrap();
+        assert_eq!((m.water_type.unwrap().to_string(), m.depth), ("IB".to_string(), 20.0));
+        // water.sun_direction drives the light-field table: the built-in's sun is its refraction,
+        // a scene whose sun disagrees is refused, naming both.
+        let sun = wet.lights.iter().find(|l| l.stands_in_for.is_none()).unwrap();
+        let scene::LightKind::Directional { direction } = sun.kind else { panic!("a sun") };
+        assert!((-direction - m.sun_dir_underwater()).length() < 1e-5);
+        let mut tilted = wet.clone();
+        tilted.water.as_mut().unwrap().sun_direction = glam::Vec3::new(1.0, 0.3, 0.0).normalize();
+        let e = format!("{:#}", water_medium(&tilted, None, None).unwrap_err());
+        assert!(e.contains("water.sun_direction") && e.contains("°"), "{e}");
+    }
+}
