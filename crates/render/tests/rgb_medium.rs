@@ -365,3 +365,38 @@ fn rgb_medium_multiple_scattering_matches_the_cpu_model_to_1e_3() {
     );
     assert!(n > 1000 && ms_share > 0.05, "{n} {ms_share}");
 }
+
+/// The environment is infinitely far: in a medium without end none of its light reaches a
+/// surface wherever σ_t > 0, as in the path tracer. The wall lit by a uniform environment only:
+/// in rgb mode a medium that is clear in blue keeps blue exactly (the dry render) and takes
+/// red and green to zero; in spectral and naive modes a medium that absorbs at every wavelength
+/// leaves the wall black. Before the environment-transmittance hooks the wall kept the
+/// environment's light, attenuated only along the view.
+#[test]
+fn the_environment_does_not_reach_into_a_medium_without_end() {
+    let mut scene = wall_scene();
+    scene.lights.clear();
+    scene.environment = Some(scene::Environment::uniform(Vec3::ONE));
+    let mut r = common::renderer();
+    r.set_scene(&scene).unwrap();
+    r.resize(W, H).unwrap();
+    let table = common::table();
+    let opts = rgb_medium::Options::default();
+    let rgb = RenderSettings { mode: Mode::Rgb, shadows: false, lambert: true, ..Default::default() };
+    let dry = render(&mut r, &scene, &rgb, CustomShader::default());
+    let clear_blue = medium([0.3, 0.15, 0.0], [0.0; 3], Attenuation::Unbounded);
+    let wet = render(&mut r, &scene, &rgb, rgb_medium::shader(&clear_blue, &table, &opts).unwrap());
+    for (i, (w, d)) in wet.iter().zip(&dry).enumerate() {
+        assert!(d[2] > 0.1, "pixel {i}: the dry wall is lit by the environment ({d:?})");
+        assert!(w[0].abs() < 1e-6 && w[1].abs() < 1e-6, "pixel {i}: red/green through the medium {w:?}");
+        assert!((w[2] - d[2]).abs() <= 1e-3 * d[2], "pixel {i}: blue {} vs dry {}", w[2], d[2]);
+    }
+    let absorbing = medium([0.3, 0.15, 0.05], [0.0; 3], Attenuation::Unbounded);
+    for mode in [Mode::Spectral, Mode::Naive] {
+        let s = RenderSettings { mode, shadows: false, lambert: true, ..Default::default() };
+        let wet = render(&mut r, &scene, &s, rgb_medium::shader(&absorbing, &table, &opts).unwrap());
+        for (i, w) in wet.iter().enumerate() {
+            assert!(w[..3].iter().all(|v| v.abs() < 1e-6), "{mode:?} pixel {i}: {w:?}");
+        }
+    }
+}

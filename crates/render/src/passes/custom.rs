@@ -67,7 +67,7 @@ pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
 pub const MEDIUM_COMMON: &str = include_str!("medium_common.wgsl");
 
 /// The hook names, in the order `custom_hooks.wgsl` defines them.
-const HOOKS: [&str; 8] = [
+const HOOKS: [&str; 10] = [
     "custom_spectral",
     "custom_rgb",
     "custom_pixel",
@@ -76,6 +76,8 @@ const HOOKS: [&str; 8] = [
     "custom_irradiance_rgb",
     "custom_light_transmittance",
     "custom_light_transmittance_rgb",
+    "custom_env_transmittance",
+    "custom_env_transmittance_rgb",
 ];
 
 /// User code for the extension point.
@@ -115,8 +117,8 @@ impl CustomShader {
     /// The source as the passes compile it: the user's code, the identity definition of each
     /// hook it leaves out, `CUSTOM_SPECTRAL` (whether the spectral hook or the light
     /// transmittance is the user's: the shading loop skips the hook, and carries the specular
-    /// term outside the nodes, when neither is) and `CUSTOM_LIGHT_T` (whether the shading loop
-    /// calls the light-transmittance hooks).
+    /// term outside the nodes, when neither is), `CUSTOM_LIGHT_T` and `CUSTOM_ENV_T` (whether
+    /// the shading loop calls the light- and environment-transmittance hooks).
     pub fn assembled(&self) -> String {
         let mut out = self.source.clone();
         for name in HOOKS {
@@ -125,12 +127,15 @@ impl CustomShader {
                 out.push_str(default_hook(name));
             }
         }
-        // A per-light spectral factor needs the specular term inside the nodes too.
+        // A per-light or environment spectral factor needs the specular term inside the nodes too.
         let transmittance =
             self.defines("custom_light_transmittance") || self.defines("custom_light_transmittance_rgb");
-        let spectral = self.defines("custom_spectral") || transmittance;
+        let env_transmittance =
+            self.defines("custom_env_transmittance") || self.defines("custom_env_transmittance_rgb");
+        let spectral = self.defines("custom_spectral") || transmittance || env_transmittance;
         out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {spectral};\n"));
         out.push_str(&format!("const CUSTOM_LIGHT_T: bool = {transmittance};\n"));
+        out.push_str(&format!("const CUSTOM_ENV_T: bool = {env_transmittance};\n"));
         // The irradiance hooks come as a pair; either one turns on the diffuse term's code.
         let irradiance = self.defines("custom_irradiance") || self.defines("custom_irradiance_rgb");
         out.push_str(&format!("const CUSTOM_IRRADIANCE: bool = {irradiance};\n"));

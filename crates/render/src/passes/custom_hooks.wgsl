@@ -54,3 +54,15 @@ fn custom_light_transmittance(li: u32, lambda: vec4<f32>, group: u32, ctx: Surfa
 fn custom_light_transmittance_rgb(li: u32, ctx: SurfaceContext) -> vec3<f32> {
     return vec3<f32>(1.0);
 }
+
+// Pass 2, spectral and naive modes, per group on a lit surface: a factor per node wavelength on
+// the environment's light at the surface (a medium's transmittance between the environment and
+// the surface), applied to its diffuse and specular terms.
+fn custom_env_transmittance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+    return vec4<f32>(1.0);
+}
+
+// Pass 2, rgb mode: the same per linear-sRGB channel.
+fn custom_env_transmittance_rgb(ctx: SurfaceContext) -> vec3<f32> {
+    return vec3<f32>(1.0);
+}

@@ -11,7 +11,9 @@
 //!   at the surface is multiplied by its transmittance `e^{−σ_t(λ)·r}` over the straight
 //!   distance r from the light (a polygon light's centroid) to the surface, per wavelength
 //!   (the `custom_light_transmittance` hooks). A directional light does not reach into a
-//!   medium without end: its transmittance is 0 wherever σ_t > 0, as in the path tracer.
+//!   medium without end: its transmittance is 0 wherever σ_t > 0, as in the path tracer; nor
+//!   does the environment, whose light on surfaces the `custom_env_transmittance` hooks take to
+//!   0 there (the background is extinguished by the view's attenuation).
 //! - The in-scattering is single scattering of the first [`SS_LIGHTS`] point, spot and polygon
 //!   lights (a polygon as a point at its centroid with intensity L·area·cos), shadow-mapped,
 //!   integrated by [`Options::steps`] equiangular steps (Kulla & Fajardo 2012; the underwater
@@ -160,6 +162,7 @@ mod tests {
             s.defines("custom_light_transmittance") && s.assembled().contains("CUSTOM_LIGHT_T: bool = true")
         );
         assert!(s.defines("custom_irradiance") && s.assembled().contains("CUSTOM_IRRADIANCE: bool = true"));
+        assert!(s.defines("custom_env_transmittance") && s.assembled().contains("CUSTOM_ENV_T: bool = true"));
         let e = shader(&m, &table, &Options { steps: 33, ..Default::default() }).unwrap_err().to_string();
         assert!(e.contains("march steps") && e.contains("33"), "{e}");
     }

@@ -407,6 +407,21 @@ fn custom_light_transmittance_rgb(li: u32, ctx: SurfaceContext) -> vec3<f32> {
     return rm_transmittance(rm_light_extinction(k[0], k[1]), rm_light_distance(li, ctx.world_pos)).rgb;
 }
 
+// The environment is infinitely far: a medium without end lets none of its light reach a
+// surface wherever σ_t > 0 (as the path tracer; the background is extinguished by the view
+// attenuation). Extinction σ_t, not the similarity-reduced one: the light is removed, not
+// scattered within the medium's own term.
+fn custom_env_transmittance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> vec4<f32> {
+    if (rm_boxed(false)) {
+        return rm_box(rm_transmittance(vec4<f32>(custom.params[2].xyz, 0.0), -1.0).xyz, lambda);
+    }
+    return rm_transmittance(rm_coefficients(group, false)[1], -1.0);
+}
+
+fn custom_env_transmittance_rgb(ctx: SurfaceContext) -> vec3<f32> {
+    return rm_transmittance(rm_coefficients(0u, true)[1], -1.0).rgb;
+}
+
 fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
     return rm_shade(radiance, lambda, group, false, ctx);
 }

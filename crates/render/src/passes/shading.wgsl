@@ -361,7 +361,11 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (shading_env() && !s.unlit) {
             let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
-            rgb += (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
+            var env_rgb = (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
+            if (CUSTOM_ENV_T) {
+                env_rgb *= custom_env_transmittance_rgb(ctx);
+            }
+            rgb += env_rgb;
         }
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
@@ -485,9 +489,16 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             }
         }
         if (has_env && !background) {
-            acc_a += env_w(et.a, g, ng);
+            var wa = env_w(et.a, g, ng);
+            var wb = env_w(et.b, g, ng);
+            if (CUSTOM_ENV_T) {
+                let t = custom_env_transmittance(lambda, g, ctx);
+                wa = s3_scale(wa, t);
+                wb = s3_scale(wb, t);
+            }
+            acc_a += wa;
             if (CUSTOM_SPECTRAL || capturing) {
-                acc_b += env_w(et.b, g, ng);
+                acc_b += wb;
             }
         }
         var em = vec4<f32>(0.0);
