@@ -16,7 +16,7 @@ use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::rgb_medium;
 use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
 use scene::medium::RgbMedium;
-use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
+use scene::{Camera, Light, Material, Mesh, Scene};
 
 const W: u32 = 24;
 const H: u32 = 16;
@@ -37,18 +37,9 @@ fn wall_scene() -> Scene {
     let mut scene = Scene::empty("test:rgb-medium-wall", camera);
     // Facing +z, at z = −WALL.
     scene.meshes.push(Mesh::quad(Vec3::new(-s, -s, -WALL), Vec3::X * 2.0 * s, Vec3::Y * 2.0 * s, 0));
-    scene.materials.push(Material {
-        name: "white".into(),
-        base_color: Vec4::ONE,
-        roughness: 1.0,
-        ..Default::default()
-    });
-    scene.lights.push(Light {
-        name: "lamp".into(),
-        kind: LightKind::Point { position: light_pos(), range: None },
-        emission: Emission { rgb: Vec3::ONE, intensity: INTENSITY, spectrum: None },
-        stands_in_for: None,
-    });
+    // The default material: white, rough, not metallic.
+    scene.materials.push(Material { name: "white".into(), ..Default::default() });
+    scene.lights.push(Light::point("lamp", light_pos(), INTENSITY));
     scene
 }
 

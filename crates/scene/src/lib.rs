@@ -359,6 +359,19 @@ pub struct Light {
     pub stands_in_for: Option<usize>,
 }
 
+impl Light {
+    /// A point light of white RGB emission (`rgb` 1, no spectrum) with `intensity` at
+    /// `position`, without a range.
+    pub fn point(name: &str, position: Vec3, intensity: f32) -> Self {
+        Light {
+            name: name.into(),
+            kind: LightKind::Point { position, range: None },
+            emission: Emission { rgb: Vec3::ONE, intensity, spectrum: None },
+            stands_in_for: None,
+        }
+    }
+}
+
 /// A perspective pinhole camera.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {

@@ -3,8 +3,8 @@
 //! --rgb-medium`, the same upsampled medium). Figures and the accuracy they support are in
 //! docs/rgb-media.md ("Real time against the path tracer").
 
-use glam::{Vec3, Vec4};
-use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
+use glam::Vec3;
+use scene::{Camera, Light, Material, Mesh, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -36,18 +36,9 @@ fn wall_scene() -> Scene {
     let mut scene = Scene::empty("test:rgb-medium-wall", camera);
     // Facing +z, at z = −WALL.
     scene.meshes.push(Mesh::quad(Vec3::new(-s, -s, -WALL), Vec3::X * 2.0 * s, Vec3::Y * 2.0 * s, 0));
-    scene.materials.push(Material {
-        name: "white".into(),
-        base_color: Vec4::ONE,
-        roughness: 1.0,
-        ..Default::default()
-    });
-    scene.lights.push(Light {
-        name: "lamp".into(),
-        kind: LightKind::Point { position: Vec3::new(0.1, 0.0, 0.0), range: None },
-        emission: Emission { rgb: Vec3::ONE, intensity: 10.0, spectrum: None },
-        stands_in_for: None,
-    });
+    // The default material: white, rough, not metallic.
+    scene.materials.push(Material { name: "white".into(), ..Default::default() });
+    scene.lights.push(Light::point("lamp", Vec3::new(0.1, 0.0, 0.0), 10.0));
     scene
 }
 
