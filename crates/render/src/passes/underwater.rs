@@ -26,7 +26,8 @@
 //!   Fajardo 2012), attenuated by c from the light and to the camera.
 //!
 //! `scene::water` (`in_scatter`, `single`) is the CPU reference of every term;
-//! `tests/underwater.rs` and `tests/underwater_single.rs` check the GPU against it.
+//! `tests/underwater.rs` checks the GPU against it (the hooks' pixel terms, single scattering,
+//! the light-field table).
 //!
 //! Spectral and naive modes sample b, c and Kd at the frame's wavelengths (the renderer
 //! resamples [`CustomShader::spectra`] whenever N or the range change). The RGB baseline uses
