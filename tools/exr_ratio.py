@@ -11,15 +11,8 @@ import argparse
 import sys
 
 import numpy as np
-import OpenEXR
 
-
-def read(path):
-    with OpenEXR.File(path) as f:
-        ch = f.channels()
-        if "RGB" in ch:
-            return np.array(ch["RGB"].pixels, dtype=np.float64)
-        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+from exr_rows import read  # the same reader (tools/ is the script's directory)
 
 
 def blocks(img, b):

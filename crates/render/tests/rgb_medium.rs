@@ -43,6 +43,14 @@ fn wall_scene() -> Scene {
     scene
 }
 
+/// A renderer holding `scene` at the tests' frame size.
+fn wall_renderer(scene: &Scene) -> render::Renderer {
+    let mut r = common::renderer();
+    r.set_scene(scene).unwrap();
+    r.resize(W, H).unwrap();
+    r
+}
+
 /// Unit view direction through pixel (px, py) and the distance to the wall.
 fn pixel_ray(camera: &Camera, px: u32, py: u32) -> (DVec3, f64) {
     let proj = Mat4::perspective_rh(camera.yfov, W as f32 / H as f32, camera.znear, camera.zfar);
@@ -102,9 +110,7 @@ fn one_wavelength(mode: Mode, lambda: f64) -> RenderSettings {
 #[test]
 fn rgb_medium_hooks_match_the_cpu_model_to_1e_3() {
     let scene = wall_scene();
-    let mut r = common::renderer();
-    r.set_scene(&scene).unwrap();
-    r.resize(W, H).unwrap();
+    let mut r = wall_renderer(&scene);
     let table = common::table();
     let light = light_pos().as_dvec3();
     let g = 0.4;
@@ -284,9 +290,7 @@ fn multiple_cpu(
 #[test]
 fn rgb_medium_multiple_scattering_matches_the_cpu_model_to_1e_3() {
     let scene = wall_scene();
-    let mut r = common::renderer();
-    r.set_scene(&scene).unwrap();
-    r.resize(W, H).unwrap();
+    let mut r = wall_renderer(&scene);
     let table = common::table();
     let light = light_pos().as_dvec3();
     let g = 0.4;
@@ -368,9 +372,7 @@ fn the_environment_does_not_reach_into_a_medium_without_end() {
     let mut scene = wall_scene();
     scene.lights.clear();
     scene.environment = Some(scene::Environment::uniform(Vec3::ONE));
-    let mut r = common::renderer();
-    r.set_scene(&scene).unwrap();
-    r.resize(W, H).unwrap();
+    let mut r = wall_renderer(&scene);
     let table = common::table();
     let opts = rgb_medium::Options::default();
     let rgb = RenderSettings { mode: Mode::Rgb, shadows: false, lambert: true, ..Default::default() };
