@@ -49,9 +49,10 @@ impl GpuCoeffTable {
     }
 
     /// What the shader's `coeff_scale` holds: the brightness levels (`res`), the chroma nodes
-    /// (`res`), then the chroma weight's [`CHROMA_WARP`] and [`CHROMA_WARP_SLOPE`], so the WGSL
-    /// fetch takes the table's grids and the weight's constants from the CPU side and cannot
-    /// drift from `CoeffTable::fetch`.
+    /// (`res`), the chroma weight's [`CHROMA_WARP`] and [`CHROMA_WARP_SLOPE`], then each axis's
+    /// interval index ([`interval_index`], [`AXIS_INDEX`] entries: brightness, then chroma), so
+    /// the WGSL fetch takes the table's grids and the weight's constants from the CPU side and
+    /// cannot drift from `CoeffTable::fetch`.
     ///
     /// [`CHROMA_WARP`]: color::upsample::table::CHROMA_WARP
     /// [`CHROMA_WARP_SLOPE`]: color::upsample::table::CHROMA_WARP_SLOPE
@@ -60,13 +61,69 @@ impl GpuCoeffTable {
         let mut v = table.scale.clone();
         v.extend_from_slice(&table.chroma);
         v.extend_from_slice(&[CHROMA_WARP, CHROMA_WARP_SLOPE]);
+        v.extend(interval_index(&table.scale).into_iter().map(|i| i as f32));
+        v.extend(interval_index(&table.chroma).into_iter().map(|i| i as f32));
         v
     }
+}
+
+/// Entries of an axis's interval index (`AXIS_INDEX` in wgsl/spectral.wgsl; a power of two, so
+/// that `floor(v · AXIS_INDEX) / AXIS_INDEX` is exact and never above `v`).
+pub const AXIS_INDEX: usize = 1024;
+
+/// Entry m: the interval of `axis` (increasing, at least 2 nodes) that holds m / [`AXIS_INDEX`],
+/// as the fetch numbers intervals (the largest n with `axis[n] <= t`, within 0 ..= len − 2). The
+/// shader starts there and steps up while the next node is still at or below its value, which
+/// reaches the binary search's interval in at most the nodes inside one entry's width (one on
+/// spectra's grids at 64³; a few next to black on rgb2spec's double smoothstep) instead of
+/// log₂(res) dependent loads.
+pub fn interval_index(axis: &[f32]) -> Vec<u32> {
+    let last = axis.len().saturating_sub(2);
+    (0..AXIS_INDEX)
+        .map(|m| {
+            let t = m as f32 / AXIS_INDEX as f32;
+            (axis.partition_point(|&a| a <= t).max(1) - 1).min(last) as u32
+        })
+        .collect()
+}
+
+/// The interval the shader finds for `v` from the index: [`interval_index`]'s entry, then the
+/// steps up (the CPU mirror of `find_interval` in wgsl/spectral.wgsl, for the tests).
+pub fn indexed_interval(axis: &[f32], index: &[u32], v: f32) -> usize {
+    let vv = if v > 0.0 { v.min(1.0) } else { 0.0 };
+    let mut i = index[((vv * AXIS_INDEX as f32) as usize).min(AXIS_INDEX - 1)] as usize;
+    while i < axis.len() - 2 && axis[i + 1] <= v {
+        i += 1;
+    }
+    i
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The indexed search finds the binary search's interval (the largest node at or below the
+    /// value, clamped to the last interval) on spectra's grids and rgb2spec's, at every node, on
+    /// both sides of it, and between, including values outside [0, 1] and NaN.
+    #[test]
+    fn indexed_interval_equals_the_binary_search() {
+        use color::upsample::fit::{rgb2spec_scale, spectra_chroma, spectra_scale, uniform_chroma};
+        let res = 64;
+        for axis in [spectra_scale(res), spectra_chroma(res), rgb2spec_scale(res), uniform_chroma(res)] {
+            let axis: Vec<f32> = axis.iter().map(|&a| a as f32).collect();
+            let index = interval_index(&axis);
+            let binary = |v: f32| axis.partition_point(|&a| a <= v).clamp(1, res - 1) - 1;
+            let mut values = vec![-1.0, 0.0, 1.0, 2.0, f32::NAN, f32::MIN_POSITIVE, 1e-9];
+            for &a in &axis {
+                values.extend([a, a.next_up(), a.next_down(), a * 1.0001 + 1e-7]);
+            }
+            values.extend((0..=20_000).map(|i| i as f32 / 20_000.0));
+            for v in values {
+                let want = if v.is_nan() { 0 } else { binary(v) };
+                assert_eq!(indexed_interval(&axis, &index, v), want, "v = {v}");
+            }
+        }
+    }
     use crate::gpu::Gpu;
     use color::upsample::adversarial::{AdversarialOptions, adversarial_set};
     use color::upsample::fit::{LabModel, nm_to_normalised};

@@ -129,6 +129,11 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(&shading, "EnvUniforms", rust_layout!(EnvUniforms { totals, params, flags }));
     check(
         &shading,
+        "MaterialSpectrum",
+        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission }),
+    );
+    check(
+        &shading,
         "WavelengthGroup",
         rust_layout!(WavelengthGroup { lambda, white_x, white_y, white_z, band_r, band_g, band_b, _pad }),
     );
@@ -139,7 +144,7 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &gbuffer,
         "MaterialUniforms",
-        rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv }),
+        rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv, slot }),
     );
     let shadow_pass = parse(&[shader::MATERIAL, include_str!("passes/shadow.wgsl")]);
     check(&shadow_pass, "ShadowLayer", rust_layout!(shadow::LayerUniforms { view_proj, params }));
@@ -152,6 +157,7 @@ fn shared_constants_match_the_rust_constants() {
     assert_eq!(const_u32(&shading, "MAX_LIGHTS") as usize, MAX_LIGHTS);
     assert_eq!(const_u32(&shading, "MAX_SHADOWS") as usize, shadow::MAX_SHADOWS);
     assert_eq!(const_u32(&shading, "NO_SHADOW"), shadow::NO_SHADOW);
+    assert_eq!(const_u32(&shading, "AXIS_INDEX") as usize, crate::coeff_table::AXIS_INDEX);
 
     let hooks = format!("{MEDIUM_COMMON}\n{}", underwater::HOOKS);
     let water = shading_module(&CustomShader::new(hooks));

@@ -31,6 +31,7 @@ pub mod error;
 pub mod gpu;
 #[cfg(test)]
 mod layout_tests;
+pub mod material_spectra;
 pub mod passes;
 mod readback;
 pub mod renderer;

@@ -5,6 +5,7 @@ use crate::coeff_table::GpuCoeffTable;
 use crate::env_gpu::{EnvUniforms, GpuEnvironment};
 use crate::error::{RenderError, Result};
 use crate::gpu::Gpu;
+use crate::material_spectra::MaterialSpectrum;
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
@@ -602,9 +603,17 @@ impl Renderer {
             self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral, occlusion_radius);
         self.gpu.queue.write_buffer(&self.env_buffer, 0, bytemuck::bytes_of(&env_uniforms));
 
-        let variant =
-            Variant { polygons: !scene.emitters.is_empty(), environment: env_uniforms.flags[0] != 0 };
-        self.shading.select(&self.gpu.device, variant)?;
+        let variant = Variant {
+            polygons: !scene.emitters.is_empty(),
+            environment: env_uniforms.flags[0] != 0,
+            emission: scene.has_emission,
+            naive: settings.mode == Mode::Naive,
+            capture: self.capture.is_some(),
+        };
+        self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
+        if settings.mode == Mode::Spectral {
+            self.gbuffer.prepare_spectral(&self.gpu.device)?;
+        }
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
         let ts = |i: usize| timer.map(|t| t.writes(i));
@@ -612,14 +621,10 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        self.gbuffer.record(
-            &mut encoder,
-            [&g[0], &g[1], &g[2]],
-            &targets.depth_view,
-            &self.frame_bind_group,
-            scene,
-            ts(1),
-        );
+        let with_slot = [&g[0], &g[1], &g[2], &targets.gbuffer_slot_view];
+        // Only the spectral mode reads the material slots.
+        let colour = if settings.mode == Mode::Spectral { &with_slot[..] } else { &with_slot[..3] };
+        self.gbuffer.record(&mut encoder, colour, &targets.depth_view, &self.frame_bind_group, scene, ts(1));
         if let Some(c) = &self.capture {
             // Background pixels without an environment write nothing.
             encoder.clear_buffer(&c.buffer, 0, None);
@@ -630,8 +635,10 @@ impl Renderer {
             custom: &spectral.custom_bind_group,
         };
         let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
-        let draw = Draw { target: &targets.hdr_shaded_view, inputs, timestamps: ts(2) };
-        self.shading.record(&mut encoder, &shared, draw, settings.mode == Mode::Rgb);
+        // An identity custom pass is skipped: shading writes what the custom pass would.
+        let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };
+        let draw = Draw { target: shaded, inputs, timestamps: ts(2) };
+        self.shading.record(&mut encoder, &shared, draw);
         let draw = Draw { target: &targets.hdr_view, inputs: &bindings.custom, timestamps: ts(3) };
         self.custom_pass.record(&mut encoder, &shared, draw);
         let post_inputs = if self.accumulating {
@@ -819,6 +826,10 @@ impl Renderer {
         let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
         let light_buf = storage("lights", bytemuck::cast_slice(&lights));
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
+        let material_spectra = storage(
+            "material spectra",
+            bytemuck::cast_slice(&MaterialSpectrum::of_scene(&scene.constant_colours, &self.table)),
+        );
         let bind_group = self.shared.spectral_group(
             device,
             &SpectralInputs {
@@ -833,6 +844,7 @@ impl Renderer {
                 env_lut: &self.environment.lut,
                 env_sampler: &self.environment.sampler,
                 env_uniforms: &self.env_buffer,
+                material_spectra: &material_spectra,
             },
         );
 

@@ -66,6 +66,9 @@ pub struct MaterialUniforms {
     /// Per texture slot, two rows of its `KHR_texture_transform` matrix: `(m00, m01, m02, set)`,
     /// `(m10, m11, m12, 0)` with `set` the UV set (0 or 1), so `uv' = M · (u, v, 1)`.
     pub uv: [[f32; 4]; 2 * TEXTURE_SLOTS],
+    /// x: the material's index + 1, which the spectral G-buffer writes for the shading pass to
+    /// find its [`ConstantColour`] coefficients (`material_spectra` in shading.wgsl); yzw unused.
+    pub slot: [u32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -73,7 +76,8 @@ pub const ALPHA_MASK: f32 = 1.0;
 pub const ALPHA_BLEND: f32 = 2.0;
 
 impl MaterialUniforms {
-    pub fn new(m: &scene::Material) -> Self {
+    /// The uniforms of material `m`, number `index` in its scene.
+    pub fn new(m: &scene::Material, index: usize) -> Self {
         let (mode, cutoff) = match m.alpha_mode {
             AlphaMode::Opaque => (ALPHA_OPAQUE, 0.0),
             AlphaMode::Mask { cutoff } => (ALPHA_MASK, cutoff),
@@ -97,6 +101,7 @@ impl MaterialUniforms {
             ],
             alpha: [mode, cutoff, m.double_sided as u8 as f32, m.unlit as u8 as f32],
             uv,
+            slot: [u32::try_from(index).map_or(u32::MAX, |i| i.saturating_add(1)), 0, 0, 0],
         }
     }
 }
@@ -369,6 +374,36 @@ pub struct GpuScene {
     pub bounds: (Vec3, Vec3),
     /// What the upload had to change to fit the device (textures downscaled, …).
     pub warnings: Vec<String>,
+    /// Whether any material emits or is unlit (its colour is drawn as emission): without one the
+    /// shading pass is compiled without its emission terms.
+    pub has_emission: bool,
+    /// Per material, the G-buffer colours that do not vary over its surface.
+    pub constant_colours: Vec<ConstantColour>,
+}
+
+/// A material's base colour and emission where they do not vary over its surface (no texture,
+/// no vertex colours on any mesh that uses it), as the G-buffer would hold them but in f32: the
+/// G-buffer's f16 rounds them, and by the driver's rule (toward zero on lavapipe, to nearest
+/// elsewhere), so the exact colours make the same coefficients on every device, the ones the
+/// path tracer's colours give. The spectral shading pass takes these colours' coefficients from
+/// the CPU (`crate::material_spectra`) instead of fetching them per pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ConstantColour {
+    pub base: Option<[f32; 3]>,
+    pub emission: Option<[f32; 3]>,
+}
+
+impl ConstantColour {
+    /// Material `m`'s constant colours; `vertex_coloured`: some mesh with `COLOR_0` uses it.
+    pub fn of(m: &scene::Material, vertex_coloured: bool) -> Self {
+        let base =
+            (m.base_color_texture.is_none() && !vertex_coloured).then(|| m.base_color.truncate().to_array());
+        if m.unlit {
+            // The G-buffer stores an unlit surface's colour as emission and black as its base.
+            return ConstantColour { base: base.map(|_| [0.0; 3]), emission: base };
+        }
+        ConstantColour { base, emission: m.emissive_texture.is_none().then(|| m.emissive.to_array()) }
+    }
 }
 
 impl GpuScene {
@@ -480,7 +515,7 @@ impl GpuScene {
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
         let mut materials = Vec::new();
-        for m in &s.materials {
+        for (index, m) in s.materials.iter().enumerate() {
             let refs = texture_refs(m);
             for r in refs.iter().flatten() {
                 if r.index >= textures.len() {
@@ -504,7 +539,7 @@ impl GpuScene {
             {
                 return Err(bad(format!("material '{}' has alpha cutoff {cutoff}", m.name)));
             }
-            let u = MaterialUniforms::new(m);
+            let u = MaterialUniforms::new(m, index);
             let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(&m.name),
                 contents: bytemuck::bytes_of(&u),
@@ -559,6 +594,18 @@ impl GpuScene {
             camera: s.camera,
             bounds: (lo, hi),
             warnings,
+            has_emission: s.materials.iter().any(|m| m.unlit || m.emissive.max_element() > 0.0),
+            constant_colours: s
+                .materials
+                .iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    ConstantColour::of(
+                        m,
+                        s.meshes.iter().any(|mesh| mesh.material == i && !mesh.colors.is_empty()),
+                    )
+                })
+                .collect(),
         })
     }
 
@@ -930,7 +977,7 @@ mod tests {
             alpha_mode: AlphaMode::Mask { cutoff: 0.25 },
             ..Default::default()
         };
-        let u = MaterialUniforms::new(&m);
+        let u = MaterialUniforms::new(&m, 0);
         assert_eq!(u.alpha, [ALPHA_MASK, 0.25, 1.0, 0.0]);
         let uv = Vec2::new(0.7, -0.2);
         let (r0, r1) = (Vec4::from(u.uv[6]), Vec4::from(u.uv[7]));

@@ -1,7 +1,7 @@
 //! The size-dependent render targets of one frame.
 
 use crate::passes::accumulate::ACCUM_FORMAT;
-use crate::passes::{DEPTH_FORMAT, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+use crate::passes::{DEPTH_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT};
 
 /// G-buffer, depth, HDR and display targets at one size. Recreated on resize.
 pub struct Targets {
@@ -9,6 +9,9 @@ pub struct Targets {
     pub height: u32,
     pub gbuffer: [wgpu::Texture; 3],
     pub gbuffer_views: [wgpu::TextureView; 3],
+    /// The spectral G-buffer's material slots (written in the spectral mode only).
+    pub gbuffer_slot: wgpu::Texture,
+    pub gbuffer_slot_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     /// Shading output (pass 2).
@@ -57,6 +60,7 @@ impl Targets {
             make("gbuffer emission", GBUFFER_FORMATS[2], none),
         ];
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
+        let (gbuffer_slot, gbuffer_slot_view) = make("gbuffer material slot", GBUFFER_SLOT_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
@@ -69,6 +73,8 @@ impl Targets {
             height,
             gbuffer: [g0, g1, g2],
             gbuffer_views: [v0, v1, v2],
+            gbuffer_slot,
+            gbuffer_slot_view,
             depth,
             depth_view,
             hdr_shaded,

@@ -182,7 +182,9 @@ pub struct CustomUniforms {
 
 pub struct CustomPass {
     pub input_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    /// `None` when `custom_pixel` is the identity: the pass is skipped, the shading pass
+    /// writing its output target directly ([`Self::skipped`]).
+    pipeline: Option<wgpu::RenderPipeline>,
 }
 
 impl CustomPass {
@@ -192,6 +194,9 @@ impl CustomPass {
             label: Some("custom inputs"),
             entries: &[texture_entry(0), texture_entry(1), depth_entry(2)],
         });
+        if !custom.defines("custom_pixel") {
+            return Ok(CustomPass { input_layout, pipeline: None });
+        }
         let module = shader::compile(
             device,
             "custom",
@@ -216,7 +221,13 @@ impl CustomPass {
             }
             .build(device)
         })?;
-        Ok(CustomPass { input_layout, pipeline })
+        Ok(CustomPass { input_layout, pipeline: Some(pipeline) })
+    }
+
+    /// Whether the pass is the identity and skipped: the shading pass then renders into the
+    /// custom pass's output (`Targets::hdr`), and a frame saves a full-screen read and write.
+    pub fn skipped(&self) -> bool {
+        self.pipeline.is_none()
     }
 
     /// Group 1: the shading pass's output, the G-buffer normals and the depth.
@@ -232,8 +243,24 @@ impl CustomPass {
         })
     }
 
+    /// Records the pass; when it is skipped, only its timestamps (an empty compute pass, so
+    /// that the per-pass timings read about zero for it).
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw) {
+        let Some(pipeline) = &self.pipeline else {
+            if let Some(t) = draw.timestamps {
+                let writes = wgpu::ComputePassTimestampWrites {
+                    query_set: t.query_set,
+                    beginning_of_pass_write_index: t.beginning_of_pass_write_index,
+                    end_of_pass_write_index: t.end_of_pass_write_index,
+                };
+                encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("custom (identity, skipped)"),
+                    timestamp_writes: Some(writes),
+                });
+            }
+            return;
+        };
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
-        draw_fullscreen(encoder, "custom", &[draw.target], &self.pipeline, &groups, draw.timestamps);
+        draw_fullscreen(encoder, "custom", &[draw.target], pipeline, &groups, draw.timestamps);
     }
 }

@@ -5,17 +5,24 @@
 //! `doubleSided: false`), double-sided ones do not and flip the normal of back faces towards
 //! the viewer; `MASK` and `BLEND` materials use the fragment entry point that may discard
 //! (below the cutoff, or stochastically for `BLEND`, see `wgsl/material.wgsl`), opaque ones one
-//! without discard so that early depth testing stays on.
+//! without discard so that early depth testing stays on. The spectral mode's four add a fourth
+//! target, the material's slot ([`GBUFFER_SLOT_FORMAT`]), built on first use.
 
-use super::{DEPTH_FORMAT, GBUFFER_FORMATS, SharedLayouts};
+use super::{DEPTH_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
 
+/// `[double_sided][alpha_tested]`.
+type Pipelines = [[wgpu::RenderPipeline; 2]; 2];
+
 pub struct GBufferPass {
     pub material_layout: wgpu::BindGroupLayout,
-    /// `[double_sided][alpha_tested]`.
-    pipelines: [[wgpu::RenderPipeline; 2]; 2],
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    pipelines: Pipelines,
+    /// With the material slot, for the spectral mode ([`Self::prepare_spectral`]).
+    spectral_pipelines: Option<Pipelines>,
 }
 
 impl GBufferPass {
@@ -31,71 +38,49 @@ impl GBufferPass {
             bind_group_layouts: &[Some(&shared.frame), Some(&material_layout)],
             immediate_size: 0,
         });
-        let targets = GBUFFER_FORMATS.map(|format| {
-            Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
-        });
-        let pipeline = |double_sided: bool, alpha: bool| {
-            shader::checked(device, "gbuffer pipeline", || {
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("gbuffer"),
-                    layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some("vs_main"),
-                        compilation_options: Default::default(),
-                        buffers: &[Some(Vertex::layout())],
-                    },
-                    primitive: wgpu::PrimitiveState {
-                        cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
-                        ..Default::default()
-                    },
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Less),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(if alpha { "fs_alpha" } else { "fs_main" }),
-                        compilation_options: Default::default(),
-                        targets: &targets,
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            })
-        };
-        let pipelines = [
-            [pipeline(false, false)?, pipeline(false, true)?],
-            [pipeline(true, false)?, pipeline(true, true)?],
-        ];
-        Ok(GBufferPass { material_layout, pipelines })
+        let pipelines = build(device, &module, &layout, false)?;
+        Ok(GBufferPass { material_layout, module, layout, pipelines, spectral_pipelines: None })
+    }
+
+    /// Builds the spectral mode's pipelines unless they exist.
+    pub fn prepare_spectral(&mut self, device: &wgpu::Device) -> Result<()> {
+        if self.spectral_pipelines.is_none() {
+            self.spectral_pipelines = Some(build(device, &self.module, &self.layout, true)?);
+        }
+        Ok(())
     }
 
     /// Clears and fills `colour` (the three G-buffer targets) and `depth`.
+    /// Records the pass into `colour`: the three G-buffer targets, and the slot target as a
+    /// fourth for the spectral pipelines (after [`Self::prepare_spectral`]).
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        colour: [&wgpu::TextureView; 3],
+        colour: &[&wgpu::TextureView],
         depth: &wgpu::TextureView,
         frame: &wgpu::BindGroup,
         scene: &GpuScene,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let attachments = colour.map(|view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
+        let pipelines = if colour.len() > GBUFFER_FORMATS.len() {
+            self.spectral_pipelines.as_ref().expect("prepare_spectral before a spectral G-buffer")
+        } else {
+            &self.pipelines
+        };
+        let attachments: Vec<_> = colour
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
             })
-        });
+            .collect();
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &attachments,
@@ -116,10 +101,72 @@ impl GBufferPass {
         for d in &scene.draws {
             let key = (d.double_sided as usize, d.alpha_tested as usize);
             if current != Some(key) {
-                pass.set_pipeline(&self.pipelines[key.0][key.1]);
+                pass.set_pipeline(&pipelines[key.0][key.1]);
                 current = Some(key);
             }
             scene.draw_one(&mut pass, d);
         }
     }
+}
+
+/// The four pipelines (single/double-sided × opaque/alpha-tested), with the slot target when
+/// `spectral`.
+fn build(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    spectral: bool,
+) -> Result<Pipelines> {
+    let formats: &[wgpu::TextureFormat] = if spectral {
+        &[GBUFFER_FORMATS[0], GBUFFER_FORMATS[1], GBUFFER_FORMATS[2], GBUFFER_SLOT_FORMAT]
+    } else {
+        &GBUFFER_FORMATS
+    };
+    let targets: Vec<_> = formats
+        .iter()
+        .map(|&format| {
+            Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+        })
+        .collect();
+    let pipeline = |double_sided: bool, alpha: bool| {
+        let entry = match (alpha, spectral) {
+            (false, false) => "fs_main",
+            (true, false) => "fs_alpha",
+            (false, true) => "fs_main_spectral",
+            (true, true) => "fs_alpha_spectral",
+        };
+        shader::checked(device, "gbuffer pipeline", || {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("gbuffer"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(Vertex::layout())],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    };
+    Ok([[pipeline(false, false)?, pipeline(false, true)?], [pipeline(true, false)?, pipeline(true, true)?]])
 }

@@ -91,3 +91,26 @@ fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
 fn fs_alpha(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     return gbuffer(v, front, true);
 }
+
+// The spectral modes' G-buffer adds the material's slot, where the shading pass finds the
+// coefficients of colours that are constant over the material (src/material_spectra.rs).
+struct GBufferSpectralOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) slot: u32,
+};
+
+fn with_slot(o: GBufferOut) -> GBufferSpectralOut {
+    return GBufferSpectralOut(o.base, o.normal, o.emission, material.slot.x);
+}
+
+@fragment
+fn fs_main_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferSpectralOut {
+    return with_slot(gbuffer(v, front, false));
+}
+
+@fragment
+fn fs_alpha_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferSpectralOut {
+    return with_slot(gbuffer(v, front, true));
+}

@@ -19,6 +19,8 @@ pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// G-buffer colour targets: base colour + metallic, normal + roughness, emission.
 pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
     [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float];
+/// The spectral G-buffer's fourth target: the material's slot (`MaterialUniforms::slot`).
+pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Display output: the hardware does the sRGB encoding on store.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -68,6 +70,7 @@ impl SharedLayouts {
                     count: None,
                 },
                 uniform_entry(10, wgpu::ShaderStages::FRAGMENT),
+                storage_entry(11),
             ],
         });
         let custom = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -103,6 +106,7 @@ impl SharedLayouts {
                 view_entry(8, i.env_lut),
                 wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(i.env_sampler) },
                 buffer_entry(10, i.env_uniforms),
+                buffer_entry(11, i.material_spectra),
             ],
         })
     }
@@ -136,6 +140,8 @@ pub struct SpectralInputs<'a> {
     pub env_lut: &'a wgpu::TextureView,
     pub env_sampler: &'a wgpu::Sampler,
     pub env_uniforms: &'a wgpu::Buffer,
+    /// Per material, the coefficients of its constant colours (src/material_spectra.rs).
+    pub material_spectra: &'a wgpu::Buffer,
 }
 
 pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {

@@ -40,31 +40,56 @@ pub struct ShadingPass {
     rgb_entry: &'static str,
     /// Whether the module declares the [`Variant`] overrides (the reference shader does not).
     has_variants: bool,
-    /// Built on first use, per variant: (spectral and naive modes `fs_main`, RGB mode). RGB has
-    /// its own entry point so that the JIT-compiled RGB shader carries none of the spectral
-    /// path's per-light arrays and loops (a CPU driver paid for them even when a uniform branch
-    /// skipped them).
-    pipelines: HashMap<Variant, (wgpu::RenderPipeline, wgpu::RenderPipeline)>,
-    current: Variant,
+    /// Built on first use, per variant and entry point (`true`: RGB mode). RGB has its own
+    /// entry point so that the JIT-compiled RGB shader carries none of the spectral path's loops
+    /// (a CPU driver paid for them even when a uniform branch skipped them).
+    pipelines: HashMap<(Variant, bool), wgpu::RenderPipeline>,
+    current: (Variant, bool),
     /// The custom hooks' pipeline-overridable constants ([`CustomShader::constants`]).
     hook_constants: Vec<(String, f64)>,
 }
 
-/// What a scene needs of the shading pass beyond punctual lights: each feature is a
-/// pipeline-overridable constant, so a scene without it runs a shader compiled without its code
+/// What a frame needs of the shading pass beyond punctual lights: each feature is a
+/// pipeline-overridable constant, so a frame without it runs a shader compiled without its code
 /// (on a CPU driver an untaken uniform branch still cost: polygon lights and the environment took
-/// the RGB pass of a punctual-only scene from 97 to 187 ms at 1280×720).
+/// the RGB pass of a punctual-only scene from 97 to 187 ms at 1280×720; the capture, naive and
+/// emission branches cost the spectral pass as much again).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
     /// Emissive polygons among the lights (`HAS_POLYGONS`).
     pub polygons: bool,
     /// An environment light (`HAS_ENV`).
     pub environment: bool,
+    /// A material that emits or is unlit (`HAS_EMISSION`; spectral and naive modes).
+    pub emission: bool,
+    /// Box upsampling instead of the sigmoid (`NAIVE`: the naive mode).
+    pub naive: bool,
+    /// The frame writes the spectral capture (`CAPTURE`).
+    pub capture: bool,
 }
 
 impl Variant {
-    /// Everything compiled in: right for any scene.
-    pub const ALL: Variant = Variant { polygons: true, environment: true };
+    /// Everything compiled in: right for any scene in the spectral mode without a capture.
+    pub const ALL: Variant =
+        Variant { polygons: true, environment: true, emission: true, naive: false, capture: false };
+
+    /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
+    /// environment); its pipelines are keyed by [`Self::rgb`].
+    fn constants(&self) -> [(&'static str, f64); 5] {
+        let b = |v: bool| f64::from(u8::from(v));
+        [
+            ("HAS_POLYGONS", b(self.polygons)),
+            ("HAS_ENV", b(self.environment)),
+            ("HAS_EMISSION", b(self.emission)),
+            ("NAIVE", b(self.naive)),
+            ("CAPTURE", b(self.capture)),
+        ]
+    }
+
+    /// What the RGB entry point depends on, the rest at its defaults.
+    fn rgb(self) -> Variant {
+        Variant { polygons: self.polygons, environment: self.environment, ..Variant::ALL }
+    }
 }
 
 impl ShadingPass {
@@ -143,6 +168,17 @@ impl ShadingPass {
                     },
                     count: None,
                 },
+                // The spectral G-buffer's material slots (`gbuf_slot`).
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -163,46 +199,46 @@ impl ShadingPass {
             rgb_entry,
             has_variants,
             pipelines: HashMap::new(),
-            current: Variant::ALL,
+            current: (Variant::ALL, false),
             hook_constants,
         };
         // Built now so that a shader error shows when the pass is made, not at the first frame.
-        pass.select(device, Variant::ALL)?;
+        pass.select(device, Variant::ALL, true)?;
+        pass.select(device, Variant::ALL, false)?;
         Ok(pass)
     }
 
-    /// Makes `variant` the pipeline [`Self::record`] uses, compiling it the first time.
-    pub fn select(&mut self, device: &wgpu::Device, variant: Variant) -> Result<()> {
-        let variant = if self.has_variants { variant } else { Variant::ALL };
-        if !self.pipelines.contains_key(&variant) {
-            let constants = [
-                ("HAS_POLYGONS", f64::from(u8::from(variant.polygons))),
-                ("HAS_ENV", f64::from(u8::from(variant.environment))),
-            ];
-            let constants: Vec<(&str, f64)> = if self.has_variants { constants.to_vec() } else { Vec::new() }
+    /// Makes `variant` the pipeline [`Self::record`] uses, with the RGB-mode entry point when
+    /// `rgb`, compiling it the first time.
+    pub fn select(&mut self, device: &wgpu::Device, variant: Variant, rgb: bool) -> Result<()> {
+        let variant = match (self.has_variants, rgb) {
+            (false, _) => Variant::ALL,
+            (true, true) => variant.rgb(),
+            (true, false) => variant,
+        };
+        let key = (variant, rgb);
+        if !self.pipelines.contains_key(&key) {
+            let own = variant.constants();
+            let constants: Vec<(&str, f64)> = if self.has_variants { own.to_vec() } else { Vec::new() }
                 .into_iter()
                 .chain(self.hook_constants.iter().map(|(name, value)| (name.as_str(), *value)))
                 .collect();
-            let build = |label: &str, entry: &str| {
-                shader::checked(device, label, || {
-                    FullscreenPipeline {
-                        fragment: entry,
-                        constants: &constants,
-                        ..FullscreenPipeline::simple(
-                            label,
-                            &self.module,
-                            &self.pipeline_layout,
-                            &[HDR_FORMAT],
-                        )
-                    }
-                    .build(device)
-                })
+            let (label, entry) = if rgb {
+                ("shading pipeline (rgb)", self.rgb_entry)
+            } else {
+                ("shading pipeline", "fs_main")
             };
-            let spectral = build("shading pipeline", "fs_main")?;
-            let rgb = build("shading pipeline (rgb)", self.rgb_entry)?;
-            self.pipelines.insert(variant, (spectral, rgb));
+            let pipeline = shader::checked(device, label, || {
+                FullscreenPipeline {
+                    fragment: entry,
+                    constants: &constants,
+                    ..FullscreenPipeline::simple(label, &self.module, &self.pipeline_layout, &[HDR_FORMAT])
+                }
+                .build(device)
+            })?;
+            self.pipelines.insert(key, pipeline);
         }
-        self.current = variant;
+        self.current = key;
         Ok(())
     }
 
@@ -231,14 +267,14 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
+                view_entry(8, &t.gbuffer_slot_view),
             ],
         })
     }
 
-    /// Records the pass with the RGB-mode entry point when `rgb`.
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw, rgb: bool) {
-        let (spectral, rgb_pipeline) = &self.pipelines[&self.current];
-        let pipeline = if rgb { rgb_pipeline } else { spectral };
+    /// Records the pass with the pipeline [`Self::select`] chose.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw) {
+        let pipeline = &self.pipelines[&self.current];
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
         draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
     }

@@ -40,9 +40,8 @@ struct ShadowUniforms {
 // The spectral capture (`Renderer::set_spectral_capture`, `spectra render --spectral-out`): per
 // pixel and group of four nodes, each node's radiance in weighted form summed over X, Y and Z
 // (`capture[pixel * n_groups + group]`); the host divides by the observer's sum at the node.
-// Written only while FLAG_CAPTURE is set; otherwise a dummy buffer is bound.
+// Written only by the pipeline with CAPTURE set (below); otherwise a dummy buffer is bound.
 @group(1) @binding(7) var<storage, read_write> capture: array<vec4<f32>>;
-const FLAG_CAPTURE: u32 = 4u;
 
 fn capture_group(px: vec2<i32>, g: u32, m: mat3x4<f32>) {
     let pixel = u32(px.y) * u32(frame.viewport.x) + u32(px.x);
@@ -381,9 +380,143 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     return vec4<f32>(out, 1.0);
 }
 
+// The spectral entry point's pipeline constants (`Variant` in src/passes/shading.rs), so that a
+// frame's shader holds only the code its settings use: box upsampling instead of the
+// Jakob–Hanika sigmoid (the naive mode), the spectral capture, and emission (no emissive or
+// unlit material in the scene: no emission fetch and no emission term per node).
+override NAIVE: bool = false;
+override CAPTURE: bool = false;
+override HAS_EMISSION: bool = true;
+
+// The reflectance at group g's four nodes: the sigmoid of the base colour's coefficients `c`,
+// or in the naive mode the box of the band each node falls in.
+fn node_reflectance(c: vec3<f32>, base: vec3<f32>, g: u32) -> vec4<f32> {
+    if (NAIVE) {
+        return box4(base, g);
+    }
+    return sigmoid4(c, wavelengths[g].lambda);
+}
+
+// Emission at group g's nodes ("illuminant" upsampling: scale·sigmoid(rgb / scale), see
+// `surface_coeffs`); zero where `scale` is zero.
+fn node_emission(c: vec3<f32>, scale: f32, emission: vec3<f32>, g: u32) -> vec4<f32> {
+    if (NAIVE) {
+        return box4(emission, g);
+    }
+    return scale * sigmoid4(c, wavelengths[g].lambda);
+}
+
+// The spectral G-buffer's material slot per pixel (the material's index + 1; 0 on the
+// background) and each material's coefficients of its constant colours (src/material_spectra.rs:
+// `MaterialSpectrum`, byte for byte), fetched once on the CPU.
+@group(1) @binding(8) var gbuf_slot: texture_2d<u32>;
+struct MaterialSpectrum {
+    // The base colour's coefficients; w = 1 when the colour is constant over the material.
+    base: vec4<f32>,
+    // Coefficients of emission / scale and w = scale (0: no emission), or w = −1 when the
+    // emission varies over the material.
+    emission: vec4<f32>,
+};
+@group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
+
+// A pixel's coefficients: the base colour's, and the emission's with its scale in w.
+struct SurfaceCoeffs {
+    base: vec3<f32>,
+    emission: vec4<f32>,
+};
+
+// The spectral mode's coefficients at pixel `px`: the material's precomputed ones where its
+// colours are constant, else fetched from the G-buffer's colours. Emission is upsampled with the
+// "illuminant" variant, s·sigmoid(rgb / s)·white(λ) with s = 2·max(rgb), so that an emissive
+// (1, 1, 1) is exactly the white illuminant; a surface that emits nothing is not fetched.
+fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
+    let slot = textureLoad(gbuf_slot, px, 0).x;
+    let m = material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)];
+    let res = frame.table_res;
+    let base_known = m.base.w != 0.0;
+    let base = select(fetch_coeffs_if(s.base, res, !base_known), m.base.xyz, base_known);
+    if (!HAS_EMISSION) {
+        return SurfaceCoeffs(base, vec4<f32>(0.0));
+    }
+    let em_known = m.emission.w >= 0.0;
+    let em_max = max(s.emission.r, max(s.emission.g, s.emission.b));
+    let scale = select(0.0, 2.0 * em_max, em_max > 0.0);
+    let fetched = fetch_coeffs_if(s.emission / max(scale, 1e-30), res, !em_known && em_max > 0.0);
+    return SurfaceCoeffs(base, select(vec4<f32>(fetched, scale), m.emission, em_known));
+}
+
 // Spectral and naive modes.
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    if (CUSTOM_SPECTRAL || CAPTURE) {
+        return vec4<f32>(shade_nodes(in), 1.0);
+    }
+    let px = vec2<i32>(in.pos.xy);
+    var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
+    let has_env = shading_env();
+    if (ctx.background) {
+        if (has_env && env.flags.y != 0u) {
+            return vec4<f32>(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)), 1.0);
+        }
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    // Lights outermost: each light's factors are used as soon as they are computed, so nothing
+    // per light is kept (a private array per light cost a CPU driver its zero-initialisation and
+    // memory traffic on every pixel); the reflectance is re-evaluated per light and group instead
+    // (7 operations per node).
+    let p = ctx.world_pos;
+    let s = load_surface(px);
+    ctx.normal = s.normal;
+    let v = -ctx.view_dir;
+    let ng = frame.n_groups;
+    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0));
+    if (!NAIVE) {
+        sc = surface_coeffs(px, s);
+    }
+    let c_base = sc.base;
+    var xyz = vec3<f32>(0.0);
+    let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+    for (var li = 0u; li < n_lights; li++) {
+        let f = light_factors(li, p, s.normal, v, s.metallic, s.roughness) * custom_light_surface(li, ctx);
+        // The specular part does not depend on the reflectance: the light's XYZ once.
+        var reflected = vec3<f32>(0.0);
+        for (var g = 0u; g < ng; g++) {
+            reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
+        }
+        xyz = fma(vec3<f32>(f.x), reflected, fma(vec3<f32>(f.y), lights[li].xyz.xyz, xyz));
+    }
+    // Ambient light (environment, a hook's irradiance) and emission: one more pass over the nodes.
+    var vis = 1.0;
+    if ((has_env || CUSTOM_IRRADIANCE) && !s.unlit) {
+        vis = ambient_visibility(in.pos.xy, p, s);
+    }
+    var et: EnvTerms;
+    if (has_env && !s.unlit) {
+        et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only());
+        et.a *= vis;
+        et.b *= vis;
+        xyz += env_xyz(et.b);
+    }
+    let lobe = diffuse_lobe(s) * vis;
+    let em = sc.emission;
+    for (var g = 0u; g < ng; g++) {
+        let rho = node_reflectance(c_base, s.base, g);
+        if (has_env) {
+            xyz += rho * env_w(et.a, g, ng);
+        }
+        if (HAS_EMISSION) {
+            xyz += node_emission(em.xyz, em.w, s.emission, g) * white_weights(g);
+        }
+        if (CUSTOM_IRRADIANCE && lobe > 0.0) {
+            xyz += s3_xyz(s3_scale(custom_irradiance(wavelengths[g].lambda, g, ctx), rho * lobe));
+        }
+    }
+    return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
+}
+
+// The general spectral loop, groups outermost, for what needs each node's whole radiance: a
+// spectral hook (which transforms it) and the capture (which stores it). Returns linear RGB.
+fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     let px = vec2<i32>(in.pos.xy);
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     let background = ctx.background;
@@ -424,40 +557,30 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         }
     }
 
-    let spectral = frame.mode == MODE_SPECTRAL;
-    let res = frame.table_res;
     var c_base = vec3<f32>(0.0);
-    var c_em = vec3<f32>(0.0);
-    // Emission uses the "illuminant" variant: s·sigmoid(rgb / s)·white(λ), s = 2·max(rgb),
-    // so that an emissive (1, 1, 1) is exactly the white illuminant.
-    let em_max = max(emission.r, max(emission.g, emission.b));
-    let has_em = em_max > 0.0;
-    let em_scale = 2.0 * em_max;
-    if (spectral && !background) {
-        c_base = fetch_coeffs(base, res);
-        if (has_em) {
-            c_em = fetch_coeffs(emission / em_scale, res);
-        }
+    var em = vec4<f32>(0.0);
+    if (!background && !NAIVE) {
+        let sc = surface_coeffs(px, load_surface(px));
+        c_base = sc.base;
+        em = sc.emission;
     }
-    // The capture needs every term per node, the specular one included.
-    let capturing = (frame.flags & FLAG_CAPTURE) != 0u;
     if (background && !CUSTOM_SPECTRAL) {
         if (has_env && env.flags.y != 0u) {
             let bg = env_background(ctx.view_dir);
-            if (capturing) {
+            if (CAPTURE) {
                 for (var g = 0u; g < frame.n_groups; g++) {
                     capture_group(px, g, env_w(bg, g, frame.n_groups));
                 }
             }
-            return vec4<f32>(frame.xyz_to_rgb * env_xyz(bg), 1.0);
+            return frame.xyz_to_rgb * env_xyz(bg);
         }
         // The capture buffer is cleared before the frame: nothing to write.
-        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return vec3<f32>(0.0);
     }
     let ng = frame.n_groups;
     var xyz = vec3<f32>(0.0);
-    // Terms that do not depend on the reflectance (specular) need no nodes: each light's XYZ
-    // once. With a spectral hook they go through the nodes, where the hook can change them.
+    // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
+    // light's XYZ once; the capture still takes them per node.
     if (!CUSTOM_SPECTRAL) {
         for (var li = 0u; li < n_lights; li++) {
             xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
@@ -469,13 +592,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let zero = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     for (var g = 0u; g < ng; g++) {
         let lambda = wavelengths[g].lambda;
-        var rho: vec4<f32>;
-        if (spectral) {
-            rho = sigmoid4(c_base, lambda);
-        } else {
-            rho = box4(base, g);
-        }
-        // Σ_l a_l·W_l (and Σ_l b_l·W_l for a hook): three fma per light and group.
+        let rho = node_reflectance(c_base, base, g);
+        // Σ_l a_l·W_l and Σ_l b_l·W_l: three fma each per light and group.
         var acc_a = zero;
         var acc_b = zero;
         for (var li = 0u; li < n_lights; li++) {
@@ -484,9 +602,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
                 w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
             }
             acc_a += w * fa[li];
-            if (CUSTOM_SPECTRAL || capturing) {
-                acc_b += w * fb[li];
-            }
+            acc_b += w * fb[li];
         }
         if (has_env && !background) {
             var wa = env_w(et.a, g, ng);
@@ -497,37 +613,21 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
                 wb = s3_scale(wb, t);
             }
             acc_a += wa;
-            if (CUSTOM_SPECTRAL || capturing) {
-                acc_b += wb;
-            }
+            acc_b += wb;
         }
-        var em = vec4<f32>(0.0);
-        if (has_em) {
-            if (spectral) {
-                em = em_scale * sigmoid4(c_em, lambda);
-            } else {
-                em = box4(emission, g);
-            }
+        // This group's whole radiance in weighted form.
+        var part = s3_scale(acc_a, rho) + acc_b;
+        if (HAS_EMISSION) {
+            part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g));
         }
-        // This group's whole contribution in weighted form, for the capture.
-        var part = zero;
         if (CUSTOM_SPECTRAL) {
-            var radiance = s3_scale(acc_a, rho) + acc_b;
-            if (has_em) {
-                radiance += s3_scale(white_weights(g), em);
-            }
-            part = custom_spectral(lambda, radiance, g, ctx);
+            part = custom_spectral(lambda, part, g, ctx);
             xyz += s3_xyz(part);
         } else {
+            // The specular terms are in xyz already.
             xyz += rho * acc_a;
-            if (has_em) {
-                xyz += em * white_weights(g);
-            }
-            if (capturing) {
-                part = s3_scale(acc_a, rho) + acc_b;
-                if (has_em) {
-                    part += s3_scale(white_weights(g), em);
-                }
+            if (HAS_EMISSION) {
+                xyz += node_emission(em.xyz, em.w, emission, g) * white_weights(g);
             }
         }
         if (CUSTOM_IRRADIANCE && lobe > 0.0) {
@@ -535,9 +635,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             xyz += s3_xyz(irr);
             part += irr;
         }
-        if (capturing) {
+        if (CAPTURE) {
             capture_group(px, g, part);
         }
     }
-    return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
+    return frame.xyz_to_rgb * xyz;
 }

@@ -736,6 +736,3 @@ fn custom_rgb(radiance: vec3<f32>, ctx: SurfaceContext) -> vec3<f32> {
     return uw_shade(r, b, c, kd, 0u, true, ctx)[0].rgb;
 }
 
-fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> {
-    return hdr;
-}

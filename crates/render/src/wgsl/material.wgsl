@@ -15,6 +15,8 @@ struct MaterialUniforms {
     // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
     // (m10, m11, m12, 0); uv' = M · (u, v, 1).
     uv_rows: array<vec4<f32>, 10>,
+    // x: the material's index + 1 (`MaterialUniforms::slot`), written by the spectral G-buffer.
+    slot: vec4<u32>,
 };
 
 const ALPHA_OPAQUE: u32 = 0u;

@@ -118,16 +118,21 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
 // then CHROMA_WARP and CHROMA_WARP_SLOPE of color::upsample::table::chroma_weight.
 @group(2) @binding(4) var<storage, read> coeff_scale: array<f32>;
 
-// Largest n with coeff_scale[first + n] <= v, clamped to [0, res - 2] (binary search over the
-// axis that starts at `first`: 0 for z, res for the chroma nodes).
-fn find_interval(v: f32, first: u32, res: u32) -> u32 {
-    var lo = 0u;
-    var hi = res - 1u;
-    while (hi - lo > 1u) {
-        let mid = (lo + hi) / 2u;
-        if (coeff_scale[first + mid] <= v) { lo = mid; } else { hi = mid; }
+// Entries of each axis's interval index (render::coeff_table::AXIS_INDEX; src/layout_tests.rs
+// checks it). The indices follow the chroma weight's constants in coeff_scale.
+const AXIS_INDEX: u32 = 1024u;
+
+// Largest n with coeff_scale[first + n] <= v, clamped to [0, res - 2]: the interval index
+// `index` (at coeff_scale[index]: brightness or chroma, coeff_table::interval_index) gives the
+// interval at floor(v · AXIS_INDEX) / AXIS_INDEX, then a step up per node between that and v —
+// none or one on spectra's grids, against the six dependent loads of a binary search.
+fn find_interval(v: f32, first: u32, index: u32, res: u32) -> u32 {
+    let vv = select(0.0, min(v, 1.0), v > 0.0);
+    var n = u32(coeff_scale[index + min(u32(vv * f32(AXIS_INDEX)), AXIS_INDEX - 1u)]);
+    while (n < res - 2u && coeff_scale[first + n + 1u] <= v) {
+        n++;
     }
-    return min(lo, res - 2u);
+    return n;
 }
 
 // σ⁻¹(z) clamped to [1e-6, 1 − 2e-4]: color::upsample::table::z_logit (same constants).
@@ -165,18 +170,35 @@ fn chroma_weight(x: f32, r0: f32, r1: f32, other: f32, res: u32) -> f32 {
 // blended in by a smoothstep of the lowest channel over [0.3, 0.5] (table::white_blend, same
 // constants): coefficient interpolation next to white is poor, next to black it is smooth.
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
+    return fetch_coeffs_if(rgb_in, res, true);
+}
+
+// `fetch_coeffs`, or zero without a fetch where `enabled` is false. The colour's own fetch and
+// its complement's are the iterations of one loop over the one or two that the colour needs,
+// so that the fetch is compiled once and runs once where one is needed (a branch per case had
+// a CPU driver run all three fetches for every pixel).
+fn fetch_coeffs_if(rgb_in: vec3<f32>, res: u32, enabled: bool) -> vec3<f32> {
     let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
     let lo = min(rgb.x, min(rgb.y, rgb.z));
     let u = clamp((lo - 0.3) / (0.5 - 0.3), 0.0, 1.0);
     let alpha = u * u * (3.0 - 2.0 * u);
-    if (alpha <= 0.0) {
-        return fetch_coeffs_direct(rgb, res);
+    // Iteration 0 is the colour's fetch, 1 its complement's.
+    let first = select(0u, 1u, alpha >= 1.0);
+    let end = select(first, select(1u, 2u, alpha > 0.0), enabled);
+    var d = vec3<f32>(0.0);
+    var comp = vec3<f32>(0.0);
+    for (var i = first; i < end; i++) {
+        let complement = i == 1u;
+        let c = fetch_coeffs_direct(select(rgb, vec3<f32>(1.0) - rgb, complement), res);
+        d = select(c, d, complement);
+        comp = select(comp, -c, complement);
     }
-    let comp = -fetch_coeffs_direct(vec3<f32>(1.0) - rgb, res);
+    if (alpha <= 0.0) {
+        return d;
+    }
     if (alpha >= 1.0) {
         return comp;
     }
-    let d = fetch_coeffs_direct(rgb, res);
     return d + alpha * (comp - d);
 }
 
@@ -192,9 +214,11 @@ fn fetch_coeffs_direct(rgb: vec3<f32>, res: u32) -> vec3<f32> {
     // Channel ratios (divided as on the CPU), located on the table's chroma nodes.
     let x = select(0.0, rgb[(l + 1u) % 3u] / z, z > 0.0);
     let y = select(0.0, rgb[(l + 2u) % 3u] / z, z > 0.0);
-    let xi = find_interval(x, res, res);
-    let yi = find_interval(y, res, res);
-    let zi = find_interval(z, 0u, res);
+    let z_index = 2u * res + 2u;
+    let chroma_index = z_index + AXIS_INDEX;
+    let xi = find_interval(x, res, chroma_index, res);
+    let yi = find_interval(y, res, chroma_index, res);
+    let zi = find_interval(z, 0u, z_index, res);
     let x1 = chroma_weight(x, coeff_scale[res + xi], coeff_scale[res + xi + 1u], y, res);
     let y1 = chroma_weight(y, coeff_scale[res + yi], coeff_scale[res + yi + 1u], x, res);
     let z1 = z_weight(z, coeff_scale[zi], coeff_scale[zi + 1u]);
