@@ -214,6 +214,31 @@ fn timestamps_report_each_pass() {
     assert_eq!(r.read_timings().unwrap(), None);
 }
 
+/// With three or more shadow maps the passes between the first (begin timestamp) and the last
+/// (end timestamp) write none; a pass given neither index is a validation error (issue 27: the
+/// Khronos models with several lights failed `spectra bench`).
+#[test]
+fn timestamps_with_many_shadow_layers() {
+    let (mut r, chart) = chart_renderer(1.0);
+    if !r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY) {
+        panic!("adapter {} has no timestamp queries", r.gpu().describe());
+    }
+    let cam = r.scene_camera().unwrap();
+    for lights in [1, 2, 3, 4, render::passes::shadow::MAX_SHADOWS] {
+        let mut scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+        scene.lights = (0..lights)
+            .map(|i| scene::Light::point(&format!("p{i}"), Vec3::new(i as f32 - 1.5, 1.0, 4.0), 20.0))
+            .collect();
+        r.set_scene(&scene).unwrap();
+        for mode in [Mode::Rgb, Mode::Spectral] {
+            let s = RenderSettings { mode, wavelengths: 4, timestamps: true, ..Default::default() };
+            r.render(&cam, &s).unwrap_or_else(|e| panic!("{lights} lights, {mode:?}: {e}"));
+            let t = r.read_timings().unwrap().expect("timings of the frame");
+            assert!(t.ms.iter().all(|&ms| ms >= 0.0 && ms.is_finite()), "{lights} lights: {t:?}");
+        }
+    }
+}
+
 #[test]
 fn bad_input_is_an_error_not_a_panic() {
     let mut r = renderer();

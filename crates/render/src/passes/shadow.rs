@@ -225,12 +225,9 @@ impl ShadowPass {
     ) {
         let n = self.active.len().max(1);
         for i in 0..n {
-            // The first pass writes the start timestamp, the last one the end.
-            let ts = timestamps.as_ref().map(|t| wgpu::RenderPassTimestampWrites {
-                query_set: t.query_set,
-                beginning_of_pass_write_index: if i == 0 { t.beginning_of_pass_write_index } else { None },
-                end_of_pass_write_index: if i + 1 == n { t.end_of_pass_write_index } else { None },
-            });
+            // The first pass writes the start timestamp, the last one the end; the passes
+            // between write none (wgpu rejects timestamp writes with neither index).
+            let ts = timestamps.as_ref().and_then(|t| layer_timestamps(t, i, n));
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &[],
@@ -262,6 +259,33 @@ impl ShadowPass {
             }
         }
     }
+}
+
+/// The timestamp writes of shadow pass `i` of `n`: the begin index on the first, the end index
+/// on the last, `None` for a pass between them (wgpu rejects writes with neither index).
+fn layer_timestamps<'a>(
+    t: &wgpu::RenderPassTimestampWrites<'a>,
+    i: usize,
+    n: usize,
+) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+    let (begin, end) = layer_indices(t.beginning_of_pass_write_index, t.end_of_pass_write_index, i, n)?;
+    Some(wgpu::RenderPassTimestampWrites {
+        query_set: t.query_set,
+        beginning_of_pass_write_index: begin,
+        end_of_pass_write_index: end,
+    })
+}
+
+/// The (begin, end) query indices shadow pass `i` of `n` writes, `None` when it writes neither.
+fn layer_indices(
+    begin: Option<u32>,
+    end: Option<u32>,
+    i: usize,
+    n: usize,
+) -> Option<(Option<u32>, Option<u32>)> {
+    let begin = begin.filter(|_| i == 0);
+    let end = end.filter(|_| i + 1 == n);
+    (begin.is_some() || end.is_some()).then_some((begin, end))
 }
 
 /// Gives the first [`MAX_SHADOWS`] lights that have a frustum a layer each, in scene order.
@@ -372,6 +396,21 @@ mod tests {
             emission: scene::Emission { rgb: Vec3::ONE, intensity: 1.0, spectrum: None },
             stands_in_for,
         }
+    }
+
+    #[test]
+    fn only_the_first_and_last_layer_write_timestamps() {
+        let (b, e) = (Some(0), Some(1));
+        assert_eq!(layer_indices(b, e, 0, 1), Some((b, e)), "one pass writes both");
+        assert_eq!(layer_indices(b, e, 0, 2), Some((b, None)));
+        assert_eq!(layer_indices(b, e, 1, 2), Some((None, e)));
+        for n in 3..=MAX_SHADOWS {
+            let writes: Vec<_> = (0..n).map(|i| layer_indices(b, e, i, n)).collect();
+            assert_eq!(writes[0], Some((b, None)), "n = {n}");
+            assert_eq!(writes[n - 1], Some((None, e)), "n = {n}");
+            assert!(writes[1..n - 1].iter().all(Option::is_none), "n = {n}: {writes:?}");
+        }
+        assert_eq!(layer_indices(None, None, 0, 1), None);
     }
 
     #[test]
