@@ -102,6 +102,25 @@ fn bench_stops() {
 }
 
 #[test]
+fn bench_suite_stops() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, md) = (dir.path().join("s.csv"), dir.path().join("s.md"));
+    let cmd = spectra(&[
+        "bench",
+        "--suite",
+        "--suite-sizes",
+        "512x512",
+        "--frames",
+        "100000",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--markdown",
+        md.to_str().unwrap(),
+    ]);
+    interrupt(cmd, Duration::from_secs(4), Some(dir.path()), false);
+}
+
+#[test]
 fn lut_stops_the_fit() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.coeff");

@@ -12,25 +12,40 @@
 //! so their cost should be the same; the benchmark shows it). `--reference` adds a row that
 //! replaces the shading pass by a minimal single-light Lambert + GGX shader, the floor an RGB
 //! deferred pass cannot go below, and prints the RGB shading pass against it.
+//!
+//! A scene with water (the built-in `underwater`) is drawn with the underwater pass and its
+//! default (light-field) model, as `spectra render` draws it. `--suite` runs the fixed set of
+//! scenes, sizes and wavelength counts of [`suite`] instead of one scene.
 
 pub mod stats;
+pub mod suite;
 
-use super::setup::{RgbMediumArgs, SceneArgs, TableArgs, parse_size};
+use super::setup::{EnvArgs, RgbMediumArgs, SceneArgs, SceneFileArgs, TableArgs, parse_size};
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args as ClapArgs;
 use color::Quadrature;
 use indicatif::{ProgressBar, ProgressStyle};
-use render::{Mode, RenderSettings, Renderer};
-use stats::{LineFit, Summary, fit_line};
+use render::passes::underwater;
+use render::timing::PASSES;
+use render::{CustomShader, Mode, PassTimings, RenderSettings, Renderer};
+use stats::{LineFit, Summary, fit_line, percentile};
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
 use std::time::Instant;
+
+/// The normal run's `--wavelengths`.
+pub const WAVELENGTHS: &str = "1,2,4,8,16,32,64";
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
+    /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a
+    /// .gltf/.glb file. Not with --suite, which runs its own scenes.
+    #[arg(required_unless_present = "suite")]
+    pub scene: Option<String>,
     #[command(flatten)]
-    pub scene: SceneArgs,
+    pub files: SceneFileArgs,
+    #[command(flatten)]
+    pub env: EnvArgs,
     // Drawn with the RGB medium pass's default march steps (16).
     #[command(flatten)]
     pub rgb_medium: RgbMediumArgs,
@@ -43,9 +58,10 @@ pub struct Args {
     /// Unmeasured frames before each configuration.
     #[arg(long, default_value_t = 10)]
     pub warmup: usize,
-    /// Wavelength counts to measure, comma-separated.
-    #[arg(long, default_value = "1,2,4,8,16,32,64")]
-    pub wavelengths: String,
+    /// Wavelength counts to measure, comma-separated (default 1,2,4,8,16,32,64; with --suite
+    /// 1,4,8,16,32).
+    #[arg(long, value_name = "N,N,…")]
+    pub wavelengths: Option<String>,
     /// Also measure naive (box-upsampled) spectral rendering at every N.
     #[arg(long)]
     pub naive: bool,
@@ -62,6 +78,44 @@ pub struct Args {
     /// the RGB shading pass against it.
     #[arg(long)]
     pub reference: bool,
+    /// Run the fixed benchmark suite (docs/benchmark.md, "Suite"): Cornell box with punctual
+    /// lights, Cornell box + default environment, a textured glTF asset (--suite-asset) +
+    /// default environment, and underwater; RGB and spectral (prefiltered) at each
+    /// --wavelengths and each --suite-sizes.
+    #[arg(long, conflicts_with_all = [
+        "scene", "size", "naive", "reference", "quadrature", "env", "env_intensity", "env_rotation",
+        "rgb_medium",
+    ])]
+    pub suite: bool,
+    /// With --suite: the textured glTF asset of its third scene (e.g. DamagedHelmet.gltf from
+    /// the Khronos glTF sample models); without it that scene is skipped.
+    #[arg(long, value_name = "FILE")]
+    pub suite_asset: Option<PathBuf>,
+    /// With --suite: frame sizes, comma-separated [default: 1280x720,1920x1080].
+    #[arg(long, value_name = "WxH,WxH,…")]
+    pub suite_sizes: Option<String>,
+    /// With --suite: also write the table as Markdown to this file (atomically).
+    #[arg(long, value_name = "FILE")]
+    pub markdown: Option<PathBuf>,
+}
+
+impl Args {
+    /// The suite's own flags are refused without `--suite` (clap's `requires` cannot name a
+    /// flag that is always set, to false or true).
+    pub fn check_suite_flags(&self) -> Result<()> {
+        if !self.suite {
+            for (flag, given) in [
+                ("--suite-asset", self.suite_asset.is_some()),
+                ("--suite-sizes", self.suite_sizes.is_some()),
+                ("--markdown", self.markdown.is_some()),
+            ] {
+                if given {
+                    bail!("{flag} goes with --suite (the normal run measures one scene at --size)");
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Parses `midpoint,prefiltered` into rules.
@@ -117,6 +171,8 @@ pub struct Row {
     pub gpu: Option<Summary>,
     /// GPU time of the shading pass alone.
     pub shading: Option<Summary>,
+    /// Median GPU time of each pass, in [`PASSES`] order.
+    pub passes: Option<[f64; PASSES.len()]>,
     pub cpu: Summary,
 }
 
@@ -134,7 +190,17 @@ impl Row {
     pub fn primary(&self) -> f64 {
         self.gpu.map(|g| g.median).unwrap_or(self.cpu.median)
     }
+
+    /// The median GPU time of pass `pass` (a name in [`PASSES`]).
+    pub fn pass(&self, pass: &str) -> Option<f64> {
+        let i = PASSES.iter().position(|p| *p == pass)?;
+        self.passes.map(|p| p[i])
+    }
 }
+
+/// The per-pass columns the normal CSV appends after its original ones (the shading pass has
+/// its column there already).
+const EXTRA_PASSES: [&str; 4] = ["shadow", "gbuffer", "custom", "post"];
 
 /// The least-squares ms-per-wavelength line of one mode's rows under one rule.
 pub fn slope(rows: &[Row], mode: Mode, rule: Quadrature) -> Option<LineFit> {
@@ -155,12 +221,16 @@ fn rgb_row(rows: &[Row]) -> Option<&Row> {
 pub fn csv(rows: &[Row]) -> String {
     let rgb = rgb_row(rows).map(Row::primary);
     let mut s = String::from(
-        "mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,shading_gpu_median_ms,cpu_median_ms,cpu_p10_ms,cpu_p90_ms,ratio_to_rgb\n",
+        "mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,shading_gpu_median_ms,cpu_median_ms,cpu_p10_ms,cpu_p90_ms,ratio_to_rgb",
     );
+    for p in EXTRA_PASSES {
+        let _ = write!(s, ",{p}_gpu_median_ms");
+    }
+    s.push('\n');
     for r in rows {
         let g = |f: fn(&Summary) -> f64| r.gpu.as_ref().map(|g| format!("{:.4}", f(g))).unwrap_or_default();
         let ratio = rgb.map(|b| format!("{:.4}", r.primary() / b)).unwrap_or_default();
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{},{},{},{},{},{:.4},{:.4},{:.4},{}",
             r.name(),
@@ -174,6 +244,10 @@ pub fn csv(rows: &[Row]) -> String {
             r.cpu.p90,
             ratio
         );
+        for p in EXTRA_PASSES {
+            let _ = write!(s, ",{}", r.pass(p).map(|v| format!("{v:.4}")).unwrap_or_default());
+        }
+        s.push('\n');
     }
     s
 }
@@ -264,34 +338,136 @@ pub fn load_report(
     Some(s)
 }
 
+/// The time of each frame of one configuration, summarised.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    pub gpu: Option<Summary>,
+    pub shading: Option<Summary>,
+    pub passes: Option<[f64; PASSES.len()]>,
+    pub cpu: Summary,
+}
+
+/// The median of each pass over `frames`; `None` without frames.
+pub fn pass_medians(frames: &[PassTimings]) -> Option<[f64; PASSES.len()]> {
+    let mut out = [0.0; PASSES.len()];
+    for (i, m) in out.iter_mut().enumerate() {
+        *m = percentile(&frames.iter().map(|t| t.ms[i]).collect::<Vec<_>>(), 50.0)?;
+    }
+    Some(out)
+}
+
+/// Renders `warmup` unmeasured then `frames` measured frames with `settings` (one tick of
+/// `bar` each) and summarises their times. Stops with an error once Ctrl-C was pressed.
+pub fn measure(
+    r: &mut Renderer,
+    camera: &scene::Camera,
+    settings: &RenderSettings,
+    (warmup, frames): (usize, usize),
+    bar: &ProgressBar,
+) -> Result<Measured> {
+    let mut timings = Vec::with_capacity(frames);
+    let mut cpu_ms = Vec::with_capacity(frames);
+    for i in 0..warmup + frames {
+        if color::cancel::is_cancelled() {
+            bail!("interrupted: nothing written");
+        }
+        let t0 = Instant::now();
+        r.render(camera, settings)?;
+        // Reading the timestamps waits for the frame; without them, wait explicitly.
+        let t = r.read_timings()?;
+        if t.is_none() {
+            r.wait()?;
+        }
+        let wall = t0.elapsed().as_secs_f64() * 1e3;
+        if i >= warmup {
+            cpu_ms.push(wall);
+            timings.extend(t);
+        }
+        bar.inc(1);
+    }
+    let gpu_ms: Vec<f64> = timings.iter().map(PassTimings::total_ms).collect();
+    let shading_ms: Vec<f64> = timings.iter().filter_map(|t| t.get("shading")).collect();
+    Ok(Measured {
+        gpu: Summary::of(&gpu_ms),
+        shading: Summary::of(&shading_ms),
+        passes: pass_medians(&timings),
+        cpu: Summary::of(&cpu_ms).context("no frame times")?,
+    })
+}
+
+/// The custom shader a benchmark draws `scene` with, and a phrase for the header: the
+/// underwater pass with its default (light-field) model when the scene has water, else the RGB
+/// medium's hooks (`--rgb-medium` or the scene's), else none.
+pub fn bench_media(
+    scene: &scene::Scene,
+    rgb_medium: Option<&str>,
+    table: &color::upsample::CoeffTable,
+) -> Result<(Option<CustomShader>, String)> {
+    let water = super::setup::water_medium(scene, None, None)?;
+    let rgb = super::setup::realtime_medium(scene, rgb_medium, water.is_some(), table, Default::default())?;
+    Ok(match water {
+        Some(m) => {
+            let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());
+            let shader = underwater::shader_with(&m, &underwater::Options::default())
+                .with_context(|| format!("the underwater pass of {}", scene.source))?;
+            (Some(shader), format!(", under water {ty} at {} m (light-field model)", m.depth))
+        }
+        None => {
+            let what = if rgb.is_some() { ", in an RGB medium" } else { "" };
+            (rgb, what.to_string())
+        }
+    })
+}
+
+/// The frame-count progress bar every benchmark shows.
+pub fn progress_bar(frames: u64) -> ProgressBar {
+    ProgressBar::new(frames).with_style(
+        ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} frames, {eta} left")
+            .expect("static template")
+            .progress_chars("=> "),
+    )
+}
+
+/// Whether the adapter has timestamp queries, and the header's phrase for how frames are timed.
+pub fn timing_of(r: &Renderer) -> (bool, &'static str) {
+    let has_ts = r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY);
+    (has_ts, if has_ts { "GPU timestamps + CPU wall" } else { "CPU wall only (no timestamp queries)" })
+}
+
+/// Whether the adapter is a CPU rasteriser (its times are CPU milliseconds).
+pub fn cpu_device(r: &Renderer) -> bool {
+    r.gpu().adapter.get_info().device_type == wgpu::DeviceType::Cpu
+}
+
 pub fn run(args: Args) -> Result<()> {
+    args.check_suite_flags()?;
+    if args.suite {
+        return suite::run(args);
+    }
     let (width, height) = parse_size(&args.size)?;
     if args.frames == 0 {
         bail!("--frames 0: measure at least one frame");
     }
-    let counts = parse_counts(&args.wavelengths)?;
+    let counts = parse_counts(args.wavelengths.as_deref().unwrap_or(WAVELENGTHS))?;
     if let Some(path) = &args.csv {
         super::check_output("--csv", path)?;
     }
-    let scene = args.scene.load()?;
+    let name = args.scene.clone().context("give a scene, or --suite")?;
+    let scene = SceneArgs { scene: name, files: args.files.clone(), env: args.env.clone() }.load()?;
     let coeffs = args.table.load()?;
-    let medium =
-        super::setup::realtime_medium(&scene, args.rgb_medium.arg(), false, &coeffs, Default::default())?;
+    let (custom, under) = bench_media(&scene, args.rgb_medium.arg(), &coeffs)?;
     let mut r = Renderer::with_table(coeffs)?;
+    println!("adapter: {}", r.gpu().describe());
     r.set_scene(&scene)?;
-    if let Some(m) = medium {
-        r.set_custom_shader(m)?;
+    if let Some(c) = custom {
+        r.set_custom_shader(c)?;
     }
     r.resize(width, height)?;
     let load_before = load_average();
-    let has_ts = r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY);
+    let (has_ts, timing) = timing_of(&r);
     eprintln!(
-        "{} {width}×{height} on {}; {} frames after {} warm-up; time: {}",
-        scene.source,
-        r.gpu().describe(),
-        args.frames,
-        args.warmup,
-        if has_ts { "GPU timestamps + CPU wall" } else { "CPU wall only (no timestamp queries)" }
+        "{}{under} {width}×{height}; {} frames after {} warm-up; time: {timing}",
+        scene.source, args.frames, args.warmup,
     );
 
     let rules = parse_rules(&args.quadrature)?;
@@ -308,12 +484,7 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     let per = (args.warmup + args.frames) as u64;
-    let bar = ProgressBar::new(per * configs.len() as u64).with_style(
-        ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} frames, {eta} left")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    let interrupted = color::cancel::token();
+    let bar = progress_bar(per * configs.len() as u64);
     let mut rows = Vec::new();
     for (mode, quadrature, reference, n) in configs {
         bar.set_message(format!("{} N={}", mode.name(), n.map(|n| n.to_string()).unwrap_or("–".into())));
@@ -325,47 +496,29 @@ pub fn run(args: Args) -> Result<()> {
             ..Default::default()
         };
         r.set_reference_shading(reference)?;
-        let mut gpu_ms = Vec::with_capacity(args.frames);
-        let mut shading_ms = Vec::with_capacity(args.frames);
-        let mut cpu_ms = Vec::with_capacity(args.frames);
-        for i in 0..per as usize {
-            if interrupted.load(Ordering::SeqCst) {
+        let m = match measure(&mut r, &scene.camera, &settings, (args.warmup, args.frames), &bar) {
+            Ok(m) => m,
+            Err(e) => {
                 bar.abandon();
-                bail!("interrupted: nothing written");
+                return Err(e);
             }
-            let t0 = Instant::now();
-            r.render(&scene.camera, &settings)?;
-            // Reading the timestamps waits for the frame; without them, wait explicitly.
-            let t = r.read_timings()?;
-            if t.is_none() {
-                r.wait()?;
-            }
-            let wall = t0.elapsed().as_secs_f64() * 1e3;
-            if i >= args.warmup {
-                cpu_ms.push(wall);
-                if let Some(t) = t {
-                    gpu_ms.push(t.total_ms());
-                    shading_ms.extend(t.get("shading"));
-                }
-            }
-            bar.inc(1);
-        }
+        };
         rows.push(Row {
             mode,
             quadrature,
             reference,
             n,
-            gpu: Summary::of(&gpu_ms),
-            shading: Summary::of(&shading_ms),
-            cpu: Summary::of(&cpu_ms).context("no frame times")?,
+            gpu: m.gpu,
+            shading: m.shading,
+            passes: m.passes,
+            cpu: m.cpu,
         });
     }
     bar.finish_and_clear();
     r.set_reference_shading(false)?;
     print!("{}", table(&rows));
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    let cpu_device = r.gpu().adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-    if let Some(line) = load_report(load_before, load_average(), cores, cpu_device) {
+    if let Some(line) = load_report(load_before, load_average(), cores, cpu_device(&r)) {
         println!("{line}");
     }
     if let Some(path) = &args.csv {
@@ -391,7 +544,8 @@ mod tests {
     fn defaults_and_counts() {
         let a = Cli::try_parse_from(["bench", "cornell"]).unwrap().args;
         assert_eq!((a.size.as_str(), a.frames, a.warmup), ("1280x720", 60, 10));
-        assert_eq!(parse_counts(&a.wavelengths).unwrap(), vec![1, 2, 4, 8, 16, 32, 64]);
+        assert_eq!(a.wavelengths, None);
+        assert_eq!(parse_counts(WAVELENGTHS).unwrap(), vec![1, 2, 4, 8, 16, 32, 64]);
         assert_eq!(parse_counts(" 4, 4,8 ").unwrap(), vec![4, 8]);
         assert!(parse_counts("0").unwrap_err().to_string().contains("outside"));
         assert!(parse_counts("4,x").unwrap_err().to_string().contains("'x'"));
@@ -411,6 +565,7 @@ mod tests {
             n,
             gpu: Some(summary(ms)),
             shading: Some(summary(ms / 2.0)),
+            passes: Some([ms / 8.0, ms / 4.0, ms / 2.0, 0.0, ms / 8.0]),
             cpu: summary(ms + 5.0),
         };
         let mut rows = vec![row(Mode::Rgb, None, None, 20.0)];
@@ -430,11 +585,22 @@ mod tests {
         let text = csv(&rows);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 6);
-        assert_eq!(lines[1], "rgb,,20.0000,19.0000,21.0000,10.0000,25.0000,24.0000,26.0000,1.0000");
+        assert!(lines[0].starts_with("mode,wavelengths,gpu_median_ms,"), "{}", lines[0]);
+        assert!(
+            lines[0].ends_with(
+                ",ratio_to_rgb,shadow_gpu_median_ms,gbuffer_gpu_median_ms,custom_gpu_median_ms,post_gpu_median_ms"
+            ),
+            "{}",
+            lines[0]
+        );
+        assert_eq!(
+            lines[1],
+            "rgb,,20.0000,19.0000,21.0000,10.0000,25.0000,24.0000,26.0000,1.0000,2.5000,5.0000,0.0000,2.5000"
+        );
         // N = 8: 40 ms / 20 ms.
         assert_eq!(
             lines[5],
-            "spectral/prefiltered,8,40.0000,39.0000,41.0000,20.0000,45.0000,44.0000,46.0000,2.0000"
+            "spectral/prefiltered,8,40.0000,39.0000,41.0000,20.0000,45.0000,44.0000,46.0000,2.0000,5.0000,10.0000,0.0000,5.0000"
         );
         assert!(table(&rows).contains("spectral/prefiltered: 2.500 ms per wavelength + 20.00 ms"));
         assert_eq!(parse_rules(" midpoint,prefiltered,midpoint").unwrap(), Quadrature::ALL.to_vec());
@@ -458,9 +624,28 @@ mod tests {
         for r in &mut rows {
             r.gpu = None;
             r.shading = None;
+            r.passes = None;
         }
         let lines: Vec<String> = csv(&rows).lines().map(String::from).collect();
         // 45 ms / 25 ms, and no GPU columns.
-        assert_eq!(lines[5], "spectral/prefiltered,8,,,,,45.0000,44.0000,46.0000,1.8000");
+        assert_eq!(lines[5], "spectral/prefiltered,8,,,,,45.0000,44.0000,46.0000,1.8000,,,,");
+    }
+
+    #[test]
+    fn pass_medians_per_pass() {
+        let t = |k: f64| PassTimings { ms: [k, 2.0 * k, 3.0 * k, 0.0, 1.0] };
+        assert_eq!(pass_medians(&[]), None);
+        assert_eq!(pass_medians(&[t(1.0), t(9.0), t(2.0)]), Some([2.0, 4.0, 6.0, 0.0, 1.0]));
+        let row = Row {
+            mode: Mode::Rgb,
+            quadrature: None,
+            reference: false,
+            n: None,
+            gpu: None,
+            shading: None,
+            passes: pass_medians(&[t(1.0)]),
+            cpu: summary(3.0),
+        };
+        assert_eq!((row.pass("gbuffer"), row.pass("post"), row.pass("nope")), (Some(2.0), Some(1.0), None));
     }
 }
