@@ -130,7 +130,7 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &shading,
         "MaterialSpectrum",
-        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission }),
+        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission, emission_xyz }),
     );
     check(
         &shading,

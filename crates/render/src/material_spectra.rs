@@ -5,6 +5,7 @@
 //! in shading.wgsl is the record below.
 
 use crate::scene_gpu::ConstantColour;
+use crate::spectral_data::WavelengthGroup;
 use color::upsample::CoeffTable;
 
 /// Byte for byte `MaterialSpectrum` in shading.wgsl (src/layout_tests.rs checks it).
@@ -17,12 +18,15 @@ pub struct MaterialSpectrum {
     /// shading pass's "illuminant" upsampling; 0 for a surface that emits nothing), or w = −1
     /// when the emission varies over the surface.
     pub emission: [f32; 4],
+    /// A constant emission's XYZ at the frame's nodes (Σ over the nodes of
+    /// scale·sigmoid(λ)·white weights, what the shader's node loop would add up); w unused.
+    pub emission_xyz: [f32; 4],
 }
 
 impl MaterialSpectrum {
     /// The record of one material: the fetch the shading pass would make per pixel (the CPU
     /// `CoeffTable::fetch` matches the WGSL one, `coeff_table`'s tests), of the exact colours.
-    pub fn new(c: &ConstantColour, table: &CoeffTable) -> Self {
+    pub fn new(c: &ConstantColour, table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
         let coeffs = |rgb: [f32; 3]| {
             let p = table.fetch(rgb.map(f64::from));
             p.c.map(|v| v as f32)
@@ -42,13 +46,32 @@ impl MaterialSpectrum {
                 [0.0; 4]
             }
         });
-        MaterialSpectrum { base, emission }
+        let mut xyz = [0.0f64; 3];
+        if emission[3] > 0.0 {
+            let [c0, c1, c2, scale] = emission.map(f64::from);
+            for g in groups {
+                for lane in 0..4 {
+                    let l = f64::from(g.lambda[lane]);
+                    let x = ((c0 * l + c1) * l + c2).clamp(-1e18, 1e18);
+                    let e = scale * (0.5 + 0.5 * x / (1.0 + x * x).sqrt());
+                    for (c, w) in xyz.iter_mut().zip([g.white_x, g.white_y, g.white_z]) {
+                        *c += e * f64::from(w[lane]);
+                    }
+                }
+            }
+        }
+        let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
+        MaterialSpectrum { base, emission, emission_xyz }
     }
 
-    /// The records of a scene's materials (one zero record for a scene without any: a storage
+    /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
     /// binding cannot be empty).
-    pub fn of_scene(colours: &[ConstantColour], table: &CoeffTable) -> Vec<MaterialSpectrum> {
-        let mut v: Vec<_> = colours.iter().map(|c| Self::new(c, table)).collect();
+    pub fn of_scene(
+        colours: &[ConstantColour],
+        table: &CoeffTable,
+        groups: &[WavelengthGroup],
+    ) -> Vec<MaterialSpectrum> {
+        let mut v: Vec<_> = colours.iter().map(|c| Self::new(c, table, groups)).collect();
         if v.is_empty() {
             v.push(MaterialSpectrum::default());
         }

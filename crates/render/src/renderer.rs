@@ -609,6 +609,8 @@ impl Renderer {
             emission: scene.has_emission,
             naive: settings.mode == Mode::Naive,
             capture: self.capture.is_some(),
+            fetch_base: scene.constant_colours.iter().any(|c| c.base.is_none()),
+            fetch_emission: scene.constant_colours.iter().any(|c| c.emission.is_none()),
         };
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
         if settings.mode == Mode::Spectral {
@@ -828,7 +830,7 @@ impl Renderer {
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
         let material_spectra = storage(
             "material spectra",
-            bytemuck::cast_slice(&MaterialSpectrum::of_scene(&scene.constant_colours, &self.table)),
+            bytemuck::cast_slice(&MaterialSpectrum::of_scene(&scene.constant_colours, &self.table, &groups)),
         );
         let bind_group = self.shared.spectral_group(
             device,

@@ -402,7 +402,9 @@ impl ConstantColour {
             // The G-buffer stores an unlit surface's colour as emission and black as its base.
             return ConstantColour { base: base.map(|_| [0.0; 3]), emission: base };
         }
-        ConstantColour { base, emission: m.emissive_texture.is_none().then(|| m.emissive.to_array()) }
+        // A texture times a zero (or negative) factor emits nothing anywhere.
+        let constant_emission = m.emissive_texture.is_none() || m.emissive.max_element() <= 0.0;
+        ConstantColour { base, emission: constant_emission.then(|| m.emissive.to_array()) }
     }
 }
 

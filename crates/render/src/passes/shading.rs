@@ -66,16 +66,28 @@ pub struct Variant {
     pub naive: bool,
     /// The frame writes the spectral capture (`CAPTURE`).
     pub capture: bool,
+    /// Some material's base colour varies over its surface, so the spectral mode fetches its
+    /// coefficients per pixel (`FETCH_BASE`); the others come from the CPU.
+    pub fetch_base: bool,
+    /// The same for emission (`FETCH_EMISSION`).
+    pub fetch_emission: bool,
 }
 
 impl Variant {
     /// Everything compiled in: right for any scene in the spectral mode without a capture.
-    pub const ALL: Variant =
-        Variant { polygons: true, environment: true, emission: true, naive: false, capture: false };
+    pub const ALL: Variant = Variant {
+        polygons: true,
+        environment: true,
+        emission: true,
+        naive: false,
+        capture: false,
+        fetch_base: true,
+        fetch_emission: true,
+    };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
     /// environment); its pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 5] {
+    fn constants(&self) -> [(&'static str, f64); 7] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -83,6 +95,8 @@ impl Variant {
             ("HAS_EMISSION", b(self.emission)),
             ("NAIVE", b(self.naive)),
             ("CAPTURE", b(self.capture)),
+            ("FETCH_BASE", b(self.fetch_base)),
+            ("FETCH_EMISSION", b(self.fetch_emission)),
         ]
     }
 

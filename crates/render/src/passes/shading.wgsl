@@ -387,6 +387,10 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
 override NAIVE: bool = false;
 override CAPTURE: bool = false;
 override HAS_EMISSION: bool = true;
+// Whether some material's base colour (FETCH_BASE) or emission (FETCH_EMISSION) varies over its
+// surface (a texture, vertex colours): only then is the per-pixel coefficient fetch compiled in.
+override FETCH_BASE: bool = true;
+override FETCH_EMISSION: bool = true;
 
 // The reflectance at group g's four nodes: the sigmoid of the base colour's coefficients `c`,
 // or in the naive mode the box of the band each node falls in.
@@ -416,13 +420,19 @@ struct MaterialSpectrum {
     // Coefficients of emission / scale and w = scale (0: no emission), or w = −1 when the
     // emission varies over the material.
     emission: vec4<f32>,
+    // The constant emission's XYZ at this frame's nodes (what the node loop would add up).
+    emission_xyz: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
 
-// A pixel's coefficients: the base colour's, and the emission's with its scale in w.
+// A pixel's coefficients: the base colour's, and the emission's with its scale in w; and
+// where the emission is the material's constant one, its XYZ at the frame's nodes (zero
+// elsewhere), which spares the node loop its emission term.
 struct SurfaceCoeffs {
     base: vec3<f32>,
     emission: vec4<f32>,
+    emission_known: bool,
+    emission_xyz: vec3<f32>,
 };
 
 // The spectral mode's coefficients at pixel `px`: the material's precomputed ones where its
@@ -432,17 +442,29 @@ struct SurfaceCoeffs {
 fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
     let slot = textureLoad(gbuf_slot, px, 0).x;
     let m = material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)];
-    let res = frame.table_res;
-    let base_known = m.base.w != 0.0;
-    let base = select(fetch_coeffs_if(s.base, res, !base_known), m.base.xyz, base_known);
-    if (!HAS_EMISSION) {
-        return SurfaceCoeffs(base, vec4<f32>(0.0));
+    var base = m.base.xyz;
+    var emission = select(vec4<f32>(0.0), m.emission, m.emission.w >= 0.0);
+    // A scene whose colours are all constant has no fetch compiled in.
+    if (FETCH_BASE || (HAS_EMISSION && FETCH_EMISSION)) {
+        let base_known = m.base.w != 0.0;
+        let em_known = m.emission.w >= 0.0;
+        let em_max = max(s.emission.r, max(s.emission.g, s.emission.b));
+        let scale = select(0.0, 2.0 * em_max, em_max > 0.0);
+        let fetched = fetch_coeffs_two(
+            s.base,
+            FETCH_BASE && !base_known,
+            s.emission / max(scale, 1e-30),
+            HAS_EMISSION && FETCH_EMISSION && !em_known && em_max > 0.0,
+            frame.table_res,
+        );
+        base = select(fetched.a, base, base_known);
+        emission = select(vec4<f32>(fetched.b, scale), emission, em_known);
     }
-    let em_known = m.emission.w >= 0.0;
-    let em_max = max(s.emission.r, max(s.emission.g, s.emission.b));
-    let scale = select(0.0, 2.0 * em_max, em_max > 0.0);
-    let fetched = fetch_coeffs_if(s.emission / max(scale, 1e-30), res, !em_known && em_max > 0.0);
-    return SurfaceCoeffs(base, select(vec4<f32>(fetched, scale), m.emission, em_known));
+    if (!HAS_EMISSION) {
+        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0));
+    }
+    let known = m.emission.w >= 0.0;
+    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known));
 }
 
 // Spectral and naive modes.
@@ -469,7 +491,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     ctx.normal = s.normal;
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
-    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0));
+    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0));
     if (!NAIVE) {
         sc = surface_coeffs(px, s);
     }
@@ -498,14 +520,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         xyz += env_xyz(et.b);
     }
     let lobe = diffuse_lobe(s) * vis;
+    // Emission known for the whole material is added as its XYZ; only a varying (textured) one
+    // goes through the nodes, and in the naive mode every one.
     let em = sc.emission;
+    let em_scale = select(em.w, 0.0, sc.emission_known);
+    let em_nodes = HAS_EMISSION && (NAIVE || FETCH_EMISSION);
+    xyz += sc.emission_xyz;
     for (var g = 0u; g < ng; g++) {
         let rho = node_reflectance(c_base, s.base, g);
         if (has_env) {
             xyz += rho * env_w(et.a, g, ng);
         }
-        if (HAS_EMISSION) {
-            xyz += node_emission(em.xyz, em.w, s.emission, g) * white_weights(g);
+        if (em_nodes) {
+            xyz += node_emission(em.xyz, em_scale, s.emission, g) * white_weights(g);
         }
         if (CUSTOM_IRRADIANCE && lobe > 0.0) {
             xyz += s3_xyz(s3_scale(custom_irradiance(wavelengths[g].lambda, g, ctx), rho * lobe));

@@ -173,26 +173,26 @@ fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
     return fetch_coeffs_if(rgb_in, res, true);
 }
 
-// `fetch_coeffs`, or zero without a fetch where `enabled` is false. The colour's own fetch and
-// its complement's are the iterations of one loop over the one or two that the colour needs,
-// so that the fetch is compiled once and runs once where one is needed (a branch per case had
-// a CPU driver run all three fetches for every pixel).
+// `fetch_coeffs`, or zero without a fetch where `enabled` is false.
 fn fetch_coeffs_if(rgb_in: vec3<f32>, res: u32, enabled: bool) -> vec3<f32> {
-    let rgb = clamp(rgb_in, vec3<f32>(0.0), vec3<f32>(1.0));
+    return fetch_coeffs_two(rgb_in, enabled, vec3<f32>(0.0), false, res).a;
+}
+
+struct CoeffPair {
+    a: vec3<f32>,
+    b: vec3<f32>,
+};
+
+// The smoothstep of the lowest channel over [0.3, 0.5] that blends in the complement's fetch
+// (table::white_blend, same constants).
+fn white_blend(rgb: vec3<f32>) -> f32 {
     let lo = min(rgb.x, min(rgb.y, rgb.z));
     let u = clamp((lo - 0.3) / (0.5 - 0.3), 0.0, 1.0);
-    let alpha = u * u * (3.0 - 2.0 * u);
-    // Iteration 0 is the colour's fetch, 1 its complement's.
-    let first = select(0u, 1u, alpha >= 1.0);
-    let end = select(first, select(1u, 2u, alpha > 0.0), enabled);
-    var d = vec3<f32>(0.0);
-    var comp = vec3<f32>(0.0);
-    for (var i = first; i < end; i++) {
-        let complement = i == 1u;
-        let c = fetch_coeffs_direct(select(rgb, vec3<f32>(1.0) - rgb, complement), res);
-        d = select(c, d, complement);
-        comp = select(comp, -c, complement);
-    }
+    return u * u * (3.0 - 2.0 * u);
+}
+
+// The colour's fetch `d` and its complement's `comp` blended by `alpha` as CoeffTable::fetch.
+fn blend_complement(d: vec3<f32>, comp: vec3<f32>, alpha: f32) -> vec3<f32> {
     if (alpha <= 0.0) {
         return d;
     }
@@ -200,6 +200,41 @@ fn fetch_coeffs_if(rgb_in: vec3<f32>, res: u32, enabled: bool) -> vec3<f32> {
         return comp;
     }
     return d + alpha * (comp - d);
+}
+
+// `fetch_coeffs` of `a_in` where `use_a` and of `b_in` where `use_b` (zero where not), through
+// one call of the fetch in a loop over the none to four that they need (each colour its own
+// fetch, its complement's, or both). A CPU driver runs every copy of the fetch's code for every
+// pixel, taken or not (a branch, or a loop of no iterations): one copy is the least it can
+// cost; a GPU runs the iterations a pixel needs.
+fn fetch_coeffs_two(a_in: vec3<f32>, use_a: bool, b_in: vec3<f32>, use_b: bool, res: u32) -> CoeffPair {
+    let a = clamp(a_in, vec3<f32>(0.0), vec3<f32>(1.0));
+    let b = clamp(b_in, vec3<f32>(0.0), vec3<f32>(1.0));
+    let alpha_a = white_blend(a);
+    let alpha_b = white_blend(b);
+    // Jobs 0 and 1: a's own fetch and its complement's; 2 and 3: b's. Each colour needs the
+    // jobs [first, end) of its pair.
+    let first_a = select(0u, 1u, alpha_a >= 1.0);
+    let end_a = select(first_a, select(1u, 2u, alpha_a > 0.0), use_a);
+    let first_b = select(0u, 1u, alpha_b >= 1.0);
+    let end_b = select(first_b, select(1u, 2u, alpha_b > 0.0), use_b);
+    let n_a = end_a - first_a;
+    let n = n_a + end_b - first_b;
+    var d_a = vec3<f32>(0.0);
+    var comp_a = vec3<f32>(0.0);
+    var d_b = vec3<f32>(0.0);
+    var comp_b = vec3<f32>(0.0);
+    for (var k = 0u; k < n; k++) {
+        let job = select(2u + first_b + (k - n_a), first_a + k, k < n_a);
+        let colour = select(a, b, job >= 2u);
+        let complement = (job & 1u) == 1u;
+        let c = fetch_coeffs_direct(select(colour, vec3<f32>(1.0) - colour, complement), res);
+        d_a = select(d_a, c, job == 0u);
+        comp_a = select(comp_a, -c, job == 1u);
+        d_b = select(d_b, c, job == 2u);
+        comp_b = select(comp_b, -c, job == 3u);
+    }
+    return CoeffPair(blend_complement(d_a, comp_a, alpha_a), blend_complement(d_b, comp_b, alpha_b));
 }
 
 // rgb2spec's fetch of a colour in [0, 1]³ (table::CoeffTable::fetch_direct): manual trilinear
