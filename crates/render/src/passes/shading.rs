@@ -1,26 +1,31 @@
-//! Pass 2: spectral shading. Per pixel: fetch the Jakob–Hanika coefficients of the base colour
-//! (manual trilinear over the table in a 3D texture) and each light's two BRDF factors (A for
-//! the reflectance-weighted part, B for the specular part that carries the light's colour);
-//! then for each group of four node wavelengths evaluate the reflectance ρ and accumulate
-//! `XYZ += ρ · Σ_l A_l·W_l` with the lights' node weights W (which hold emission, observer and
-//! quadrature rule, `color::quadrature`); the B part is each light's XYZ once per pixel; add
-//! emission (illuminant-variant upsampling, the white's node weights); finally XYZ → linear RGB.
+//! Pass 2: spectral shading. Per pixel: the Jakob–Hanika coefficients of the base colour and
+//! the emission — the material's, fetched once on the CPU (`crate::material_spectra`, found
+//! through the spectral G-buffer's material slot) where the colour is constant over the
+//! material, else fetched per pixel (manual trilinear over the table in a 3D texture, the axes'
+//! intervals from an index, both colours through one call site); then, lights outermost, each
+//! light's two BRDF factors (A for the reflectance-weighted part, B for the specular part that
+//! carries the light's colour) and `XYZ += A · Σ_g ρ_g · W_g + B · XYZ_light` over the groups of
+//! four node wavelengths, with the light's node weights W (which hold its emission, the
+//! observer and the quadrature rule, `color::quadrature`); then one pass over the nodes for the
+//! environment and a varying emission (a constant one is its XYZ, from the CPU); finally
+//! XYZ → linear RGB. Nothing is kept per light, so the pass has no private arrays.
 //!
 //! Per node wavelength (one lane of the vec4 ops), for a pixel lit by L lights, without a
 //! spectral hook:
-//! - sigmoid: 2 fma (polynomial) + clamp (max, min) + fma (1 + x²) + inverseSqrt + mul + fma = 7;
+//! - sigmoid: 2 fma (polynomial) + clamp (max, min) + fma (1 + x²) + inverseSqrt + mul + fma = 7,
+//!   once per light (the reflectance is evaluated where it is used instead of being stored);
 //! - lights: 3 fma per light (the X, Y, Z columns of its weights);
-//! - XYZ: 3 mul-adds (ρ · accumulated weights);
 //! - loads: λ and 3 weights per light (storage buffers, shared by all pixels).
 //!
-//! So 10 + 3L ALU ops and 1 + 3L loads per node (13 and 4 with one light), against the paper's
-//! midpoint layout before it (11 + 2L ops, 4 + L loads: 13 and 5 with one light): the same
-//! with one light, one fma and two loads more per extra light, whichever rule made the
-//! weights. With a spectral hook (under water) the B part goes through the nodes too (+3 fma
-//! per light) so that the hook can attenuate it. Emissive pixels add a second sigmoid and 3
-//! mul-adds. The coefficient fetch (8 texel loads, trilinear, binary search over the z axis),
-//! the BRDF and the shadow lookup (once per light) are per pixel, not per node. RGB mode skips
-//! all of it: one pass over the lights, no per-light arrays.
+//! So 10L ALU ops and 4L loads per node. A spectral hook (under water) or the spectral capture
+//! needs each node's whole radiance, so that pipeline keeps groups outermost with each light's
+//! factors in an array (`shade_nodes`), and the B part goes through the nodes too (+3 fma per
+//! light). The fetch (8 texel loads), the BRDF and the shadow lookup (once per light) are per
+//! pixel, not per node. RGB mode skips all of it: one pass over the lights.
+//!
+//! What a frame does not use is not compiled in ([`Variant`]): a CPU driver runs every branch's
+//! code, taken or not, and a loop's body at least once (measured: a fetch behind a branch that
+//! no pixel takes cost the Cornell box's spectral pass as much as a fetch for every pixel).
 
 use super::custom::CustomShader;
 use super::shadow::ShadowPass;
