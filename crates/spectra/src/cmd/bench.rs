@@ -522,10 +522,16 @@ pub fn run(args: Args) -> Result<()> {
         println!("{line}");
     }
     if let Some(path) = &args.csv {
-        compare::atomic::write_atomic(path, csv(&rows).as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
+        write_table(path, &csv(&rows))?;
     }
+    Ok(())
+}
+
+/// Writes a table (CSV, markdown) atomically and says so.
+pub(crate) fn write_table(path: &std::path::Path, text: &str) -> Result<()> {
+    compare::atomic::write_atomic(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
     Ok(())
 }
 

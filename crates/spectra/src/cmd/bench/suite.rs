@@ -370,14 +370,10 @@ pub fn run(args: Args) -> Result<()> {
         println!("{line}");
     }
     if let Some(path) = &args.csv {
-        compare::atomic::write_atomic(path, csv(&rows, &adapter).as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
+        super::write_table(path, &csv(&rows, &adapter))?;
     }
     if let Some(path) = &args.markdown {
-        compare::atomic::write_atomic(path, markdown(&rows, &header, &skipped).as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
+        super::write_table(path, &markdown(&rows, &header, &skipped))?;
     }
     Ok(())
 }
