@@ -170,12 +170,7 @@ fn chroma_weight(x: f32, r0: f32, r1: f32, other: f32, res: u32) -> f32 {
 // blended in by a smoothstep of the lowest channel over [0.3, 0.5] (table::white_blend, same
 // constants): coefficient interpolation next to white is poor, next to black it is smooth.
 fn fetch_coeffs(rgb_in: vec3<f32>, res: u32) -> vec3<f32> {
-    return fetch_coeffs_if(rgb_in, res, true);
-}
-
-// `fetch_coeffs`, or zero without a fetch where `enabled` is false.
-fn fetch_coeffs_if(rgb_in: vec3<f32>, res: u32, enabled: bool) -> vec3<f32> {
-    return fetch_coeffs_two(rgb_in, enabled, vec3<f32>(0.0), false, res).a;
+    return fetch_coeffs_two(rgb_in, true, vec3<f32>(0.0), false, res).a;
 }
 
 struct CoeffPair {
