@@ -249,13 +249,19 @@ fn uw_elev_coord(th: f32) -> f32 {
     return 0.5 * (t + 1.0) * f32(UW_NE - 1u);
 }
 
-// The segment [z_i, z_{i+1}] that holds depth z (the last one beyond the last node).
+// The segment [z_i, z_{i+1}] that holds depth z (the last one beyond the last node): the
+// largest i ≤ UW_ND − 2 whose nodes 1 … i all lie above z. In closed form, as the nodes are
+// UW_ZMAX·(i/(UW_ND − 1))^1.5: i ≈ (UW_ND − 1)·(z/UW_ZMAX)^(2/3), then one comparison on each
+// side with the nodes themselves corrects the guess's rounding, so the answer is the node-by-node
+// search's exactly (that search ran up to UW_ND − 2 steps, several times per pixel and group).
 fn uw_segment(z: f32) -> u32 {
-    var i = 0u;
-    loop {
-        if (i + 2u >= UW_ND || uw_depth_node(i + 1u) >= z) { break; }
-        i++;
-    }
+    let last = UW_ND - 2u;
+    // Beyond the table, and NaN, as the search: the last segment.
+    if (!(z < UW_ZMAX)) { return last; }
+    let g = f32(UW_ND - 1u) * pow(max(z, 0.0) / UW_ZMAX, 2.0 / 3.0);
+    var i = min(u32(max(ceil(g) - 1.0, 0.0)), last);
+    if (i < last && uw_depth_node(i + 1u) < z) { i++; }
+    if (i > 0u && uw_depth_node(i) >= z) { i--; }
     return i;
 }
 
