@@ -571,7 +571,7 @@ impl Renderer {
         // The number this frame will have in the running mean (see `accumulate` below): the
         // salt of the stochastic transparency, so that its noise averages out over frames.
         let frame_index = if self.accumulating { self.accumulated.saturating_add(1) } else { 0 };
-        self.shadow.update(&self.gpu.queue, scene, settings.shadows, frame_index);
+        self.shadow.update(&self.gpu.queue, scene, self.scene_generation, settings.shadows, frame_index);
 
         let aspect = width as f32 / height as f32;
         let view = camera.transform.inverse();
@@ -659,6 +659,7 @@ impl Renderer {
         crate::shader::checked(&self.gpu.device, "rendering the frame", || {
             self.gpu.queue.submit([encoder.finish()]);
         })?;
+        self.shadow.submitted();
         if let Some(t) = self.timer.as_mut() {
             t.pending = settings.timestamps;
         }

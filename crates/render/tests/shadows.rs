@@ -197,3 +197,34 @@ fn shadows_off_lights_everything() {
     }
     assert!(darker >= 15, "{darker} pixels in B's shadow");
 }
+
+/// The shadow maps are drawn once per scene and setting and kept while neither changes (they do
+/// not depend on the camera): a second frame, shadows off and on again, and a new scene with
+/// light B from another side all give the image a fresh renderer gives.
+#[test]
+fn cached_shadow_maps_follow_the_scene_and_the_setting() {
+    let fresh = |s: &Scene, shadows: bool| {
+        let mut r = renderer();
+        r.set_scene(s).unwrap();
+        r.resize(W, H).unwrap();
+        render(&mut r, shadows)
+    };
+    let (s, _) = scene(1);
+    let mut r = renderer();
+    r.set_scene(&s).unwrap();
+    r.resize(W, H).unwrap();
+    let first = render(&mut r, true);
+    assert_eq!(render(&mut r, true), first, "second frame");
+    let off = render(&mut r, false);
+    assert_ne!(off, first, "shadows off changes the image");
+    assert_eq!(off, fresh(&s, false), "shadows off");
+    assert_eq!(render(&mut r, true), first, "shadows on again");
+    // Light B from the other side: its shadow moves.
+    let mut moved = s.clone();
+    let b = moved.lights.last_mut().unwrap();
+    b.kind = LightKind::Directional { direction: Vec3::new(-0.3, 0.3, -1.0).normalize() };
+    r.set_scene(&moved).unwrap();
+    let after = render(&mut r, true);
+    assert_ne!(after, first, "the moved light's shadow");
+    assert_eq!(after, fresh(&moved, true), "new scene");
+}

@@ -82,6 +82,23 @@ pub struct ShadowPass {
     layer_buffers: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
     /// Layers in use since the last [`Self::update`].
     active: Vec<Layer>,
+    /// What the maps hold once the last frame that drew them has been submitted
+    /// ([`Self::submitted`]), and what the next [`Self::record`] draws (`None`: the maps already
+    /// hold it, so the pass is skipped). Shadow maps depend only on the scene and its lights,
+    /// not on the camera: a static scene draws them once.
+    drawn: Option<MapsKey>,
+    pending: Option<MapsKey>,
+}
+
+/// What determines the shadow maps' content.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MapsKey {
+    /// The renderer's scene generation (any new scene or environment).
+    pub scene: u64,
+    pub enabled: bool,
+    /// The stochastic transparency's salt (the frame index), where an alpha-tested material
+    /// casts shadows; 0 otherwise.
+    pub salt: u32,
 }
 
 impl ShadowPass {
@@ -195,13 +212,39 @@ impl ShadowPass {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        Ok(ShadowPass { pipelines, view, sampler, uniforms, layer_views, layer_buffers, active: Vec::new() })
+        Ok(ShadowPass {
+            pipelines,
+            view,
+            sampler,
+            uniforms,
+            layer_views,
+            layer_buffers,
+            active: Vec::new(),
+            drawn: None,
+            pending: None,
+        })
     }
 
     /// Chooses the shadowed lights of `scene` (none when `enabled` is false), uploads their
     /// matrices for the shadow and shading passes. `frame_index` salts the stochastic
     /// transparency of `BLEND` materials (as in the G-buffer).
-    pub fn update(&mut self, queue: &wgpu::Queue, scene: &GpuScene, enabled: bool, frame_index: u32) {
+    /// Nothing is uploaded or drawn when the maps already hold what `generation` (the renderer's
+    /// scene generation), `enabled` and the salt ask for.
+    pub fn update(
+        &mut self,
+        queue: &wgpu::Queue,
+        scene: &GpuScene,
+        generation: u64,
+        enabled: bool,
+        frame_index: u32,
+    ) {
+        let salted = scene.draws.iter().any(|d| d.alpha_tested);
+        let key = MapsKey { scene: generation, enabled, salt: if salted { frame_index } else { 0 } };
+        if self.drawn == Some(key) {
+            self.pending = None;
+            return;
+        }
+        self.pending = Some(key);
         let (uniforms, layers) = assign(&scene.lights, &scene.emitters, scene.bounds, enabled);
         for (i, (view_proj, (buffer, _))) in
             uniforms.view_proj.iter().zip(&self.layer_buffers).take(layers.len()).enumerate()
@@ -223,6 +266,20 @@ impl ShadowPass {
         scene: &GpuScene,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
+        if self.pending.is_none() {
+            // The maps hold this frame's shadows already: only the timestamps.
+            if let Some(t) = timestamps {
+                encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("shadow (maps unchanged, skipped)"),
+                    timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
+                        query_set: t.query_set,
+                        beginning_of_pass_write_index: t.beginning_of_pass_write_index,
+                        end_of_pass_write_index: t.end_of_pass_write_index,
+                    }),
+                });
+            }
+            return;
+        }
         let n = self.active.len().max(1);
         for i in 0..n {
             // The first pass writes the start timestamp, the last one the end; the passes
@@ -257,6 +314,14 @@ impl ShadowPass {
                 }
                 scene.draw_one(&mut pass, d);
             }
+        }
+    }
+
+    /// The frame recorded since the last [`Self::update`] was submitted: its maps are current.
+    /// (Until then a failed frame leaves them to be drawn again.)
+    pub fn submitted(&mut self) {
+        if let Some(key) = self.pending.take() {
+            self.drawn = Some(key);
         }
     }
 }
