@@ -609,8 +609,8 @@ impl Renderer {
             emission: scene.has_emission,
             naive: settings.mode == Mode::Naive,
             capture: self.capture.is_some(),
-            fetch_base: scene.constant_colours.iter().any(|c| c.base.is_none()),
-            fetch_emission: scene.constant_colours.iter().any(|c| c.emission.is_none()),
+            fetch_base: scene.varying_colours.0,
+            fetch_emission: scene.varying_colours.1,
         };
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
         if settings.mode == Mode::Spectral {

@@ -379,6 +379,9 @@ pub struct GpuScene {
     pub has_emission: bool,
     /// Per material, the G-buffer colours that do not vary over its surface.
     pub constant_colours: Vec<ConstantColour>,
+    /// Whether some material's base colour (`.0`) or emission (`.1`) varies over its surface,
+    /// so that the spectral shading pass needs its per-pixel fetch for it.
+    pub varying_colours: (bool, bool),
 }
 
 /// A material's base colour and emission where they do not vary over its surface (no texture,
@@ -585,6 +588,17 @@ impl GpuScene {
                 entries: &entries,
             }));
         }
+        let constant_colours: Vec<ConstantColour> = s
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                ConstantColour::of(
+                    m,
+                    s.meshes.iter().any(|mesh| mesh.material == i && !mesh.colors.is_empty()),
+                )
+            })
+            .collect();
         Ok(GpuScene {
             source: s.source.clone(),
             chunks,
@@ -597,17 +611,11 @@ impl GpuScene {
             bounds: (lo, hi),
             warnings,
             has_emission: s.materials.iter().any(|m| m.unlit || m.emissive.max_element() > 0.0),
-            constant_colours: s
-                .materials
-                .iter()
-                .enumerate()
-                .map(|(i, m)| {
-                    ConstantColour::of(
-                        m,
-                        s.meshes.iter().any(|mesh| mesh.material == i && !mesh.colors.is_empty()),
-                    )
-                })
-                .collect(),
+            varying_colours: (
+                constant_colours.iter().any(|c| c.base.is_none()),
+                constant_colours.iter().any(|c| c.emission.is_none()),
+            ),
+            constant_colours,
         })
     }
 
