@@ -65,6 +65,10 @@ def mitsuba_scene(export_dir, spp, seed_offset=0):
             "type": "perspective",
             "fov": cam["fov_y_deg"],
             "fov_axis": "y",
+            # The glTF near plane: surfaces in front of it are clipped, as in spectra (exports
+            # before issue 28 have none: Mitsuba's default, 0.01, is the glTF importer's).
+            # Mitsuba refuses 0 (glTF allows it for orthographic cameras, not exported).
+            "near_clip": max(cam.get("near_clip", 0.01), 1e-6),
             "to_world": mi.ScalarTransform4f().look_at(origin=cam["origin"], target=cam["target"], up=cam["up"]),
             "film": {
                 "type": "hdrfilm",

@@ -1,6 +1,10 @@
 //! The camera, exactly as the rasteriser projects: glTF camera space (looking down −Z, +Y up),
 //! the aspect ratio of the output image, and either a pinhole (vertical field of view) or an
 //! orthographic projection (glTF `orthographic`: parallel rays along −Z).
+//!
+//! Rays start at the eye (orthographic: on the camera's plane), so a medium around the camera
+//! attenuates and scatters over the whole view ray; the near plane clips *surfaces* only
+//! ([`CameraRay::t_near`]), as the rasteriser's clipping does.
 
 use glam::{Vec2, Vec3};
 use scene::Camera;
@@ -15,11 +19,20 @@ pub struct RayCamera {
     forward: Vec3,
     ortho: bool,
     /// Distance along `forward` of the near clipping plane (glTF `znear` × the transform's
-    /// scale, as the rasteriser's view matrix applies it): camera rays start on it, so geometry
-    /// the rasteriser clips (a cockpit around the camera) is not seen here either.
+    /// scale, as the rasteriser's view matrix applies it): surfaces in front of it are not seen,
+    /// so geometry the rasteriser clips (a cockpit around the camera) is not seen here either.
     near: f32,
     width: f32,
     height: f32,
+}
+
+/// A camera ray: from the eye (or the orthographic camera's plane) along the unit direction
+/// `d`; surfaces closer than `t_near` along it are clipped by the near plane, media are not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraRay {
+    pub o: Vec3,
+    pub d: Vec3,
+    pub t_near: f32,
 }
 
 impl RayCamera {
@@ -48,17 +61,16 @@ impl RayCamera {
         }
     }
 
-    /// The ray (origin, unit direction) through image position `p` in pixels (origin
-    /// top-left, y down). Rays start on the near clipping plane (orthographic rays: the camera's
-    /// z = −near plane).
-    pub fn ray(&self, p: Vec2) -> (Vec3, Vec3) {
+    /// The ray through image position `p` in pixels (origin top-left, y down).
+    pub fn ray(&self, p: Vec2) -> CameraRay {
         let x = 2.0 * p.x / self.width - 1.0;
         let y = 1.0 - 2.0 * p.y / self.height;
         if self.ortho {
-            (self.origin + self.right * x + self.up * y + self.forward * self.near, self.forward)
+            CameraRay { o: self.origin + self.right * x + self.up * y, d: self.forward, t_near: self.near }
         } else {
             let d = (self.forward + self.right * x + self.up * y).normalize();
-            (self.origin + d * (self.near / d.dot(self.forward)), d)
+            // The near plane is a plane: farther along the oblique rays.
+            CameraRay { o: self.origin, d, t_near: self.near / d.dot(self.forward) }
         }
     }
 }
@@ -72,11 +84,14 @@ mod tests {
     fn centre_looks_at_target_and_edges_span_the_fov() {
         let cam = Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 0.8);
         let c = RayCamera::new(&cam, 200, 100);
-        let dir = |p| c.ray(p).1;
-        // Rays start on the near plane (look_at's znear is 0.01, 5 units from the target).
-        let (o, d) = c.ray(Vec2::new(3.0, 7.0));
-        assert!(((o - Vec3::new(0.0, 1.0, 5.0)).dot(-Vec3::Z) - 0.01).abs() < 1e-6);
-        assert!((o - d * (0.01 / d.dot(-Vec3::Z)) - Vec3::new(0.0, 1.0, 5.0)).length() < 1e-5);
+        let dir = |p| c.ray(p).d;
+        // Rays start at the eye; the near plane (look_at's znear is 0.01) is where they cross
+        // the plane 0.01 in front of it.
+        let r = c.ray(Vec2::new(3.0, 7.0));
+        assert_eq!(r.o, Vec3::new(0.0, 1.0, 5.0));
+        assert!(((r.d * r.t_near).dot(-Vec3::Z) - 0.01).abs() < 1e-7);
+        assert!(r.t_near > 0.01);
+        assert!((c.ray(Vec2::new(100.0, 50.0)).t_near - 0.01).abs() < 1e-7);
         assert!((dir(Vec2::new(100.0, 50.0)) - (-Vec3::Z)).length() < 1e-6);
         let top = dir(Vec2::new(100.0, 0.0));
         assert!((top.angle_between(-Vec3::Z) - 0.4).abs() < 1e-5 && top.y > 0.0);
@@ -95,20 +110,22 @@ mod tests {
         cam.znear = 0.0;
         let c = RayCamera::new(&cam, 200, 100);
         for p in [Vec2::ZERO, Vec2::new(200.0, 100.0), Vec2::new(37.0, 81.0), Vec2::new(100.0, 50.0)] {
-            let (o, d) = c.ray(p);
+            let CameraRay { o, d, t_near } = c.ray(p);
             assert!((d - (-Vec3::Z)).length() < 1e-6, "{d}");
             assert!((o.z - 5.0).abs() < 1e-5);
+            assert_eq!(t_near, 0.0);
         }
-        let o = |x, y| c.ray(Vec2::new(x, y)).0;
+        let o = |x, y| c.ray(Vec2::new(x, y)).o;
         assert!((o(100.0, 50.0) - Vec3::new(1.0, 2.0, 5.0)).length() < 1e-5);
         assert!((o(0.0, 0.0) - Vec3::new(1.0 - xmag, 2.0 + ymag, 5.0)).length() < 1e-5);
         assert!((o(200.0, 100.0) - Vec3::new(1.0 + xmag, 2.0 - ymag, 5.0)).length() < 1e-5);
         // A square image keeps ymag and narrows to ±ymag horizontally.
         let sq = RayCamera::new(&cam, 64, 64);
-        assert!((sq.ray(Vec2::new(64.0, 0.0)).0 - Vec3::new(1.0 + ymag, 2.0 + ymag, 5.0)).length() < 1e-5);
-        // The near plane, scaled like the rasteriser's view matrix scales it: 0.5 × 2 in front.
+        assert!((sq.ray(Vec2::new(64.0, 0.0)).o - Vec3::new(1.0 + ymag, 2.0 + ymag, 5.0)).length() < 1e-5);
+        // The near plane, scaled like the rasteriser's view matrix scales it: 0.5 × 2 in front;
+        // the ray still starts on the camera's plane.
         cam.znear = 0.5;
-        let near = RayCamera::new(&cam, 200, 100);
-        assert!((near.ray(Vec2::new(37.0, 81.0)).0.z - 4.0).abs() < 1e-5);
+        let near = RayCamera::new(&cam, 200, 100).ray(Vec2::new(37.0, 81.0));
+        assert!((near.o.z - 5.0).abs() < 1e-5 && (near.t_near - 1.0).abs() < 1e-6);
     }
 }

@@ -196,6 +196,11 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
     if world.surface.is_some() {
         unsupported.push("water surface (Fresnel, TIR) and the sky seen through it".into());
     }
+    if world.medium.is_some() {
+        // Mitsuba's sensors would also start their rays on `near_clip`, skipping the medium in
+        // front of it, where ours attenuate from the eye (truth::camera).
+        unsupported.push("participating medium (not exported)".into());
+    }
     if let Some(env) = &world.env_map {
         unsupported.push(format!("environment map ({})", env.env.source));
     }
@@ -208,6 +213,8 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
         "camera": {
             "origin": origin.to_array(), "target": (origin + forward).to_array(), "up": up.to_array(),
             "fov_y_deg": cam.yfov.to_degrees(),
+            // Surfaces nearer than this along the view axis are clipped, as `RayCamera` does.
+            "near_clip": cam.znear.max(0.0) * cam.transform.transform_vector3(-Vec3::Z).length(),
         },
         "materials": materials, "meshes": meshes, "lights": lights,
         "medium": world.medium.is_some(),
@@ -238,6 +245,7 @@ mod tests {
         assert!(export(&w, 16, 8, &dir).unwrap().is_empty());
         let doc: Value = serde_json::from_str(&fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
         assert_eq!(doc["meshes"][0]["ply"], "mesh_0.ply");
+        assert!((doc["camera"]["near_clip"].as_f64().unwrap() - 0.01).abs() < 1e-9);
         let e = &doc["materials"][0]["emission"]["values"];
         // Grey RGB 2 under a D65 white is 2·D65: 2 × 100 at 560 nm.
         assert!((e[560 - 380].as_f64().unwrap() - 200.0).abs() < 1.0, "{}", e[180]);

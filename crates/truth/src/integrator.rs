@@ -3,7 +3,9 @@
 //! emissive triangles and the environment map, delta lights by NEE only, Russian roulette, and
 //! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
+use crate::accel::Hit;
 use crate::bsdf::Brdf;
+use crate::camera::CameraRay;
 use crate::material;
 use crate::medium::{Phase, phase_eval, phase_sample};
 use crate::rng::Sampler;
@@ -154,7 +156,25 @@ impl Integrator<'_, '_> {
     }
 
     /// Radiance arriving at `o` from direction `-d` at the four wavelengths `wl`.
-    pub fn radiance(&self, mut o: Vec3, mut d: Vec3, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
+    pub fn radiance(&self, o: Vec3, d: Vec3, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
+        self.clipped_radiance(o, d, 0.0, wl, rng)
+    }
+
+    /// Radiance along a camera ray: the near plane clips the surfaces in front of it (as the
+    /// rasteriser's clipping does), not the medium, which attenuates and scatters from the eye.
+    pub fn camera_radiance(&self, ray: CameraRay, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
+        self.clipped_radiance(ray.o, ray.d, ray.t_near, wl, rng)
+    }
+
+    /// [`Self::radiance`] with surfaces closer than `t_near` along the first segment ignored.
+    fn clipped_radiance(
+        &self,
+        mut o: Vec3,
+        mut d: Vec3,
+        mut t_near: f32,
+        wl: &Wavelengths,
+        rng: &mut Sampler,
+    ) -> Vec4 {
         let w = self.world;
         let l = wl.0;
         // Path throughput for the hero-wavelength MIS (Wilkie et al. 2014): `f` is the product
@@ -169,7 +189,14 @@ impl Integrator<'_, '_> {
         let mut prev_pdf = 0.0f32;
         let mut depth = 0u32;
         loop {
-            let hit = w.intersect(o, d, f32::INFINITY, w.ray_key(rng));
+            let hit = if t_near > 0.0 {
+                // Traced from the near plane, with distances still counted from the eye.
+                w.intersect(o + d * t_near, d, f32::INFINITY, w.ray_key(rng))
+                    .map(|h| Hit { t: h.t + t_near, ..h })
+            } else {
+                w.intersect(o, d, f32::INFINITY, w.ray_key(rng))
+            };
+            t_near = 0.0;
             let mut t_hit = hit.map_or(f32::INFINITY, |h| h.t);
             // The water surface, from below, comes before anything above it.
             let at_surface = w.surface.as_ref().and_then(|s| s.crossing(o, d)).filter(|&t| t <= t_hit);

@@ -313,8 +313,8 @@ fn env_furnace_white_sphere_renders_one() {
     let on_sphere: Vec<bool> = (0..w * h)
         .map(|i| {
             let px = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            let (o, d) = cam.ray(px);
-            world.geometry.intersect(o, d, f32::INFINITY).is_some()
+            let r = cam.ray(px);
+            world.geometry.intersect(r.o, r.d, f32::INFINITY).is_some()
         })
         .collect();
     let n_sphere = on_sphere.iter().filter(|&&b| b).count();

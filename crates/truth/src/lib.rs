@@ -36,6 +36,8 @@ pub mod world;
 #[cfg(test)]
 mod gltf_features_tests;
 #[cfg(test)]
+mod near_plane_tests;
+#[cfg(test)]
 mod rgb_medium_tests;
 #[cfg(test)]
 mod testing;

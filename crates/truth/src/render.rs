@@ -210,13 +210,13 @@ pub fn render_world(
                         return None;
                     }
                     let jitter = r2(shift, s);
-                    let (origin, dir) = camera.ray(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
+                    let ray = camera.ray(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
                     // Hero wavelengths stratified over the pixel's samples (one stratum of
                     // 1/spp each, times the four rotations): spiky spectra such as F11 need
                     // far fewer samples for the same colour noise. Unbiased, since every
                     // other dimension is independent of the stratum.
                     let wl = sensor.sample((s as f32 + rng.uniform()) / settings.spp as f32);
-                    let l = integ.radiance(origin, dir, &wl, &mut rng);
+                    let l = integ.camera_radiance(ray, &wl, &mut rng);
                     if !l.is_finite() {
                         dropped.fetch_add(1, Ordering::Relaxed);
                         continue;

@@ -43,10 +43,9 @@ var<private> rm_s: array<f32, 128>;
 var<private> rm_r: array<f32, 128>;
 var<private> rm_dt: array<f32, 128>;
 var<private> rm_iavg: array<f32, RM_SS_LIGHTS>;
-// Where the medium starts along the view ray (scene units from `ctx.origin`): the near plane,
-// where the path tracer starts its camera rays (truth::camera), so both see the same path.
-var<private> rm_t0: f32 = 0.0;
-// The view ray's length through the medium to the surface (0 for the background).
+// The view ray's length through the medium to the surface (0 for the background). The medium
+// starts at the eye (`ctx.origin`), as the path tracer's camera rays do (truth::camera): the
+// near plane clips surfaces, not the medium.
 var<private> rm_d: f32 = 0.0;
 
 // (σ_s, σ_t) of the group (spectral mode, smooth upsampling) or, in rgb mode, of the three
@@ -115,11 +114,8 @@ fn rm_mean_intensity(li: u32) -> f32 {
 fn rm_prepare(ctx: SurfaceContext) {
     if (rm_ready) { return; }
     rm_ready = true;
-    let near = world_from_depth(vec2<f32>(ctx.pixel) + 0.5, 0.0, frame);
-    rm_t0 = distance(ctx.origin, near);
     if (!ctx.background) {
-        rm_t0 = min(rm_t0, ctx.distance);
-        rm_d = ctx.distance - rm_t0;
+        rm_d = ctx.distance;
     }
     let m = min(u32(custom.params[0].x), RM_MAX_STEPS);
     rm_steps = m;
@@ -130,7 +126,7 @@ fn rm_prepare(ctx: SurfaceContext) {
     // optical depths of the clearest wavelength).
     let len = select(min(rm_d, cap), cap, ctx.background);
     let w = ctx.view_dir;
-    let cam = ctx.origin + w * rm_t0;
+    let cam = ctx.origin;
     var n = 0u;
     for (var li = 0u; li < min(frame.n_lights, RM_MAX_LIGHTS); li++) {
         if (n == RM_SS_LIGHTS) { break; }
