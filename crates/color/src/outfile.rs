@@ -47,6 +47,91 @@ pub fn check_writable(path: &Path) -> io::Result<()> {
         .map_err(|e| io::Error::new(e.kind(), format!("cannot create files in {}: {e}", dir.display())))
 }
 
+/// What a path names on disk, for telling whether two paths are the same file: the device and
+/// inode where it exists (so symlinks and hard links compare equal), else the real path of its
+/// directory joined with its name (two outputs that do not exist yet).
+#[derive(Debug, PartialEq, Eq)]
+enum FileId {
+    #[cfg(unix)]
+    Inode(u64, u64),
+    Path(PathBuf),
+}
+
+fn file_id(path: &Path) -> FileId {
+    #[cfg(unix)]
+    if let Ok(m) = std::fs::metadata(path) {
+        use std::os::unix::fs::MetadataExt;
+        return FileId::Inode(m.dev(), m.ino());
+    }
+    if let Ok(real) = path.canonicalize() {
+        return FileId::Path(real);
+    }
+    let dir = parent_dir(path);
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    FileId::Path(path.file_name().map_or(dir.clone(), |n| dir.join(n)))
+}
+
+/// What kind of non-regular thing `path` is, if it exists and is not a regular file (or a
+/// symlink to one): outputs are written by renaming a new file over the path, which would
+/// replace a device or a FIFO with a regular file.
+fn not_regular(path: &Path) -> Option<&'static str> {
+    let m = std::fs::metadata(path).ok()?;
+    let t = m.file_type();
+    if t.is_file() {
+        return None;
+    }
+    if t.is_dir() {
+        return Some("a directory");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_char_device() {
+            return Some("a character device");
+        }
+        if t.is_block_device() {
+            return Some("a block device");
+        }
+        if t.is_fifo() {
+            return Some("a FIFO");
+        }
+        if t.is_socket() {
+            return Some("a socket");
+        }
+    }
+    Some("not a regular file")
+}
+
+/// Checks a command's outputs together, before any work, each named by its flag: every output
+/// is a regular file or does not exist yet, and none is the same file as an input (the command
+/// would destroy what it reads) or as another output (only the last would survive). The
+/// message names both flags and the path.
+pub fn check_distinct(outputs: &[(&str, &Path)], inputs: &[(&str, &Path)]) -> Result<(), String> {
+    let ids: Vec<FileId> = outputs.iter().map(|(_, p)| file_id(p)).collect();
+    for (i, (flag, path)) in outputs.iter().enumerate() {
+        if let Some(kind) = not_regular(path) {
+            return Err(format!("{flag} {}: is {kind}; outputs must be regular files", path.display()));
+        }
+        for (what, input) in inputs {
+            if file_id(input) == ids[i] {
+                return Err(format!(
+                    "{flag} {}: is the {what} this command reads; an output must not overwrite an input",
+                    path.display()
+                ));
+            }
+        }
+        if let Some(j) = (0..i).find(|&j| ids[j] == ids[i]) {
+            return Err(format!(
+                "{flag} {} and {} {}: the same file; each output needs a path of its own",
+                path.display(),
+                outputs[j].0,
+                outputs[j].1.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The process's umask: read from `/proc/self/status` (setting and restoring it with
 /// `umask(2)` would race with other threads creating files). `0o022` where unknown.
 pub fn umask() -> u32 {
@@ -183,6 +268,40 @@ pub fn persist_dir(tmp: tempfile::TempDir, target: &Path) -> io::Result<PathBuf>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn outputs_must_be_distinct_regular_files_and_not_inputs() {
+        let d = tempfile::tempdir().unwrap();
+        let (a, b) = (d.path().join("a.exr"), d.path().join("b.exr"));
+        std::fs::write(&a, b"reference").unwrap();
+        let p = |n: &str| d.path().join(n);
+        // Distinct, new or existing regular files: fine.
+        check_distinct(&[("--out", &p("x.exr")), ("--heatmap", &p("y.png"))], &[("reference", &a)]).unwrap();
+        check_distinct(&[("--out", &b)], &[]).unwrap();
+        // An output that is an input, also through another spelling, a symlink or a hard link.
+        let e = check_distinct(&[("--per-pixel-out", &a)], &[("reference", &a)]).unwrap_err();
+        assert!(e.contains("--per-pixel-out") && e.contains("reference") && e.contains("a.exr"), "{e}");
+        let dotted = d.path().join(".").join("a.exr");
+        assert!(check_distinct(&[("--out", &dotted)], &[("test", &a)]).is_err());
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&a, p("link.exr")).unwrap();
+            assert!(check_distinct(&[("--out", &p("link.exr"))], &[("test", &a)]).is_err());
+            std::fs::hard_link(&a, p("hard.exr")).unwrap();
+            assert!(check_distinct(&[("--out", &p("hard.exr"))], &[("test", &a)]).is_err());
+            // Not regular: a device, a FIFO.
+            let e = check_distinct(&[("--out", Path::new("/dev/null"))], &[]).unwrap_err();
+            assert!(e.contains("character device"), "{e}");
+            let fifo = p("fifo");
+            assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+            assert!(check_distinct(&[("--out", &fifo)], &[]).unwrap_err().contains("FIFO"));
+        }
+        assert!(check_distinct(&[("--out", d.path())], &[]).unwrap_err().contains("directory"));
+        // Two outputs on one path, existing or not.
+        let e = check_distinct(&[("--out", &p("n.exr")), ("--spectral-out", &p("n.exr"))], &[]).unwrap_err();
+        assert!(e.contains("--out") && e.contains("--spectral-out") && e.contains("same file"), "{e}");
+        assert!(check_distinct(&[("--heatmap", &b), ("--flip-map", &b)], &[]).is_err());
+    }
 
     fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)

@@ -28,6 +28,36 @@ pub struct EnvTextures {
     pub radiance: wgpu::TextureView,
     pub irradiance: wgpu::TextureView,
     pub max_lod: f32,
+    /// What the textures' values are multiplied by to give the coefficients (a power of two, 1
+    /// for every map whose values fit; see [`texture_scale`]).
+    pub scale: f32,
+}
+
+/// The largest magnitude the half-float maps hold: a quarter of f16's largest finite value
+/// (65504), so that nothing the sampler mixes from them overflows.
+pub const F16_SAFE: f32 = 16384.0;
+
+/// The power of two by which the maps' values are divided before they are stored as f16, so that
+/// none exceeds [`F16_SAFE`]: outdoor HDRIs with an unclipped sun reach 10⁴–10⁵ per texel, and a
+/// spectral coefficient or an irradiance is larger still (π·L, the basis' normalisation), where
+/// f16 would hold ∞ (and ∞·0 = NaN in the shader). A power of two divides exactly, so a map
+/// that fits (scale 1) is stored bit for bit as before, and the f16's relative precision is the
+/// same at any scale; what it loses is texels below 2⁻²⁴·scale, i.e. ~10⁻⁹ of the brightest.
+pub fn texture_scale(maps: &EnvMaps) -> f32 {
+    let max = maps
+        .radiance
+        .iter()
+        .chain(std::iter::once(&maps.irradiance))
+        .flat_map(|m| m.texels.iter())
+        .map(|t| t.abs().max_element())
+        .fold(0.0f32, f32::max);
+    if max <= F16_SAFE {
+        return 1.0;
+    }
+    // Finite for any map of finite texels (scene::environment::MAX_RADIANCE keeps the sums so).
+    let k = (max.min(f32::MAX) / F16_SAFE).log2().ceil();
+    let scale = k.exp2();
+    if max / scale > F16_SAFE { scale * 2.0 } else { scale }
 }
 
 /// An environment on the GPU (or the black stand-in when the scene has none).
@@ -42,7 +72,13 @@ pub struct GpuEnvironment {
     pub sampler: wgpu::Sampler,
 }
 
-fn upload_map(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, levels: &[Map]) -> wgpu::TextureView {
+fn upload_map(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    levels: &[Map],
+    scale: f32,
+) -> wgpu::TextureView {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: levels[0].width, height: levels[0].height, depth_or_array_layers: 1 },
@@ -54,7 +90,8 @@ fn upload_map(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, levels: &
         view_formats: &[],
     });
     for (mip, level) in levels.iter().enumerate() {
-        let data: Vec<[f16; 4]> = level.texels.iter().map(|t| t.to_array().map(f16::from_f32)).collect();
+        let data: Vec<[f16; 4]> =
+            level.texels.iter().map(|t| (*t / scale).to_array().map(f16::from_f32)).collect();
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
@@ -75,15 +112,18 @@ fn upload_map(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, levels: &
 }
 
 fn upload_maps(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, maps: &EnvMaps) -> EnvTextures {
+    let scale = texture_scale(maps);
     EnvTextures {
-        radiance: upload_map(device, queue, &format!("{label} radiance"), &maps.radiance),
+        radiance: upload_map(device, queue, &format!("{label} radiance"), &maps.radiance, scale),
         irradiance: upload_map(
             device,
             queue,
             &format!("{label} irradiance"),
             std::slice::from_ref(&maps.irradiance),
+            scale,
         ),
         max_lod: (maps.radiance.len() - 1) as f32,
+        scale,
     }
 }
 
@@ -151,13 +191,11 @@ impl GpuEnvironment {
         let Some(env) = &self.source else {
             return EnvUniforms { params: [0.0, 0.0, 0.0, occlusion_radius], ..EnvUniforms::default() };
         };
-        let max_lod = match (&self.spectral, spectral) {
-            (Some((_, t)), true) => t.max_lod,
-            _ => self.rgb.max_lod,
-        };
+        let t = self.textures(spectral);
         EnvUniforms {
             totals,
-            params: [env.rotation, max_lod, env.intensity, occlusion_radius],
+            // The maps' scale rides on the intensity: the shader multiplies every sample by it.
+            params: [env.rotation, t.max_lod, env.intensity * t.scale, occlusion_radius],
             flags: [1, 1, 0, 0],
         }
     }
@@ -178,5 +216,29 @@ impl GpuEnvironment {
             contents: bytemuck::cast_slice(w),
             usage: wgpu::BufferUsages::STORAGE,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn maps(max: f32) -> EnvMaps {
+        let m = |v: f32| Map { width: 2, height: 1, texels: vec![Vec4::new(0.5, -v, 0.0, 1.0), Vec4::ONE] };
+        EnvMaps { radiance: vec![m(max), m(max / 2.0)], irradiance: m(1.0) }
+    }
+
+    /// Maps that fit are stored as before (scale 1); brighter ones are divided by the smallest
+    /// power of two that brings every value, negative coefficients included, within F16_SAFE.
+    #[test]
+    fn texture_scale_is_the_smallest_power_of_two_that_fits() {
+        for (max, want) in
+            [(1.0, 1.0), (F16_SAFE, 1.0), (F16_SAFE * 1.0001, 2.0), (1e5, 8.0), (1e15 * 50.0, 2f32.powi(42))]
+        {
+            let s = texture_scale(&maps(max));
+            assert_eq!(s, want, "max {max}");
+            assert!(max / s <= F16_SAFE && (max / s > F16_SAFE / 2.0 || s == 1.0), "max {max}: scale {s}");
+            assert!(f16::from_f32(max / s).is_finite());
+        }
     }
 }

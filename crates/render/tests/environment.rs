@@ -45,6 +45,7 @@ fn sphere_scene(env: Environment) -> Scene {
         water: None,
         environment: Some(env),
         medium: None,
+        inputs: vec![],
     }
 }
 
@@ -178,6 +179,7 @@ fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
         water: None,
         environment: None,
         medium: None,
+        inputs: vec![],
     };
     let want = radiance as f64 * square_irradiance(0.5, 1.0) / std::f64::consts::PI;
     for (mode, shadows) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {

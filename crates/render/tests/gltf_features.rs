@@ -82,6 +82,7 @@ fn scene(meshes: Vec<Mesh>, materials: Vec<Material>, textures: Vec<Texture>, li
         warnings: vec![],
         environment: None,
         medium: None,
+        inputs: vec![],
     }
 }
 

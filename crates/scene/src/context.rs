@@ -12,6 +12,9 @@ pub(crate) struct Ctx {
     pub dir: Option<PathBuf>,
     /// Whether file references may leave `dir` (`--allow-outside-scene-dir`).
     pub allow_outside: bool,
+    /// Every file read so far: the scene file, then each reference as it is resolved
+    /// ([`crate::Scene::inputs`]).
+    pub inputs: std::cell::RefCell<Vec<PathBuf>>,
 }
 
 impl Ctx {
@@ -19,11 +22,16 @@ impl Ctx {
         let dir = path
             .parent()
             .map(|p| if p.as_os_str().is_empty() { PathBuf::from(".") } else { p.to_path_buf() });
-        Ctx { path: path.to_path_buf(), dir, allow_outside: false }
+        Ctx { path: path.to_path_buf(), dir, allow_outside: false, inputs: vec![path.to_path_buf()].into() }
     }
 
     pub fn builtin(name: &str) -> Self {
-        Ctx { path: PathBuf::from(format!("builtin:{name}")), dir: None, allow_outside: false }
+        Ctx {
+            path: PathBuf::from(format!("builtin:{name}")),
+            dir: None,
+            allow_outside: false,
+            inputs: Vec::new().into(),
+        }
     }
 
     pub fn extras(&self, field: impl Into<String>, message: impl std::fmt::Display) -> SceneError {
@@ -52,7 +60,9 @@ impl Ctx {
             );
         };
         if self.allow_outside {
-            return Ok(d.join(rel));
+            let p = d.join(rel);
+            self.inputs.borrow_mut().push(p.clone());
+            return Ok(p);
         }
         let refuse = |why: &str| {
             self.invalid(
@@ -78,6 +88,7 @@ impl Ctx {
         {
             return Err(refuse("resolves (through a symbolic link) outside the folder"));
         }
+        self.inputs.borrow_mut().push(joined.clone());
         Ok(joined)
     }
 }

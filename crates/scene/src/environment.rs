@@ -23,7 +23,8 @@
 //!
 //! Input is refused, with the file and the reason, when it is not a regular file, not an HDR
 //! image (`.hdr` Radiance RGBE or `.exr` OpenEXR), larger than [`MAX_INPUT_WIDTH`] ×
-//! [`MAX_INPUT_HEIGHT`], not 2:1, empty, or has a negative or non-finite texel. Images wider than
+//! [`MAX_INPUT_HEIGHT`], not 2:1, empty, or has a negative, non-finite or brighter than
+//! [`MAX_RADIANCE`] texel. Images wider than
 //! [`WORKING_WIDTH`] are box-filtered down (exactly: the mean radiance of each block, so the
 //! integral over the sphere is kept), which is what both renderers then see.
 
@@ -42,6 +43,10 @@ pub const MAX_INPUT_BYTES: u64 = 1 << 30;
 pub const WORKING_WIDTH: u32 = 2048;
 /// Largest accepted `intensity`.
 pub const MAX_INTENSITY: f32 = 1e6;
+/// Brightest texel accepted (radiance in the map's units): far above any sky (the sun's disc is
+/// ~10⁷–10⁹ in photometric units), and low enough that the prefiltered maps (sums of π × the
+/// brightest texel) and [`MAX_INTENSITY`] × it stay finite in f32.
+pub const MAX_RADIANCE: f32 = 1e15;
 
 /// The radiance of the default environment's sky (its ground is [`DEFAULT_GROUND`] × this).
 pub const DEFAULT_SKY: f32 = 1.0;
@@ -103,6 +108,13 @@ impl Environment {
             let (x, y) = (i as u32 % width, i as u32 / width);
             return Err(err(format!(
                 "texel ({x}, {y}) is {} — radiance must be finite and not negative",
+                texels[i]
+            )));
+        }
+        if let Some(i) = texels.iter().position(|t| t.max_element() > MAX_RADIANCE) {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            return Err(err(format!(
+                "texel ({x}, {y}) is {} — radiance must be at most {MAX_RADIANCE:e}",
                 texels[i]
             )));
         }
@@ -493,7 +505,12 @@ mod tests {
         t[5] = Vec3::new(f32::NAN, 0.0, 0.0);
         assert!(e(4, 2, t.clone()).contains("(1, 1)"));
         t[5] = Vec3::new(-1.0, 0.0, 0.0);
-        assert!(e(4, 2, t).contains("negative"));
+        assert!(e(4, 2, t.clone()).contains("negative"));
+        t[5] = Vec3::new(0.0, 2.0 * MAX_RADIANCE, 0.0);
+        let m = e(4, 2, t.clone());
+        assert!(m.contains("(1, 1)") && m.contains("at most"), "{m}");
+        t[5] = Vec3::splat(MAX_RADIANCE);
+        assert!(Environment::from_rgb("sky.hdr", 4, 2, t).is_ok());
         let env = Environment::uniform(Vec3::ONE);
         assert!(env.clone().with_intensity(f32::NAN).unwrap_err().to_string().contains("intensity"));
         assert!(env.with_rotation_degrees(f32::INFINITY).is_err());

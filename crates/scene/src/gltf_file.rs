@@ -70,7 +70,12 @@ pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Sc
 /// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
 /// (and must stay inside it). `name` is used in messages in place of a path.
 pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, SceneError> {
-    let ctx = Ctx { path: name.into(), dir: base_dir.map(Path::to_path_buf), allow_outside: false };
+    let ctx = Ctx {
+        path: name.into(),
+        dir: base_dir.map(Path::to_path_buf),
+        allow_outside: false,
+        inputs: Vec::new().into(),
+    };
     from_slice(&ctx, bytes)
 }
 
@@ -257,6 +262,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         water: sx.water,
         environment: sx.environment,
         medium: sx.medium,
+        inputs: ctx.inputs.take(),
     };
     if scene.water.is_some() && scene.medium.is_some() {
         return Err(ctx.extras(

@@ -82,6 +82,10 @@ pub struct Scene {
     /// A homogeneous medium in RGB filling the scene (`extras.medium`, [`medium::RgbMedium`]);
     /// `None`: clear air. Never together with [`Self::water`].
     pub medium: Option<medium::RgbMedium>,
+    /// The files the scene was read from: the glTF file and every file it references (buffers,
+    /// images, CSV spectra, environment maps); empty for scenes built in code. A command's
+    /// outputs must not overwrite any of them (`color::outfile::check_distinct`).
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 impl Scene {
@@ -101,6 +105,7 @@ impl Scene {
             water: None,
             environment: None,
             medium: None,
+            inputs: Vec::new(),
         }
     }
 }

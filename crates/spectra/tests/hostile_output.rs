@@ -66,3 +66,66 @@ fn a_closed_stdout_ends_quietly() {
     use std::os::unix::process::ExitStatusExt;
     assert!(out.status.success() || out.status.signal() == Some(libc::SIGPIPE), "{:?}: {err}", out.status);
 }
+
+/// Outputs that would destroy an input, another output of the same command, or something that
+/// is not a regular file (issue 29) are refused before any work, naming both flags; the inputs
+/// are left as they were.
+#[test]
+fn outputs_never_overwrite_inputs_each_other_or_devices() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_images(dir.path());
+    let before = std::fs::read(&a).unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    refused(
+        &["diff", &a, &b, "--per-pixel-out", &a],
+        &["--per-pixel-out", "reference", "must not overwrite"],
+    );
+    refused(&["diff", &a, &b, "--heatmap", &b], &["--heatmap", "test image"]);
+    refused(&["diff", &a, &b, "--heatmap", &p("h.png"), "--per-pixel-out", &p("h.png")], &["same file"]);
+    refused(
+        &["diff", &a, &b, "--metric", "flip", "--heatmap", &p("m.png"), "--flip-map", &p("m.png")],
+        &["--flip-map", "--heatmap", "same file"],
+    );
+    let x = p("x.exr");
+    refused(
+        &["render", "cornell", "--size", "8x8", "--out", &x, "--spectral-out", &x],
+        &["--spectral-out", "same file"],
+    );
+    refused(
+        &["truth", "cornell", "--size", "8x8", "--spp", "1", "--out", &x, "--spectral-out", &x],
+        &["--spectral-out", "same file"],
+    );
+    // A device or a FIFO behind an image name (the write renames a new file over the path, which
+    // would replace the device node).
+    let null = p("null.exr");
+    std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+    refused(&["render", "cornell", "--size", "8x8", "--out", &null], &["character device"]);
+    refused(&["truth", "cornell", "--size", "8x8", "--spp", "1", "--out", &null], &["character device"]);
+    let fifo = p("fifo.png");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    refused(&["diff", &a, &b, "--heatmap", &fifo], &["--heatmap", "FIFO"]);
+    // The files a scene references: its textures are PNGs, which `--out` could name.
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../scene/tests/data");
+    for f in ["textured.gltf", "base.png", "normal.png", "quad.bin", "reflectance.csv", "spectrum.csv"] {
+        std::fs::copy(format!("{data}/{f}"), dir.path().join(f)).unwrap();
+    }
+    let g = p("textured.gltf");
+    let texture = p("base.png");
+    let texture_before = std::fs::read(&texture).unwrap();
+    refused(
+        &["render", &g, "--size", "8x8", "--out", &texture],
+        &["--out", "file the scene references", "base.png"],
+    );
+    refused(&["truth", &g, "--size", "8x8", "--spp", "1", "--out", &texture], &["file the scene references"]);
+    refused(&["bench", &g, "--size", "8x8", "--frames", "1", "--csv", &g], &["--csv", "scene file"]);
+    assert_eq!(std::fs::read(&texture).unwrap(), texture_before);
+    let env = p("sky.exr");
+    compare::io::write_image(
+        &env,
+        &compare::image::Image::new(4, 2, vec![[1.0; 3]; 8]).unwrap(),
+        Default::default(),
+    )
+    .unwrap();
+    refused(&["render", "cornell", "--env", &env, "--size", "8x8", "--out", &env], &["--env file"]);
+    assert_eq!(std::fs::read(&a).unwrap(), before);
+}

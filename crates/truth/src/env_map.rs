@@ -444,8 +444,17 @@ mod tests {
         let black = Environment::from_rgb("black", 4, 2, vec![Vec3::ZERO; 8]).unwrap();
         let map = EnvMap::new(&black, &units(), &GreyOnly).unwrap();
         assert!(map.is_empty() && map.sample([0.5; 6]).is_none() && map.pdf(Vec3::Y) == 0.0);
-        let mut huge = Environment::from_rgb("huge", 4, 2, vec![Vec3::splat(1e38); 8]).unwrap();
-        huge.intensity = 1e6;
+        // Past what the loader accepts (scene::environment::MAX_RADIANCE), built directly: the
+        // tracer's own guard still holds.
+        assert!(Environment::from_rgb("huge", 4, 2, vec![Vec3::splat(1e38); 8]).is_err());
+        let huge = Environment {
+            source: "huge".into(),
+            width: 4,
+            height: 2,
+            texels: vec![Vec3::splat(1e38); 8],
+            intensity: 1e6,
+            rotation: 0.0,
+        };
         assert!(EnvMap::new(&huge, &units(), &GreyOnly).err().unwrap().to_string().contains("huge"));
     }
 }

@@ -23,6 +23,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         water: None,
         environment: None,
         medium: None,
+        inputs: vec![],
     }
 }
 

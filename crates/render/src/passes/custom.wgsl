@@ -19,5 +19,6 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if (!ctx.background) {
         ctx.normal = normalize(textureLoad(gbuf_normal, px, 0).xyz);
     }
-    return custom_pixel(textureLoad(hdr_in, px, 0), ctx);
+    let c = custom_pixel(textureLoad(hdr_in, px, 0), ctx);
+    return vec4<f32>(hdr_out(c.rgb).rgb, c.a);
 }

@@ -16,6 +16,15 @@ pub mod underwater;
 
 /// HDR colour targets (shading output, custom output).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The largest finite value of [`HDR_FORMAT`], where the passes clamp what they write
+/// (`hdr_out` in wgsl/common.wgsl) rather than store ∞.
+pub const HDR_MAX: f32 = 65504.0;
+
+/// How many pixels of a read-back HDR image reached [`HDR_MAX`] in some channel (clipped: the
+/// true value is larger), for the caller to warn about.
+pub fn hdr_clipped(pixels: &[[f32; 4]]) -> usize {
+    pixels.iter().filter(|p| p[..3].iter().any(|c| c.abs() >= HDR_MAX)).count()
+}
 /// G-buffer colour targets: base colour + metallic, normal + roughness, emission.
 pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
     [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float];

@@ -377,7 +377,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
             out += s.base * (lobe * ambient_visibility(in.pos.xy, ctx.world_pos, s)) * custom_irradiance_rgb(ctx);
         }
     }
-    return vec4<f32>(out, 1.0);
+    return hdr_out(out);
 }
 
 // The spectral entry point's pipeline constants (`Variant` in src/passes/shading.rs), so that a
@@ -471,14 +471,14 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if (CUSTOM_SPECTRAL || CAPTURE) {
-        return vec4<f32>(shade_nodes(in), 1.0);
+        return hdr_out(shade_nodes(in));
     }
     let px = vec2<i32>(in.pos.xy);
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     let has_env = shading_env();
     if (ctx.background) {
         if (has_env && env.flags.y != 0u) {
-            return vec4<f32>(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)), 1.0);
+            return hdr_out(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)));
         }
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
@@ -538,7 +538,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             xyz += s3_xyz(s3_scale(custom_irradiance(wavelengths[g].lambda, g, ctx), rho * lobe));
         }
     }
-    return vec4<f32>(frame.xyz_to_rgb * xyz, 1.0);
+    return hdr_out(frame.xyz_to_rgb * xyz);
 }
 
 // The general spectral loop, groups outermost, for what needs each node's whole radiance: a

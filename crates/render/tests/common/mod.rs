@@ -129,6 +129,7 @@ impl Chart {
             water: None,
             environment: None,
             medium: None,
+            inputs: vec![],
         }
     }
 }

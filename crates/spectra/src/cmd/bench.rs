@@ -453,7 +453,12 @@ pub fn run(args: Args) -> Result<()> {
         super::check_output("--csv", path)?;
     }
     let name = args.scene.clone().context("give a scene, or --suite")?;
-    let scene = SceneArgs { scene: name, files: args.files.clone(), env: args.env.clone() }.load()?;
+    let scene_args = SceneArgs { scene: name, files: args.files.clone(), env: args.env.clone() };
+    let scene = scene_args.load()?;
+    let mut inputs = scene_args.input_files(&scene);
+    inputs.extend(args.table.input_files());
+    inputs.extend(args.rgb_medium.input_files());
+    super::check_outputs(&[("--csv", args.csv.as_deref())], &inputs)?;
     let coeffs = args.table.load()?;
     let (custom, under) = bench_media(&scene, args.rgb_medium.arg(), &coeffs)?;
     let mut r = Renderer::with_table(coeffs)?;

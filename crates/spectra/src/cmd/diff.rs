@@ -167,6 +167,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("--max-de must be a positive number, got {m}");
     }
 
+    // Before the (possibly long) comparison: every output writable, none an input or another.
+    let outputs = [
+        ("--heatmap", args.heatmap.as_deref()),
+        ("--per-pixel-out", args.per_pixel_out.as_deref()),
+        ("--flip-map", args.flip_map.as_deref()),
+    ];
+    let inputs =
+        [("reference".to_string(), args.reference.clone()), ("test image".to_string(), args.test.clone())];
+    super::check_outputs(&outputs, &inputs)?;
+    for (flag, p) in outputs {
+        if let Some(p) = p {
+            super::check_output(flag, p)?;
+        }
+    }
     let (mut reference, ref_note) = load(&args.reference, "reference", &args)?;
     let (mut test, test_note) = load(&args.test, "test", &args)?;
     if (args.observer.is_some() || args.white.is_some()) && ref_note.is_none() && test_note.is_none() {

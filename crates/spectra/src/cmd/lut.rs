@@ -42,6 +42,7 @@ pub fn run(a: Args) -> Result<()> {
         bail!("--res {} is outside 2..={}", a.res, upsample::table::MAX_RES);
     }
     super::check_output("--out", &a.out)?;
+    super::check_outputs(&[("--out", Some(&a.out))], &[])?;
     // Checked before the fit (minutes), not after it.
     if a.check > 0 {
         roundtrip::check_count(a.check).map_err(|e| anyhow::anyhow!("--check {}: {e}", a.check))?;

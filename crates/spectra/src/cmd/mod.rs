@@ -17,3 +17,16 @@ pub mod view;
 pub fn check_output(flag: &str, path: &std::path::Path) -> anyhow::Result<()> {
     color::outfile::check_writable(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
 }
+
+/// Refuses, before the work, a command's outputs (flag, path; `None` for one not asked for) that
+/// are not regular files, are the same file as one of `inputs` (what, path) or as each other:
+/// one guard for every command (`color::outfile::check_distinct`).
+pub fn check_outputs(
+    outputs: &[(&str, Option<&std::path::Path>)],
+    inputs: &[(String, std::path::PathBuf)],
+) -> anyhow::Result<()> {
+    let outs: Vec<(&str, &std::path::Path)> =
+        outputs.iter().filter_map(|(f, p)| p.map(|p| (*f, p))).collect();
+    let ins: Vec<(&str, &std::path::Path)> = inputs.iter().map(|(w, p)| (w.as_str(), p.as_path())).collect();
+    color::outfile::check_distinct(&outs, &ins).map_err(anyhow::Error::msg)
+}

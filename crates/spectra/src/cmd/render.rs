@@ -82,11 +82,23 @@ fn render_frame(
     let interrupted =
         || if color::cancel::is_cancelled() { Err(render::RenderError::Cancelled) } else { Ok(()) };
     let k = settings.exposure_ev.exp2();
+    // Linear outputs hold the HDR values themselves, so their clipping is worth a warning (a PNG
+    // is tone mapped: a clipped pixel is white either way).
+    let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
+    let hdr = if linear_out { r.read_hdr()? } else { Vec::new() };
+    let clipped = render::passes::hdr_clipped(&hdr);
+    if clipped > 0 {
+        eprintln!(
+            "warning: {clipped} pixels reached the HDR target's largest value ({}) and are clipped there; \
+             lower the light (--env-intensity, the scene's intensities) and raise --exposure",
+            render::passes::HDR_MAX
+        );
+    }
     // The spectral file first: an interrupted run leaves neither complete, never a colour image
     // without the spectral one it was asked to go with.
     if let Some(sp) = &args.spectral_out {
         let cap = r.read_spectral_capture()?;
-        let rgb = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+        let rgb = hdr.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
         let rgb = compare::image::Image::new(width, height, rgb)?;
         let spec = compare::SpectralImage {
             width,
@@ -112,7 +124,7 @@ fn render_frame(
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
         OutFormat::Exr => {
-            let data = r.read_hdr()?.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+            let data = hdr.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
             let img = compare::image::Image::new(width, height, data)?;
             interrupted()?;
             compare::io::write_image(&args.out, &img, Default::default())
@@ -141,6 +153,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         super::check_output("--spectral-out", sp)?;
     }
     let scene = args.scene.load()?;
+    let mut inputs = args.scene.input_files(&scene);
+    inputs.extend(args.look.table.input_files());
+    inputs.extend(args.look.rgb_medium.input_files());
+    super::check_outputs(
+        &[("--out", Some(&args.out)), ("--spectral-out", args.spectral_out.as_deref())],
+        &inputs,
+    )?;
     let settings = args.look.settings(&scene, !args.no_shadows, false)?;
     let table = args.look.table.load()?;
     let media = args.look.media(&scene, &table)?;

@@ -28,6 +28,33 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
+    /// The files `scene` (loaded from these arguments) was read from, named for messages: the
+    /// glTF file, every file it references, and `--env`'s file.
+    pub fn input_files(&self, scene: &scene::Scene) -> Vec<(String, PathBuf)> {
+        let mut v: Vec<(String, PathBuf)> = scene
+            .inputs
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let what = if i == 0 {
+                    "scene file".to_string()
+                } else {
+                    format!("file the scene references ({})", p.display())
+                };
+                (what, p.clone())
+            })
+            .collect();
+        if let Some(e) = self
+            .env
+            .env
+            .as_deref()
+            .filter(|e| !["default", "none"].contains(&e.to_ascii_lowercase().as_str()))
+        {
+            v.push(("--env file".into(), PathBuf::from(e)));
+        }
+        v
+    }
+
     /// Loads the scene, prints the loader's warnings and applies the environment flags.
     pub fn load(&self) -> Result<scene::Scene> {
         let mut scene = self.files.load(&self.scene)?;
@@ -322,6 +349,15 @@ impl RgbMediumArgs {
     pub fn arg(&self) -> Option<&str> {
         self.rgb_medium.as_deref()
     }
+
+    /// `--rgb-medium`'s file (not an inline JSON object), named for [`super::check_outputs`].
+    pub fn input_files(&self) -> Vec<(String, PathBuf)> {
+        self.arg()
+            .filter(|a| !a.trim_start().starts_with('{'))
+            .map(|a| ("--rgb-medium file".to_string(), PathBuf::from(a)))
+            .into_iter()
+            .collect()
+    }
 }
 
 /// `--table` (`render`, `view`, `bench`, `truth`, `eval`).
@@ -334,6 +370,11 @@ pub struct TableArgs {
 }
 
 impl TableArgs {
+    /// `--table`'s file, named for [`super::check_outputs`].
+    pub fn input_files(&self) -> Vec<(String, PathBuf)> {
+        self.table.iter().map(|p| ("--table file".to_string(), p.clone())).collect()
+    }
+
     /// The table: `--table`, else the colour crate's cached sRGB fit (fitted on first use).
     pub fn load(&self) -> Result<Arc<CoeffTable>> {
         load_table(self.table.as_deref())

@@ -158,6 +158,14 @@ pub fn run(a: Args) -> Result<()> {
         super::check_output("--export-mitsuba", dir)?;
     }
     let scene = a.scene.load()?;
+    let mut inputs = a.scene.input_files(&scene);
+    inputs.extend(a.table.input_files());
+    inputs.extend(a.rgb_medium.input_files());
+    inputs.extend(a.medium.iter().map(|m| ("--medium file".to_string(), m.clone())));
+    super::check_outputs(
+        &[("--out", a.out.as_deref()), ("--spectral-out", a.spectral_out.as_deref())],
+        &inputs,
+    )?;
     let table = a.table.load()?;
     let st = settings(&a, &scene, &table)?;
     let t0 = Instant::now();

@@ -64,6 +64,7 @@ fn scene(mesh: Mesh, white: &str) -> Scene {
         warnings: vec![],
         environment: None,
         medium: None,
+        inputs: vec![],
     }
 }
 

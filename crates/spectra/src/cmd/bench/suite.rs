@@ -253,6 +253,12 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.markdown {
         crate::cmd::check_output("--markdown", path)?;
     }
+    let mut inputs = args.table.input_files();
+    inputs.extend(args.suite_asset.iter().map(|a| ("--suite-asset".to_string(), a.clone())));
+    crate::cmd::check_outputs(
+        &[("--csv", args.csv.as_deref()), ("--markdown", args.markdown.as_deref())],
+        &inputs,
+    )?;
     let (scenes, note) = scenes(args.suite_asset.as_deref());
     let coeffs = args.table.load()?;
     let mut r = Renderer::with_table(coeffs.clone())?;
