@@ -3,6 +3,10 @@
 use crate::error::{ColorError, Result};
 use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
 
+/// Most bins a spectral image may have (also the most bands a spectral EXR is read with:
+/// 1 nm over 360–830 nm is 471).
+pub const MAX_BINS: usize = 2048;
+
 /// A closed wavelength interval in nanometres, validated against the observer data range.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WavelengthRange {
@@ -36,14 +40,24 @@ impl WavelengthRange {
         Ok(WavelengthRange { min, max })
     }
 
-    /// Edges of box bins `width` nm wide from `min` (the last bin ends at `max`, narrower when
+    /// Edges of box bins `width` nm wide from `min`, at most [`MAX_BINS`] of them (the last bin ends at `max`, narrower when
     /// `width` does not divide the range): the bins of a spectral image.
     pub fn bin_edges(&self, width: f64) -> Result<Vec<f64>> {
         if !(width.is_finite() && width > 0.0) {
             return Err(ColorError::BadSpectrum(format!("bin width {width} nm: must be a positive number")));
         }
         // A bin narrower than 1 % of the width at the end is rounding, not a bin.
-        let n = ((self.width() / width) - 0.01).ceil().max(1.0) as usize;
+        let n = ((self.width() / width) - 0.01).ceil().max(1.0);
+        // Counted before anything is allocated (1e-9 nm used to ask for terabytes).
+        if n > MAX_BINS as f64 {
+            return Err(ColorError::BadSpectrum(format!(
+                "bin width {width} nm: {n:.0} bins over {}–{} nm; at most {MAX_BINS} (a width of at least {:.4} nm)",
+                self.min,
+                self.max,
+                self.width() / (MAX_BINS as f64 - 1.0)
+            )));
+        }
+        let n = n as usize;
         let mut edges: Vec<f64> = (0..n).map(|i| self.min + i as f64 * width).collect();
         edges.push(self.max);
         Ok(edges)
@@ -174,6 +188,11 @@ mod tests {
         assert_eq!(e, vec![400.0, 405.0, 410.0, 415.0, 417.0]);
         assert!(WavelengthRange::VISIBLE.bin_edges(0.0).is_err());
         assert!(WavelengthRange::VISIBLE.bin_edges(-5.0).is_err());
+        // Bounded before anything is allocated; the message gives the narrowest width allowed.
+        let e = WavelengthRange::VISIBLE.bin_edges(1e-9).unwrap_err().to_string();
+        assert!(e.contains("at most 2048") && e.contains("0.1710"), "{e}");
+        let w = WavelengthRange::VISIBLE.width() / (MAX_BINS as f64 - 1.0);
+        assert!(WavelengthRange::VISIBLE.bin_edges(w).unwrap().len() <= MAX_BINS + 1);
         let w = SampledWavelengths::from_edges(&[400.0, 405.0, 415.0]).unwrap();
         assert_eq!((w.lambda, w.weight), (vec![402.5, 410.0], vec![5.0, 10.0]));
         let m = SampledWavelengths::from_edges(&[400.0, 410.0, 405.0]).unwrap_err().to_string();

@@ -88,6 +88,16 @@ impl ToneMapper {
     }
 }
 
+/// Pixels per degree accepted (FLIP's default, 67, is a 4K monitor at 0.7 m): FLIP's filter
+/// kernels grow with it, so 1000 is seconds on a megapixel image where 1e9 ran for minutes, and
+/// below 1 they are narrower than a pixel.
+pub const PPD_RANGE: (f32, f32) = (1.0, 1000.0);
+/// HDR-FLIP exposures accepted, in stops (2^±64 keeps any finite f16 or sane f32 radiance
+/// finite).
+pub const EXPOSURE_RANGE: (f32, f32) = (-64.0, 64.0);
+/// Widest exposure span: FLIP evaluates ⌈stop − start⌉ exposures when not told how many.
+pub const MAX_EXPOSURE_SPAN: f32 = 64.0;
+
 /// HDR-FLIP settings; `None` means the reference implementation's default.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HdrOptions {
@@ -161,9 +171,10 @@ fn check_pair(reference: &Image, test: &Image, pixels_per_degree: f32) -> Result
     }
     reference.check_finite("reference image")?;
     test.check_finite("test image")?;
-    if !(pixels_per_degree.is_finite() && pixels_per_degree > 0.0) {
+    if !(PPD_RANGE.0..=PPD_RANGE.1).contains(&pixels_per_degree) {
         return Err(CompareError::InvalidOption(format!(
-            "pixels per degree must be a positive number, got {pixels_per_degree}"
+            "pixels per degree must be between {} and {} (FLIP's filters grow with it: 1e9 ran for minutes), got {pixels_per_degree}",
+            PPD_RANGE.0, PPD_RANGE.1
         )));
     }
     let (w, h) = reference.size();
@@ -272,6 +283,19 @@ pub fn hdr_flip(
     if !(start.is_finite() && stop.is_finite() && start <= stop) {
         return Err(CompareError::InvalidOption(format!(
             "HDR-FLIP exposures: the start ({start}) must not exceed the stop ({stop}), both finite"
+        )));
+    }
+    // 2^±1e30 overflows into garbage and ⌈stop − start⌉ exposures of 2·10⁵ run for minutes.
+    let (lo, hi) = EXPOSURE_RANGE;
+    if start < lo || stop > hi || stop - start > MAX_EXPOSURE_SPAN {
+        return Err(CompareError::InvalidOption(format!(
+            "HDR-FLIP exposures {start}…{stop}: each must lie within {lo}…{hi} stops and the span be at most \
+             {MAX_EXPOSURE_SPAN} stops{}",
+            if opts.start_exposure.is_none() || opts.stop_exposure.is_none() {
+                " (FLIP chose them from the reference image; give --flip-start-exposure and --flip-stop-exposure)"
+            } else {
+                ""
+            }
         )));
     }
     let count = match opts.exposures {

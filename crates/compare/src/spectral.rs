@@ -32,8 +32,8 @@ use crate::image::Image;
 pub const BAND_EDGES_ATTRIBUTE: &str = "spectra.bandEdgesNm";
 /// Header attribute naming the scene white the radiances are normalised against (informative).
 pub const WHITE_ATTRIBUTE: &str = "spectra.white";
-/// Most spectral channels read (1 nm over 360–830 nm is 471).
-pub const MAX_BANDS: usize = 2048;
+/// Most spectral channels read (1 nm over 360–830 nm is 471): as many as are written.
+pub const MAX_BANDS: usize = color::wavelengths::MAX_BINS;
 
 /// What the band values are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -44,7 +44,50 @@ fn absurd_counts_and_sizes_are_refused() {
     refused(&["truth", "cornell", "--size", "4294967295x1", "--out", &exr], &["4294967295", "too large"]);
     let missing = dir.path().join("no/such/dir/t.exr").display().to_string();
     refused(&["truth", "cornell", "--spp", "100000", "--out", &missing], &["--out", "does not exist"]);
+    // Issue 29: numbers that aborted, ran for minutes or overflowed into garbage.
+    refused(
+        &[
+            "truth",
+            "cornell",
+            "--size",
+            "8x8",
+            "--spp",
+            "1",
+            "--out",
+            &exr,
+            "--spectral-out",
+            &p_(dir.path(), "s.exr"),
+            "--spectral-bin",
+            "1e-9",
+        ],
+        &["--spectral-bin", "at most 2048"],
+    );
+    for ppd in ["1e9", "1e30", "1e-30", "0.5"] {
+        refused(&["diff", &a, &b, "--metric", "flip", "--flip-ppd", ppd], &["--flip-ppd", "between"]);
+    }
+    for (s0, s1) in [("-1e5", "1e5"), ("-1e30", "1e30"), ("-40", "40")] {
+        refused(
+            &[
+                "diff",
+                &a,
+                &b,
+                "--metric",
+                "flip",
+                "--flip",
+                "hdr",
+                "--flip-start-exposure",
+                s0,
+                "--flip-stop-exposure",
+                s1,
+            ],
+            &["exposure"],
+        );
+    }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+fn p_(d: &std::path::Path, f: &str) -> String {
+    d.join(f).display().to_string()
 }
 
 /// `spectra diff … --json | head -c 100`: the reader goes away; the writer ends quietly

@@ -148,8 +148,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     {
         bail!("{}: the FLIP map is written as PNG; give it a .png name", p.display());
     }
-    if !(args.flip_ppd.is_finite() && args.flip_ppd > 0.0) {
-        bail!("--flip-ppd must be a positive number, got {}", args.flip_ppd);
+    let (lo, hi) = compare::flip::PPD_RANGE;
+    if !(lo..=hi).contains(&args.flip_ppd) {
+        bail!("--flip-ppd {}: pixels per degree must be between {lo} and {hi}", args.flip_ppd);
+    }
+    let (lo, hi) = compare::flip::EXPOSURE_RANGE;
+    for (flag, v) in [
+        ("--flip-start-exposure", args.flip_start_exposure),
+        ("--flip-stop-exposure", args.flip_stop_exposure),
+    ] {
+        if let Some(v) = v
+            && !(lo..=hi).contains(&v)
+        {
+            bail!("{flag} {v}: an exposure must lie within {lo}…{hi} stops");
+        }
+    }
+    if let (Some(a), Some(b)) = (args.flip_start_exposure, args.flip_stop_exposure)
+        && b - a > compare::flip::MAX_EXPOSURE_SPAN
+    {
+        bail!(
+            "--flip-start-exposure {a} --flip-stop-exposure {b}: the span must be at most {} stops",
+            compare::flip::MAX_EXPOSURE_SPAN
+        );
     }
     let colormap = ColorMap::by_name(&args.colormap)?;
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
