@@ -34,9 +34,9 @@ pub fn projection(camera: &scene::Camera, aspect: f32) -> Mat4 {
         Some((_, ymag)) => {
             let y = ymag.abs();
             let x = y * aspect;
-            Mat4::orthographic_rh(-x, x, -y, y, camera.znear, camera.zfar)
+            Mat4::orthographic_rh(-x, x, -y, y, camera.clip_near(), camera.zfar)
         }
-        None => Mat4::perspective_rh(camera.yfov, aspect, camera.znear, camera.zfar),
+        None => Mat4::perspective_rh(camera.yfov, aspect, camera.clip_near(), camera.zfar),
     }
 }
 
@@ -531,12 +531,13 @@ impl Renderer {
             return Err(RenderError::Settings("no render size: call resize first".into()));
         };
         let (width, height) = (targets.width, targets.height);
+        let (lo, hi) = scene::ORTHO_MAG_RANGE;
         if let Some((xmag, ymag)) = camera.ortho
-            && !(ymag.is_finite() && ymag != 0.0 && xmag.is_finite() && camera.zfar > camera.znear)
+            && !([xmag, ymag].iter().all(|m| (lo..=hi).contains(&m.abs())) && camera.zfar > camera.znear)
         {
             return Err(RenderError::Settings(format!(
                 "orthographic camera with xmag {xmag}, ymag {ymag}, znear {}, zfar {}: the \
-                 magnifications must be finite and non-zero and zfar > znear",
+                 magnifications must be between {lo:e} and {hi:e} and zfar > znear",
                 camera.znear, camera.zfar
             )));
         }

@@ -409,10 +409,13 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
         gltf::camera::Projection::Perspective(p) => p,
         gltf::camera::Projection::Orthographic(o) => {
             let (xmag, ymag, znear, zfar) = (o.xmag(), o.ymag(), o.znear(), o.zfar());
-            if !(xmag.is_finite() && ymag.is_finite() && xmag != 0.0 && ymag != 0.0) {
+            let (lo, hi) = crate::ORTHO_MAG_RANGE;
+            if !([xmag, ymag].iter().all(|m| (lo..=hi).contains(&m.abs()))) {
                 return Err(ctx.invalid(
                     format!("{at}.orthographic"),
-                    format!("xmag and ymag must be finite and non-zero, got {xmag}, {ymag}"),
+                    format!(
+                        "|xmag| and |ymag| must be between {lo:e} and {hi:e} scene units, got {xmag}, {ymag}"
+                    ),
                 ));
             }
             if !(znear >= 0.0 && zfar.is_finite() && zfar > znear) {
@@ -437,10 +440,11 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
         }
     };
     let (yfov, znear) = (p.yfov(), p.znear());
-    if !(yfov > 0.0 && yfov < std::f32::consts::PI && znear > 0.0 && znear.is_finite()) {
-        return Err(
-            ctx.invalid(at, format!("needs 0 < yfov < π and znear > 0, got yfov {yfov}, znear {znear}"))
-        );
+    if !((crate::MIN_YFOV..std::f32::consts::PI).contains(&yfov) && znear > 0.0 && znear.is_finite()) {
+        return Err(ctx.invalid(
+            at,
+            format!("needs {:e} ≤ yfov < π and znear > 0, got yfov {yfov}, znear {znear}", crate::MIN_YFOV),
+        ));
     }
     let zfar = p.zfar().unwrap_or(1.0e4);
     if zfar.partial_cmp(&znear) != Some(std::cmp::Ordering::Greater) {
@@ -450,7 +454,15 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
     if aspect.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
         return Err(ctx.invalid(at, "aspectRatio must be positive"));
     }
-    Ok((Camera { ortho: None, transform, yfov, znear, zfar, aspect }, None))
+    let camera = Camera { ortho: None, transform, yfov, znear, zfar, aspect };
+    let warning = (camera.clip_near() > znear).then(|| {
+        format!(
+            "{at}: znear {znear} is below zfar {zfar} × {:e}, more than a depth buffer resolves; both renderers clip at {}",
+            crate::MIN_NEAR_FAR_RATIO,
+            camera.clip_near()
+        )
+    });
+    Ok((camera, warning))
 }
 
 fn light_of(

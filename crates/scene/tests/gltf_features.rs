@@ -647,11 +647,39 @@ fn orthographic_cameras_are_read() {
     for (o, field) in [
         (json!({"xmag": 0, "ymag": 1, "znear": 0, "zfar": 1}), "xmag"),
         (json!({"xmag": 1, "ymag": 1, "znear": 2, "zfar": 1}), "zfar"),
+        // Issue 29: a tiny magnification rendered NaN, a huge aspect black in real time only.
+        (json!({"xmag": 1e-30, "ymag": 1, "znear": 0, "zfar": 1}), "xmag"),
+        (json!({"xmag": 1e30, "ymag": 1e-30, "znear": 0, "zfar": 1}), "between"),
     ] {
         let mut d = doc.clone();
         d["cameras"][0]["orthographic"] = o;
         assert_has(&error(&d), &["cameras[0].orthographic", field]);
     }
+}
+
+/// A near plane far smaller than the far plane is more than a depth buffer resolves (issue 29:
+/// znear 1e-6 rendered wrong in real time, 1e-8 black): both renderers clip at zfar × 1e-6,
+/// with a warning naming the camera; at the ratio the built-ins use nothing changes.
+#[test]
+fn tiny_near_planes_are_raised_for_both_renderers_with_a_warning() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let cam = |znear: f64, yfov: f64| json!([{"type": "perspective", "perspective": {"yfov": yfov, "znear": znear, "zfar": 1000}}]);
+    let mut doc = b.finish(json!({
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+        "cameras": cam(1e-8, 0.8),
+    }));
+    let s = load(&doc).unwrap();
+    assert_eq!(s.camera.znear, 1e-8);
+    assert!((s.camera.clip_near() - 1e-3).abs() < 1e-9, "{}", s.camera.clip_near());
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("cameras[0]") && s.warnings[0].contains("znear"), "{:?}", s.warnings);
+    doc["cameras"] = cam(0.01, 0.8);
+    let s = load(&doc).unwrap();
+    assert!(s.warnings.is_empty() && s.camera.clip_near() == 0.01);
+    doc["cameras"] = cam(0.01, 1e-30);
+    assert_has(&error(&doc), &["cameras[0]", "yfov"]);
 }
 
 #[test]

@@ -48,7 +48,7 @@ impl RayCamera {
             Some((_, ymag)) => (ymag.abs(), true),
             None => ((cam.yfov * 0.5).tan(), false),
         };
-        let near = cam.znear.max(0.0) * t.transform_vector3(-Vec3::Z).length();
+        let near = cam.clip_near().max(0.0) * t.transform_vector3(-Vec3::Z).length();
         RayCamera {
             near: if near.is_finite() { near } else { 0.0 },
             origin: t.transform_point3(Vec3::ZERO),

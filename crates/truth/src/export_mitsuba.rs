@@ -214,7 +214,7 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
             "origin": origin.to_array(), "target": (origin + forward).to_array(), "up": up.to_array(),
             "fov_y_deg": cam.yfov.to_degrees(),
             // Surfaces nearer than this along the view axis are clipped, as `RayCamera` does.
-            "near_clip": cam.znear.max(0.0) * cam.transform.transform_vector3(-Vec3::Z).length(),
+            "near_clip": cam.clip_near().max(0.0) * cam.transform.transform_vector3(-Vec3::Z).length(),
         },
         "materials": materials, "meshes": meshes, "lights": lights,
         "medium": world.medium.is_some(),
