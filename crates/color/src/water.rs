@@ -119,6 +119,11 @@ impl WaterType {
                 known: format!("{}; 9C is the last type, so it cannot be blended further", Self::known()),
             });
         }
+        // So many nines that the fraction rounds to 1 (`II.99999999999999999`): that is the next
+        // type, named as such (it rendered III labelled "II.1").
+        if frac >= 1.0 {
+            return Ok(WaterType { lower: i + 1, t: 0.0 });
+        }
         Ok(WaterType { lower: i, t: frac })
     }
 
@@ -369,6 +374,7 @@ mod tests {
             ("III.25", "III.25"),
             ("II.50", "II.5"),
             ("III.1", "III.1"),
+            ("II.99999999999999999", "III"),
         ] {
             assert_eq!(WaterType::parse(s).unwrap().to_string(), canon);
             assert_eq!(WaterType::parse(canon).unwrap(), WaterType::parse(s).unwrap());

@@ -667,6 +667,14 @@ impl Loader<'_> {
         if values.iter().any(|v| !v.is_finite()) || out.emissive.min_element() < 0.0 {
             return Err(self.ctx.invalid(&at, "factors must be finite (and emissive non-negative)"));
         }
+        // glTF allows any scale; past this the renderers' normalize((n.xy·scale, n.z)) squares
+        // past f32 (−1e30 made NaN normals), and no bump needs more than a few.
+        if out.normal_scale.abs() > crate::MAX_NORMAL_SCALE {
+            return Err(self.ctx.invalid(
+                format!("{at}.normalTexture.scale"),
+                format!("{} is outside ±{} (typical: 0–2)", out.normal_scale, crate::MAX_NORMAL_SCALE),
+            ));
+        }
         // glTF 2.0 gives these factors the range [0, 1]; outside it they are not materials
         // (a negative albedo, a roughness of 5), and the renderers' results are meaningless.
         let unit = [

@@ -404,6 +404,8 @@ pub const MIN_NEAR_FAR_RATIO: f32 = 1e-6;
 pub const ORTHO_MAG_RANGE: (f32, f32) = (1e-6, 1e6);
 /// Narrowest vertical field of view accepted, radians (the projection holds 1/tan(yfov/2)).
 pub const MIN_YFOV: f32 = 1e-5;
+/// Largest |normalTexture.scale| accepted.
+pub const MAX_NORMAL_SCALE: f32 = 1000.0;
 
 impl Camera {
     /// The near plane both renderers clip surfaces at: `znear`, or for a perspective camera at

@@ -150,3 +150,29 @@ fn default_camera_frames_a_scene_without_one() {
     let v = s.camera.transform.inverse().transform_point3((lo + hi) * 0.5);
     assert!(v.x.abs() < 1e-4 && v.y.abs() < 1e-4 && v.z < 0.0, "centre at {v} in view space");
 }
+
+/// A normal-map scale so large that normalize((n.xy·scale, n.z)) leaves f32 made NaN normals in
+/// both renderers (issue 29): refused, naming the field.
+#[test]
+fn absurd_normal_scales_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["base.png", "normal.png", "quad.bin", "reflectance.csv", "spectrum.csv"] {
+        std::fs::copy(data(f), dir.path().join(f)).unwrap();
+    }
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("textured.gltf")).unwrap()).unwrap();
+    let i =
+        doc["materials"].as_array().unwrap().iter().position(|m| m.get("normalTexture").is_some()).unwrap();
+    for (scale, ok) in [(2.0, true), (-1000.0, true), (-1e30, false), (1001.0, false)] {
+        doc["materials"][i]["normalTexture"]["scale"] = serde_json::json!(scale);
+        let p = dir.path().join("t.gltf");
+        std::fs::write(&p, serde_json::to_string(&doc).unwrap()).unwrap();
+        match load(&p) {
+            Ok(_) => assert!(ok, "scale {scale} accepted"),
+            Err(e) => {
+                assert!(!ok, "scale {scale}: {e}");
+                assert!(e.to_string().contains("normalTexture.scale"), "{e}");
+            }
+        }
+    }
+}

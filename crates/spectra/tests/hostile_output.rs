@@ -83,6 +83,20 @@ fn absurd_counts_and_sizes_are_refused() {
             &["exposure"],
         );
     }
+    // A well-formed table too coarse to upsample anything (res 2: round trip ΔE 40–66) rendered
+    // black; the cache refused such tables, `--table` did not.
+    let coarse = p_(dir.path(), "coarse.coeff");
+    let out = spectra(&["lut", "--res", "2", "--check", "0", "--out", &coarse]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    refused(
+        &["render", "cornell", "--size", "8x8", "--table", &coarse, "--out", &exr],
+        &["--table", "coarse.coeff", "ΔE2000"],
+    );
+    refused(
+        &["truth", "cornell", "--size", "8x8", "--spp", "1", "--table", &coarse, "--out", &exr],
+        &["--table", "round trip"],
+    );
+    std::fs::remove_file(&coarse).unwrap();
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
 }
 

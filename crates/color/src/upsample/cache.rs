@@ -88,8 +88,23 @@ pub fn read_cached(path: &std::path::Path, space: &RgbColorSpace, res: usize) ->
     if sum != fnv1a64(payload) {
         return None;
     }
-    let rt = crate::upsample::roundtrip::roundtrip_table(&t, space, 32, 1).ok()?;
-    (rt.stats.mean <= MAX_CACHED_MEAN_DE).then_some(t)
+    check_usable(&t, space).ok()?;
+    Some(t)
+}
+
+/// Whether `t` upsamples `space`'s colours at all: the mean round-trip ΔE2000 of 32 random
+/// colours at most [`MAX_CACHED_MEAN_DE`] (a res-2 table, 48–66, rendered black; a table for
+/// another colour space fails too). The error gives the figure. For the cache and `--table`.
+pub fn check_usable(t: &CoeffTable, space: &RgbColorSpace) -> Result<()> {
+    let rt = crate::upsample::roundtrip::roundtrip_table(t, space, 32, 1)?;
+    if rt.stats.mean.is_finite() && rt.stats.mean <= MAX_CACHED_MEAN_DE {
+        return Ok(());
+    }
+    Err(ColorError::Table(format!(
+        "a round trip of 32 {} colours through this {}³ table has mean ΔE2000 {:.1} (a usable table is below \
+         {MAX_CACHED_MEAN_DE}): too coarse, damaged, or fitted for another colour space",
+        space.name, t.res, rt.stats.mean
+    )))
 }
 
 /// The table cached at `path` if it loads and has resolution `res`; otherwise a fresh

@@ -385,7 +385,11 @@ impl TableArgs {
 pub fn load_table(explicit: Option<&std::path::Path>) -> Result<Arc<CoeffTable>> {
     match explicit {
         Some(p) => {
-            Ok(Arc::new(CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?))
+            let t = CoeffTable::read(p).with_context(|| format!("reading table {}", p.display()))?;
+            // The scene's colours are linear sRGB (scene::Material), whatever space a file was fitted for.
+            color::upsample::cache::check_usable(&t, &color::RgbColorSpace::srgb())
+                .map_err(|e| anyhow!("--table {}: {e}", p.display()))?;
+            Ok(Arc::new(t))
         }
         None => color::upsample::table("srgb").context("the sRGB coefficient table"),
     }
