@@ -6,6 +6,8 @@ use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
 /// Most bins a spectral image may have (also the most bands a spectral EXR is read with:
 /// 1 nm over 360–830 nm is 471).
 pub const MAX_BINS: usize = 2048;
+/// Most samples of one [`SampledWavelengths::midpoint`] set (0.00035 nm over the visible range).
+pub const MAX_SAMPLES: usize = 1_000_000;
 
 /// A closed wavelength interval in nanometres, validated against the observer data range.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,6 +106,10 @@ impl SampledWavelengths {
     pub fn midpoint(range: WavelengthRange, n: usize) -> Result<Self> {
         if n == 0 {
             return Err(ColorError::NoSamples);
+        }
+        // Counted before allocating (`upsample --samples 1e11` aborted asking for 800 GB).
+        if n > MAX_SAMPLES {
+            return Err(ColorError::BadSpectrum(format!("{n} wavelength samples: at most {MAX_SAMPLES}")));
         }
         let d = range.width() / n as f64;
         Ok(SampledWavelengths {

@@ -140,6 +140,8 @@ mod cli {
 
 /// Largest number of wavelengths per pixel.
 pub const MAX_WAVELENGTHS: usize = 256;
+/// Largest |exposure| in stops ([`RenderSettings::exposure_ev`]).
+pub const MAX_EXPOSURE_EV: f32 = 64.0;
 
 /// Narrowest wavelength range a render accepts (nm).
 pub const MIN_RANGE_NM: f64 = 1.0;
@@ -230,8 +232,12 @@ impl RenderSettings {
                 self.range.min, self.range.max
             )));
         }
-        if !self.exposure_ev.is_finite() {
-            return Err(RenderError::Settings(format!("exposure must be finite (got {})", self.exposure_ev)));
+        // 2^±64 keeps every finite f16 pixel finite (2^1e30 wrote ∞ and NaN).
+        if !(-MAX_EXPOSURE_EV..=MAX_EXPOSURE_EV).contains(&self.exposure_ev) {
+            return Err(RenderError::Settings(format!(
+                "exposure must be within ±{MAX_EXPOSURE_EV} stops (got {})",
+                self.exposure_ev
+            )));
         }
         if let Some(u) = self.jitter
             && !(0.0..1.0).contains(&u)

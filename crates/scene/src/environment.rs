@@ -47,6 +47,8 @@ pub const MAX_INTENSITY: f32 = 1e6;
 /// ~10⁷–10⁹ in photometric units), and low enough that the prefiltered maps (sums of π × the
 /// brightest texel) and [`MAX_INTENSITY`] × it stay finite in f32.
 pub const MAX_RADIANCE: f32 = 1e15;
+/// Largest |rotation| accepted, degrees.
+pub const MAX_ROTATION_DEGREES: f32 = 1e6;
 
 /// The radiance of the default environment's sky (its ground is [`DEFAULT_GROUND`] × this).
 pub const DEFAULT_SKY: f32 = 1.0;
@@ -235,10 +237,13 @@ impl Environment {
 
     /// Rotation about +Y in degrees.
     pub fn with_rotation_degrees(mut self, deg: f32) -> Result<Self, EnvironmentError> {
-        if !deg.is_finite() {
+        // Past 10⁶ an f32 holds the angle to worse than 0.1°: 1e30 degrees turned it arbitrarily.
+        if !(deg.is_finite() && deg.abs() <= MAX_ROTATION_DEGREES) {
             return Err(EnvironmentError {
                 file: PathBuf::from(&self.source),
-                message: format!("rotation must be a finite number of degrees (got {deg})"),
+                message: format!(
+                    "rotation must be a finite number of degrees within ±{MAX_ROTATION_DEGREES:e} (got {deg})"
+                ),
             });
         }
         self.rotation = deg.rem_euclid(360.0).to_radians();

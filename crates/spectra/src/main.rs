@@ -4,6 +4,8 @@
 
 mod cmd;
 mod eval;
+#[cfg(test)]
+mod limits_doc_tests;
 mod progress;
 mod view;
 

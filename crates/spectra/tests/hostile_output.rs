@@ -83,6 +83,19 @@ fn absurd_counts_and_sizes_are_refused() {
             &["exposure"],
         );
     }
+    for (flag, v) in [("--frames", "4294967295"), ("--warmup", "4294967295"), ("--frames", "0")] {
+        refused(&["bench", "cornell", "--size", "8x8", flag, v], &[flag, v]);
+    }
+    let r = ["render", "cornell", "--size", "8x8", "--out", &exr];
+    for (flag, v, needle) in [
+        ("--exposure", "1e30", "±64"),
+        ("--exposure", "-200", "±64"),
+        ("--env-rotation", "1e30", "rotation"),
+        ("--env-intensity", "-1", "between 0 and"),
+    ] {
+        refused(&[&r[..], &["--env", "default", flag, v]].concat(), &[needle]);
+    }
+    refused(&["upsample", "0.5", "0.2", "0.1", "--samples", "100000000000"], &["--samples", "at most"]);
     // A well-formed table too coarse to upsample anything (res 2: round trip ΔE 40–66) rendered
     // black; the cache refused such tables, `--table` did not.
     let coarse = p_(dir.path(), "coarse.coeff");

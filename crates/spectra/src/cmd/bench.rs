@@ -36,6 +36,9 @@ use std::time::Instant;
 /// The normal run's `--wavelengths`.
 pub const WAVELENGTHS: &str = "1,2,4,8,16,32,64";
 
+/// Most measured (and most warm-up) frames per configuration.
+pub const MAX_FRAMES: usize = 10_000;
+
 #[derive(ClapArgs, Debug)]
 pub struct Args {
     /// Built-in scene name (cornell, colorchecker, metamerism, underwater, fog, tinted-fog) or a
@@ -52,10 +55,10 @@ pub struct Args {
     /// Frame size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT).
     #[arg(long, default_value = "1280x720")]
     pub size: String,
-    /// Measured frames per configuration.
+    /// Measured frames per configuration (1–10000).
     #[arg(long, default_value_t = 60)]
     pub frames: usize,
-    /// Unmeasured frames before each configuration.
+    /// Unmeasured frames before each configuration (0–10000).
     #[arg(long, default_value_t = 10)]
     pub warmup: usize,
     /// Wavelength counts to measure, comma-separated (default 1,2,4,8,16,32,64; with --suite
@@ -103,6 +106,13 @@ impl Args {
     /// The suite's own flags are refused without `--suite` (clap's `requires` cannot name a
     /// flag that is always set, to false or true).
     pub fn check_suite_flags(&self) -> Result<()> {
+        // The frame times are kept for the medians: 4294967295 frames aborted allocating them.
+        if !(1..=MAX_FRAMES).contains(&self.frames) {
+            bail!("--frames {}: measure 1 to {MAX_FRAMES} frames", self.frames);
+        }
+        if self.warmup > MAX_FRAMES {
+            bail!("--warmup {}: at most {MAX_FRAMES} frames", self.warmup);
+        }
         if !self.suite {
             for (flag, given) in [
                 ("--suite-asset", self.suite_asset.is_some()),
@@ -445,9 +455,6 @@ pub fn run(args: Args) -> Result<()> {
         return suite::run(args);
     }
     let (width, height) = parse_size(&args.size)?;
-    if args.frames == 0 {
-        bail!("--frames 0: measure at least one frame");
-    }
     let counts = parse_counts(args.wavelengths.as_deref().unwrap_or(WAVELENGTHS))?;
     if let Some(path) = &args.csv {
         super::check_output("--csv", path)?;

@@ -575,7 +575,7 @@ pub struct EnvArgs {
     #[arg(long, value_name = "FILE|default|none")]
     pub env: Option<String>,
     /// Multiplies the environment's radiance.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub env_intensity: Option<f32>,
     /// Turns the environment about +Y, degrees.
     #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]

@@ -242,9 +242,6 @@ fn load(
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.frames == 0 {
-        bail!("--frames 0: measure at least one frame");
-    }
     let sizes = parse_sizes(args.suite_sizes.as_deref().unwrap_or(SIZES))?;
     let counts = parse_counts_for("--wavelengths", args.wavelengths.as_deref().unwrap_or(WAVELENGTHS))?;
     if let Some(path) = &args.csv {
