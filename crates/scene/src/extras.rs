@@ -330,7 +330,12 @@ fn water(ctx: &Ctx, at: &str, v: &Value) -> Result<WaterSettings, SceneError> {
             let a =
                 d.as_array().filter(|a| a.len() == 3).ok_or_else(|| ctx.extras(&sf, "expected [x, y, z]"))?;
             let v = Vec3::new(finite(ctx, &sf, &a[0])?, finite(ctx, &sf, &a[1])?, finite(ctx, &sf, &a[2])?);
-            let n = v.normalize_or_zero();
+            // Scaled first: [1e38, 1e38, 1e38] overflowed the length and read as "below the horizon".
+            let big = v.abs().max_element();
+            if big == 0.0 {
+                return Err(ctx.extras(&sf, "the sun direction is [0, 0, 0]: give a direction (+y up)"));
+            }
+            let n = (v / big).normalize();
             if n.y <= 0.0 {
                 return Err(ctx.extras(&sf, format!("the sun must be above the horizon (+y up), got {v}")));
             }

@@ -98,7 +98,8 @@ impl RgbMedium {
                 "absorption and scattering are all zero: the medium would do nothing",
             ));
         }
-        if !(g > -1.0 && g < 1.0) {
+        // Also as the f32 both renderers use: 0.999999999 rounds to 1, which the tracer refused later.
+        if !(g > -1.0 && g < 1.0 && (g as f32).abs() < 1.0) {
             return Err(err(
                 "g",
                 format!("the Henyey–Greenstein g = {g} must lie strictly between −1 and 1"),
@@ -313,6 +314,7 @@ mod tests {
             (r#"{"absorption": [0, 0, 0], "scattering": [0, 0, 0]}"#, "absorption", "all zero"),
             (r#"{"absorption": [1, 1, 1], "g": 1}"#, "g", "between"),
             (r#"{"absorption": [1, 1, 1], "g": -1.5}"#, "g", "between"),
+            (r#"{"absorption": [1, 1, 1], "g": 0.999999999}"#, "g", "between"),
             (r#"{"absorption": [1, 1, 1], "scale": 0}"#, "scale", "> 0"),
             (r#"{"absorption": [1, 1]}"#, "absorption", "three numbers"),
             (r#"{"absorption": [1, "x", 1]}"#, "absorption", "three numbers"),

@@ -177,6 +177,14 @@ fn bad_extras() {
         &["water.sun_direction", "horizon"],
     );
     expect(
+        &mutate(|d| d["scenes"][0]["extras"]["water"]["sun_direction"] = json!([0, 0, 0])),
+        &["water.sun_direction", "[0, 0, 0]"],
+    );
+    // Huge but valid: straight up the diagonal, not "below the horizon" (issue 29).
+    let doc = mutate(|d| d["scenes"][0]["extras"]["water"]["sun_direction"] = json!([1e38, 1e38, 1e38]));
+    let s = scene::load_slice("huge.gltf", doc.to_string().as_bytes(), Some(&data("")));
+    assert!(s.is_ok(), "{:?}", s.err());
+    expect(
         &mutate(|d| {
             d["scenes"][0]["extras"]["water"].as_object_mut().unwrap().remove("type").map(|_| ()).unwrap()
         }),

@@ -106,7 +106,7 @@ fn bench_stops() {
         "--size",
         "512x512",
         "--frames",
-        "100000",
+        "10000",
         "--csv",
         out.to_str().unwrap(),
     ]);
@@ -123,7 +123,7 @@ fn bench_suite_stops() {
         "--suite-sizes",
         "512x512",
         "--frames",
-        "100000",
+        "10000",
         "--csv",
         csv.to_str().unwrap(),
         "--markdown",
