@@ -21,9 +21,10 @@ fn main() -> ExitCode {
         "demo" => demo(rest),
         "test" => test(rest),
         "ci" => ci(),
+        "fuzz" => fuzz(rest),
         _ => {
             eprintln!(
-                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, then test"
+                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, test, then a 10 s coverage-guided fuzz slice per target\n  fuzz    coverage-guided fuzzing (libFuzzer, nightly): [--seconds S per target, default 60] [--targets a,b]"
             );
             return if task == "help" { ExitCode::SUCCESS } else { ExitCode::FAILURE };
         }
@@ -200,7 +201,115 @@ fn ci() -> Result {
     run(cargo().args(["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"]))?;
     let result = test(&[]);
     disk_report("after the tests");
-    result
+    result?;
+    // The bounded coverage-guided slice (the long run is `cargo xtask fuzz --seconds 3600`).
+    // It needs a nightly toolchain; where none can be installed, say so and keep the stable
+    // harness's run (`cargo test -p fuzz`, above) as the only fuzzing.
+    match ensure_fuzz_tools() {
+        Ok(()) => fuzz(&["--seconds".into(), "10".into()]),
+        Err(e) => {
+            eprintln!("coverage-guided fuzz slice skipped: {e}");
+            Ok(())
+        }
+    }
+}
+
+/// The coverage-guided targets (`crates/fuzz/coverage`) and the seed corpus each starts from
+/// (`crates/fuzz/corpus/<name>`; the structure-aware glTF target builds its own documents).
+const FUZZ_TARGETS: &[(&str, Option<&str>)] = &[
+    ("gltf", Some("gltf")),
+    ("gltf-structured", None),
+    ("coeff", Some("coeff")),
+    ("csv", Some("csv")),
+    ("medium", Some("medium")),
+    ("rgb-medium", Some("rgb-medium")),
+    ("exr", Some("exr")),
+    ("spectral-exr", Some("spectral-exr")),
+    ("png", Some("png")),
+    ("env", Some("env")),
+];
+
+fn nightly() -> Command {
+    let mut c = Command::new("rustup");
+    c.args(["run", "nightly"]);
+    c
+}
+
+fn succeeds(cmd: &mut Command) -> bool {
+    cmd.output().map(|o| o.status.success()).unwrap_or(false)
+}
+
+/// A nightly toolchain (libFuzzer's sanitizer coverage needs it) and cargo-fuzz, installed if
+/// missing.
+fn ensure_fuzz_tools() -> Result {
+    if !succeeds(nightly().args(["rustc", "--version"])) {
+        eprintln!("No nightly toolchain: installing one (minimal profile) for the coverage-guided fuzzer.");
+        run(Command::new("rustup").args(["toolchain", "install", "nightly", "--profile", "minimal"]))?;
+    }
+    if !succeeds(nightly().args(["cargo", "fuzz", "--version"])) {
+        eprintln!("No cargo-fuzz: installing it.");
+        run(cargo().args(["install", "cargo-fuzz", "--locked"]))?;
+    }
+    Ok(())
+}
+
+/// Runs each coverage-guided target for `--seconds` from its seed corpus (copied: libFuzzer
+/// writes what it finds into the first corpus directory) and prints executions, coverage and
+/// features; a crash (libFuzzer's exit status) fails the task, its input under
+/// `crates/fuzz/coverage/artifacts/<target>/`.
+fn fuzz(args: &[String]) -> Result {
+    let get = |k: &str| args.iter().position(|a| a == k).and_then(|i| args.get(i + 1));
+    let seconds: u64 =
+        get("--seconds").map_or(Ok(60), |s| s.parse().map_err(|_| format!("--seconds {s}")))?;
+    let only: Option<Vec<&str>> = get("--targets").map(|t| t.split(',').collect());
+    ensure_fuzz_tools()?;
+    let dir = root().join("crates/fuzz/coverage");
+    let mut rows = Vec::new();
+    for (target, seeds) in FUZZ_TARGETS {
+        if only.as_ref().is_some_and(|o| !o.contains(target)) {
+            continue;
+        }
+        let work = std::env::temp_dir().join(format!("spectra-fuzz-{target}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&work);
+        std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
+        let mut cmd = nightly();
+        cmd.args(["cargo", "fuzz", "run", "--fuzz-dir"])
+            .arg(&dir)
+            .args(["-s", "none", "-O", target])
+            .arg(&work);
+        if let Some(s) = seeds {
+            cmd.arg(root().join("crates/fuzz/corpus").join(s));
+        }
+        cmd.args(["--", &format!("-max_total_time={seconds}"), "-rss_limit_mb=4096", "-print_final_stats=1"]);
+        eprintln!("$ {}", describe(&cmd));
+        let out = cmd.current_dir(root()).output().map_err(|e| format!("cannot start cargo fuzz: {e}"))?;
+        let log = String::from_utf8_lossy(&out.stderr);
+        let _ = std::fs::remove_dir_all(&work);
+        let stat = |name: &str| {
+            log.lines().find_map(|l| l.strip_prefix(&format!("stat::{name}:")).map(|v| v.trim().to_string()))
+        };
+        let done = log.lines().rev().find(|l| l.contains("cov:")).unwrap_or("").to_string();
+        let field =
+            |k: &str| done.split_whitespace().skip_while(|w| *w != k).nth(1).unwrap_or("?").to_string();
+        if !out.status.success() {
+            let tail: Vec<&str> = log.lines().rev().take(30).collect();
+            let tail: Vec<&str> = tail.into_iter().rev().collect();
+            return Err(format!("fuzz target {target} failed ({}):\n{}", out.status, tail.join("\n")));
+        }
+        rows.push(format!(
+            "{target:16} {:>12} execs  cov {:>6}  ft {:>7}  corpus {:>5}  peak RSS {} MB",
+            stat("number_of_executed_units").unwrap_or_else(|| "?".into()),
+            field("cov:"),
+            field("ft:"),
+            field("corp:"),
+            stat("peak_rss_mb").unwrap_or_else(|| "?".into()),
+        ));
+    }
+    println!("coverage-guided fuzzing, {seconds} s per target (crashes: 0):");
+    for r in rows {
+        println!("  {r}");
+    }
+    Ok(())
 }
 
 /// Prints free disk space and the target directory's size: a CI machine once ran out of disk

@@ -1,0 +1,3 @@
+//! libFuzzer target: `fuzz::run_one("csv", data)` — a panic is a crash; an `Err` is a refused input.
+#![no_main]
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzz::run_one("csv", data));
