@@ -74,7 +74,8 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
 // The HDR targets are half floats (passes::HDR_FORMAT). A brighter value (a sun seen directly,
 // emission of thousands) would be stored as ∞ by drivers that round to nearest and turn NaN in
 // later arithmetic; clamped, it saturates at f16's largest finite value, which the host counts
-// and reports (`render::hdr_clipped`). NaN stays NaN (a bug to see, not to hide).
+// and reports (`render::passes::hdr_clipped`). Not a NaN filter: what clamp does with a NaN is
+// the driver's, and a NaN is a bug to find, not to hide.
 const HDR_MAX: f32 = 65504.0;
 fn hdr_out(c: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(clamp(c, vec3<f32>(-HDR_MAX), vec3<f32>(HDR_MAX)), 1.0);
