@@ -24,7 +24,7 @@ fn main() -> ExitCode {
         "fuzz" => fuzz(rest),
         _ => {
             eprintln!(
-                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, test, then a 10 s coverage-guided fuzz slice per target\n  fuzz    coverage-guided fuzzing (libFuzzer, nightly): [--seconds S per target, default 60] [--targets a,b]"
+                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, test, then a 10 s coverage-guided fuzz slice per target\n  fuzz    coverage-guided fuzzing (libFuzzer, nightly): [--seconds S per target, default 60 | --runs N executions per target] [--targets a,b]"
             );
             return if task == "help" { ExitCode::SUCCESS } else { ExitCode::FAILURE };
         }
@@ -262,6 +262,9 @@ fn fuzz(args: &[String]) -> Result {
     let seconds: u64 =
         get("--seconds").map_or(Ok(60), |s| s.parse().map_err(|_| format!("--seconds {s}")))?;
     let only: Option<Vec<&str>> = get("--targets").map(|t| t.split(',').collect());
+    // `--runs N`: stop each target after N executions (the long run's 10⁷), whatever the time.
+    let runs: Option<u64> =
+        get("--runs").map(|s| s.parse().map_err(|_| format!("--runs {s}"))).transpose()?;
     ensure_fuzz_tools()?;
     let dir = root().join("crates/fuzz/coverage");
     let mut rows = Vec::new();
@@ -280,7 +283,11 @@ fn fuzz(args: &[String]) -> Result {
         if let Some(s) = seeds {
             cmd.arg(root().join("crates/fuzz/corpus").join(s));
         }
-        cmd.args(["--", &format!("-max_total_time={seconds}"), "-rss_limit_mb=4096", "-print_final_stats=1"]);
+        cmd.args(["--", "-rss_limit_mb=4096", "-print_final_stats=1"]);
+        match runs {
+            Some(n) => cmd.arg(format!("-runs={n}")),
+            None => cmd.arg(format!("-max_total_time={seconds}")),
+        };
         eprintln!("$ {}", describe(&cmd));
         let out = cmd.current_dir(root()).output().map_err(|e| format!("cannot start cargo fuzz: {e}"))?;
         let log = String::from_utf8_lossy(&out.stderr);
@@ -305,7 +312,10 @@ fn fuzz(args: &[String]) -> Result {
             stat("peak_rss_mb").unwrap_or_else(|| "?".into()),
         ));
     }
-    println!("coverage-guided fuzzing, {seconds} s per target (crashes: 0):");
+    match runs {
+        Some(n) => println!("coverage-guided fuzzing, {n} executions per target (crashes: 0):"),
+        None => println!("coverage-guided fuzzing, {seconds} s per target (crashes: 0):"),
+    }
     for r in rows {
         println!("  {r}");
     }

@@ -19,3 +19,25 @@ pub enum ColorError {
 }
 
 pub type Result<T, E = ColorError> = std::result::Result<T, E>;
+
+/// `x` as an error message shows a value: as Rust writes it where that is short, in exponent
+/// form outside 1e-4…1e15 (Rust writes 1e300 as 301 digits).
+pub fn show(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn values_in_messages_stay_short() {
+        assert_eq!(super::show(1e300), "1e300");
+        assert_eq!(super::show(-2.5e-9), "-2.5e-9");
+        assert_eq!(super::show(0.05), "0.05");
+        assert_eq!(super::show(f64::NAN), "NaN");
+        assert_eq!(super::show(123456.0), "123456");
+    }
+}

@@ -15,6 +15,7 @@ pub mod observer;
 pub mod outfile;
 pub mod progress;
 pub mod quadrature;
+pub mod signature;
 pub mod spectrum;
 pub mod upsample;
 pub mod water;

@@ -19,10 +19,37 @@ pub fn parent_dir(path: &Path) -> &Path {
     }
 }
 
+/// Longest file name, in bytes, that Linux file systems accept (NAME_MAX: ext4, XFS, tmpfs).
+pub const NAME_MAX: usize = 255;
+
 fn file_name(path: &Path) -> io::Result<String> {
-    path.file_name()
+    let name = path
+        .file_name()
         .map(|n| n.to_string_lossy().into_owned())
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path has no file name"))
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the path has no file name"))?;
+    if path.file_name().map_or(0, |n| n.len()) > NAME_MAX {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("the file name is {} bytes long; file systems allow at most {NAME_MAX}", name.len()),
+        ));
+    }
+    Ok(name)
+}
+
+/// The part of a temporary name that identifies the destination `name`: the name itself, or,
+/// where `.<name>.<pid>.<random>.tmp` would pass [`NAME_MAX`] (a legal 244-byte output name
+/// used to fail after the render), its first bytes and a hash of the whole.
+fn temp_stem(name: &str) -> String {
+    // "." + "." + a u32 pid + "." + tempfile's 6 random characters + ".tmp".
+    const EXTRA: usize = 2 + 10 + 1 + 6 + 4;
+    if name.len() + EXTRA <= NAME_MAX {
+        return name.to_string();
+    }
+    let mut cut = 160;
+    while !name.is_char_boundary(cut) {
+        cut -= 1;
+    }
+    format!("{}~{:016x}", &name[..cut], crate::signature::fnv1a64(name.as_bytes()))
 }
 
 /// Checks, before any long work, that `path` could be written: its directory exists and is a
@@ -165,7 +192,7 @@ pub fn write_atomic_with(
     }
     remove_stale_temps(dir, &name);
     let mut builder = tempfile::Builder::new();
-    let prefix = format!(".{name}.{}.", std::process::id());
+    let prefix = format!(".{}.{}.", temp_stem(&name), std::process::id());
     builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
     let existing = std::fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| m.permissions());
@@ -190,7 +217,11 @@ pub fn write_atomic_with(
 
 /// The process id in a temporary name `.<name>.<pid>.<random>.tmp`, if it is one.
 fn temp_owner(entry: &str, name: &str) -> Option<u32> {
-    let rest = entry.strip_prefix('.')?.strip_prefix(name)?.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let rest = entry
+        .strip_prefix('.')?
+        .strip_prefix(temp_stem(name).as_str())?
+        .strip_prefix('.')?
+        .strip_suffix(".tmp")?;
     let (pid, random) = rest.split_once('.')?;
     (!random.is_empty()).then_some(())?;
     pid.parse().ok()
@@ -237,7 +268,7 @@ pub fn temp_dir_next_to(target: &Path) -> io::Result<tempfile::TempDir> {
     let name = file_name(target)?;
     remove_stale_temps(dir, &name);
     let mut builder = tempfile::Builder::new();
-    let prefix = format!(".{name}.{}.", std::process::id());
+    let prefix = format!(".{}.{}.", temp_stem(&name), std::process::id());
     builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
     {
@@ -356,6 +387,29 @@ mod tests {
         let mut want = want.to_vec();
         want.sort();
         assert_eq!(entries(dir.path()), want);
+    }
+
+    /// A legal name near the limit writes (its temporary name is shortened, and still
+    /// recognised as its leftover); a name over the limit is refused by the early check.
+    #[test]
+    fn names_near_the_length_limit() {
+        let dir = tempfile::tempdir().unwrap();
+        for len in [232, 244, NAME_MAX] {
+            let name = format!("{}.exr", "é".repeat((len - 4) / 2) + &"a".repeat((len - 4) % 2));
+            assert_eq!(name.len(), len);
+            let p = dir.path().join(&name);
+            check_writable(&p).unwrap();
+            let dead = dir.path().join(format!(".{}.4194305.AbC123.tmp", temp_stem(&name)));
+            std::fs::write(&dead, b"partial").unwrap();
+            write_atomic(&p, b"x").unwrap();
+            assert_eq!(std::fs::read(&p).unwrap(), b"x");
+            assert!(!dead.exists(), "{len}: the dead writer's leftover is removed");
+            std::fs::remove_file(&p).unwrap();
+        }
+        let long = dir.path().join(format!("{}.exr", "a".repeat(NAME_MAX - 3)));
+        let e = check_writable(&long).unwrap_err().to_string();
+        assert!(e.contains("256 bytes") && e.contains("255"), "{e}");
+        assert!(entries(dir.path()).is_empty());
     }
 
     #[test]

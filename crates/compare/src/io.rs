@@ -198,15 +198,61 @@ fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {
     let ct = img.color();
     let bits_per_channel = ct.bits_per_pixel() / u16::from(ct.channel_count());
     let (width, height) = (img.width(), img.height());
+    let to_linear = png_transfer(bytes).map_err(decode)?;
     // Lookup tables: decoding is the same few thousand values over and over.
     let data = if bits_per_channel > 8 {
-        let lut: Vec<f32> = (0..=u16::MAX).map(|v| srgb_decode(f64::from(v) / 65535.0) as f32).collect();
+        let lut: Vec<f32> = (0..=u16::MAX).map(|v| to_linear.decode(f64::from(v) / 65535.0) as f32).collect();
         img.to_rgb16().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
     } else {
-        let lut: Vec<f32> = (0..=u8::MAX).map(|v| srgb_decode(f64::from(v) / 255.0) as f32).collect();
+        let lut: Vec<f32> = (0..=u8::MAX).map(|v| to_linear.decode(f64::from(v) / 255.0) as f32).collect();
         img.to_rgb8().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
     };
     Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+}
+
+/// How a PNG's samples become linear light, from its colour chunks, in the PNG specification's
+/// order of precedence (3rd edition, §4.3): cICP, then iCCP, then sRGB, then gAMA; with none,
+/// sRGB. A gAMA of 1.0 (linear data) was read as sRGB before.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum PngTransfer {
+    Srgb,
+    /// `linear = sample^(1/gamma)`: gAMA's "image gamma" (0.45455 for a 2.2 display).
+    Power(f64),
+}
+
+impl PngTransfer {
+    fn decode(self, v: f64) -> f64 {
+        match self {
+            PngTransfer::Srgb => srgb_decode(v),
+            PngTransfer::Power(g) => v.powf(1.0 / g),
+        }
+    }
+}
+
+/// The transfer of the PNG in `bytes` (see [`PngTransfer`]); ICC profiles are not interpreted
+/// (read as sRGB, the profile nearly every PNG that carries one has); cICP is accepted for
+/// Rec. 709 primaries with the sRGB or a linear transfer, refused otherwise (HDR PNGs: PQ, HLG).
+fn png_transfer(bytes: &[u8]) -> std::result::Result<PngTransfer, String> {
+    let reader = png::Decoder::new(Cursor::new(bytes)).read_info().map_err(|e| e.to_string())?;
+    let info = reader.info();
+    if let Some(c) = &info.coding_independent_code_points {
+        return match (c.color_primaries, c.transfer_function) {
+            (1, 13) => Ok(PngTransfer::Srgb),
+            (1, 8) => Ok(PngTransfer::Power(1.0)),
+            (p, t) => Err(format!(
+                "cICP chunk: colour primaries {p}, transfer {t} (ITU-T H.273) are not supported; only Rec. 709 \
+                 primaries (1) with the sRGB (13) or linear (8) transfer are: write an EXR of linear sRGB instead"
+            )),
+        };
+    }
+    if info.icc_profile.is_some() || info.srgb.is_some() {
+        return Ok(PngTransfer::Srgb);
+    }
+    match info.gama_chunk.map(|g| f64::from(g.into_value())) {
+        None => Ok(PngTransfer::Srgb),
+        Some(g) if (0.01..=100.0).contains(&g) => Ok(PngTransfer::Power(g)),
+        Some(g) => Err(format!("gAMA chunk: image gamma {g} is outside 0.01–100")),
+    }
 }
 
 /// Writes an image as EXR or PNG (by extension), atomically: on error no file is created
@@ -297,6 +343,73 @@ mod tests {
         // HDR and negative values on purpose: EXR must keep them.
         Image::from_fn(13, 7, |x, y| [x as f32 * 0.37 - 0.5, y as f32 * 1.9, (x * y) as f32 / 91.0 + 1e-4])
             .unwrap()
+    }
+
+    /// A PNG of one grey row `v` (8-bit) with the chunks `setup` adds, and `extra` chunks (type,
+    /// data) after IHDR.
+    fn png_with(
+        v: &[u8],
+        setup: impl FnOnce(&mut png::Encoder<&mut Vec<u8>>),
+        extra: &[(&[u8; 4], &[u8])],
+    ) -> Vec<u8> {
+        let mut out = Vec::new();
+        {
+            let mut e = png::Encoder::new(&mut out, v.len() as u32, 1);
+            e.set_color(png::ColorType::Grayscale);
+            setup(&mut e);
+            e.write_header().unwrap().write_image_data(v).unwrap();
+        }
+        // After the 8-byte signature and IHDR (4 + 4 + 13 + 4 bytes).
+        let mut chunks = Vec::new();
+        for (kind, data) in extra {
+            let crc = |b: &[u8]| {
+                let mut c = 0xffff_ffffu32;
+                for &x in b {
+                    c ^= u32::from(x);
+                    for _ in 0..8 {
+                        c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+                    }
+                }
+                !c
+            };
+            chunks.extend_from_slice(&(data.len() as u32).to_be_bytes());
+            let body = [&kind[..], data].concat();
+            chunks.extend_from_slice(&body);
+            chunks.extend_from_slice(&crc(&body).to_be_bytes());
+        }
+        [&out[..33], &chunks, &out[33..]].concat()
+    }
+
+    /// PNG colour chunks decide how samples become linear (gAMA 1.0 used to be read as sRGB).
+    #[test]
+    fn png_colour_chunks_are_honoured() {
+        let v = [0u8, 10, 64, 128, 200, 255];
+        let read =
+            |b: &[u8]| decode_image("t.png", b).map(|i| i.data.iter().map(|p| p[0]).collect::<Vec<f32>>());
+        let srgb: Vec<f32> = v.iter().map(|&x| srgb_decode(f64::from(x) / 255.0) as f32).collect();
+        assert_eq!(read(&png_with(&v, |_| {}, &[])).unwrap(), srgb, "no chunk: sRGB");
+        let with_srgb = png_with(&v, |e| e.set_source_srgb(png::SrgbRenderingIntent::Perceptual), &[]);
+        assert_eq!(read(&with_srgb).unwrap(), srgb, "sRGB chunk (with its fallback gAMA)");
+        let linear = read(&png_with(&v, |e| e.set_source_gamma(png::ScaledFloat::new(1.0)), &[])).unwrap();
+        for (&got, &x) in linear.iter().zip(&v) {
+            assert!((got - f32::from(x) / 255.0).abs() < 1e-6, "gAMA 1.0: linear");
+        }
+        let g22 = read(&png_with(&v, |e| e.set_source_gamma(png::ScaledFloat::new(0.45455)), &[])).unwrap();
+        for (&got, &x) in g22.iter().zip(&v) {
+            let want = (f64::from(x) / 255.0).powf(1.0 / 0.45455) as f32;
+            assert!((got - want).abs() < 1e-6, "gAMA 0.45455: a 2.2 power, {got} vs {want}");
+        }
+        // cICP: Rec. 709 primaries with a linear transfer is linear; PQ (16) is refused.
+        let cicp = |t: u8| png_with(&v, |_| {}, &[(b"cICP", &[1, t, 0, 1])]);
+        assert_eq!(read(&cicp(13)).unwrap(), srgb);
+        assert!((read(&cicp(8)).unwrap()[3] - 128.0 / 255.0).abs() < 1e-6);
+        let e = read(&cicp(16)).unwrap_err().to_string();
+        assert!(e.contains("t.png") && e.contains("cICP") && e.contains("16"), "{e}");
+        // gAMA 0 is invalid (the png decoder drops it: sRGB); an absurd one is refused.
+        assert_eq!(read(&png_with(&v, |_| {}, &[(b"gAMA", &0u32.to_be_bytes())])).unwrap(), srgb);
+        let huge = png_with(&v, |_| {}, &[(b"gAMA", &1_000_000_000u32.to_be_bytes())]);
+        let e = read(&huge).unwrap_err().to_string();
+        assert!(e.contains("gAMA") && e.contains("10000"), "{e}");
     }
 
     fn names(dir: &Path) -> Vec<String> {

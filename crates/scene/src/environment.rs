@@ -39,6 +39,10 @@ pub const MAX_INPUT_WIDTH: u32 = 16384;
 pub const MAX_INPUT_HEIGHT: u32 = 8192;
 /// Largest input file (bytes): an HDR of the largest accepted size, uncompressed, fits easily.
 pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+/// Most a decoder may allocate for one map: the largest accepted map as RGBA f32 (2 GiB). A map
+/// of that size needs about 3.5 GB while it loads (decoded, then as texels), then is reduced to
+/// [`WORKING_WIDTH`].
+pub const MAX_DECODED_BYTES: u64 = 16 * MAX_INPUT_WIDTH as u64 * MAX_INPUT_HEIGHT as u64;
 /// Width both renderers work at: larger images are box-filtered down to at most this.
 pub const WORKING_WIDTH: u32 = 2048;
 /// Largest accepted `intensity`.
@@ -183,17 +187,33 @@ impl Environment {
                 }
             }
         }
+        let header = if format == image::ImageFormat::Hdr { radiance_header(path, bytes)? } else { None };
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         reader.set_format(format);
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_INPUT_WIDTH);
         limits.max_image_height = Some(MAX_INPUT_HEIGHT);
-        limits.max_alloc = Some(4 * 4 * MAX_INPUT_WIDTH as u64 * MAX_INPUT_HEIGHT as u64 / 2);
+        // The decoded image of the largest accepted size, as RGBA f32 (the EXR decoder's form; a
+        // limit of half that refused the 16384×8192 maps promised above).
+        limits.max_alloc = Some(MAX_DECODED_BYTES);
         reader.limits(limits);
         let img = reader.decode().map_err(|e| err(format!("not a readable {format:?} image: {e}")))?;
-        let rgb = img.into_rgb32f();
-        let (w, h) = rgb.dimensions();
-        let texels = rgb.pixels().map(|p| Vec3::from_array(p.0)).collect();
+        let (w, h) = (img.width(), img.height());
+        // Straight from the decoder's f32 buffer where it has one: a converted copy on the way
+        // would add 1.5 GB at the largest size.
+        let texels: Vec<Vec3> = match img {
+            image::DynamicImage::ImageRgb32F(b) => b.as_raw().chunks_exact(3).map(Vec3::from_slice).collect(),
+            image::DynamicImage::ImageRgba32F(b) => {
+                b.as_raw().chunks_exact(4).map(Vec3::from_slice).collect()
+            }
+            other => other.into_rgb32f().pixels().map(|p| Vec3::from_array(p.0)).collect(),
+        };
+        let texels = match header {
+            // Colours outside sRGB's gamut have no non-negative radiance in it: clipped to its
+            // edge, as any sRGB renderer shows them.
+            Some(m) => texels.into_iter().map(|t| (m * t).max(Vec3::ZERO)).collect(),
+            None => texels,
+        };
         Self::from_rgb(&path.display().to_string(), w, h, texels)
     }
 
@@ -449,6 +469,84 @@ impl EnvironmentChoice {
     }
 }
 
+/// What a Radiance header says about its pixels, as the matrix that takes them to linear sRGB
+/// radiance, or `None` where they already are: `EXPOSURE` (every factor the file's writers
+/// applied; the pixels are divided by their product, per the Radiance file format) and
+/// `COLORCORR` (the same, per channel), and `PRIMARIES` other than Rec. 709's (converted, with
+/// Bradford adaptation from the file's white to D65). These used to be ignored: a file written
+/// with `EXPOSURE=4` rendered four times too bright.
+fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, EnvironmentError> {
+    use glam::{DMat3, DVec3};
+    let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
+    // The header ends at the first empty line; Radiance's own tools write a few hundred bytes.
+    let head = &bytes[..bytes.len().min(1 << 16)];
+    let xyze = head
+        .split(|&b| b == b'\n')
+        .take_while(|l| !l.is_empty())
+        .any(|l| std::str::from_utf8(l).is_ok_and(|l| l.trim().replace(' ', "") == "FORMAT=32-bit_rle_xyze"));
+    if xyze {
+        return Err(err(
+            "header FORMAT=32-bit_rle_xyze: CIE XYZ pixels are not supported; convert to RGB with Radiance's \
+             `ra_xyze -r in.hdr out.hdr`"
+                .into(),
+        ));
+    }
+    let meta = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes))
+        .map_err(|e| err(format!("not a readable Hdr image: {e}")))?
+        .metadata();
+    let positive = |v: f32| v.is_finite() && v > 0.0;
+    let mut scale = DVec3::ONE;
+    if let Some(e) = meta.exposure {
+        if !positive(e) {
+            return Err(err(format!(
+                "header EXPOSURE: the product of its values is {e}; it must be a positive number"
+            )));
+        }
+        scale /= f64::from(e);
+    }
+    if let Some((r, g, b)) = meta.color_correction {
+        if ![r, g, b].into_iter().all(positive) {
+            return Err(err(format!("header COLORCORR: {r} {g} {b}; each factor must be a positive number")));
+        }
+        scale /= DVec3::new(r.into(), g.into(), b.into());
+    }
+    let mut m = DMat3::from_diagonal(scale);
+    if let Some((_, v)) = meta.custom_attributes.iter().rev().find(|(k, _)| k == "PRIMARIES") {
+        let n: Vec<f64> = v.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+        let ok = n.len() == 8
+            && n.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))
+            && n.chunks(2).all(|c| c[1] > 0.0 && c[0] + c[1] <= 1.0);
+        let space = ok.then(|| {
+            color::RgbColorSpace::new(
+                "PRIMARIES",
+                [[n[0], n[1]], [n[2], n[3]], [n[4], n[5]]],
+                [n[6], n[7]],
+                "",
+                color::colorspace::TransferFunction::Linear,
+            )
+        });
+        let Some(space) = space.filter(|s| s.to_xyz.is_finite() && s.to_xyz.determinant().abs() > 1e-6)
+        else {
+            return Err(err(format!(
+                "header PRIMARIES: '{}' is not eight chromaticities (x y of red, green, blue, white) of a colour space",
+                v.trim()
+            )));
+        };
+        let srgb = color::RgbColorSpace::srgb();
+        let same = space
+            .primaries
+            .iter()
+            .flatten()
+            .chain(&space.white)
+            .zip(srgb.primaries.iter().flatten().chain(&srgb.white))
+            .all(|(a, b)| (a - b).abs() < 1e-3);
+        if !same {
+            m = space.conversion_to(&srgb) * m;
+        }
+    }
+    Ok((m != DMat3::IDENTITY).then(|| m.as_mat3()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -586,6 +684,70 @@ mod tests {
         assert_eq!((e.width, e.height), (8, 4));
         assert!((e.texels[3] - Vec3::new(1.5, 1.0, 0.25)).abs().max_element() < 0.02);
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Radiance headers are honoured (they used to be ignored): EXPOSURE divides, cumulatively,
+    /// COLORCORR per channel, PRIMARIES other than Rec. 709's are converted; bad values name
+    /// the header field.
+    #[test]
+    fn radiance_headers_are_honoured() {
+        let px: Vec<image::Rgb<f32>> = (0..32).map(|_| image::Rgb([0.5, 1.0, 0.25])).collect();
+        let mut plain = Vec::new();
+        image::codecs::hdr::HdrEncoder::new(&mut plain).encode(&px, 8, 4).unwrap();
+        let with = |lines: &str| {
+            let text = String::from_utf8_lossy(&plain[..plain.len().min(64)]).to_string();
+            let end = text.find("\n\n").unwrap();
+            [&plain[..end + 1], lines.as_bytes(), &plain[end + 1..]].concat()
+        };
+        let load = |b: &[u8]| Environment::from_bytes(Path::new("sky.hdr"), b);
+        let base = load(&plain).unwrap().texels[5];
+        let t = load(&with("EXPOSURE=2\nEXPOSURE=4\n")).unwrap().texels[5];
+        assert!((t * 8.0 - base).abs().max_element() < 1e-6, "{t} vs {base}/8");
+        let t = load(&with("COLORCORR=1 2 4\n")).unwrap().texels[5];
+        assert!((t * Vec3::new(1.0, 2.0, 4.0) - base).abs().max_element() < 1e-6, "{t}");
+        let srgb = load(&with("PRIMARIES=0.64 0.33 0.3 0.6 0.15 0.06 0.3127 0.329\n")).unwrap().texels[5];
+        assert!((srgb - base).abs().max_element() < 1e-6, "Rec. 709 primaries change nothing");
+        // Radiance's own standard primaries and equal-energy white: against the same matrices
+        // built independently (colour space from chromaticities, then Bradford to D65).
+        let rad =
+            load(&with("PRIMARIES=0.640 0.330 0.290 0.600 0.150 0.060 0.333 0.333\n")).unwrap().texels[5];
+        let space = color::RgbColorSpace::new(
+            "r",
+            [[0.64, 0.33], [0.29, 0.6], [0.15, 0.06]],
+            [0.333, 0.333],
+            "",
+            color::colorspace::TransferFunction::Linear,
+        );
+        let want = space.conversion_to(&color::RgbColorSpace::srgb()) * base.as_dvec3();
+        assert!((rad.as_dvec3() - want.max(glam::DVec3::ZERO)).abs().max_element() < 1e-5, "{rad} vs {want}");
+        assert!((rad - base).abs().max_element() > 0.01, "they differ from sRGB's");
+        for (line, field) in [
+            ("EXPOSURE=0\n", "EXPOSURE"),
+            ("EXPOSURE=-1\n", "EXPOSURE"),
+            ("COLORCORR=1 0 1\n", "COLORCORR"),
+            ("PRIMARIES=0.64 0.33\n", "PRIMARIES"),
+            ("PRIMARIES=0.3 0.3 0.3 0.3 0.3 0.3 0.3 0.3\n", "PRIMARIES"),
+            ("FORMAT=32-bit_rle_xyze\n", "ra_xyze -r"),
+        ] {
+            let m = load(&with(line)).unwrap_err().to_string();
+            assert!(m.contains("sky.hdr") && m.contains(field), "{line}: {m}");
+        }
+    }
+
+    /// The largest map the documentation promises is not refused by the decoder's memory limit
+    /// (16384×8192 was, "Memory limit exceeded"): a header of that size with a few scanlines
+    /// fails as a truncated file, not for its size.
+    #[test]
+    fn the_largest_promised_size_is_not_refused_for_memory() {
+        let (w, h) = (MAX_INPUT_WIDTH, MAX_INPUT_HEIGHT);
+        let mut b = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();
+        b.extend(std::iter::repeat_n([0x80u8, 0x80, 0x80, 0x81], 4 * w as usize).flatten());
+        let m = Environment::from_bytes(Path::new("big.hdr"), &b).unwrap_err().to_string();
+        assert!(!m.to_lowercase().contains("memory") && !m.contains("larger than"), "{m}");
+        let mut over = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {}\n", w * 2).into_bytes();
+        over.extend_from_slice(&[0x80; 64]);
+        let m = Environment::from_bytes(Path::new("big.hdr"), &over).unwrap_err().to_string();
+        assert!(m.contains("big.hdr"), "{m}");
     }
 
     #[test]

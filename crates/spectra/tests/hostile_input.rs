@@ -111,3 +111,23 @@ fn absurd_settings_are_refused_before_rendering() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `demo` hands its values to the commands it drives as values: a scene or size that looks
+/// like an option is that command's one clean error about the value (it used to print
+/// "error: error:" and a hidden subcommand's usage).
+#[test]
+fn demo_values_that_look_like_options_stay_values() {
+    let d = tmp("demo-dash");
+    let o = d.join("out");
+    let o = o.to_str().unwrap();
+    refused(
+        &["demo", "--scene=--xyz", "--out", o, "--size", "8x8", "--spp", "1"],
+        &["'--xyz'", "unknown built-in scene"],
+    );
+    refused(&["demo", "--size=--spp", "--out", o], &["--size", "'--spp'"]);
+    for args in [["demo", "--scene=--xyz", "--out", o], ["demo", "--size=--spp", "--out", o]] {
+        let err = String::from_utf8_lossy(&spectra(&args).stderr).to_string();
+        assert!(!err.contains("error: error") && !err.contains("Usage"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

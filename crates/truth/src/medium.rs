@@ -63,7 +63,8 @@ impl Medium {
                 let v = s.eval(l);
                 if !(0.0..=MAX_SIGMA).contains(&v) {
                     return bad(format!(
-                        "{name} is {v} at {l} nm; coefficients must lie in 0–{MAX_SIGMA:e} per scene unit"
+                        "{name} is {} at {l} nm; coefficients must lie in 0–{MAX_SIGMA:e} per scene unit",
+                        color::error::show(v)
                     ));
                 }
             }
@@ -71,12 +72,19 @@ impl Medium {
         if let Phase::HenyeyGreenstein { g } = self.phase
             && !(g > -1.0 && g < 1.0)
         {
-            return bad(format!("Henyey–Greenstein g = {g} must lie strictly between −1 and 1"));
+            return bad(format!("phase: Henyey–Greenstein g = {g} must lie strictly between −1 and 1"));
         }
-        if let Region::Box { min, max } = self.region
-            && (!min.is_finite() || !max.is_finite() || min.cmpgt(max).any())
-        {
-            return bad(format!("box {min}..{max} is empty or not finite"));
+        if let Region::Box { min, max } = self.region {
+            if !min.is_finite() || !max.is_finite() {
+                return bad(format!("box: min {min} and max {max} must be finite"));
+            }
+            if let Some(axis) = (0..3).find(|&i| min[i] > max[i]) {
+                let name = ["x", "y", "z"][axis];
+                return bad(format!(
+                    "box: max.{name} = {} is below min.{name} = {}: the box is empty",
+                    max[axis], min[axis]
+                ));
+            }
         }
         if let Some(n) = self.surface_ior {
             if !(n.is_finite() && n > 1.0) {

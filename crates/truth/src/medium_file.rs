@@ -46,9 +46,23 @@ fn spectrum(origin: &str, key: &str, v: Option<&Value>) -> Result<Spectrum> {
 fn vec3(origin: &str, key: &str, v: Option<&Value>) -> Result<Vec3> {
     let a = v.and_then(Value::as_array).filter(|a| a.len() == 3);
     let a = a.ok_or_else(|| bad(origin, format!("\"box.{key}\" must be [x, y, z]")))?;
-    let f = |i: usize| a[i].as_f64().ok_or_else(|| bad(origin, format!("\"box.{key}\" must hold numbers")));
-    Ok(Vec3::new(f(0)? as f32, f(1)? as f32, f(2)? as f32))
+    let f = |i: usize| {
+        let x = a[i].as_f64().ok_or_else(|| bad(origin, format!("\"box.{key}\" must hold numbers")))?;
+        // The tracer's coordinates are f32: 1e39 would become infinite there.
+        if !(x.is_finite() && x.abs() <= MAX_COORDINATE) {
+            return Err(bad(
+                origin,
+                format!("\"box.{key}\"[{i}] = {x:e}: box coordinates must lie within ±{MAX_COORDINATE:e}"),
+            ));
+        }
+        Ok(x as f32)
+    };
+    Ok(Vec3::new(f(0)?, f(1)?, f(2)?))
 }
+
+/// Largest box coordinate accepted (scene units): far beyond any scene, and finite in f32 with
+/// room for the ray arithmetic.
+pub const MAX_COORDINATE: f64 = 1.0e30;
 
 /// Largest `--medium` file read (bytes); a sampled coefficient at 0.1 nm steps is far below it.
 pub const MAX_MEDIUM_FILE_BYTES: u64 = 1 << 20;
@@ -74,6 +88,15 @@ impl Medium {
             None => Phase::Isotropic,
             Some(Value::String(s)) if s == "isotropic" => Phase::Isotropic,
             Some(p) => match p.get("hg").and_then(Value::as_f64) {
+                // Checked here, as written: as f32 0.99999999999 is 1, refused below as "g = 1".
+                Some(g) if !(g > -1.0 && g < 1.0 && (g as f32).abs() < 1.0) => {
+                    return Err(bad(
+                        origin,
+                        format!(
+                            "\"phase.hg\" = {g}: the Henyey–Greenstein g must lie strictly between −1 and 1 (as a 32-bit float)"
+                        ),
+                    ));
+                }
                 Some(g) => Phase::HenyeyGreenstein { g: g as f32 },
                 None => {
                     return Err(bad(
@@ -136,5 +159,26 @@ mod tests {
         assert!(e(r#"{"sigma_a": 1, "sigma_s": 1, "phase": {"g": 1}}"#).contains("phase"));
         let neg = Medium::from_json(r#"{"sigma_a": -1, "sigma_s": 1}"#, "w.json").unwrap();
         assert!(neg.validate(WavelengthRange::VISIBLE).unwrap_err().to_string().contains("sigma_a"));
+    }
+
+    /// Values the f32 tracer cannot hold are refused as written, naming the field (they used
+    /// to read "box [-inf, -1, -1]..[inf, 1, 1]" and "g = 1").
+    #[test]
+    fn values_beyond_f32_name_their_field() {
+        let e = |t: &str| Medium::from_json(t, "w.json").unwrap_err().to_string();
+        let m = e(r#"{"sigma_a": 1, "sigma_s": 0, "box": {"min": [-1e39, -1, -1], "max": [1, 1, 1]}}"#);
+        assert!(m.contains("w.json") && m.contains("\"box.min\"[0]") && m.contains("-1e39"), "{m}");
+        let m = e(r#"{"sigma_a": 1, "sigma_s": 0, "phase": {"hg": 0.99999999999}}"#);
+        assert!(m.contains("\"phase.hg\" = 0.99999999999"), "{m}");
+        let flat = Medium::from_json(
+            r#"{"sigma_a": 1, "sigma_s": 0, "box": {"min": [1, 1, 1], "max": [2, 0, 2]}}"#,
+            "w.json",
+        )
+        .unwrap();
+        let m = flat.validate(WavelengthRange::VISIBLE).unwrap_err().to_string();
+        assert!(m.contains("box") && m.contains("max") && m.contains("y"), "{m}");
+        let huge = Medium::from_json(r#"{"sigma_a": 1e300, "sigma_s": 0}"#, "w.json").unwrap();
+        let m = huge.validate(WavelengthRange::VISIBLE).unwrap_err().to_string();
+        assert!(m.contains("1e300") && m.len() < 200, "{m}");
     }
 }

@@ -41,28 +41,14 @@ pub fn cache_path(space: &RgbColorSpace) -> Result<PathBuf> {
     Ok(cache_dir()?.join(format!("{}-{TABLE_RES}-v{TABLE_VERSION}.coeff", space.name)))
 }
 
-/// Marks the signature this cache appends after a table's payload (readers of `.coeff` files,
-/// ours and Mitsuba's, ignore trailing bytes).
-const SIGNATURE_TAG: &[u8] = b"\nspectra-cache-signature fnv1a64=";
-
 /// Most mean round-trip ΔE2000 a cached table may show on 32 random colours. Fitted tables are
 /// below it (2.7 even at 8³, the coarsest the tests fit; far less at 64³); a well-formed but
 /// wrong table is above it (all zeros, every colour the same grey: 24.6).
 const MAX_CACHED_MEAN_DE: f64 = 10.0;
 
-/// FNV-1a, 64 bits: enough to tell a damaged or substituted payload from the one we wrote (not
-/// a defence against someone forging it, which the round trip below covers for useless tables).
-fn fnv1a64(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
-}
-
 /// The `.coeff` bytes of `t` with this cache's signature appended.
 fn signed_bytes(t: &CoeffTable) -> Vec<u8> {
-    let mut out = t.to_bytes();
-    let sum = fnv1a64(&out);
-    out.extend_from_slice(SIGNATURE_TAG);
-    out.extend_from_slice(format!("{sum:016x}\n").as_bytes());
-    out
+    crate::signature::sign(t.to_bytes())
 }
 
 /// Writes a table to the cache atomically, signed.
@@ -82,12 +68,7 @@ pub fn read_cached(path: &std::path::Path, space: &RgbColorSpace, res: usize) ->
     if t.res != res {
         return None;
     }
-    let (payload, trailer) = bytes.split_at(t.encoded_len());
-    let hex = trailer.strip_prefix(SIGNATURE_TAG)?.strip_suffix(b"\n")?;
-    let sum = u64::from_str_radix(std::str::from_utf8(hex).ok()?, 16).ok()?;
-    if sum != fnv1a64(payload) {
-        return None;
-    }
+    crate::signature::payload(&bytes, t.encoded_len())?;
     check_usable(&t, space).ok()?;
     Some(t)
 }

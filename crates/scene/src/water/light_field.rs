@@ -86,8 +86,13 @@ pub const N_NORMAL_ELEV: usize = 9;
 pub const N_NORMAL_AZ: usize = 5;
 /// Entries of [`LightFieldTable::irradiance`].
 const N_IRRADIANCE: usize = N_DEPTH * N_NORMAL_ELEV * N_NORMAL_AZ * N_LAMBDA;
+/// Most downwelling irradiance ([`LightFieldTable::e_d`], per unit entering) a cached table
+/// may hold: energy allows little more than the floor's and the surface's returns doubling it
+/// (a white floor 3 m under the clearest Jerlov water, the brightest case, gives 1.72). A
+/// plausibility check on signed caches, not a physical limit the solver enforces.
+const MAX_E_D: f64 = 4.0;
 /// Table format version (bump when the solver's output changes, so stale caches are refitted).
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 
 /// What a table is computed for (also its cache key).
 #[derive(Clone, Debug, PartialEq)]
@@ -700,8 +705,11 @@ impl LightFieldTable {
     ) -> Result<Self, WaterError> {
         key.validate()?;
         let path = dir.map(|d| d.join(key.cache_name()));
-        if let Some(t) =
-            path.as_ref().and_then(|p| std::fs::read(p).ok()).and_then(|b| Self::from_bytes(&b, key))
+        let cap = (Self::payload_len() + color::signature::LEN) as u64;
+        if let Some(t) = path
+            .as_ref()
+            .and_then(|p| color::input::read_regular(p, cap).ok())
+            .and_then(|b| Self::from_bytes(&b, key))
         {
             return Ok(t);
         }
@@ -709,16 +717,20 @@ impl LightFieldTable {
         if let (Some(p), Some(d)) = (&path, dir) {
             let _ = std::fs::create_dir_all(d);
             let tmp = p.with_extension("tmp");
-            if std::fs::write(&tmp, t.to_bytes()).is_ok() {
+            if std::fs::write(&tmp, color::signature::sign(t.to_bytes())).is_ok() {
                 let _ = std::fs::rename(&tmp, p);
             }
         }
         Ok(t)
     }
 
+    /// Bytes of [`LightFieldTable::to_bytes`]: a header of five f64, then the floats.
+    const fn payload_len() -> usize {
+        40 + 4 * (N_DEPTH * N_ELEV * N_AZ * N_LAMBDA + N_DEPTH * N_LAMBDA + 2 * N_SURFACE + N_IRRADIANCE)
+    }
+
     fn to_bytes(&self) -> Vec<u8> {
-        let mut out =
-            Vec::with_capacity(8 * 5 + 4 * (self.j.len() + self.e_d.len() + 2 * N_SURFACE + N_IRRADIANCE));
+        let mut out = Vec::with_capacity(Self::payload_len());
         for x in [VERSION as f64, self.z_max, self.sun_mu, self.j.len() as f64, self.e_d.len() as f64] {
             out.extend_from_slice(&x.to_le_bytes());
         }
@@ -735,7 +747,12 @@ impl LightFieldTable {
         out
     }
 
+    /// The table in cache file `b` if it is one this cache wrote for `key`: the signature
+    /// matches (a damaged, truncated or edited file does not), the header matches the key and
+    /// every value is plausible — finite, non-negative (radiances and irradiances), and the
+    /// downwelling irradiance at most [`MAX_E_D`] of what enters. Else `None`, to be solved again.
     fn from_bytes(b: &[u8], key: &LightFieldKey) -> Option<Self> {
+        let b = color::signature::payload(b, Self::payload_len())?;
         let f64_at = |i: usize| Some(f64::from_le_bytes(b.get(i * 8..i * 8 + 8)?.try_into().ok()?));
         let (ver, z_max, mu, nj, ne) =
             (f64_at(0)?, f64_at(1)?, f64_at(2)?, f64_at(3)? as usize, f64_at(4)? as usize);
@@ -750,7 +767,9 @@ impl LightFieldTable {
         }
         let floats: Vec<f32> =
             b[40..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
-        if floats.iter().any(|x| !x.is_finite()) {
+        if floats.iter().any(|x| !(x.is_finite() && *x >= 0.0))
+            || floats[nj..nj + ne].iter().any(|&x| x as f64 > MAX_E_D)
+        {
             return None;
         }
         Some(LightFieldTable {
@@ -1023,6 +1042,45 @@ mod tests {
         assert_ne!(dark.cache_name(), key.cache_name());
         dark.floor = Some(Floor { albedo: vec![1.5; N_LAMBDA] });
         assert!(dark.validate().unwrap_err().to_string().contains("albedo"));
+    }
+
+    /// The cache is used only as written: a copy whose values were edited (all set to 8.0, as a
+    /// hostile-input case did), truncated, or re-signed with implausible values is solved again
+    /// and replaced; an intact copy loads without solving.
+    #[test]
+    fn cache_is_verified_on_load() {
+        let dir = std::env::temp_dir().join(format!("spectra-lf-cache-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let key = key("II", 0.8, 300);
+        let path = dir.join(key.cache_name());
+        let solve =
+            || LightFieldTable::cached(&key, Some(&dir), &|_, _| {}, &AtomicBool::new(false)).unwrap();
+        let first = solve();
+        assert!(first.seconds > 0.0, "solved");
+        let written = std::fs::read(&path).unwrap();
+        let loaded = solve();
+        assert_eq!(loaded.seconds, 0.0, "an intact copy loads");
+        assert_eq!(loaded.j, first.j);
+        let n = LightFieldTable::payload_len();
+        let eights: Vec<u8> = written[..40]
+            .iter()
+            .copied()
+            .chain(std::iter::repeat_n(8.0f32.to_le_bytes(), (n - 40) / 4).flatten())
+            .collect();
+        let cases: [(&str, Vec<u8>); 4] = [
+            ("all values 8.0, old signature", [&eights[..], &written[n..]].concat()),
+            ("all values 8.0, re-signed", color::signature::sign(eights.clone())),
+            ("truncated", written[..written.len() - 100].to_vec()),
+            ("unsigned", written[..n].to_vec()),
+        ];
+        for (what, bytes) in cases {
+            std::fs::write(&path, bytes).unwrap();
+            let t = solve();
+            assert!(t.seconds > 0.0, "{what}: solved again, not used");
+            assert_eq!(t.j, first.j, "{what}");
+            assert_eq!(std::fs::read(&path).unwrap(), written, "{what}: replaced by a good copy");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

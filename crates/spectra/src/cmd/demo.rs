@@ -33,14 +33,20 @@ pub struct Args {
     pub spp: u32,
 }
 
-/// Parses a subcommand's arguments exactly as the command line would.
+/// Parses a subcommand's arguments exactly as the command line would. Callers pass values as
+/// `--option=value` and the scene after `--`, so a user's value that looks like an option (a
+/// scene named `--xyz`) stays a value and gets that command's own error about it.
 fn parse<A: clap::Args>(argv: &[&str]) -> Result<A> {
     #[derive(Parser)]
     struct Wrap<A: clap::Args> {
         #[command(flatten)]
         inner: A,
     }
-    Ok(Wrap::<A>::try_parse_from(argv)?.inner)
+    // clap's rendering starts "error: ", as main's does: keep one.
+    Wrap::<A>::try_parse_from(argv).map(|w| w.inner).map_err(|e| {
+        let text = e.render().to_string();
+        anyhow::anyhow!("{}", text.trim_start_matches("error: ").lines().next().unwrap_or(""))
+    })
 }
 
 fn path_str(p: &Path) -> Result<&str> {
@@ -55,8 +61,8 @@ pub fn run(a: Args) -> Result<()> {
     eprintln!("1/3 ground truth: CPU spectral path tracer, direct lighting, {} spp", a.spp);
     let truth = file("truth.exr");
     for out in [&truth, &file("truth.png")] {
-        let argv =
-            ["truth", &a.scene, "--direct-only", "--spp", &spp, "--size", &a.size, "--out", path_str(out)?];
+        let (size, out) = (format!("--size={}", a.size), format!("--out={}", path_str(out)?));
+        let argv = ["truth", "--direct-only", "--spp", &spp, &size, &out, "--", &a.scene];
         let mut args: super::truth::Args = parse(&argv)?;
         args.scene.files = a.files.clone();
         super::truth::run(args)?;
@@ -67,7 +73,8 @@ pub fn run(a: Args) -> Result<()> {
     for mode in modes {
         for ext in ["exr", "png"] {
             let out = file(&format!("{mode}.{ext}"));
-            let argv = ["render", &a.scene, "--mode", mode, "--size", &a.size, "--out", path_str(&out)?];
+            let (size, out) = (format!("--size={}", a.size), format!("--out={}", path_str(&out)?));
+            let argv = ["render", "--mode", mode, &size, &out, "--", &a.scene];
             let mut args: super::render::RenderArgs = parse(&argv)?;
             args.scene.files = a.files.clone();
             super::render::run(args)?;
