@@ -123,9 +123,21 @@ pub(crate) fn read_flat_exr(bytes: &[u8]) -> std::result::Result<FlatExr, exr::e
         .from_buffered(Cursor::new(bytes))
 }
 
+/// The R, G, B channels of a spectral EXR (which holds them beside its bands: more channels
+/// than [`read_image`] takes).
+pub fn read_spectral_exr_rgb(path: impl AsRef<Path>) -> Result<Image> {
+    let path = path.as_ref();
+    let bytes = color::input::read_regular(path, MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
+    read_exr_channels(path, &bytes, crate::spectral::MAX_BANDS as u64 + 8)
+}
+
 fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
+    read_exr_channels(path, bytes, 64)
+}
+
+fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<Image> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
-    check_exr_headers(path, bytes, 64)?;
+    check_exr_headers(path, bytes, max_channels)?;
     let layer = read_flat_exr(bytes).map_err(|e| decode(e.to_string()))?.layer_data;
     let channels = &layer.channel_data.list;
     let find = |name: &str| channels.iter().find(|c| c.name.eq(name));
@@ -266,37 +278,60 @@ pub fn write_image(path: impl AsRef<Path>, image: &Image, opts: WriteOptions) ->
     // The fields are public, so a hand-built image may be inconsistent.
     image.validate()?;
     let bytes = match format {
-        Format::Exr => encode_exr(path, image, opts.exr)?,
+        Format::Exr => encode_exr(path, image, opts.exr, None)?,
         Format::Png => encode_png(path, image, opts.png)?,
     };
     write_atomic(path, &bytes)
 }
 
-fn encode_exr(path: &Path, image: &Image, precision: ExrPrecision) -> Result<Vec<u8>> {
+/// Writes `image` as an EXR (f32) whose pixels sit in `frame` (display and data windows,
+/// `spectra.*` attributes), atomically: a crop or sample chunk of a render.
+pub fn write_exr_framed(path: impl AsRef<Path>, image: &Image, frame: &crate::frame::ExrFrame) -> Result<()> {
+    let path = path.as_ref();
+    if format_of(path)? != Format::Exr {
+        return Err(CompareError::InvalidImage(format!(
+            "{}: a crop or sample chunk is stored as OpenEXR; give it a .exr name",
+            path.display()
+        )));
+    }
+    image.validate()?;
+    write_atomic(path, &encode_exr(path, image, ExrPrecision::F32, Some(frame))?)
+}
+
+fn encode_exr(
+    path: &Path,
+    image: &Image,
+    precision: ExrPrecision,
+    frame: Option<&crate::frame::ExrFrame>,
+) -> Result<Vec<u8>> {
     let w = image.width as usize;
     let size = (w, image.height as usize);
     let px = |x: usize, y: usize| image.data[y * w + x];
+    let mut attributes = exr::meta::header::LayerAttributes::default();
+    let image_attributes = match frame {
+        Some(f) => Some(f.apply(path, (image.width, image.height), &mut attributes)?),
+        None => None,
+    };
     let mut buf = Cursor::new(Vec::new());
     // ZIP over scan lines: lossless, compact, and readable by every EXR implementation.
+    macro_rules! write_with {
+        ($ch:expr) => {{
+            let layer = exr::prelude::Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, $ch);
+            match image_attributes {
+                Some(ia) => exr::prelude::Image::new(ia, layer).write().to_buffered(&mut buf),
+                None => exr::prelude::Image::from_layer(layer).write().to_buffered(&mut buf),
+            }
+        }};
+    }
     let res = match precision {
-        ExrPrecision::F32 => {
-            let ch = SpecificChannels::rgb(|Vec2(x, y)| {
-                let p = px(x, y);
-                (p[0], p[1], p[2])
-            });
-            exr::prelude::Image::from_encoded_channels(size, Encoding::SMALL_LOSSLESS, ch)
-                .write()
-                .to_buffered(&mut buf)
-        }
-        ExrPrecision::F16 => {
-            let ch = SpecificChannels::rgb(|Vec2(x, y)| {
-                let p = px(x, y).map(f16::from_f32);
-                (p[0], p[1], p[2])
-            });
-            exr::prelude::Image::from_encoded_channels(size, Encoding::SMALL_LOSSLESS, ch)
-                .write()
-                .to_buffered(&mut buf)
-        }
+        ExrPrecision::F32 => write_with!(SpecificChannels::rgb(|Vec2(x, y)| {
+            let p = px(x, y);
+            (p[0], p[1], p[2])
+        })),
+        ExrPrecision::F16 => write_with!(SpecificChannels::rgb(|Vec2(x, y)| {
+            let p = px(x, y).map(f16::from_f32);
+            (p[0], p[1], p[2])
+        })),
     };
     res.map_err(|e| CompareError::Encode { path: path.into(), format: "OpenEXR", reason: e.to_string() })?;
     Ok(buf.into_inner())

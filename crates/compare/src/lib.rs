@@ -13,6 +13,7 @@ pub mod diff;
 pub mod error;
 pub mod flip;
 pub mod font;
+pub mod frame;
 pub mod heatmap;
 pub mod image;
 pub mod io;
@@ -20,7 +21,12 @@ pub mod spectral;
 
 pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
+pub use frame::{ExrFrame, read_exr_frame};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
-pub use io::{ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_image};
-pub use spectral::{SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr};
+pub use io::{
+    ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_exr_framed, write_image,
+};
+pub use spectral::{
+    SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr, write_spectral_exr_framed,
+};

@@ -328,6 +328,17 @@ fn edges_from_centres(
 /// colour image) as R, G, B beside the bands so viewers without spectral support show it. f32
 /// samples, ZIP compression.
 pub fn write_spectral_exr(path: impl AsRef<Path>, image: &SpectralImage, rgb: Option<&Image>) -> Result<()> {
+    write_spectral_exr_framed(path, image, rgb, None)
+}
+
+/// [`write_spectral_exr`] with the pixels placed in `frame` (display and data windows,
+/// `spectra.*` attributes): a crop or sample chunk of a render.
+pub fn write_spectral_exr_framed(
+    path: impl AsRef<Path>,
+    image: &SpectralImage,
+    rgb: Option<&Image>,
+    frame: Option<&crate::frame::ExrFrame>,
+) -> Result<()> {
     let path = path.as_ref();
     image.validate()?;
     let (w, h) = (image.width as usize, image.height as usize);
@@ -368,10 +379,20 @@ pub fn write_spectral_exr(path: impl AsRef<Path>, image: &SpectralImage, rgb: Op
     if let Some(white) = &image.white {
         set(WHITE_ATTRIBUTE, white);
     }
+    let image_attributes = match frame {
+        Some(f) => Some(f.apply(path, (image.width, image.height), &mut attributes)?),
+        None => None,
+    };
     let layer = Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(list.into()));
     let mut buf = Cursor::new(Vec::new());
-    exr::prelude::Image::from_layer(layer).write().to_buffered(&mut buf).map_err(|e| {
-        CompareError::Encode { path: path.into(), format: "spectral OpenEXR", reason: e.to_string() }
+    let image = match image_attributes {
+        Some(ia) => exr::prelude::Image::new(ia, layer),
+        None => exr::prelude::Image::from_layer(layer),
+    };
+    image.write().to_buffered(&mut buf).map_err(|e| CompareError::Encode {
+        path: path.into(),
+        format: "spectral OpenEXR",
+        reason: e.to_string(),
     })?;
     write_atomic(path, &buf.into_inner())
 }

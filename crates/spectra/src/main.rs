@@ -36,6 +36,8 @@ enum Command {
     Upsample(cmd::upsample::Args),
     /// Ground truth: render a scene with the CPU spectral path tracer (or export it for Mitsuba).
     Truth(cmd::truth::Args),
+    /// Combine sample chunks and crop tiles of one `truth` render into one image.
+    Merge(cmd::merge::Args),
     /// Open an interactive window: live mode/N/range/observer/exposure, orbit and fly camera.
     View(cmd::view::Args),
     /// Frame time of RGB vs spectral rendering at N = 1…64 (median, p10/p90, cost per wavelength).
@@ -137,6 +139,7 @@ fn main() {
         Command::Lut(a) => cmd::lut::run(a),
         Command::Upsample(a) => cmd::upsample::run(a),
         Command::Truth(a) => cmd::truth::run(a),
+        Command::Merge(a) => cmd::merge::run(a),
         Command::View(a) => cmd::view::run(a),
         Command::Bench(a) => cmd::bench::run(a),
         Command::Eval(a) => cmd::eval::run(a),

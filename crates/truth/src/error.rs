@@ -14,6 +14,10 @@ pub enum TruthError {
         max_px = crate::render::MAX_PIXELS
     )]
     TooLarge(u32, u32),
+    #[error("crop window {0}")]
+    BadCrop(String),
+    #[error("sample range: {0}")]
+    BadSamples(String),
     #[error("spectral output: {0}")]
     BadBands(String),
     #[error("invalid medium: {0}")]

@@ -16,9 +16,17 @@ use scene::Scene;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// The s-th point of the R2 sequence shifted by `shift`, in [0, 1)².
-fn r2(shift: [f32; 2], s: u32) -> [f32; 2] {
+fn r2(shift: [f32; 2], s: u64) -> [f32; 2] {
     const A: [f64; 2] = [0.754_877_666_246_692_8, 0.569_840_290_998_053_3];
     std::array::from_fn(|i| ((shift[i] as f64 + s as f64 * A[i]).fract() as f32).min(0.999_999_94))
+}
+
+/// The s-th point of the golden-ratio (R1) sequence shifted by `shift`, in [0, 1): the hero
+/// wavelength's stratification. Any run of consecutive samples is spread evenly, so a chunk
+/// (`--sample-offset`) is stratified by itself and the union of chunks is the full render's.
+fn r1(shift: f32, s: u64) -> f32 {
+    const A: f64 = 0.618_033_988_749_894_8;
+    ((shift as f64 + s as f64 * A).fract() as f32).min(0.999_999_94)
 }
 
 /// Samples between two looks at the cancellation token (a few hundred microseconds at most).
@@ -32,12 +40,28 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 /// Most memory the binned spectral image may take (f32 samples).
 pub const MAX_SPECTRAL_BYTES: u64 = 1 << 31;
 
+/// A pixel rectangle of the full frame (`--crop X,Y,W,H`): origin at the top-left pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
 /// What to render and how.
 #[derive(Clone, Debug)]
 pub struct Settings {
+    /// The full frame (the camera's image), also when only a crop of it is rendered.
     pub width: u32,
     pub height: u32,
+    /// Samples per pixel in this render: samples `sample_offset` … `sample_offset + spp − 1`
+    /// of each pixel's sequence.
     pub spp: u32,
+    /// The first sample rendered (0 for a whole render; chunk i of n renders from i·spp).
+    pub sample_offset: u64,
+    /// Only this rectangle of the frame (the same per-pixel samples as the full render).
+    pub crop: Option<Crop>,
     pub seed: u64,
     pub range: WavelengthRange,
     pub observer: Observer,
@@ -61,6 +85,8 @@ impl Settings {
             width,
             height,
             spp,
+            sample_offset: 0,
+            crop: None,
             seed: 0,
             range: WavelengthRange::VISIBLE,
             observer: Observer::cie1931(),
@@ -81,12 +107,34 @@ impl Settings {
         if self.width == 0 || self.height == 0 {
             return Err(TruthError::BadSize(self.width, self.height));
         }
-        // Checked before anything is allocated: `4294967295x1` used to try.
+        // Checked before anything is allocated: `4294967295x1` used to try. A crop may come
+        // from a larger frame (up to MAX_SIDE a side): the pixel budget is the crop's.
+        let c = self.window();
         if self.width > MAX_SIDE
             || self.height > MAX_SIDE
-            || self.width as u64 * self.height as u64 > MAX_PIXELS
+            || (self.crop.is_none() && self.width as u64 * self.height as u64 > MAX_PIXELS)
         {
             return Err(TruthError::TooLarge(self.width, self.height));
+        }
+        if c.width == 0
+            || c.height == 0
+            || u64::from(c.x) + u64::from(c.width) > u64::from(self.width)
+            || u64::from(c.y) + u64::from(c.height) > u64::from(self.height)
+        {
+            return Err(TruthError::BadCrop(format!(
+                "{},{},{},{} (x, y, width, height) is not a non-empty rectangle inside the {}×{} frame",
+                c.x, c.y, c.width, c.height, self.width, self.height
+            )));
+        }
+        if c.width as u64 * c.height as u64 > MAX_PIXELS {
+            return Err(TruthError::TooLarge(c.width, c.height));
+        }
+        if self.sample_offset.checked_add(u64::from(self.spp)).is_none_or(|end| end > MAX_SAMPLE_INDEX) {
+            return Err(TruthError::BadSamples(format!(
+                "samples {} … {} pass the last sample index, {MAX_SAMPLE_INDEX}",
+                self.sample_offset,
+                self.sample_offset as u128 + u128::from(self.spp) - 1
+            )));
         }
         if let Some(m) = &self.medium {
             m.validate(self.range)?;
@@ -100,12 +148,12 @@ impl Settings {
                     self.range.min, self.range.max
                 )));
             }
-            let bytes = self.width as u64 * self.height as u64 * (edges.len() as u64 - 1) * 4;
+            let bytes = c.width as u64 * c.height as u64 * (edges.len() as u64 - 1) * 4;
             if bytes > MAX_SPECTRAL_BYTES {
                 return Err(TruthError::BadBands(format!(
                     "{}×{} pixels × {} bands is {} MiB of samples; at most {} MiB: use wider bands or a smaller image",
-                    self.width,
-                    self.height,
+                    c.width,
+                    c.height,
                     edges.len() - 1,
                     bytes >> 20,
                     MAX_SPECTRAL_BYTES >> 20
@@ -114,11 +162,24 @@ impl Settings {
         }
         Ok(())
     }
+
+    /// The rectangle rendered: the crop, or the whole frame.
+    pub fn window(&self) -> Crop {
+        self.crop.unwrap_or(Crop { x: 0, y: 0, width: self.width, height: self.height })
+    }
 }
+
+/// Version of the per-pixel sample sequence (the pixel's shift, each sample's stream): renders
+/// of different versions do not merge.
+pub const SAMPLER_VERSION: u32 = 2;
+
+/// One past the largest sample index (2⁵³: the sequences' arithmetic is exact in f64 below it).
+pub const MAX_SAMPLE_INDEX: u64 = 1 << 53;
 
 /// A rendered image: CIE XYZ per pixel, row-major from the top-left.
 #[derive(Clone, Debug)]
 pub struct XyzImage {
+    /// The rendered rectangle's size ([`Settings::window`]; the frame's without a crop).
     pub width: u32,
     pub height: u32,
     pub xyz: Vec<[f32; 3]>,
@@ -171,8 +232,10 @@ pub fn render_world(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<XyzImage> {
     settings.validate()?;
-    let (w, h) = (settings.width, settings.height);
-    let camera = RayCamera::new(&world.scene.camera, w, h);
+    let (full_w, full_h) = (settings.width, settings.height);
+    let win = settings.window();
+    let (w, h) = (win.width, win.height);
+    let camera = RayCamera::new(&world.scene.camera, full_w, full_h);
     let sensor = XyzSensor::new(&settings.observer, &settings.white, settings.range);
     let integ = Integrator {
         world,
@@ -186,7 +249,7 @@ pub fn render_world(
     let nb = bins.as_ref().map_or(0, |b| b.len());
     // A row's colours and, when binning, its bands.
     type Row = (Vec<[f32; 3]>, Vec<f32>);
-    let rows: Vec<Option<Row>> = (0..h)
+    let rows: Vec<Option<Row>> = (win.y..win.y + h)
         .into_par_iter()
         .map(|y| {
             if cancel.load(Ordering::Relaxed) {
@@ -195,27 +258,36 @@ pub fn render_world(
             let mut row = Vec::with_capacity(w as usize);
             let mut spectral_row = Vec::with_capacity(w as usize * nb);
             let mut bin_acc = vec![0.0f64; nb];
-            for x in 0..w {
-                let mut rng = Sampler::new(settings.seed, y as u64 * w as u64 + x as u64);
+            for x in win.x..win.x + w {
+                // Pixels are numbered in the full frame, so a crop draws what its pixels draw
+                // in the full render.
+                let pixel = y as u64 * full_w as u64 + x as u64;
+                let mut rng = Sampler::new(settings.seed, pixel);
                 let mut acc = [0.0f64; 3];
                 bin_acc.iter_mut().for_each(|v| *v = 0.0);
                 // Pixel positions from the R2 rank-1 lattice (Roberts 2018) with a random
                 // per-pixel shift (Cranley–Patterson rotation): well spread over the pixel, and
                 // each sample still uniform, so the estimate stays unbiased.
                 let shift = rng.next2();
-                for s in 0..settings.spp {
+                let shift_lambda = rng.uniform();
+                for i in 0..settings.spp {
                     // Polled every few samples, not only per pixel: at `--spp 10⁸` one pixel
                     // takes minutes.
-                    if s % CANCEL_POLL_SAMPLES == 0 && s > 0 && cancel.load(Ordering::Relaxed) {
+                    if i % CANCEL_POLL_SAMPLES == 0 && i > 0 && cancel.load(Ordering::Relaxed) {
                         return None;
                     }
+                    // Sample s of the pixel's sequence: its position, wavelengths and stream
+                    // depend on (seed, pixel, s) alone.
+                    let s = settings.sample_offset + u64::from(i);
+                    let mut rng = Sampler::for_sample(settings.seed, pixel, s);
                     let jitter = r2(shift, s);
                     let ray = camera.ray(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
-                    // Hero wavelengths stratified over the pixel's samples (one stratum of
-                    // 1/spp each, times the four rotations): spiky spectra such as F11 need
-                    // far fewer samples for the same colour noise. Unbiased, since every
-                    // other dimension is independent of the stratum.
-                    let wl = sensor.sample((s as f32 + rng.uniform()) / settings.spp as f32);
+                    // Hero wavelengths stratified over the pixel's samples by the golden-ratio
+                    // sequence (times the four rotations): spiky spectra such as F11 need far
+                    // fewer samples for the same colour noise. Unbiased: each sample's
+                    // wavelength is uniform (the per-pixel shift) and independent of its other
+                    // dimensions.
+                    let wl = sensor.sample(r1(shift_lambda, s));
                     let l = integ.camera_radiance(ray, &wl, &mut rng);
                     if !l.is_finite() {
                         dropped.fetch_add(1, Ordering::Relaxed);
@@ -449,6 +521,93 @@ mod tests {
             let got = acc[b] / n as f64;
             assert!((got - exact).abs() < 2e-3 * exact.max(1.0), "band {e:?}: {got} vs {exact}");
         }
+    }
+
+    /// Chunks of one sample sequence, merged weighted by their sample counts, are the render
+    /// of all their samples: to f32 rounding (the means are stored as f32; the sum's order
+    /// differs), for colour and bins, direct and full transport, with and without a medium.
+    #[test]
+    fn chunks_merge_into_the_full_render() {
+        let scene = small_scene();
+        let fog = Medium {
+            sigma_a: Spectrum::Constant(0.2),
+            sigma_s: Spectrum::Constant(0.6),
+            phase: crate::Phase::HenyeyGreenstein { g: 0.3 },
+            region: crate::Region::Everywhere,
+            surface_ior: None,
+        };
+        for (direct_only, medium) in [(true, None), (false, None), (false, Some(fog))] {
+            let base = Settings {
+                seed: 9,
+                direct_only,
+                medium,
+                spectral_bands: Some(WavelengthRange::VISIBLE.bin_edges(50.0).unwrap()),
+                ..Settings::new(7, 5, 12).unwrap()
+            };
+            let full = pool_free_render(&scene, &base);
+            let sizes = [3u32, 1, 5, 3];
+            let mut offset = 0;
+            let mut sum = vec![0.0f64; full.xyz.len() * 3];
+            let mut bins = vec![0.0f64; full.spectral.as_ref().unwrap().len()];
+            for n in sizes {
+                let c = pool_free_render(&scene, &Settings { spp: n, sample_offset: offset, ..base.clone() });
+                offset += u64::from(n);
+                for (a, v) in sum.iter_mut().zip(c.xyz.iter().flatten()) {
+                    *a += f64::from(*v) * f64::from(n);
+                }
+                for (a, v) in bins.iter_mut().zip(c.spectral.as_ref().unwrap()) {
+                    *a += f64::from(*v) * f64::from(n);
+                }
+            }
+            let want: Vec<f32> = full.xyz.iter().flatten().copied().collect();
+            let close = |got: &[f64], want: &[f32], what: &str| {
+                let mut worst: f64 = 0.0;
+                for (g, w) in got.iter().zip(want) {
+                    let g = g / 12.0;
+                    let rel = (g - f64::from(*w)).abs() / f64::from(w.abs()).max(1e-6);
+                    worst = worst.max(rel);
+                }
+                assert!(worst <= 1e-6, "{what}, direct {direct_only}: worst relative difference {worst:e}");
+            };
+            close(&sum, &want, "xyz");
+            close(&bins, full.spectral.as_ref().unwrap(), "bins");
+            assert!(full.mean()[1] > 0.0);
+        }
+    }
+
+    /// A tiling of crops is the full render, bit for bit: each pixel draws the same samples.
+    #[test]
+    fn crops_tile_the_full_render_exactly() {
+        let scene = small_scene();
+        let base = Settings {
+            seed: 4,
+            spectral_bands: Some(WavelengthRange::VISIBLE.bin_edges(70.0).unwrap()),
+            ..Settings::new(9, 6, 4).unwrap()
+        };
+        let full = pool_free_render(&scene, &base);
+        let nb = base.spectral_bands.as_ref().unwrap().len() - 1;
+        for (x, y, w, h) in [(0, 0, 5, 4), (5, 0, 4, 4), (0, 4, 5, 2), (5, 4, 4, 2), (3, 2, 1, 1)] {
+            let crop = Crop { x, y, width: w, height: h };
+            let t = pool_free_render(&scene, &Settings { crop: Some(crop), ..base.clone() });
+            assert_eq!((t.width, t.height), (w, h));
+            for ty in 0..h {
+                for tx in 0..w {
+                    let f = ((y + ty) * 9 + x + tx) as usize;
+                    let c = (ty * w + tx) as usize;
+                    assert_eq!(t.xyz[c], full.xyz[f], "crop {crop:?} pixel ({tx}, {ty})");
+                    assert_eq!(
+                        t.spectral.as_ref().unwrap()[c * nb..(c + 1) * nb],
+                        full.spectral.as_ref().unwrap()[f * nb..(f + 1) * nb]
+                    );
+                }
+            }
+        }
+        for bad in [Crop { x: 5, y: 0, width: 5, height: 1 }, Crop { x: 0, y: 0, width: 0, height: 1 }] {
+            let e = Settings { crop: Some(bad), ..base.clone() }.validate().unwrap_err().to_string();
+            assert!(e.contains("crop") && e.contains("9×6"), "{e}");
+        }
+        let e = Settings { sample_offset: MAX_SAMPLE_INDEX, ..base }.validate().unwrap_err().to_string();
+        assert!(e.contains("sample"), "{e}");
     }
 
     /// Direct lighting never exceeds full transport, and both see the lamp.

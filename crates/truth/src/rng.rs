@@ -21,6 +21,14 @@ impl Sampler {
         Sampler(Pcg32::new(mix(seed ^ mix(pixel)), mix(pixel.wrapping_add(seed.rotate_left(17)))))
     }
 
+    /// The random stream of sample `sample` of pixel `pixel`: every sample has its own, so a
+    /// render of samples K … K+N−1 (`--sample-offset`, `--chunk`) draws exactly what those
+    /// samples draw in one render of them all, and a crop exactly what its pixels draw.
+    pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Self {
+        let key = mix(seed ^ mix(pixel)) ^ mix(sample.wrapping_add(0x5851_f42d_4c95_7f2d));
+        Sampler(Pcg32::new(mix(key), mix(key ^ pixel.rotate_left(29) ^ sample.rotate_left(7))))
+    }
+
     /// Uniform in [0, 1) with 24 bits, so it never rounds up to 1.
     #[inline]
     pub fn uniform(&mut self) -> f32 {

@@ -716,10 +716,9 @@ impl LightFieldTable {
         let t = Self::compute(key, progress, cancel)?;
         if let (Some(p), Some(d)) = (&path, dir) {
             let _ = std::fs::create_dir_all(d);
-            let tmp = p.with_extension("tmp");
-            if std::fs::write(&tmp, color::signature::sign(t.to_bytes())).is_ok() {
-                let _ = std::fs::rename(&tmp, p);
-            }
+            // A temporary name of its own (a fixed `.tmp` was shared by two processes solving
+            // the same table at once).
+            let _ = color::outfile::write_atomic(p, &color::signature::sign(t.to_bytes()));
         }
         Ok(t)
     }

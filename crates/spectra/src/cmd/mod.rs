@@ -5,6 +5,7 @@ pub mod demo;
 pub mod diff;
 pub mod eval;
 pub mod lut;
+pub mod merge;
 pub mod render;
 pub mod setup;
 pub mod truth;

@@ -17,9 +17,23 @@ pub struct Args {
     // with MIS against the BRDF (truth::env_map).
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Samples (paths) per pixel; each path carries four wavelengths.
+    /// Samples (paths) per pixel; each path carries four wavelengths. With --sample-offset or
+    /// --chunk, the samples of this chunk.
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
+    /// Render samples K … K+spp−1 of each pixel's sample sequence: chunks with disjoint ranges
+    /// merge (`spectra merge`) into exactly the render of all their samples.
+    #[arg(long, value_name = "K", conflicts_with = "chunk")]
+    pub sample_offset: Option<u64>,
+    /// Chunk i of n (from 0): `--spp 64 --chunk 2/4` renders samples 128 … 191, a quarter of a
+    /// 256-sample render. The shorthand for --sample-offset i·spp.
+    #[arg(long, value_name = "i/n")]
+    pub chunk: Option<String>,
+    /// Render only this pixel rectangle of the --size frame, X,Y,WIDTH,HEIGHT from the top-left:
+    /// its pixels get exactly the samples of the full render (the EXR's data window inside the
+    /// full display window); tiles merge with `spectra merge`.
+    #[arg(long, value_name = "X,Y,W,H")]
+    pub crop: Option<String>,
     /// Direct lighting only (one scattering vertex), to compare like for like with the
     /// real-time image.
     #[arg(long)]
@@ -79,6 +93,8 @@ fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable)
     let (width, height) = parse_size(&a.size)?;
     let mut s = Settings::new(width, height, a.spp)?;
     s.seed = a.seed;
+    s.sample_offset = sample_offset(a)?;
+    s.crop = a.crop.as_deref().map(parse_crop).transpose()?;
     s.direct_only = a.direct_only;
     s.max_depth = a.max_depth;
     s.lambert = a.lambert;
@@ -118,6 +134,93 @@ fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable)
     s.validate()?;
     Ok(s)
 }
+
+/// The first sample: `--sample-offset`, or i·spp for `--chunk i/n`.
+fn sample_offset(a: &Args) -> Result<u64> {
+    let Some(c) = &a.chunk else { return Ok(a.sample_offset.unwrap_or(0)) };
+    let parsed = c
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse::<u64>().ok()?, n.trim().parse::<u64>().ok()?)));
+    match parsed {
+        Some((i, n)) if n >= 1 && i < n => i
+            .checked_mul(u64::from(a.spp))
+            .with_context(|| format!("--chunk {c}: the sample offset {i}·{} is too large", a.spp)),
+        _ => bail!("--chunk '{c}' must be i/n with 0 ≤ i < n, e.g. 0/4 for the first of four chunks"),
+    }
+}
+
+/// `--crop X,Y,W,H`.
+fn parse_crop(s: &str) -> Result<truth::Crop> {
+    let v: Vec<u32> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+    match v[..] {
+        [x, y, width, height] if s.split(',').count() == 4 => Ok(truth::Crop { x, y, width, height }),
+        _ => bail!("--crop '{s}' must be X,Y,WIDTH,HEIGHT in pixels (whole numbers), e.g. 0,0,128,128"),
+    }
+}
+
+/// What the output holds, for `spectra merge`: every setting that changes the image (resolved,
+/// so two spellings of one setting agree), the contents of every input file (not their paths,
+/// which differ between machines), the seed, the sample range and the crop.
+/// `spectral`: the record of the --spectral-out file (its bands are part of what it holds; the
+/// --out image is the same with or without them).
+fn record(
+    a: &Args,
+    scene: &scene::Scene,
+    st: &Settings,
+    table: &color::upsample::CoeffTable,
+    spectral: bool,
+) -> Result<Vec<(String, String)>> {
+    use color::signature::fnv1a64;
+    let hash = |s: &str| format!("{:016x}", fnv1a64(s.as_bytes()));
+    let mut fields: Vec<(String, String)> = vec![
+        ("size".into(), format!("{}x{}", st.width, st.height)),
+        ("seed".into(), st.seed.to_string()),
+        ("range".into(), format!("{}-{} nm", st.range.min, st.range.max)),
+        ("observer".into(), format!("{} {}", st.observer.name, hash(&format!("{:?}", st.observer.bar)))),
+        ("white".into(), hash(&format!("{:?}", st.white))),
+        ("direct_only".into(), st.direct_only.to_string()),
+        ("max_depth".into(), st.max_depth.to_string()),
+        ("lambert".into(), st.lambert.to_string()),
+        ("medium".into(), st.medium.as_ref().map_or("none".into(), |m| hash(&format!("{m:?}")))),
+        ("uniform_environment".into(), format!("{:?}", st.environment)),
+        ("channels".into(), if a.xyz { "CIE XYZ" } else { "linear sRGB" }.into()),
+        ("table".into(), format!("{:016x}", fnv1a64(&table.to_bytes()))),
+        ("truth".into(), format!("{} sampler {}", env!("CARGO_PKG_VERSION"), truth::render::SAMPLER_VERSION)),
+    ];
+    if scene.inputs.is_empty() {
+        fields.push(("scene".into(), scene.source.clone()));
+    }
+    if spectral {
+        fields.push(("content".into(), "spectral".into()));
+        fields.push(("bands".into(), hash(&format!("{:?}", st.spectral_bands))));
+    }
+    if let Some(e) = &scene.environment {
+        let name = std::path::Path::new(&e.source).file_name().map(|n| n.to_string_lossy().into_owned());
+        fields.push((
+            "environment".into(),
+            format!("{} × {} rotated {}", name.unwrap_or_default(), e.intensity, e.rotation),
+        ));
+    }
+    for (i, (what, p)) in a.scene.input_files(scene).iter().enumerate() {
+        let bytes = color::input::read_regular(p, scene::environment::MAX_INPUT_BYTES)
+            .with_context(|| format!("{what} {}", p.display()))?;
+        fields.push((format!("input{i}"), format!("{:016x}", fnv1a64(&bytes))));
+    }
+    let identity = hash(&fields.iter().map(|(k, v)| format!("{k}={v}\n")).collect::<String>());
+    let mut out: Vec<(String, String)> = vec![
+        ("spectra.version".into(), RECORD_VERSION.into()),
+        ("spectra.identity".into(), identity),
+        ("spectra.samples".into(), format!("{}..{}", st.sample_offset, st.sample_offset + u64::from(st.spp))),
+    ];
+    if spectral {
+        out.push(("spectra.content".into(), "spectral".into()));
+    }
+    out.extend(fields.into_iter().map(|(k, v)| (format!("spectra.setting.{k}"), v)));
+    Ok(out)
+}
+
+/// Version of the `spectra.*` attributes' meaning.
+pub const RECORD_VERSION: &str = "1";
 
 pub fn run(a: Args) -> Result<()> {
     if a.spectral_out.is_some() && a.out.is_none() {
@@ -203,38 +306,57 @@ pub fn run(a: Args) -> Result<()> {
         bail!("interrupted; nothing written");
     }
     let data = if a.xyz { img.xyz.clone() } else { img.to_rgb(&RgbColorSpace::srgb()) };
-    let image = compare::image::Image::new(st.width, st.height, data)?;
+    let image = compare::image::Image::new(img.width, img.height, data)?;
+    let win = st.window();
+    let frame = compare::ExrFrame {
+        display: (st.width, st.height),
+        origin: (win.x, win.y),
+        attributes: record(&a, &scene, &st, &table, false)?,
+    };
     // The spectral file first: an interrupted run leaves neither complete, never a colour image
     // without the spectral one it was asked to go with.
     if let (Some(sp), Some(bands)) = (&a.spectral_out, img.spectral.clone()) {
         let edges = st.spectral_bands.clone().expect("bands were asked for");
         let white = a.spectrum.resolve(&scene)?.white;
         let spec = compare::SpectralImage {
-            width: st.width,
-            height: st.height,
+            width: img.width,
+            height: img.height,
             kind: compare::SpectralKind::Emissive,
             edges,
             data: bands,
             white: Some(white),
         };
-        compare::write_spectral_exr(sp, &spec, Some(&image))
+        let spectral_frame =
+            compare::ExrFrame { attributes: record(&a, &scene, &st, &table, true)?, ..frame.clone() };
+        compare::write_spectral_exr_framed(sp, &spec, Some(&image), Some(&spectral_frame))
             .with_context(|| format!("writing {}", sp.display()))?;
     }
-    compare::io::write_image(out, &image, Default::default())
-        .with_context(|| format!("writing {}", out.display()))?;
-    let paths = st.width as f64 * st.height as f64 * st.spp as f64;
+    let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if is_exr {
+        compare::write_exr_framed(out, &image, &frame)
+    } else {
+        compare::io::write_image(out, &image, Default::default())
+    }
+    .with_context(|| format!("writing {}", out.display()))?;
+    let paths = img.width as f64 * img.height as f64 * st.spp as f64;
     let y = img.mean()[1];
     let env = match &scene.environment {
         Some(e) => format!(", environment {} × {}", e.source, e.intensity),
         None => String::new(),
     };
     eprintln!(
-        "{}: {} {}×{} at {} spp, {:.0}–{:.0} nm{}{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
+        "{}: {} {}×{}{} at {} spp{}, {:.0}–{:.0} nm{}{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
         out.display(),
         scene.source,
         st.width,
         st.height,
+        st.crop.map_or(String::new(), |c| format!(" (crop {}×{} at {},{})", c.width, c.height, c.x, c.y)),
         st.spp,
+        if st.sample_offset > 0 || a.chunk.is_some() {
+            format!(" (samples {}..{})", st.sample_offset, st.sample_offset + u64::from(st.spp))
+        } else {
+            String::new()
+        },
         st.range.min,
         st.range.max,
         if st.direct_only { ", direct only" } else { "" },

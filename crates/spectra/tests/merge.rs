@@ -1,0 +1,198 @@
+//! `spectra truth` chunks and crops, and `spectra merge` (issue 31), on the real binary: chunks
+//! merged are the render of all their samples, tiles stitched are the full render, and
+//! anything else is refused naming the file and the mismatch, with nothing written. CPU only.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn spectra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_spectra")).args(args).output().expect("running spectra")
+}
+
+fn ok(args: &[&str]) {
+    let out = spectra(args);
+    assert!(out.status.success(), "spectra {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn refused(args: &[&str], parts: &[&str]) {
+    let out = spectra(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "spectra {args:?}: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert_eq!(lines.len(), 1, "one error line: {err}");
+    for p in parts {
+        assert!(lines[0].contains(p), "'{p}' missing: {err}");
+    }
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("spectra-merge-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Largest per-pixel relative difference between two images of `n` values a pixel: a pixel's
+/// largest difference over its largest value (a channel near zero, where RGB cancels, is
+/// measured against the pixel, not against itself).
+fn worst(got: &[f32], want: &[f32], n: usize) -> f64 {
+    assert_eq!(got.len(), want.len());
+    got.chunks(n)
+        .zip(want.chunks(n))
+        .map(|(g, w)| {
+            let d = g.iter().zip(w).map(|(a, b)| (f64::from(*a) - f64::from(*b)).abs()).fold(0.0, f64::max);
+            let m = w.iter().map(|b| f64::from(b.abs())).fold(0.0, f64::max);
+            if m > 0.0 { d / m } else { d }
+        })
+        .fold(0.0, f64::max)
+}
+
+fn rgb(p: &Path) -> Vec<f32> {
+    compare::read_image(p).unwrap().data.into_iter().flatten().collect()
+}
+
+fn bands(p: &Path) -> Vec<f32> {
+    compare::read_spectral_exr(p).unwrap().data
+}
+
+/// Four chunks merged equal one render of all their samples, for the colour and the spectral
+/// output, direct and full transport, dry and under water.
+#[test]
+fn chunks_merge_into_one_render() {
+    let d = tmp("chunks");
+    let cases: [(&str, &[&str]); 3] =
+        [("cornell", &["--direct-only"]), ("cornell", &[]), ("underwater", &["--max-depth", "8"])];
+    for (k, (scene, extra)) in cases.iter().enumerate() {
+        let base = |spp: &str, out: &Path, sp: &Path| -> Vec<String> {
+            let size = if *scene == "underwater" { "12x8" } else { "24x16" };
+            let mut v: Vec<String> = ["truth", scene, "--size", size, "--spp", spp, "--seed", "3"]
+                .iter()
+                .map(|x| x.to_string())
+                .collect();
+            v.extend(extra.iter().map(|x| x.to_string()));
+            v.extend([
+                "--out".into(),
+                s(out).into(),
+                "--spectral-out".into(),
+                s(sp).into(),
+                "--spectral-bin".into(),
+                "25".into(),
+            ]);
+            v
+        };
+        let (full, full_s) = (d.join(format!("full{k}.exr")), d.join(format!("full{k}-s.exr")));
+        let args = base("12", &full, &full_s);
+        ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        let mut chunks = Vec::new();
+        let mut chunks_s = Vec::new();
+        for i in 0..4 {
+            let (c, cs) = (d.join(format!("c{k}-{i}.exr")), d.join(format!("c{k}-{i}-s.exr")));
+            let mut args = base("3", &c, &cs);
+            args.extend(["--chunk".into(), format!("{i}/4")]);
+            ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+            chunks.push(c);
+            chunks_s.push(cs);
+        }
+        let (m, ms) = (d.join(format!("m{k}.exr")), d.join(format!("m{k}-s.exr")));
+        let mut margs: Vec<&str> = vec!["merge"];
+        margs.extend(chunks.iter().rev().map(|p| s(p)));
+        margs.extend(["--out", s(&m)]);
+        ok(&margs);
+        let mut margs: Vec<&str> = vec!["merge"];
+        margs.extend(chunks_s.iter().map(|p| s(p)));
+        margs.extend(["--out", s(&ms)]);
+        ok(&margs);
+        let nb = compare::read_spectral_exr(&ms).unwrap().bands();
+        let (wr, ws) = (worst(&rgb(&m), &rgb(&full), 3), worst(&bands(&ms), &bands(&full_s), nb));
+        eprintln!(
+            "{scene} {extra:?}: 4 chunks vs one render: worst relative difference rgb {wr:e}, bands {ws:e}"
+        );
+        assert!(wr <= 1e-6 && ws <= 1e-6, "{scene} {extra:?}: rgb {wr:e}, bands {ws:e}");
+        let frame = compare::read_exr_frame(&m).unwrap();
+        assert_eq!(frame.get("spectra.samples"), Some("0..12"));
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A 2 × 2 tiling of crops, stitched, is the full render (bit for bit: each pixel draws the
+/// same samples); the crop's EXR sits in the full frame.
+#[test]
+fn crops_stitch_into_the_full_render() {
+    let d = tmp("crops");
+    let full = d.join("full.exr");
+    let base = ["truth", "cornell", "--size", "20x14", "--spp", "4", "--seed", "1"];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        base.iter().chain(extra).copied().collect()
+    }
+    ok(&with(&base, &["--out", s(&full)]));
+    let mut tiles = Vec::new();
+    for (i, c) in ["0,0,11,6", "11,0,9,6", "0,6,11,8", "11,6,9,8"].iter().enumerate() {
+        let t = d.join(format!("t{i}.exr"));
+        ok(&with(&base, &["--crop", c, "--out", s(&t)]));
+        tiles.push(t);
+    }
+    let f = compare::read_exr_frame(&tiles[3]).unwrap();
+    assert_eq!((f.display, f.origin), ((20, 14), (11, 6)));
+    assert_eq!(compare::read_image(&tiles[3]).unwrap().size(), (9, 8));
+    let m = d.join("m.exr");
+    let mut args: Vec<&str> = vec!["merge"];
+    args.extend(tiles.iter().map(|p| s(p)));
+    args.extend(["--out", s(&m)]);
+    ok(&args);
+    assert_eq!(rgb(&m), rgb(&full), "stitched tiles are the full render, bit for bit");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// What does not merge is refused with one line naming the file and the mismatch; nothing is
+/// written.
+#[test]
+fn mixtures_are_refused() {
+    let d = tmp("bad");
+    let p = |n: &str| d.join(n);
+    let r = |scene: &str, extra: &[&str], out: &Path| {
+        let mut a = vec!["truth", scene, "--size", "12x8", "--spp", "2"];
+        a.extend(extra);
+        a.extend(["--out", s(out)]);
+        ok(&a);
+    };
+    r("cornell", &["--chunk", "0/2"], &p("a.exr"));
+    r("cornell", &["--chunk", "1/2"], &p("b.exr"));
+    r("colorchecker", &["--chunk", "1/2"], &p("other.exr"));
+    r("cornell", &["--chunk", "1/2", "--seed", "7"], &p("seed.exr"));
+    r("cornell", &["--sample-offset", "1"], &p("overlap.exr"));
+    r("cornell", &["--crop", "0,0,6,8", "--chunk", "1/2"], &p("left.exr"));
+    let out = p("m.exr");
+    let m = |inputs: &[&str], parts: &[&str]| {
+        let mut a = vec!["merge"];
+        a.extend(inputs);
+        a.extend(["--out", s(&out)]);
+        refused(&a, parts);
+        assert!(!out.exists(), "nothing written");
+    };
+    m(&[s(&p("a.exr")), s(&p("other.exr"))], &["other.exr", "a different render", "a.exr"]);
+    m(&[s(&p("a.exr")), s(&p("seed.exr"))], &["seed.exr", "seed is 0 there and 7 here"]);
+    m(&[s(&p("a.exr")), s(&p("overlap.exr"))], &["overlap.exr", "1..3", "overlap", "0..2"]);
+    m(&[s(&p("a.exr")), s(&p("a.exr"))], &["a.exr", "overlap"]);
+    m(&[s(&p("a.exr")), s(&p("left.exr"))], &["left.exr", "samples"]);
+    // Truncated, and foreign (an EXR without the record).
+    let bytes = std::fs::read(p("b.exr")).unwrap();
+    std::fs::write(p("cut.exr"), &bytes[..bytes.len() / 2]).unwrap();
+    m(&[s(&p("a.exr")), s(&p("cut.exr"))], &["cut.exr"]);
+    let img = compare::Image::new(12, 8, vec![[0.5; 3]; 96]).unwrap();
+    compare::write_image(p("plain.exr"), &img, Default::default()).unwrap();
+    m(&[s(&p("a.exr")), s(&p("plain.exr"))], &["plain.exr", "not a spectra truth render"]);
+    // The output may not be an input; a crop outside the frame is refused before rendering.
+    let a = p("a.exr");
+    refused(&["merge", s(&a), s(&p("b.exr")), "--out", s(&a)], &["--out", "input"]);
+    refused(
+        &["truth", "cornell", "--size", "12x8", "--crop", "8,0,6,8", "--out", s(&out)],
+        &["crop", "8,0,6,8", "12×8"],
+    );
+    refused(&["truth", "cornell", "--chunk", "4/4", "--out", s(&out)], &["--chunk", "4/4"]);
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
