@@ -7,7 +7,8 @@ use clap::CommandFactory;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Options whose value is a number written as text of its own syntax (parsed by the command).
-const TEXT_NUMBERS: &[&str] = &["size", "range", "wavelengths", "sweep", "suite-sizes", "depth", "crop", "chunk"];
+const TEXT_NUMBERS: &[&str] =
+    &["size", "range", "wavelengths", "sweep", "suite-sizes", "depth", "crop", "chunk"];
 
 /// (option, commands) for every numeric option.
 fn numeric_options() -> BTreeMap<String, BTreeSet<String>> {
@@ -94,6 +95,7 @@ fn the_table_states_the_bounds_the_code_enforces() {
     has("--env-rotation", format!("±{:e}", scene::environment::MAX_ROTATION_DEGREES));
     has("--frames", format!("1–{}", crate::cmd::bench::MAX_FRAMES));
     has("--warmup", format!("0–{}", crate::cmd::bench::MAX_FRAMES));
+    has("--checkpoint-every", format!("–{:e} s", crate::cmd::truth::MAX_CHECKPOINT_SECONDS));
     has("--sample-offset", format!("+ spp ≤ 2^{}", truth::render::MAX_SAMPLE_INDEX.trailing_zeros()));
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
     has("--white-y", format!("{lo:e}…{hi:e}"));

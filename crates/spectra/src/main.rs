@@ -148,8 +148,11 @@ fn main() {
         Ok(()) => 0,
         // Whatever error the interruption surfaced as ("fit interrupted", a GPU wait cut
         // short), the user pressed Ctrl-C: say so once.
-        Err(_) if color::cancel::is_cancelled() => {
-            eprintln!("interrupted (Ctrl-C): stopped; {unwritten}");
+        Err(e) if color::cancel::is_cancelled() => {
+            match e.downcast_ref::<cmd::KeptOnInterrupt>() {
+                Some(kept) => eprintln!("interrupted (Ctrl-C): stopped; {kept}"),
+                None => eprintln!("interrupted (Ctrl-C): stopped; {unwritten}"),
+            }
             EXIT_INTERRUPTED
         }
         Err(e) => {

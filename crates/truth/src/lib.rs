@@ -44,6 +44,6 @@ mod testing;
 
 pub use error::{Result, TruthError};
 pub use medium::{Medium, Phase, Region};
-pub use render::{Crop, Settings, XyzImage, render, render_world};
+pub use render::{Accumulator, Crop, Settings, XyzImage, render, render_pass, render_world};
 pub use upsample::RgbToSpectrum;
 pub use world::World;

@@ -21,12 +21,25 @@ fn r2(shift: [f32; 2], s: u64) -> [f32; 2] {
     std::array::from_fn(|i| ((shift[i] as f64 + s as f64 * A[i]).fract() as f32).min(0.999_999_94))
 }
 
-/// The s-th point of the golden-ratio (R1) sequence shifted by `shift`, in [0, 1): the hero
-/// wavelength's stratification. Any run of consecutive samples is spread evenly, so a chunk
-/// (`--sample-offset`) is stratified by itself and the union of chunks is the full render's.
-fn r1(shift: f32, s: u64) -> f32 {
-    const A: f64 = 0.618_033_988_749_894_8;
-    ((shift as f64 + s as f64 * A).fract() as f32).min(0.999_999_94)
+/// The hero wavelength's stratification: point `s` of the base-2 radical inverse (van der
+/// Corput) with hash-based Owen scrambling keyed by the pixel (Burley 2020, "Practical
+/// Hash-based Owen Scrambling"), in [0, 1). Any 2^k consecutive samples starting at a multiple
+/// of 2^k fall one in each of 2^k equal strata (the scrambled sequence is a (0,1)-sequence), so
+/// a chunk (`--sample-offset`) is stratified by itself and like the jittered strata over the
+/// whole pixel this replaced; a randomly shifted golden-ratio sequence, tried first, doubled
+/// the colour noise of smooth spectra (eval --quick colorchecker-d65 truth noise 0.007 → 0.016).
+/// Samples past 2³² repeat the pattern under another scramble.
+fn owen_vdc(s: u64, seed: u64) -> f32 {
+    let key = (seed ^ (s >> 32).wrapping_mul(0x9e37_79b9_7f4a_7c15)) as u32 ^ (seed >> 32) as u32;
+    // The radical inverse is reverse_bits(s); Owen scrambling it is reverse_bits of a
+    // Laine–Karras permutation of reverse_bits of it (each bit flipped depending only on the
+    // bits above it in the inverse): the two inner reversals cancel.
+    let mut x = (s as u32).wrapping_add(key);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    ((x.reverse_bits() >> 8) as f32 * (1.0 / 16_777_216.0)).min(0.999_999_94)
 }
 
 /// Samples between two looks at the cancellation token (a few hundred microseconds at most).
@@ -171,7 +184,7 @@ impl Settings {
 
 /// Version of the per-pixel sample sequence (the pixel's shift, each sample's stream): renders
 /// of different versions do not merge.
-pub const SAMPLER_VERSION: u32 = 2;
+pub const SAMPLER_VERSION: u32 = 3;
 
 /// One past the largest sample index (2⁵³: the sequences' arithmetic is exact in f64 below it).
 pub const MAX_SAMPLE_INDEX: u64 = 1 << 53;
@@ -231,10 +244,70 @@ pub fn render_world(
     cancel: &AtomicBool,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<XyzImage> {
+    let mut acc = Accumulator::new(settings)?;
+    render_pass(world, settings, cancel, &mut acc, settings.spp, progress)?;
+    Ok(acc.finish(settings))
+}
+
+/// The running sums of a render done in passes (for checkpoints): per pixel of the window, the
+/// sums over the samples so far of XYZ and of the bins, in f64. Each pixel's sums grow in
+/// sample order whatever the passes, so a render in passes — or resumed from a checkpoint of
+/// these sums — is bit-identical to one in a single pass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulator {
+    /// Samples summed, from `settings.sample_offset`.
+    pub done: u32,
+    pub xyz: Vec<[f64; 3]>,
+    /// `bins[(pixel) * bands + b]`; empty without bins.
+    pub bins: Vec<f64>,
+    pub dropped: u64,
+}
+
+impl Accumulator {
+    /// No samples yet, for `settings` (validated).
+    pub fn new(settings: &Settings) -> Result<Self> {
+        settings.validate()?;
+        let win = settings.window();
+        let n = win.width as usize * win.height as usize;
+        let nb = settings.spectral_bands.as_ref().map_or(0, |e| e.len() - 1);
+        Ok(Accumulator { done: 0, xyz: vec![[0.0; 3]; n], bins: vec![0.0; n * nb], dropped: 0 })
+    }
+
+    /// The image of the samples so far (all of `settings.spp` for a finished render): the sums
+    /// over `settings.spp`, as f32.
+    pub fn finish(&self, settings: &Settings) -> XyzImage {
+        let win = settings.window();
+        let spp = settings.spp as f64;
+        XyzImage {
+            width: win.width,
+            height: win.height,
+            xyz: self.xyz.iter().map(|p| p.map(|v| (v / spp) as f32)).collect(),
+            dropped: self.dropped,
+            spectral: settings
+                .spectral_bands
+                .as_ref()
+                .map(|_| self.bins.iter().map(|v| (v / spp) as f32).collect()),
+        }
+    }
+}
+
+/// Adds the next `samples` samples of every pixel (from `acc.done`, at most to `settings.spp`)
+/// to `acc`. `progress` is called with the rows finished in this pass. Cancelled, it leaves
+/// `acc` as it was (the pass's work is discarded, the earlier passes' kept).
+pub fn render_pass(
+    world: &World,
+    settings: &Settings,
+    cancel: &AtomicBool,
+    acc: &mut Accumulator,
+    samples: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<()> {
     settings.validate()?;
     let (full_w, full_h) = (settings.width, settings.height);
     let win = settings.window();
     let (w, h) = (win.width, win.height);
+    let first = acc.done;
+    let last = first.saturating_add(samples).min(settings.spp);
     let camera = RayCamera::new(&world.scene.camera, full_w, full_h);
     let sensor = XyzSensor::new(&settings.observer, &settings.white, settings.range);
     let integ = Integrator {
@@ -247,33 +320,36 @@ pub fn render_world(
     let dropped = AtomicU64::new(0);
     let bins = settings.spectral_bands.as_deref().map(|e| Bins::new(e, settings.range));
     let nb = bins.as_ref().map_or(0, |b| b.len());
-    // A row's colours and, when binning, its bands.
-    type Row = (Vec<[f32; 3]>, Vec<f32>);
-    let rows: Vec<Option<Row>> = (win.y..win.y + h)
+    // A row's sums (colour, and bands when binning), continued from the accumulator's.
+    type Row = (Vec<[f64; 3]>, Vec<f64>);
+    let acc_ref = &*acc;
+    let rows: Vec<Option<Row>> = (0..h)
         .into_par_iter()
-        .map(|y| {
+        .map(|ry| {
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let mut row = Vec::with_capacity(w as usize);
-            let mut spectral_row = Vec::with_capacity(w as usize * nb);
-            let mut bin_acc = vec![0.0f64; nb];
-            for x in win.x..win.x + w {
+            let y = win.y + ry;
+            let base = ry as usize * w as usize;
+            let mut row = acc_ref.xyz[base..base + w as usize].to_vec();
+            let mut spectral_row = acc_ref.bins[base * nb..(base + w as usize) * nb].to_vec();
+            for rx in 0..w {
+                let x = win.x + rx;
                 // Pixels are numbered in the full frame, so a crop draws what its pixels draw
                 // in the full render.
                 let pixel = y as u64 * full_w as u64 + x as u64;
                 let mut rng = Sampler::new(settings.seed, pixel);
-                let mut acc = [0.0f64; 3];
-                bin_acc.iter_mut().for_each(|v| *v = 0.0);
+                let acc = &mut row[rx as usize];
+                let bin_acc = &mut spectral_row[rx as usize * nb..(rx as usize + 1) * nb];
                 // Pixel positions from the R2 rank-1 lattice (Roberts 2018) with a random
                 // per-pixel shift (Cranley–Patterson rotation): well spread over the pixel, and
                 // each sample still uniform, so the estimate stays unbiased.
                 let shift = rng.next2();
-                let shift_lambda = rng.uniform();
-                for i in 0..settings.spp {
+                let lambda_key = rng.key();
+                for i in first..last {
                     // Polled every few samples, not only per pixel: at `--spp 10⁸` one pixel
                     // takes minutes.
-                    if i % CANCEL_POLL_SAMPLES == 0 && i > 0 && cancel.load(Ordering::Relaxed) {
+                    if i % CANCEL_POLL_SAMPLES == 0 && i > first && cancel.load(Ordering::Relaxed) {
                         return None;
                     }
                     // Sample s of the pixel's sequence: its position, wavelengths and stream
@@ -282,12 +358,15 @@ pub fn render_world(
                     let mut rng = Sampler::for_sample(settings.seed, pixel, s);
                     let jitter = r2(shift, s);
                     let ray = camera.ray(Vec2::new(x as f32 + jitter[0], y as f32 + jitter[1]));
-                    // Hero wavelengths stratified over the pixel's samples by the golden-ratio
-                    // sequence (times the four rotations): spiky spectra such as F11 need far
-                    // fewer samples for the same colour noise. Unbiased: each sample's
-                    // wavelength is uniform (the per-pixel shift) and independent of its other
-                    // dimensions.
-                    let wl = sensor.sample(r1(shift_lambda, s));
+                    // Hero wavelengths stratified over the pixel's samples: a path's four
+                    // wavelengths are the hero and its rotations by a quarter of the range, so
+                    // t = frac(4u) decides them and is what is stratified; which of the four is
+                    // the hero is uniform (each sample's own stream). Spiky spectra such as F11
+                    // need far fewer samples for the same colour noise. Unbiased: u is uniform
+                    // and independent of the sample's other dimensions.
+                    let t = owen_vdc(s, lambda_key);
+                    let lane = (rng.uniform() * 4.0).floor().min(3.0);
+                    let wl = sensor.sample(((lane + t) * 0.25).min(0.999_999_94));
                     let l = integ.camera_radiance(ray, &wl, &mut rng);
                     if !l.is_finite() {
                         dropped.fetch_add(1, Ordering::Relaxed);
@@ -296,11 +375,9 @@ pub fn render_world(
                     let xyz = sensor.to_xyz(&wl, l);
                     (0..3).for_each(|c| acc[c] += xyz[c]);
                     if let Some(b) = &bins {
-                        b.add(&mut bin_acc, &wl, l);
+                        b.add(bin_acc, &wl, l);
                     }
                 }
-                row.push(acc.map(|v| (v / settings.spp as f64) as f32));
-                spectral_row.extend(bin_acc.iter().map(|v| (v / settings.spp as f64) as f32));
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
@@ -312,12 +389,14 @@ pub fn render_world(
     if cancel.load(Ordering::Relaxed) || rows.iter().any(Option::is_none) {
         return Err(TruthError::Cancelled);
     }
-    let (mut xyz, mut spectral) = (Vec::with_capacity(w as usize * h as usize), Vec::new());
-    for (r, s) in rows.into_iter().flatten() {
-        xyz.extend(r);
-        spectral.extend(s);
+    for (ry, (r, sp)) in rows.into_iter().flatten().enumerate() {
+        let base = ry * w as usize;
+        acc.xyz[base..base + w as usize].copy_from_slice(&r);
+        acc.bins[base * nb..(base + w as usize) * nb].copy_from_slice(&sp);
     }
-    Ok(XyzImage { width: w, height: h, xyz, dropped: dropped.into_inner(), spectral: bins.map(|_| spectral) })
+    acc.dropped += dropped.into_inner();
+    acc.done = last;
+    Ok(())
 }
 
 /// Box bands over the render range, accumulating per-band mean radiance. With wavelengths drawn
@@ -573,6 +652,56 @@ mod tests {
             close(&bins, full.spectral.as_ref().unwrap(), "bins");
             assert!(full.mean()[1] > 0.0);
         }
+    }
+
+    /// The wavelength sequence is stratified over every aligned power-of-two block of samples
+    /// (one point per stratum), whatever the pixel's scramble.
+    #[test]
+    fn wavelength_sequence_is_stratified_in_aligned_blocks() {
+        for seed in [0u64, 1, 0xdead_beef_1234_5678] {
+            for (start, n) in [(0u64, 16u64), (64, 64), (1 << 20, 256), (3 << 32, 32)] {
+                let mut hit = vec![false; n as usize];
+                for s in start..start + n {
+                    let t = owen_vdc(s, seed);
+                    assert!((0.0..1.0).contains(&t));
+                    hit[(t * n as f32) as usize] = true;
+                }
+                assert!(hit.iter().all(|&h| h), "seed {seed}, samples {start}..{}", start + n);
+            }
+        }
+    }
+
+    /// A render in passes (as checkpoints make it) is bit-identical to one pass, and a
+    /// cancelled pass leaves the accumulator as it was.
+    #[test]
+    fn passes_are_bit_identical_to_one_render() {
+        let scene = small_scene();
+        let st = Settings {
+            seed: 8,
+            spectral_bands: Some(WavelengthRange::VISIBLE.bin_edges(35.0).unwrap()),
+            ..Settings::new(6, 5, 11).unwrap()
+        };
+        let one = pool_free_render(&scene, &st);
+        let world = World::new(&scene, &GreyOnly, &st.white, st.range, None).unwrap();
+        let no = AtomicBool::new(false);
+        let mut acc = Accumulator::new(&st).unwrap();
+        for n in [1, 4, 2, 100] {
+            render_pass(&world, &st, &no, &mut acc, n, &|_| {}).unwrap();
+        }
+        assert_eq!(acc.done, 11);
+        let passes = acc.finish(&st);
+        assert_eq!(passes.xyz, one.xyz);
+        assert_eq!(passes.spectral, one.spectral);
+        let before = acc.clone();
+        let mut again = acc.clone();
+        again.done = 3;
+        let kept = again.clone();
+        assert!(matches!(
+            render_pass(&world, &st, &AtomicBool::new(true), &mut again, 4, &|_| {}),
+            Err(TruthError::Cancelled)
+        ));
+        assert_eq!(again, kept);
+        assert_eq!(acc, before);
     }
 
     /// A tiling of crops is the full render, bit for bit: each pixel draws the same samples.

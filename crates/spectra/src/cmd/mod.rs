@@ -1,6 +1,7 @@
 //! Subcommands, one file each.
 
 pub mod bench;
+pub mod checkpoint;
 pub mod demo;
 pub mod diff;
 pub mod eval;
@@ -11,6 +12,19 @@ pub mod setup;
 pub mod truth;
 pub mod upsample;
 pub mod view;
+
+/// What an interrupted command kept (a truth checkpoint): main prints it instead of "no output
+/// written".
+#[derive(Debug)]
+pub struct KeptOnInterrupt(pub String);
+
+impl std::fmt::Display for KeptOnInterrupt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for KeptOnInterrupt {}
 
 /// Checks before the work that the output `path` given with `flag` can be written (its
 /// directory exists and takes new files), so a long render never ends in "directory does not

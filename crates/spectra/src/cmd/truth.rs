@@ -87,7 +87,19 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub spectral_bin: f64,
+    /// Once the render has run this long, write its samples so far to `<out>.checkpoint`
+    /// (atomically), again every such interval and on Ctrl-C; 0: never. A finished render
+    /// removes it.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0, allow_negative_numbers = true)]
+    pub checkpoint_every: f64,
+    /// Continue the render from `<out>.checkpoint` (the same command otherwise): the result is
+    /// the uninterrupted render's, bit for bit.
+    #[arg(long)]
+    pub resume: bool,
 }
+
+/// Longest `--checkpoint-every`, seconds (a year).
+pub const MAX_CHECKPOINT_SECONDS: f64 = 3.2e7;
 
 fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
     let (width, height) = parse_size(&a.size)?;
@@ -260,13 +272,33 @@ pub fn run(a: Args) -> Result<()> {
         }
         super::check_output("--export-mitsuba", dir)?;
     }
+    if !(a.checkpoint_every.is_finite() && (0.0..=MAX_CHECKPOINT_SECONDS).contains(&a.checkpoint_every)) {
+        bail!(
+            "--checkpoint-every {}: give seconds from 0 (never) to {MAX_CHECKPOINT_SECONDS:e}",
+            a.checkpoint_every
+        );
+    }
+    if let Some(out) = &a.out {
+        let ckpt = super::checkpoint::path_for(out);
+        if !a.resume && std::fs::symlink_metadata(&ckpt).is_ok() {
+            bail!(
+                "{}: the checkpoint of an interrupted render is there: add --resume to continue it, or remove it to start over",
+                ckpt.display()
+            );
+        }
+    }
     let scene = a.scene.load()?;
     let mut inputs = a.scene.input_files(&scene);
     inputs.extend(a.table.input_files());
     inputs.extend(a.rgb_medium.input_files());
     inputs.extend(a.medium.iter().map(|m| ("--medium file".to_string(), m.clone())));
+    let ckpt = a.out.as_deref().map(super::checkpoint::path_for);
     super::check_outputs(
-        &[("--out", a.out.as_deref()), ("--spectral-out", a.spectral_out.as_deref())],
+        &[
+            ("--out", a.out.as_deref()),
+            ("--spectral-out", a.spectral_out.as_deref()),
+            ("the checkpoint", ckpt.as_deref()),
+        ],
         &inputs,
     )?;
     let table = a.table.load()?;
@@ -287,20 +319,70 @@ pub fn run(a: Args) -> Result<()> {
     }
     let Some(out) = &a.out else { return Ok(()) };
 
-    let pb = ProgressBar::new(st.height as u64);
+    let ckpt = super::checkpoint::path_for(out);
+    let ckpt_record = record(&a, &scene, &st, &table, st.spectral_bands.is_some())?;
+    let mut acc = if a.resume {
+        if std::fs::symlink_metadata(&ckpt).is_err() {
+            bail!("--resume: there is no checkpoint {} to continue", ckpt.display());
+        }
+        super::checkpoint::read(&ckpt, &ckpt_record, &st)?
+    } else {
+        truth::Accumulator::new(&st)?
+    };
+    let rows = u64::from(st.window().height);
+    // Progress in pixel rows × samples, so resumed samples show as done.
+    let pb = ProgressBar::new(rows * u64::from(st.spp));
     if let Ok(style) =
-        ProgressStyle::with_template("truth [{bar:30}] {pos}/{len} rows, {elapsed} (eta {eta})")
+        ProgressStyle::with_template("truth [{bar:30}] {percent}% {msg}, {elapsed} (eta {eta})")
     {
         pb.set_style(style.progress_chars("=> "));
     }
     let t1 = Instant::now();
     let cancel = color::cancel::token();
-    let img = truth::render_world(&world, &st, cancel, &|rows| pb.set_position(rows));
+    let interval = a.checkpoint_every;
+    let mut last_write = t1;
+    let mut per_sample: Option<f64> = None;
+    let resumed = acc.done;
+    while acc.done < st.spp {
+        // Passes of about half an interval (a first pass of one sample measures them), so a
+        // checkpoint is at most one interval old; without checkpoints, one pass.
+        let left = st.spp - acc.done;
+        let n = match (interval > 0.0, per_sample) {
+            (false, _) => left,
+            (true, None) => 1,
+            (true, Some(t)) => ((0.5 * interval / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
+        };
+        let done = acc.done;
+        pb.set_message(format!("samples {}/{}", done, st.spp));
+        let t = Instant::now();
+        let r = truth::render_pass(&world, &st, cancel, &mut acc, n, &|r| {
+            pb.set_position(rows * u64::from(done) + r * u64::from(n))
+        });
+        match r {
+            Err(TruthError::Cancelled) => {
+                pb.finish_and_clear();
+                if interval > 0.0 && t1.elapsed().as_secs_f64() >= interval && acc.done > resumed {
+                    super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc)?;
+                    return Err(super::KeptOnInterrupt(format!(
+                        "{} of {} samples kept in {}: the same command with --resume continues",
+                        acc.done,
+                        st.spp,
+                        ckpt.display()
+                    ))
+                    .into());
+                }
+                bail!("interrupted; nothing written");
+            }
+            r => r?,
+        }
+        per_sample = Some(t.elapsed().as_secs_f64() / f64::from(n));
+        if interval > 0.0 && acc.done < st.spp && last_write.elapsed().as_secs_f64() >= interval {
+            super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc)?;
+            last_write = Instant::now();
+        }
+    }
     pb.finish_and_clear();
-    let img = match img {
-        Err(TruthError::Cancelled) => bail!("interrupted; nothing written"),
-        r => r?,
-    };
+    let img = acc.finish(&st);
     let secs = t1.elapsed().as_secs_f64();
     if cancel.load(Ordering::Relaxed) {
         bail!("interrupted; nothing written");
@@ -338,7 +420,12 @@ pub fn run(a: Args) -> Result<()> {
         compare::io::write_image(out, &image, Default::default())
     }
     .with_context(|| format!("writing {}", out.display()))?;
-    let paths = img.width as f64 * img.height as f64 * st.spp as f64;
+    // The outputs are complete: the samples are safe in them.
+    if std::fs::symlink_metadata(&ckpt).is_ok() {
+        std::fs::remove_file(&ckpt).with_context(|| format!("removing the checkpoint {}", ckpt.display()))?;
+    }
+    // This process's paths (a resumed render did the checkpoint's before).
+    let paths = img.width as f64 * img.height as f64 * f64::from(st.spp - resumed);
     let y = img.mean()[1];
     let env = match &scene.environment {
         Some(e) => format!(", environment {} × {}", e.source, e.intensity),
@@ -368,6 +455,9 @@ pub fn run(a: Args) -> Result<()> {
         y,
         if img.dropped > 0 { format!(", {} non-finite samples dropped", img.dropped) } else { String::new() }
     );
+    if resumed > 0 {
+        eprintln!("  resumed from {} with {resumed} of {} samples done", ckpt.display(), st.spp);
+    }
     if let (Some(sp), Some(edges)) = (&a.spectral_out, &st.spectral_bands) {
         eprintln!(
             "{}: {} bands of {} nm, {:.0}–{:.0} nm (S0.<λ>nm channels, with R, G, B)",
