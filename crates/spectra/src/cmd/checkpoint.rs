@@ -75,21 +75,10 @@ pub fn read(path: &Path, record: &[(String, String)], st: &Settings) -> Result<A
     }
     let header: Header =
         serde_json::from_slice(&body[8..8 + len]).map_err(|e| bad(format!("unreadable header: {e}")))?;
-    let get = |r: &[(String, String)], k: &str| {
-        r.iter().find(|(kk, _)| kk == k).map_or("(absent)".to_string(), |(_, v)| v.clone())
-    };
-    let keys: std::collections::BTreeSet<&String> =
-        header.record.iter().chain(record).map(|(k, _)| k).collect();
-    // A setting names the difference; the identity (their hash) only when no setting differs.
-    let differs = |k: &str| get(&header.record, k) != get(record, k);
-    let setting = keys.iter().find(|k| k.starts_with("spectra.setting.") && differs(k));
-    if let Some(k) = setting.or_else(|| keys.iter().find(|k| differs(k))) {
+    if let Some((k, there, here)) = super::truth::record_difference(&header.record, record) {
         bail!(
-            "--resume: the checkpoint {} is of a different render: {} is {} there and {} here; remove it to start over",
-            path.display(),
-            k.trim_start_matches("spectra.setting."),
-            get(&header.record, k),
-            get(record, k)
+            "--resume: the checkpoint {} is of a different render: {k} is {there} there and {here} here; remove it to start over",
+            path.display()
         );
     }
     if header.window != window(st) || header.spp != st.spp || header.done > st.spp {

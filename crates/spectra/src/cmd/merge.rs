@@ -100,30 +100,12 @@ fn mismatch(a: &Piece, b: &Piece) -> Option<String> {
     if a.frame.get("spectra.identity") == b.frame.get("spectra.identity") {
         return None;
     }
-    let settings = |p: &Piece| -> Vec<(String, String)> {
-        p.frame.attributes.iter().filter(|(k, _)| k.starts_with("spectra.setting.")).cloned().collect()
-    };
-    let (sa, sb) = (settings(a), settings(b));
-    let keys: std::collections::BTreeSet<&String> = sa.iter().chain(&sb).map(|(k, _)| k).collect();
-    let get = |s: &[(String, String)], k: &str| {
-        s.iter().find(|(kk, _)| kk == k).map_or("(absent)".to_string(), |(_, v)| v.clone())
-    };
-    let key = keys.into_iter().find(|k| get(&sa, k) != get(&sb, k));
-    Some(match key {
-        Some(k) => format!(
-            "{}: a different render from {}: {} is {} there and {} here",
-            b.path.display(),
-            a.path.display(),
-            k.trim_start_matches("spectra.setting."),
-            get(&sa, k),
-            get(&sb, k)
-        ),
-        None => format!(
-            "{}: a different render from {} (their identities differ)",
-            b.path.display(),
-            a.path.display()
-        ),
-    })
+    let (k, there, here) = super::truth::record_difference(&a.frame.attributes, &b.frame.attributes)?;
+    Some(format!(
+        "{}: a different render from {}: {k} is {there} there and {here} here",
+        b.path.display(),
+        a.path.display()
+    ))
 }
 
 pub fn run(a: Args) -> Result<()> {

@@ -231,6 +231,23 @@ fn record(
     Ok(out)
 }
 
+/// Where two records (`spectra.*` attributes) differ: the first setting (`spectra.setting.*`)
+/// that does, shown without its prefix, else the first other key — as (key, there, here). For
+/// `spectra merge` and `--resume`, so both name the same setting the same way.
+pub fn record_difference(
+    there: &[(String, String)],
+    here: &[(String, String)],
+) -> Option<(String, String, String)> {
+    let get = |r: &[(String, String)], k: &str| {
+        r.iter().find(|(kk, _)| kk == k).map_or("(absent)".to_string(), |(_, v)| v.clone())
+    };
+    let keys: std::collections::BTreeSet<&String> = there.iter().chain(here).map(|(k, _)| k).collect();
+    let differs = |k: &str| get(there, k) != get(here, k);
+    let setting = keys.iter().find(|k| k.starts_with("spectra.setting.") && differs(k));
+    let k = setting.or_else(|| keys.iter().find(|k| differs(k)))?;
+    Some((k.trim_start_matches("spectra.setting.").to_string(), get(there, k), get(here, k)))
+}
+
 /// Version of the `spectra.*` attributes' meaning.
 pub const RECORD_VERSION: &str = "1";
 
