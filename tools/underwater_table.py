@@ -15,8 +15,9 @@ Usage: tools/underwater_table.py [--bin target/release/spectra] [--size 72x48] [
        [--truth-cache DIR] [--models ours,naive] [--out FILE.md] [--json FILE.json]
        [--render-args '--forward-cone 5']
 
---truth-cache keeps the path-traced images (keyed by type, depth, size, spp, seed) so a
-second run with a changed real-time model reuses them.
+--truth-cache DIR is `spectra truth --truth-cache DIR` (docs/ground-truth.md): the path-traced
+samples are kept by everything they depend on, so a second run with a changed real-time model
+renders no truth, and one with a higher --spp renders only the samples it lacks.
 
 Every number comes from `spectra truth`, `spectra render` and `spectra diff --json`; nothing is
 computed here but the table layout and means.
@@ -78,11 +79,10 @@ def main():
         os.makedirs(a.truth_cache, exist_ok=True)
 
     def truth_image(tmp, ty, depth, seed):
-        name = f"truth-{ty}-{depth}-{a.size}-{a.spp}-{seed}.exr"
-        path = os.path.join(a.truth_cache or tmp, name)
-        if not (a.truth_cache and os.path.exists(path)):
-            run([a.bin, "truth", "underwater", "--water", ty, "--depth", depth, "--size", a.size,
-                 "--spp", str(a.spp), "--seed", str(seed), "--out", path])
+        path = os.path.join(tmp, f"truth-{ty}-{depth}-{seed}.exr")
+        cache = ["--truth-cache", a.truth_cache] if a.truth_cache else []
+        run([a.bin, "truth", "underwater", "--water", ty, "--depth", depth, "--size", a.size,
+             "--spp", str(a.spp), "--seed", str(seed), *cache, "--out", path])
         return path
     rows = []
     t_start = time.time()

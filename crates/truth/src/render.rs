@@ -212,6 +212,10 @@ impl Settings {
 /// of different versions do not merge.
 pub const SAMPLER_VERSION: u32 = 3;
 
+/// Hash of the source this crate's images depend on (its own, `scene`'s and `color`'s; see
+/// build.rs): stored truths are reused only by a tracer of the same code.
+pub const CODE_HASH: &str = env!("TRUTH_CODE_HASH");
+
 /// One past the largest sample index (2⁵³: the sequences' arithmetic is exact in f64 below it).
 pub const MAX_SAMPLE_INDEX: u64 = 1 << 53;
 

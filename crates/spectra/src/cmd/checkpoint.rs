@@ -60,48 +60,68 @@ pub fn write(path: &Path, record: &[(String, String)], st: &Settings, acc: &Accu
 
 /// The accumulator in the checkpoint at `path`, if it is one of this render (`record`, `st`).
 pub fn read(path: &Path, record: &[(String, String)], st: &Settings) -> Result<Accumulator> {
+    let bad = |why: String| anyhow::anyhow!("--resume: the checkpoint {}: {why}", path.display());
+    let check = |there: &[(String, String)], spp: u32, done: u32| -> Result<()> {
+        if let Some((k, there, here)) = super::truth::record_difference(there, record) {
+            bail!(
+                "--resume: the checkpoint {} is of a different render: {k} is {there} there and {here} here; remove it to start over",
+                path.display()
+            );
+        }
+        if spp != st.spp || done > st.spp {
+            bail!(
+                "--resume: the checkpoint {} is of a different render: {spp} spp there, {} here",
+                path.display(),
+                st.spp
+            );
+        }
+        Ok(())
+    };
+    read_sums(path, st, &bad, "remove it to start over", &check)
+}
+
+/// Accepts a stored record, the samples of the render it was written for and the samples done.
+pub type CheckStored<'a> = dyn Fn(&[(String, String)], u32, u32) -> Result<()> + 'a;
+
+/// The sums in the file at `path` (a checkpoint, or a truth-cache entry) for the render `st`:
+/// `check` accepts the record, the samples of the render it was written for and the samples
+/// done (or says why not), before the pixel window and bands are checked against `st`'s;
+/// `bad` says what is wrong with the file, `fix` what to do about a damaged one.
+pub fn read_sums(
+    path: &Path,
+    st: &Settings,
+    bad: &dyn Fn(String) -> anyhow::Error,
+    fix: &str,
+    check: &CheckStored<'_>,
+) -> Result<Accumulator> {
     let fresh = Accumulator::new(st)?;
     let floats = fresh.xyz.len() * 3 + fresh.bins.len();
     let cap = (MAGIC.len() + 8 + (1 << 20) + 8 * floats + color::signature::LEN) as u64;
-    let bad = |why: String| anyhow::anyhow!("--resume: the checkpoint {}: {why}", path.display());
     let bytes = color::input::read_regular(path, cap).map_err(|e| bad(format!("cannot read it: {e}")))?;
-    let body = bytes.strip_prefix(MAGIC).ok_or_else(|| bad("not a spectra truth checkpoint".into()))?;
+    let damaged = || bad(format!("truncated or damaged (its signature does not match); {fix}"));
+    let signed = color::signature::payload(&bytes, bytes.len().saturating_sub(color::signature::LEN))
+        .ok_or_else(damaged)?;
+    let body = signed.strip_prefix(MAGIC).ok_or_else(|| bad("not a spectra truth checkpoint".into()))?;
     let len = body.get(..8).map(|b| u64::from_le_bytes(b.try_into().unwrap()) as usize).unwrap_or(usize::MAX);
-    let payload_len = MAGIC.len() + 8 + len.min(1 << 20) + 8 * floats;
-    if len > 1 << 20 || color::signature::payload(&bytes, payload_len).is_none() {
-        return Err(bad(
-            "truncated or damaged (its signature does not match); remove it to start over".into()
-        ));
-    }
-    let header: Header =
-        serde_json::from_slice(&body[8..8 + len]).map_err(|e| bad(format!("unreadable header: {e}")))?;
-    if let Some((k, there, here)) = super::truth::record_difference(&header.record, record) {
-        bail!(
-            "--resume: the checkpoint {} is of a different render: {k} is {there} there and {here} here; remove it to start over",
-            path.display()
-        );
-    }
-    if header.window != window(st) || header.spp != st.spp || header.done > st.spp {
-        bail!(
-            "--resume: the checkpoint {} is of a different render: window {:?} at {} spp there, {:?} at {} spp here",
-            path.display(),
+    let json = body.get(8..8usize.saturating_add(len)).filter(|_| len <= 1 << 20).ok_or_else(damaged)?;
+    let header: Header = serde_json::from_slice(json).map_err(|e| bad(format!("unreadable header: {e}")))?;
+    check(&header.record, header.spp, header.done)?;
+    if header.window != window(st) {
+        return Err(bad(format!(
+            "it holds the pixels {:?} (x, y, width, height), this render {:?}",
             header.window,
-            header.spp,
-            window(st),
-            st.spp
-        );
+            window(st)
+        )));
     }
     let expect_bands = if fresh.xyz.is_empty() { 0 } else { fresh.bins.len() / fresh.xyz.len() };
     if header.bands != expect_bands {
-        bail!(
-            "--resume: the checkpoint {} holds {} bands, this render {expect_bands}",
-            path.display(),
-            header.bands
-        );
+        return Err(bad(format!("it holds {} bands, this render {expect_bands}", header.bands)));
     }
-    let mut vals = body[8 + len..8 + len + 8 * floats]
-        .chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().unwrap()));
+    let sums = &body[8 + len..];
+    if sums.len() != 8 * floats {
+        return Err(damaged());
+    }
+    let mut vals = sums.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap()));
     let mut acc = fresh;
     for p in &mut acc.xyz {
         for c in p.iter_mut() {

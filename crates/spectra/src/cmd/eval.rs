@@ -31,6 +31,11 @@ pub struct Args {
     pub sweep: Option<String>,
     #[command(flatten)]
     pub table: crate::cmd::setup::TableArgs,
+    /// Keep the ground truths in this directory (created) and start from the ones kept: a
+    /// second run renders no truth, one with a higher --spp only the samples it lacks. Shared
+    /// with `spectra truth --truth-cache` (docs/ground-truth.md).
+    #[arg(long, value_name = "DIR")]
+    pub truth_cache: Option<PathBuf>,
     /// Output directory (created); gets index.html, results.json, results.csv, images, charts.
     #[arg(long)]
     pub out: PathBuf,
@@ -56,7 +61,15 @@ pub fn run(a: Args) -> Result<()> {
     };
     let notes = suite::notes(&ids);
     let out = a.out.clone();
-    let r = eval::run(Config { out: a.out, quick: a.quick, budget, ids, notes, table: a.table.table })?;
+    let r = eval::run(Config {
+        out: a.out,
+        quick: a.quick,
+        budget,
+        ids,
+        notes,
+        table: a.table.table,
+        truth_cache: a.truth_cache,
+    })?;
     println!("{}", eval::report::markdown_table(&r));
     println!("{}", eval::report::markdown_sweep(&r));
     println!("report: {}  ({:.0} s)", out.join("index.html").display(), r.seconds);

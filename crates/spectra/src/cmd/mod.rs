@@ -10,6 +10,7 @@ pub mod merge;
 pub mod render;
 pub mod setup;
 pub mod truth;
+pub mod truth_cache;
 pub mod upsample;
 pub mod view;
 

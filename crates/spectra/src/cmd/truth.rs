@@ -96,6 +96,11 @@ pub struct Args {
     /// the uninterrupted render's, bit for bit.
     #[arg(long)]
     pub resume: bool,
+    /// Keep finished renders' samples in this directory (created) and start from them: the same
+    /// render again renders nothing, one with more --spp only the samples it lacks (the result
+    /// is the full render's, bit for bit). Shared with `spectra eval --truth-cache`.
+    #[arg(long, value_name = "DIR")]
+    pub truth_cache: Option<PathBuf>,
 }
 
 /// Longest `--checkpoint-every`, seconds (a year).
@@ -182,6 +187,45 @@ fn record(
     table: &color::upsample::CoeffTable,
     spectral: bool,
 ) -> Result<Vec<(String, String)>> {
+    let mut fields = sum_fields(scene, st, table, &a.scene.input_files(scene), spectral)?;
+    fields.push(("channels".into(), if a.xyz { "CIE XYZ" } else { "linear sRGB" }.into()));
+    Ok(wrap_record(fields, st, spectral))
+}
+
+/// A record's `spectra.*` attributes from its setting fields (`spectra.identity` is their hash).
+fn wrap_record(fields: Vec<(String, String)>, st: &Settings, spectral: bool) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = vec![
+        ("spectra.version".into(), RECORD_VERSION.into()),
+        ("spectra.identity".into(), fields_hash(&fields)),
+        ("spectra.samples".into(), format!("{}..{}", st.sample_offset, st.sample_offset + u64::from(st.spp))),
+    ];
+    if spectral {
+        out.push(("spectra.content".into(), "spectral".into()));
+    }
+    out.extend(fields.into_iter().map(|(k, v)| (format!("spectra.setting.{k}"), v)));
+    out
+}
+
+/// The hash of setting fields, as 16 hex digits.
+pub fn fields_hash(fields: &[(String, String)]) -> String {
+    let text: String = fields.iter().map(|(k, v)| format!("{k}={v}\n")).collect();
+    format!("{:016x}", color::signature::fnv1a64(text.as_bytes()))
+}
+
+/// Every setting that changes a render's per-pixel sums (`truth::Accumulator`), whatever is
+/// written from them: the scene (its input files' contents; a scene built in code, its
+/// description), the tracer's settings, the coefficient table and the tracer's code
+/// (`truth::render::CODE_HASH`). Not the samples or the crop, which a record holds beside
+/// them. `inputs`: the files the scene was read from (`SceneArgs::input_files`); `spectral`:
+/// the sums include the --spectral-out bands. Shared by `spectra truth`'s records and the
+/// truth cache (`super::truth_cache`), which `spectra eval` uses too.
+pub fn sum_fields(
+    scene: &scene::Scene,
+    st: &Settings,
+    table: &color::upsample::CoeffTable,
+    inputs: &[(String, PathBuf)],
+    spectral: bool,
+) -> Result<Vec<(String, String)>> {
     use color::signature::fnv1a64;
     let hash = |s: &str| format!("{:016x}", fnv1a64(s.as_bytes()));
     let mut fields: Vec<(String, String)> = vec![
@@ -195,12 +239,25 @@ fn record(
         ("lambert".into(), st.lambert.to_string()),
         ("medium".into(), st.medium.as_ref().map_or("none".into(), |m| hash(&format!("{m:?}")))),
         ("uniform_environment".into(), format!("{:?}", st.environment)),
-        ("channels".into(), if a.xyz { "CIE XYZ" } else { "linear sRGB" }.into()),
         ("table".into(), format!("{:016x}", fnv1a64(&table.to_bytes()))),
-        ("truth".into(), format!("{} sampler {}", env!("CARGO_PKG_VERSION"), truth::render::SAMPLER_VERSION)),
+        (
+            "truth".into(),
+            format!(
+                "{} sampler {} code {}",
+                env!("CARGO_PKG_VERSION"),
+                truth::render::SAMPLER_VERSION,
+                truth::render::CODE_HASH
+            ),
+        ),
     ];
     if scene.inputs.is_empty() {
-        fields.push(("scene".into(), scene.source.clone()));
+        // Built in code: its name, and what it holds (a built-in changes with the code).
+        let s = scene;
+        let described = format!(
+            "{:?}{:?}{:?}{:?}{:?}{:?}{:?}{:?}",
+            s.meshes, s.materials, s.textures, s.lights, s.camera, s.spectral, s.water, s.medium
+        );
+        fields.push(("scene".into(), format!("{} {}", scene.source, hash(&described))));
     }
     if spectral {
         fields.push(("content".into(), "spectral".into()));
@@ -208,27 +265,21 @@ fn record(
     }
     if let Some(e) = &scene.environment {
         let name = std::path::Path::new(&e.source).file_name().map(|n| n.to_string_lossy().into_owned());
-        fields.push((
-            "environment".into(),
-            format!("{} × {} rotated {}", name.unwrap_or_default(), e.intensity, e.rotation),
-        ));
+        let mut v = format!("{} × {} rotated {}", name.unwrap_or_default(), e.intensity, e.rotation);
+        if !inputs.iter().any(|(_, p)| p.as_os_str() == e.source.as_str()) {
+            // Made in code (the default sky): its texels, which no input file covers.
+            let bytes: Vec<u8> =
+                e.texels.iter().flat_map(|t| t.to_array()).flat_map(f32::to_le_bytes).collect();
+            v.push_str(&format!(" {}x{} {:016x}", e.width, e.height, fnv1a64(&bytes)));
+        }
+        fields.push(("environment".into(), v));
     }
-    for (i, (what, p)) in a.scene.input_files(scene).iter().enumerate() {
+    for (i, (what, p)) in inputs.iter().enumerate() {
         let bytes = color::input::read_regular(p, scene::environment::MAX_INPUT_BYTES)
             .with_context(|| format!("{what} {}", p.display()))?;
         fields.push((format!("input{i}"), format!("{:016x}", fnv1a64(&bytes))));
     }
-    let identity = hash(&fields.iter().map(|(k, v)| format!("{k}={v}\n")).collect::<String>());
-    let mut out: Vec<(String, String)> = vec![
-        ("spectra.version".into(), RECORD_VERSION.into()),
-        ("spectra.identity".into(), identity),
-        ("spectra.samples".into(), format!("{}..{}", st.sample_offset, st.sample_offset + u64::from(st.spp))),
-    ];
-    if spectral {
-        out.push(("spectra.content".into(), "spectral".into()));
-    }
-    out.extend(fields.into_iter().map(|(k, v)| (format!("spectra.setting.{k}"), v)));
-    Ok(out)
+    Ok(fields)
 }
 
 /// Where two records (`spectra.*` attributes) differ: the first setting (`spectra.setting.*`)
@@ -338,11 +389,35 @@ pub fn run(a: Args) -> Result<()> {
 
     let ckpt = super::checkpoint::path_for(out);
     let ckpt_record = record(&a, &scene, &st, &table, st.spectral_bands.is_some())?;
+    let cache = a.truth_cache.as_deref().map(super::truth_cache::TruthCache::open).transpose()?;
+    let fields = sum_fields(&scene, &st, &table, &a.scene.input_files(&scene), st.spectral_bands.is_some())?;
+    let mut cached = 0;
     let mut acc = if a.resume {
         if std::fs::symlink_metadata(&ckpt).is_err() {
             bail!("--resume: there is no checkpoint {} to continue", ckpt.display());
         }
         super::checkpoint::read(&ckpt, &ckpt_record, &st)?
+    } else if let Some(c) = &cache {
+        let start = c.start(&fields, &st)?;
+        for n in &start.notes {
+            eprintln!("{n}");
+        }
+        cached = start.acc.done;
+        match &start.from {
+            Some(p) if cached == st.spp => {
+                eprintln!("truth cache: all {} samples from {}; nothing to render", st.spp, p.display())
+            }
+            Some(p) => eprintln!(
+                "truth cache: {cached} of {} samples from {}; rendering the other {}",
+                st.spp,
+                p.display(),
+                st.spp - cached
+            ),
+            None => {
+                eprintln!("truth cache: nothing stored for this render yet; rendering {} samples", st.spp)
+            }
+        }
+        start.acc
     } else {
         truth::Accumulator::new(&st)?
     };
@@ -399,6 +474,13 @@ pub fn run(a: Args) -> Result<()> {
         }
     }
     pb.finish_and_clear();
+    if let Some(c) = cache.as_ref().filter(|_| cached < st.spp) {
+        // A cache that cannot take them does not cost the outputs.
+        match c.store(&fields, &st, &acc) {
+            Ok(p) => eprintln!("truth cache: stored {} samples in {}", st.spp, p.display()),
+            Err(e) => eprintln!("warning: {e:#}: the samples are not cached"),
+        }
+    }
     let img = acc.finish(&st);
     let secs = t1.elapsed().as_secs_f64();
     if cancel.load(Ordering::Relaxed) {
@@ -449,7 +531,7 @@ pub fn run(a: Args) -> Result<()> {
         None => String::new(),
     };
     eprintln!(
-        "{}: {} {}×{}{} at {} spp{}, {:.0}–{:.0} nm{}{}{}; {:.2} s ({:.2} s setup), {:.3} Mpaths/s, mean Y {:.5}{}",
+        "{}: {} {}×{}{} at {} spp{}, {:.0}–{:.0} nm{}{}{}; {:.2} s ({:.2} s setup), {} Mpaths/s, mean Y {:.5}{}",
         out.display(),
         scene.source,
         st.width,
@@ -468,11 +550,11 @@ pub fn run(a: Args) -> Result<()> {
         env,
         secs,
         prep.as_secs_f64(),
-        paths / secs / 1e6,
+        if paths > 0.0 { format!("{:.3}", paths / secs / 1e6) } else { "–".into() },
         y,
         if img.dropped > 0 { format!(", {} non-finite samples dropped", img.dropped) } else { String::new() }
     );
-    if resumed > 0 {
+    if a.resume && resumed > 0 {
         eprintln!("  resumed from {} with {resumed} of {} samples done", ckpt.display(), st.spp);
     }
     if let (Some(sp), Some(edges)) = (&a.spectral_out, &st.spectral_bands) {

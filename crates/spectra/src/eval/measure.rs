@@ -49,14 +49,26 @@ pub fn water(scene: &scene::Scene) -> Result<Option<scene::water::WaterMedium>> 
     crate::cmd::setup::water_medium(scene, None, None)
 }
 
-/// Ground truth of a scene: direct lighting only, linear sRGB.
+/// Where a ground truth's samples came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TruthSource {
+    /// Samples read from the truth cache (0 without one or on a miss).
+    pub cached: u32,
+    /// Samples rendered now.
+    pub rendered: u32,
+}
+
+/// Ground truth of a scene: direct lighting only (full transport under water), linear sRGB.
+/// With `cache`, starts from the cache's samples of the same render and stores the result
+/// (`crate::cmd::truth_cache`).
 pub fn truth(
     scene: &scene::Scene,
     table: &color::upsample::CoeffTable,
     job: TruthJob,
+    cache: Option<&crate::cmd::truth_cache::TruthCache>,
     cancel: &AtomicBool,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<Image> {
+) -> Result<(Image, TruthSource)> {
     let (width, height) = (job.width, job.height);
     let mut st = truth::Settings::new(width, height, job.spp)?;
     st.seed = job.seed;
@@ -69,14 +81,36 @@ pub fn truth(
     }
     st.white = color::illuminant::by_name(scene.spectral.white_name())?;
     let world = truth::World::new(scene, table, &st.white, st.range, st.medium.as_ref())?;
-    let img = match truth::render_world(&world, &st, cancel, progress) {
-        Err(truth::TruthError::Cancelled) => bail!("interrupted"),
-        r => r?,
+    let fields = match cache {
+        Some(_) => crate::cmd::truth::sum_fields(scene, &st, table, &[], false)?,
+        None => Vec::new(),
     };
-    if cancel.load(Ordering::Relaxed) {
-        bail!("interrupted");
+    let (mut acc, cached) = match cache {
+        Some(c) => {
+            let start = c.start(&fields, &st)?;
+            for n in &start.notes {
+                eprintln!("{n}");
+            }
+            let done = start.acc.done;
+            (start.acc, done)
+        }
+        None => (truth::Accumulator::new(&st)?, 0),
+    };
+    let rendered = st.spp - cached;
+    if rendered > 0 {
+        match truth::render_pass(&world, &st, cancel, &mut acc, rendered, progress) {
+            Err(truth::TruthError::Cancelled) => bail!("interrupted"),
+            r => r?,
+        }
+        if cancel.load(Ordering::Relaxed) {
+            bail!("interrupted");
+        }
+        if let Some(c) = cache {
+            c.store(&fields, &st, &acc)?;
+        }
     }
-    Ok(Image::new(width, height, img.to_rgb(&RgbColorSpace::srgb()))?)
+    let img = acc.finish(&st);
+    Ok((Image::new(width, height, img.to_rgb(&RgbColorSpace::srgb()))?, TruthSource { cached, rendered }))
 }
 
 /// The real-time renderer's linear HDR image of the scene's camera.

@@ -47,6 +47,8 @@ pub struct Config {
     pub ids: Vec<String>,
     pub notes: Vec<String>,
     pub table: Option<PathBuf>,
+    /// Keep the ground truths here and start from the ones kept (`--truth-cache`).
+    pub truth_cache: Option<PathBuf>,
 }
 
 /// One mode's result in one case.
@@ -161,6 +163,19 @@ pub struct Results {
     pub jitter: Vec<JitterPoint>,
 }
 
+/// What the truth cache gave the renders of a case, for the log: each render's samples per
+/// pixel from the cache and rendered now.
+fn describe_source(s: &[measure::TruthSource]) -> String {
+    let one = |t: &measure::TruthSource| match (t.cached, t.rendered) {
+        (c, 0) => format!("{c} spp from the cache"),
+        (0, r) => format!("{r} spp rendered"),
+        (c, r) => format!("{c} spp from the cache + {r} rendered"),
+    };
+    let all: Vec<String> = s.iter().map(one).collect();
+    let nothing = if s.iter().all(|t| t.rendered == 0) { "; nothing rendered" } else { "" };
+    format!("{}{nothing}", all.join(", "))
+}
+
 fn bar(len: u64, what: &str) -> ProgressBar {
     let pb = ProgressBar::new(len);
     if let Ok(st) = ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {msg} ({elapsed})") {
@@ -191,6 +206,8 @@ pub fn run(cfg: Config) -> Result<Results> {
         Ok(())
     };
     let adapter = Renderer::with_table(table.clone())?.gpu().describe();
+    let cache = cfg.truth_cache.as_deref().map(crate::cmd::truth_cache::TruthCache::open).transpose()?;
+    let cache = cache.as_ref();
     let b = &cfg.budget;
     let job = |c: &suite::Case, seed: u64, range: WavelengthRange| {
         let (width, height, spp) = b.for_case(c);
@@ -208,9 +225,13 @@ pub fn run(cfg: Config) -> Result<Results> {
         pb.set_message("ground truth");
         let pbr = &pb;
         let rows = |base: u64| move |k: u64| pbr.set_position(base + k);
-        let t0 = measure::truth(&c.scene, &table, job(c, 1, range), cancel, &rows(0))?;
-        let t1 = measure::truth(&c.scene, &table, job(c, 2, range), cancel, &rows(height as u64))?;
+        let (t0, s0) = measure::truth(&c.scene, &table, job(c, 1, range), cache, cancel, &rows(0))?;
+        let (t1, s1) =
+            measure::truth(&c.scene, &table, job(c, 2, range), cache, cancel, &rows(height as u64))?;
         pb.finish_and_clear();
+        if cache.is_some() {
+            eprintln!("{:<18} ground truth: {}", c.id, describe_source(&[s0, s1]));
+        }
         check()?;
         // Volumetric truth is too noisy for a luminance-edge mask (it would mask everything).
         let water = measure::water(&c.scene)?;
@@ -316,9 +337,13 @@ pub fn run(cfg: Config) -> Result<Results> {
     let jrange = range;
     let (jw, jh, _) = b.for_case(ft_case);
     let pb = bar(jh as u64, "jitter truth");
-    let jt =
-        measure::truth(&ft_case.scene, &table, job(ft_case, 3, jrange), cancel, &|k| pb.set_position(k))?;
+    let (jt, js) = measure::truth(&ft_case.scene, &table, job(ft_case, 3, jrange), cache, cancel, &|k| {
+        pb.set_position(k)
+    })?;
     pb.finish_and_clear();
+    if cache.is_some() {
+        eprintln!("{:<18} jitter truth: {}", ft_case.id, describe_source(&[js]));
+    }
     check()?;
     r.resize(jw, jh)?;
     let mut jitter = Vec::new();
