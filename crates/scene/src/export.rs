@@ -204,6 +204,21 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
         if m.unlit {
             j["extensions"]["KHR_materials_unlit"] = json!({});
         }
+        if let Some(ir) = &m.iridescence {
+            let mut e = json!({
+                "iridescenceFactor": ir.factor,
+                "iridescenceIor": ir.ior,
+                "iridescenceThicknessMinimum": ir.thickness_min,
+                "iridescenceThicknessMaximum": ir.thickness_max,
+            });
+            if let Some(t) = &ir.texture {
+                e["iridescenceTexture"] = tex(t);
+            }
+            if let Some(t) = &ir.thickness_texture {
+                e["iridescenceThicknessTexture"] = tex(t);
+            }
+            j["extensions"]["KHR_materials_iridescence"] = e;
+        }
         let mut extras = serde_json::Map::new();
         match &m.spectral {
             Some(SpectralReflectance::Uniform(s)) => {
@@ -332,7 +347,7 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
 
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"],
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_materials_iridescence"],
         "scene": 0,
         "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
         "nodes": nodes,

@@ -72,9 +72,10 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_ior" => {
             ("the index of refraction is ignored (1.5 is used)", "this renderer fixes the IOR at 1.5")
         }
-        "KHR_materials_iridescence" => {
-            ("iridescence (thin films) is ignored", "this renderer has no thin films")
-        }
+        "KHR_materials_iridescence" => (
+            "thin films are drawn by the path tracer (`spectra truth`) only; the real-time renderer ignores them",
+            "the real-time renderer has no thin films yet",
+        ),
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }

@@ -658,6 +658,9 @@ impl Loader<'_> {
         if let Some(sg) = info("/extensions/KHR_materials_pbrSpecularGlossiness") {
             self.spec_gloss(&at, sg, &mut out)?;
         }
+        if let Some(ir) = info("/extensions/KHR_materials_iridescence") {
+            out.iridescence = self.iridescence(&at, ir)?;
+        }
         let values = [
             out.base_color.to_array().as_slice(),
             &[out.metallic, out.roughness, out.normal_scale],
@@ -749,6 +752,59 @@ impl Loader<'_> {
             out.emission_spectrum = e.spectrum;
         }
         Ok((out, needs))
+    }
+
+    /// `KHR_materials_iridescence` (`ir` is its JSON), validated: `None` when its factor is 0
+    /// (the extension's default: no film).
+    fn iridescence(&mut self, at: &str, ir: &Value) -> Result<Option<crate::Iridescence>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_iridescence");
+        let number = |key: &str, default: f32, lo: f32, hi: f32, what: &str| -> Result<f32, SceneError> {
+            let Some(v) = ir.get(key) else { return Ok(default) };
+            match v.as_f64() {
+                Some(x) if x.is_finite() && (f64::from(lo)..=f64::from(hi)).contains(&x) => Ok(x as f32),
+                _ => Err(self.ctx.invalid(format!("{at}.{key}"), format!("{v} is not {what}"))),
+            }
+        };
+        let max_d = crate::MAX_FILM_THICKNESS_NM;
+        let factor = number("iridescenceFactor", 0.0, 0.0, 1.0, "a number in [0, 1]")?;
+        let ior =
+            number("iridescenceIor", 1.3, 1.0, crate::MAX_FILM_IOR, "an index of refraction in [1, 10]")?;
+        let nm = format!("a thickness in nm from 0 to {max_d}");
+        let thickness_min = number("iridescenceThicknessMinimum", 100.0, 0.0, max_d, &nm)?;
+        let thickness_max = number("iridescenceThicknessMaximum", 400.0, 0.0, max_d, &nm)?;
+        if thickness_min > thickness_max {
+            return Err(self.ctx.invalid(
+                format!("{at}.iridescenceThicknessMinimum"),
+                format!(
+                    "{thickness_min} nm is more than iridescenceThicknessMaximum ({thickness_max} nm); the extension needs minimum ≤ maximum"
+                ),
+            ));
+        }
+        let mut texture = |key: &str| -> Result<Option<TextureRef>, SceneError> {
+            let Some(info) = ir.get(key) else { return Ok(None) };
+            let field = format!("{at}.{key}");
+            let t = info
+                .get("index")
+                .and_then(Value::as_u64)
+                .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
+                .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
+            let tex_coord =
+                info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
+            self.texture(&field, t, tex_coord, false, Some(info)).map(Some)
+        };
+        let texture_ref = texture("iridescenceTexture")?;
+        let thickness_texture = texture("iridescenceThicknessTexture")?;
+        if factor == 0.0 {
+            return Ok(None);
+        }
+        Ok(Some(crate::Iridescence {
+            factor,
+            texture: texture_ref,
+            ior,
+            thickness_min,
+            thickness_max,
+            thickness_texture,
+        }))
     }
 
     /// `KHR_materials_pbrSpecularGlossiness` (`sg` is its JSON) converted into `out`'s

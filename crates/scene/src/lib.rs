@@ -14,6 +14,7 @@ pub mod environment;
 mod error;
 pub mod export;
 mod extras;
+pub mod film;
 pub mod framing;
 mod gltf_ext;
 mod gltf_file;
@@ -177,6 +178,47 @@ pub struct Material {
     /// white is the scene's white); it does not light other surfaces in real time, and in the
     /// path tracer only through paths that hit it (it is not a light source).
     pub unlit: bool,
+    /// `KHR_materials_iridescence`: a thin dielectric film over the surface ([`film`]).
+    pub iridescence: Option<Iridescence>,
+}
+
+/// `KHR_materials_iridescence` of a material: a thin dielectric film whose interference
+/// reflectance ([`film::reflectance`]) replaces the specular Fresnel term in proportion to
+/// `factor` (× the texture's R channel), over the dielectric base (index 1.5, F0 0.04) and the
+/// metallic one (its base colour as F0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Iridescence {
+    /// `iridescenceFactor` in [0, 1].
+    pub factor: f32,
+    /// `iridescenceTexture`: R multiplies `factor`.
+    pub texture: Option<TextureRef>,
+    /// `iridescenceIor`: the film's index (≥ 1).
+    pub ior: f32,
+    /// `iridescenceThicknessMinimum` / `Maximum`, nm: the thickness is
+    /// min + (max − min) × the thickness texture's G channel, or `thickness_max` without one.
+    pub thickness_min: f32,
+    pub thickness_max: f32,
+    pub thickness_texture: Option<TextureRef>,
+}
+
+/// Thickest film a material may describe, nm. Interference colours fade out beyond a few
+/// micrometres (white light's coherence length), and the phase 4π·η·d/λ must stay exact in
+/// the real-time renderer's f32.
+pub const MAX_FILM_THICKNESS_NM: f32 = 100_000.0;
+
+/// Largest film index accepted (diamond is 2.4; no film material is near this).
+pub const MAX_FILM_IOR: f32 = 10.0;
+
+impl Iridescence {
+    /// The film thickness at a point whose thickness texture reads `g` (G channel, 0–1).
+    pub fn thickness(&self, g: Option<f32>) -> f32 {
+        match g {
+            Some(g) if self.thickness_texture.is_some() => {
+                self.thickness_min + (self.thickness_max - self.thickness_min) * g.clamp(0.0, 1.0)
+            }
+            _ => self.thickness_max,
+        }
+    }
 }
 
 impl Default for Material {
@@ -201,6 +243,7 @@ impl Default for Material {
             spectral: None,
             emission_spectrum: None,
             unlit: false,
+            iridescence: None,
         }
     }
 }

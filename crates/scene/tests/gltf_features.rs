@@ -764,3 +764,83 @@ fn specular_glossiness_materials_are_converted_to_metallic_roughness() {
         json!(7);
     assert_has(&error(&bad), &["diffuseTexture.index", "no texture"]);
 }
+
+#[test]
+fn iridescence_is_read_with_its_defaults_and_bad_values_are_named() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let ir = |x: Value| json!({"extensions": {"KHR_materials_iridescence": x}});
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos}, "material": m});
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_iridescence"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2)]}],
+        "materials": [
+            ir(json!({"iridescenceFactor": 1.0})),
+            ir(json!({"iridescenceFactor": 0.5, "iridescenceIor": 1.8, "iridescenceThicknessMinimum": 200,
+                      "iridescenceThicknessMaximum": 800, "iridescenceTexture": {"index": 0},
+                      "iridescenceThicknessTexture": {"index": 0}})),
+            // The extension's default factor is 0: no film.
+            ir(json!({"iridescenceIor": 1.5})),
+        ],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    let s = load(&doc).unwrap();
+    let d = s.materials[0].iridescence.as_ref().expect("a film");
+    assert_eq!((d.factor, d.ior, d.thickness_min, d.thickness_max), (1.0, 1.3, 100.0, 400.0));
+    assert!(d.texture.is_none() && d.thickness_texture.is_none());
+    // Without a thickness texture the film is the maximum thick.
+    assert_eq!(d.thickness(Some(0.0)), 400.0);
+    let t = s.materials[1].iridescence.as_ref().unwrap();
+    assert_eq!((t.factor, t.ior, t.thickness_min, t.thickness_max), (0.5, 1.8, 200.0, 800.0));
+    let tex = &s.textures[t.thickness_texture.unwrap().index];
+    assert!(!tex.srgb, "film textures are data");
+    assert_eq!(t.thickness(Some(0.25)), 350.0);
+    assert!(s.materials[2].iridescence.is_none());
+
+    let bad = |key: &str, v: Value, parts: &[&str]| {
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_iridescence"][key] = v;
+        assert_has(&error(&d), parts);
+    };
+    let at = "materials[1].extensions.KHR_materials_iridescence";
+    bad(
+        "iridescenceThicknessMinimum",
+        json!(900),
+        &[&format!("{at}.iridescenceThicknessMinimum"), "minimum ≤ maximum"],
+    );
+    bad(
+        "iridescenceThicknessMaximum",
+        json!(-5),
+        &[&format!("{at}.iridescenceThicknessMaximum"), "thickness in nm"],
+    );
+    bad("iridescenceIor", json!(0.9), &[&format!("{at}.iridescenceIor"), "[1, 10]"]);
+    bad("iridescenceIor", json!("1.3"), &[&format!("{at}.iridescenceIor"), "index of refraction"]);
+    bad("iridescenceFactor", json!(1.5), &[&format!("{at}.iridescenceFactor"), "[0, 1]"]);
+    bad("iridescenceThicknessMaximum", json!(1e9), &[&format!("{at}.iridescenceThicknessMaximum"), "100000"]);
+    bad(
+        "iridescenceTexture",
+        json!({"index": 7}),
+        &[&format!("{at}.iridescenceTexture.index"), "no texture"],
+    );
+}
+
+#[test]
+fn iridescence_survives_export() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_iridescence"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0}]}],
+        "materials": [{"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 0.75, "iridescenceIor": 1.6,
+                       "iridescenceThicknessMinimum": 50, "iridescenceThicknessMaximum": 650}}}],
+    }));
+    let s = load(&doc).unwrap();
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert_eq!(back.materials[0].iridescence, s.materials[0].iridescence);
+    assert!(s.materials[0].iridescence.is_some());
+}

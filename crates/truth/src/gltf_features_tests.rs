@@ -363,3 +363,54 @@ fn unlit_surfaces_emit_their_base_colour_and_reflect_nothing() {
     // Not a light source: next-event estimation never samples it.
     assert_eq!(world(&dark).emitters.pmf.iter().sum::<f32>(), 0.0);
 }
+
+/// `KHR_materials_iridescence` reaches the BRDF with each lane's wavelength: a black
+/// dielectric floor under a point light, seen at 45°, reflects only its specular lobe, so the
+/// film's direct radiance over the plain floor's is, lane by lane, the film's reflectance over
+/// Schlick's at v·h — and a factor of 0 is no film at all.
+#[test]
+fn iridescence_replaces_the_specular_fresnel_per_wavelength() {
+    let film = scene::Iridescence {
+        factor: 1.0,
+        texture: None,
+        ior: 1.33,
+        thickness_min: 100.0,
+        thickness_max: 380.0,
+        thickness_texture: None,
+    };
+    let floor = |ir: Option<scene::Iridescence>| Material {
+        base_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
+        roughness: 0.5,
+        iridescence: ir,
+        ..Default::default()
+    };
+    let render = |m: Material| {
+        let s = scene_with(
+            vec![quad(Vec3::ZERO, Vec3::Y, 4.0, 0)],
+            vec![m],
+            vec![point_light(Vec3::new(0.0, 2.0, 0.0))],
+        );
+        let w = world(&s);
+        let integ = Integrator { world: &w, direct_only: true, max_depth: 4, lambert: false };
+        let o = Vec3::new(1.0, 1.0, 0.0);
+        integ.radiance(o, -o.normalize(), &wl(), &mut Sampler::new(1, 0))
+    };
+    let plain = render(floor(None));
+    let with = render(floor(Some(film.clone())));
+    assert_eq!(render(floor(Some(scene::Iridescence { factor: 0.0, ..film.clone() }))), plain);
+    let v = Vec3::new(1.0, 1.0, 0.0).normalize();
+    let v_h = v.dot((v + Vec3::Y).normalize()) as f64;
+    let schlick = 0.04 + 0.96 * (1.0 - v_h).powi(5);
+    for i in 0..4 {
+        let r = scene::film::reflectance(
+            f64::from(wl().0[i]),
+            v_h,
+            380.0,
+            1.33,
+            num_complex::Complex64::new(1.5, 0.0),
+        );
+        let got = f64::from(with[i] / plain[i]);
+        assert!((got - r / schlick).abs() < 1e-4 * (r / schlick), "lane {i}: {got} vs {}", r / schlick);
+    }
+    assert!(plain.min_element() > 0.0);
+}

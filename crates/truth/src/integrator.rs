@@ -4,7 +4,7 @@
 //! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
 use crate::accel::Hit;
-use crate::bsdf::Brdf;
+use crate::bsdf::{Brdf, FilmLanes};
 use crate::camera::CameraRay;
 use crate::material;
 use crate::medium::{Phase, phase_eval, phase_sample};
@@ -326,8 +326,16 @@ impl Integrator<'_, '_> {
                 l,
             );
             let (metallic, roughness) = material::metallic_roughness(mat, &w.scene.textures, &s.tc);
-            let brdf =
-                if self.lambert { Brdf::lambertian(base) } else { Brdf::new(base, metallic, roughness) };
+            let film = material::film(mat, &w.scene.textures, &s.tc).map(|(weight, film)| FilmLanes {
+                weight,
+                film,
+                lambda: l,
+            });
+            let brdf = if self.lambert {
+                Brdf::lambertian(base)
+            } else {
+                Brdf::new(base, metallic, roughness).with_film(film)
+            };
             let frame = Frame::from_normal(ns);
             let vtx = Vertex::Surface { brdf, frame, ng };
 

@@ -131,6 +131,23 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture], tc: &TexCoords) ->
     }
 }
 
+/// The thin film (`KHR_materials_iridescence`) at a surface point: its weight (factor ×
+/// texture R) and the film (thickness from the thickness texture's G); `None` without one or
+/// where its weight is 0.
+pub fn film(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(f32, scene::film::Film)> {
+    let ir = m.iridescence.as_ref()?;
+    let weight = match tex(textures, &ir.texture, tc) {
+        Some((t, uv)) => ir.factor * texture::sample(t, uv).x,
+        None => ir.factor,
+    };
+    if weight <= 0.0 {
+        return None;
+    }
+    let g = tex(textures, &ir.thickness_texture, tc).map(|(t, uv)| texture::sample(t, uv).y);
+    let film = scene::film::Film { thickness_nm: f64::from(ir.thickness(g)), ior: f64::from(ir.ior) };
+    Some((weight, film))
+}
+
 /// Linear emissive RGB (factor × sRGB-decoded texture).
 pub fn emissive_rgb(m: &Material, textures: &[Texture], tc: &TexCoords) -> Vec3 {
     match tex(textures, &m.emissive_texture, tc) {
