@@ -345,9 +345,14 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
         );
     }
 
+    let mut extensions_used =
+        vec!["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"];
+    if scene.materials.iter().any(|m| m.iridescence.is_some()) {
+        extensions_used.push("KHR_materials_iridescence");
+    }
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_materials_iridescence"],
+        "extensionsUsed": extensions_used,
         "scene": 0,
         "scenes": [{"nodes": (0..nodes.len()).collect::<Vec<_>>()}],
         "nodes": nodes,
