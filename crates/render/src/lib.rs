@@ -28,6 +28,8 @@ pub mod coeff_table;
 pub mod env_gpu;
 pub mod environment;
 pub mod error;
+#[cfg(test)]
+mod film_tests;
 pub mod gpu;
 #[cfg(test)]
 mod layout_tests;
