@@ -23,6 +23,10 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_pbrSpecularGlossiness",
 ];
 
+/// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
+/// warning saying which renderer ignores what) but not require them.
+const PARTLY_SUPPORTED: &[&str] = &["KHR_materials_iridescence"];
+
 pub(crate) const DECOMPRESS: &str =
     "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
 pub(crate) const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
@@ -118,7 +122,8 @@ pub(crate) fn warnings(raw: &Value) -> Vec<String> {
         .filter(|e| !SUPPORTED.contains(e) && !required.contains(e))
         .filter_map(|e| {
             let (lost, _) = unsupported(e);
-            (!lost.is_empty()).then(|| format!("{e} is not supported: {lost}"))
+            let how = if PARTLY_SUPPORTED.contains(&e) { "only partly supported" } else { "not supported" };
+            (!lost.is_empty()).then(|| format!("{e} is {how}: {lost}"))
         })
         .collect()
 }
