@@ -105,8 +105,9 @@ pub fn truth(
         if cancel.load(Ordering::Relaxed) {
             bail!("interrupted");
         }
-        if let Some(c) = cache {
-            c.store(&fields, &st, &acc)?;
+        // As `spectra truth`: a cache that cannot take the samples does not stop the run.
+        if let Some(Err(e)) = cache.map(|c| c.store(&fields, &st, &acc)) {
+            eprintln!("warning: {e:#}: the samples are not cached");
         }
     }
     let img = acc.finish(&st);
