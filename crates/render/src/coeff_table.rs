@@ -154,71 +154,42 @@ mod tests {
             crate::shader::SPECTRAL,
             table.res
         );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("fetch test"),
-            source: wgpu::ShaderSource::Wgsl(src.into()),
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("fetch test"),
-            layout: None,
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
         let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: None,
             contents: bytemuck::cast_slice(&colours),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let size = (colours.len() * 16) as u64;
-        let output = device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(2),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&coeff.view),
-                },
-                wgpu::BindGroupEntry { binding: 4, resource: coeff.scale.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 10, resource: input.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 11, resource: output.as_entire_binding() },
-            ],
-        });
-        let empty: Vec<wgpu::BindGroup> = (0..2)
-            .map(|g| {
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bytes = crate::compute_tests::run(
+            device,
+            queue,
+            src,
+            colours.len(),
+            (colours.len() * 16) as u64,
+            |p, output| {
+                let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: None,
-                    layout: &pipeline.get_bind_group_layout(g),
-                    entries: &[],
-                })
-            })
-            .collect();
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &empty[0], &[]);
-            pass.set_bind_group(1, &empty[1], &[]);
-            pass.set_bind_group(2, &bind, &[]);
-            pass.dispatch_workgroups(colours.len().div_ceil(64) as u32, 1, 1);
-        }
-        enc.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-        queue.submit([enc.finish()]);
-        let out: Vec<[f32; 4]> =
-            crate::readback::map_buffer(device, &staging, |b| bytemuck::cast_slice(b).to_vec()).unwrap();
+                    layout: &p.get_bind_group_layout(2),
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::TextureView(&coeff.view),
+                        },
+                        wgpu::BindGroupEntry { binding: 4, resource: coeff.scale.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 10, resource: input.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 11, resource: output.as_entire_binding() },
+                    ],
+                });
+                let empty = |g: u32| {
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: None,
+                        layout: &p.get_bind_group_layout(g),
+                        entries: &[],
+                    })
+                };
+                vec![empty(0), empty(1), bind]
+            },
+        );
+        let out: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
         let model = LabModel::new(&space).unwrap();
         let mut worst = (0.0f64, [0.0f32; 4]);
         for (rgb, g) in colours.iter().zip(&out) {

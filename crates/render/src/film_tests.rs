@@ -42,56 +42,24 @@ fn wgsl_film_matches_the_cpu() {
         crate::shader::COMMON,
         crate::shader::FILM,
     );
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("film test"),
-        source: wgpu::ShaderSource::Wgsl(src.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("film test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let args: Vec<f32> = cases.iter().flat_map(|(a, _)| *a).collect();
     let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: None,
         contents: bytemuck::cast_slice(&args),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let size = (cases.len() * 4) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-        ],
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(cases.len().div_ceil(64) as u32, 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-    queue.submit([enc.finish()]);
-    let out: Vec<f32> =
-        crate::readback::map_buffer(device, &staging, |b| bytemuck::cast_slice(b).to_vec()).unwrap();
+    let bytes =
+        crate::compute_tests::run(device, queue, src, cases.len(), (cases.len() * 4) as u64, |p, output| {
+            vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &p.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+                ],
+            })]
+        });
+    let out: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
     let mut worst = (0.0f64, [0.0f32; 5]);
     for ((a, cpu), gpu) in cases.iter().zip(&out) {
         let e = (f64::from(*gpu) - cpu).abs();

@@ -25,6 +25,8 @@
 //! ```
 
 pub mod coeff_table;
+#[cfg(test)]
+mod compute_tests;
 pub mod env_gpu;
 pub mod environment;
 pub mod error;

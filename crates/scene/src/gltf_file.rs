@@ -754,6 +754,26 @@ impl Loader<'_> {
         Ok((out, needs))
     }
 
+    /// The textureInfo `key` of an extension object `ext` at `at`, which the `gltf` crate does
+    /// not parse: its texture (decoded as sRGB colour or as data), UV set and transform.
+    fn extension_texture(
+        &mut self,
+        at: &str,
+        ext: &Value,
+        key: &str,
+        srgb: bool,
+    ) -> Result<Option<TextureRef>, SceneError> {
+        let Some(info) = ext.get(key) else { return Ok(None) };
+        let field = format!("{at}.{key}");
+        let t = info
+            .get("index")
+            .and_then(Value::as_u64)
+            .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
+            .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
+        let tex_coord = info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
+        self.texture(&field, t, tex_coord, srgb, Some(info)).map(Some)
+    }
+
     /// `KHR_materials_iridescence` (`ir` is its JSON), validated: `None` when its factor is 0
     /// (the extension's default: no film).
     fn iridescence(&mut self, at: &str, ir: &Value) -> Result<Option<crate::Iridescence>, SceneError> {
@@ -780,20 +800,8 @@ impl Loader<'_> {
                 ),
             ));
         }
-        let mut texture = |key: &str| -> Result<Option<TextureRef>, SceneError> {
-            let Some(info) = ir.get(key) else { return Ok(None) };
-            let field = format!("{at}.{key}");
-            let t = info
-                .get("index")
-                .and_then(Value::as_u64)
-                .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
-                .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
-            let tex_coord =
-                info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
-            self.texture(&field, t, tex_coord, false, Some(info)).map(Some)
-        };
-        let texture_ref = texture("iridescenceTexture")?;
-        let thickness_texture = texture("iridescenceThicknessTexture")?;
+        let texture_ref = self.extension_texture(&at, ir, "iridescenceTexture", false)?;
+        let thickness_texture = self.extension_texture(&at, ir, "iridescenceThicknessTexture", false)?;
         if factor == 0.0 {
             return Ok(None);
         }
@@ -837,20 +845,8 @@ impl Loader<'_> {
         let diffuse = factor("diffuseFactor", Vec4::ONE, 4)?;
         let specular = factor("specularFactor", Vec4::ONE, 3)?.truncate();
         let glossiness = factor("glossinessFactor", Vec4::ONE, 1)?.x;
-        let mut texture = |key: &str| -> Result<Option<TextureRef>, SceneError> {
-            let Some(info) = sg.get(key) else { return Ok(None) };
-            let field = format!("{at}.{key}");
-            let t = info
-                .get("index")
-                .and_then(Value::as_u64)
-                .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
-                .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
-            let tex_coord =
-                info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
-            self.texture(&field, t, tex_coord, true, Some(info)).map(Some)
-        };
-        let diffuse_tex = texture("diffuseTexture")?;
-        let mut sg_tex = texture("specularGlossinessTexture")?;
+        let diffuse_tex = self.extension_texture(&at, sg, "diffuseTexture", true)?;
+        let mut sg_tex = self.extension_texture(&at, sg, "specularGlossinessTexture", true)?;
         if let (Some(d), Some(g)) = (&diffuse_tex, &sg_tex)
             && (d.tex_coord != g.tex_coord || d.transform != g.transform)
         {
