@@ -88,6 +88,7 @@ fn shading_module(custom: &CustomShader) -> Module {
         shader::COMMON,
         shader::SPECTRAL,
         shader::ENVIRONMENT,
+        shader::FILM,
         shader::CUSTOM_API,
         &hooks,
         include_str!("passes/shading.wgsl"),
@@ -130,7 +131,7 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &shading,
         "MaterialSpectrum",
-        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission, emission_xyz }),
+        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission, emission_xyz, film }),
     );
     check(
         &shading,
@@ -144,7 +145,7 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &gbuffer,
         "MaterialUniforms",
-        rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv, slot }),
+        rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv, slot, film }),
     );
     let shadow_pass = parse(&[shader::MATERIAL, include_str!("passes/shadow.wgsl")]);
     check(&shadow_pass, "ShadowLayer", rust_layout!(shadow::LayerUniforms { view_proj, params }));

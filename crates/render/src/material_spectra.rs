@@ -21,12 +21,16 @@ pub struct MaterialSpectrum {
     /// A constant emission's XYZ at the frame's nodes (Σ over the nodes of
     /// scale·sigmoid(λ)·white weights, what the shader's node loop would add up); w unused.
     pub emission_xyz: [f32; 4],
+    /// The material's thin film (`KHR_materials_iridescence`): x its index (1 without a film),
+    /// y and z its thickness minimum and maximum in nm, which every mode reads (the G-buffer
+    /// holds only the weight and where the thickness lies between them per pixel); w unused.
+    pub film: [f32; 4],
 }
 
 impl MaterialSpectrum {
     /// The record of one material: the fetch the shading pass would make per pixel (the CPU
     /// `CoeffTable::fetch` matches the WGSL one, `coeff_table`'s tests), of the exact colours.
-    pub fn new(c: &ConstantColour, table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
+    pub fn new(c: &ConstantColour, film: [f32; 3], table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
         let coeffs = |rgb: [f32; 3]| {
             let p = table.fetch(rgb.map(f64::from));
             p.c.map(|v| v as f32)
@@ -61,17 +65,22 @@ impl MaterialSpectrum {
             }
         }
         let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
-        MaterialSpectrum { base, emission, emission_xyz }
+        MaterialSpectrum { base, emission, emission_xyz, film: [film[0], film[1], film[2], 0.0] }
     }
 
     /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
     /// binding cannot be empty).
     pub fn of_scene(
         colours: &[ConstantColour],
+        films: &[[f32; 3]],
         table: &CoeffTable,
         groups: &[WavelengthGroup],
     ) -> Vec<MaterialSpectrum> {
-        let mut v: Vec<_> = colours.iter().map(|c| Self::new(c, table, groups)).collect();
+        let mut v: Vec<_> = colours
+            .iter()
+            .enumerate()
+            .map(|(i, c)| Self::new(c, films.get(i).copied().unwrap_or([1.0, 0.0, 0.0]), table, groups))
+            .collect();
         if v.is_empty() {
             v.push(MaterialSpectrum::default());
         }

@@ -9,6 +9,7 @@ use crate::material_spectra::MaterialSpectrum;
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
+use crate::passes::gbuffer::Targets as GBufferTargets;
 use crate::passes::post::PostPass;
 use crate::passes::shading::{ShadingPass, Variant};
 use crate::passes::shadow::ShadowPass;
@@ -612,11 +613,18 @@ impl Renderer {
             capture: self.capture.is_some(),
             fetch_base: scene.varying_colours.0,
             fetch_emission: scene.varying_colours.1,
+            film: scene.has_film,
         };
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        if settings.mode == Mode::Spectral {
-            self.gbuffer.prepare_spectral(&self.gpu.device)?;
-        }
+        // Only the spectral mode reads the material slots; every mode reads the films.
+        let gbuffer_targets = if scene.has_film {
+            GBufferTargets::Film
+        } else if settings.mode == Mode::Spectral {
+            GBufferTargets::Slot
+        } else {
+            GBufferTargets::Plain
+        };
+        self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
         let ts = |i: usize| timer.map(|t| t.writes(i));
@@ -624,9 +632,12 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        let with_slot = [&g[0], &g[1], &g[2], &targets.gbuffer_slot_view];
-        // Only the spectral mode reads the material slots.
-        let colour = if settings.mode == Mode::Spectral { &with_slot[..] } else { &with_slot[..3] };
+        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_slot_view, &targets.gbuffer_film_view];
+        let colour = match gbuffer_targets {
+            GBufferTargets::Plain => &all[..3],
+            GBufferTargets::Slot => &all[..4],
+            GBufferTargets::Film => &all[..],
+        };
         self.gbuffer.record(&mut encoder, colour, &targets.depth_view, &self.frame_bind_group, scene, ts(1));
         if let Some(c) = &self.capture {
             // Background pixels without an environment write nothing.
@@ -832,7 +843,12 @@ impl Renderer {
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
         let material_spectra = storage(
             "material spectra",
-            bytemuck::cast_slice(&MaterialSpectrum::of_scene(&scene.constant_colours, &self.table, &groups)),
+            bytemuck::cast_slice(&MaterialSpectrum::of_scene(
+                &scene.constant_colours,
+                &scene.films,
+                &self.table,
+                &groups,
+            )),
         );
         let bind_group = self.shared.spectral_group(
             device,

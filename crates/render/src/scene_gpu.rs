@@ -47,9 +47,9 @@ impl Vertex {
     }
 }
 
-/// Texture slots of a material, in binding order (textures at bindings 1..=5, their samplers at
-/// 6..=10; the order of `TEX_*` in `wgsl/material.wgsl`).
-pub const TEXTURE_SLOTS: usize = 5;
+/// Texture slots of a material, in binding order (textures at bindings 1..=7, their samplers at
+/// 8..=14; the order of `TEX_*` in `wgsl/material.wgsl`).
+pub const TEXTURE_SLOTS: usize = 7;
 
 /// `MaterialUniforms` in `wgsl/material.wgsl` (checked by `layout_tests`).
 #[repr(C)]
@@ -69,6 +69,12 @@ pub struct MaterialUniforms {
     /// x: the material's index + 1, which the spectral G-buffer writes for the shading pass to
     /// find its [`ConstantColour`] coefficients (`material_spectra` in shading.wgsl); yzw unused.
     pub slot: [u32; 4],
+    /// `KHR_materials_iridescence`: x factor (0: no film); y, z, w the film's index and
+    /// thickness minimum and maximum in nm, for reference (the shading pass reads them per
+    /// material from `MaterialSpectrum::film`; the G-buffer writes the weight and the thickness
+    /// texture's G, whose default texture is white: without one the thickness is the maximum,
+    /// as the extension says).
+    pub film: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -102,24 +108,31 @@ impl MaterialUniforms {
             alpha: [mode, cutoff, m.double_sided as u8 as f32, m.unlit as u8 as f32],
             uv,
             slot: [u32::try_from(index).map_or(u32::MAX, |i| i.saturating_add(1)), 0, 0, 0],
+            film: match &m.iridescence {
+                Some(f) if !m.unlit => [f.factor, f.ior, f.thickness_min, f.thickness_max],
+                _ => [0.0; 4],
+            },
         }
     }
 }
 
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
-/// occlusion.
+/// occlusion, the film's weight (iridescence texture, R) and thickness (G).
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
+    let film = m.iridescence.as_ref();
     [
         m.base_color_texture,
         m.metallic_roughness_texture,
         m.normal_texture,
         m.emissive_texture,
         m.occlusion_texture,
+        film.and_then(|f| f.texture),
+        film.and_then(|f| f.thickness_texture),
     ]
 }
 
 /// The material bind group's layout (group 1 of the G-buffer and shadow passes): uniforms at
-/// 0, the five textures at 1..=5 and their samplers at 6..=10.
+/// 0, the seven textures at 1..=7 and their samplers at 8..=14.
 pub fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![crate::passes::uniform_entry(0, visibility)];
@@ -382,6 +395,12 @@ pub struct GpuScene {
     /// Whether some material's base colour (`.0`) or emission (`.1`) varies over its surface,
     /// so that the spectral shading pass needs its per-pixel fetch for it.
     pub varying_colours: (bool, bool),
+    /// Whether some material has a thin film (`KHR_materials_iridescence` with a factor above
+    /// 0): only then do the G-buffer and shading passes carry the film's code and target.
+    pub has_film: bool,
+    /// Per material, its film's index and thickness minimum and maximum in nm (`[1, 0, 0]`
+    /// without a film), for `MaterialSpectrum::film`.
+    pub films: Vec<[f32; 3]>,
 }
 
 /// A material's base colour and emission where they do not vary over its surface (no texture,
@@ -556,6 +575,8 @@ impl GpuScene {
                 &defaults.flat_normal,
                 &defaults.white_srgb,
                 &defaults.white_linear,
+                &defaults.white_linear,
+                &defaults.white_linear,
             ];
             let views: Vec<wgpu::TextureView> = refs
                 .iter()
@@ -616,6 +637,19 @@ impl GpuScene {
                 constant_colours.iter().any(|c| c.emission.is_none()),
             ),
             constant_colours,
+            has_film: s
+                .materials
+                .iter()
+                .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
+            films: s
+                .materials
+                .iter()
+                .map(|m| {
+                    m.iridescence
+                        .as_ref()
+                        .map_or([1.0, 0.0, 0.0], |f| [f.ior, f.thickness_min, f.thickness_max])
+                })
+                .collect(),
         })
     }
 

@@ -8,8 +8,7 @@ pub(crate) const SPECTRAL: &str = include_str!("wgsl/spectral.wgsl");
 pub(crate) const ENVIRONMENT: &str = include_str!("wgsl/environment.wgsl");
 pub(crate) const CUSTOM_API: &str = include_str!("wgsl/custom_api.wgsl");
 pub(crate) const MATERIAL: &str = include_str!("wgsl/material.wgsl");
-/// Thin-film interference, `scene::film` in WGSL (not yet called by a pass: issue 30).
-#[cfg_attr(not(test), allow(dead_code))]
+/// Thin-film interference: `scene::film` in WGSL, and the RGB mode's Belcour–Barla film.
 pub(crate) const FILM: &str = include_str!("wgsl/film.wgsl");
 
 /// Concatenates `parts` and compiles them, turning validation errors into a [`RenderError`]

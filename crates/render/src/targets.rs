@@ -1,7 +1,9 @@
 //! The size-dependent render targets of one frame.
 
 use crate::passes::accumulate::ACCUM_FORMAT;
-use crate::passes::{DEPTH_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT};
+use crate::passes::{
+    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT,
+};
 
 /// G-buffer, depth, HDR and display targets at one size. Recreated on resize.
 pub struct Targets {
@@ -12,6 +14,9 @@ pub struct Targets {
     /// The spectral G-buffer's material slots (written in the spectral mode only).
     pub gbuffer_slot: wgpu::Texture,
     pub gbuffer_slot_view: wgpu::TextureView,
+    /// The thin film per pixel (written only for scenes with a film).
+    pub gbuffer_film: wgpu::Texture,
+    pub gbuffer_film_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     /// Shading output (pass 2).
@@ -61,6 +66,7 @@ impl Targets {
         ];
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
         let (gbuffer_slot, gbuffer_slot_view) = make("gbuffer material slot", GBUFFER_SLOT_FORMAT, none);
+        let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
@@ -75,6 +81,8 @@ impl Targets {
             gbuffer_views: [v0, v1, v2],
             gbuffer_slot,
             gbuffer_slot_view,
+            gbuffer_film,
+            gbuffer_film_view,
             depth,
             depth_view,
             hdr_shaded,

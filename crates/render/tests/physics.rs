@@ -6,11 +6,10 @@
 
 mod common;
 
-use color::quadrature::{NodeQuadrature, Nodes, Quadrature, integrate_nodes, sum_weights};
-use color::upsample::CoeffTable;
+use color::quadrature::Quadrature;
 use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spectrum};
 use common::*;
-use glam::{DMat3, DVec3, Vec3};
+use glam::Vec3;
 use render::{Mode, RenderSettings, Renderer};
 
 const W: u32 = 96;
@@ -45,81 +44,6 @@ fn pixel_geometry(chart: &Chart, roughness: f64, metallic: f64) -> Vec<Option<(u
         }
     }
     out
-}
-
-/// Independent CPU spectral shading of a patch: ρ from the table (the colour crate's fetch) at
-/// the nodes, the light's node weights from `color::quadrature` (midpoint or prefiltered),
-/// scaled to the requested luminance, and the XYZ → sRGB matrix corrected so that the white
-/// D65 as the same quadrature integrates it is the sRGB white.
-struct CpuSpectral {
-    lambda: Vec<f64>,
-    /// The light's normalised node weights.
-    light: Vec<[f64; 3]>,
-    /// D65's normalised node weights (for emission).
-    white: Vec<[f64; 3]>,
-    to_rgb: DMat3,
-}
-
-impl CpuSpectral {
-    fn new(n: usize, rule: Quadrature, light_spectrum: &Spectrum, luminance: f64) -> Self {
-        let nodes = Nodes::new(color::WavelengthRange::VISIBLE, n, 0.5).unwrap();
-        let quad = NodeQuadrature::new(rule, nodes, &Observer::cie1931());
-        let d65 = color::illuminant::by_name("D65").unwrap();
-        let white_raw = quad.weights(|l| d65.eval(l));
-        let white_xyz = sum_weights(&white_raw);
-        let k = white_xyz[1];
-        let raw = quad.weights(|l| light_spectrum.eval(l));
-        let scale = luminance / sum_weights(&raw)[1];
-        let space = RgbColorSpace::srgb();
-        let t = space.white_xyz();
-        let corr = DMat3::from_diagonal(DVec3::new(
-            t[0] * k / white_xyz[0],
-            t[1] * k / white_xyz[1],
-            t[2] * k / white_xyz[2],
-        ));
-        CpuSpectral {
-            lambda: quad.nodes.lambda.clone(),
-            light: raw.iter().map(|w| w.map(|c| c * scale)).collect(),
-            white: white_raw.iter().map(|w| w.map(|c| c / k)).collect(),
-            to_rgb: space.from_xyz * corr,
-        }
-    }
-
-    fn shade(&self, table: &CoeffTable, albedo: [f32; 3], a: f64, b: f64) -> [f64; 3] {
-        let poly = table.fetch(albedo.map(f64::from));
-        self.shade_with(|l| poly.to_f32_poly_eval(l), a, b)
-    }
-
-    /// Naive mode: the colour crate's box spectrum of the albedo.
-    fn shade_box(&self, albedo: [f32; 3], a: f64, b: f64) -> [f64; 3] {
-        let boxed = color::upsample::boxes::BoxSpectrum { rgb: albedo.map(f64::from) };
-        self.shade_with(|l| boxed.eval(l), a, b)
-    }
-
-    fn shade_with(&self, rho: impl Fn(f64) -> f64, a: f64, b: f64) -> [f64; 3] {
-        let values: Vec<f64> = self.lambda.iter().map(|&l| rho(l) * a + b).collect();
-        (self.to_rgb * DVec3::from(integrate_nodes(&self.light, &values))).to_array()
-    }
-
-    /// An emitter of linear RGB `e` with the illuminant variant: s·ρ(e/s)(λ)·D65(λ), s = 2·max.
-    fn emitter(&self, table: &CoeffTable, e: [f64; 3]) -> [f64; 3] {
-        let s = 2.0 * e[0].max(e[1]).max(e[2]);
-        let poly = table.fetch(e.map(|c| c / s));
-        let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
-        (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
-    }
-}
-
-/// Evaluates the sigmoid the way the GPU stores it (coefficients rounded to f32).
-trait F32Eval {
-    fn to_f32_poly_eval(&self, lambda: f64) -> f64;
-}
-
-impl F32Eval for color::upsample::SigmoidPolynomial {
-    fn to_f32_poly_eval(&self, lambda: f64) -> f64 {
-        let c = self.to_f32().map(f64::from);
-        color::upsample::SigmoidPolynomial::new(c[0], c[1], c[2]).eval(lambda)
-    }
 }
 
 #[test]

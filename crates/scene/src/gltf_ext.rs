@@ -21,11 +21,12 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "EXT_meshopt_compression",
     "KHR_materials_unlit",
     "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_iridescence",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
-/// warning saying which renderer ignores what) but not require them.
-const PARTLY_SUPPORTED: &[&str] = &["KHR_materials_iridescence"];
+/// warning saying which renderer ignores what) but not require them. None at present.
+const PARTLY_SUPPORTED: &[&str] = &[];
 
 pub(crate) const DECOMPRESS: &str =
     "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
@@ -76,10 +77,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_ior" => {
             ("the index of refraction is ignored (1.5 is used)", "this renderer fixes the IOR at 1.5")
         }
-        "KHR_materials_iridescence" => (
-            "thin films are drawn by the path tracer (`spectra truth`) only; the real-time renderer ignores them",
-            "the real-time renderer has no thin films yet",
-        ),
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }

@@ -6,9 +6,11 @@
 //! the viewer; `MASK` and `BLEND` materials use the fragment entry point that may discard
 //! (below the cutoff, or stochastically for `BLEND`, see `wgsl/material.wgsl`), opaque ones one
 //! without discard so that early depth testing stays on. The spectral mode's four add a fourth
-//! target, the material's slot ([`GBUFFER_SLOT_FORMAT`]), built on first use.
+//! target, the material's slot ([`GBUFFER_SLOT_FORMAT`]), built on first use; a scene with a thin
+//! film adds a fifth in every mode, the film's values ([`GBUFFER_FILM_FORMAT`]), so that a scene
+//! without one samples no film texture and writes no film target.
 
-use super::{DEPTH_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
+use super::{DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -21,8 +23,21 @@ pub struct GBufferPass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     pipelines: Pipelines,
-    /// With the material slot, for the spectral mode ([`Self::prepare_spectral`]).
+    /// With the material slot, for the spectral mode ([`Self::prepare`]).
     spectral_pipelines: Option<Pipelines>,
+    /// With the slot and the film, for scenes with a thin film ([`Self::prepare_film`]).
+    film_pipelines: Option<Pipelines>,
+}
+
+/// Which targets a G-buffer pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Targets {
+    /// Base, normal, emission.
+    Plain,
+    /// + the material slot.
+    Slot,
+    /// + the slot and the film.
+    Film,
 }
 
 impl GBufferPass {
@@ -38,21 +53,32 @@ impl GBufferPass {
             bind_group_layouts: &[Some(&shared.frame), Some(&material_layout)],
             immediate_size: 0,
         });
-        let pipelines = build(device, &module, &layout, false)?;
-        Ok(GBufferPass { material_layout, module, layout, pipelines, spectral_pipelines: None })
+        let pipelines = build(device, &module, &layout, Targets::Plain)?;
+        Ok(GBufferPass {
+            material_layout,
+            module,
+            layout,
+            pipelines,
+            spectral_pipelines: None,
+            film_pipelines: None,
+        })
     }
 
-    /// Builds the spectral mode's pipelines unless they exist.
-    pub fn prepare_spectral(&mut self, device: &wgpu::Device) -> Result<()> {
-        if self.spectral_pipelines.is_none() {
-            self.spectral_pipelines = Some(build(device, &self.module, &self.layout, true)?);
+    /// Builds the pipelines for `targets` unless they exist.
+    pub fn prepare(&mut self, device: &wgpu::Device, targets: Targets) -> Result<()> {
+        let slot = match targets {
+            Targets::Plain => return Ok(()),
+            Targets::Slot => &mut self.spectral_pipelines,
+            Targets::Film => &mut self.film_pipelines,
+        };
+        if slot.is_none() {
+            *slot = Some(build(device, &self.module, &self.layout, targets)?);
         }
         Ok(())
     }
 
-    /// Clears and fills `colour` (the three G-buffer targets) and `depth`.
-    /// Records the pass into `colour`: the three G-buffer targets, and the slot target as a
-    /// fourth for the spectral pipelines (after [`Self::prepare_spectral`]).
+    /// Records the pass into `colour`: the three G-buffer targets, the slot target as a fourth
+    /// and the film target as a fifth, as many as the [`Targets`] prepared ([`Self::prepare`]).
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -62,10 +88,10 @@ impl GBufferPass {
         scene: &GpuScene,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let pipelines = if colour.len() > GBUFFER_FORMATS.len() {
-            self.spectral_pipelines.as_ref().expect("prepare_spectral before a spectral G-buffer")
-        } else {
-            &self.pipelines
+        let pipelines = match colour.len() {
+            3 => &self.pipelines,
+            4 => self.spectral_pipelines.as_ref().expect("prepare(Slot) before a spectral G-buffer"),
+            _ => self.film_pipelines.as_ref().expect("prepare(Film) before a G-buffer with films"),
         };
         let attachments: Vec<_> = colour
             .iter()
@@ -109,18 +135,18 @@ impl GBufferPass {
     }
 }
 
-/// The four pipelines (single/double-sided × opaque/alpha-tested), with the slot target when
-/// `spectral`.
+/// The four pipelines (single/double-sided × opaque/alpha-tested) writing `which` targets.
 fn build(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
     layout: &wgpu::PipelineLayout,
-    spectral: bool,
+    which: Targets,
 ) -> Result<Pipelines> {
-    let formats: &[wgpu::TextureFormat] = if spectral {
-        &[GBUFFER_FORMATS[0], GBUFFER_FORMATS[1], GBUFFER_FORMATS[2], GBUFFER_SLOT_FORMAT]
-    } else {
-        &GBUFFER_FORMATS
+    let [base, normal, emission] = GBUFFER_FORMATS;
+    let formats: &[wgpu::TextureFormat] = match which {
+        Targets::Plain => &GBUFFER_FORMATS,
+        Targets::Slot => &[base, normal, emission, GBUFFER_SLOT_FORMAT],
+        Targets::Film => &[base, normal, emission, GBUFFER_SLOT_FORMAT, GBUFFER_FILM_FORMAT],
     };
     let targets: Vec<_> = formats
         .iter()
@@ -129,11 +155,13 @@ fn build(
         })
         .collect();
     let pipeline = |double_sided: bool, alpha: bool| {
-        let entry = match (alpha, spectral) {
-            (false, false) => "fs_main",
-            (true, false) => "fs_alpha",
-            (false, true) => "fs_main_spectral",
-            (true, true) => "fs_alpha_spectral",
+        let entry = match (alpha, which) {
+            (false, Targets::Plain) => "fs_main",
+            (true, Targets::Plain) => "fs_alpha",
+            (false, Targets::Slot) => "fs_main_spectral",
+            (true, Targets::Slot) => "fs_alpha_spectral",
+            (false, Targets::Film) => "fs_main_film",
+            (true, Targets::Film) => "fs_alpha_film",
         };
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -114,3 +114,41 @@ fn fs_main_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBuffer
 fn fs_alpha_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferSpectralOut {
     return with_slot(gbuffer(v, front, true));
 }
+
+// Scenes with a thin film (KHR_materials_iridescence) add its per-pixel values, in RGB mode as
+// in the spectral ones (the slot is written in both then, and read only by the spectral modes).
+struct GBufferFilmOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) slot: u32,
+    // x weight (factor × texture R; 0: no film), y the thickness texture's G: where the thickness
+    // lies between the material's minimum and maximum.
+    @location(4) film: vec2<f32>,
+};
+
+// The film's values (sampled before `gbuffer`, whose discard would leave the derivatives of
+// later samples undefined): weight and thickness fraction.
+fn film_values(v: VertexOut) -> vec2<f32> {
+    let weight = textureSample(film_tex, film_smp, material_uv(TEX_FILM, v.uv, v.uv1)).r * material.film.x;
+    let t = textureSample(film_thickness_tex, film_thickness_smp, material_uv(TEX_FILM_THICKNESS, v.uv, v.uv1)).g;
+    return vec2<f32>(clamp(weight, 0.0, 1.0), clamp(t, 0.0, 1.0));
+}
+
+fn with_film(o: GBufferOut, f: vec2<f32>) -> GBufferFilmOut {
+    // An unlit surface (UNLIT_MARK) reflects nothing, so it has no film either.
+    let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
+    return GBufferFilmOut(o.base, o.normal, o.emission, material.slot.x, film);
+}
+
+@fragment
+fn fs_main_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmOut {
+    let f = film_values(v);
+    return with_film(gbuffer(v, front, false), f);
+}
+
+@fragment
+fn fs_alpha_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmOut {
+    let f = film_values(v);
+    return with_film(gbuffer(v, front, true), f);
+}

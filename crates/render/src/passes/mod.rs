@@ -30,6 +30,13 @@ pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
     [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float];
 /// The spectral G-buffer's fourth target: the material's slot (`MaterialUniforms::slot`).
 pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The thin film per pixel (written only when the scene has one): weight and where the
+/// thickness lies between the material's minimum and maximum (f16: exact at the ends, 2⁻¹¹ of
+/// the range near the maximum; the thickness texture itself has 8 bits); the film's index and
+/// thickness range are the material's (`MaterialSpectrum::film`).
+/// Two channels because the G-buffer's five targets must fit the 32 bytes per sample WebGPU
+/// guarantees (3 × 8 + 4 + 4).
+pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Display output: the hardware does the sRGB encoding on store.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;

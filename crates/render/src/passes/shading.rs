@@ -76,6 +76,9 @@ pub struct Variant {
     pub fetch_base: bool,
     /// The same for emission (`FETCH_EMISSION`).
     pub fetch_emission: bool,
+    /// Some material has a thin film (`HAS_FILM`): the G-buffer's film target is read and
+    /// filmed pixels take the film's Fresnel term (all modes).
+    pub film: bool,
 }
 
 impl Variant {
@@ -88,11 +91,12 @@ impl Variant {
         capture: false,
         fetch_base: true,
         fetch_emission: true,
+        film: true,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment); its pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 7] {
+    /// environment, film); its pipelines are keyed by [`Self::rgb`].
+    fn constants(&self) -> [(&'static str, f64); 8] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -102,12 +106,13 @@ impl Variant {
             ("CAPTURE", b(self.capture)),
             ("FETCH_BASE", b(self.fetch_base)),
             ("FETCH_EMISSION", b(self.fetch_emission)),
+            ("HAS_FILM", b(self.film)),
         ]
     }
 
     /// What the RGB entry point depends on, the rest at its defaults.
     fn rgb(self) -> Variant {
-        Variant { polygons: self.polygons, environment: self.environment, ..Variant::ALL }
+        Variant { polygons: self.polygons, environment: self.environment, film: self.film, ..Variant::ALL }
     }
 }
 
@@ -121,6 +126,7 @@ impl ShadingPass {
                 shader::COMMON,
                 shader::SPECTRAL,
                 shader::ENVIRONMENT,
+                shader::FILM,
                 shader::CUSTOM_API,
                 &custom.assembled(),
                 include_str!("shading.wgsl"),
@@ -198,6 +204,8 @@ impl ShadingPass {
                     },
                     count: None,
                 },
+                // The films (`gbuf_film`).
+                texture_entry(9),
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -287,6 +295,7 @@ impl ShadingPass {
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
                 view_entry(8, &t.gbuffer_slot_view),
+                view_entry(9, &t.gbuffer_film_view),
             ],
         })
     }

@@ -1,5 +1,6 @@
 // Pass 2: spectral (or RGB) shading of the G-buffer into the HDR target.
-// Prepended: wgsl/common.wgsl, wgsl/spectral.wgsl, wgsl/environment.wgsl, wgsl/custom_api.wgsl,
+// Prepended: wgsl/common.wgsl, wgsl/spectral.wgsl, wgsl/environment.wgsl, wgsl/film.wgsl,
+// wgsl/custom_api.wgsl,
 // then the custom shader.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -22,6 +23,9 @@ const NO_SHADOW: u32 = 0xffffffffu;
 // them the driver compiles the shader without their code.
 override HAS_POLYGONS: bool = true;
 override HAS_ENV: bool = true;
+// A material with a thin film (KHR_materials_iridescence): the G-buffer's film target is read,
+// and filmed pixels take the film's Fresnel term (every mode).
+override HAS_FILM: bool = true;
 
 fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
@@ -36,6 +40,9 @@ struct ShadowUniforms {
     layer_of_light: array<vec4<u32>, 8>,
 };
 @group(1) @binding(6) var<uniform> shadows: ShadowUniforms;
+// The films: x weight (0: none), y the thickness between the material's minimum and maximum
+// (gbuffer.wgsl).
+@group(1) @binding(9) var gbuf_film: texture_2d<f32>;
 
 // The spectral capture (`Renderer::set_spectral_capture`, `spectra render --spectral-out`): per
 // pixel and group of four nodes, each node's radiance in weighted form summed over X, Y and Z
@@ -73,22 +80,28 @@ fn lambert_only() -> bool {
     return (frame.flags & FLAG_LAMBERT) != 0u;
 }
 
-// Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
-// where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
-// Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
-// costs two fma per light.
-fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+// One light's geometry at a surface: radiance = E·(kd·(1 − F)·c_diff/π + ks·F) with F the
+// Fresnel term at v·h — kd the cosine-weighted irradiance factor, ks that times the GGX
+// distribution and visibility (D·V). Zero for a light that does not reach p.
+struct LightTerms {
+    kd: f32,
+    ks: f32,
+    vh: f32,
+};
+
+fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> LightTerms {
     if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
-        return polygon_factors(li, p, n, v, metallic, roughness);
+        return polygon_terms(li, p, n, v, roughness);
     }
     let inc = light_incidence(li, p);
     let wi = inc.xyz;
     var atten = inc.w;
     let nl = dot(n, wi);
-    if (nl <= 0.0 || atten <= 0.0) { return vec2<f32>(0.0); }
+    if (nl <= 0.0 || atten <= 0.0) { return LightTerms(0.0, 0.0, 1.0); }
     atten *= light_visibility(li, p, n);
+    let k = nl * atten;
     if (lambert_only()) {
-        return vec2<f32>(nl * atten / PI, 0.0);
+        return LightTerms(k, 0.0, 1.0);
     }
     let h = normalize(wi + v);
     let nv = max(dot(n, v), 1e-4);
@@ -99,13 +112,26 @@ fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f3
     let dd = nh * nh * (a2 - 1.0) + 1.0;
     let dist = a2 / (PI * dd * dd);
     let vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
-    let dv = dist * vis;
-    let fres = pow(1.0 - vh, 5.0);
+    return LightTerms(k, k * dist * vis, vh);
+}
+
+// Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
+// where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
+// Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
+// costs two fma per light.
+fn factors_of(t: LightTerms, metallic: f32) -> vec2<f32> {
+    if (lambert_only()) {
+        return vec2<f32>(t.kd / PI, 0.0);
+    }
+    let fres = pow(1.0 - t.vh, 5.0);
     let f_dielectric = 0.04 + 0.96 * fres;
-    let k = nl * atten;
-    let a = k * ((1.0 - metallic) * (1.0 - f_dielectric) / PI + metallic * dv * (1.0 - fres));
-    let b = k * dv * ((1.0 - metallic) * f_dielectric + metallic * fres);
+    let a = t.kd * (1.0 - metallic) * (1.0 - f_dielectric) / PI + t.ks * metallic * (1.0 - fres);
+    let b = t.ks * ((1.0 - metallic) * f_dielectric + metallic * fres);
     return vec2<f32>(a, b);
+}
+
+fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+    return factors_of(light_terms(li, p, n, v, roughness), metallic);
 }
 
 // E/L of a polygon light at p with normal n: ∫ max(n·l, 0) dl over the polygon clipped to
@@ -158,20 +184,21 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
     return atan2(s, dot(ua, ub)) * dot(n, c) / s;
 }
 
-// `light_factors` for a polygon light (an emissive surface, src/scene_gpu.rs): diffuse exactly
+// `light_terms` for a polygon light (an emissive surface, src/scene_gpu.rs): diffuse exactly
 // (polygon_irradiance), specular by the representative point (Karis 2013: the point of the
 // polygon nearest the mirror ray, with the lobe widened by the light's size), shadowed by one
 // shadow map from the centroid.
-fn polygon_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
+fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> LightTerms {
+    let none = LightTerms(0.0, 0.0, 1.0);
     let ln = polygon_normal(li);
     let v0 = polygon_vertex(li, 0u);
     // One-sided: nothing reaches points behind the emitting side.
-    if (dot(p - v0, ln) <= 0.0) { return vec2<f32>(0.0); }
+    if (dot(p - v0, ln) <= 0.0) { return none; }
     let g = polygon_irradiance(li, p, n);
-    if (g <= 0.0) { return vec2<f32>(0.0); }
+    if (g <= 0.0) { return none; }
     let vis = light_visibility(li, p, n);
     if (lambert_only()) {
-        return vec2<f32>(g * vis / PI, 0.0);
+        return LightTerms(g * vis, 0.0, 1.0);
     }
     // Representative point: where the mirror ray meets the light's plane, else the centroid,
     // pulled into the polygon's bounding sphere.
@@ -208,11 +235,7 @@ fn polygon_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: 
     // Solid angle of the polygon from p (as a disc of its area seen at the light's cosine).
     let omega = min(area * max(dot(ln, -wi), 0.0) / dist2, 2.0 * PI);
     let dv = select(0.0, dist_d * vis_s * nl * omega, nl > 0.0);
-    let fres = pow(1.0 - vh, 5.0);
-    let f_dielectric = 0.04 + 0.96 * fres;
-    let a = vis * ((1.0 - metallic) * (1.0 - f_dielectric) * g / PI + metallic * dv * (1.0 - fres));
-    let b = vis * dv * ((1.0 - metallic) * f_dielectric + metallic * fres);
-    return vec2<f32>(a, b);
+    return LightTerms(vis * g, vis * dv, vh);
 }
 
 // Screen-space occlusion of the environment at pixel `pix` (world position p, normal n): the
@@ -334,6 +357,86 @@ fn diffuse_lobe(s: GSurface) -> f32 {
     return (1.0 - s.metallic) * (1.0 - (0.04 + 0.96 / 21.0)) / PI;
 }
 
+// The thin film at a pixel (KHR_materials_iridescence): how much of the Fresnel term is the
+// film's (0: none), its thickness and index. None without films in the scene, on unlit
+// surfaces, and in the Lambert-only comparison mode (whose BRDF has no Fresnel term).
+struct FilmSurface {
+    weight: f32,
+    thickness_nm: f32,
+    ior: f32,
+};
+
+fn load_film(px: vec2<i32>) -> FilmSurface {
+    if (!HAS_FILM || lambert_only()) {
+        return FilmSurface(0.0, 0.0, 1.0);
+    }
+    let f = textureLoad(gbuf_film, px, 0);
+    let slot = textureLoad(gbuf_slot, px, 0).x;
+    let m = material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)].film;
+    return FilmSurface(f.x, mix(m.y, m.z, f.y), max(m.x, 1.0));
+}
+
+// The Fresnel terms under a film at four node wavelengths and the cosine c: the dielectric
+// base's (index 1.5, the glTF F0 of 0.04) and the metal's (its reflectance ρ(λ) as F0, the
+// extension's convention), each Schlick's blended with the film's exact reflectance
+// (wgsl/film.wgsl) by the film's weight — the truth's `Brdf::fresnel`, per node.
+struct FilmFresnel {
+    dielectric: vec4<f32>,
+    metal: vec4<f32>,
+};
+
+fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, c: f32) -> FilmFresnel {
+    let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
+    var r: FilmFresnel;
+    r.dielectric = mix(vec4<f32>(0.04 + 0.96 * fres),
+        film_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(1.5)), f.weight);
+    if (metallic > 0.0) {
+        r.metal = mix(rho + (1.0 - rho) * fres,
+            film_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho)), f.weight);
+    }
+    return r;
+}
+
+// One light's radiance over E(λ) at a filmed surface, per node: the factors of `factors_of`
+// with the film's Fresnel terms, which depend on λ.
+fn film_light_node(t: LightTerms, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> vec4<f32> {
+    let fr = film_fresnel(f, rho, metallic, lambda, t.vh);
+    let spec = (1.0 - metallic) * fr.dielectric + metallic * fr.metal;
+    return t.kd * (1.0 - metallic) / PI * (1.0 - fr.dielectric) * rho + t.ks * spec;
+}
+
+// The environment at a filmed surface, per node: what multiplies the irradiance's node weights
+// and what multiplies the prefiltered radiance's (`env_terms` with the film's Fresnel terms at
+// n·v: each lobe's directional albedo F0·A + B becomes the film's R(n·v)·(A + B), blended by
+// the weight — Fresnel at n·v, the split sum's own approximation).
+struct FilmEnvNode {
+    irr: vec4<f32>,
+    spec: vec4<f32>,
+};
+
+fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> FilmEnvNode {
+    let a = l.ab.x;
+    let b = l.ab.y;
+    var fd = mix(vec4<f32>(0.04 * a + b), film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(1.5)) * (a + b), f.weight);
+    var fm = vec4<f32>(0.0);
+    if (metallic > 0.0) {
+        fm = mix(rho * a + b, film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, film_ior_from_f0(rho)) * (a + b), f.weight);
+    }
+    return FilmEnvNode((1.0 - metallic) / PI * (1.0 - fd) * rho, (1.0 - metallic) * fd + metallic * fm);
+}
+
+// RGB mode's film (the extension's Belcour–Barla evaluation in RGB, wgsl/film.wgsl): the
+// dielectric and metal Fresnel terms at cosine c, blended with Schlick's by the weight.
+fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> mat2x3<f32> {
+    let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
+    let fd = mix(vec3<f32>(0.04 + 0.96 * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(0.04)), f.weight);
+    var fm = vec3<f32>(0.0);
+    if (metallic > 0.0) {
+        fm = mix(base + (1.0 - base) * fres, film_rgb(c, f.thickness_nm, f.ior, base), f.weight);
+    }
+    return mat2x3<f32>(fd, fm);
+}
+
 // RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
 // own), so that RGB pays only for what RGB needs.
 @fragment
@@ -347,19 +450,47 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+        let film = load_film(px);
+        let filmed = HAS_FILM && film.weight > 0.0;
         for (var li = 0u; li < n_lit; li++) {
-            let f = light_factors(li, ctx.world_pos, s.normal, -ctx.view_dir, s.metallic, s.roughness)
-                * custom_light_surface(li, ctx);
             var e = lights[li].rgb.rgb;
             if (CUSTOM_LIGHT_T) {
                 e *= custom_light_transmittance_rgb(li, ctx);
             }
-            sum_a = fma(vec3<f32>(f.x), e, sum_a);
-            sum_b = fma(vec3<f32>(f.y), e, sum_b);
+            var t = light_terms(li, ctx.world_pos, s.normal, -ctx.view_dir, s.roughness);
+            let k = custom_light_surface(li, ctx);
+            t.kd *= k;
+            t.ks *= k;
+            if (filmed) {
+                // The film's Fresnel terms are colours: the whole reflection goes into sum_b.
+                let fr = film_fresnel_rgb(film, s.base, s.metallic, t.vh);
+                let spec = (1.0 - s.metallic) * fr[0] + s.metallic * fr[1];
+                let r = t.kd * (1.0 - s.metallic) / PI * (1.0 - fr[0]) * s.base + t.ks * spec;
+                sum_b = fma(r, e, sum_b);
+            } else {
+                let f = factors_of(t, s.metallic);
+                sum_a = fma(vec3<f32>(f.x), e, sum_a);
+                sum_b = fma(vec3<f32>(f.y), e, sum_b);
+            }
         }
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (shading_env() && !s.unlit) {
-            let et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+            var et: EnvTerms;
+            if (!filmed) {
+                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+            } else {
+                let l = env_lobes(s.normal, -ctx.view_dir, s.roughness);
+                let a = l.ab.x;
+                let b = l.ab.y;
+                let fd = mix(vec3<f32>(0.04 * a + b), film_rgb(l.nv, film.thickness_nm, film.ior, vec3<f32>(0.04)) * (a + b), film.weight);
+                var fm = vec3<f32>(0.0);
+                if (s.metallic > 0.0) {
+                    fm = mix(s.base * a + b, film_rgb(l.nv, film.thickness_nm, film.ior, s.base) * (a + b), film.weight);
+                }
+                et.a = vec4<f32>(0.0);
+                et.b = vec4<f32>((1.0 - s.metallic) / PI * (1.0 - fd) * s.base * l.irr.rgb
+                    + ((1.0 - s.metallic) * fd + s.metallic * fm) * l.spec.rgb, 0.0);
+            }
             var env_rgb = (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
             if (CUSTOM_ENV_T) {
                 env_rgb *= custom_env_transmittance_rgb(ctx);
@@ -422,6 +553,9 @@ struct MaterialSpectrum {
     emission: vec4<f32>,
     // The constant emission's XYZ at this frame's nodes (what the node loop would add up).
     emission_xyz: vec4<f32>,
+    // The thin film (KHR_materials_iridescence): x its index (1 without a film), y and z its
+    // thickness minimum and maximum, nm.
+    film: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
 
@@ -498,14 +632,28 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let c_base = sc.base;
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+    let film = load_film(px);
+    let filmed = HAS_FILM && film.weight > 0.0;
     for (var li = 0u; li < n_lights; li++) {
-        let f = light_factors(li, p, s.normal, v, s.metallic, s.roughness) * custom_light_surface(li, ctx);
-        // The specular part does not depend on the reflectance: the light's XYZ once.
-        var reflected = vec3<f32>(0.0);
-        for (var g = 0u; g < ng; g++) {
-            reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
+        var t = light_terms(li, p, s.normal, v, s.roughness);
+        let k = custom_light_surface(li, ctx);
+        t.kd *= k;
+        t.ks *= k;
+        if (filmed) {
+            // Under a film the specular part depends on λ too: all of it through the nodes.
+            for (var g = 0u; g < ng; g++) {
+                let rho = node_reflectance(c_base, s.base, g);
+                xyz += film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda) * light_w(li, g, ng);
+            }
+        } else {
+            let f = factors_of(t, s.metallic);
+            // The specular part does not depend on the reflectance: the light's XYZ once.
+            var reflected = vec3<f32>(0.0);
+            for (var g = 0u; g < ng; g++) {
+                reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
+            }
+            xyz = fma(vec3<f32>(f.x), reflected, fma(vec3<f32>(f.y), lights[li].xyz.xyz, xyz));
         }
-        xyz = fma(vec3<f32>(f.x), reflected, fma(vec3<f32>(f.y), lights[li].xyz.xyz, xyz));
     }
     // Ambient light (environment, a hook's irradiance) and emission: one more pass over the nodes.
     var vis = 1.0;
@@ -513,11 +661,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         vis = ambient_visibility(in.pos.xy, p, s);
     }
     var et: EnvTerms;
+    var lobes: EnvLobes;
+    let film_env = filmed && has_env;
     if (has_env && !s.unlit) {
-        et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only());
-        et.a *= vis;
-        et.b *= vis;
-        xyz += env_xyz(et.b);
+        if (film_env) {
+            lobes = env_lobes(s.normal, v, s.roughness);
+            lobes.irr *= vis;
+            lobes.spec *= vis;
+        } else {
+            et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only());
+            et.a *= vis;
+            et.b *= vis;
+            xyz += env_xyz(et.b);
+        }
     }
     let lobe = diffuse_lobe(s) * vis;
     // Emission known for the whole material is added as its XYZ; only a varying (textured) one
@@ -528,7 +684,10 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     xyz += sc.emission_xyz;
     for (var g = 0u; g < ng; g++) {
         let rho = node_reflectance(c_base, s.base, g);
-        if (has_env) {
+        if (film_env) {
+            let fe = film_env_node(lobes, film, rho, s.metallic, wavelengths[g].lambda);
+            xyz += fe.irr * env_w(lobes.irr, g, ng) + fe.spec * env_w(lobes.spec, g, ng);
+        } else if (has_env) {
             xyz += rho * env_w(et.a, g, ng);
         }
         if (em_nodes) {
@@ -559,16 +718,30 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
     var et: EnvTerms;
     let has_env = shading_env();
+    // A filmed pixel keeps each light's terms instead (its Fresnel term depends on λ), and the
+    // environment's lobes.
+    var film = FilmSurface(0.0, 0.0, 1.0);
+    var ft: array<LightTerms, MAX_LIGHTS>;
+    var lobes: EnvLobes;
+    var metallic = 0.0;
     if (!background) {
         let s = load_surface(px);
+        film = load_film(px);
+        metallic = s.metallic;
         var vis = 1.0;
         if ((has_env || CUSTOM_IRRADIANCE) && !s.unlit) {
             vis = ambient_visibility(in.pos.xy, p, s);
         }
         if (has_env && !s.unlit) {
-            et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
-            et.a *= vis;
-            et.b *= vis;
+            if (HAS_FILM && film.weight > 0.0) {
+                lobes = env_lobes(s.normal, -ctx.view_dir, s.roughness);
+                lobes.irr *= vis;
+                lobes.spec *= vis;
+            } else {
+                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+                et.a *= vis;
+                et.b *= vis;
+            }
         }
         base = s.base;
         emission = s.emission;
@@ -577,12 +750,20 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         // The hook's irradiance is ambient light too: occluded like the environment.
         lobe = diffuse_lobe(s) * vis;
         for (var li = 0u; li < n_lights; li++) {
-            let f = light_factors(li, p, s.normal, -ctx.view_dir, s.metallic, s.roughness)
-                * custom_light_surface(li, ctx);
-            fa[li] = f.x;
-            fb[li] = f.y;
+            var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness);
+            let k = custom_light_surface(li, ctx);
+            t.kd *= k;
+            t.ks *= k;
+            if (HAS_FILM && film.weight > 0.0) {
+                ft[li] = t;
+            } else {
+                let f = factors_of(t, s.metallic);
+                fa[li] = f.x;
+                fb[li] = f.y;
+            }
         }
     }
+    let filmed = HAS_FILM && film.weight > 0.0;
 
     var c_base = vec3<f32>(0.0);
     var em = vec4<f32>(0.0);
@@ -608,7 +789,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var xyz = vec3<f32>(0.0);
     // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
     // light's XYZ once; the capture still takes them per node.
-    if (!CUSTOM_SPECTRAL) {
+    if (!CUSTOM_SPECTRAL && !filmed) {
         for (var li = 0u; li < n_lights; li++) {
             xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
         }
@@ -623,27 +804,48 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         // Σ_l a_l·W_l and Σ_l b_l·W_l: three fma each per light and group.
         var acc_a = zero;
         var acc_b = zero;
+        // A filmed pixel's reflection, all of it (it is not a multiple of ρ).
+        var acc_f = zero;
         for (var li = 0u; li < n_lights; li++) {
             var w = light_w(li, g, ng);
             if (CUSTOM_LIGHT_T) {
                 w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
             }
-            acc_a += w * fa[li];
-            acc_b += w * fb[li];
+            if (filmed) {
+                acc_f += s3_scale(w, film_light_node(ft[li], film, rho, metallic, lambda));
+            } else {
+                acc_a += w * fa[li];
+                acc_b += w * fb[li];
+            }
         }
         if (has_env && !background) {
-            var wa = env_w(et.a, g, ng);
-            var wb = env_w(et.b, g, ng);
-            if (CUSTOM_ENV_T) {
-                let t = custom_env_transmittance(lambda, g, ctx);
-                wa = s3_scale(wa, t);
-                wb = s3_scale(wb, t);
+            if (filmed) {
+                let fe = film_env_node(lobes, film, rho, metallic, lambda);
+                var wi = s3_scale(env_w(lobes.irr, g, ng), fe.irr);
+                var ws = s3_scale(env_w(lobes.spec, g, ng), fe.spec);
+                if (CUSTOM_ENV_T) {
+                    let t = custom_env_transmittance(lambda, g, ctx);
+                    wi = s3_scale(wi, t);
+                    ws = s3_scale(ws, t);
+                }
+                acc_f += wi + ws;
+            } else {
+                var wa = env_w(et.a, g, ng);
+                var wb = env_w(et.b, g, ng);
+                if (CUSTOM_ENV_T) {
+                    let t = custom_env_transmittance(lambda, g, ctx);
+                    wa = s3_scale(wa, t);
+                    wb = s3_scale(wb, t);
+                }
+                acc_a += wa;
+                acc_b += wb;
             }
-            acc_a += wa;
-            acc_b += wb;
         }
         // This group's whole radiance in weighted form.
         var part = s3_scale(acc_a, rho) + acc_b;
+        if (filmed) {
+            part += acc_f;
+        }
         if (HAS_EMISSION) {
             part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g));
         }
@@ -651,8 +853,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             part = custom_spectral(lambda, part, g, ctx);
             xyz += s3_xyz(part);
         } else {
-            // The specular terms are in xyz already.
+            // The specular terms are in xyz already (a filmed pixel has them in acc_f).
             xyz += rho * acc_a;
+            if (filmed) {
+                xyz += s3_xyz(acc_f);
+            }
             if (HAS_EMISSION) {
                 xyz += node_emission(em.xyz, em.w, emission, g) * white_weights(g);
             }

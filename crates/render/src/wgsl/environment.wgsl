@@ -49,27 +49,43 @@ struct EnvTerms {
     b: vec4<f32>,
 };
 
+// The environment's two lobes at a surface, before any material weighs them: the irradiance
+// coefficients, the prefiltered radiance around the mirror direction, the split-sum factors
+// (A, B) of the specular lobe's directional albedo F0·A + B, and n·v.
+struct EnvLobes {
+    irr: vec4<f32>,
+    spec: vec4<f32>,
+    ab: vec2<f32>,
+    nv: f32,
+};
+
+fn env_lobes(n: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
+    var l: EnvLobes;
+    let k = env.params.z;
+    l.nv = max(dot(n, v), 1e-4);
+    let r = reflect(-v, n);
+    let half_texel = 0.5 / ENV_LUT_SIZE;
+    let lut_uv = clamp(vec2<f32>(l.nv, roughness), vec2<f32>(half_texel), vec2<f32>(1.0 - half_texel));
+    l.ab = textureSampleLevel(env_lut, env_sampler, lut_uv, 0.0).xy;
+    l.irr = textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * k;
+    l.spec = textureSampleLevel(env_radiance, env_sampler, env_uv(r), roughness * env.params.y) * k;
+    return l;
+}
+
 fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool) -> EnvTerms {
     var t: EnvTerms;
     if (!env_enabled()) {
         return t;
     }
-    let k = env.params.z;
-    let irr = textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * k;
     if (lambert) {
-        t.a = irr / PI;
+        t.a = textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * env.params.z / PI;
         return t;
     }
-    let nv = max(dot(n, v), 1e-4);
-    let r = reflect(-v, n);
-    let half_texel = 0.5 / ENV_LUT_SIZE;
-    let lut_uv = clamp(vec2<f32>(nv, roughness), vec2<f32>(half_texel), vec2<f32>(1.0 - half_texel));
-    let ab = textureSampleLevel(env_lut, env_sampler, lut_uv, 0.0).xy;
-    let spec = textureSampleLevel(env_radiance, env_sampler, env_uv(r), roughness * env.params.y) * k;
+    let l = env_lobes(n, v, roughness);
     // Directional albedo of the dielectric specular lobe: what the diffuse layer does not get.
-    let f_d = 0.04 * ab.x + ab.y;
-    t.a = (1.0 - metallic) * (1.0 - f_d) / PI * irr + metallic * ab.x * spec;
-    t.b = ((1.0 - metallic) * f_d + metallic * ab.y) * spec;
+    let f_d = 0.04 * l.ab.x + l.ab.y;
+    t.a = (1.0 - metallic) * (1.0 - f_d) / PI * l.irr + metallic * l.ab.x * l.spec;
+    t.b = ((1.0 - metallic) * f_d + metallic * l.ab.y) * l.spec;
     return t;
 }
 

@@ -3,27 +3,101 @@
 // of index ≥ 1, seen from air. Then no interface reflects totally and every cosine is real;
 // only the film's round-trip phase δ is complex, and Airy's |r₁₂ + r₂₃e^{iδ}|² / |1 +
 // r₁₂r₂₃e^{iδ}|² is (a² + b² + 2ab·cos δ) / (1 + a²b² + 2ab·cos δ) with real amplitudes a, b,
-// for both polarisations at once (x: s, y: p). Tested against the Rust (src/film_tests.rs).
-fn film_reflectance(lambda_nm: f32, cos_i: f32, thickness_nm: f32, film_ior: f32, base_ior: f32) -> f32 {
-    let c1 = clamp(cos_i, 0.0, 1.0);
+// per polarisation. Four wavelengths at once (a node group); the first interface and the
+// film's cosine do not depend on λ. Tested against the Rust (src/film_tests.rs).
+fn film_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_ior: f32, base_ior: vec4<f32>) -> vec4<f32> {
+    // Not quite grazing: at cos 0 under a film of index 1 both amplitudes would be 0/0.
+    let c1 = clamp(cos_i, 1e-6, 1.0);
     let s2 = 1.0 - c1 * c1;
     let n2 = film_ior;
     let n3 = base_ior;
     let c2 = sqrt(max(1.0 - s2 / (n2 * n2), 0.0));
-    let c3 = sqrt(max(1.0 - s2 / (n3 * n3), 0.0));
-    let a = vec2<f32>((c1 - n2 * c2) / (c1 + n2 * c2), (n2 * c1 - c2) / (n2 * c1 + c2));
-    let b = vec2<f32>((n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3), (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3));
-    let cd = vec2<f32>(cos(4.0 * PI * thickness_nm * n2 * c2 / lambda_nm));
+    let c3 = sqrt(max(vec4<f32>(1.0) - s2 / (n3 * n3), vec4<f32>(0.0)));
+    let a_s = (c1 - n2 * c2) / (c1 + n2 * c2);
+    let a_p = (n2 * c1 - c2) / (n2 * c1 + c2);
+    let b_s = (n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3);
+    let b_p = (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3);
+    let cd = cos((4.0 * PI * thickness_nm * n2 * c2) / lambda_nm);
+    return clamp(0.5 * (film_airy(a_s, b_s, cd) + film_airy(a_p, b_p, cd)), vec4<f32>(0.0), vec4<f32>(1.0));
+}
+
+fn film_airy(a: f32, b: vec4<f32>, cd: vec4<f32>) -> vec4<f32> {
     let ab2 = 2.0 * a * b * cd;
     let num = a * a + b * b + ab2;
     let den = 1.0 + a * a * b * b + ab2;
-    // den ≥ (1 − |ab|)², zero only at grazing incidence under a film of index 1: total there.
-    let r = select(num / den, vec2<f32>(1.0), den <= vec2<f32>(1e-20));
-    return clamp(0.5 * (r.x + r.y), 0.0, 1.0);
+    // den ≥ (1 − |ab|)², zero only when both interfaces reflect totally: total then.
+    return select(num / den, vec4<f32>(1.0), den <= vec4<f32>(1e-20));
 }
 
 // The index of a base whose normal-incidence reflectance is f0 (`scene::film::ior_from_f0`).
-fn film_ior_from_f0(f0: f32) -> f32 {
-    let s = sqrt(clamp(f0, 0.0, 0.9999));
+fn film_ior_from_f0(f0: vec4<f32>) -> vec4<f32> {
+    let s = sqrt(clamp(f0, vec4<f32>(0.0), vec4<f32>(0.9999)));
     return (1.0 + s) / (1.0 - s);
+}
+
+// The RGB mode's film: the extension's own RGB evaluation (Belcour & Barla 2017, "A Practical
+// Extension to Microfacet Theory for the Modeling of Varying Iridescence"): Schlick interfaces,
+// the Airy series to its second order, each order's spectral integral in closed form from
+// Gaussian fits of the colour-matching functions' Fourier transform, then XYZ → linear sRGB.
+// What an RGB renderer can do; the spectral modes evaluate the exact film per node instead.
+// `base_f0`: the base's normal-incidence reflectance per channel (0.04 for the dielectric).
+
+// XYZ → linear sRGB, the colour crate's (from the sRGB primaries and D65); src/film_tests.rs
+// checks that they agree.
+const FILM_XYZ_TO_SRGB: mat3x3<f32> = mat3x3<f32>(
+    vec3<f32>(3.2409699, -0.9692436, 0.0556301),
+    vec3<f32>(-1.5373832, 1.8759675, -0.2039770),
+    vec3<f32>(-0.4986108, 0.0415551, 1.0569715),
+);
+
+// The colour-matching functions' Fourier transform at optical path difference `opd_nm` with
+// phase shifts `shift` per channel (Belcour & Barla's supplemental fit: a Gaussian per X, Y, Z,
+// a second one for X's short-wave lobe), normalised so that zero path difference is Y = 1.
+fn film_sensitivity(opd_nm: f32, shift: vec3<f32>) -> vec3<f32> {
+    let phase = 2.0 * PI * opd_nm * 1e-9;
+    let amp = vec3<f32>(5.4856e-13, 4.4201e-13, 5.2481e-13);
+    let freq = vec3<f32>(1.6810e6, 1.7953e6, 2.2084e6);
+    let spread = vec3<f32>(4.3278e9, 9.3046e9, 6.6121e9);
+    var xyz = amp * sqrt(2.0 * PI * spread) * cos(freq * phase + shift) * exp(-phase * phase * spread);
+    xyz.x += 9.7470e-14 * sqrt(2.0 * PI * 4.5282e9) * cos(2.2399e6 * phase + shift.x) * exp(-4.5282e9 * phase * phase);
+    return FILM_XYZ_TO_SRGB * (xyz / 1.0685e-7);
+}
+
+fn film_schlick(f0: vec3<f32>, c: f32) -> vec3<f32> {
+    return f0 + (1.0 - f0) * pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
+}
+
+fn film_rgb(cos_i: f32, thickness_nm: f32, film_ior: f32, base_f0: vec3<f32>) -> vec3<f32> {
+    // A film that thins to nothing takes the outside's index, so that it vanishes.
+    let n2 = mix(1.0, film_ior, smoothstep(0.0, 0.03, thickness_nm));
+    let c1 = clamp(cos_i, 0.0, 1.0);
+    let s2 = (1.0 - c1 * c1) / (n2 * n2);
+    if (s2 >= 1.0) {
+        return vec3<f32>(1.0);
+    }
+    let c2 = sqrt(1.0 - s2);
+    // Air → film: reflected and transmitted (both ways) energy; the phase on reflection inside
+    // the film is π (it is denser than air).
+    let r0 = ((n2 - 1.0) / (n2 + 1.0)) * ((n2 - 1.0) / (n2 + 1.0));
+    let r12 = film_schlick(vec3<f32>(r0), c1).x;
+    let t121 = 1.0 - r12;
+    let phi21 = select(PI, 0.0, n2 < 1.0);
+    // Film → base, with the base's index from its F0; phase π where the base is the thinner.
+    let s = sqrt(clamp(base_f0, vec3<f32>(0.0), vec3<f32>(0.9999)));
+    let n3 = (1.0 + s) / (1.0 - s);
+    let f23 = ((n3 - n2) / (n3 + n2)) * ((n3 - n2) / (n3 + n2));
+    let r23 = film_schlick(f23, c2);
+    let phi23 = select(vec3<f32>(0.0), vec3<f32>(PI), n3 < vec3<f32>(n2));
+    let opd = 2.0 * n2 * thickness_nm * c2;
+    let phi = vec3<f32>(phi21) + phi23;
+    let r123 = clamp(r12 * r23, vec3<f32>(1e-5), vec3<f32>(0.9999));
+    let amp = sqrt(r123);
+    let rs = t121 * t121 * r23 / (1.0 - r123);
+    var i = vec3<f32>(r12) + rs;
+    var cm = rs - t121;
+    for (var m = 1; m <= 2; m++) {
+        cm *= amp;
+        i += cm * 2.0 * film_sensitivity(f32(m) * opd, f32(m) * phi);
+    }
+    return max(i, vec3<f32>(0.0));
 }

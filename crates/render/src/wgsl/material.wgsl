@@ -1,4 +1,4 @@
-// A material (bind group 1 of the G-buffer and shadow passes): factors, five textures each
+// A material (bind group 1 of the G-buffer and shadow passes): factors, seven textures each
 // with its own sampler, UV set and KHR_texture_transform, and the alpha mode. Prepended to
 // passes/gbuffer.wgsl and passes/shadow.wgsl.
 
@@ -14,9 +14,11 @@ struct MaterialUniforms {
     alpha: vec4<f32>,
     // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
     // (m10, m11, m12, 0); uv' = M · (u, v, 1).
-    uv_rows: array<vec4<f32>, 10>,
+    uv_rows: array<vec4<f32>, 14>,
     // x: the material's index + 1 (`MaterialUniforms::slot`), written by the spectral G-buffer.
     slot: vec4<u32>,
+    // KHR_materials_iridescence: x factor (0: none), y film index, z/w thickness min/max (nm).
+    film: vec4<f32>,
 };
 
 const ALPHA_OPAQUE: u32 = 0u;
@@ -28,6 +30,8 @@ const TEX_METAL_ROUGH: u32 = 1u;
 const TEX_NORMAL: u32 = 2u;
 const TEX_EMISSIVE: u32 = 3u;
 const TEX_OCCLUSION: u32 = 4u;
+const TEX_FILM: u32 = 5u;
+const TEX_FILM_THICKNESS: u32 = 6u;
 
 @group(1) @binding(0) var<uniform> material: MaterialUniforms;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;
@@ -35,11 +39,15 @@ const TEX_OCCLUSION: u32 = 4u;
 @group(1) @binding(3) var normal_tex: texture_2d<f32>;
 @group(1) @binding(4) var emissive_tex: texture_2d<f32>;
 @group(1) @binding(5) var occlusion_tex: texture_2d<f32>;
-@group(1) @binding(6) var base_color_smp: sampler;
-@group(1) @binding(7) var metal_rough_smp: sampler;
-@group(1) @binding(8) var normal_smp: sampler;
-@group(1) @binding(9) var emissive_smp: sampler;
-@group(1) @binding(10) var occlusion_smp: sampler;
+@group(1) @binding(6) var film_tex: texture_2d<f32>;
+@group(1) @binding(7) var film_thickness_tex: texture_2d<f32>;
+@group(1) @binding(8) var base_color_smp: sampler;
+@group(1) @binding(9) var metal_rough_smp: sampler;
+@group(1) @binding(10) var normal_smp: sampler;
+@group(1) @binding(11) var emissive_smp: sampler;
+@group(1) @binding(12) var occlusion_smp: sampler;
+@group(1) @binding(13) var film_smp: sampler;
+@group(1) @binding(14) var film_thickness_smp: sampler;
 
 // The texture coordinates of slot `slot`: its UV set, transformed.
 fn material_uv(slot: u32, uv0: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {

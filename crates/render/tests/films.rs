@@ -1,0 +1,230 @@
+//! Thin films (KHR_materials_iridescence) in the real-time renderer, against independent CPU
+//! references: in the spectral and naive modes a filmed patch equals the CPU's per-node
+//! evaluation — the glTF BRDF with the film's exact reflectance (`scene::film`, itself checked
+//! against a transfer-matrix oracle by tools/check_film.py) in its Fresnel term, at the frame's
+//! nodes and weights — to 1e-3 (relative above 1: the HDR target is f16; 2e-3 in the naive
+//! mode, whose box spectrum is of the G-buffer's f16 colour), over dielectric and metal bases; the RGB mode draws the
+//! extension's RGB film, which differs from the unfilmed surface; a film of weight 0 is no film.
+
+mod common;
+
+use color::quadrature::Quadrature;
+use common::*;
+use glam::Vec3;
+use render::{Mode, RenderSettings, Renderer};
+use scene::{Iridescence, Scene};
+
+const W: u32 = 96;
+const H: u32 = 64;
+const MARGIN: f32 = 0.1;
+const ROUGHNESS: f32 = 0.5;
+
+fn settings(mode: Mode, n: usize, quadrature: Quadrature) -> RenderSettings {
+    RenderSettings { mode, wavelengths: n, quadrature, shadows: false, ..Default::default() }
+}
+
+fn render_hdr(r: &mut Renderer, s: &RenderSettings) -> Vec<[f64; 3]> {
+    let cam = r.scene_camera().unwrap();
+    r.render(&cam, s).unwrap();
+    r.read_hdr().unwrap().iter().map(rgb_of).collect()
+}
+
+/// Patch i's film: thickness 120–1040 nm and index 1.2–1.8 across the chart, weight 1 except
+/// on every fourth patch (0.5).
+fn film_of(i: usize) -> Iridescence {
+    Iridescence {
+        factor: if i % 4 == 3 { 0.5 } else { 1.0 },
+        texture: None,
+        ior: 1.2 + 0.2 * (i % 4) as f32,
+        thickness_min: 0.0,
+        thickness_max: 120.0 + 40.0 * i as f32,
+        thickness_texture: None,
+    }
+}
+
+fn filmed_chart(chart: &Chart, metallic: f32, films: bool) -> Scene {
+    let mut s =
+        chart.scene(white_light(1.5, Some(color::illuminant::by_name("F11").unwrap())), ROUGHNESS, metallic);
+    if films {
+        for (i, m) in s.materials.iter_mut().enumerate() {
+            m.iridescence = Some(film_of(i));
+        }
+    }
+    s
+}
+
+/// The light's geometry at a chart pixel seen along `d`, lit from +z: (kd, ks, v·h) with
+/// radiance = E·(kd·(1 − F)·c_diff/π + ks·F), written out from the glTF BRDF (GGX,
+/// height-correlated Smith).
+fn terms(d: Vec3) -> (f64, f64, f64) {
+    let (n, v, wi) = (Vec3::Z, -d, Vec3::Z);
+    let nl = f64::from(n.dot(wi));
+    let h = (wi + v).normalize();
+    let nv = f64::from(n.dot(v)).max(1e-4);
+    let nh = f64::from(n.dot(h)).max(0.0);
+    let vh = f64::from(v.dot(h)).max(0.0);
+    let alpha = (f64::from(ROUGHNESS) * f64::from(ROUGHNESS)).max(1e-3);
+    let a2 = alpha * alpha;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let dist = a2 / (std::f64::consts::PI * dd * dd);
+    let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+    (nl, nl * dist * vis, vh)
+}
+
+/// Radiance over E at wavelength λ of a filmed surface of reflectance ρ(λ).
+fn filmed_value(
+    rho: f64,
+    lambda: f64,
+    metallic: f64,
+    film: &Iridescence,
+    (kd, ks, vh): (f64, f64, f64),
+) -> f64 {
+    let f = scene::film::Film { thickness_nm: f64::from(film.thickness_max), ior: f64::from(film.ior) };
+    let w = f64::from(film.factor);
+    let fres = (1.0 - vh).powi(5);
+    let fd = (0.04 + 0.96 * fres) * (1.0 - w) + w * f.over_dielectric(lambda, vh, 1.5);
+    let fm = (rho + (1.0 - rho) * fres) * (1.0 - w) + w * f.over_f0(lambda, vh, rho);
+    let spec = (1.0 - metallic) * fd + metallic * fm;
+    kd * (1.0 - metallic) / std::f64::consts::PI * (1.0 - fd) * rho + ks * spec
+}
+
+#[test]
+fn filmed_patches_match_the_cpu_per_node_in_spectral_and_naive_modes() {
+    let chart = Chart::colorchecker();
+    let f11 = color::illuminant::by_name("F11").unwrap();
+    let table = table();
+    let mut r = renderer();
+    r.resize(W, H).unwrap();
+    for metallic in [0.0f32, 1.0] {
+        r.set_scene(&filmed_chart(&chart, metallic, true)).unwrap();
+        for (rule, n) in
+            [(Quadrature::Prefiltered, 16), (Quadrature::Midpoint, 8), (Quadrature::Prefiltered, 7)]
+        {
+            let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n, rule));
+            let naive = render_hdr(&mut r, &settings(Mode::Naive, n, rule));
+            let cpu = CpuSpectral::new(n, rule, &f11, 1.5);
+            let (mut worst, mut worst_naive, mut compared) = (0.0f64, 0.0f64, 0);
+            for y in 0..H {
+                for x in 0..W {
+                    let (p, d) = pixel_to_chart(x, y, W, H);
+                    let Some(patch) = chart.patch_at(p, MARGIN) else { continue };
+                    let i = (y * W + x) as usize;
+                    let film = film_of(patch);
+                    let t = terms(d);
+                    let m = f64::from(metallic);
+                    let poly = table.fetch(chart.colours[patch].map(f64::from));
+                    let want = cpu.shade_values(|l| filmed_value(poly.to_f32_poly_eval(l), l, m, &film, t));
+                    let boxed =
+                        color::upsample::boxes::BoxSpectrum { rgb: chart.colours[patch].map(f64::from) };
+                    let want_naive = cpu.shade_values(|l| filmed_value(boxed.eval(l), l, m, &film, t));
+                    // The HDR target is f16 (2⁻¹⁰ relative, rounded toward zero on lavapipe):
+                    // 1e-3 absolute below 1, relative above (a bare metal's highlight is ~2).
+                    for c in 0..3 {
+                        worst = worst.max((spectral[i][c] - want[c]).abs() / want[c].abs().max(1.0));
+                        worst_naive = worst_naive
+                            .max((naive[i][c] - want_naive[c]).abs() / want_naive[c].abs().max(1.0));
+                    }
+                    compared += 1;
+                }
+            }
+            println!(
+                "films, metallic {metallic}, {rule} N={n}: |GPU − CPU| max {worst:.2e} (naive {worst_naive:.2e}) over {compared} pixels"
+            );
+            assert!(compared > 1000);
+            assert!(
+                worst < 1e-3,
+                "metallic {metallic} {rule} N={n}: filmed spectral GPU vs CPU differ by {worst}"
+            );
+            // The naive mode's box spectrum is of the G-buffer's f16 base colour (2⁻¹⁰ relative
+            // on lavapipe, which truncates), and a metal's Fresnel term is that colour: one more
+            // f16 step than the spectral mode (whose coefficients come from the exact colour).
+            assert!(
+                worst_naive < 2e-3,
+                "metallic {metallic} {rule} N={n}: filmed naive GPU vs CPU differ by {worst_naive}"
+            );
+        }
+    }
+}
+
+#[test]
+fn films_change_every_mode_and_a_zero_weight_film_is_none() {
+    let chart = Chart::colorchecker();
+    let mut r = renderer();
+    r.resize(W, H).unwrap();
+    for metallic in [0.0f32, 1.0] {
+        let plain_scene = filmed_chart(&chart, metallic, false);
+        let mut zero = filmed_chart(&chart, metallic, true);
+        for m in &mut zero.materials {
+            m.iridescence.as_mut().unwrap().factor = 0.0;
+        }
+        for mode in [Mode::Rgb, Mode::Spectral, Mode::Naive] {
+            let s = settings(mode, 16, Quadrature::Prefiltered);
+            r.set_scene(&plain_scene).unwrap();
+            let plain = render_hdr(&mut r, &s);
+            r.set_scene(&zero).unwrap();
+            assert_eq!(render_hdr(&mut r, &s), plain, "{mode:?}: a film of weight 0 changed the image");
+            r.set_scene(&filmed_chart(&chart, metallic, true)).unwrap();
+            let filmed = render_hdr(&mut r, &s);
+            let mut de = Vec::new();
+            for y in 0..H {
+                for x in 0..W {
+                    let (p, _) = pixel_to_chart(x, y, W, H);
+                    if chart.patch_at(p, MARGIN).is_some() {
+                        let i = (y * W + x) as usize;
+                        // Finite; not necessarily inside sRGB (a metal's film under F11 is not).
+                        assert!(filmed[i].iter().all(|c| c.is_finite()), "{mode:?}: {:?}", filmed[i]);
+                        de.push(color::ciede2000(lab(filmed[i]), lab(plain[i])));
+                    }
+                }
+            }
+            let (mean, _) = stats(de);
+            println!("metallic {metallic} {mode:?}: ΔE(filmed, plain) mean {mean:.2}");
+            assert!(mean > 2.0, "{mode:?} metallic {metallic}: films changed the image by only ΔE {mean}");
+        }
+    }
+}
+
+/// The spectral capture takes the general node loop (groups outermost, each light's terms kept,
+/// as the underwater and RGB-medium hooks do): it draws a filmed chart lit by a light and the
+/// environment as the plain loop does; and the environment's film (Fresnel at n·v) changes the
+/// image in every mode, finitely.
+#[test]
+fn films_under_the_environment_and_through_the_general_node_loop() {
+    let chart = Chart::colorchecker();
+    let mut r = renderer();
+    r.resize(W, H).unwrap();
+    r.set_environment(Some(&scene::Environment::default_sky()));
+    for metallic in [0.0f32, 1.0] {
+        let filmed = filmed_chart(&chart, metallic, true);
+        let plain_scene = filmed_chart(&chart, metallic, false);
+        let s = settings(Mode::Spectral, 8, Quadrature::Prefiltered);
+        r.set_scene(&filmed).unwrap();
+        let plain_loop = render_hdr(&mut r, &s);
+        r.set_spectral_capture(true);
+        let general = render_hdr(&mut r, &s);
+        let captured = r.read_spectral_capture().expect("the frame took the capture's loop");
+        assert!(captured.data.iter().any(|&v| v > 0.0), "the capture wrote nothing");
+        r.set_spectral_capture(false);
+        let mut worst = 0.0f64;
+        for (a, b) in plain_loop.iter().zip(&general) {
+            for c in 0..3 {
+                worst = worst.max((a[c] - b[c]).abs() / a[c].abs().max(1.0));
+            }
+        }
+        println!("metallic {metallic}: filmed, with environment: capture loop vs plain loop max {worst:.2e}");
+        assert!(worst < 2e-3, "metallic {metallic}: the general node loop draws films differently ({worst})");
+        for mode in [Mode::Rgb, Mode::Spectral, Mode::Naive] {
+            let s = settings(mode, 8, Quadrature::Prefiltered);
+            r.set_scene(&plain_scene).unwrap();
+            let plain = render_hdr(&mut r, &s);
+            r.set_scene(&filmed).unwrap();
+            let with = render_hdr(&mut r, &s);
+            assert!(with.iter().flatten().all(|c| c.is_finite()), "{mode:?}: a non-finite pixel");
+            let de: Vec<f64> =
+                plain.iter().zip(&with).map(|(a, b)| color::ciede2000(lab(*a), lab(*b))).collect();
+            let (mean, _) = stats(de);
+            println!("metallic {metallic} {mode:?} + environment: ΔE(filmed, plain) mean {mean:.2}");
+            assert!(mean > 1.0, "{mode:?}: under the environment films changed the image by only ΔE {mean}");
+        }
+    }
+}
