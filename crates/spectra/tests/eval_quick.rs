@@ -69,7 +69,15 @@ fn quick_suite_orders_the_modes() {
     let ids: Vec<&str> = v["cases"].as_array().unwrap().iter().map(|c| c["id"].as_str().unwrap()).collect();
     assert_eq!(
         ids,
-        ["metamerism", "colorchecker-d65", "colorchecker-f11", "colorchecker-led", "underwater-i"]
+        [
+            "metamerism",
+            "colorchecker-d65",
+            "colorchecker-f11",
+            "colorchecker-led",
+            "iridescence-d65",
+            "iridescence-f11",
+            "underwater-i"
+        ]
     );
 
     // The method's claim, on the spiky-emission scene and under water: closer to truth than
@@ -82,6 +90,10 @@ fn quick_suite_orders_the_modes() {
     // wavelength-dependent. On the spiky scene it does not (it is the worst mode there), so
     // that is not asserted: docs/evaluation.md records it as a finding.
     beats(&v, "underwater-i", "naive", "rgb");
+    // Thin films: the exact film per node against the extension's RGB approximation.
+    for case in ["iridescence-d65", "iridescence-f11"] {
+        beats(&v, case, "ours", "rgb");
+    }
     // Direct-lighting truth must be clean enough for per-pixel errors to mean something.
     for case in ["metamerism", "colorchecker-f11"] {
         let (ours, noise) = (mean(&v, case, "ours"), mean(&v, case, "noise"));

@@ -8,6 +8,7 @@ mod colorchecker;
 mod cornell;
 mod dense;
 pub mod fog;
+pub mod iridescence;
 mod metamerism;
 pub(crate) mod shapes;
 mod underwater;
@@ -22,7 +23,7 @@ use crate::{Emission, Material, Scene, SpectralReflectance, srgb};
 /// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
 /// about N triangles, for large-mesh measurements).
 pub const BUILTIN_NAMES: &[&str] =
-    &["cornell", "colorchecker", "metamerism", "underwater", "fog", "tinted-fog"];
+    &["cornell", "colorchecker", "metamerism", "iridescence", "underwater", "fog", "tinted-fog"];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
@@ -31,6 +32,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "cornell" => cornell::build(&ctx),
         "colorchecker" => colorchecker::build(&ctx),
         "metamerism" => metamerism::build(&ctx),
+        "iridescence" => iridescence::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),

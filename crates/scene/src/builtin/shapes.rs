@@ -74,3 +74,36 @@ mod tests {
         assert!((lo.y - 0.0).abs() < 1e-6 && (hi.y - 0.5).abs() < 1e-6);
     }
 }
+
+/// A smooth UV sphere: `rings` × `segments` quads sharing their vertices, normals radial (the
+/// exact sphere's, as the path tracer's interpolated normals give), counter-clockwise outside.
+pub(crate) fn sphere(centre: Vec3, radius: f32, rings: u32, segments: u32, material: usize) -> Mesh {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    for i in 0..=rings {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        for j in 0..=segments {
+            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            positions.push(centre + radius * n);
+            normals.push(n);
+            uvs.push(Vec2::new(j as f32 / segments as f32, i as f32 / rings as f32));
+        }
+    }
+    let row = segments + 1;
+    let mut indices = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (i * row + j, (i + 1) * row + j, (i + 1) * row + j + 1, i * row + j + 1);
+            // The poles' degenerate triangles are left out.
+            if i > 0 {
+                indices.extend_from_slice(&[a, c, b]);
+            }
+            if i + 1 < rings {
+                indices.extend_from_slice(&[a, d, c]);
+            }
+        }
+    }
+    Mesh { colors: vec![], uvs1: vec![], positions, normals, tangents: Vec::new(), uvs, indices, material }
+}

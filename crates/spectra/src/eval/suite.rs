@@ -117,7 +117,14 @@ pub struct Case {
 }
 
 /// Case ids `spectra eval --scenes` accepts.
-pub const CASE_IDS: &[&str] = &["metamerism", "colorchecker-d65", "colorchecker-f11", "colorchecker-led"];
+pub const CASE_IDS: &[&str] = &[
+    "metamerism",
+    "colorchecker-d65",
+    "colorchecker-f11",
+    "colorchecker-led",
+    "iridescence-d65",
+    "iridescence-f11",
+];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
@@ -181,6 +188,17 @@ pub fn case(id: &str) -> Result<Case> {
         }
         "colorchecker-f11" => cc("F11", "ColorChecker under CIE F11 (narrow-band fluorescent)"),
         "colorchecker-led" => cc("LED-RGB1", "ColorChecker under CIE LED-RGB1 (three-peak LED)"),
+        "iridescence-d65" => Ok(Case {
+            id: id.into(),
+            title: "Thin films (KHR_materials_iridescence) of 200–800 nm on dielectric and metal spheres, D65 spots"
+                .into(),
+            scene: scene::builtin("iridescence")?,
+        }),
+        "iridescence-f11" => {
+            let mut s = scene::builtin("iridescence")?;
+            relight(&mut s, "F11").context("relighting the iridescence scene with F11")?;
+            Ok(Case { id: id.into(), title: "Thin films on dielectric and metal spheres, F11 spots".into(), scene: s })
+        }
         w if w.starts_with("underwater-") => {
             let rest = &w["underwater-".len()..];
             // `underwater-TYPE-DEPTHm`: a depth suffix is a number of metres ending in `m`.
