@@ -54,27 +54,6 @@ pub(crate) fn cuboid(base: Vec3, size: Vec3, yaw: f32, material: usize) -> Mesh 
     m
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cuboid_faces_point_outwards_and_wind_counter_clockwise() {
-        let b = cuboid(Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.3, 0.5, 0.2), 0.4, 0);
-        assert_eq!(b.indices.len(), 36);
-        let centre = Vec3::new(1.0, 0.25, 2.0);
-        for t in b.indices.chunks_exact(3) {
-            let [a, p, q] = [0, 1, 2].map(|k| b.positions[t[k] as usize]);
-            let geo = (p - a).cross(q - a).normalize();
-            let n = b.normals[t[0] as usize];
-            assert!(geo.abs_diff_eq(n, 1e-5), "winding {geo} vs normal {n}");
-            assert!(n.dot((a + p + q) / 3.0 - centre) > 0.0, "normal {n} points inwards");
-        }
-        let (lo, hi) = crate::framing::bounds(std::slice::from_ref(&b)).unwrap();
-        assert!((lo.y - 0.0).abs() < 1e-6 && (hi.y - 0.5).abs() < 1e-6);
-    }
-}
-
 /// A smooth UV sphere: `rings` × `segments` quads sharing their vertices, normals radial (the
 /// exact sphere's, as the path tracer's interpolated normals give), counter-clockwise outside.
 pub(crate) fn sphere(centre: Vec3, radius: f32, rings: u32, segments: u32, material: usize) -> Mesh {
@@ -106,4 +85,25 @@ pub(crate) fn sphere(centre: Vec3, radius: f32, rings: u32, segments: u32, mater
         }
     }
     Mesh { colors: vec![], uvs1: vec![], positions, normals, tangents: Vec::new(), uvs, indices, material }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cuboid_faces_point_outwards_and_wind_counter_clockwise() {
+        let b = cuboid(Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.3, 0.5, 0.2), 0.4, 0);
+        assert_eq!(b.indices.len(), 36);
+        let centre = Vec3::new(1.0, 0.25, 2.0);
+        for t in b.indices.chunks_exact(3) {
+            let [a, p, q] = [0, 1, 2].map(|k| b.positions[t[k] as usize]);
+            let geo = (p - a).cross(q - a).normalize();
+            let n = b.normals[t[0] as usize];
+            assert!(geo.abs_diff_eq(n, 1e-5), "winding {geo} vs normal {n}");
+            assert!(n.dot((a + p + q) / 3.0 - centre) > 0.0, "normal {n} points inwards");
+        }
+        let (lo, hi) = crate::framing::bounds(std::slice::from_ref(&b)).unwrap();
+        assert!((lo.y - 0.0).abs() < 1e-6 && (hi.y - 0.5).abs() < 1e-6);
+    }
 }
