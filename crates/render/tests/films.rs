@@ -228,3 +228,89 @@ fn films_under_the_environment_and_through_the_general_node_loop() {
         }
     }
 }
+
+/// The film's textures: the iridescence texture's R scales the weight and the thickness
+/// texture's G places the thickness between minimum and maximum. A 2×1 nearest-sampled texture
+/// (left texel R 1, G 0; right R 128/255, G 1) on every patch draws its left half as a film of
+/// weight 1 at the minimum thickness and its right half as one of weight 128/255 at the maximum,
+/// each equal to the same film given by factors alone.
+#[test]
+fn film_textures_pick_the_weight_and_the_thickness() {
+    use scene::{Filter, Sampler, Texture, TextureRef, Wrap};
+    let chart = Chart::colorchecker();
+    let (t_min, t_max) = (250.0f32, 650.0f32);
+    let with = |films: &dyn Fn(usize) -> Iridescence| {
+        let mut s = filmed_chart(&chart, 0.0, false);
+        for (i, m) in s.materials.iter_mut().enumerate() {
+            m.metallic = if i % 2 == 0 { 0.0 } else { 1.0 };
+            m.iridescence = Some(films(i));
+        }
+        s
+    };
+    let plain = |factor: f32, thickness: f32| {
+        move |i: usize| Iridescence {
+            factor,
+            texture: None,
+            ior: 1.3 + 0.1 * (i % 3) as f32,
+            thickness_min: 0.0,
+            thickness_max: thickness,
+            thickness_texture: None,
+        }
+    };
+    let mut textured = with(&|i| Iridescence {
+        texture: Some(TextureRef::new(0)),
+        thickness_min: t_min,
+        thickness_texture: Some(TextureRef::new(0)),
+        ..plain(1.0, t_max)(i)
+    });
+    let nearest = Sampler {
+        wrap_s: Wrap::ClampToEdge,
+        wrap_t: Wrap::ClampToEdge,
+        mag: Filter::Nearest,
+        min: Filter::Nearest,
+        mipmaps: false,
+    };
+    textured.textures.push(Texture {
+        name: "film 2x1".into(),
+        width: 2,
+        height: 1,
+        rgba8: vec![255, 0, 0, 255, 128, 255, 0, 255],
+        srgb: false,
+        sampler: nearest,
+    });
+    let left = with(&plain(1.0, t_min));
+    let right = with(&plain(128.0 / 255.0, t_max));
+    let mut r = renderer();
+    r.resize(W, H).unwrap();
+    for mode in [Mode::Rgb, Mode::Spectral, Mode::Naive] {
+        let s = settings(mode, 8, Quadrature::Prefiltered);
+        let mut image = |scene: &Scene| {
+            r.set_scene(scene).unwrap();
+            render_hdr(&mut r, &s)
+        };
+        let (t, a, b) = (image(&textured), image(&left), image(&right));
+        let (mut worst, mut halves) = (0.0f64, [0usize; 2]);
+        for y in 0..H {
+            for x in 0..W {
+                let (p, _) = pixel_to_chart(x, y, W, H);
+                let Some(patch) = chart.patch_at(p, MARGIN) else { continue };
+                // u across the patch; keep clear of the texel edge in its middle.
+                let u = p.x - chart.origin(patch % chart.cols, patch / chart.cols).x;
+                if (u - 0.5).abs() < 0.1 {
+                    continue;
+                }
+                let i = (y * W + x) as usize;
+                let want = if u < 0.5 { a[i] } else { b[i] };
+                halves[usize::from(u >= 0.5)] += 1;
+                for c in 0..3 {
+                    worst = worst.max((t[i][c] - want[c]).abs() / want[c].abs().max(1.0));
+                }
+            }
+        }
+        println!(
+            "{mode:?}: textured film vs the films of its texels: max {worst:.2e} over {halves:?} pixels"
+        );
+        assert!(halves[0] > 300 && halves[1] > 300, "{halves:?}");
+        assert!(worst < 2e-3, "{mode:?}: the film textures give {worst} off the films they stand for");
+    }
+}

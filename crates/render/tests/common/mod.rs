@@ -70,7 +70,7 @@ impl Chart {
         Chart { colours, cols: 6, rows: 4, gap: 0.15 }
     }
 
-    fn origin(&self, col: usize, row: usize) -> Vec2 {
+    pub fn origin(&self, col: usize, row: usize) -> Vec2 {
         let pitch = 1.0 + self.gap;
         let w = self.cols as f32 * pitch - self.gap;
         let h = self.rows as f32 * pitch - self.gap;
