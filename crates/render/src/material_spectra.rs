@@ -23,14 +23,15 @@ pub struct MaterialSpectrum {
     pub emission_xyz: [f32; 4],
     /// The material's thin film (`KHR_materials_iridescence`): x its index (1 without a film),
     /// y and z its thickness minimum and maximum in nm, which every mode reads (the G-buffer
-    /// holds only the weight and where the thickness lies between them per pixel); w unused.
+    /// holds only the weight and where the thickness lies between them per pixel); w the
+    /// dielectric's F0 (`KHR_materials_ior`, `scene::dielectric_f0`).
     pub film: [f32; 4],
 }
 
 impl MaterialSpectrum {
     /// The record of one material: the fetch the shading pass would make per pixel (the CPU
     /// `CoeffTable::fetch` matches the WGSL one, `coeff_table`'s tests), of the exact colours.
-    pub fn new(c: &ConstantColour, film: [f32; 3], table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
+    pub fn new(c: &ConstantColour, film: [f32; 4], table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
         let coeffs = |rgb: [f32; 3]| {
             let p = table.fetch(rgb.map(f64::from));
             p.c.map(|v| v as f32)
@@ -65,21 +66,21 @@ impl MaterialSpectrum {
             }
         }
         let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
-        MaterialSpectrum { base, emission, emission_xyz, film: [film[0], film[1], film[2], 0.0] }
+        MaterialSpectrum { base, emission, emission_xyz, film }
     }
 
     /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
     /// binding cannot be empty).
     pub fn of_scene(
         colours: &[ConstantColour],
-        films: &[[f32; 3]],
+        films: &[[f32; 4]],
         table: &CoeffTable,
         groups: &[WavelengthGroup],
     ) -> Vec<MaterialSpectrum> {
         let mut v: Vec<_> = colours
             .iter()
             .enumerate()
-            .map(|(i, c)| Self::new(c, films.get(i).copied().unwrap_or([1.0, 0.0, 0.0]), table, groups))
+            .map(|(i, c)| Self::new(c, films.get(i).copied().unwrap_or([1.0, 0.0, 0.0, 0.04]), table, groups))
             .collect();
         if v.is_empty() {
             v.push(MaterialSpectrum::default());

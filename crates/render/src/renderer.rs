@@ -614,12 +614,14 @@ impl Renderer {
             fetch_base: scene.varying_colours.0,
             fetch_emission: scene.varying_colours.1,
             film: scene.has_film,
+            ior: scene.has_ior,
         };
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        // Only the spectral mode reads the material slots; every mode reads the films.
+        // The spectral mode reads the material slots, and every mode does for the films and
+        // the indices of refraction.
         let gbuffer_targets = if scene.has_film {
             GBufferTargets::Film
-        } else if settings.mode == Mode::Spectral {
+        } else if settings.mode == Mode::Spectral || scene.has_ior {
             GBufferTargets::Slot
         } else {
             GBufferTargets::Plain
@@ -845,7 +847,7 @@ impl Renderer {
             "material spectra",
             bytemuck::cast_slice(&MaterialSpectrum::of_scene(
                 &scene.constant_colours,
-                &scene.films,
+                &scene.material_films,
                 &self.table,
                 &groups,
             )),

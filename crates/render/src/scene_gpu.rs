@@ -398,9 +398,13 @@ pub struct GpuScene {
     /// Whether some material has a thin film (`KHR_materials_iridescence` with a factor above
     /// 0): only then do the G-buffer and shading passes carry the film's code and target.
     pub has_film: bool,
+    /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
+    /// only then does the shading pass read F0 per material.
+    pub has_ior: bool,
     /// Per material, its film's index and thickness minimum and maximum in nm (`[1, 0, 0]`
-    /// without a film), for `MaterialSpectrum::film`.
-    pub films: Vec<[f32; 3]>,
+    /// without a film) and its dielectric's F0 (`scene::dielectric_f0`), for
+    /// `MaterialSpectrum::film`.
+    pub material_films: Vec<[f32; 4]>,
 }
 
 /// A material's base colour and emission where they do not vary over its surface (no texture,
@@ -641,13 +645,16 @@ impl GpuScene {
                 .materials
                 .iter()
                 .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
-            films: s
+            has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
+            material_films: s
                 .materials
                 .iter()
                 .map(|m| {
-                    m.iridescence
+                    let [a, b, c] = m
+                        .iridescence
                         .as_ref()
-                        .map_or([1.0, 0.0, 0.0], |f| [f.ior, f.thickness_min, f.thickness_max])
+                        .map_or([1.0, 0.0, 0.0], |f| [f.ior, f.thickness_min, f.thickness_max]);
+                    [a, b, c, m.dielectric_f0()]
                 })
                 .collect(),
         })

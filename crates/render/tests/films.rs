@@ -48,9 +48,15 @@ fn filmed_chart(chart: &Chart, metallic: f32, films: bool) -> Scene {
     if films {
         for (i, m) in s.materials.iter_mut().enumerate() {
             m.iridescence = Some(film_of(i));
+            m.ior = ior_of(i);
         }
     }
     s
+}
+
+/// Patch i's dielectric index under the film (`KHR_materials_ior`): 1.5, 1.4 or 1.7.
+fn ior_of(i: usize) -> f32 {
+    [1.5, 1.4, 1.7][i % 3]
 }
 
 /// The light's geometry at a chart pixel seen along `d`, lit from +z: (kd, ks, v·h) with
@@ -77,12 +83,14 @@ fn filmed_value(
     lambda: f64,
     metallic: f64,
     film: &Iridescence,
+    ior: f32,
     (kd, ks, vh): (f64, f64, f64),
 ) -> f64 {
     let f = scene::film::Film { thickness_nm: f64::from(film.thickness_max), ior: f64::from(film.ior) };
     let w = f64::from(film.factor);
     let fres = (1.0 - vh).powi(5);
-    let fd = (0.04 + 0.96 * fres) * (1.0 - w) + w * f.over_dielectric(lambda, vh, 1.5);
+    let f0 = f64::from(scene::dielectric_f0(ior));
+    let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w) + w * f.over_dielectric(lambda, vh, f64::from(ior));
     let fm = (rho + (1.0 - rho) * fres) * (1.0 - w) + w * f.over_f0(lambda, vh, rho);
     let spec = (1.0 - metallic) * fd + metallic * fm;
     kd * (1.0 - metallic) / std::f64::consts::PI * (1.0 - fd) * rho + ks * spec
@@ -113,10 +121,13 @@ fn filmed_patches_match_the_cpu_per_node_in_spectral_and_naive_modes() {
                     let t = terms(d);
                     let m = f64::from(metallic);
                     let poly = table.fetch(chart.colours[patch].map(f64::from));
-                    let want = cpu.shade_values(|l| filmed_value(poly.to_f32_poly_eval(l), l, m, &film, t));
+                    let want = cpu.shade_values(|l| {
+                        filmed_value(poly.to_f32_poly_eval(l), l, m, &film, ior_of(patch), t)
+                    });
                     let boxed =
                         color::upsample::boxes::BoxSpectrum { rgb: chart.colours[patch].map(f64::from) };
-                    let want_naive = cpu.shade_values(|l| filmed_value(boxed.eval(l), l, m, &film, t));
+                    let want_naive =
+                        cpu.shade_values(|l| filmed_value(boxed.eval(l), l, m, &film, ior_of(patch), t));
                     // The HDR target is f16 (2⁻¹⁰ relative, rounded toward zero on lavapipe):
                     // 1e-3 absolute below 1, relative above (a bare metal's highlight is ~2).
                     for c in 0..3 {
@@ -152,7 +163,10 @@ fn films_change_every_mode_and_a_zero_weight_film_is_none() {
     let mut r = renderer();
     r.resize(W, H).unwrap();
     for metallic in [0.0f32, 1.0] {
-        let plain_scene = filmed_chart(&chart, metallic, false);
+        let mut plain_scene = filmed_chart(&chart, metallic, false);
+        for (i, m) in plain_scene.materials.iter_mut().enumerate() {
+            m.ior = ior_of(i);
+        }
         let mut zero = filmed_chart(&chart, metallic, true);
         for m in &mut zero.materials {
             m.iridescence.as_mut().unwrap().factor = 0.0;

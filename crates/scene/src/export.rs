@@ -219,6 +219,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_iridescence"] = e;
         }
+        if m.ior != 1.5 {
+            j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
+        }
         let mut extras = serde_json::Map::new();
         match &m.spectral {
             Some(SpectralReflectance::Uniform(s)) => {
@@ -347,6 +350,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
 
     let mut extensions_used =
         vec!["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"];
+    if scene.materials.iter().any(|m| m.ior != 1.5) {
+        extensions_used.push("KHR_materials_ior");
+    }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");
     }

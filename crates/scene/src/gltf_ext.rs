@@ -22,6 +22,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_unlit",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_iridescence",
+    "KHR_materials_ior",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -74,9 +75,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
             "specular strength and colour are ignored (dielectrics use F0 = 0.04)",
             "this renderer has no specular extension",
         ),
-        "KHR_materials_ior" => {
-            ("the index of refraction is ignored (1.5 is used)", "this renderer fixes the IOR at 1.5")
-        }
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }

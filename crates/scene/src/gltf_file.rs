@@ -661,6 +661,17 @@ impl Loader<'_> {
         if let Some(ir) = info("/extensions/KHR_materials_iridescence") {
             out.iridescence = self.iridescence(&at, ir)?;
         }
+        if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
+            out.ior = match v.as_f64() {
+                Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.extensions.KHR_materials_ior.ior"),
+                        format!("{v} is not an index of refraction in [1, {}]", crate::MAX_IOR),
+                    ));
+                }
+            };
+        }
         let values = [
             out.base_color.to_array().as_slice(),
             &[out.metallic, out.roughness, out.normal_scale],

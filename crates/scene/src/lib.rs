@@ -180,6 +180,31 @@ pub struct Material {
     pub unlit: bool,
     /// `KHR_materials_iridescence`: a thin dielectric film over the surface ([`film`]).
     pub iridescence: Option<Iridescence>,
+    /// `KHR_materials_ior`: the dielectric's index of refraction (glTF's default 1.5), which
+    /// sets its normal-incidence reflectance F0 = ((η − 1)/(η + 1))² ([`Material::dielectric_f0`])
+    /// and the index under a thin film.
+    pub ior: f32,
+}
+
+/// Largest index of refraction a material may give (diamond is 2.42).
+pub const MAX_IOR: f32 = 10.0;
+
+/// A dielectric's normal-incidence reflectance from air, ((η − 1)/(η + 1))²: exactly glTF's
+/// constant 0.04 at its default η = 1.5 (so that files without `KHR_materials_ior` keep the
+/// f32 value both renderers always used). One home for both renderers.
+pub fn dielectric_f0(ior: f32) -> f32 {
+    if ior == 1.5 {
+        return 0.04;
+    }
+    let r = (ior - 1.0) / (ior + 1.0);
+    r * r
+}
+
+impl Material {
+    /// The dielectric's normal-incidence reflectance from air ([`dielectric_f0`]).
+    pub fn dielectric_f0(&self) -> f32 {
+        dielectric_f0(self.ior)
+    }
 }
 
 /// `KHR_materials_iridescence` of a material: a thin dielectric film whose interference
@@ -244,6 +269,7 @@ impl Default for Material {
             emission_spectrum: None,
             unlit: false,
             iridescence: None,
+            ior: 1.5,
         }
     }
 }

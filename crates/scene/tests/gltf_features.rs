@@ -850,3 +850,37 @@ fn iridescence_survives_export() {
     assert_eq!(back.materials[0].iridescence, s.materials[0].iridescence);
     assert!(s.materials[0].iridescence.is_some());
 }
+
+/// `KHR_materials_ior`: the index sets the dielectric's F0 (glTF's 0.04 exactly at the
+/// default 1.5), survives export, and a value outside [1, 10] is an error naming the field.
+#[test]
+fn index_of_refraction_is_read_checked_and_exported() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos}, "material": m});
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_ior"],
+        "extensionsRequired": ["KHR_materials_ior"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1)]}],
+        "materials": [{"extensions": {"KHR_materials_ior": {"ior": 2.0}}}, {"extensions": {"KHR_materials_ior": {}}}],
+    }));
+    let s = load(&doc).unwrap();
+    assert!(!s.warnings.join("\n").contains("KHR_materials_ior"), "{:?}", s.warnings);
+    assert_eq!((s.materials[0].ior, s.materials[1].ior), (2.0, 1.5));
+    assert!((s.materials[0].dielectric_f0() - 1.0 / 9.0).abs() < 1e-7);
+    assert_eq!(s.materials[1].dielectric_f0(), 0.04);
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert_eq!((back.materials[0].ior, back.materials[1].ior), (2.0, 1.5));
+    for v in [json!(0.9), json!(11), json!("1.4"), json!(-1)] {
+        let mut d = doc.clone();
+        d["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = v.clone();
+        let e = load(&d).unwrap_err().to_string();
+        assert!(
+            e.contains("materials[0].extensions.KHR_materials_ior.ior") && e.contains("[1, 10]"),
+            "{v}: {e}"
+        );
+    }
+}

@@ -1,12 +1,13 @@
 //! The glTF 2.0 metallic-roughness BRDF (specification, appendix B), one lane per wavelength:
 //!
 //! f = (1 − F)·c_diff/π + F·D·V, with c_diff = base·(1 − metallic),
-//! F = f0 + (1 − f0)(1 − |v·h|)⁵, f0 = lerp(0.04, base, metallic), α = roughness²,
+//! F = f0 + (1 − f0)(1 − |v·h|)⁵, f0 = lerp(F0(η), base, metallic), α = roughness², with the
+//! dielectric's F0(η) = ((η − 1)/(η + 1))², 0.04 at glTF's default η = 1.5 (`KHR_materials_ior`),
 //! D the Trowbridge–Reitz (GGX) distribution and V the height-correlated Smith visibility
 //! V = 0.5 / (n·l·√(n·v²(1−α²)+α²) + n·v·√(n·l²(1−α²)+α²)) the appendix's implementation uses.
 //!
 //! With a thin film (`KHR_materials_iridescence`), F at each lane's wavelength is
-//! lerp(F, (1 − metallic)·R_film(1.5) + metallic·R_film(η(base)), weight): the exact film
+//! lerp(F, (1 − metallic)·R_film(η) + metallic·R_film(η(base)), weight): the exact film
 //! reflectance (`scene::film`) over the dielectric base and over the metal (its base colour
 //! as F0, the extension's convention), at v·h.
 //!
@@ -30,6 +31,8 @@ pub struct Brdf {
     /// renderers that have no glTF BRDF (Mitsuba's `diffuse`).
     pub lambert: bool,
     pub film: Option<FilmLanes>,
+    /// The dielectric's index of refraction (`KHR_materials_ior`; 1.5 by default).
+    pub ior: f32,
 }
 
 /// A thin film over the BRDF, at the four wavelengths of the lanes.
@@ -58,11 +61,18 @@ impl Brdf {
             alpha: (r * r).max(MIN_ALPHA),
             lambert: false,
             film: None,
+            ior: 1.5,
         }
     }
 
     pub fn lambertian(base: Vec4) -> Self {
-        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true, film: None }
+        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true, film: None, ior: 1.5 }
+    }
+
+    /// This BRDF with the dielectric's index `ior` (≥ 1; `scene::Material::ior`).
+    pub fn with_ior(mut self, ior: f32) -> Self {
+        self.ior = ior.max(1.0);
+        self
     }
 
     /// This BRDF with a thin film (weight 0: none).
@@ -78,7 +88,7 @@ impl Brdf {
         let Some(f) = &self.film else { return schlick };
         let m = f64::from(self.metallic);
         let c = f64::from(v_h);
-        let dielectric_base = scene::film::ior_from_f0(0.04);
+        let dielectric_base = f64::from(self.ior);
         let lanes: [f32; 4] = std::array::from_fn(|i| {
             let l = f64::from(f.lambda[i]);
             let dielectric = if m < 1.0 { f.film.over_dielectric(l, c, dielectric_base) } else { 0.0 };
@@ -89,7 +99,7 @@ impl Brdf {
     }
 
     fn f0(&self) -> Vec4 {
-        Vec4::splat(0.04 * (1.0 - self.metallic)) + self.base * self.metallic
+        Vec4::splat(scene::dielectric_f0(self.ior) * (1.0 - self.metallic)) + self.base * self.metallic
     }
 
     fn d(&self, n_h: f32) -> f32 {
@@ -206,6 +216,19 @@ mod tests {
         let f = b.eval(Vec3::Z, Vec3::Z);
         let diffuse = 0.96 * 0.5 / PI;
         assert!(f.x > diffuse && f.x < diffuse + 0.1);
+    }
+
+    /// `KHR_materials_ior`: at normal incidence the dielectric's Fresnel term is
+    /// ((η − 1)/(η + 1))², so a black dielectric's reflection scales with it; 1.5 is glTF's 0.04.
+    #[test]
+    fn the_index_sets_the_dielectric_f0() {
+        let black = |ior: f32| Brdf::new(Vec4::ZERO, 0.0, 0.4).with_ior(ior).eval(Vec3::Z, Vec3::Z).x;
+        assert_eq!(black(1.5), Brdf::new(Vec4::ZERO, 0.0, 0.4).eval(Vec3::Z, Vec3::Z).x);
+        for ior in [1.0f32, 1.33, 2.0, 2.42] {
+            let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+            let want = black(1.5) * f0 / 0.04;
+            assert!((black(ior) - want).abs() <= 1e-5 * want.max(1e-3), "η {ior}: {} vs {want}", black(ior));
+        }
     }
 
     #[test]

@@ -334,7 +334,7 @@ impl Integrator<'_, '_> {
             let brdf = if self.lambert {
                 Brdf::lambertian(base)
             } else {
-                Brdf::new(base, metallic, roughness).with_film(film)
+                Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film)
             };
             let frame = Frame::from_normal(ns);
             let vtx = Vertex::Surface { brdf, frame, ng };

@@ -79,6 +79,8 @@ pub struct Variant {
     /// Some material has a thin film (`HAS_FILM`): the G-buffer's film target is read and
     /// filmed pixels take the film's Fresnel term (all modes).
     pub film: bool,
+    /// Some dielectric's index is not 1.5 (`HAS_IOR`, `KHR_materials_ior`): F0 per material.
+    pub ior: bool,
 }
 
 impl Variant {
@@ -92,11 +94,12 @@ impl Variant {
         fetch_base: true,
         fetch_emission: true,
         film: true,
+        ior: true,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, film); its pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 8] {
+    /// environment, film, ior); its pipelines are keyed by [`Self::rgb`].
+    fn constants(&self) -> [(&'static str, f64); 9] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -107,12 +110,19 @@ impl Variant {
             ("FETCH_BASE", b(self.fetch_base)),
             ("FETCH_EMISSION", b(self.fetch_emission)),
             ("HAS_FILM", b(self.film)),
+            ("HAS_IOR", b(self.ior)),
         ]
     }
 
     /// What the RGB entry point depends on, the rest at its defaults.
     fn rgb(self) -> Variant {
-        Variant { polygons: self.polygons, environment: self.environment, film: self.film, ..Variant::ALL }
+        Variant {
+            polygons: self.polygons,
+            environment: self.environment,
+            film: self.film,
+            ior: self.ior,
+            ..Variant::ALL
+        }
     }
 }
 

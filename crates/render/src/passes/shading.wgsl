@@ -26,6 +26,9 @@ override HAS_ENV: bool = true;
 // A material with a thin film (KHR_materials_iridescence): the G-buffer's film target is read,
 // and filmed pixels take the film's Fresnel term (every mode).
 override HAS_FILM: bool = true;
+// A dielectric whose index is not glTF's 1.5 (KHR_materials_ior): its F0 comes from the
+// material's record (every mode reads the G-buffer's material slot then).
+override HAS_IOR: bool = true;
 
 fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
@@ -119,19 +122,15 @@ fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32
 // where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
-fn factors_of(t: LightTerms, metallic: f32) -> vec2<f32> {
+fn factors_of(t: LightTerms, metallic: f32, f0: f32) -> vec2<f32> {
     if (lambert_only()) {
         return vec2<f32>(t.kd / PI, 0.0);
     }
     let fres = pow(1.0 - t.vh, 5.0);
-    let f_dielectric = 0.04 + 0.96 * fres;
+    let f_dielectric = f0 + (1.0 - f0) * fres;
     let a = t.kd * (1.0 - metallic) * (1.0 - f_dielectric) / PI + t.ks * metallic * (1.0 - fres);
     let b = t.ks * ((1.0 - metallic) * f_dielectric + metallic * fres);
     return vec2<f32>(a, b);
-}
-
-fn light_factors(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32) -> vec2<f32> {
-    return factors_of(light_terms(li, p, n, v, roughness), metallic);
 }
 
 // E/L of a polygon light at p with normal n: ∫ max(n·l, 0) dl over the polygon clipped to
@@ -338,23 +337,38 @@ struct GSurface {
     occlusion: f32,
     // KHR_materials_unlit: only `emission` (its base colour) leaves the surface.
     unlit: bool,
+    // The dielectric's normal-incidence reflectance (KHR_materials_ior; glTF's 0.04 at 1.5).
+    f0: f32,
 };
 
 fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let e = textureLoad(gbuf_emission, px, 0);
-    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0);
+    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0, surface_f0(px));
+}
+
+// The material's record (src/material_spectra.rs) at pixel px, by its slot.
+fn material_at(px: vec2<i32>) -> MaterialSpectrum {
+    let slot = textureLoad(gbuf_slot, px, 0).x;
+    return material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)];
+}
+
+fn surface_f0(px: vec2<i32>) -> f32 {
+    if (!HAS_IOR) {
+        return 0.04;
+    }
+    return material_at(px).film.w;
 }
 
 // Diffuse radiance per unit irradiance arriving from all sides (the hooks' medium
 // irradiance): the Lambertian layer under the dielectric coat, (1 − metallic)·(1 − F̄)/π with
-// F̄ = 0.04 + 0.96/21 the cosine-weighted hemispherical mean of Schlick's Fresnel (the
+// F̄ = F0 + (1 − F0)/21 the cosine-weighted hemispherical mean of Schlick's Fresnel (the
 // per-light term uses the Fresnel of its own half vector instead). Unlit surfaces: 0.
 fn diffuse_lobe(s: GSurface) -> f32 {
     if (s.unlit) { return 0.0; }
     if (lambert_only()) { return 1.0 / PI; }
-    return (1.0 - s.metallic) * (1.0 - (0.04 + 0.96 / 21.0)) / PI;
+    return (1.0 - s.metallic) * (1.0 - (s.f0 + (1.0 - s.f0) / 21.0)) / PI;
 }
 
 // The thin film at a pixel (KHR_materials_iridescence): how much of the Fresnel term is the
@@ -364,20 +378,28 @@ struct FilmSurface {
     weight: f32,
     thickness_nm: f32,
     ior: f32,
+    // The dielectric base's F0 and index (glTF's 0.04 and 1.5 without KHR_materials_ior).
+    f0: f32,
+    base_ior: f32,
 };
 
 fn load_film(px: vec2<i32>) -> FilmSurface {
     if (!HAS_FILM || lambert_only()) {
-        return FilmSurface(0.0, 0.0, 1.0);
+        return FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
     }
     let f = textureLoad(gbuf_film, px, 0);
-    let slot = textureLoad(gbuf_slot, px, 0).x;
-    let m = material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)].film;
-    return FilmSurface(f.x, mix(m.y, m.z, f.y), max(m.x, 1.0));
+    let m = material_at(px).film;
+    var f0 = 0.04;
+    var base_ior = 1.5;
+    if (HAS_IOR) {
+        f0 = m.w;
+        base_ior = film_ior_from_f0(vec4<f32>(f0)).x;
+    }
+    return FilmSurface(f.x, mix(m.y, m.z, f.y), max(m.x, 1.0), f0, base_ior);
 }
 
 // The Fresnel terms under a film at four node wavelengths and the cosine c: the dielectric
-// base's (index 1.5, the glTF F0 of 0.04) and the metal's (its reflectance ρ(λ) as F0, the
+// base's (index 1.5 and F0 0.04 unless KHR_materials_ior says otherwise) and the metal's (its reflectance ρ(λ) as F0, the
 // extension's convention), each Schlick's blended with the film's exact reflectance
 // (wgsl/film.wgsl) by the film's weight — the truth's `Brdf::fresnel`, per node.
 struct FilmFresnel {
@@ -388,8 +410,8 @@ struct FilmFresnel {
 fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, c: f32) -> FilmFresnel {
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
     var r: FilmFresnel;
-    r.dielectric = mix(vec4<f32>(0.04 + 0.96 * fres),
-        film_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(1.5)), f.weight);
+    r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
+        film_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior)), f.weight);
     if (metallic > 0.0) {
         r.metal = mix(rho + (1.0 - rho) * fres,
             film_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho)), f.weight);
@@ -417,7 +439,7 @@ struct FilmEnvNode {
 fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> FilmEnvNode {
     let a = l.ab.x;
     let b = l.ab.y;
-    var fd = mix(vec4<f32>(0.04 * a + b), film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(1.5)) * (a + b), f.weight);
+    var fd = mix(vec4<f32>(f.f0 * a + b), film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(f.base_ior)) * (a + b), f.weight);
     var fm = vec4<f32>(0.0);
     if (metallic > 0.0) {
         fm = mix(rho * a + b, film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, film_ior_from_f0(rho)) * (a + b), f.weight);
@@ -429,7 +451,7 @@ fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lam
 // dielectric and metal Fresnel terms at cosine c, blended with Schlick's by the weight.
 fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> mat2x3<f32> {
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
-    let fd = mix(vec3<f32>(0.04 + 0.96 * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(0.04)), f.weight);
+    let fd = mix(vec3<f32>(f.f0 + (1.0 - f.f0) * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(f.f0)), f.weight);
     var fm = vec3<f32>(0.0);
     if (metallic > 0.0) {
         fm = mix(base + (1.0 - base) * fres, film_rgb(c, f.thickness_nm, f.ior, base), f.weight);
@@ -468,7 +490,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
                 let r = t.kd * (1.0 - s.metallic) / PI * (1.0 - fr[0]) * s.base + t.ks * spec;
                 sum_b = fma(r, e, sum_b);
             } else {
-                let f = factors_of(t, s.metallic);
+                let f = factors_of(t, s.metallic, s.f0);
                 sum_a = fma(vec3<f32>(f.x), e, sum_a);
                 sum_b = fma(vec3<f32>(f.y), e, sum_b);
             }
@@ -477,12 +499,12 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
             if (!filmed) {
-                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
             } else {
                 let l = env_lobes(s.normal, -ctx.view_dir, s.roughness);
                 let a = l.ab.x;
                 let b = l.ab.y;
-                let fd = mix(vec3<f32>(0.04 * a + b), film_rgb(l.nv, film.thickness_nm, film.ior, vec3<f32>(0.04)) * (a + b), film.weight);
+                let fd = mix(vec3<f32>(film.f0 * a + b), film_rgb(l.nv, film.thickness_nm, film.ior, vec3<f32>(film.f0)) * (a + b), film.weight);
                 var fm = vec3<f32>(0.0);
                 if (s.metallic > 0.0) {
                     fm = mix(s.base * a + b, film_rgb(l.nv, film.thickness_nm, film.ior, s.base) * (a + b), film.weight);
@@ -554,7 +576,7 @@ struct MaterialSpectrum {
     // The constant emission's XYZ at this frame's nodes (what the node loop would add up).
     emission_xyz: vec4<f32>,
     // The thin film (KHR_materials_iridescence): x its index (1 without a film), y and z its
-    // thickness minimum and maximum, nm.
+    // thickness minimum and maximum, nm; w the dielectric's F0 (KHR_materials_ior).
     film: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
@@ -646,7 +668,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
                 xyz += film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda) * light_w(li, g, ng);
             }
         } else {
-            let f = factors_of(t, s.metallic);
+            let f = factors_of(t, s.metallic, s.f0);
             // The specular part does not depend on the reflectance: the light's XYZ once.
             var reflected = vec3<f32>(0.0);
             for (var g = 0u; g < ng; g++) {
@@ -669,7 +691,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             lobes.irr *= vis;
             lobes.spec *= vis;
         } else {
-            et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only());
+            et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0);
             et.a *= vis;
             et.b *= vis;
             xyz += env_xyz(et.b);
@@ -720,7 +742,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     let has_env = shading_env();
     // A filmed pixel keeps each light's terms instead (its Fresnel term depends on λ), and the
     // environment's lobes.
-    var film = FilmSurface(0.0, 0.0, 1.0);
+    var film = FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
     var ft: array<LightTerms, MAX_LIGHTS>;
     var lobes: EnvLobes;
     var metallic = 0.0;
@@ -738,7 +760,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 lobes.irr *= vis;
                 lobes.spec *= vis;
             } else {
-                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only());
+                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
                 et.a *= vis;
                 et.b *= vis;
             }
@@ -757,7 +779,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             if (HAS_FILM && film.weight > 0.0) {
                 ft[li] = t;
             } else {
-                let f = factors_of(t, s.metallic);
+                let f = factors_of(t, s.metallic, s.f0);
                 fa[li] = f.x;
                 fb[li] = f.y;
             }

@@ -43,7 +43,7 @@ fn env_background(d: vec3<f32>) -> vec4<f32> {
 
 // What the environment contributes at a surface, as two coefficient vectors: `a` multiplies
 // the reflectance ρ(λ) (diffuse, and metals' tinted specular), `b` does not (dielectric and
-// edge specular), like `light_factors` for a punctual light.
+// edge specular), like `factors_of` for a punctual light.
 struct EnvTerms {
     a: vec4<f32>,
     b: vec4<f32>,
@@ -72,7 +72,7 @@ fn env_lobes(n: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
     return l;
 }
 
-fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool) -> EnvTerms {
+fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32) -> EnvTerms {
     var t: EnvTerms;
     if (!env_enabled()) {
         return t;
@@ -83,7 +83,7 @@ fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert:
     }
     let l = env_lobes(n, v, roughness);
     // Directional albedo of the dielectric specular lobe: what the diffuse layer does not get.
-    let f_d = 0.04 * l.ab.x + l.ab.y;
+    let f_d = f0 * l.ab.x + l.ab.y;
     t.a = (1.0 - metallic) * (1.0 - f_d) / PI * l.irr + metallic * l.ab.x * l.spec;
     t.b = ((1.0 - metallic) * f_d + metallic * l.ab.y) * l.spec;
     return t;

@@ -40,7 +40,7 @@ fn film_ior_from_f0(f0: vec4<f32>) -> vec4<f32> {
 // the Airy series to its second order, each order's spectral integral in closed form from
 // Gaussian fits of the colour-matching functions' Fourier transform, then XYZ → linear sRGB.
 // What an RGB renderer can do; the spectral modes evaluate the exact film per node instead.
-// `base_f0`: the base's normal-incidence reflectance per channel (0.04 for the dielectric).
+// `base_f0`: the base's normal-incidence reflectance per channel (glTF's 0.04 for the dielectric).
 
 // XYZ → linear sRGB, the colour crate's (from the sRGB primaries and D65); src/film_tests.rs
 // checks that they agree.

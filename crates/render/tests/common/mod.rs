@@ -157,6 +157,11 @@ pub fn pixel_to_chart(px: u32, py: u32, w: u32, h: u32) -> (Vec2, Vec3) {
 /// Independent CPU implementation of the renderer's BRDF (glTF metallic-roughness: Lambert +
 /// GGX, height-correlated Smith, Schlick), as (A, B) with radiance = E·(ρ·A + B).
 pub fn brdf_factors(n: Vec3, v: Vec3, wi: Vec3, metallic: f64, roughness: f64) -> (f64, f64) {
+    brdf_factors_f0(n, v, wi, metallic, roughness, 0.04)
+}
+
+/// [`brdf_factors`] with the dielectric's F0 (`KHR_materials_ior`).
+pub fn brdf_factors_f0(n: Vec3, v: Vec3, wi: Vec3, metallic: f64, roughness: f64, f0: f64) -> (f64, f64) {
     let nl = n.dot(wi) as f64;
     if nl <= 0.0 {
         return (0.0, 0.0);
@@ -171,7 +176,7 @@ pub fn brdf_factors(n: Vec3, v: Vec3, wi: Vec3, metallic: f64, roughness: f64) -
     let d = a2 / (std::f64::consts::PI * dd * dd);
     let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
     let fres = (1.0 - vh).powi(5);
-    let fd = 0.04 + 0.96 * fres;
+    let fd = f0 + (1.0 - f0) * fres;
     let a = nl * ((1.0 - metallic) * (1.0 - fd) / std::f64::consts::PI + metallic * d * vis * (1.0 - fres));
     let b = nl * d * vis * ((1.0 - metallic) * fd + metallic * fres);
     (a, b)
