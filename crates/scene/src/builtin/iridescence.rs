@@ -53,7 +53,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         m.iridescence = film(d, n);
         s.materials.push(m);
         let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, -0.2), r, 32, 64, s.materials.len() - 1));
+        s.meshes.push(shapes::sphere(Vec3::new(x, r, -0.2), r, 14, 22, s.materials.len() - 1));
     }
     for (i, &(c, d, n)) in METAL_FILMS.iter().enumerate() {
         s.materials.push(Material {
@@ -65,7 +65,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
             ..Material::default()
         });
         let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, 0.15), r, 32, 64, s.materials.len() - 1));
+        s.meshes.push(shapes::sphere(Vec3::new(x, r, 0.15), r, 14, 22, s.materials.len() - 1));
     }
     let fw = 2.0f32;
     s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));

@@ -75,11 +75,11 @@ pub(crate) fn sphere(centre: Vec3, radius: f32, rings: u32, segments: u32, mater
     for i in 0..rings {
         for j in 0..segments {
             let (a, b, c, d) = (i * row + j, (i + 1) * row + j, (i + 1) * row + j + 1, i * row + j + 1);
-            // The poles' degenerate triangles are left out.
-            if i > 0 {
+            // a and d meet at the top pole, b and c at the bottom one.
+            if i + 1 < rings {
                 indices.extend_from_slice(&[a, c, b]);
             }
-            if i + 1 < rings {
+            if i > 0 {
                 indices.extend_from_slice(&[a, d, c]);
             }
         }
