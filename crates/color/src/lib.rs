@@ -12,6 +12,7 @@ pub mod input;
 pub mod lab;
 pub mod metrics;
 pub mod observer;
+pub mod observer_file;
 pub mod outfile;
 pub mod progress;
 pub mod quadrature;

@@ -139,6 +139,8 @@ impl Observer {
         match self.name.as_str() {
             "cie1931" | "cie1964" => ObserverKind::CieXyz,
             "nikon_d5100" | "sigma_sd_merrill" | "canon_5d_mark_ii" | "aces_ricd" => ObserverKind::CameraRgb,
+            // A file (`--observer FILE.csv`): most such files are cameras.
+            n if crate::observer_file::is_file_name(n) => ObserverKind::CameraRgb,
             _ => ObserverKind::Receptors,
         }
     }
@@ -220,8 +222,12 @@ impl Observer {
         "dog",
     ];
 
-    /// Looks an observer up by name (any of [`Self::NAMES`] or a short alias; case-insensitive).
+    /// Looks an observer up by name (any of [`Self::NAMES`] or a short alias; case-insensitive),
+    /// or reads it from a CSV file when `name` is a path (`crate::observer_file`).
     pub fn by_name(name: &str) -> Result<Self> {
+        if crate::observer_file::is_file_name(name) {
+            return crate::observer_file::read(std::path::Path::new(name.trim()));
+        }
         match name.trim().to_ascii_lowercase().as_str() {
             "cie1931" | "cie1931_2" | "1931" => Ok(Self::cie1931()),
             "cie1964" | "cie1964_10" | "1964" => Ok(Self::cie1964()),
@@ -237,7 +243,10 @@ impl Observer {
             _ => Err(ColorError::Unknown {
                 kind: "observer",
                 name: name.into(),
-                known: Self::NAMES.join(", "),
+                known: format!(
+                    "{}, or a CSV file (wavelength and three sensitivities)",
+                    Self::NAMES.join(", ")
+                ),
             }),
         }
     }

@@ -1,0 +1,94 @@
+//! `--observer FILE.csv` (issue 33) on the real binary: a CSV holding a built-in camera's
+//! samples renders exactly the image of that camera by name, in real time and in the path
+//! tracer; a bad file is one error naming the file, row and column, and nothing is written.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn run(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_spectra")).args(args).output().expect("running spectra")
+}
+
+fn ok(args: &[&str]) -> std::process::Output {
+    let out = run(args);
+    assert!(out.status.success(), "spectra {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("spectra-observer-file-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn p(d: &Path, f: &str) -> String {
+    d.join(f).display().to_string()
+}
+
+/// ΔE2000 max and linear MAE of `b` against `a`.
+fn difference(a: &str, b: &str) -> (f64, f64) {
+    let out = ok(&["diff", a, b, "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("diff --json");
+    (v["delta_e2000"]["max"].as_f64().unwrap(), v["mae_linear"]["mean"].as_f64().unwrap())
+}
+
+#[test]
+fn a_csv_of_a_built_in_camera_renders_as_that_camera_and_bad_files_are_refused() {
+    let d = dir();
+    let nikon = color::Observer::nikon_d5100();
+    let color::Spectrum::Piecewise { lambda, .. } = &nikon.bar[0] else { panic!("tabulated") };
+    let mut csv = String::from("wavelength_nm,r,g,b\n");
+    for &l in lambda {
+        let v = nikon.eval(l);
+        csv.push_str(&format!("{l},{:?},{:?},{:?}\n", v[0], v[1], v[2]));
+    }
+    let file = p(&d, "nikon.csv");
+    std::fs::write(&file, csv).unwrap();
+    for (cmd, extra) in [("render", &["--wavelengths", "8"][..]), ("truth", &["--spp", "4"][..])] {
+        let by_name = p(&d, &format!("{cmd}-name.exr"));
+        let by_file = p(&d, &format!("{cmd}-file.exr"));
+        let common = [cmd, "metamerism", "--size", "48x32"];
+        let a: Vec<&str> = common
+            .iter()
+            .copied()
+            .chain(extra.iter().copied())
+            .chain(["--observer", "nikon_d5100", "--out", &by_name])
+            .collect();
+        let b: Vec<&str> = common
+            .iter()
+            .copied()
+            .chain(extra.iter().copied())
+            .chain(["--observer", &file, "--out", &by_file])
+            .collect();
+        ok(&a);
+        ok(&b);
+        let (de, mae) = difference(&by_name, &by_file);
+        assert!(
+            de == 0.0 && mae == 0.0,
+            "{cmd}: the CSV's image differs from the camera's: ΔE max {de}, MAE {mae}"
+        );
+    }
+    // The camera is not the CIE observer: the file is really used.
+    let cie = p(&d, "cie.exr");
+    ok(&["render", "metamerism", "--size", "48x32", "--wavelengths", "8", "--out", &cie]);
+    assert!(difference(&cie, &p(&d, "render-file.exr")).1 > 1e-3);
+
+    let bad = p(&d, "bad.csv");
+    std::fs::write(&bad, "400,0.1,0.2\n500,0.1,0.2\n600,0.1,0.2\n").unwrap();
+    let out_file = p(&d, "never.exr");
+    for (cmd, extra) in [("render", &[][..]), ("truth", &["--spp", "1"][..])] {
+        let args: Vec<&str> = [cmd, "metamerism", "--size", "16x16", "--observer", &bad, "--out", &out_file]
+            .into_iter()
+            .chain(extra.iter().copied())
+            .collect();
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{cmd} accepted a bad observer file");
+        assert!(
+            err.contains("bad.csv") && err.contains("row 1") && err.contains("3 columns"),
+            "{cmd}: {err}"
+        );
+        assert!(!Path::new(&out_file).exists(), "{cmd} wrote an output");
+    }
+}
