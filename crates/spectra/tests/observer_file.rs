@@ -91,4 +91,21 @@ fn a_csv_of_a_built_in_camera_renders_as_that_camera_and_bad_files_are_refused()
         );
         assert!(!Path::new(&out_file).exists(), "{cmd} wrote an output");
     }
+
+    // A file shorter than the render range (380–730 nm by default) warns; one outside it fails.
+    let short = p(&d, "short.csv");
+    std::fs::write(&short, "400,0.1,0.2,0.3\n500,0.5,0.6,0.7\n600,0.2,0.1,0.1\n").unwrap();
+    let out =
+        ok(&["render", "metamerism", "--size", "16x16", "--observer", &short, "--out", &p(&d, "short.png")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("warning: observer file") && err.contains("400–600 nm"), "{err}");
+    let far = p(&d, "far.csv");
+    std::fs::write(&far, "750,0.1,0.2,0.3\n800,0.5,0.6,0.7\n830,0.2,0.1,0.1\n").unwrap();
+    let out = run(&["render", "metamerism", "--size", "16x16", "--observer", &far, "--out", &out_file]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("far.csv") && err.contains("do not overlap the render range"),
+        "{err}"
+    );
+    assert!(!Path::new(&out_file).exists());
 }

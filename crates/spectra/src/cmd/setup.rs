@@ -307,7 +307,26 @@ impl SpectrumArgs {
             None => format!("scene {}: spectra {}", scene.source, &flag[2..]),
         };
         let observer = self.observer.clone().or(scene.spectral.observer.clone()).unwrap_or(d.observer);
-        color::Observer::by_name(&observer).with_context(|| from("--observer", &self.observer))?;
+        let obs = color::Observer::by_name(&observer).with_context(|| from("--observer", &self.observer))?;
+        if color::observer_file::is_file_name(&observer)
+            && let color::Spectrum::Piecewise { lambda, .. } = &obs.bar[0]
+        {
+            let (lo, hi) = (lambda[0], lambda[lambda.len() - 1]);
+            if hi <= range.min || lo >= range.max {
+                bail!(
+                    "observer file {observer}: its wavelengths {lo}–{hi} nm do not overlap the render range {}–{} nm",
+                    range.min,
+                    range.max
+                );
+            }
+            if lo > range.min || hi < range.max {
+                eprintln!(
+                    "warning: observer file {observer} covers {lo}–{hi} nm, less than the render range {}–{} nm; \
+                     its sensitivities are taken as zero outside it",
+                    range.min, range.max
+                );
+            }
+        }
         let white = self.white.clone().unwrap_or_else(|| scene.spectral.white_name().to_string());
         color::illuminant::by_name(&white).with_context(|| from("--white", &self.white))?;
         Ok(Spectrum { range, observer, white })
