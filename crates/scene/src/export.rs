@@ -222,6 +222,27 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
         if m.ior != 1.5 {
             j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
         }
+        if let Some(t) = &m.transmission {
+            let mut e = json!({ "transmissionFactor": t.factor });
+            if let Some(x) = &t.texture {
+                e["transmissionTexture"] = tex(x);
+            }
+            j["extensions"]["KHR_materials_transmission"] = e;
+            if let Some(v) = &t.volume {
+                let mut e =
+                    json!({ "thicknessFactor": v.thickness, "attenuationColor": v.attenuation_color });
+                if v.attenuation_distance.is_finite() {
+                    e["attenuationDistance"] = json!(v.attenuation_distance);
+                }
+                if let Some(x) = &v.thickness_texture {
+                    e["thicknessTexture"] = tex(x);
+                }
+                j["extensions"]["KHR_materials_volume"] = e;
+            }
+            if t.dispersion > 0.0 {
+                j["extensions"]["KHR_materials_dispersion"] = json!({ "dispersion": t.dispersion });
+            }
+        }
         let mut extras = serde_json::Map::new();
         match &m.spectral {
             Some(SpectralReflectance::Uniform(s)) => {
@@ -355,6 +376,16 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");
+    }
+    let transmissive = || scene.materials.iter().filter_map(|m| m.transmission.as_ref());
+    if transmissive().next().is_some() {
+        extensions_used.push("KHR_materials_transmission");
+    }
+    if transmissive().any(|t| t.volume.is_some()) {
+        extensions_used.push("KHR_materials_volume");
+    }
+    if transmissive().any(|t| t.dispersion > 0.0) {
+        extensions_used.push("KHR_materials_dispersion");
     }
     let mut doc = json!({
         "asset": {"version": "2.0", "generator": format!("spectra scene exporter (from {})", scene.source)},

@@ -27,7 +27,8 @@ pub(crate) const SUPPORTED: &[&str] = &[
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
 /// warning saying which renderer ignores what) but not require them. None at present.
-const PARTLY_SUPPORTED: &[&str] = &[];
+const PARTLY_SUPPORTED: &[&str] =
+    &["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_dispersion"];
 
 pub(crate) const DECOMPRESS: &str =
     "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
@@ -63,12 +64,13 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
         "KHR_materials_transmission" => (
-            "transmission is ignored: see-through (glass-like) materials are drawn opaque",
-            "this renderer has no refraction",
+            "the path tracer refracts through it; the real-time renderer draws see-through (glass-like) materials opaque",
+            "the real-time renderer has no refraction",
         ),
-        "KHR_materials_volume" => {
-            ("volume absorption (thickness, attenuation colour) is ignored", "this renderer has no volumes")
-        }
+        "KHR_materials_volume" => (
+            "the path tracer absorbs inside the volume; the real-time renderer ignores it",
+            "the real-time renderer has no volumes",
+        ),
         "KHR_materials_clearcoat" => ("the clear-coat layer is ignored", "this renderer has no clear coat"),
         "KHR_materials_sheen" => ("sheen (cloth, velvet) is ignored", "this renderer has no sheen"),
         "KHR_materials_specular" => (
@@ -78,7 +80,10 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }
-        "KHR_materials_dispersion" => ("dispersion is ignored", "this renderer has no refraction"),
+        "KHR_materials_dispersion" => (
+            "the path tracer disperses by wavelength; the real-time renderer ignores it",
+            "the real-time renderer has no refraction",
+        ),
         "KHR_materials_diffuse_transmission" => {
             ("diffuse transmission is ignored", "this renderer has no translucency")
         }

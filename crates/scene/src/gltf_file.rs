@@ -672,6 +672,11 @@ impl Loader<'_> {
                 }
             };
         }
+        if let Some(tr) = info("/extensions/KHR_materials_transmission") {
+            let volume = info("/extensions/KHR_materials_volume");
+            let dispersion = info("/extensions/KHR_materials_dispersion");
+            out.transmission = self.transmission(&at, tr, volume, dispersion)?;
+        }
         let values = [
             out.base_color.to_array().as_slice(),
             &[out.metallic, out.roughness, out.normal_scale],
@@ -824,6 +829,106 @@ impl Loader<'_> {
             thickness_max,
             thickness_texture,
         }))
+    }
+
+    /// `KHR_materials_transmission` with the material's `KHR_materials_volume` and
+    /// `KHR_materials_dispersion` (their JSON), validated: `None` when the factor is 0 (the
+    /// extension's default: opaque).
+    fn transmission(
+        &mut self,
+        at: &str,
+        tr: &Value,
+        volume: Option<&Value>,
+        dispersion: Option<&Value>,
+    ) -> Result<Option<crate::transmission::Transmission>, SceneError> {
+        use crate::transmission::{MAX_DISPERSION, MAX_THICKNESS, Transmission, Volume};
+        let number = |ext: &str, json: &Value, key: &str, default: f32, lo: f32, hi: f32, what: &str| {
+            let Some(v) = json.get(key) else { return Ok(default) };
+            match v.as_f64() {
+                Some(x) if x.is_finite() && (f64::from(lo)..=f64::from(hi)).contains(&x) => Ok(x as f32),
+                _ => Err(self
+                    .ctx
+                    .invalid(format!("{at}.extensions.{ext}.{key}"), format!("{v} is not {what}"))),
+            }
+        };
+        const T: &str = "KHR_materials_transmission";
+        let factor = number(T, tr, "transmissionFactor", 0.0, 0.0, 1.0, "a number in [0, 1]")?;
+        let texture =
+            self.extension_texture(&format!("{at}.extensions.{T}"), tr, "transmissionTexture", false)?;
+        let volume = match volume {
+            None => None,
+            Some(v) => {
+                const V: &str = "KHR_materials_volume";
+                let thickness = number(
+                    V,
+                    v,
+                    "thicknessFactor",
+                    0.0,
+                    0.0,
+                    MAX_THICKNESS,
+                    &format!("a thickness in scene units from 0 to {MAX_THICKNESS:e}"),
+                )?;
+                let distance = number(
+                    V,
+                    v,
+                    "attenuationDistance",
+                    f32::INFINITY,
+                    f32::MIN_POSITIVE,
+                    f32::MAX,
+                    "a distance > 0 in scene units",
+                )?;
+                let color = match v.get("attenuationColor") {
+                    None => [1.0; 3],
+                    Some(c) => {
+                        let nums: Option<Vec<f32>> = c
+                            .as_array()
+                            .map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect());
+                        match nums {
+                            Some(x)
+                                if x.len() == 3
+                                    && c.as_array().is_some_and(|a| a.len() == 3)
+                                    && x.iter().all(|c| (0.0..=1.0).contains(c)) =>
+                            {
+                                [x[0], x[1], x[2]]
+                            }
+                            _ => {
+                                return Err(self.ctx.invalid(
+                                    format!("{at}.extensions.{V}.attenuationColor"),
+                                    format!("{c} is not three numbers in [0, 1] (linear RGB)"),
+                                ));
+                            }
+                        }
+                    }
+                };
+                let thickness_texture =
+                    self.extension_texture(&format!("{at}.extensions.{V}"), v, "thicknessTexture", false)?;
+                // The extension: thickness 0 is a thin-walled surface.
+                (thickness > 0.0).then_some(Volume {
+                    thickness,
+                    thickness_texture,
+                    attenuation_color: color,
+                    attenuation_distance: distance,
+                })
+            }
+        };
+        let dispersion = match dispersion {
+            None => 0.0,
+            Some(d) => number(
+                "KHR_materials_dispersion",
+                d,
+                "dispersion",
+                0.0,
+                0.0,
+                MAX_DISPERSION,
+                &format!(
+                    "a dispersion (20 / Abbe number) in [0, {MAX_DISPERSION}]; an Abbe number must be > 0"
+                ),
+            )?,
+        };
+        if factor == 0.0 {
+            return Ok(None);
+        }
+        Ok(Some(Transmission { factor, texture, volume, dispersion }))
     }
 
     /// `KHR_materials_pbrSpecularGlossiness` (`sg` is its JSON) converted into `out`'s

@@ -27,6 +27,7 @@ pub mod spec_gloss;
 pub mod spectrum_desc;
 pub mod srgb;
 mod tangents;
+pub mod transmission;
 mod uri;
 pub mod vertex;
 pub mod water;
@@ -184,6 +185,9 @@ pub struct Material {
     /// sets its normal-incidence reflectance F0 = ((η − 1)/(η + 1))² ([`Material::dielectric_f0`])
     /// and the index under a thin film.
     pub ior: f32,
+    /// `KHR_materials_transmission` (with `_volume` and `_dispersion`): a see-through
+    /// dielectric ([`transmission`]); `None` when the factor is 0 (opaque).
+    pub transmission: Option<transmission::Transmission>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42).
@@ -270,6 +274,7 @@ impl Default for Material {
             unlit: false,
             iridescence: None,
             ior: 1.5,
+            transmission: None,
         }
     }
 }

@@ -571,14 +571,14 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // Draco used with an uncompressed fallback: drawn, with a warning.
     let mut d = base.clone();
     d["extensionsUsed"] =
-        json!(["KHR_draco_mesh_compression", "KHR_materials_transmission", "KHR_materials_variants"]);
+        json!(["KHR_draco_mesh_compression", "KHR_materials_clearcoat", "KHR_materials_variants"]);
     d["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
     assert!(
-        s.warnings[1].starts_with("KHR_materials_transmission is not supported: ")
-            && s.warnings[1].contains("opaque")
+        s.warnings[1].starts_with("KHR_materials_clearcoat is not supported: ")
+            && s.warnings[1].contains("clear-coat layer is ignored")
     );
     // KTX2 only: a texture without a PNG/JPEG source.
     let mut d = base.clone();
@@ -883,4 +883,70 @@ fn index_of_refraction_is_read_checked_and_exported() {
             "{v}: {e}"
         );
     }
+}
+
+/// `KHR_materials_transmission` with `_volume` and `_dispersion`: read with their defaults
+/// (thickness 0 is thin-walled, no attenuation distance is a clear interior), kept through
+/// export, and every bad value named with its field; nothing is loaded then.
+#[test]
+fn transmission_volume_and_dispersion_are_read_checked_and_exported() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos}, "material": m});
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_dispersion"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2), prim(3)]}],
+        "images": [{"uri": png_uri()}],
+        "textures": [{"source": 0}],
+        "materials": [
+            {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}},
+            {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5, "transmissionTexture": {"index": 0}},
+                            "KHR_materials_volume": {"thicknessFactor": 0.2, "attenuationDistance": 0.5,
+                                                     "attenuationColor": [0.9, 0.5, 0.1], "thicknessTexture": {"index": 0}},
+                            "KHR_materials_dispersion": {"dispersion": 0.36},
+                            "KHR_materials_ior": {"ior": 2.42}}},
+            {"extensions": {"KHR_materials_transmission": {}}},
+            {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_volume": {}}},
+        ],
+    }));
+    let s = load(&doc).unwrap();
+    let thin = s.materials[0].transmission.as_ref().expect("transmissive");
+    assert_eq!(
+        (thin.factor, thin.volume.is_none(), thin.dispersion, thin.disperses()),
+        (1.0, true, 0.0, false)
+    );
+    let gem = s.materials[1].transmission.as_ref().unwrap();
+    let v = gem.volume.as_ref().expect("a volume");
+    assert_eq!((gem.factor, gem.dispersion, v.thickness, v.attenuation_distance), (0.5, 0.36, 0.2, 0.5));
+    assert_eq!(v.attenuation_color, [0.9, 0.5, 0.1]);
+    assert!(gem.texture.is_some() && v.thickness_texture.is_some() && gem.disperses() && v.absorbs());
+    // The default factor is 0: opaque. A volume of thickness 0 is thin-walled.
+    assert!(s.materials[2].transmission.is_none());
+    assert!(s.materials[3].transmission.as_ref().unwrap().volume.is_none());
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    for i in 0..4 {
+        assert_eq!(back.materials[i].transmission, s.materials[i].transmission, "material {i}");
+    }
+    let bad = |ext: &str, key: &str, v: Value, parts: &[&str]| {
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"][ext][key] = v.clone();
+        let e = load(&d).unwrap_err();
+        let at = format!("materials[1].extensions.{ext}.{key}");
+        assert!(e.contains(&at), "{key} = {v}: {e}");
+        assert_has(&e, parts);
+    };
+    for v in [json!(-0.1), json!(1.5), json!("1")] {
+        bad("KHR_materials_transmission", "transmissionFactor", v, &["[0, 1]"]);
+    }
+    bad("KHR_materials_volume", "thicknessFactor", json!(-1), &["thickness"]);
+    bad("KHR_materials_volume", "attenuationDistance", json!(0), &["> 0"]);
+    bad("KHR_materials_volume", "attenuationDistance", json!(-2), &["> 0"]);
+    bad("KHR_materials_volume", "attenuationColor", json!([1.2, 0.5, 0.5]), &["[0, 1]"]);
+    bad("KHR_materials_volume", "attenuationColor", json!([0.5, 0.5]), &["three numbers"]);
+    bad("KHR_materials_dispersion", "dispersion", json!(-0.5), &["Abbe number must be > 0"]);
+    bad("KHR_materials_dispersion", "dispersion", json!(1e9), &["[0, 20]"]);
+    bad("KHR_materials_transmission", "transmissionTexture", json!({"index": 7}), &["no texture"]);
 }
