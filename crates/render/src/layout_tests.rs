@@ -92,6 +92,7 @@ fn shading_module(custom: &CustomShader) -> Module {
         shader::CUSTOM_API,
         &hooks,
         include_str!("passes/shading.wgsl"),
+        include_str!("passes/transmission.wgsl"),
     ])
 }
 
@@ -131,7 +132,14 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &shading,
         "MaterialSpectrum",
-        rust_layout!(crate::material_spectra::MaterialSpectrum { base, emission, emission_xyz, film }),
+        rust_layout!(crate::material_spectra::MaterialSpectrum {
+            base,
+            emission,
+            emission_xyz,
+            film,
+            refraction,
+            absorption
+        }),
     );
     check(
         &shading,

@@ -26,12 +26,24 @@ pub struct MaterialSpectrum {
     /// holds only the weight and where the thickness lies between them per pixel); w the
     /// dielectric's F0 (`KHR_materials_ior`, `scene::dielectric_f0`).
     pub film: [f32; 4],
+    /// A see-through material (`scene_gpu::refraction_record`): x its index at the d line, y
+    /// its dispersion (20 / Abbe number; 0: none), z its volume's thickness in scene units (0:
+    /// thin-walled); w unused. Read only by the transmissive layer's shading.
+    pub refraction: [f32; 4],
+    /// Its interior's absorption per scene unit, linear RGB (box-upsampled per node); w unused.
+    pub absorption: [f32; 4],
 }
 
 impl MaterialSpectrum {
     /// The record of one material: the fetch the shading pass would make per pixel (the CPU
     /// `CoeffTable::fetch` matches the WGSL one, `coeff_table`'s tests), of the exact colours.
-    pub fn new(c: &ConstantColour, film: [f32; 4], table: &CoeffTable, groups: &[WavelengthGroup]) -> Self {
+    pub fn new(
+        c: &ConstantColour,
+        film: [f32; 4],
+        refraction: [[f32; 4]; 2],
+        table: &CoeffTable,
+        groups: &[WavelengthGroup],
+    ) -> Self {
         let coeffs = |rgb: [f32; 3]| {
             let p = table.fetch(rgb.map(f64::from));
             p.c.map(|v| v as f32)
@@ -66,7 +78,8 @@ impl MaterialSpectrum {
             }
         }
         let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
-        MaterialSpectrum { base, emission, emission_xyz, film }
+        let [refraction, absorption] = refraction;
+        MaterialSpectrum { base, emission, emission_xyz, film, refraction, absorption }
     }
 
     /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
@@ -74,13 +87,18 @@ impl MaterialSpectrum {
     pub fn of_scene(
         colours: &[ConstantColour],
         films: &[[f32; 4]],
+        refraction: &[[[f32; 4]; 2]],
         table: &CoeffTable,
         groups: &[WavelengthGroup],
     ) -> Vec<MaterialSpectrum> {
         let mut v: Vec<_> = colours
             .iter()
             .enumerate()
-            .map(|(i, c)| Self::new(c, films.get(i).copied().unwrap_or([1.0, 0.0, 0.0, 0.04]), table, groups))
+            .map(|(i, c)| {
+                let film = films.get(i).copied().unwrap_or([1.0, 0.0, 0.0, 0.04]);
+                let refr = refraction.get(i).copied().unwrap_or([[1.5, 0.0, 0.0, 0.0], [0.0; 4]]);
+                Self::new(c, film, refr, table, groups)
+            })
             .collect();
         if v.is_empty() {
             v.push(MaterialSpectrum::default());

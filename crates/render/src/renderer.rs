@@ -9,7 +9,7 @@ use crate::material_spectra::MaterialSpectrum;
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
-use crate::passes::gbuffer::Targets as GBufferTargets;
+use crate::passes::gbuffer::{Layer as GBufferLayer, Targets as GBufferTargets};
 use crate::passes::post::PostPass;
 use crate::passes::shading::{ShadingPass, Variant};
 use crate::passes::shadow::ShadowPass;
@@ -615,7 +615,25 @@ impl Renderer {
             fetch_emission: scene.varying_colours.1,
             film: scene.has_film,
             ior: scene.has_ior,
+            transmission: false,
         };
+        // See-through materials get a layer of their own, shaded over the opaque one
+        // (`passes::gbuffer::Layer`), except where the shading runs its general node loop (a
+        // spectral hook, the capture): there they are drawn opaque (`Layer::All`).
+        let layered = scene.has_transmission
+            && self.capture.is_none()
+            && !(settings.mode != Mode::Rgb && self.custom.spectral());
+        if layered {
+            // Prepared first: `select` leaves the pipeline it makes last current.
+            let layer_variant =
+                Variant { film: false, emission: variant.emission, transmission: true, ..variant };
+            self.shading.select(&self.gpu.device, layer_variant, settings.mode == Mode::Rgb)?;
+            let (t, _) = self.targets.as_mut().expect("checked above");
+            if t.layer.is_none() {
+                t.layer = Some(crate::targets::LayerTargets::new(&self.gpu.device, t.width, t.height));
+            }
+        }
+        let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
         // The spectral mode reads the material slots, and every mode does for the films and
         // the indices of refraction.
@@ -627,6 +645,10 @@ impl Renderer {
             GBufferTargets::Plain
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
+        if layered {
+            // The see-through layer's film target holds its transmission.
+            self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Film)?;
+        }
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
         let ts = |i: usize| timer.map(|t| t.writes(i));
@@ -640,7 +662,16 @@ impl Renderer {
             GBufferTargets::Slot => &all[..4],
             GBufferTargets::Film => &all[..],
         };
-        self.gbuffer.record(&mut encoder, colour, &targets.depth_view, &self.frame_bind_group, scene, ts(1));
+        let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
+        self.gbuffer.record(
+            &mut encoder,
+            colour,
+            &targets.depth_view,
+            &self.frame_bind_group,
+            scene,
+            first,
+            ts(1),
+        );
         if let Some(c) = &self.capture {
             // Background pixels without an environment write nothing.
             encoder.clear_buffer(&c.buffer, 0, None);
@@ -653,8 +684,40 @@ impl Renderer {
         let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
         // An identity custom pass is skipped: shading writes what the custom pass would.
         let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };
-        let draw = Draw { target: shaded, inputs, timestamps: ts(2) };
-        self.shading.record(&mut encoder, &shared, draw);
+        match (layered, targets.layer.as_ref()) {
+            (true, Some(layer)) => {
+                // The opaque layer into the background, the see-through one over it.
+                let draw = Draw { target: &layer.background_view, inputs, timestamps: ts(2) };
+                self.shading.record(&mut encoder, &shared, draw);
+                encoder.copy_texture_to_texture(
+                    targets.depth.as_image_copy(),
+                    layer.depth.as_image_copy(),
+                    wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                );
+                let views: Vec<&wgpu::TextureView> = layer.gbuffer_views.iter().collect();
+                self.gbuffer.record(
+                    &mut encoder,
+                    &views,
+                    &layer.depth_view,
+                    &self.frame_bind_group,
+                    scene,
+                    GBufferLayer::Transmissive,
+                    None,
+                );
+                let layer_inputs = self.shading.bind_layer_inputs(
+                    &self.gpu.device,
+                    layer,
+                    &self.shadow,
+                    &self.capture_dummy,
+                );
+                let draw = Draw { target: shaded, inputs: &layer_inputs, timestamps: None };
+                self.shading.record_with(&mut encoder, &shared, draw, layer_key);
+            }
+            _ => {
+                let draw = Draw { target: shaded, inputs, timestamps: ts(2) };
+                self.shading.record(&mut encoder, &shared, draw);
+            }
+        }
         let draw = Draw { target: &targets.hdr_view, inputs: &bindings.custom, timestamps: ts(3) };
         self.custom_pass.record(&mut encoder, &shared, draw);
         let post_inputs = if self.accumulating {
@@ -848,6 +911,7 @@ impl Renderer {
             bytemuck::cast_slice(&MaterialSpectrum::of_scene(
                 &scene.constant_colours,
                 &scene.material_films,
+                &scene.material_refraction,
                 &self.table,
                 &groups,
             )),

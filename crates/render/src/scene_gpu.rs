@@ -108,26 +108,41 @@ impl MaterialUniforms {
             alpha: [mode, cutoff, m.double_sided as u8 as f32, m.unlit as u8 as f32],
             uv,
             slot: [u32::try_from(index).map_or(u32::MAX, |i| i.saturating_add(1)), 0, 0, 0],
-            film: match &m.iridescence {
-                Some(f) if !m.unlit => [f.factor, f.ior, f.thickness_min, f.thickness_max],
+            film: match (transmission(m), &m.iridescence) {
+                // The transmissive layer's G-buffer writes the factor and the thickness texture's
+                // G where a film's weight and thickness would be (module `passes::gbuffer`).
+                (Some(t), _) => [t.factor, 0.0, 0.0, 0.0],
+                (None, Some(f)) if !m.unlit => [f.factor, f.ior, f.thickness_min, f.thickness_max],
                 _ => [0.0; 4],
             },
         }
     }
 }
 
+/// The material's transmission as the real-time renderer draws it: the transmissive layer
+/// (`passes::gbuffer::Layer::Transmissive`) for a lit material with a factor above 0. Such a
+/// material's thin film, if any, is not drawn in real time (its G-buffer channels hold the
+/// transmission); the path tracer draws both.
+pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmission> {
+    m.transmission.as_ref().filter(|t| !m.unlit && t.factor > 0.0)
+}
+
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
 /// occlusion, the film's weight (iridescence texture, R) and thickness (G).
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
+    let (weight, thickness) = match transmission(m) {
+        Some(t) => (t.texture, t.volume.as_ref().and_then(|v| v.thickness_texture)),
+        None => (film.and_then(|f| f.texture), film.and_then(|f| f.thickness_texture)),
+    };
     [
         m.base_color_texture,
         m.metallic_roughness_texture,
         m.normal_texture,
         m.emissive_texture,
         m.occlusion_texture,
-        film.and_then(|f| f.texture),
-        film.and_then(|f| f.thickness_texture),
+        weight,
+        thickness,
     ]
 }
 
@@ -242,6 +257,8 @@ pub struct Draw {
     pub double_sided: bool,
     /// The material's alpha mode is `Mask` or `Blend`: the fragment shader may discard.
     pub alpha_tested: bool,
+    /// The material is see-through ([`transmission`]): drawn in the transmissive layer.
+    pub transmissive: bool,
 }
 
 /// A vertex buffer and the index buffer whose indices refer to it.
@@ -405,6 +422,11 @@ pub struct GpuScene {
     /// without a film) and its dielectric's F0 (`scene::dielectric_f0`), for
     /// `MaterialSpectrum::film`.
     pub material_films: Vec<[f32; 4]>,
+    /// Whether some material is see-through ([`transmission`]): only then is the transmissive
+    /// layer drawn and shaded.
+    pub has_transmission: bool,
+    /// Per material, `MaterialSpectrum::refraction` and `::absorption` ([`refraction_record`]).
+    pub material_refraction: Vec<[[f32; 4]; 2]>,
 }
 
 /// A material's base colour and emission where they do not vary over its surface (no texture,
@@ -520,6 +542,7 @@ impl GpuScene {
                 material: m.material,
                 double_sided: mat.double_sided,
                 alpha_tested: mat.alpha_mode != AlphaMode::Opaque,
+                transmissive: transmission(mat).is_some(),
             };
             draws.extend(chunks.add(vertices, &m.indices, template));
         }
@@ -646,6 +669,8 @@ impl GpuScene {
                 .iter()
                 .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
+            has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
+            material_refraction: s.materials.iter().map(refraction_record).collect(),
             material_films: s
                 .materials
                 .iter()
@@ -1004,6 +1029,21 @@ impl DefaultTextures {
             ),
         }
     }
+}
+
+/// A material's refraction for the shading pass: (index at the d line, dispersion (20 / Abbe
+/// number), thickness in scene units (0: thin-walled), 0) and the interior's absorption
+/// coefficient per scene unit in linear RGB (0 when clear), which the spectral modes upsample
+/// as a box spectrum per channel: `color::upsample::medium::Attenuation::DEFAULT`, the path
+/// tracer's upsampling of the same `scene::transmission::Volume::medium`.
+pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
+    let Some(t) = transmission(m) else { return [[m.ior, 0.0, 0.0, 0.0], [0.0; 4]] };
+    let (thickness, sigma) = match &t.volume {
+        Some(v) => (v.thickness, v.medium().map_or([0.0; 3], |md| md.absorption.map(|a| a as f32))),
+        None => (0.0, [0.0; 3]),
+    };
+    let dispersion = if t.disperses() { t.dispersion } else { 0.0 };
+    [[m.ior, dispersion, thickness, 0.0], [sigma[0], sigma[1], sigma[2], 0.0]]
 }
 
 #[cfg(test)]

@@ -37,6 +37,8 @@ pub struct Targets {
     /// Tone-mapped, sRGB-encoded display image (pass 4).
     pub ldr: wgpu::Texture,
     pub ldr_view: wgpu::TextureView,
+    /// The transmissive layer's, once a scene needs them.
+    pub layer: Option<LayerTargets>,
 }
 
 impl Targets {
@@ -97,6 +99,49 @@ impl Targets {
             accum_display_view,
             ldr,
             ldr_view,
+            layer: None,
         }
+    }
+}
+
+/// The transmissive layer's targets (`passes::gbuffer::Layer::Transmissive`), made at the
+/// first frame of a scene with see-through materials: its own G-buffer (all five targets, the
+/// film's holding the transmission) and depth, and the background — the opaque layer's shaded
+/// image, which the transmissive layer's shading samples where refracted rays leave the surface.
+pub struct LayerTargets {
+    pub gbuffer_views: [wgpu::TextureView; 5],
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+    pub background: wgpu::Texture,
+    pub background_view: wgpu::TextureView,
+}
+
+impl LayerTargets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
+            let t = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
+                view_formats: &[],
+            });
+            let v = t.create_view(&Default::default());
+            (t, v)
+        };
+        let none = wgpu::TextureUsages::empty();
+        let views = [
+            make("layer gbuffer base", GBUFFER_FORMATS[0], none).1,
+            make("layer gbuffer normal", GBUFFER_FORMATS[1], none).1,
+            make("layer gbuffer emission", GBUFFER_FORMATS[2], none).1,
+            make("layer gbuffer slot", GBUFFER_SLOT_FORMAT, none).1,
+            make("layer gbuffer transmission", GBUFFER_FILM_FORMAT, none).1,
+        ];
+        let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);
+        let (background, background_view) = make("background", HDR_FORMAT, none);
+        LayerTargets { gbuffer_views: views, depth, depth_view, background, background_view }
     }
 }

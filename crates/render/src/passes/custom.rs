@@ -114,6 +114,15 @@ impl CustomShader {
         defines(&self.source, name)
     }
 
+    /// Whether the shading pass runs its general node loop for these hooks (`CUSTOM_SPECTRAL`:
+    /// the spectral hook or a light or environment transmittance is the user's).
+    pub fn spectral(&self) -> bool {
+        ["custom_spectral", "custom_light_transmittance", "custom_light_transmittance_rgb"]
+            .iter()
+            .chain(&["custom_env_transmittance", "custom_env_transmittance_rgb"])
+            .any(|name| self.defines(name))
+    }
+
     /// The source as the passes compile it: the user's code, the identity definition of each
     /// hook it leaves out, `CUSTOM_SPECTRAL` (whether the spectral hook or the light
     /// transmittance is the user's: the shading loop skips the hook, and carries the specular
@@ -132,7 +141,8 @@ impl CustomShader {
             self.defines("custom_light_transmittance") || self.defines("custom_light_transmittance_rgb");
         let env_transmittance =
             self.defines("custom_env_transmittance") || self.defines("custom_env_transmittance_rgb");
-        let spectral = self.defines("custom_spectral") || transmittance || env_transmittance;
+        let spectral = self.spectral();
+        debug_assert_eq!(spectral, self.defines("custom_spectral") || transmittance || env_transmittance);
         out.push_str(&format!("\nconst CUSTOM_SPECTRAL: bool = {spectral};\n"));
         out.push_str(&format!("const CUSTOM_LIGHT_T: bool = {transmittance};\n"));
         out.push_str(&format!("const CUSTOM_ENV_T: bool = {env_transmittance};\n"));

@@ -29,6 +29,23 @@ pub struct GBufferPass {
     film_pipelines: Option<Pipelines>,
 }
 
+/// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
+/// layers: the opaque one, shaded into the background image, then the transmissive one over a
+/// copy of its depth (so that it keeps only see-through surfaces in front of the opaque ones),
+/// whose shading refracts into that background (`passes::shading`, `HAS_TRANSMISSION`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layer {
+    /// Every draw, see-through ones as opaque (scenes without them; frames that cannot draw
+    /// the second layer).
+    All,
+    /// Every draw but the see-through ones.
+    Opaque,
+    /// Only the see-through ones, depth-tested against the opaque layer's depth, which the
+    /// caller copied into `depth`. The film target then holds the transmission factor and the
+    /// thickness texture's G (`scene_gpu::MaterialUniforms::film`).
+    Transmissive,
+}
+
 /// Which targets a G-buffer pass writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Targets {
@@ -79,6 +96,7 @@ impl GBufferPass {
 
     /// Records the pass into `colour`: the three G-buffer targets, the slot target as a fourth
     /// and the film target as a fifth, as many as the [`Targets`] prepared ([`Self::prepare`]).
+    #[allow(clippy::too_many_arguments)] // a pass's inputs, each its own kind
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -86,6 +104,7 @@ impl GBufferPass {
         depth: &wgpu::TextureView,
         frame: &wgpu::BindGroup,
         scene: &GpuScene,
+        layer: Layer,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let pipelines = match colour.len() {
@@ -113,7 +132,11 @@ impl GBufferPass {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: if layer == Layer::Transmissive {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(1.0)
+                    },
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,
@@ -125,6 +148,11 @@ impl GBufferPass {
         pass.set_bind_group(0, frame, &[]);
         let mut current = None;
         for d in &scene.draws {
+            match layer {
+                Layer::Opaque if d.transmissive => continue,
+                Layer::Transmissive if !d.transmissive => continue,
+                _ => {}
+            }
             let key = (d.double_sided as usize, d.alpha_tested as usize);
             if current != Some(key) {
                 pass.set_pipeline(&pipelines[key.0][key.1]);

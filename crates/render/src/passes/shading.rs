@@ -81,6 +81,9 @@ pub struct Variant {
     pub film: bool,
     /// Some dielectric's index is not 1.5 (`HAS_IOR`, `KHR_materials_ior`): F0 per material.
     pub ior: bool,
+    /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
+    /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
+    pub transmission: bool,
 }
 
 impl Variant {
@@ -95,11 +98,12 @@ impl Variant {
         fetch_emission: true,
         film: true,
         ior: true,
+        transmission: false,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
     /// environment, film, ior); its pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 9] {
+    fn constants(&self) -> [(&'static str, f64); 10] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -111,6 +115,7 @@ impl Variant {
             ("FETCH_EMISSION", b(self.fetch_emission)),
             ("HAS_FILM", b(self.film)),
             ("HAS_IOR", b(self.ior)),
+            ("HAS_TRANSMISSION", b(self.transmission)),
         ]
     }
 
@@ -121,6 +126,7 @@ impl Variant {
             environment: self.environment,
             film: self.film,
             ior: self.ior,
+            transmission: self.transmission,
             ..Variant::ALL
         }
     }
@@ -140,6 +146,7 @@ impl ShadingPass {
                 shader::CUSTOM_API,
                 &custom.assembled(),
                 include_str!("shading.wgsl"),
+                include_str!("transmission.wgsl"),
             ],
             "fs_rgb",
             true,
@@ -216,6 +223,8 @@ impl ShadingPass {
                 },
                 // The films (`gbuf_film`).
                 texture_entry(9),
+                // The transmissive layer's background (`background`, transmission.wgsl).
+                super::filterable_entry(10),
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -306,13 +315,64 @@ impl ShadingPass {
                 buffer_entry(7, capture),
                 view_entry(8, &t.gbuffer_slot_view),
                 view_entry(9, &t.gbuffer_film_view),
+                // Not read outside the transmissive layer: any filterable texture the pass does
+                // not write.
+                view_entry(10, &t.accum_display_view),
             ],
         })
     }
 
+    /// Group 1 of the transmissive layer: its G-buffer and depth, the shadow maps, and the
+    /// opaque layer's shaded image as the background.
+    pub fn bind_layer_inputs(
+        &self,
+        device: &wgpu::Device,
+        layer: &crate::targets::LayerTargets,
+        shadow: &ShadowPass,
+        capture: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let g = &layer.gbuffer_views;
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shading inputs (transmissive layer)"),
+            layout: &self.input_layout,
+            entries: &[
+                view_entry(0, &g[0]),
+                view_entry(1, &g[1]),
+                view_entry(2, &g[2]),
+                view_entry(3, &layer.depth_view),
+                view_entry(4, &shadow.view),
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(&shadow.sampler),
+                },
+                buffer_entry(6, &shadow.uniforms),
+                buffer_entry(7, capture),
+                view_entry(8, &g[3]),
+                view_entry(9, &g[4]),
+                view_entry(10, &layer.background_view),
+            ],
+        })
+    }
+
+    /// The pipeline [`Self::select`] made current, for [`Self::record_with`].
+    pub fn current(&self) -> (Variant, bool) {
+        self.current
+    }
+
     /// Records the pass with the pipeline [`Self::select`] chose.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, shared: &SharedGroups, draw: Draw) {
-        let pipeline = &self.pipelines[&self.current];
+        self.record_with(encoder, shared, draw, self.current);
+    }
+
+    /// Records the pass with the pipeline `key` ([`Self::current`] after its `select`).
+    pub fn record_with(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &SharedGroups,
+        draw: Draw,
+        key: (Variant, bool),
+    ) {
+        let pipeline = &self.pipelines[&key];
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
         draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
     }

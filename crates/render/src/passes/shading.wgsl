@@ -464,11 +464,21 @@ fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> m
 @fragment
 fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
+    if (HAS_TRANSMISSION && textureLoad(gbuf_slot, px, 0).x == 0u) {
+        return textureLoad(background, px, 0);
+    }
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     var rgb = vec3<f32>(0.0);
+    var through = vec3<f32>(0.0);
     if (!ctx.background) {
         let s = load_surface(px);
         ctx.normal = s.normal;
+        var keep = 1.0;
+        if (HAS_TRANSMISSION) {
+            let tr = load_transmissive(px, s);
+            keep = 1.0 - tr.weight;
+            through = transmitted_rgb(in.pos.xy, ctx, s, tr);
+        }
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
@@ -483,6 +493,9 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
+            if (HAS_TRANSMISSION) {
+                t.kd *= keep;
+            }
             if (filmed) {
                 // The film's Fresnel terms are colours: the whole reflection goes into sum_b.
                 let fr = film_fresnel_rgb(film, s.base, s.metallic, t.vh);
@@ -498,7 +511,9 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
-            if (!filmed) {
+            if (HAS_TRANSMISSION) {
+                et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+            } else if (!filmed) {
                 et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
             } else {
                 let l = env_lobes(s.normal, -ctx.view_dir, s.roughness);
@@ -522,7 +537,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
-    var out = custom_rgb(rgb, ctx);
+    var out = custom_rgb(rgb, ctx) + through;
     if (CUSTOM_IRRADIANCE && !ctx.background) {
         let s = load_surface(px);
         let lobe = diffuse_lobe(s);
@@ -578,6 +593,11 @@ struct MaterialSpectrum {
     // The thin film (KHR_materials_iridescence): x its index (1 without a film), y and z its
     // thickness minimum and maximum, nm; w the dielectric's F0 (KHR_materials_ior).
     film: vec4<f32>,
+    // A see-through material: x its index at the d line, y its dispersion (20 / Abbe number),
+    // z its volume's thickness in scene units (0: thin-walled).
+    refraction: vec4<f32>,
+    // Its interior's absorption per scene unit, linear RGB (a box spectrum per node).
+    absorption: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
 
@@ -630,6 +650,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         return hdr_out(shade_nodes(in));
     }
     let px = vec2<i32>(in.pos.xy);
+    if (HAS_TRANSMISSION && textureLoad(gbuf_slot, px, 0).x == 0u) {
+        return textureLoad(background, px, 0);
+    }
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     let has_env = shading_env();
     if (ctx.background) {
@@ -656,11 +679,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
     let film = load_film(px);
     let filmed = HAS_FILM && film.weight > 0.0;
+    var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
+    if (HAS_TRANSMISSION) {
+        tr = load_transmissive(px, s);
+    }
+    let keep = 1.0 - tr.weight;
     for (var li = 0u; li < n_lights; li++) {
         var t = light_terms(li, p, s.normal, v, s.roughness);
         let k = custom_light_surface(li, ctx);
         t.kd *= k;
         t.ks *= k;
+        if (HAS_TRANSMISSION) {
+            t.kd *= keep;
+        }
         if (filmed) {
             // Under a film the specular part depends on λ too: all of it through the nodes.
             for (var g = 0u; g < ng; g++) {
@@ -691,7 +722,11 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             lobes.irr *= vis;
             lobes.spec *= vis;
         } else {
-            et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0);
+            if (HAS_TRANSMISSION) {
+                et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+            } else {
+                et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0);
+            }
             et.a *= vis;
             et.b *= vis;
             xyz += env_xyz(et.b);
@@ -718,6 +753,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         if (CUSTOM_IRRADIANCE && lobe > 0.0) {
             xyz += s3_xyz(s3_scale(custom_irradiance(wavelengths[g].lambda, g, ctx), rho * lobe));
         }
+    }
+    if (HAS_TRANSMISSION) {
+        xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base);
     }
     return hdr_out(frame.xyz_to_rgb * xyz);
 }
