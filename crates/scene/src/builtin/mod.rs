@@ -8,6 +8,7 @@ mod colorchecker;
 mod cornell;
 mod dense;
 pub mod fog;
+pub mod glass;
 pub mod iridescence;
 mod metamerism;
 pub(crate) mod shapes;
@@ -23,7 +24,7 @@ use crate::{Emission, Material, Scene, SpectralReflectance, srgb};
 /// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
 /// about N triangles, for large-mesh measurements).
 pub const BUILTIN_NAMES: &[&str] =
-    &["cornell", "colorchecker", "metamerism", "iridescence", "underwater", "fog", "tinted-fog"];
+    &["cornell", "colorchecker", "metamerism", "iridescence", "glass", "underwater", "fog", "tinted-fog"];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
@@ -33,6 +34,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "colorchecker" => colorchecker::build(&ctx),
         "metamerism" => metamerism::build(&ctx),
         "iridescence" => iridescence::build(&ctx),
+        "glass" => glass::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),

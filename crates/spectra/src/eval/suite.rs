@@ -124,6 +124,7 @@ pub const CASE_IDS: &[&str] = &[
     "colorchecker-led",
     "iridescence-d65",
     "iridescence-f11",
+    "glass",
 ];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
@@ -199,6 +200,13 @@ pub fn case(id: &str) -> Result<Case> {
             relight(&mut s, "F11").context("relighting the iridescence scene with F11")?;
             Ok(Case { id: id.into(), title: "Thin films on dielectric and metal spheres, F11 spots".into(), scene: s })
         }
+        "glass" => Ok(Case {
+            id: id.into(),
+            title: "See-through dielectrics (KHR_materials_transmission, _volume, _dispersion): clear, dispersive, \
+                    absorbing and frosted glass spheres on a tiled floor, one D65 spot"
+                .into(),
+            scene: scene::builtin("glass")?,
+        }),
         w if w.starts_with("underwater-") => {
             let rest = &w["underwater-".len()..];
             // `underwater-TYPE-DEPTHm`: a depth suffix is a number of metres ending in `m`.
