@@ -686,9 +686,17 @@ impl Renderer {
         let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };
         match (layered, targets.layer.as_ref()) {
             (true, Some(layer)) => {
-                // The opaque layer into the background, the see-through one over it.
-                let draw = Draw { target: &layer.background_view, inputs, timestamps: ts(2) };
+                // The opaque layer, kept aside as the background; the see-through one over it.
+                // The shading's time spans both layers (the first's start, the second's end).
+                let draw = Draw { target: shaded, inputs, timestamps: timer.map(|t| t.begins(2)) };
                 self.shading.record(&mut encoder, &shared, draw);
+                let shaded_texture =
+                    if self.custom_pass.skipped() { &targets.hdr } else { &targets.hdr_shaded };
+                encoder.copy_texture_to_texture(
+                    shaded_texture.as_image_copy(),
+                    layer.background.as_image_copy(),
+                    wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                );
                 encoder.copy_texture_to_texture(
                     targets.depth.as_image_copy(),
                     layer.depth.as_image_copy(),
@@ -710,8 +718,9 @@ impl Renderer {
                     &self.shadow,
                     &self.capture_dummy,
                 );
-                let draw = Draw { target: shaded, inputs: &layer_inputs, timestamps: None };
-                self.shading.record_with(&mut encoder, &shared, draw, layer_key);
+                let draw =
+                    Draw { target: shaded, inputs: &layer_inputs, timestamps: timer.map(|t| t.ends(2)) };
+                self.shading.record_layer(&mut encoder, &shared, draw, &layer.depth_view, scene, layer_key);
             }
             _ => {
                 let draw = Draw { target: shaded, inputs, timestamps: ts(2) };

@@ -688,6 +688,15 @@ impl GpuScene {
     /// Records draw `d` with its material at group 1 and its buffers; the caller has set the
     /// pipeline. (Setting the buffers per draw costs little: a scene has few chunks and
     /// draws, and it keeps the passes unaware of the chunking.)
+    /// Records draw `d`'s geometry only: its buffers, no material (for passes whose group 1 is
+    /// their own, the transmissive layer's shading).
+    pub fn draw_geometry(&self, pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
+        let c = &self.chunks[d.chunk];
+        pass.set_vertex_buffer(0, c.vertices.slice(..));
+        pass.set_index_buffer(c.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(d.first_index..d.first_index + d.index_count, d.base_vertex, 0..1);
+    }
+
     pub fn draw_one(&self, pass: &mut wgpu::RenderPass<'_>, d: &Draw) {
         let c = &self.chunks[d.chunk];
         pass.set_vertex_buffer(0, c.vertices.slice(..));

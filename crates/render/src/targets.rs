@@ -141,7 +141,7 @@ impl LayerTargets {
             make("layer gbuffer transmission", GBUFFER_FILM_FORMAT, none).1,
         ];
         let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);
-        let (background, background_view) = make("background", HDR_FORMAT, none);
+        let (background, background_view) = make("background", HDR_FORMAT, wgpu::TextureUsages::COPY_DST);
         LayerTargets { gbuffer_views: views, depth, depth_view, background, background_view }
     }
 }

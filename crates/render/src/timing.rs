@@ -63,6 +63,16 @@ impl Timer {
         }
     }
 
+    /// Only the start of pass `pass`'s time: a pass recorded in two parts starts with this one.
+    pub fn begins(&self, pass: usize) -> wgpu::RenderPassTimestampWrites<'_> {
+        wgpu::RenderPassTimestampWrites { end_of_pass_write_index: None, ..self.writes(pass) }
+    }
+
+    /// Only the end of pass `pass`'s time (the second part of [`Self::begins`]).
+    pub fn ends(&self, pass: usize) -> wgpu::RenderPassTimestampWrites<'_> {
+        wgpu::RenderPassTimestampWrites { beginning_of_pass_write_index: None, ..self.writes(pass) }
+    }
+
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.resolve_query_set(&self.queries, 0..COUNT, &self.resolve, 0);
         encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, COUNT as u64 * 8);

@@ -13,7 +13,10 @@ struct VertexIn {
 };
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the transmissive layer's shading redraws the see-through meshes with the same
+    // transform (`vs_layer` in passes/transmission.wgsl) and keeps the fragments whose depth is
+    // not behind the G-buffer's.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) uv: vec2<f32>,
     @location(2) tangent: vec4<f32>,

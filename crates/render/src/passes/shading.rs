@@ -275,6 +275,9 @@ impl ShadingPass {
                 ("shading pipeline", "fs_main")
             };
             let pipeline = shader::checked(device, label, || {
+                if variant.transmission {
+                    return self.layer_pipeline(device, entry, &constants);
+                }
                 FullscreenPipeline {
                     fragment: entry,
                     constants: &constants,
@@ -286,6 +289,87 @@ impl ShadingPass {
         }
         self.current = key;
         Ok(())
+    }
+
+    /// The transmissive layer's pipeline: the see-through meshes redrawn (`vs_layer`) over the
+    /// frame that holds the background, keeping only fragments not behind the layer's depth (its
+    /// own surfaces; read-only), so that only see-through pixels run the shading.
+    fn layer_pipeline(
+        &self,
+        device: &wgpu::Device,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> wgpu::RenderPipeline {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shading pipeline (transmissive layer)"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &self.module,
+                entry_point: Some("vs_layer"),
+                compilation_options: Default::default(),
+                buffers: &[Some(crate::scene_gpu::Vertex::layout())],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: super::DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: HDR_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// Records the transmissive layer's shading with the pipeline `key` (a [`Variant`] with
+    /// `transmission`): the see-through draws of `scene` over `target`, which already holds the
+    /// opaque layer, depth-tested against `depth` (the layer's, also bound in `inputs`).
+    #[allow(clippy::too_many_arguments)] // a pass's inputs, each its own kind
+    pub fn record_layer(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        shared: &SharedGroups,
+        draw: Draw,
+        depth: &wgpu::TextureView,
+        scene: &crate::scene_gpu::GpuScene,
+        key: (Variant, bool),
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shading (transmissive layer)"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: draw.target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
+            timestamp_writes: draw.timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipelines[&key]);
+        for (i, g) in [shared.frame, draw.inputs, shared.spectral, shared.custom].into_iter().enumerate() {
+            pass.set_bind_group(i as u32, g, &[]);
+        }
+        for d in scene.draws.iter().filter(|d| d.transmissive) {
+            scene.draw_geometry(&mut pass, d);
+        }
     }
 
     /// Group 1: the G-buffer, its depth, the shadow maps and `capture` as the spectral capture

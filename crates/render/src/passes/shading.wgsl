@@ -616,8 +616,7 @@ struct SurfaceCoeffs {
 // "illuminant" variant, s·sigmoid(rgb / s)·white(λ) with s = 2·max(rgb), so that an emissive
 // (1, 1, 1) is exactly the white illuminant; a surface that emits nothing is not fetched.
 fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
-    let slot = textureLoad(gbuf_slot, px, 0).x;
-    let m = material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)];
+    let m = material_at(px);
     var base = m.base.xyz;
     var emission = select(vec4<f32>(0.0), m.emission, m.emission.w >= 0.0);
     // A scene whose colours are all constant has no fetch compiled in.

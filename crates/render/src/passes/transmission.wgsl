@@ -16,6 +16,19 @@
 @group(1) @binding(10) var background: texture_2d<f32>;
 override HAS_TRANSMISSION: bool = false;
 
+// The transmissive layer's shading is drawn over the see-through meshes themselves, not over the
+// whole screen (the frame's other pixels already hold the background, copied there): a CPU
+// driver runs a fragment shader's every branch, so a full-screen pass cost every pixel the
+// whole shading. The G-buffer pass transforms the same vertices the same way (`@invariant`).
+@vertex
+fn vs_layer(@location(0) position: vec3<f32>) -> LayerOut {
+    return LayerOut(frame.view_proj * vec4<f32>(position, 1.0));
+}
+
+struct LayerOut {
+    @builtin(position) @invariant pos: vec4<f32>,
+};
+
 struct Transmissive {
     // Transmission factor × texture R × (1 − metallic): the share of the dielectric's diffuse
     // layer that is a refracted lobe instead.
