@@ -76,6 +76,7 @@ fn quick_suite_orders_the_modes() {
             "colorchecker-led",
             "iridescence-d65",
             "iridescence-f11",
+            "glass",
             "underwater-i"
         ]
     );
