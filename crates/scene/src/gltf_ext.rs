@@ -23,12 +23,14 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_iridescence",
     "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_materials_dispersion",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
 /// warning saying which renderer ignores what) but not require them. None at present.
-const PARTLY_SUPPORTED: &[&str] =
-    &["KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_dispersion"];
+const PARTLY_SUPPORTED: &[&str] = &[];
 
 pub(crate) const DECOMPRESS: &str =
     "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
@@ -63,14 +65,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         }
         "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
-        "KHR_materials_transmission" => (
-            "the path tracer refracts through it; the real-time renderer draws see-through (glass-like) materials opaque",
-            "the real-time renderer has no refraction",
-        ),
-        "KHR_materials_volume" => (
-            "the path tracer absorbs inside the volume; the real-time renderer ignores it",
-            "the real-time renderer has no volumes",
-        ),
         "KHR_materials_clearcoat" => ("the clear-coat layer is ignored", "this renderer has no clear coat"),
         "KHR_materials_sheen" => ("sheen (cloth, velvet) is ignored", "this renderer has no sheen"),
         "KHR_materials_specular" => (
@@ -80,10 +74,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }
-        "KHR_materials_dispersion" => (
-            "the path tracer disperses by wavelength; the real-time renderer ignores it",
-            "the real-time renderer has no refraction",
-        ),
         "KHR_materials_diffuse_transmission" => {
             ("diffuse transmission is ignored", "this renderer has no translucency")
         }
@@ -264,12 +254,12 @@ mod tests {
     #[test]
     fn optional_extensions_warn_required_ones_refuse_with_advice() {
         let raw = json!({
-            "extensionsUsed": ["KHR_materials_transmission", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
+            "extensionsUsed": ["KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
             "extensionsRequired": ["KHR_draco_mesh_compression"],
         });
         let w = warnings(&raw);
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].contains("KHR_materials_transmission") && w[0].contains("opaque"), "{w:?}");
+        assert!(w[0].contains("KHR_materials_sheen") && w[0].contains("ignored"), "{w:?}");
         let e = check_required(&Ctx::builtin("t"), &raw).unwrap_err().to_string();
         assert!(e.contains("extensionsRequired[0]") && e.contains("KHR_draco_mesh_compression"), "{e}");
         assert!(e.contains("@gltf-transform/cli copy"), "{e}");

@@ -598,8 +598,8 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     assert_has(&error(&d), &["images[0]: is a KTX2 image", "ktxdecompress"]);
     // A required material extension: refused, naming it.
     let mut d = base.clone();
-    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_volume"]);
-    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_volume"]);
+    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_sheen"]);
+    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_sheen"]);
 }
 
 #[test]
@@ -911,6 +911,10 @@ fn transmission_volume_and_dispersion_are_read_checked_and_exported() {
         ],
     }));
     let s = load(&doc).unwrap();
+    assert!(!s.warnings.join("\n").contains("KHR_materials_"), "{:?}", s.warnings);
+    let mut required = doc.clone();
+    required["extensionsRequired"] = required["extensionsUsed"].clone();
+    assert!(load(&required).unwrap().materials[1].transmission.is_some());
     let thin = s.materials[0].transmission.as_ref().expect("transmissive");
     assert_eq!(
         (thin.factor, thin.volume.is_none(), thin.dispersion, thin.disperses()),

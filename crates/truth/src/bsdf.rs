@@ -20,7 +20,7 @@ use glam::{Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// Smallest α: below it the lobe is a mirror that neither NEE nor f32 can represent.
-const MIN_ALPHA: f32 = 1e-3;
+pub const MIN_ALPHA: f32 = 1e-3;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Brdf {
@@ -183,9 +183,17 @@ impl Brdf {
         (pdf > 0.0).then(|| BrdfSample { wi, f: self.eval(wo, wi), pdf })
     }
 
-    /// Heitz 2018, "Sampling the GGX distribution of visible normals".
     fn sample_visible_normal(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
-        let a = self.alpha;
+        visible_normal(self.alpha, wo, u)
+    }
+}
+
+/// Heitz 2018, "Sampling the GGX distribution of visible normals": a microfacet normal of the
+/// GGX distribution of roughness α seen from `wo` (above the surface). Shared by the BRDF and
+/// the dielectric BSDF (`crate::dielectric`).
+pub fn visible_normal(alpha: f32, wo: Vec3, u: [f32; 2]) -> Vec3 {
+    {
+        let a = alpha;
         let vh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
         let len2 = vh.x * vh.x + vh.y * vh.y;
         let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };

@@ -6,6 +6,7 @@
 use crate::accel::Hit;
 use crate::bsdf::{Brdf, FilmLanes};
 use crate::camera::CameraRay;
+use crate::dielectric::Dielectric;
 use crate::material;
 use crate::medium::{Phase, phase_eval, phase_sample};
 use crate::rng::Sampler;
@@ -14,9 +15,10 @@ use crate::spectral::Wavelengths;
 use crate::world::{World, offset};
 use glam::{Vec3, Vec4};
 
-/// Where a path scatters: a surface (BRDF in a shading frame) or a point in the medium.
+/// Where a path scatters: a surface (BRDF in a shading frame; a see-through material mixes in
+/// the rough dielectric with weight T·(1 − metallic)) or a point in the medium.
 enum Vertex {
-    Surface { brdf: Brdf, frame: Frame, ng: Vec3 },
+    Surface { brdf: Brdf, frame: Frame, ng: Vec3, glass: Option<(Dielectric, f32)> },
     Medium { phase: Phase },
 }
 
@@ -25,13 +27,29 @@ impl Vertex {
     /// back along the path.
     fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec4, f32) {
         match self {
-            Vertex::Surface { brdf, frame, ng } => {
-                // Reflection only: both directions on the side of the (flipped) geometric normal.
-                if ng.dot(wi) <= 0.0 {
-                    return (Vec4::ZERO, 0.0);
-                }
+            Vertex::Surface { brdf, frame, ng, glass } => {
                 let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
-                (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li))
+                // The BRDF reflects only: both directions on the side of the (flipped)
+                // geometric normal.
+                let above = ng.dot(wi) > 0.0;
+                let Some((d, w)) = glass else {
+                    if !above {
+                        return (Vec4::ZERO, 0.0);
+                    }
+                    return (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li));
+                };
+                let (f_o, p_o) = if above {
+                    (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li))
+                } else {
+                    (Vec4::ZERO, 0.0)
+                };
+                // A transmission must really cross the surface (shading and geometric normal agree).
+                let (f_d, p_d) = if above == (li.z > 0.0) {
+                    (d.eval(lo, li) * li.z.abs(), d.pdf(lo, li))
+                } else {
+                    (Vec4::ZERO, 0.0)
+                };
+                (f_o * (1.0 - w) + f_d * *w, p_o * (1.0 - w) + p_d * w)
             }
             Vertex::Medium { phase } => {
                 let p = phase_eval(*phase, (-wo).dot(wi));
@@ -188,6 +206,11 @@ impl Integrator<'_, '_> {
         // (so emitters hit directly get full weight).
         let mut prev_pdf = 0.0f32;
         let mut depth = 0u32;
+        // Scattering events that count as bounces for `direct_only`: refractions through
+        // see-through surfaces do not (direct light seen through glass is direct light).
+        let mut bounces = 0u32;
+        // The see-through material whose closed volume the path is in (KHR_materials_volume).
+        let mut inside: Option<usize> = None;
         loop {
             let hit = if t_near > 0.0 {
                 // Traced from the near plane, with distances still counted from the eye.
@@ -198,6 +221,14 @@ impl Integrator<'_, '_> {
             };
             t_near = 0.0;
             let mut t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+            // Inside an absorbing volume: Beer's law per lane up to the next surface (the same
+            // for every lane's pdf, so only `f` changes).
+            if let Some(m) = inside
+                && let Some(sigma) = w.absorption[m]
+                && t_hit.is_finite()
+            {
+                f *= beer(material::absorption_at(sigma, l), t_hit);
+            }
             // The water surface, from below, comes before anything above it.
             let at_surface = w.surface.as_ref().and_then(|s| s.crossing(o, d)).filter(|&t| t <= t_hit);
             if let Some(t) = at_surface {
@@ -222,7 +253,7 @@ impl Integrator<'_, '_> {
                     p *= pdf / pdf.x;
                     let pos = o + d * t;
                     let vtx = Vertex::Medium { phase: m.phase };
-                    if self.direct_only && depth >= 1 {
+                    if self.direct_only && bounces >= 1 {
                         break;
                     }
                     radiance += f / mean(p) * self.direct(pos, None, -d, &vtx, wl, rng);
@@ -235,6 +266,7 @@ impl Integrator<'_, '_> {
                     o = pos;
                     d = wi;
                     depth += 1;
+                    bounces += 1;
                     if !self.roulette(&mut f, p, depth, rng) {
                         break;
                     }
@@ -259,7 +291,7 @@ impl Integrator<'_, '_> {
                 // The mirror direction with probability R: unbiased for the reflected light
                 // (R/R = 1), always under TIR. A specular vertex: light sampling cannot find
                 // what lies along it, so what it hits gets full MIS weight (prev_pdf = 0).
-                if (self.direct_only && depth >= 1) || depth + 1 > self.max_depth || rng.uniform() >= r {
+                if (self.direct_only && bounces >= 1) || depth + 1 > self.max_depth || rng.uniform() >= r {
                     break;
                 }
                 let pos = o + d * t;
@@ -267,6 +299,7 @@ impl Integrator<'_, '_> {
                 d = Vec3::new(d.x, -d.y, d.z);
                 prev_pdf = 0.0;
                 depth += 1;
+                bounces += 1;
                 if !self.roulette(&mut f, p, depth, rng) {
                     break;
                 }
@@ -299,7 +332,7 @@ impl Integrator<'_, '_> {
                 };
                 radiance += f / mean(p) * le * mis;
             }
-            if (self.direct_only && depth >= 1) || depth + 1 > self.max_depth {
+            if (self.direct_only && bounces >= 1) || depth + 1 > self.max_depth {
                 break;
             }
             let mat = &w.scene.materials[s.material];
@@ -310,7 +343,8 @@ impl Integrator<'_, '_> {
 
             // Double-sided materials face their normals towards the viewer; a single-sided one
             // is hit from the front only (`World::coverage`), so the flip never applies to it.
-            let flip = if s.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+            let front = s.ng.dot(wo) >= 0.0;
+            let flip = if front { 1.0 } else { -1.0 };
             let ng = s.ng * flip;
             let mut ns = material::mapped_normal(mat, &w.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
             if ns.dot(wo) <= 0.0 {
@@ -337,21 +371,68 @@ impl Integrator<'_, '_> {
                 Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film)
             };
             let frame = Frame::from_normal(ns);
-            let vtx = Vertex::Surface { brdf, frame, ng };
+            let glass = match (mat.transmission.as_ref(), self.lambert) {
+                (Some(t), false) => material::transmission(mat, &w.scene.textures, &s.tc).map(|weight| {
+                    if t.disperses() {
+                        // Each wavelength refracts its own way: the hero carries the path on
+                        // alone (its pdf over the four lanes' mean, so 4× its own estimate), an
+                        // unbiased single-wavelength estimate from here on.
+                        f = Vec4::new(f.x, 0.0, 0.0, 0.0);
+                        p = Vec4::new(p.x, 0.0, 0.0, 0.0);
+                    }
+                    let ior = t.ior_at(mat.ior, f64::from(l.x)) as f32;
+                    let thin = t.volume.is_none();
+                    let eta = if thin || front { ior } else { 1.0 / ior };
+                    let alpha = (roughness * roughness).clamp(crate::bsdf::MIN_ALPHA, 1.0);
+                    (Dielectric { tint: base, alpha, eta, thin }, weight * (1.0 - metallic))
+                }),
+                _ => None,
+            };
+            let vtx = Vertex::Surface { brdf, frame, ng, glass };
 
             radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);
 
-            let Some(bs) = brdf.sample(frame.to_local(wo), rng.uniform(), rng.next2()) else { break };
-            let wi = frame.to_world(bs.wi);
-            if ng.dot(wi) <= 0.0 {
-                break;
-            }
-            // The BRDF pdf is the same for every lane, so it only scales `f`.
-            f *= bs.f * (bs.wi.z / bs.pdf);
-            prev_pdf = bs.pdf;
+            let lo = frame.to_local(wo);
+            let (wi, crossed) = if let Some((d, wt)) = glass {
+                let (wi, crossed) = if rng.uniform() < wt {
+                    let Some(x) = d.sample(lo, rng.uniform(), rng.next2()) else { break };
+                    (frame.to_world(x.wi), x.transmitted)
+                } else {
+                    let Some(x) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
+                    (frame.to_world(x.wi), false)
+                };
+                if (ng.dot(wi) <= 0.0) != crossed {
+                    break;
+                }
+                // The mixture's value and pdf (a one-sample estimate of both lobes).
+                let (fv, pdf) = vtx.eval(wo, wi);
+                if pdf <= 0.0 || !pdf.is_finite() {
+                    break;
+                }
+                f *= fv / pdf;
+                prev_pdf = pdf;
+                (wi, crossed)
+            } else {
+                let Some(bs) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
+                let wi = frame.to_world(bs.wi);
+                if ng.dot(wi) <= 0.0 {
+                    break;
+                }
+                // The BRDF pdf is the same for every lane, so it only scales `f`.
+                f *= bs.f * (bs.wi.z / bs.pdf);
+                prev_pdf = bs.pdf;
+                (wi, false)
+            };
             o = offset(s.p, ng, wi);
             d = wi;
             depth += 1;
+            if crossed {
+                if glass.is_some_and(|(d, _)| !d.thin) {
+                    inside = if front { Some(s.material) } else { None };
+                }
+            } else {
+                bounces += 1;
+            }
             if !self.roulette(&mut f, p, depth, rng) {
                 break;
             }

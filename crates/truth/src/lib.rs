@@ -15,6 +15,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod dielectric;
 pub mod env_map;
 pub mod error;
 pub mod export_mitsuba;
@@ -41,6 +42,8 @@ mod near_plane_tests;
 mod rgb_medium_tests;
 #[cfg(test)]
 mod testing;
+#[cfg(test)]
+mod transmission_tests;
 
 pub use error::{Result, TruthError};
 pub use medium::{Medium, Phase, Region};

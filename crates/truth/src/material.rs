@@ -131,6 +131,35 @@ pub fn metallic_roughness(m: &Material, textures: &[Texture], tc: &TexCoords) ->
     }
 }
 
+/// The transmission weight (`KHR_materials_transmission`: factor × texture R) at a surface
+/// point; `None` for an opaque material or where it is 0.
+pub fn transmission(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<f32> {
+    let t = m.transmission.as_ref()?;
+    let w = match tex(textures, &t.texture, tc) {
+        Some((x, uv)) => t.factor * texture::sample(x, uv).x,
+        None => t.factor,
+    };
+    (w > 0.0).then_some(w.min(1.0))
+}
+
+/// The absorption coefficient per scene unit inside material `m`'s volume
+/// (`KHR_materials_volume`), linear RGB, as the RGB media have it
+/// (`scene::transmission::Volume::medium`); `None` when it is clear or has no volume.
+pub fn volume_absorption(m: &Material) -> Option<[f64; 3]> {
+    let md = m.transmission.as_ref()?.volume.as_ref()?.medium()?;
+    // The spectral side upsamples it by boxes (`absorption_at`): the default upsampling of
+    // every RGB medium, which the real-time renderer's box per node matches.
+    debug_assert_eq!(md.upsampling, color::upsample::medium::Attenuation::Box);
+    Some(md.absorption)
+}
+
+/// σ_a(λ) at four wavelengths of the RGB absorption `sigma` upsampled as a box per channel
+/// (`color::upsample::medium::Attenuation::Box`, the default for RGB media).
+pub fn absorption_at(sigma: [f64; 3], l: Vec4) -> Vec4 {
+    let b = color::upsample::boxes::BoxSpectrum { rgb: sigma };
+    Vec4::from_array(l.to_array().map(|x| b.eval(f64::from(x)) as f32))
+}
+
 /// The thin film (`KHR_materials_iridescence`) at a surface point: its weight (factor ×
 /// texture R) and the film (thickness from the thickness texture's G); `None` without one or
 /// where its weight is 0.

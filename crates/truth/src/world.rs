@@ -59,6 +59,8 @@ pub struct World<'s> {
     /// Some triangle has an `AlphaMode::Blend` material: rays then draw a key from the path's
     /// sampler for their stochastic opacity decisions ([`World::ray_key`]).
     pub stochastic: bool,
+    /// Per material, the absorption inside its volume (`material::volume_absorption`).
+    pub absorption: Vec<Option<[f64; 3]>>,
 }
 
 impl<'s> World<'s> {
@@ -161,6 +163,7 @@ impl<'s> World<'s> {
             env_map,
             surface,
             stochastic,
+            absorption: original.materials.iter().map(crate::material::volume_absorption).collect(),
         })
     }
 
