@@ -1,0 +1,109 @@
+"""Type stub of the `spectra` package (the extension module spectra._spectra). See docs/python.md."""
+
+import os
+from typing import Optional, Tuple, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+#: The built-in scene names `load` accepts.
+BUILTINS: list[str]
+
+RGBImage = npt.NDArray[np.float32]
+"""A linear RGB image: float32, shape (height, width, 3), C-contiguous."""
+
+class Stats(TypedDict):
+    mean: float
+    median: float
+    p95: float
+    p99: float
+    max: float
+
+class DiffSummary(TypedDict):
+    width: int
+    height: int
+    white_luminance: float
+    delta_e2000: Stats
+    mae_linear: Stats
+    mae_srgb: Stats
+
+class Scene:
+    """A loaded scene (from `load`); immutable."""
+
+    @property
+    def source(self) -> str:
+        """Where it came from: a path, or `builtin:NAME`."""
+    @property
+    def warnings(self) -> list[str]:
+        """What the loader skipped or approximated."""
+    @property
+    def lights(self) -> int:
+        """The number of lights (stand-ins included)."""
+
+def load(path_or_builtin: Union[str, os.PathLike[str]], allow_outside_scene_dir: bool = False) -> Scene:
+    """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
+    underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
+    without lights gets the default environment. `allow_outside_scene_dir`: let the file's
+    references leave its folder. Raises ValueError (bad scene), FileNotFoundError."""
+
+class Renderer:
+    """The real-time renderer (wgpu; lavapipe without a GPU) for one scene at one size. The GPU
+    device, pipelines and scene buffers are kept between `render()` calls."""
+
+    def __init__(self, scene: Scene, size: Tuple[int, int] = (640, 480)) -> None: ...
+    def render(
+        self,
+        mode: str = "spectral",
+        *,
+        wavelengths: Optional[int] = None,
+        quadrature: str = "prefiltered",
+        range: Optional[Tuple[float, float]] = None,
+        observer: Optional[str] = None,
+        white: Optional[str] = None,
+        exposure: float = 0.0,
+    ) -> RGBImage:
+        """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
+
+        mode: "spectral", "naive" or "rgb". wavelengths: 1–256 (default: the scene's, else 16).
+        quadrature: "prefiltered" or "midpoint". range: (min_nm, max_nm) (default: the scene's,
+        else (380, 730)). observer: "cie1931" (default, unless the scene sets one), "cie1964", a
+        camera or a CSV file. white: an illuminant name (default: the scene's, else D65).
+        Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
+        is released while rendering."""
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def size(self) -> Tuple[int, int]:
+        """(width, height)."""
+    @property
+    def device(self) -> str:
+        """The GPU adapter and backend."""
+
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Tuple[int, int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    range: Optional[Tuple[float, float]] = None,
+    observer: Optional[str] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+) -> RGBImage:
+    """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
+    options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
+    `sample_offset=K` renders samples K … K+spp−1 (the CLI's --sample-offset / --chunk). The
+    same seed gives the same image. Ctrl-C raises KeyboardInterrupt; the GIL is released."""
+
+def diff(a: npt.ArrayLike, b: npt.ArrayLike, *, white_y: float = 1.0) -> DiffSummary:
+    """`spectra diff --json`'s statistics of image `b` against the reference `a` (float32 or
+    float64 arrays of shape (H, W, 3), linear sRGB): ΔE2000, MAE linear and sRGB-encoded.
+    ValueError naming the argument for a wrong dtype or shape, or a non-finite pixel."""
+
+def read_image(path: Union[str, os.PathLike[str]]) -> RGBImage:
+    """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""
