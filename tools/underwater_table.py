@@ -19,6 +19,12 @@ Usage: tools/underwater_table.py [--bin target/release/spectra] [--size 72x48] [
 samples are kept by everything they depend on, so a second run with a changed real-time model
 renders no truth, and one with a higher --spp renders only the samples it lacks.
 
+--ray [--ray-chunks K]: every truth of the table is submitted at once as Ray tasks through the
+Python package (`spectra.distributed`, docs/python.md; K sample chunks each, default 8) on the
+Ray instance of $RAY_ADDRESS or a new local one, and written as the EXR `spectra truth` would
+write; the real-time renders and the statistics stay on this machine. Needs
+`pip install './python[distributed]'`.
+
 Every number comes from `spectra truth`, `spectra render` and `spectra diff --json`; nothing is
 computed here but the table layout and means.
 """
@@ -65,6 +71,8 @@ def main():
     ap.add_argument("--depths", default=",".join(map(str, DEPTHS)))
     ap.add_argument("--noise-depths", default="all", help="depths with a second truth seed, or 'all'")
     ap.add_argument("--truth-cache")
+    ap.add_argument("--ray", action="store_true", help="render the truths as Ray tasks (spectra.distributed)")
+    ap.add_argument("--ray-chunks", type=int, default=8)
     ap.add_argument("--models", default=DEFAULT_MODELS)
     ap.add_argument("--out")
     ap.add_argument("--json")
@@ -78,8 +86,26 @@ def main():
     if a.truth_cache:
         os.makedirs(a.truth_cache, exist_ok=True)
 
+    if a.ray and a.truth_cache:
+        sys.exit("--ray and --truth-cache: pick one (the cache is the command line's)")
+    jobs = {}
+    if a.ray:
+        import spectra
+        import spectra.distributed
+        scene = spectra.load("underwater")
+        w, h = (int(v) for v in a.size.lower().split("x"))
+        for ty in a.types.split(","):
+            for depth in a.depths.split(","):
+                for seed in (1, 2) if depth in noise_depths else (1,):
+                    jobs[(ty, depth, seed)] = spectra.distributed.submit(
+                        scene, spp=a.spp, size=(w, h), seed=seed, water=ty, depth=float(depth),
+                        chunks=a.ray_chunks, label=f"{ty} {depth} m seed {seed}")
+
     def truth_image(tmp, ty, depth, seed):
         path = os.path.join(tmp, f"truth-{ty}-{depth}-{seed}.exr")
+        if a.ray:
+            spectra.write_image(path, jobs[(ty, depth, seed)].result())
+            return path
         cache = ["--truth-cache", a.truth_cache] if a.truth_cache else []
         run([a.bin, "truth", "underwater", "--water", ty, "--depth", depth, "--size", a.size,
              "--spp", str(a.spp), "--seed", str(seed), *cache, "--out", path])

@@ -10,6 +10,45 @@ CLI's ΔE2000 / MAE statistics, on numpy arrays.
 See docs/python.md.
 """
 
-from ._spectra import BUILTINS, Renderer, Scene, __version__, diff, load, read_image, truth
+import functools
 
-__all__ = ["BUILTINS", "Renderer", "Scene", "__version__", "diff", "load", "read_image", "truth"]
+from ._spectra import (
+    BUILTINS,
+    ILLUMINANTS,
+    OBSERVERS,
+    Renderer,
+    Scene,
+    __version__,
+    diff,
+    illuminant,
+    load,
+    observer,
+    read_image,
+    truth,
+    upsample,
+    write_image,
+)
+
+__all__ = [
+    "BUILTINS",
+    "ILLUMINANTS",
+    "OBSERVERS",
+    "Renderer",
+    "Scene",
+    "__version__",
+    "diff",
+    "illuminant",
+    "load",
+    "observer",
+    "read_image",
+    "truth",
+    "upsample",
+    "write_image",
+]
+
+
+@functools.lru_cache(maxsize=8)
+def _load_cached(path_or_builtin, allow_outside_scene_dir=False, env=None, env_intensity=None, env_rotation=None):
+    """`load`, kept per process: what an unpickled `Scene` is (a Ray worker loads a scene
+    once, however many tasks it runs with it)."""
+    return load(path_or_builtin, allow_outside_scene_dir, env, env_intensity, env_rotation)

@@ -1,7 +1,7 @@
 """Type stub of the `spectra` package (the extension module spectra._spectra). See docs/python.md."""
 
 import os
-from typing import Optional, Tuple, TypedDict, Union
+from typing import Any, Optional, Tuple, TypedDict, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -10,6 +10,10 @@ __version__: str
 
 #: The built-in scene names `load` accepts.
 BUILTINS: list[str]
+#: The built-in observer and camera names `observer` and `observer=` accept.
+OBSERVERS: list[str]
+#: The tabulated illuminant names (`illuminant`, `white=`); "5000K" / "blackbody:5000" too.
+ILLUMINANTS: list[str]
 
 RGBImage = npt.NDArray[np.float32]
 """A linear RGB image: float32, shape (height, width, 3), C-contiguous."""
@@ -30,7 +34,8 @@ class DiffSummary(TypedDict):
     mae_srgb: Stats
 
 class Scene:
-    """A loaded scene (from `load`); immutable."""
+    """A loaded scene (from `load`); immutable. Pickles as `load` with the same arguments (a
+    file by its absolute path), so it can be a Ray task's argument."""
 
     @property
     def source(self) -> str:
@@ -42,17 +47,36 @@ class Scene:
     def lights(self) -> int:
         """The number of lights (stand-ins included)."""
 
-def load(path_or_builtin: Union[str, os.PathLike[str]], allow_outside_scene_dir: bool = False) -> Scene:
+def load(
+    path_or_builtin: Union[str, os.PathLike[str]],
+    allow_outside_scene_dir: bool = False,
+    env: Optional[str] = None,
+    env_intensity: Optional[float] = None,
+    env_rotation: Optional[float] = None,
+) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
     without lights gets the default environment. `allow_outside_scene_dir`: let the file's
-    references leave its folder. Raises ValueError (bad scene), FileNotFoundError."""
+    references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"
+    (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y. Raises
+    ValueError (bad scene), FileNotFoundError."""
 
 class Renderer:
     """The real-time renderer (wgpu; lavapipe without a GPU) for one scene at one size. The GPU
     device, pipelines and scene buffers are kept between `render()` calls."""
 
-    def __init__(self, scene: Scene, size: Tuple[int, int] = (640, 480)) -> None: ...
+    def __init__(
+        self,
+        scene: Scene,
+        size: Tuple[int, int] = (640, 480),
+        *,
+        water: Optional[str] = None,
+        depth: Optional[float] = None,
+        rgb_medium: Optional[str] = None,
+    ) -> None:
+        """`water`: a Jerlov type ("IB", …) with the camera `depth` in metres; `rgb_medium`: the
+        `--rgb-medium` JSON or a JSON file; by default the scene's own medium."""
+    @overload
     def render(
         self,
         mode: str = "spectral",
@@ -63,13 +87,16 @@ class Renderer:
         observer: Optional[str] = None,
         white: Optional[str] = None,
         exposure: float = 0.0,
-    ) -> RGBImage:
+        spectral: bool = False,
+    ) -> Any:
         """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
 
         mode: "spectral", "naive" or "rgb". wavelengths: 1–256 (default: the scene's, else 16).
         quadrature: "prefiltered" or "midpoint". range: (min_nm, max_nm) (default: the scene's,
         else (380, 730)). observer: "cie1931" (default, unless the scene sets one), "cie1964", a
         camera or a CSV file. white: an illuminant name (default: the scene's, else D65).
+        spectral=True: the tuple (image, node radiances float32 (H, W, N), node wavelengths
+        float64 (N,)), as `--spectral-out` writes them (not in rgb mode).
         Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
         is released while rendering."""
     @property
@@ -94,16 +121,51 @@ def truth(
     observer: Optional[str] = None,
     white: Optional[str] = None,
     max_depth: int = 1024,
-) -> RGBImage:
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[str] = None,
+    spectral_bin: Optional[float] = None,
+) -> Any:
     """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
     options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
     `sample_offset=K` renders samples K … K+spp−1 (the CLI's --sample-offset / --chunk). The
-    same seed gives the same image. Ctrl-C raises KeyboardInterrupt; the GIL is released."""
+    same seed gives the same image. water / depth / rgb_medium as for `Renderer`.
+    spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
+    (`--spectral-out`). Ctrl-C raises KeyboardInterrupt; the GIL is released."""
 
-def diff(a: npt.ArrayLike, b: npt.ArrayLike, *, white_y: float = 1.0) -> DiffSummary:
+def diff(
+    a: npt.ArrayLike,
+    b: npt.ArrayLike,
+    *,
+    white_y: float = 1.0,
+    flip: Optional[str] = None,
+    flip_ppd: Optional[float] = None,
+    maps: bool = False,
+) -> dict[str, Any]:
     """`spectra diff --json`'s statistics of image `b` against the reference `a` (float32 or
-    float64 arrays of shape (H, W, 3), linear sRGB): ΔE2000, MAE linear and sRGB-encoded.
-    ValueError naming the argument for a wrong dtype or shape, or a non-finite pixel."""
+    float64 arrays of shape (H, W, 3), linear sRGB): ΔE2000, MAE linear and sRGB-encoded
+    (a `DiffSummary`); flip="ldr"/"hdr" adds NVIDIA FLIP (`flip`, `flip_kind`, `flip_ppd`);
+    maps=True adds the per-pixel (H, W) arrays `delta_e2000_map`, `mae_linear_map`,
+    `mae_srgb_map` (and `flip_map`). ValueError naming the argument for a wrong dtype or
+    shape, or a non-finite pixel."""
+
+def upsample(
+    rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: Optional[npt.ArrayLike] = None
+) -> Any:
+    """Jakob–Hanika coefficients (c0, c1, c2), float64 (..., 3), of linear RGB reflectances
+    (..., 3) in [0, 1] in `space` (srgb, p3, rec2020, acescg), the renderers' own fetch; with
+    `wavelengths` (nm, 1-D) the tuple (coefficients, spectra (..., L))."""
+
+def observer(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """An observer's colour-matching functions or a camera's sensitivities at `wavelengths`
+    (nm): float64 (L, 3)."""
+
+def illuminant(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """An illuminant's relative spectral power at `wavelengths` (nm): float64 (L,)."""
 
 def read_image(path: Union[str, os.PathLike[str]]) -> RGBImage:
     """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""
+
+def write_image(path: Union[str, os.PathLike[str]], image: npt.ArrayLike) -> None:
+    """Writes an (H, W, 3) linear RGB array as `.exr` (float32) or `.png` (sRGB, 8-bit),
+    atomically."""

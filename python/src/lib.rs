@@ -1,8 +1,9 @@
 //! `spectra._spectra`: the Python extension module behind the `spectra` package (PyO3).
 //!
-//! Scenes, settings and media are resolved by the command line's own code
-//! (`crates/spectra/src/cmd/setup.rs`, compiled in here as the module `setup`), so a render or a
-//! truth from Python is the CLI's with the same options. Long work (loading, rendering,
+//! Scenes, settings and media are resolved by the command line's own code (the `spectra`
+//! crate's library, `spectra::cmd::setup`), so a render or a truth from Python is the CLI's
+//! with the same options; `spectra.distributed.eval` runs the CLI's evaluation
+//! (`spectra::eval`). Long work (loading, rendering,
 //! path tracing, statistics) runs with the GIL released. Errors carry the Rust error's message
 //! (its whole chain on one line, as the CLI prints it): bad values raise `ValueError`, a missing
 //! file `FileNotFoundError`, failures of the work itself `RuntimeError`.
@@ -16,10 +17,8 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// The CLI's scene, spectrum, water, medium and table options (not all of them are used here).
-#[allow(dead_code)]
-#[path = "../../crates/spectra/src/cmd/setup.rs"]
-mod setup;
+/// The CLI's scene, spectrum, water, medium and table options.
+use spectra::cmd::setup;
 
 /// Why a call failed, carried out of a GIL-free section and raised as the matching exception.
 enum Fail {
@@ -103,6 +102,19 @@ fn rgb_array<'py>(
 #[pyclass(frozen, module = "spectra")]
 struct Scene {
     inner: Arc<scene::Scene>,
+    /// `load`'s arguments, so that a pickled scene (a Ray task's argument) loads again where it
+    /// is unpickled: the name or path, then the options in `load`'s order.
+    how: LoadArgs,
+}
+
+/// `load`'s arguments, as given.
+#[derive(Clone)]
+struct LoadArgs {
+    name: String,
+    allow_outside_scene_dir: bool,
+    env: Option<String>,
+    env_intensity: Option<f32>,
+    env_rotation: Option<f32>,
 }
 
 #[pymethods]
@@ -123,6 +135,20 @@ impl Scene {
     #[getter]
     fn lights(&self) -> usize {
         self.inner.lights.len()
+    }
+
+    /// Pickled as `spectra.load` with the same arguments: unpickling loads the scene again (a
+    /// file must be reachable at the same path there, e.g. on every node of a Ray cluster).
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
+        let load = py.import("spectra")?.getattr("_load_cached")?;
+        let h = &self.how;
+        let args =
+            (h.name.clone(), h.allow_outside_scene_dir, h.env.clone(), h.env_intensity, h.env_rotation)
+                .into_pyobject(py)?;
+        Ok((load, args))
     }
 
     fn __repr__(&self) -> String {
@@ -151,31 +177,67 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Arc<scene::Scene>> {
 ///
 /// `allow_outside_scene_dir`: let the file's references (buffers, images, spectra,
 /// environment maps) leave its folder (off by default, as on the command line).
+/// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
+/// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
+/// environment when the scene has no lights. `env_intensity` multiplies it, `env_rotation`
+/// turns it about +Y (degrees).
 #[pyfunction]
-#[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false))]
-fn load(py: Python<'_>, path_or_builtin: PathBuf, allow_outside_scene_dir: bool) -> PyResult<Scene> {
+#[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false, env = None, env_intensity = None,
+                    env_rotation = None))]
+fn load(
+    py: Python<'_>,
+    path_or_builtin: PathBuf,
+    allow_outside_scene_dir: bool,
+    env: Option<String>,
+    env_intensity: Option<f32>,
+    env_rotation: Option<f32>,
+) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
         .ok_or_else(|| PyValueError::new_err(format!("{}: not a UTF-8 path", path_or_builtin.display())))?
         .to_string();
+    // A file is reloaded by its absolute path where the scene is unpickled (another process's
+    // working directory may differ).
+    let lower = name.to_ascii_lowercase();
+    let abs = if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+        std::path::absolute(&name)
+            .ok()
+            .and_then(|p| p.to_str().map(String::from))
+            .unwrap_or_else(|| name.clone())
+    } else {
+        name.clone()
+    };
+    let env_abs = env.as_ref().map(|e| match e.to_ascii_lowercase().as_str() {
+        "default" | "none" => e.clone(),
+        _ => std::path::absolute(e)
+            .ok()
+            .and_then(|p| p.to_str().map(String::from))
+            .unwrap_or_else(|| e.clone()),
+    });
+    let how = LoadArgs { name: abs, allow_outside_scene_dir, env: env_abs, env_intensity, env_rotation };
+    let h = LoadArgs { env, ..how.clone() };
     let scene = py.detach(move || -> Result<scene::Scene, PyErr> {
         let lower = name.to_ascii_lowercase();
         let is_file = lower.ends_with(".gltf") || lower.ends_with(".glb");
+        let env_missing = h.env.as_deref().is_some_and(|e| {
+            !matches!(e.to_ascii_lowercase().as_str(), "default" | "none")
+                && std::fs::symlink_metadata(e).is_err()
+        });
         let args = setup::SceneArgs {
             scene: name.clone(),
             files: setup::SceneFileArgs { allow_outside_scene_dir },
-            env: setup::EnvArgs::default(),
+            env: setup::EnvArgs { env: h.env, env_intensity: h.env_intensity, env_rotation: h.env_rotation },
         };
         args.load().map_err(|e| {
             // The loader's message names the missing file; its type says so too.
-            if is_file && std::fs::symlink_metadata(&name).is_err() {
+            if (is_file && std::fs::symlink_metadata(&name).is_err()) || env_missing {
                 PyFileNotFoundError::new_err(format!("{e:#}"))
             } else {
                 value(e).into()
             }
         })
     })?;
-    Ok(Scene { inner: Arc::new(scene) })
+    Ok(Scene { inner: Arc::new(scene), how })
 }
 
 /// The CLI's `LookArgs` with every default (`spectra render SCENE` without options).
@@ -193,7 +255,15 @@ struct Inner {
     renderer: render::Renderer,
     scene: Arc<scene::Scene>,
     size: (u32, u32),
+    /// The water and RGB medium options the renderer was made with (`render` resolves its
+    /// settings with them, as `spectra render` does).
+    water: setup::WaterArgs,
+    rgb_medium: setup::RgbMediumArgs,
 }
+
+/// A (H, W, 3) float32 image, and with a spectral capture its (H, W, N) node radiances and the
+/// N node wavelengths.
+type Frame = (Vec<f32>, Option<(Vec<f32>, Vec<f64>)>, (u32, u32));
 
 /// The real-time renderer (wgpu) for one scene at one size. It keeps its GPU device, pipelines
 /// and scene buffers between `render()` calls, so only the first call pays for them.
@@ -206,17 +276,30 @@ struct Renderer {
 #[pymethods]
 impl Renderer {
     /// Creates the GPU device (lavapipe without a GPU), uploads `scene` and sizes the targets to
-    /// `size=(width, height)`. The water or RGB medium of the scene is set up as
-    /// `spectra render` sets it up.
+    /// `size=(width, height)`. The medium is set up as `spectra render` sets it up: `water` (a
+    /// Jerlov type, e.g. "IB") with the camera `depth` in metres, or `rgb_medium` (the
+    /// `--rgb-medium` JSON or a JSON file); by default the scene's own.
     #[new]
-    #[pyo3(signature = (scene, size = (640, 480)))]
-    fn new(py: Python<'_>, scene: &Bound<'_, PyAny>, size: (i64, i64)) -> PyResult<Self> {
+    #[pyo3(signature = (scene, size = (640, 480), *, water = None, depth = None, rgb_medium = None))]
+    fn new(
+        py: Python<'_>,
+        scene: &Bound<'_, PyAny>,
+        size: (i64, i64),
+        water: Option<String>,
+        depth: Option<f64>,
+        rgb_medium: Option<String>,
+    ) -> PyResult<Self> {
         let sc = scene_of(scene, "scene")?;
         let scene_obj: Py<Scene> = scene.extract()?;
         let (w, h) = size_arg(size)?;
+        let water = setup::WaterArgs { water, depth };
+        let rgb_medium = setup::RgbMediumArgs { rgb_medium };
         let s = sc.clone();
+        let (wa, ra) = (water.clone(), rgb_medium.clone());
         let renderer = py.detach(move || -> Result<render::Renderer, Fail> {
-            let look = default_look();
+            let mut look = default_look();
+            look.water = wa;
+            look.rgb_medium = ra;
             let table = look.table.load().map_err(runtime)?;
             let media = look.media(&s, &table).map_err(value)?;
             let custom = media.shader().map_err(value)?;
@@ -231,7 +314,10 @@ impl Renderer {
             r.resize(w, h).map_err(value)?;
             Ok(r)
         })?;
-        Ok(Renderer { inner: Mutex::new(Inner { renderer, scene: sc, size: (w, h) }), scene: scene_obj })
+        Ok(Renderer {
+            inner: Mutex::new(Inner { renderer, scene: sc, size: (w, h), water, rgb_medium }),
+            scene: scene_obj,
+        })
     }
 
     /// One frame as a float32 array of shape (height, width, 3), C-contiguous: the linear RGB
@@ -247,8 +333,13 @@ impl Renderer {
     /// white: the scene white, an illuminant name ("D65", "F11", "5000K", …; default: the
     /// scene's, else D65).
     /// exposure: stops.
+    /// spectral: also return the radiance at each of the N nodes, as `--spectral-out` writes
+    /// it: the tuple (image, radiance of shape (H, W, N) float32, wavelengths of shape (N,)
+    /// float64, nm). With the midpoint rule a node's value is L(λₖ); with the prefiltered rule
+    /// it is the node's share of the integral as a radiance (docs/spectral-exr.md). Not in rgb
+    /// mode.
     #[pyo3(signature = (mode = "spectral", *, wavelengths = None, quadrature = "prefiltered", range = None,
-                        observer = None, white = None, exposure = 0.0))]
+                        observer = None, white = None, exposure = 0.0, spectral = false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -260,7 +351,8 @@ impl Renderer {
         observer: Option<String>,
         white: Option<String>,
         exposure: f32,
-    ) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+        spectral: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let mut look = default_look();
         look.mode = render::Mode::parse(mode).map_err(|e| PyValueError::new_err(e.to_string()))?;
         look.wavelengths = match wavelengths {
@@ -278,18 +370,45 @@ impl Renderer {
             .map_err(|e| PyValueError::new_err(format!("--quadrature '{quadrature}': {e}")))?;
         look.spectrum = setup::SpectrumArgs { range: range_arg(range), observer, white };
         look.exposure = exposure;
-        let (data, (w, h)) = py.detach(|| -> Result<(Vec<f32>, (u32, u32)), Fail> {
+        let (data, capture, (w, h)) = py.detach(|| -> Result<Frame, Fail> {
             let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
             let inner = &mut *g;
+            look.water = inner.water.clone();
+            look.rgb_medium = inner.rgb_medium.clone();
             let settings = look.settings(&inner.scene, true, false).map_err(value)?;
+            let (w, h) = inner.size;
+            if spectral {
+                if settings.mode == render::Mode::Rgb {
+                    return Err(value(anyhow::anyhow!(
+                        "spectral=True: rgb mode has no wavelength nodes (use mode='spectral' or 'naive')"
+                    )));
+                }
+                inner.renderer.check_spectral_capture(w, h, settings.wavelengths).map_err(value)?;
+            }
+            inner.renderer.set_spectral_capture(spectral);
             inner.renderer.render(&inner.scene.camera, &settings).map_err(runtime)?;
             let hdr = inner.renderer.read_hdr().map_err(runtime)?;
             // As `spectra render --out x.exr` writes them.
             let k = settings.exposure_ev.exp2();
             let data = hdr.iter().flat_map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
-            Ok((data, inner.size))
+            let capture = if spectral {
+                let cap = inner.renderer.read_spectral_capture().map_err(runtime)?;
+                Some((cap.data.into_iter().map(|v| v * k).collect(), cap.lambda))
+            } else {
+                None
+            };
+            Ok((data, capture, (w, h)))
         })?;
-        rgb_array(py, w, h, data)
+        let img = rgb_array(py, w, h, data)?;
+        match capture {
+            None => Ok(img.into_any()),
+            Some((nodes, lambda)) => {
+                let n = lambda.len();
+                let nodes = PyArray1::from_vec(py, nodes).reshape([h as usize, w as usize, n])?;
+                let lambda = PyArray1::from_vec(py, lambda);
+                Ok((img, nodes, lambda).into_pyobject(py)?.into_any())
+            }
+        }
     }
 
     /// The scene this renderer draws.
@@ -316,48 +435,163 @@ impl Renderer {
     }
 }
 
-/// The truth settings `spectra truth` builds from these options (its `settings()`), the
-/// scene's RGB medium or water included.
-#[allow(clippy::too_many_arguments)]
-fn truth_settings(
-    scene: &scene::Scene,
-    table: &color::upsample::CoeffTable,
-    (width, height): (u32, u32),
+/// A truth render's options, as `truth()` takes them (the CLI's `spectra truth` flags).
+struct TruthArgs {
     spp: u32,
+    size: (u32, u32),
+    direct_only: bool,
     seed: u64,
     sample_offset: u64,
     crop: Option<truth::Crop>,
-    direct_only: bool,
     max_depth: u32,
-    spectrum: &setup::SpectrumArgs,
-) -> anyhow::Result<truth::Settings> {
-    let mut s = truth::Settings::new(width, height, spp)?;
-    s.seed = seed;
-    s.sample_offset = sample_offset;
-    s.crop = crop;
-    s.direct_only = direct_only;
-    s.max_depth = max_depth;
-    let sp = spectrum.resolve(scene)?;
-    s.range = sp.range;
-    s.observer = color::Observer::by_name(&sp.observer)?;
-    s.white = color::illuminant::by_name(&sp.white)?;
-    let rgb = scene.medium.is_some();
-    if let Some(m) = &scene.medium {
-        let origin = format!("{}: extras.medium", scene.source);
-        let m = truth::Medium::from_rgb(m, table).with_context(|| origin.clone())?;
-        m.validate(s.range).with_context(|| origin.clone())?;
-        s.medium = Some(m);
-    }
-    if let Some(w) = setup::water_medium(scene, None, None)? {
-        if rgb {
-            anyhow::bail!(
-                "--medium / --rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
-            );
+    spectrum: setup::SpectrumArgs,
+    water: setup::WaterArgs,
+    rgb_medium: setup::RgbMediumArgs,
+    spectral_bin: Option<f64>,
+}
+
+impl TruthArgs {
+    /// Checks and converts `truth()`'s arguments; errors name the argument.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        spp: i64,
+        size: (i64, i64),
+        direct_only: bool,
+        seed: i64,
+        sample_offset: i64,
+        crop: Option<(i64, i64, i64, i64)>,
+        range: Option<(f64, f64)>,
+        observer: Option<String>,
+        white: Option<String>,
+        max_depth: i64,
+        water: Option<String>,
+        depth: Option<f64>,
+        rgb_medium: Option<String>,
+        spectral_bin: Option<f64>,
+    ) -> PyResult<Self> {
+        let spp = whole("spp", spp, 1)?;
+        let size = size_arg(size)?;
+        if seed < 0 {
+            return Err(PyValueError::new_err(format!("seed {seed}: must be a whole number ≥ 0")));
         }
-        s.medium = Some(truth::water::medium(&w, scene.camera.position()));
+        if sample_offset < 0 {
+            return Err(PyValueError::new_err(format!(
+                "sample_offset {sample_offset}: must be a whole number ≥ 0"
+            )));
+        }
+        let crop = match crop {
+            Some((x, y, cw, ch)) => Some(truth::Crop {
+                x: whole("crop x", x, 0)?,
+                y: whole("crop y", y, 0)?,
+                width: whole("crop width", cw, 1)?,
+                height: whole("crop height", ch, 1)?,
+            }),
+            None => None,
+        };
+        Ok(TruthArgs {
+            spp,
+            size,
+            direct_only,
+            seed: seed as u64,
+            sample_offset: sample_offset as u64,
+            crop,
+            max_depth: whole("max_depth", max_depth, 0)?,
+            spectrum: setup::SpectrumArgs { range: range_arg(range), observer, white },
+            water: setup::WaterArgs { water, depth },
+            rgb_medium: setup::RgbMediumArgs { rgb_medium },
+            spectral_bin,
+        })
     }
-    s.validate()?;
-    Ok(s)
+
+    /// The settings `spectra truth` builds from the same flags (its `settings()`): the scene's
+    /// RGB medium unless `rgb_medium` replaces it, the water of `water`/`depth` or the scene's.
+    fn settings(
+        &self,
+        scene: &scene::Scene,
+        table: &color::upsample::CoeffTable,
+    ) -> anyhow::Result<truth::Settings> {
+        let (width, height) = self.size;
+        let mut s = truth::Settings::new(width, height, self.spp)?;
+        s.seed = self.seed;
+        s.sample_offset = self.sample_offset;
+        s.crop = self.crop;
+        s.direct_only = self.direct_only;
+        s.max_depth = self.max_depth;
+        let sp = self.spectrum.resolve(scene)?;
+        s.range = sp.range;
+        s.observer = color::Observer::by_name(&sp.observer)?;
+        s.white = color::illuminant::by_name(&sp.white)?;
+        let rgb = match (self.rgb_medium.arg(), &scene.medium) {
+            (Some(arg), _) => Some((setup::rgb_medium_arg(arg)?, "rgb_medium".to_string())),
+            (None, Some(m)) => Some((m.clone(), format!("{}: extras.medium", scene.source))),
+            (None, None) => None,
+        };
+        if let Some((m, origin)) = &rgb {
+            let m = truth::Medium::from_rgb(m, table).with_context(|| origin.clone())?;
+            m.validate(s.range).with_context(|| origin.clone())?;
+            s.medium = Some(m);
+        }
+        if let Some(w) = self.water.medium(scene)? {
+            if rgb.is_some() {
+                anyhow::bail!(
+                    "rgb_medium / the scene's medium and water (from water= or the scene) cannot be combined: pick one medium"
+                );
+            }
+            s.medium = Some(truth::water::medium(&w, scene.camera.position()));
+        }
+        if let Some(bin) = self.spectral_bin {
+            s.spectral_bands = Some(s.range.bin_edges(bin).context("spectral_bin")?);
+        }
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// Renders the samples: passes of about a quarter second (the first, of one sample,
+    /// measures them), with a look at Python's signals between them, so Ctrl-C raises
+    /// KeyboardInterrupt within about a second. The sums do not depend on the passes.
+    fn run(&self, sc: &scene::Scene) -> Result<(truth::Settings, truth::Accumulator), Fail> {
+        let table = setup::load_table(None).map_err(runtime)?;
+        let st = self.settings(sc, &table).map_err(value)?;
+        let mut world =
+            truth::World::new(sc, table.as_ref(), &st.white, st.range, st.medium.as_ref()).map_err(value)?;
+        if let Some(env) = &st.environment {
+            world = world.with_environment(env);
+        }
+        let mut acc = truth::Accumulator::new(&st).map_err(value)?;
+        let cancel = AtomicBool::new(false);
+        let mut per_sample: Option<f64> = None;
+        while acc.done < st.spp {
+            let left = st.spp - acc.done;
+            let n = match per_sample {
+                None => 1,
+                Some(t) => ((0.25 / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
+            };
+            let t = Instant::now();
+            truth::render_pass(&world, &st, &cancel, &mut acc, n, &|_| {}).map_err(runtime)?;
+            per_sample = Some(t.elapsed().as_secs_f64() / f64::from(n));
+            Python::attach(|py| py.check_signals()).map_err(Fail::Py)?;
+        }
+        if acc.dropped > 0 {
+            eprintln!("warning: truth: {} non-finite samples dropped", acc.dropped);
+        }
+        Ok((st, acc))
+    }
+}
+
+/// The image of per-pixel sums over `spp` samples, as `spectra truth` finishes a render
+/// (`Accumulator::finish`: the mean as f32, then XYZ → linear sRGB): one place for the
+/// single-process and the distributed truth.
+fn finish(width: u32, height: u32, xyz: &[[f64; 3]], bins: &[f64], spp: u32) -> (Vec<f32>, Vec<f32>) {
+    let n = f64::from(spp);
+    let img = truth::XyzImage {
+        width,
+        height,
+        xyz: xyz.iter().map(|p| p.map(|v| (v / n) as f32)).collect(),
+        dropped: 0,
+        spectral: None,
+    };
+    let rgb = img.to_rgb(&color::RgbColorSpace::srgb()).into_iter().flatten().collect();
+    (rgb, bins.iter().map(|v| (v / n) as f32).collect())
 }
 
 /// The CPU spectral path tracer's image of `scene` (what `spectra truth` renders with the same
@@ -370,12 +604,16 @@ fn truth_settings(
 /// K … K+spp−1 of each pixel's sequence (the CLI's --sample-offset; chunks with disjoint ranges
 /// average into the full render). crop: (x, y, w, h) of the frame, rendered with exactly the
 /// full render's samples. range / observer / white: as for `Renderer.render`. max_depth: the
-/// longest path in scattering events.
+/// longest path in scattering events. water / depth / rgb_medium: as for `Renderer`.
+/// spectral_bin: also bin the radiance by wavelength, in bins of this many nm over the range
+/// (`--spectral-out` with `--spectral-bin`): returns (image, bands of shape (h, w, B) float32,
+/// band edges of shape (B + 1,) float64, nm).
 ///
 /// Ctrl-C interrupts it (KeyboardInterrupt) within about a second.
 #[pyfunction(name = "truth")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
-                    crop = None, range = None, observer = None, white = None, max_depth = 1024))]
+                    crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
+                    depth = None, rgb_medium = None, spectral_bin = None))]
 #[allow(clippy::too_many_arguments)]
 fn truth_image<'py>(
     py: Python<'py>,
@@ -390,73 +628,177 @@ fn truth_image<'py>(
     observer: Option<String>,
     white: Option<String>,
     max_depth: i64,
-) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+    water: Option<String>,
+    depth: Option<f64>,
+    rgb_medium: Option<String>,
+    spectral_bin: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
     let sc = scene_of(scene, "scene")?;
-    let spp = whole("spp", spp, 1)?;
-    let (w, h) = size_arg(size)?;
-    if seed < 0 {
-        return Err(PyValueError::new_err(format!("seed {seed}: must be a whole number ≥ 0")));
-    }
-    if sample_offset < 0 {
-        return Err(PyValueError::new_err(format!(
-            "sample_offset {sample_offset}: must be a whole number ≥ 0"
-        )));
-    }
-    let crop = match crop {
-        Some((x, y, cw, ch)) => Some(truth::Crop {
-            x: whole("crop x", x, 0)?,
-            y: whole("crop y", y, 0)?,
-            width: whole("crop width", cw, 1)?,
-            height: whole("crop height", ch, 1)?,
-        }),
-        None => None,
-    };
-    let max_depth = whole("max_depth", max_depth, 0)?;
-    let spectrum = setup::SpectrumArgs { range: range_arg(range), observer, white };
-    let (data, (iw, ih)) = py.detach(move || -> Result<(Vec<f32>, (u32, u32)), Fail> {
-        let table = setup::load_table(None).map_err(runtime)?;
-        let st = truth_settings(
-            &sc,
-            &table,
-            (w, h),
-            spp,
-            seed as u64,
-            sample_offset as u64,
-            crop,
-            direct_only,
-            max_depth,
-            &spectrum,
-        )
-        .map_err(value)?;
-        let mut world =
-            truth::World::new(&sc, table.as_ref(), &st.white, st.range, st.medium.as_ref()).map_err(value)?;
-        if let Some(env) = &st.environment {
-            world = world.with_environment(env);
-        }
-        let mut acc = truth::Accumulator::new(&st).map_err(value)?;
-        let cancel = AtomicBool::new(false);
-        // Passes of about a quarter second (the first, of one sample, measures them), with a
-        // look at Python's signals between them; the sums do not depend on the passes.
-        let mut per_sample: Option<f64> = None;
-        while acc.done < st.spp {
-            let left = st.spp - acc.done;
-            let n = match per_sample {
-                None => 1,
-                Some(t) => ((0.25 / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
-            };
-            let t = Instant::now();
-            truth::render_pass(&world, &st, &cancel, &mut acc, n, &|_| {}).map_err(runtime)?;
-            per_sample = Some(t.elapsed().as_secs_f64() / f64::from(n));
-            Python::attach(|py| py.check_signals()).map_err(Fail::Py)?;
-        }
-        let img = acc.finish(&st);
-        if img.dropped > 0 {
-            eprintln!("warning: truth: {} non-finite samples dropped", img.dropped);
-        }
-        let rgb = img.to_rgb(&color::RgbColorSpace::srgb());
-        Ok((rgb.into_iter().flatten().collect(), (img.width, img.height)))
+    let a = TruthArgs::new(
+        spp,
+        size,
+        direct_only,
+        seed,
+        sample_offset,
+        crop,
+        range,
+        observer,
+        white,
+        max_depth,
+        water,
+        depth,
+        rgb_medium,
+        spectral_bin,
+    )?;
+    let (rgb, bands, edges, (w, h)) = py.detach(move || -> Result<_, Fail> {
+        let (st, acc) = a.run(&sc)?;
+        let win = st.window();
+        let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp);
+        Ok((rgb, bands, st.spectral_bands, (win.width, win.height)))
     })?;
-    rgb_array(py, iw, ih, data)
+    let img = rgb_array(py, w, h, rgb)?;
+    match edges {
+        None => Ok(img.into_any()),
+        Some(edges) => {
+            let nb = edges.len() - 1;
+            let bands = PyArray1::from_vec(py, bands).reshape([h as usize, w as usize, nb])?;
+            Ok((img, bands, PyArray1::from_vec(py, edges)).into_pyobject(py)?.into_any())
+        }
+    }
+}
+
+/// `truth`'s sums before they are averaged, for renders split into chunks and tiles
+/// (`spectra.distributed`): a dict of `xyz` (float64 (h, w, 3), the per-pixel sums of CIE XYZ
+/// over the samples), `bins` (float64 (h, w, B) or None), `edges`, `window` (x, y, w, h of the
+/// frame), `spp` and `dropped`. Sums of disjoint sample ranges add up to the sums of their
+/// union; `_truth_finish` turns sums into `truth`'s image.
+///
+/// threads: the tracer's threads (default: every core). dry_run: check the arguments and
+/// return the dict without `xyz`, `bins` and `dropped`, rendering nothing.
+#[pyfunction(name = "_truth_sums")]
+#[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
+                    crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
+                    depth = None, rgb_medium = None, spectral_bin = None, threads = None, dry_run = false))]
+#[allow(clippy::too_many_arguments)]
+fn truth_sums<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    spp: i64,
+    size: (i64, i64),
+    direct_only: bool,
+    seed: i64,
+    sample_offset: i64,
+    crop: Option<(i64, i64, i64, i64)>,
+    range: Option<(f64, f64)>,
+    observer: Option<String>,
+    white: Option<String>,
+    max_depth: i64,
+    water: Option<String>,
+    depth: Option<f64>,
+    rgb_medium: Option<String>,
+    spectral_bin: Option<f64>,
+    threads: Option<i64>,
+    dry_run: bool,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let sc = scene_of(scene, "scene")?;
+    let a = TruthArgs::new(
+        spp,
+        size,
+        direct_only,
+        seed,
+        sample_offset,
+        crop,
+        range,
+        observer,
+        white,
+        max_depth,
+        water,
+        depth,
+        rgb_medium,
+        spectral_bin,
+    )?;
+    let threads = threads.map(|t| whole("threads", t, 1)).transpose()?;
+    let d = pyo3::types::PyDict::new(py);
+    let st = if dry_run {
+        py.detach(|| -> Result<_, Fail> {
+            let table = setup::load_table(None).map_err(runtime)?;
+            a.settings(&sc, &table).map_err(value)
+        })?
+    } else {
+        let (st, acc) = py.detach(move || match threads {
+            None => a.run(&sc),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .build()
+                .map_err(runtime)?
+                .install(|| a.run(&sc)),
+        })?;
+        let win = st.window();
+        let (w, h) = (win.width as usize, win.height as usize);
+        let xyz: Vec<f64> = acc.xyz.iter().flatten().copied().collect();
+        d.set_item("xyz", PyArray1::from_vec(py, xyz).reshape([h, w, 3])?)?;
+        d.set_item("dropped", acc.dropped)?;
+        match &st.spectral_bands {
+            Some(edges) => {
+                d.set_item("bins", PyArray1::from_vec(py, acc.bins).reshape([h, w, edges.len() - 1])?)?
+            }
+            None => d.set_item("bins", py.None())?,
+        }
+        st
+    };
+    let win = st.window();
+    match &st.spectral_bands {
+        Some(edges) => d.set_item("edges", PyArray1::from_vec(py, edges.clone()))?,
+        None => d.set_item("edges", py.None())?,
+    }
+    d.set_item("window", (win.x, win.y, win.width, win.height))?;
+    d.set_item("spp", st.spp)?;
+    Ok(d)
+}
+
+/// The image (and bands) of sums over `spp` samples, exactly as `truth` finishes its own:
+/// `xyz` float64 (h, w, 3), `bins` float64 (h, w, B) or None. Returns the float32 (h, w, 3)
+/// linear sRGB image, or (image, bands) with bins.
+#[pyfunction(name = "_truth_finish")]
+#[pyo3(signature = (xyz, spp, bins = None))]
+fn truth_finish<'py>(
+    py: Python<'py>,
+    xyz: PyReadonlyArrayDyn<'py, f64>,
+    spp: i64,
+    bins: Option<PyReadonlyArrayDyn<'py, f64>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let spp = whole("spp", spp, 1)?;
+    let shape = xyz.shape().to_vec();
+    let [h, w, 3] = shape[..] else {
+        return Err(PyValueError::new_err(format!("xyz: expected shape (h, w, 3), got {shape:?}")));
+    };
+    let sums: Vec<[f64; 3]> = xyz
+        .as_array()
+        .iter()
+        .copied()
+        .collect::<Vec<_>>()
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    let (bin_vals, nb) = match &bins {
+        Some(b) => {
+            let bs = b.shape().to_vec();
+            if bs.len() != 3 || bs[0] != h || bs[1] != w {
+                return Err(PyValueError::new_err(format!("bins: expected shape ({h}, {w}, B), got {bs:?}")));
+            }
+            (b.as_array().iter().copied().collect::<Vec<_>>(), Some(bs[2]))
+        }
+        None => (Vec::new(), None),
+    };
+    let (rgb, bands) = finish(w as u32, h as u32, &sums, &bin_vals, spp);
+    let img = rgb_array(py, w as u32, h as u32, rgb)?;
+    match nb {
+        None => Ok(img.into_any()),
+        Some(nb) => {
+            let bands = PyArray1::from_vec(py, bands).reshape([h, w, nb])?;
+            Ok((img, bands).into_pyobject(py)?.into_any())
+        }
+    }
 }
 
 /// An (H, W, 3) float32 or float64 array as an image, or a `ValueError` naming `what`.
@@ -495,13 +837,23 @@ fn image_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<compare::Image> {
 /// `mean`, `median`, `p95`, `p99`, `max`.
 ///
 /// white_y: the luminance of the CIELAB reference white (D65 chromaticity), 1 by default.
+/// flip: also NVIDIA's FLIP (its reference C++ code, as `spectra diff --metric flip`):
+/// "ldr" or "hdr" (HDR-FLIP over the exposures FLIP chooses from `a`); adds `flip` (the same
+/// statistics, `mean` as FLIP computes it), `flip_kind` and `flip_ppd`.
+/// flip_ppd: FLIP's pixels per degree (default FLIP's, 67.0).
+/// maps: also return the per-pixel maps, float64 arrays of shape (H, W): `delta_e2000_map`,
+/// `mae_linear_map` and `mae_srgb_map` (the mean absolute difference over R, G, B), and
+/// `flip_map` (float32) with `flip`.
 #[pyfunction]
-#[pyo3(signature = (a, b, *, white_y = 1.0))]
+#[pyo3(signature = (a, b, *, white_y = 1.0, flip = None, flip_ppd = None, maps = false))]
 fn diff<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
     white_y: f64,
+    flip: Option<String>,
+    flip_ppd: Option<f32>,
+    maps: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let reference = image_arg("a", a)?;
     let test = image_arg("b", b)?;
@@ -512,13 +864,204 @@ fn diff<'py>(
             ra.0, ra.1, rb.0, rb.1
         )));
     }
-    let json = py.detach(move || -> Result<String, Fail> {
-        let maps =
+    let hdr = match flip.as_deref().map(str::to_ascii_lowercase).as_deref() {
+        None => None,
+        Some("ldr") => Some(false),
+        Some("hdr") => Some(true),
+        Some(_) => {
+            return Err(PyValueError::new_err(format!(
+                "flip '{}': FLIP can be 'ldr' or 'hdr'",
+                flip.unwrap_or_default()
+            )));
+        }
+    };
+    let ppd = flip_ppd.unwrap_or(compare::flip::DEFAULT_PIXELS_PER_DEGREE);
+    let (lo, hi) = compare::flip::PPD_RANGE;
+    if !(lo..=hi).contains(&ppd) {
+        return Err(PyValueError::new_err(format!(
+            "flip_ppd {ppd}: pixels per degree must be between {lo} and {hi}"
+        )));
+    }
+    let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
+    if !(lo..=hi).contains(&white_y) {
+        return Err(PyValueError::new_err(format!(
+            "white_y {white_y:e}: the white luminance must be between {lo:e} and {hi:e}"
+        )));
+    }
+    let (json, dm, flip_map) = py.detach(move || -> Result<_, Fail> {
+        let dm =
             compare::DiffMaps::compute(&reference, &test, compare::DiffOptions { white_luminance: white_y })
                 .map_err(value)?;
-        serde_json::to_string(&maps.summary()).map_err(runtime)
+        let mut v = serde_json::to_value(dm.summary()).map_err(runtime)?;
+        let mut flip_map = None;
+        if let Some(hdr) = hdr {
+            let map = if hdr {
+                compare::flip::hdr_flip(&reference, &test, ppd, &Default::default())
+                    .context("HDR-FLIP")
+                    .map_err(value)?
+            } else {
+                compare::flip::ldr_flip(&reference, &test, ppd).context("LDR-FLIP").map_err(value)?
+            };
+            let vals: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
+            // The mean as FLIP's own tool computes it, as `spectra diff` reports it.
+            let st = color::metrics::Stats::of(&vals)
+                .map(|st| color::metrics::Stats { mean: map.mean(), ..st })
+                .ok_or_else(|| runtime(anyhow::anyhow!("FLIP returned no pixels")))?;
+            let o = v.as_object_mut().expect("a struct serialises to an object");
+            o.insert("flip".into(), serde_json::to_value(st).map_err(runtime)?);
+            o.insert("flip_kind".into(), if hdr { "hdr" } else { "ldr" }.into());
+            o.insert("flip_ppd".into(), ppd.into());
+            flip_map = Some(map.values);
+        }
+        Ok((serde_json::to_string(&v).map_err(runtime)?, dm, flip_map))
     })?;
-    py.import("json")?.call_method1("loads", (json,))
+    let d = py.import("json")?.call_method1("loads", (json,))?;
+    if maps {
+        let (w, h) = (dm.width as usize, dm.height as usize);
+        d.set_item("delta_e2000_map", PyArray1::from_vec(py, dm.delta_e2000).reshape([h, w])?)?;
+        d.set_item("mae_linear_map", PyArray1::from_vec(py, dm.abs_linear).reshape([h, w])?)?;
+        d.set_item("mae_srgb_map", PyArray1::from_vec(py, dm.abs_srgb).reshape([h, w])?)?;
+        if let Some(f) = flip_map {
+            d.set_item("flip_map", PyArray1::from_vec(py, f).reshape([h, w])?)?;
+        }
+    }
+    Ok(d)
+}
+
+/// An array of any shape (…, 3) of float32/float64 as f64 values and its leading shape, or a
+/// `ValueError` naming `what`.
+fn triples(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<usize>, Vec<f64>)> {
+    let bad = |got: String| {
+        PyValueError::new_err(format!("{what}: expected a float array of shape (..., 3), got {got}"))
+    };
+    let (shape, data): (Vec<usize>, Vec<f64>) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
+        (a.shape().to_vec(), a.as_array().iter().copied().collect())
+    } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
+        (a.shape().to_vec(), a.as_array().iter().map(|&v| f64::from(v)).collect())
+    } else if let Ok(a) = obj.extract::<Bound<'_, numpy::PyUntypedArray>>() {
+        return Err(bad(format!("dtype {} with shape {:?}", a.dtype(), a.shape())));
+    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
+        (vec![v.len()], v)
+    } else if let Ok(v) = obj.extract::<Vec<Vec<f64>>>() {
+        let n = v.len();
+        if v.iter().any(|r| r.len() != 3) {
+            return Err(bad("a list of rows that are not all of length 3".into()));
+        }
+        (vec![n, 3], v.into_iter().flatten().collect())
+    } else {
+        let t = obj.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "another type".into());
+        return Err(bad(format!("a {t}")));
+    };
+    if shape.last() != Some(&3) {
+        return Err(bad(format!("shape {shape:?}")));
+    }
+    Ok((shape[..shape.len() - 1].to_vec(), data))
+}
+
+/// A 1-D array of wavelengths in nm (float), or a `ValueError` naming `what`.
+fn wavelengths_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let v: Vec<f64> = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
+        if a.ndim() != 1 {
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected a 1-D array of wavelengths in nm, got shape {:?}",
+                a.shape()
+            )));
+        }
+        a.as_array().iter().copied().collect()
+    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
+        v
+    } else {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected a 1-D sequence or float array of wavelengths in nm"
+        )));
+    };
+    if let Some((i, l)) = v.iter().enumerate().find(|(_, l)| !(l.is_finite() && **l > 0.0 && **l < 1e5)) {
+        return Err(PyValueError::new_err(format!(
+            "{what}[{i}] = {l}: a wavelength must be a positive, finite number of nm"
+        )));
+    }
+    Ok(v)
+}
+
+/// Jakob–Hanika upsampling of linear RGB reflectances, vectorised: `rgb` is a float array of
+/// shape (..., 3) with components in [0, 1] in colour space `space` ("srgb", "p3", "rec2020",
+/// "acescg"; the space's fitted table, cached as `spectra lut` caches it). Returns the sigmoid
+/// polynomial coefficients (c0, c1, c2) of shape (..., 3) float64, λ in nm —
+/// s(λ) = ½ + x / (2√(1 + x²)), x = (c0·λ + c1)·λ + c2 — exactly those the renderers use; with
+/// `wavelengths` (1-D, nm) the tuple (coefficients, spectra of shape (..., L)).
+#[pyfunction]
+#[pyo3(signature = (rgb, space = "srgb", *, wavelengths = None))]
+fn upsample<'py>(
+    py: Python<'py>,
+    rgb: &Bound<'py, PyAny>,
+    space: &str,
+    wavelengths: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (lead, data) = triples("rgb", rgb)?;
+    if let Some((i, v)) = data.iter().enumerate().find(|(_, v)| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+    {
+        return Err(PyValueError::new_err(format!(
+            "rgb: element {} (flat index {i}) is {v}: a reflectance's components must be finite and within [0, 1]",
+            i / 3
+        )));
+    }
+    let lambda = wavelengths.map(|w| wavelengths_arg("wavelengths", w)).transpose()?;
+    let cs =
+        color::RgbColorSpace::by_name(space).map_err(|e| PyValueError::new_err(format!("space: {e}")))?;
+    let (coeffs, spectra) = py.detach(move || -> Result<_, Fail> {
+        let table = color::upsample::table_for(&cs).map_err(runtime)?;
+        let polys: Vec<color::upsample::SigmoidPolynomial> =
+            data.chunks_exact(3).map(|p| table.fetch([p[0], p[1], p[2]])).collect();
+        let coeffs: Vec<f64> = polys.iter().flat_map(|p| p.c).collect();
+        let spectra = lambda
+            .as_ref()
+            .map(|l| polys.iter().flat_map(|p| l.iter().map(|&x| p.eval(x))).collect::<Vec<f64>>());
+        Ok((coeffs, spectra))
+    })?;
+    let mut shape = lead.clone();
+    shape.push(3);
+    let c = PyArray1::from_vec(py, coeffs).reshape(shape)?;
+    match (spectra, lambda_len(wavelengths)?) {
+        (Some(sp), Some(n)) => {
+            let mut shape = lead;
+            shape.push(n);
+            Ok((c, PyArray1::from_vec(py, sp).reshape(shape)?).into_pyobject(py)?.into_any())
+        }
+        _ => Ok(c.into_any()),
+    }
+}
+
+fn lambda_len(w: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    w.map(|w| wavelengths_arg("wavelengths", w).map(|v| v.len())).transpose()
+}
+
+/// An observer's three colour-matching functions (or a camera's sensitivities) at
+/// `wavelengths` (1-D, nm), as spectra uses them: float64 of shape (L, 3). `name`: "cie1931",
+/// "cie1964", a camera ("nikon_d5100", …) or a CSV file (wavelength and three columns).
+#[pyfunction]
+fn observer<'py>(
+    py: Python<'py>,
+    name: &str,
+    wavelengths: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let l = wavelengths_arg("wavelengths", wavelengths)?;
+    let o = color::Observer::by_name(name).map_err(value)?;
+    let v: Vec<f64> = l.iter().flat_map(|&x| o.eval(x)).collect();
+    PyArray1::from_vec(py, v).reshape([l.len(), 3])
+}
+
+/// An illuminant's relative spectral power at `wavelengths` (1-D, nm), float64 of shape (L,):
+/// "D65", "A", "F1"…"F12", "LED-B1"…, "5000K" / "blackbody:5000", as tabulated (D series 100
+/// at 560 nm).
+#[pyfunction]
+fn illuminant<'py>(
+    py: Python<'py>,
+    name: &str,
+    wavelengths: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let l = wavelengths_arg("wavelengths", wavelengths)?;
+    let s = color::illuminant::by_name(name).map_err(value)?;
+    Ok(PyArray1::from_vec(py, s.sample(&l)))
 }
 
 /// Reads an EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it: a float32
@@ -530,6 +1073,201 @@ fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, numpy::PyArra
     rgb_array(py, w, h, img.data.into_iter().flatten().collect())
 }
 
+/// Writes an (H, W, 3) float32/float64 linear RGB array as `spectra truth` and `spectra render`
+/// write images: `.exr` (float32, linear) or `.png` (sRGB-encoded, clipped, 8-bit), atomically
+/// (the file is complete or absent). A `ValueError` names a bad array or extension.
+#[pyfunction]
+fn write_image(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
+    let img = image_arg("image", image)?;
+    py.detach(|| {
+        compare::io::write_image(&path, &img, Default::default())
+            .with_context(|| format!("writing {}", path.display()))
+            .map_err(value)
+    })?;
+    Ok(())
+}
+
+/// `spectra eval`'s arguments from a command line (`["eval", "--out", DIR, …]`), parsed by
+/// the CLI's own parser; a `ValueError` with clap's message otherwise.
+fn eval_args(argv: Vec<String>) -> PyResult<spectra::cmd::eval::Args> {
+    use clap::Parser;
+    #[derive(Parser)]
+    struct Wrap {
+        #[command(flatten)]
+        inner: spectra::cmd::eval::Args,
+    }
+    Wrap::try_parse_from(argv).map(|w| w.inner).map_err(|e| {
+        let text = e.render().to_string();
+        PyValueError::new_err(text.trim_start_matches("error: ").lines().next().unwrap_or("").to_string())
+    })
+}
+
+/// A planned truth of `_eval_plan` as a dict, and back.
+fn job_dict<'py>(
+    py: Python<'py>,
+    p: &spectra::eval::PlannedTruth,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("case", &p.case)?;
+    d.set_item("seed", p.job.seed)?;
+    d.set_item("width", p.job.width)?;
+    d.set_item("height", p.job.height)?;
+    d.set_item("spp", p.job.spp)?;
+    d.set_item("range", (p.job.range.min, p.job.range.max))?;
+    Ok(d)
+}
+
+fn job_of(d: &Bound<'_, pyo3::types::PyDict>) -> PyResult<spectra::eval::PlannedTruth> {
+    let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+        d.get_item(k)?.ok_or_else(|| PyValueError::new_err(format!("job: no '{k}'")))
+    };
+    let (lo, hi): (f64, f64) = get("range")?.extract()?;
+    let range =
+        color::WavelengthRange::new(lo, hi).map_err(|e| PyValueError::new_err(format!("job range: {e}")))?;
+    Ok(spectra::eval::PlannedTruth {
+        case: get("case")?.extract()?,
+        seed: get("seed")?.extract()?,
+        job: spectra::eval::measure::TruthJob {
+            width: get("width")?.extract()?,
+            height: get("height")?.extract()?,
+            spp: get("spp")?.extract()?,
+            seed: get("seed")?.extract()?,
+            range,
+        },
+    })
+}
+
+/// The ground truths `spectra eval ARGV` would render and its truth cache (`--truth-cache`,
+/// required) does not hold in full: a list of dicts (`case`, `seed`, `width`, `height`, `spp`,
+/// `range`), in the evaluation's order.
+#[pyfunction(name = "_eval_plan")]
+fn eval_plan<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Vec<Bound<'py, pyo3::types::PyDict>>> {
+    let args = eval_args(argv)?;
+    let plan = py.detach(|| -> Result<Vec<spectra::eval::PlannedTruth>, Fail> {
+        let cfg = spectra::cmd::eval::config(&args).map_err(value)?;
+        let dir = cfg.truth_cache.clone().ok_or_else(|| value(anyhow::anyhow!("--truth-cache is needed")))?;
+        let cache = spectra::cmd::truth_cache::TruthCache::open(&dir).map_err(value)?;
+        let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
+        let mut out = Vec::new();
+        for p in spectra::eval::truth_plan(&cfg).map_err(value)? {
+            let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+            let have =
+                spectra::eval::measure::cached_samples(&c.scene, &table, p.job, &cache).map_err(runtime)?;
+            if have < p.job.spp {
+                out.push(p);
+            }
+        }
+        Ok(out)
+    })?;
+    plan.iter().map(|p| job_dict(py, p)).collect()
+}
+
+/// The sums of samples `sample_offset` … +`spp`−1 of one planned truth (`_eval_plan`'s dict),
+/// on `threads` threads: a dict of `xyz` (float64 (h, w, 3)) and `dropped`.
+#[pyfunction(name = "_eval_truth_sums")]
+fn eval_truth_sums<'py>(
+    py: Python<'py>,
+    argv: Vec<String>,
+    job: &Bound<'py, pyo3::types::PyDict>,
+    sample_offset: u32,
+    spp: u32,
+    threads: usize,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let args = eval_args(argv)?;
+    let p = job_of(job)?;
+    let acc = py.detach(|| -> Result<truth::Accumulator, Fail> {
+        let cfg = spectra::cmd::eval::config(&args).map_err(value)?;
+        let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
+        let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+        let cancel = AtomicBool::new(false);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build().map_err(runtime)?;
+        pool.install(|| {
+            spectra::eval::measure::truth_piece(&c.scene, &table, p.job, sample_offset, spp, &cancel)
+        })
+        .map_err(runtime)
+    })?;
+    let d = pyo3::types::PyDict::new(py);
+    let (w, h) = (p.job.width as usize, p.job.height as usize);
+    let xyz: Vec<f64> = acc.xyz.iter().flatten().copied().collect();
+    d.set_item("xyz", PyArray1::from_vec(py, xyz).reshape([h, w, 3])?)?;
+    d.set_item("dropped", acc.dropped)?;
+    Ok(d)
+}
+
+/// Stores the sums of all samples of one planned truth in the evaluation's truth cache, as
+/// `spectra eval` stores its own.
+#[pyfunction(name = "_eval_truth_store")]
+fn eval_truth_store<'py>(
+    py: Python<'py>,
+    argv: Vec<String>,
+    job: &Bound<'py, pyo3::types::PyDict>,
+    xyz: PyReadonlyArrayDyn<'py, f64>,
+    dropped: u64,
+) -> PyResult<()> {
+    let args = eval_args(argv)?;
+    let p = job_of(job)?;
+    let (w, h) = (p.job.width as usize, p.job.height as usize);
+    if xyz.shape() != [h, w, 3] {
+        return Err(PyValueError::new_err(format!(
+            "xyz: expected shape ({h}, {w}, 3), got {:?}",
+            xyz.shape()
+        )));
+    }
+    let sums: Vec<[f64; 3]> = xyz
+        .as_array()
+        .iter()
+        .copied()
+        .collect::<Vec<_>>()
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    py.detach(|| -> Result<(), Fail> {
+        let cfg = spectra::cmd::eval::config(&args).map_err(value)?;
+        let dir = cfg.truth_cache.clone().ok_or_else(|| value(anyhow::anyhow!("--truth-cache is needed")))?;
+        let cache = spectra::cmd::truth_cache::TruthCache::open(&dir).map_err(value)?;
+        let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
+        let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+        let acc = truth::Accumulator { done: p.job.spp, xyz: sums, bins: Vec::new(), dropped };
+        spectra::eval::measure::store_truth(&c.scene, &table, p.job, &acc, &cache).map_err(runtime)
+    })?;
+    Ok(())
+}
+
+/// Runs `spectra eval ARGV` here (its progress and tables on stderr/stdout, as the command
+/// prints them). Ctrl-C stops it (KeyboardInterrupt) as it stops the command.
+#[pyfunction(name = "_eval_run")]
+fn eval_run(py: Python<'_>, argv: Vec<String>) -> PyResult<()> {
+    let args = eval_args(argv)?;
+    let (tx, rx) = std::sync::mpsc::channel();
+    let worker = std::thread::spawn(move || {
+        let _ = tx.send(spectra::cmd::eval::run(args));
+    });
+    let result = py.detach(move || {
+        loop {
+            match rx.recv_timeout(std::time::Duration::from_millis(200)) {
+                Ok(r) => return Ok(r),
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        // The command's own Ctrl-C: every long loop polls this token.
+                        color::cancel::cancel();
+                        let _ = rx.recv();
+                        color::cancel::token().store(false, std::sync::atomic::Ordering::Relaxed);
+                        return Err(e);
+                    }
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                    return Ok(Err(anyhow::anyhow!("the evaluation ended without a result")));
+                }
+            }
+        }
+    });
+    let _ = worker.join();
+    match result? {
+        Ok(()) => Ok(()),
+        Err(e) => Err(Fail::Runtime(e).into()),
+    }
+}
+
 /// The extension module: `spectra/__init__.py` re-exports it.
 #[pymodule]
 fn _spectra(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -537,8 +1275,20 @@ fn _spectra(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Renderer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(truth_image, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(truth_finish, m)?)?;
     m.add_function(wrap_pyfunction!(diff, m)?)?;
     m.add_function(wrap_pyfunction!(read_image, m)?)?;
+    m.add_function(wrap_pyfunction!(write_image, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_truth_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_truth_store, m)?)?;
+    m.add_function(wrap_pyfunction!(eval_run, m)?)?;
+    m.add_function(wrap_pyfunction!(upsample, m)?)?;
+    m.add_function(wrap_pyfunction!(observer, m)?)?;
+    m.add_function(wrap_pyfunction!(illuminant, m)?)?;
+    m.add("OBSERVERS", color::Observer::NAMES.to_vec())?;
+    m.add("ILLUMINANTS", color::illuminant::names())?;
     m.add("BUILTINS", scene::BUILTIN_NAMES.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

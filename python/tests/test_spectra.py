@@ -206,3 +206,218 @@ def test_media_scenes_render(tmp_path):
     for name in ("underwater", "fog"):
         img = spectra.Renderer(spectra.load(name), size=(32, 24)).render(wavelengths=4)
         assert img.shape == (24, 32, 3) and np.isfinite(img).all()
+
+
+def test_spectral_capture(renderer):
+    img, nodes, lam = renderer.render(wavelengths=8, quadrature="midpoint", spectral=True)
+    assert img.shape == (H, W, 3) and nodes.shape == (H, W, 8) and lam.shape == (8,)
+    assert nodes.dtype == np.float32 and lam.dtype == np.float64 and nodes.flags["C_CONTIGUOUS"]
+    # The node wavelengths are the centres of 8 equal bins over 380–730 nm.
+    np.testing.assert_allclose(lam, 380 + (np.arange(8) + 0.5) * 350 / 8)
+    # Capturing does not change the image (its pipeline is another compile of the shader: at
+    # most an f16 rounding step apart).
+    np.testing.assert_allclose(img, renderer.render(wavelengths=8, quadrature="midpoint"), rtol=1e-3, atol=0)
+    assert np.isfinite(nodes).all() and nodes.max() > 0
+    # With the midpoint rule the nodes are L(λₖ): their luminance (the CIE 1931 ȳ at the
+    # nodes, midpoint rule) is the frame's, up to one constant (the units' white).
+    ybar = spectra.observer("cie1931", lam)[:, 1]
+    y_nodes = nodes.astype(np.float64) @ ybar
+    y_img = img.astype(np.float64) @ np.array([0.2126729, 0.7151522, 0.0721750])
+    lit = y_img > 0.01
+    assert lit.mean() > 0.3
+    ratio = y_nodes[lit] / y_img[lit]
+    assert np.std(ratio) / np.mean(ratio) < 1e-3, (np.mean(ratio), np.std(ratio))
+    with pytest.raises(ValueError, match="rgb mode"):
+        renderer.render("rgb", spectral=True)
+
+
+def test_truth_spectral_bins(cornell):
+    plain = spectra.truth(cornell, spp=2, size=(16, 12), direct_only=True)
+    img, bands, edges = spectra.truth(cornell, spp=2, size=(16, 12), direct_only=True, spectral_bin=10)
+    assert np.array_equal(img, plain)  # the bins do not change the image
+    assert edges.dtype == np.float64 and edges[0] == 380 and edges[-1] == 730
+    assert bands.shape == (12, 16, len(edges) - 1) and bands.dtype == np.float32
+    assert np.isfinite(bands).all() and bands.max() > 0
+    with pytest.raises(ValueError, match="spectral_bin"):
+        spectra.truth(cornell, spp=1, size=(8, 8), spectral_bin=-1)
+
+
+def test_media_options(tmp_path):
+    dry = spectra.load("cornell")
+    fog = '{"absorption": [0.05, 0.1, 0.2], "scattering": [0.3, 0.3, 0.3], "g": 0.3}'
+    plain = spectra.truth(dry, spp=2, size=(16, 12), direct_only=True)
+    foggy = spectra.truth(dry, spp=2, size=(16, 12), direct_only=True, rgb_medium=fog)
+    assert foggy.shape == plain.shape and not np.array_equal(foggy, plain)
+    r = spectra.Renderer(dry, size=(16, 12), rgb_medium=fog)
+    assert not np.array_equal(r.render(), spectra.Renderer(dry, size=(16, 12)).render())
+    sea = spectra.load("underwater")
+    a = spectra.truth(sea, spp=1, size=(8, 6), direct_only=True, water="IB", depth=5)
+    b = spectra.truth(sea, spp=1, size=(8, 6), direct_only=True, water="IB", depth=20)
+    assert not np.array_equal(a, b)
+    shallow = spectra.Renderer(sea, size=(16, 12), water="IB", depth=5).render(wavelengths=4)
+    deep = spectra.Renderer(sea, size=(16, 12), water="IB", depth=20).render(wavelengths=4)
+    assert shallow.mean() > deep.mean()
+    with pytest.raises(ValueError, match="depth"):
+        spectra.truth(dry, spp=1, size=(8, 6), depth=5)
+    with pytest.raises(ValueError, match="cannot be combined"):
+        spectra.truth(sea, spp=1, size=(8, 6), rgb_medium=fog)
+    with pytest.raises(ValueError, match="Jerlov|water"):
+        spectra.Renderer(dry, size=(8, 6), water="muddy")
+
+
+def test_scene_pickles_as_a_reload(tmp_path):
+    import pickle
+
+    s = spectra.load("cornell", env="default", env_intensity=0.5)
+    t = pickle.loads(pickle.dumps(s))
+    assert t.source == s.source and t.lights == s.lights
+    a = spectra.truth(s, spp=1, size=(16, 12))
+    assert np.array_equal(a, spectra.truth(t, spp=1, size=(16, 12)))
+    assert not np.array_equal(a, spectra.truth(spectra.load("cornell"), spp=1, size=(16, 12)))
+
+
+def test_env_options():
+    with pytest.raises(FileNotFoundError, match="no_such_sky.hdr"):
+        spectra.load("cornell", env="no_such_sky.hdr")
+    with pytest.raises(ValueError, match="intensity"):
+        spectra.load("cornell", env="default", env_intensity=-1)
+
+
+def test_diff_maps_and_flip(renderer):
+    a, b = renderer.render("rgb"), renderer.render()
+    d = spectra.diff(a, b, maps=True, flip="ldr")
+    m = d["delta_e2000_map"]
+    assert m.shape == (H, W) and m.dtype == np.float64
+    assert m.mean() == pytest.approx(d["delta_e2000"]["mean"], rel=1e-12)
+    assert d["mae_linear_map"].mean() == pytest.approx(d["mae_linear"]["mean"], rel=1e-12)
+    assert d["flip_kind"] == "ldr" and 0 < d["flip"]["mean"] < 1
+    assert d["flip_map"].shape == (H, W)
+    assert spectra.diff(a, a, flip="hdr")["flip"]["max"] == 0.0
+    with pytest.raises(ValueError, match="flip 'xyz'"):
+        spectra.diff(a, b, flip="xyz")
+    with pytest.raises(ValueError, match="flip_ppd"):
+        spectra.diff(a, b, flip="ldr", flip_ppd=0)
+    with pytest.raises(ValueError, match="white_y"):
+        spectra.diff(a, b, white_y=-1)
+
+
+def test_diff_equals_the_cli(tmp_path):
+    import json
+
+    exe = spectra_bin()
+    env = {**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))}
+    ref, test = tmp_path / "t.exr", tmp_path / "s.exr"
+    subprocess.run(
+        [exe, "truth", "metamerism", "--direct-only", "--spp", "4", "--size", "40x30", "--out", str(ref)],
+        check=True,
+        env=env,
+    )
+    subprocess.run([exe, "render", "metamerism", "--size", "40x30", "--out", str(test)], check=True, env=env)
+    out = subprocess.run(
+        [exe, "diff", str(ref), str(test), "--json", "--metric", "flip"],
+        check=True,
+        env=env,
+        capture_output=True,
+        text=True,
+    ).stdout
+    cli = json.loads(out)
+    py = spectra.diff(spectra.read_image(ref), spectra.read_image(test), flip="hdr")
+    for key in ("delta_e2000", "mae_linear", "mae_srgb", "flip"):
+        assert py[key] == cli[key], key
+    # The truth EXR holds what spectra.truth returns, bit for bit.
+    scene = spectra.load("metamerism")
+    assert np.array_equal(
+        spectra.truth(scene, spp=4, size=(40, 30), direct_only=True), read_exr(ref)
+    )
+
+
+def test_demo_table_equals_spectra_demo(tmp_path):
+    import importlib.util
+
+    exe = spectra_bin()
+    env = {**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))}
+    out = subprocess.run(
+        [exe, "demo", "--size", "48x36", "--spp", "4", "--out", str(tmp_path / "demo")],
+        check=True,
+        env=env,
+        capture_output=True,
+        text=True,
+    ).stdout
+    spec = importlib.util.spec_from_file_location("demo_table", ROOT / "python/examples/demo_table.py")
+    demo = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(demo)
+    ours = demo.format_table("metamerism", 4, demo.table("metamerism", (48, 36), 4))
+    assert ours in out, (ours, out)
+
+
+def test_upsample_against_colour_science():
+    colour = pytest.importorskip("colour")
+    rng = np.random.default_rng(5)
+    rgb = rng.uniform(0.02, 0.98, size=(200, 3))
+    lam = np.arange(360.0, 781.0, 5.0)
+    coeffs, spectra_ = spectra.upsample(rgb, wavelengths=lam)
+    assert coeffs.shape == (200, 3) and spectra_.shape == (200, lam.size)
+    assert np.array_equal(spectra.upsample(rgb), coeffs)
+    shape = colour.SpectralShape(360, 780, 5)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
+    d65_xy = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
+    de = []
+    for c, s, target in zip(coeffs, spectra_, rgb):
+        # colour-science evaluates the same sigmoid polynomial (Jakob & Hanika 2019) itself.
+        sd = colour.recovery.sd_Jakob2019(c, shape)
+        np.testing.assert_allclose(sd.values, s, rtol=1e-12, atol=1e-12)
+        xyz = colour.sd_to_XYZ(sd, cmfs, d65) / 100
+        lab = colour.XYZ_to_Lab(xyz, d65_xy)
+        want = colour.XYZ_to_Lab(colour.RGB_to_XYZ(target, "sRGB", d65_xy), d65_xy)
+        de.append(colour.delta_E(lab, want, method="CIE 2000"))
+    # The round trip through colour-science's integration (5 nm, 360–780) stays within the
+    # table's documented accuracy (mean 0.0034, max 0.059 at 1 nm; 5 nm adds its own error).
+    assert np.mean(de) < 0.05 and np.max(de) < 0.3, (np.mean(de), np.max(de))
+    # Any leading shape, float32 too.
+    c4 = spectra.upsample(rgb.reshape(10, 20, 3).astype(np.float32))
+    assert c4.shape == (10, 20, 3)
+    with pytest.raises(ValueError, match="rgb: .*within \\[0, 1\\]"):
+        spectra.upsample([[0.5, 1.5, 0.2]])
+    with pytest.raises(ValueError, match="rgb: .*shape"):
+        spectra.upsample(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="rgb: .*dtype"):
+        spectra.upsample(np.zeros((4, 3), dtype=np.int64))
+    with pytest.raises(ValueError, match="wavelengths"):
+        spectra.upsample(rgb, wavelengths=[500, np.nan])
+    with pytest.raises(ValueError, match="space"):
+        spectra.upsample(rgb, space="cmyk")
+
+
+def test_diff_against_colour_science():
+    colour = pytest.importorskip("colour")
+    rng = np.random.default_rng(9)
+    a = rng.uniform(0, 1, size=(12, 10, 3)).astype(np.float32)
+    b = np.clip(a + rng.normal(0, 0.05, size=a.shape), 0, 1).astype(np.float32)
+    d = spectra.diff(a, b, maps=True)
+    # sRGB's matrix derived from its primaries and D65 (0.3127, 0.3290), as spectra derives it.
+    cs = colour.RGB_COLOURSPACES["sRGB"].copy()
+    cs.use_derived_transformation_matrices(True)
+    d65 = np.array([0.3127, 0.3290])
+    lab = lambda x: colour.XYZ_to_Lab(colour.RGB_to_XYZ(x.astype(np.float64), cs, apply_cctf_decoding=False), d65)
+    want = colour.delta_E(lab(a), lab(b), method="CIE 2000")
+    np.testing.assert_allclose(d["delta_e2000_map"], want, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(d["mae_linear_map"], np.abs(a - b).astype(np.float64).mean(-1), rtol=1e-6, atol=1e-7)
+
+
+def test_observers_and_illuminants_against_colour_science():
+    colour = pytest.importorskip("colour")
+    lam = np.arange(380.0, 781.0, 10.0)
+    d65 = spectra.illuminant("D65", lam)
+    np.testing.assert_allclose(d65, colour.SDS_ILLUMINANTS["D65"][lam], rtol=1e-6)
+    xyz = spectra.observer("cie1931", lam)
+    assert xyz.shape == (lam.size, 3)
+    ref = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"][lam]
+    np.testing.assert_allclose(xyz / xyz[:, 1].max(), ref / ref[:, 1].max(), rtol=1e-4, atol=1e-6)
+    assert set(spectra.OBSERVERS) >= {"cie1931", "cie1964"} and "D65" in spectra.ILLUMINANTS
+    with pytest.raises(ValueError, match="observer"):
+        spectra.observer("martian", lam)
+    with pytest.raises(ValueError, match="illuminant"):
+        spectra.illuminant("Z99", lam)
+    with pytest.raises(ValueError, match=r"wavelengths\[1\]"):
+        spectra.illuminant("D65", [500, -3])

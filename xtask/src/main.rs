@@ -24,7 +24,7 @@ fn main() -> ExitCode {
         "fuzz" => fuzz(rest),
         _ => {
             eprintln!(
-                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, then the oracle checks in tools/)\n  ci      cargo fmt --check, clippy -D warnings, test, then a 10 s coverage-guided fuzz slice per target\n  fuzz    coverage-guided fuzzing (libFuzzer, nightly): [--seconds S per target, default 60 | --runs N executions per target] [--targets a,b]"
+                "usage: cargo xtask <task>\n\n  setup   install the Vulkan driver and Python test oracles if missing\n  demo    render the demo scene to out/\n  test    run every test (Rust tests, the oracle checks in tools/, the Python package's tests)\n  ci      cargo fmt --check, clippy -D warnings, test, then a 10 s coverage-guided fuzz slice per target\n  fuzz    coverage-guided fuzzing (libFuzzer, nightly): [--seconds S per target, default 60 | --runs N executions per target] [--targets a,b]"
             );
             return if task == "help" { ExitCode::SUCCESS } else { ExitCode::FAILURE };
         }
@@ -161,7 +161,8 @@ fn demo(extra: &[String]) -> Result {
     run(cargo().args(["run", "--release", "--package", "spectra", "--", "demo", "--out", "out"]).args(extra))
 }
 
-/// Every test: the Rust suite, then each `tools/check_*.py` oracle script.
+/// Every test: the Rust suite, then each `tools/check_*.py` oracle script, then the Python
+/// package's pytest suite.
 fn test(extra: &[String]) -> Result {
     setup_vulkan()?;
     setup_cxx()?;
@@ -188,7 +189,47 @@ fn test(extra: &[String]) -> Result {
         }
     }
     println!("oracle checks: {passed} passed, {} failed", failed.len());
-    if failed.is_empty() { Ok(()) } else { Err(format!("oracle checks failed: {}", failed.join(", "))) }
+    let package = python_package();
+    if !failed.is_empty() {
+        return Err(format!("oracle checks failed: {}", failed.join(", ")));
+    }
+    package
+}
+
+/// The Python package's packages besides itself: what its tests need (OpenEXR, as an EXR reader
+/// independent of spectra's; colour-science, the oracle of `upsample`, `diff`, observers and
+/// illuminants; Ray, for `spectra.distributed`).
+const PYTHON_PACKAGE_TEST_DEPS: &[&str] =
+    &["pytest", "numpy", "OpenEXR==3.5.3", "colour-science==0.4.7", "ray==2.60.0"];
+
+/// The Python package (python/): built and installed into a venv in target/ with
+/// `pip install ./python` (debug profile, so it reuses the Rust suite's build), then its
+/// pytest suite. Skipped, saying so, when there is no Python.
+fn python_package() -> Result {
+    if Command::new(python()).arg("--version").output().is_err() {
+        eprintln!("python package tests skipped: no {} on this machine", python());
+        return Ok(());
+    }
+    let t0 = std::time::Instant::now();
+    let target =
+        std::env::var("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|_| root().join("target"));
+    let venv = target.join("py-venv");
+    let bin = venv.join("bin");
+    if !bin.join("python").exists() {
+        let mk = || run(Command::new(python()).args(["-m", "venv"]).arg(&venv));
+        if mk().is_err() {
+            apt_install(&["python3-venv"])?;
+            mk()?;
+        }
+    }
+    let py = bin.join("python");
+    run(Command::new(&py)
+        .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "./python"])
+        .args(PYTHON_PACKAGE_TEST_DEPS)
+        .env("MATURIN_PEP517_ARGS", "--profile dev"))?;
+    let r = run(Command::new(&py).args(["-m", "pytest", "-q", "-s", "python/tests"]));
+    eprintln!("python package: built, installed and tested in {:.0} s", t0.elapsed().as_secs_f64());
+    r
 }
 
 fn ci() -> Result {

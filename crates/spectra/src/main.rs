@@ -1,13 +1,12 @@
 //! `spectra`: real-time spectral rendering of RGB scenes, with the instruments to prove it.
 //!
-//! Each subcommand lives in its own file under `cmd/`.
+//! The command line over the library (`lib.rs`): each subcommand lives in its own file under
+//! `cmd/`.
 
-mod cmd;
-mod eval;
 #[cfg(test)]
 mod limits_doc_tests;
-mod progress;
-mod view;
+
+use spectra::{cmd, progress};
 
 use clap::{Parser, Subcommand};
 
@@ -39,6 +38,7 @@ enum Command {
     /// Combine sample chunks and crop tiles of one `truth` render into one image.
     Merge(cmd::merge::Args),
     /// Open an interactive window: live mode/N/range/observer/exposure, orbit and fly camera.
+    #[cfg(feature = "viewer")]
     View(cmd::view::Args),
     /// Frame time of RGB vs spectral rendering at N = 1…64 (median, p10/p90, cost per wavelength).
     Bench(cmd::bench::Args),
@@ -117,7 +117,11 @@ fn quiet_runtime_dir(headless: bool) -> Option<tempfile::TempDir> {
 
 fn main() {
     let cli = Cli::parse();
-    let runtime_dir = quiet_runtime_dir(!matches!(cli.command, Command::View(_)));
+    #[cfg(feature = "viewer")]
+    let headless = !matches!(cli.command, Command::View(_));
+    #[cfg(not(feature = "viewer"))]
+    let headless = true;
+    let runtime_dir = quiet_runtime_dir(headless);
     // Rust ignores SIGPIPE, so printing to a closed pipe (`spectra diff … --json | head -c
     // 100`) would panic; the default action ends the process quietly, as for any Unix filter.
     #[cfg(unix)]
@@ -140,6 +144,7 @@ fn main() {
         Command::Upsample(a) => cmd::upsample::run(a),
         Command::Truth(a) => cmd::truth::run(a),
         Command::Merge(a) => cmd::merge::run(a),
+        #[cfg(feature = "viewer")]
         Command::View(a) => cmd::view::run(a),
         Command::Bench(a) => cmd::bench::run(a),
         Command::Eval(a) => cmd::eval::run(a),

@@ -41,7 +41,8 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-pub fn run(a: Args) -> Result<()> {
+/// The evaluation these flags ask for (suite, budget, cases), checked.
+pub fn config(a: &Args) -> Result<Config> {
     let mut budget = if a.quick { suite::Budget::quick() } else { suite::Budget::full() };
     if a.spp == Some(0) {
         bail!("--spp must be at least 1");
@@ -60,16 +61,20 @@ pub fn run(a: Args) -> Result<()> {
         a.scenes.clone()
     };
     let notes = suite::notes(&ids);
-    let out = a.out.clone();
-    let r = eval::run(Config {
-        out: a.out,
+    Ok(Config {
+        out: a.out.clone(),
         quick: a.quick,
         budget,
         ids,
         notes,
-        table: a.table.table,
-        truth_cache: a.truth_cache,
-    })?;
+        table: a.table.table.clone(),
+        truth_cache: a.truth_cache.clone(),
+    })
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let out = a.out.clone();
+    let r = eval::run(config(&a)?)?;
     println!("{}", eval::report::markdown_table(&r));
     println!("{}", eval::report::markdown_sweep(&r));
     println!("report: {}  ({:.0} s)", out.join("index.html").display(), r.seconds);

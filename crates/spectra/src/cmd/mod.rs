@@ -12,6 +12,7 @@ pub mod setup;
 pub mod truth;
 pub mod truth_cache;
 pub mod upsample;
+#[cfg(feature = "viewer")]
 pub mod view;
 
 /// What an interrupted command kept (a truth checkpoint): main prints it instead of "no output

@@ -58,6 +58,82 @@ pub struct TruthSource {
     pub rendered: u32,
 }
 
+/// The tracer's settings of a case's ground truth: direct lighting only (full transport under
+/// water), the scene's white.
+pub fn truth_settings(scene: &scene::Scene, job: TruthJob) -> Result<truth::Settings> {
+    let mut st = truth::Settings::new(job.width, job.height, job.spp)?;
+    st.seed = job.seed;
+    st.direct_only = true;
+    st.range = job.range;
+    if let Some(w) = water(scene)? {
+        // Full transport under water: the real-time model's Kd stands for multiple scattering.
+        st.direct_only = false;
+        st.medium = Some(truth::water::medium(&w, scene.camera.position()));
+    }
+    st.white = color::illuminant::by_name(scene.spectral.white_name())?;
+    Ok(st)
+}
+
+/// The sums of samples `first` … `first + samples − 1` of a case's ground truth (the same
+/// per-pixel sample sequence as [`truth`] renders): a piece of it that another process may
+/// render (`spectra.distributed.eval`); pieces add up to the sums of the whole.
+pub fn truth_piece(
+    scene: &scene::Scene,
+    table: &color::upsample::CoeffTable,
+    job: TruthJob,
+    first: u32,
+    samples: u32,
+    cancel: &AtomicBool,
+) -> Result<truth::Accumulator> {
+    let mut st = truth_settings(scene, TruthJob { spp: samples, ..job })?;
+    st.sample_offset = u64::from(first);
+    let world = truth::World::new(scene, table, &st.white, st.range, st.medium.as_ref())?;
+    let mut acc = truth::Accumulator::new(&st)?;
+    match truth::render_pass(&world, &st, cancel, &mut acc, samples, &|_| {}) {
+        Err(truth::TruthError::Cancelled) => bail!("interrupted"),
+        r => r?,
+    }
+    Ok(acc)
+}
+
+/// Stores the sums of all of a case's ground-truth samples (`acc.done == job.spp`, the pieces of
+/// [`truth_piece`] added up) in `cache` as [`truth`] stores its own, so that [`truth`] then
+/// renders nothing.
+pub fn store_truth(
+    scene: &scene::Scene,
+    table: &color::upsample::CoeffTable,
+    job: TruthJob,
+    acc: &truth::Accumulator,
+    cache: &crate::cmd::truth_cache::TruthCache,
+) -> Result<()> {
+    let st = truth_settings(scene, job)?;
+    if acc.done != st.spp || acc.xyz.len() != st.width as usize * st.height as usize {
+        bail!(
+            "the sums hold {} samples of {} pixels; the truth has {} samples of {}×{} pixels",
+            acc.done,
+            acc.xyz.len(),
+            st.spp,
+            st.width,
+            st.height
+        );
+    }
+    let fields = crate::cmd::truth::sum_fields(scene, &st, table, &[], false)?;
+    cache.store(&fields, &st, acc).map(|_| ())
+}
+
+/// How many samples of a case's ground truth `cache` already holds from the first one (what
+/// [`truth`] would not render).
+pub fn cached_samples(
+    scene: &scene::Scene,
+    table: &color::upsample::CoeffTable,
+    job: TruthJob,
+    cache: &crate::cmd::truth_cache::TruthCache,
+) -> Result<u32> {
+    let st = truth_settings(scene, job)?;
+    let fields = crate::cmd::truth::sum_fields(scene, &st, table, &[], false)?;
+    Ok(cache.start(&fields, &st)?.acc.done)
+}
+
 /// Ground truth of a scene: direct lighting only (full transport under water), linear sRGB.
 /// With `cache`, starts from the cache's samples of the same render and stores the result
 /// (`crate::cmd::truth_cache`).
@@ -70,16 +146,7 @@ pub fn truth(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<(Image, TruthSource)> {
     let (width, height) = (job.width, job.height);
-    let mut st = truth::Settings::new(width, height, job.spp)?;
-    st.seed = job.seed;
-    st.direct_only = true;
-    st.range = job.range;
-    if let Some(w) = water(scene)? {
-        // Full transport under water: the real-time model's Kd stands for multiple scattering.
-        st.direct_only = false;
-        st.medium = Some(truth::water::medium(&w, scene.camera.position()));
-    }
-    st.white = color::illuminant::by_name(scene.spectral.white_name())?;
+    let st = truth_settings(scene, job)?;
     let world = truth::World::new(scene, table, &st.white, st.range, st.medium.as_ref())?;
     let fields = match cache {
         Some(_) => crate::cmd::truth::sum_fields(scene, &st, table, &[], false)?,

@@ -185,6 +185,36 @@ fn bar(len: u64, what: &str) -> ProgressBar {
     pb
 }
 
+/// One ground truth a run renders: the case (by id), its seed and its job.
+#[derive(Clone, Debug)]
+pub struct PlannedTruth {
+    pub case: String,
+    pub seed: u64,
+    pub job: measure::TruthJob,
+}
+
+/// The ground truths [`run`] renders for `cfg`, in its order: per case seeds 1 and 2 (the
+/// noise floor), then the jittered-accumulation truth (seed 3) of the first case. With them in
+/// the truth cache ([`measure::store_truth`]) a run renders no truth.
+pub fn truth_plan(cfg: &Config) -> Result<Vec<PlannedTruth>> {
+    let mut plan = Vec::new();
+    for id in &cfg.ids {
+        let c = suite::case(id)?;
+        let range = scene_range(&c.scene)?;
+        let (width, height, spp) = cfg.budget.for_case(&c);
+        for seed in [1, 2] {
+            plan.push(PlannedTruth {
+                case: id.clone(),
+                seed,
+                job: measure::TruthJob { width, height, spp, seed, range },
+            });
+        }
+    }
+    let first = plan.first().cloned().context("no scenes to evaluate")?;
+    plan.push(PlannedTruth { seed: 3, job: measure::TruthJob { seed: 3, ..first.job }, ..first });
+    Ok(plan)
+}
+
 /// Runs the suite into `cfg.out` (a new or empty-able directory). Ctrl-C stops it with an
 /// error; files already finished stay, `results.json` and `index.html` are written last, so a
 /// directory without them is an interrupted run.

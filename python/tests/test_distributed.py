@@ -1,0 +1,117 @@
+"""spectra.distributed on a local Ray instance: a truth split into 8 chunk tasks (and tiles)
+equals the single-process render; a worker killed mid-task is replaced and the result is still
+exact. Needs Ray (`cargo xtask test` installs it in its venv)."""
+
+import os
+
+import numpy as np
+import pytest
+
+import spectra
+
+ray = pytest.importorskip("ray")
+import spectra.distributed as dist  # noqa: E402
+
+SIZE = (40, 30)
+
+
+@pytest.fixture(scope="module")
+def local_ray(tmp_path_factory):
+    marker = tmp_path_factory.mktemp("kill") / "chunk0-killed"
+    # Two CPUs: two tasks at a time whatever the machine. The marker makes the first attempt
+    # of chunk 0 kill its worker (see distributed._piece).
+    ray.init(
+        num_cpus=2,
+        include_dashboard=False,
+        runtime_env={"env_vars": {"SPECTRA_TEST_KILL_CHUNK0_ONCE": str(marker)}},
+    )
+    yield marker
+    ray.shutdown()
+
+
+def relative(a, b):
+    return np.abs(a.astype(np.float64) - b) / np.maximum(np.abs(b.astype(np.float64)), 1e-30)
+
+
+def test_split():
+    pieces = dist.split(10, (7, 5), chunks=3, tiles=(2, 1))
+    assert [(c, o, n) for c, o, n, _ in pieces] == [(0, 0, 4), (0, 0, 4), (1, 4, 3), (1, 4, 3), (2, 7, 3), (2, 7, 3)]
+    assert [t for *_, t in pieces[:2]] == [(0, 0, 3, 5), (3, 0, 4, 5)]
+    with pytest.raises(ValueError, match="chunks 11"):
+        dist.split(10, (7, 5), chunks=11)
+    with pytest.raises(ValueError, match="tiles"):
+        dist.split(10, (7, 5), tiles=(8, 1))
+
+
+def test_eight_chunks_equal_one_process(local_ray):
+    scene = spectra.load("cornell")
+    one = spectra.truth(scene, spp=16, size=SIZE, seed=4)
+    many = dist.truth(scene, spp=16, size=SIZE, seed=4, chunks=8)
+    assert many.shape == one.shape and many.dtype == np.float32
+    assert relative(many, one).max() <= 1e-6
+    # The marker shows chunk 0's first worker was killed: Ray ran it again, still exact.
+    assert local_ray.exists()
+
+
+def test_chunks_and_tiles_with_crop_and_bins(local_ray):
+    scene = spectra.load("metamerism")
+    kw = dict(spp=6, size=SIZE, direct_only=True, seed=2, crop=(5, 4, 30, 20), spectral_bin=25)
+    img, bands, edges = spectra.truth(scene, **kw)
+    dimg, dbands, dedges = dist.truth(scene, chunks=3, tiles=(2, 2), **kw)
+    assert np.array_equal(edges, dedges)
+    assert relative(dimg, img).max() <= 1e-6
+    assert np.abs(dbands - bands).max() <= 1e-6 * np.abs(bands).max()
+
+
+def test_bad_input_before_any_task(local_ray):
+    scene = spectra.load("cornell")
+    with pytest.raises(ValueError, match="spp 0"):
+        dist.truth(scene, spp=0)
+    with pytest.raises(ValueError, match="chunks 0"):
+        dist.truth(scene, spp=4, chunks=0)
+    with pytest.raises(ValueError, match="--observer 'martian'"):
+        dist.truth(scene, spp=4, observer="martian")
+    with pytest.raises(TypeError, match="spectra.Scene"):
+        dist.truth("cornell", spp=4)
+    with pytest.raises(TypeError):
+        dist.truth(scene, spp=4, no_such_option=1)
+
+
+def test_eval_truths_as_tasks(local_ray, tmp_path, capfd):
+    """`spectra eval`'s truths as Ray tasks: stored in the truth cache, the evaluation renders
+    none of them, and its results are the command's (same truths up to float64 summation
+    order)."""
+    import json
+    import subprocess
+
+    from test_spectra import spectra_bin
+
+    args = dict(quick=True, scenes=["colorchecker-d65"], spp=6, size="32x24", sweep="4")
+    cache = tmp_path / "cache"
+    got = dist.eval(tmp_path / "ray", truth_cache=cache, chunks=3, **args)
+    err = capfd.readouterr().err
+    # The evaluation's own log: every truth came from the cache, none was rendered here.
+    lines = [ln for ln in err.splitlines() if "ground truth:" in ln or "jitter truth:" in ln]
+    assert len(lines) == 2 and all(ln.endswith("nothing rendered") for ln in lines), err
+    assert len(list(cache.glob("*.truth"))) == 3  # seeds 1, 2 and the jitter truth
+    # Again: nothing left to render.
+    assert spectra._spectra._eval_plan(
+        ["eval", "--out", str(tmp_path / "x"), "--quick", "--scenes", "colorchecker-d65", "--spp", "6",
+         "--size", "32x24", "--sweep", "4", "--truth-cache", str(cache)]
+    ) == []
+    subprocess.run(
+        [spectra_bin(), "eval", "--quick", "--scenes", "colorchecker-d65", "--spp", "6", "--size", "32x24",
+         "--sweep", "4", "--out", str(tmp_path / "cli")],
+        check=True,
+        capture_output=True,
+    )
+    want = json.loads((tmp_path / "cli" / "results.json").read_text())
+    a, b = got["cases"][0], want["cases"][0]
+    assert a["truth_spp"] == b["truth_spp"] == 6
+    for ma, mb in zip(a["modes"], b["modes"]):
+        assert ma["mode"] == mb["mode"]
+        for k in ("delta_e2000", "mae_linear"):
+            x, y = ma["errors"][k]["mean"], mb["errors"][k]["mean"]
+            assert x == pytest.approx(y, rel=1e-5, abs=1e-7), (ma["mode"], k)
+    with pytest.raises(ValueError, match="--sweep"):
+        dist.eval(tmp_path / "bad", quick=True, sweep="0")
