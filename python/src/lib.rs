@@ -503,47 +503,37 @@ impl TruthArgs {
         })
     }
 
-    /// The settings `spectra truth` builds from the same flags (its `settings()`): the scene's
-    /// RGB medium unless `rgb_medium` replaces it, the water of `water`/`depth` or the scene's.
+    /// The settings `spectra truth` builds from the same flags: its own `settings()` (the
+    /// scene's RGB medium unless `rgb_medium` replaces it, the water of `water`/`depth` or the
+    /// scene's), so the two cannot drift apart.
     fn settings(
         &self,
         scene: &scene::Scene,
         table: &color::upsample::CoeffTable,
     ) -> anyhow::Result<truth::Settings> {
-        let (width, height) = self.size;
-        let mut s = truth::Settings::new(width, height, self.spp)?;
-        s.seed = self.seed;
-        s.sample_offset = self.sample_offset;
-        s.crop = self.crop;
-        s.direct_only = self.direct_only;
-        s.max_depth = self.max_depth;
-        let sp = self.spectrum.resolve(scene)?;
-        s.range = sp.range;
-        s.observer = color::Observer::by_name(&sp.observer)?;
-        s.white = color::illuminant::by_name(&sp.white)?;
-        let rgb = match (self.rgb_medium.arg(), &scene.medium) {
-            (Some(arg), _) => Some((setup::rgb_medium_arg(arg)?, "rgb_medium".to_string())),
-            (None, Some(m)) => Some((m.clone(), format!("{}: extras.medium", scene.source))),
-            (None, None) => None,
-        };
-        if let Some((m, origin)) = &rgb {
-            let m = truth::Medium::from_rgb(m, table).with_context(|| origin.clone())?;
-            m.validate(s.range).with_context(|| origin.clone())?;
-            s.medium = Some(m);
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            truth: spectra::cmd::truth::Args,
         }
-        if let Some(w) = self.water.medium(scene)? {
-            if rgb.is_some() {
-                anyhow::bail!(
-                    "rgb_medium / the scene's medium and water (from water= or the scene) cannot be combined: pick one medium"
-                );
-            }
-            s.medium = Some(truth::water::medium(&w, scene.camera.position()));
-        }
+        let mut a =
+            Cli::try_parse_from(["truth", "--", &scene.source]).expect("truth's options have defaults").truth;
+        a.spp = self.spp;
+        a.size = format!("{}x{}", self.size.0, self.size.1);
+        a.sample_offset = Some(self.sample_offset);
+        a.crop = self.crop.map(|c| format!("{},{},{},{}", c.x, c.y, c.width, c.height));
+        a.direct_only = self.direct_only;
+        a.seed = self.seed;
+        a.max_depth = self.max_depth;
+        a.spectrum = self.spectrum.clone();
+        a.water = self.water.clone();
+        a.rgb_medium = self.rgb_medium.clone();
         if let Some(bin) = self.spectral_bin {
-            s.spectral_bands = Some(s.range.bin_edges(bin).context("spectral_bin")?);
+            a.spectral_bands = true;
+            a.spectral_bin = bin;
         }
-        s.validate()?;
-        Ok(s)
+        spectra::cmd::truth::settings(&a, scene, table)
     }
 
     /// Renders the samples: passes of about a quarter second (the first, of one sample,

@@ -238,7 +238,7 @@ def test_truth_spectral_bins(cornell):
     assert edges.dtype == np.float64 and edges[0] == 380 and edges[-1] == 730
     assert bands.shape == (12, 16, len(edges) - 1) and bands.dtype == np.float32
     assert np.isfinite(bands).all() and bands.max() > 0
-    with pytest.raises(ValueError, match="spectral_bin"):
+    with pytest.raises(ValueError, match="spectral.bin"):
         spectra.truth(cornell, spp=1, size=(8, 8), spectral_bin=-1)
 
 

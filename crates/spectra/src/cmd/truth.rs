@@ -101,12 +101,18 @@ pub struct Args {
     /// is the full render's, bit for bit). Shared with `spectra eval --truth-cache`.
     #[arg(long, value_name = "DIR")]
     pub truth_cache: Option<PathBuf>,
+    /// Bin the radiance by wavelength (`--spectral-bin`) without a --spectral-out file: for
+    /// callers of [`settings`] that keep the bands themselves (the Python package).
+    #[arg(skip)]
+    pub spectral_bands: bool,
 }
 
 /// Longest `--checkpoint-every`, seconds (a year).
 pub const MAX_CHECKPOINT_SECONDS: f64 = 3.2e7;
 
-fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
+/// The tracer's settings these flags ask for, the scene's own medium and water included: what
+/// `spectra truth` renders, and what the Python package's `truth` renders with the same options.
+pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable) -> Result<Settings> {
     let (width, height) = parse_size(&a.size)?;
     let mut s = Settings::new(width, height, a.spp)?;
     s.seed = a.seed;
@@ -145,7 +151,7 @@ fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTable)
         }
         s.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
-    if a.spectral_out.is_some() {
+    if a.spectral_out.is_some() || a.spectral_bands {
         s.spectral_bands = Some(s.range.bin_edges(a.spectral_bin).context("--spectral-bin")?);
     }
     s.validate()?;
