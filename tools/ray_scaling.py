@@ -11,11 +11,14 @@ import argparse
 import os
 import time
 
-import numpy as np
-import ray
+# Local instances on the loopback address (Ray's "no cluster" mode), read when ray is imported.
+os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
 
-import spectra
-import spectra.distributed as dist
+import numpy as np  # noqa: E402
+import ray  # noqa: E402
+
+import spectra  # noqa: E402
+import spectra.distributed as dist  # noqa: E402
 
 
 def main():

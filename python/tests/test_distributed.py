@@ -9,6 +9,10 @@ import pytest
 
 import spectra
 
+# A local Ray instance on the loopback address, not the machine's network address: what Ray
+# does on a laptop (its "no cluster" mode), so the tests send nothing beyond this machine.
+# Read when ray is imported.
+os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
 ray = pytest.importorskip("ray")
 import spectra.distributed as dist  # noqa: E402
 
@@ -25,6 +29,7 @@ def local_ray(tmp_path_factory):
         include_dashboard=False,
         runtime_env={"env_vars": {"SPECTRA_TEST_KILL_CHUNK0_ONCE": str(marker)}},
     )
+    assert ray.util.get_node_ip_address() == "127.0.0.1"
     yield marker
     ray.shutdown()
 
