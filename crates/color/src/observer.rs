@@ -207,6 +207,30 @@ impl Observer {
         Ok((m, rms))
     }
 
+    /// Where each of [`Self::NAMES`] comes from, in the same order (`spectra observers`).
+    pub const SOURCES: &'static [&'static str] = &[
+        "CIE 1931 2° standard observer (CIE 018:2019 / ISO 11664-1 tables, via colour-science)",
+        "CIE 1964 10° supplementary standard observer (CIE 018:2019 / ISO 11664-1 tables, via colour-science)",
+        "Nikon D5100 raw RGB, measured at NPL: Darrodi et al. 2015, JOSA A 32(3) 381",
+        "Sigma SD Merrill (Foveon) raw RGB, measured at NPL: Darrodi et al. 2015, JOSA A 32(3) 381",
+        "Canon EOS 5D Mark II raw RGB: the Academy's rawtoaces data",
+        "ACES Reference Input Capture Device (the Academy; a linear transform of CIE 1931)",
+        "human L, M, S cones: Stockman & Sharpe 2000 2° (CIE 170-1:2006, CVRL)",
+        "human protanope: Stockman & Sharpe 2° cones as (M, M, S)",
+        "human deuteranope: Stockman & Sharpe 2° cones as (L, L, S)",
+        "Picasso triggerfish: pigments λmax 528/480/413 nm (Cheney et al. 2013), Govardovskii A1 template",
+        "dog: pigments λmax 555/429 nm (Neitz, Geist & Jacobs 1989), Govardovskii A1 template",
+    ];
+
+    /// The wavelengths (nm, whole) where any channel is above zero: the span the data covers.
+    pub fn support(&self) -> Option<(f64, f64)> {
+        let positive = |l: f64| self.eval(l).iter().any(|&v| v > 0.0);
+        let lambda = (LAMBDA_MIN as u32..=LAMBDA_MAX as u32).map(f64::from);
+        let first = lambda.clone().find(|&l| positive(l))?;
+        let last = lambda.rev().find(|&l| positive(l))?;
+        Some((first, last))
+    }
+
     /// Names accepted by [`Observer::by_name`].
     pub const NAMES: &'static [&'static str] = &[
         "cie1931",
@@ -277,6 +301,17 @@ pub fn govardovskii_a1(lambda_max: f64, lambda: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_builtin_has_a_source_and_a_support() {
+        assert_eq!(Observer::SOURCES.len(), Observer::NAMES.len());
+        for name in Observer::NAMES {
+            let o = Observer::by_name(name).unwrap();
+            let (a, b) = o.support().unwrap_or_else(|| panic!("{name}: no support"));
+            assert!((LAMBDA_MIN..450.0).contains(&a) && b > 650.0 && b <= LAMBDA_MAX, "{name}: {a}–{b}");
+        }
+        assert_eq!(Observer::cie1931().support(), Some((360.0, 830.0)));
+    }
+
     use super::*;
     use crate::illuminant;
 

@@ -37,6 +37,8 @@ enum Command {
     Truth(cmd::truth::Args),
     /// Combine sample chunks and crop tiles of one `truth` render into one image.
     Merge(cmd::merge::Args),
+    /// List the built-in observers and cameras (--observer NAME) with their sources.
+    Observers(cmd::observers::Args),
     /// Open an interactive window: live mode/N/range/observer/exposure, orbit and fly camera.
     #[cfg(feature = "viewer")]
     View(cmd::view::Args),
@@ -144,6 +146,7 @@ fn main() {
         Command::Upsample(a) => cmd::upsample::run(a),
         Command::Truth(a) => cmd::truth::run(a),
         Command::Merge(a) => cmd::merge::run(a),
+        Command::Observers(a) => cmd::observers::run(a),
         #[cfg(feature = "viewer")]
         Command::View(a) => cmd::view::run(a),
         Command::Bench(a) => cmd::bench::run(a),

@@ -7,6 +7,7 @@ pub mod diff;
 pub mod eval;
 pub mod lut;
 pub mod merge;
+pub mod observers;
 pub mod render;
 pub mod setup;
 pub mod truth;
