@@ -38,8 +38,9 @@ def table(name, doc, sd):
 
 
 def cmfs():
-    src = [HEADER, "//! CIE standard colorimetric observers, 360–830 nm at 1 nm.\n//!\n",
-           "//! Source: CIE 018:2019 / ISO 11664-1 tables as distributed by colour-science\n",
+    src = [HEADER, "//! CIE standard colorimetric observers: 1931 2° and 1964 10°, 360–830 nm at 1 nm; 2015 2° and\n",
+           "//! 10° (CIE 170-2:2015, from the CIE 2006 cone fundamentals), 390–830 nm at 1 nm.\n//!\n",
+           "//! Source: CIE 018:2019 / ISO 11664-1 and CIE 170-2:2015 tables as distributed by colour-science\n",
            "//! (`colour.MSDS_CMFS`). The CIE publishes these tables for free use with attribution\n",
            "//! (CIE datasets, CC BY-SA 4.0).\n\n", "use super::SampledTable;\n\n"]
     for key, prefix, doc in [
@@ -47,6 +48,19 @@ def cmfs():
         ("CIE 1964 10 Degree Standard Observer", "CIE1964_10", "CIE 1964 10° colour-matching function"),
     ]:
         m = colour.MSDS_CMFS[key].copy().align(colour.SpectralShape(360, 830, 1))
+        for i, ch in enumerate("XYZ"):
+            sd = colour.SpectralDistribution(m.values[:, i], m.wavelengths)
+            src.append(table(f"{prefix}_{ch}", f"{doc} {ch.lower()}̄(λ).", sd))
+    # CIE 170-2:2015, the colour-matching functions derived from the CIE 2006 LMS cone
+    # fundamentals: tabulated 390–830 nm only, kept at that sampling (zero below 390 nm) rather
+    # than extrapolated.
+    for key, prefix, doc in [
+        ("CIE 2015 2 Degree Standard Observer", "CIE2015_2",
+         "CIE 2015 2° colour-matching function (CIE 170-2:2015), 390–830 nm at 1 nm,"),
+        ("CIE 2015 10 Degree Standard Observer", "CIE2015_10",
+         "CIE 2015 10° colour-matching function (CIE 170-2:2015), 390–830 nm at 1 nm,"),
+    ]:
+        m = colour.MSDS_CMFS[key]
         for i, ch in enumerate("XYZ"):
             sd = colour.SpectralDistribution(m.values[:, i], m.wavelengths)
             src.append(table(f"{prefix}_{ch}", f"{doc} {ch.lower()}̄(λ).", sd))

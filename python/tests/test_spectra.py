@@ -421,3 +421,25 @@ def test_observers_and_illuminants_against_colour_science():
         spectra.illuminant("Z99", lam)
     with pytest.raises(ValueError, match=r"wavelengths\[1\]"):
         spectra.illuminant("D65", [500, -3])
+
+
+def test_cie2015_observers_against_colour_science():
+    colour = pytest.importorskip("colour")
+    lam = np.arange(390.0, 831.0, 1.0)
+    for name, key in (("cie2015_2", "CIE 2015 2 Degree Standard Observer"),
+                      ("cie2015_10", "CIE 2015 10 Degree Standard Observer")):
+        ours = spectra.observer(name, lam)
+        ref = colour.MSDS_CMFS[key]
+        np.testing.assert_allclose(ours, ref[lam], rtol=1e-12, atol=1e-15)  # its z̄ tail has -5e-21s
+        # The ColorChecker's XYZ under D65 (1 nm sums over 390–830 nm, Y of the white = 100) with
+        # spectra's tables equals colour-science's own integration.
+        d65 = spectra.illuminant("D65", lam)
+        k = 100 / (d65 @ ours[:, 1])
+        shape = colour.SpectralShape(390, 830, 1)
+        d65_sd = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
+        for patch, sd in colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"].items():
+            r = sd.copy().align(shape)
+            xyz = k * (r.values * d65) @ ours
+            want = colour.sd_to_XYZ(r, ref.copy().align(shape), d65_sd, method="Integration")
+            np.testing.assert_allclose(xyz, want, rtol=1e-4, err_msg=f"{name} {patch}")
+    assert spectra.observer("cie2015_2", [380.0])[0].tolist() == [0.0, 0.0, 0.0]  # not tabulated there

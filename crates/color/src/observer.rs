@@ -53,6 +53,17 @@ impl Observer {
         Self::from_tables("cie1964", [&cmf::CIE1964_10_X, &cmf::CIE1964_10_Y, &cmf::CIE1964_10_Z])
     }
 
+    /// CIE 2015 2° observer (CIE 170-2:2015): x̄, ȳ, z̄ derived from the CIE 2006 LMS cone
+    /// fundamentals, 390–830 nm at 1 nm (zero below 390 nm, where it is not tabulated).
+    pub fn cie2015_2() -> Self {
+        Self::from_tables("cie2015_2", [&cmf::CIE2015_2_X, &cmf::CIE2015_2_Y, &cmf::CIE2015_2_Z])
+    }
+
+    /// CIE 2015 10° observer (CIE 170-2:2015), 390–830 nm at 1 nm.
+    pub fn cie2015_10() -> Self {
+        Self::from_tables("cie2015_10", [&cmf::CIE2015_10_X, &cmf::CIE2015_10_Y, &cmf::CIE2015_10_Z])
+    }
+
     /// Nikon D5100 camera raw RGB, measured at NPL (Darrodi et al. 2015), 380–780 nm at 5 nm.
     pub fn nikon_d5100() -> Self {
         Self::from_tables("nikon_d5100", [&ox::NIKON_D5100_R, &ox::NIKON_D5100_G, &ox::NIKON_D5100_B])
@@ -137,7 +148,7 @@ impl Observer {
     /// What the channels of this observer mean (by name; unknown names count as receptors).
     pub fn kind(&self) -> ObserverKind {
         match self.name.as_str() {
-            "cie1931" | "cie1964" => ObserverKind::CieXyz,
+            "cie1931" | "cie1964" | "cie2015_2" | "cie2015_10" => ObserverKind::CieXyz,
             "nikon_d5100" | "sigma_sd_merrill" | "canon_5d_mark_ii" | "aces_ricd" => ObserverKind::CameraRgb,
             // A file (`--observer FILE.csv`): most such files are cameras.
             n if crate::observer_file::is_file_name(n) => ObserverKind::CameraRgb,
@@ -211,6 +222,8 @@ impl Observer {
     pub const SOURCES: &'static [&'static str] = &[
         "CIE 1931 2° standard observer (CIE 018:2019 / ISO 11664-1 tables, via colour-science)",
         "CIE 1964 10° supplementary standard observer (CIE 018:2019 / ISO 11664-1 tables, via colour-science)",
+        "CIE 2015 2° observer from the CIE 2006 cone fundamentals (CIE 170-2:2015, via colour-science)",
+        "CIE 2015 10° observer from the CIE 2006 cone fundamentals (CIE 170-2:2015, via colour-science)",
         "Nikon D5100 raw RGB, measured at NPL: Darrodi et al. 2015, JOSA A 32(3) 381",
         "Sigma SD Merrill (Foveon) raw RGB, measured at NPL: Darrodi et al. 2015, JOSA A 32(3) 381",
         "Canon EOS 5D Mark II raw RGB: the Academy's rawtoaces data",
@@ -235,6 +248,8 @@ impl Observer {
     pub const NAMES: &'static [&'static str] = &[
         "cie1931",
         "cie1964",
+        "cie2015_2",
+        "cie2015_10",
         "nikon_d5100",
         "sigma_sd_merrill",
         "canon_5d_mark_ii",
@@ -255,6 +270,8 @@ impl Observer {
         match name.trim().to_ascii_lowercase().as_str() {
             "cie1931" | "cie1931_2" | "1931" => Ok(Self::cie1931()),
             "cie1964" | "cie1964_10" | "1964" => Ok(Self::cie1964()),
+            "cie2015_2" | "cie2015" | "2015" => Ok(Self::cie2015_2()),
+            "cie2015_10" => Ok(Self::cie2015_10()),
             "nikon_d5100" | "nikon" => Ok(Self::nikon_d5100()),
             "sigma_sd_merrill" | "sigma" => Ok(Self::sigma_sd_merrill()),
             "canon_5d_mark_ii" | "canon" => Ok(Self::canon_5d_mark_ii()),
