@@ -164,8 +164,8 @@ fn bad_extras() {
         &["root.extras.spectra.range", "360–830"],
     );
     expect(
-        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("cie2015")),
-        &["spectra.observer", "cie2015"],
+        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("cie2030")),
+        &["spectra.observer", "cie2030"],
     );
     expect(&mutate(|d| d["extras"]["spectra"]["wavelengths"] = json!(0)), &["spectra.wavelengths"]);
     expect(
