@@ -996,6 +996,7 @@ fn upsample<'py>(
         )));
     }
     let lambda = wavelengths.map(|w| wavelengths_arg("wavelengths", w)).transpose()?;
+    let n_lambda = lambda.as_ref().map(Vec::len);
     let cs =
         color::RgbColorSpace::by_name(space).map_err(|e| PyValueError::new_err(format!("space: {e}")))?;
     let (coeffs, spectra) = py.detach(move || -> Result<_, Fail> {
@@ -1011,7 +1012,7 @@ fn upsample<'py>(
     let mut shape = lead.clone();
     shape.push(3);
     let c = PyArray1::from_vec(py, coeffs).reshape(shape)?;
-    match (spectra, lambda_len(wavelengths)?) {
+    match (spectra, n_lambda) {
         (Some(sp), Some(n)) => {
             let mut shape = lead;
             shape.push(n);
@@ -1019,10 +1020,6 @@ fn upsample<'py>(
         }
         _ => Ok(c.into_any()),
     }
-}
-
-fn lambda_len(w: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
-    w.map(|w| wavelengths_arg("wavelengths", w).map(|v| v.len())).transpose()
 }
 
 /// An observer's three colour-matching functions (or a camera's sensitivities) at
