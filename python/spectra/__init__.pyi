@@ -88,13 +88,16 @@ class Renderer:
         white: Optional[str] = None,
         exposure: float = 0.0,
         spectral: bool = False,
+        camera_to_display: bool = False,
     ) -> Any:
         """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
 
         mode: "spectral", "naive" or "rgb". wavelengths: 1–256 (default: the scene's, else 16).
         quadrature: "prefiltered" or "midpoint". range: (min_nm, max_nm) (default: the scene's,
         else (380, 730)). observer: "cie1931" (default, unless the scene sets one), "cie1964", a
-        camera or a CSV file. white: an illuminant name (default: the scene's, else D65).
+        camera (`OBSERVERS`) or a file (CSV, rawtoaces JSON); a camera's channels are white
+        balanced, or with camera_to_display=True shown through its ColorChecker fit to XYZ and
+        sRGB. white: an illuminant name (default: the scene's, else D65).
         spectral=True: the tuple (image, node radiances float32 (H, W, N), node wavelengths
         float64 (N,)), as `--spectral-out` writes them (not in rgb mode).
         Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
@@ -125,11 +128,13 @@ def truth(
     depth: Optional[float] = None,
     rgb_medium: Optional[str] = None,
     spectral_bin: Optional[float] = None,
+    camera_to_display: bool = False,
 ) -> Any:
     """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
     options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
     `sample_offset=K` renders samples K … K+spp−1 (the CLI's --sample-offset / --chunk). The
-    same seed gives the same image. water / depth / rgb_medium as for `Renderer`.
+    same seed gives the same image. water / depth / rgb_medium / observer / camera_to_display as
+    for `Renderer.render`.
     spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
     (`--spectral-out`). Ctrl-C raises KeyboardInterrupt; the GIL is released."""
 
@@ -162,6 +167,11 @@ def observer(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
 
 def illuminant(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """An illuminant's relative spectral power at `wavelengths` (nm): float64 (L,)."""
+
+def chart(observer: str, illuminant: str = "D65", *, balanced: bool = False) -> npt.NDArray[np.float64]:
+    """The 24 ColorChecker Classic patches seen by `observer` under `illuminant`: float64
+    (24, 3), ∫ sensitivity·R·E dλ at 1 nm over 360–830 nm; balanced=True divides by the
+    perfect white's response."""
 
 def read_image(path: Union[str, os.PathLike[str]]) -> RGBImage:
     """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""

@@ -146,8 +146,8 @@ class Job:
         if dropped:
             print(f"warning: truth: {dropped} non-finite samples dropped", file=sys.stderr)
         if bins is None:
-            return _spectra._truth_finish(xyz, self._spp)
-        img, bands = _spectra._truth_finish(xyz, self._spp, bins)
+            return _spectra._truth_finish(xyz, self._spp, display=plan["display"])
+        img, bands = _spectra._truth_finish(xyz, self._spp, bins, display=plan["display"])
         return img, bands, plan["edges"]
 
 
@@ -168,6 +168,7 @@ def submit(
     depth=None,
     rgb_medium=None,
     spectral_bin=None,
+    camera_to_display=False,
     chunks=8,
     tiles=(1, 1),
     threads_per_task=1,
@@ -197,6 +198,7 @@ def submit(
         depth=depth,
         rgb_medium=rgb_medium,
         spectral_bin=spectral_bin,
+        camera_to_display=camera_to_display,
     )
     # Every argument checked here, before any task: the errors `spectra.truth` raises.
     plan = _spectra._truth_sums(scene, spp=spp, sample_offset=sample_offset, crop=crop, dry_run=True, **options)
@@ -227,8 +229,8 @@ def truth(
 ):
     """`spectra.truth` split into `chunks` sample chunks × a `tiles=(nx, ny)` grid of tiles,
     each a Ray task, and merged: the same arguments (`sample_offset`, `crop`, `range`,
-    `observer`, `white`, `max_depth`, `water`, `depth`, `rgb_medium`, `spectral_bin` as
-    keywords) and the same result (an (h, w, 3) float32 linear sRGB array; with
+    `observer`, `white`, `max_depth`, `water`, `depth`, `rgb_medium`, `spectral_bin`,
+    `camera_to_display` as keywords) and the same result (an (h, w, 3) float32 linear sRGB array; with
     `spectral_bin`, (image, bands, edges)).
 
     threads_per_task: CPUs each task asks Ray for and uses (the tracer's threads); Ray runs as
@@ -262,6 +264,7 @@ def eval(
     size=None,
     sweep=None,
     table=None,
+    observer=None,
     truth_cache=None,
     chunks=8,
     threads_per_task=1,
@@ -277,7 +280,7 @@ def eval(
     --truth-cache` stores its own; then the evaluation runs here, on this machine's GPU, with
     every truth taken from the cache (it renders none). Truths the cache already holds are not
     rendered again. Same arguments as the command (`quick`, `scenes` (a list of case ids),
-    `spp`, `size` "WxH", `sweep` "4,8,16", `table`); returns `results.json` as a dict."""
+    `spp`, `size` "WxH", `sweep` "4,8,16", `table`, `observer`); returns `results.json` as a dict."""
     import json
     import tempfile
 
@@ -295,6 +298,8 @@ def eval(
         argv += ["--sweep", sweep if isinstance(sweep, str) else ",".join(map(str, sweep))]
     if table is not None:
         argv += ["--table", str(table)]
+    if observer is not None:
+        argv += ["--observer", str(observer)]
     with tempfile.TemporaryDirectory(prefix="spectra-truth-cache-") as tmp:
         cache = str(truth_cache) if truth_cache is not None else tmp
         argv += ["--truth-cache", cache]

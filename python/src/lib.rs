@@ -339,7 +339,7 @@ impl Renderer {
     /// it is the node's share of the integral as a radiance (docs/spectral-exr.md). Not in rgb
     /// mode.
     #[pyo3(signature = (mode = "spectral", *, wavelengths = None, quadrature = "prefiltered", range = None,
-                        observer = None, white = None, exposure = 0.0, spectral = false))]
+                        observer = None, white = None, exposure = 0.0, spectral = false, camera_to_display = false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -352,6 +352,7 @@ impl Renderer {
         white: Option<String>,
         exposure: f32,
         spectral: bool,
+        camera_to_display: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mut look = default_look();
         look.mode = render::Mode::parse(mode).map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -368,7 +369,7 @@ impl Renderer {
         };
         look.quadrature = setup::parse_quadrature(quadrature)
             .map_err(|e| PyValueError::new_err(format!("--quadrature '{quadrature}': {e}")))?;
-        look.spectrum = setup::SpectrumArgs { range: range_arg(range), observer, white };
+        look.spectrum = setup::SpectrumArgs { range: range_arg(range), observer, white, camera_to_display };
         look.exposure = exposure;
         let (data, capture, (w, h)) = py.detach(|| -> Result<Frame, Fail> {
             let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
@@ -468,6 +469,7 @@ impl TruthArgs {
         depth: Option<f64>,
         rgb_medium: Option<String>,
         spectral_bin: Option<f64>,
+        camera_to_display: bool,
     ) -> PyResult<Self> {
         let spp = whole("spp", spp, 1)?;
         let size = size_arg(size)?;
@@ -496,7 +498,7 @@ impl TruthArgs {
             sample_offset: sample_offset as u64,
             crop,
             max_depth: whole("max_depth", max_depth, 0)?,
-            spectrum: setup::SpectrumArgs { range: range_arg(range), observer, white },
+            spectrum: setup::SpectrumArgs { range: range_arg(range), observer, white, camera_to_display },
             water: setup::WaterArgs { water, depth },
             rgb_medium: setup::RgbMediumArgs { rgb_medium },
             spectral_bin,
@@ -571,7 +573,14 @@ impl TruthArgs {
 /// The image of per-pixel sums over `spp` samples, as `spectra truth` finishes a render
 /// (`Accumulator::finish`: the mean as f32, then XYZ → linear sRGB): one place for the
 /// single-process and the distributed truth.
-fn finish(width: u32, height: u32, xyz: &[[f64; 3]], bins: &[f64], spp: u32) -> (Vec<f32>, Vec<f32>) {
+fn finish(
+    width: u32,
+    height: u32,
+    xyz: &[[f64; 3]],
+    bins: &[f64],
+    spp: u32,
+    display: glam::DMat3,
+) -> (Vec<f32>, Vec<f32>) {
     let n = f64::from(spp);
     let img = truth::XyzImage {
         width,
@@ -580,7 +589,14 @@ fn finish(width: u32, height: u32, xyz: &[[f64; 3]], bins: &[f64], spp: u32) -> 
         dropped: 0,
         spectral: None,
     };
-    let rgb = img.to_rgb(&color::RgbColorSpace::srgb()).into_iter().flatten().collect();
+    let rgb = img
+        .xyz
+        .iter()
+        .flat_map(|p| {
+            let v = display * glam::DVec3::from_array(p.map(f64::from));
+            [v.x as f32, v.y as f32, v.z as f32]
+        })
+        .collect();
     (rgb, bins.iter().map(|v| (v / n) as f32).collect())
 }
 
@@ -603,7 +619,7 @@ fn finish(width: u32, height: u32, xyz: &[[f64; 3]], bins: &[f64], spp: u32) -> 
 #[pyfunction(name = "truth")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
-                    depth = None, rgb_medium = None, spectral_bin = None))]
+                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false))]
 #[allow(clippy::too_many_arguments)]
 fn truth_image<'py>(
     py: Python<'py>,
@@ -622,6 +638,7 @@ fn truth_image<'py>(
     depth: Option<f64>,
     rgb_medium: Option<String>,
     spectral_bin: Option<f64>,
+    camera_to_display: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let sc = scene_of(scene, "scene")?;
     let a = TruthArgs::new(
@@ -639,11 +656,14 @@ fn truth_image<'py>(
         depth,
         rgb_medium,
         spectral_bin,
+        camera_to_display,
     )?;
+    let view = color::film::CameraView::from_flag(camera_to_display);
     let (rgb, bands, edges, (w, h)) = py.detach(move || -> Result<_, Fail> {
         let (st, acc) = a.run(&sc)?;
         let win = st.window();
-        let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp);
+        let display = st.display_matrix(view).map_err(value)?;
+        let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp, display);
         Ok((rgb, bands, st.spectral_bands, (win.width, win.height)))
     })?;
     let img = rgb_array(py, w, h, rgb)?;
@@ -668,7 +688,8 @@ fn truth_image<'py>(
 #[pyfunction(name = "_truth_sums")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
-                    depth = None, rgb_medium = None, spectral_bin = None, threads = None, dry_run = false))]
+                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false, threads = None,
+                    dry_run = false))]
 #[allow(clippy::too_many_arguments)]
 fn truth_sums<'py>(
     py: Python<'py>,
@@ -687,6 +708,7 @@ fn truth_sums<'py>(
     depth: Option<f64>,
     rgb_medium: Option<String>,
     spectral_bin: Option<f64>,
+    camera_to_display: bool,
     threads: Option<i64>,
     dry_run: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
@@ -706,6 +728,7 @@ fn truth_sums<'py>(
         depth,
         rgb_medium,
         spectral_bin,
+        camera_to_display,
     )?;
     let threads = threads.map(|t| whole("threads", t, 1)).transpose()?;
     let d = pyo3::types::PyDict::new(py);
@@ -743,6 +766,10 @@ fn truth_sums<'py>(
     }
     d.set_item("window", (win.x, win.y, win.width, win.height))?;
     d.set_item("spp", st.spp)?;
+    // What `_truth_finish` turns the sums into linear sRGB with (`color::film`), row-major.
+    let m =
+        st.display_matrix(color::film::CameraView::from_flag(camera_to_display)).map_err(value)?.transpose();
+    d.set_item("display", m.to_cols_array().to_vec())?;
     Ok(d)
 }
 
@@ -750,14 +777,26 @@ fn truth_sums<'py>(
 /// `xyz` float64 (h, w, 3), `bins` float64 (h, w, B) or None. Returns the float32 (h, w, 3)
 /// linear sRGB image, or (image, bands) with bins.
 #[pyfunction(name = "_truth_finish")]
-#[pyo3(signature = (xyz, spp, bins = None))]
+#[pyo3(signature = (xyz, spp, bins = None, display = None))]
 fn truth_finish<'py>(
     py: Python<'py>,
     xyz: PyReadonlyArrayDyn<'py, f64>,
     spp: i64,
     bins: Option<PyReadonlyArrayDyn<'py, f64>>,
+    display: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let spp = whole("spp", spp, 1)?;
+    let display = match display {
+        None => color::RgbColorSpace::srgb().from_xyz,
+        Some(m) if m.len() == 9 && m.iter().all(|v| v.is_finite()) => {
+            glam::DMat3::from_cols_array(&[m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8]]).transpose()
+        }
+        Some(m) => {
+            return Err(PyValueError::new_err(format!(
+                "display: expected the 9 finite entries of a 3×3 matrix, row by row, got {m:?}"
+            )));
+        }
+    };
     let shape = xyz.shape().to_vec();
     let [h, w, 3] = shape[..] else {
         return Err(PyValueError::new_err(format!("xyz: expected shape (h, w, 3), got {shape:?}")));
@@ -780,7 +819,7 @@ fn truth_finish<'py>(
         }
         None => (Vec::new(), None),
     };
-    let (rgb, bands) = finish(w as u32, h as u32, &sums, &bin_vals, spp);
+    let (rgb, bands) = finish(w as u32, h as u32, &sums, &bin_vals, spp, display);
     let img = rgb_array(py, w as u32, h as u32, rgb)?;
     match nb {
         None => Ok(img.into_any()),
@@ -1024,7 +1063,8 @@ fn upsample<'py>(
 
 /// An observer's three colour-matching functions (or a camera's sensitivities) at
 /// `wavelengths` (1-D, nm), as spectra uses them: float64 of shape (L, 3). `name`: "cie1931",
-/// "cie1964", a camera ("nikon_d5100", …) or a CSV file (wavelength and three columns).
+/// "cie1964", a camera ("nikon_d5100", "canon_eos_r5", … `OBSERVERS`) or a file (CSV of
+/// wavelength and three columns, or rawtoaces camera JSON).
 #[pyfunction]
 fn observer<'py>(
     py: Python<'py>,
@@ -1035,6 +1075,31 @@ fn observer<'py>(
     let o = color::Observer::by_name(name).map_err(value)?;
     let v: Vec<f64> = l.iter().flat_map(|&x| o.eval(x)).collect();
     PyArray1::from_vec(py, v).reshape([l.len(), 3])
+}
+
+/// The 24 ColorChecker Classic patches (N. Ohta's reflectances, chart order) seen by an
+/// observer under an illuminant: float64 (24, 3), each channel ∫ sensitivity·R·E dλ at 1 nm
+/// over 360–830 nm (`Observer::response`, what white balance and the camera fit integrate).
+/// balanced=True divides by the perfect white's response (white = (1, 1, 1)).
+#[pyfunction]
+#[pyo3(signature = (observer, illuminant = "D65", *, balanced = false))]
+fn chart<'py>(
+    py: Python<'py>,
+    observer: &str,
+    illuminant: &str,
+    balanced: bool,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let o = color::Observer::by_name(observer).map_err(value)?;
+    let e = color::illuminant::by_name(illuminant).map_err(value)?;
+    let white = if balanced { o.white_balance(&e) } else { [1.0; 3] };
+    let v: Vec<f64> = color::data::colorchecker::SPECTRA
+        .iter()
+        .flat_map(|t| {
+            let r = o.response(&color::Spectrum::from_table(t), &e);
+            [r[0] / white[0], r[1] / white[1], r[2] / white[2]]
+        })
+        .collect();
+    PyArray1::from_vec(py, v).reshape([color::data::colorchecker::SPECTRA.len(), 3])
 }
 
 /// An illuminant's relative spectral power at `wavelengths` (1-D, nm), float64 of shape (L,):
@@ -1137,7 +1202,7 @@ fn eval_plan<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Vec<Bound<'py,
         let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
         let mut out = Vec::new();
         for p in spectra::eval::truth_plan(&cfg).map_err(value)? {
-            let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+            let c = cfg.case(&p.case).map_err(value)?;
             let have =
                 spectra::eval::measure::cached_samples(&c.scene, &table, p.job, &cache).map_err(runtime)?;
             if have < p.job.spp {
@@ -1165,7 +1230,7 @@ fn eval_truth_sums<'py>(
     let acc = py.detach(|| -> Result<truth::Accumulator, Fail> {
         let cfg = spectra::cmd::eval::config(&args).map_err(value)?;
         let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
-        let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+        let c = cfg.case(&p.case).map_err(value)?;
         let cancel = AtomicBool::new(false);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build().map_err(runtime)?;
         pool.install(|| {
@@ -1213,7 +1278,7 @@ fn eval_truth_store<'py>(
         let dir = cfg.truth_cache.clone().ok_or_else(|| value(anyhow::anyhow!("--truth-cache is needed")))?;
         let cache = spectra::cmd::truth_cache::TruthCache::open(&dir).map_err(value)?;
         let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
-        let c = spectra::eval::suite::case(&p.case).map_err(value)?;
+        let c = cfg.case(&p.case).map_err(value)?;
         let acc = truth::Accumulator { done: p.job.spp, xyz: sums, bins: Vec::new(), dropped };
         spectra::eval::measure::store_truth(&c.scene, &table, p.job, &acc, &cache).map_err(runtime)
     })?;
@@ -1274,7 +1339,8 @@ fn _spectra(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(upsample, m)?)?;
     m.add_function(wrap_pyfunction!(observer, m)?)?;
     m.add_function(wrap_pyfunction!(illuminant, m)?)?;
-    m.add("OBSERVERS", color::Observer::NAMES.to_vec())?;
+    m.add_function(wrap_pyfunction!(chart, m)?)?;
+    m.add("OBSERVERS", color::Observer::names())?;
     m.add("ILLUMINANTS", color::illuminant::names())?;
     m.add("BUILTINS", scene::BUILTIN_NAMES.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -443,3 +443,70 @@ def test_cie2015_observers_against_colour_science():
             want = colour.sd_to_XYZ(r, ref.copy().align(shape), d65_sd, method="Integration")
             np.testing.assert_allclose(xyz, want, rtol=1e-4, err_msg=f"{name} {patch}")
     assert spectra.observer("cie2015_2", [380.0])[0].tolist() == [0.0, 0.0, 0.0]  # not tabulated there
+
+
+def _camera_files():
+    """Every camera spectra ships, with its data file read independently of spectra: the
+    database's rawtoaces JSON files (json module), and the three older built-ins' tables from
+    colour-science, where they come from (tools/gen_observer_data.py)."""
+    out = {}
+    for path in sorted((ROOT / "crates" / "color" / "data" / "cameras").glob("*.json")):
+        import json
+
+        doc = json.loads(path.read_text())
+        idx = doc["spectral_data"]["index"]["main"]
+        rows = sorted((float(k), v) for k, v in doc["spectral_data"]["data"]["main"].items())
+        lam = np.array([r[0] for r in rows])
+        vals = np.array([[r[1][idx.index(c)] for c in "RGB"] for r in rows], dtype=float)
+        name = path.name[: -len("_380_780_5.json")].lower().replace("-", "_")
+        out[name] = (lam, vals)
+    return out
+
+
+def test_every_camera_sees_the_colorchecker_as_numpy_integrates_its_file():
+    """Issue 33's acceptance: the 24 patches under D65 and F11 in camera RGB, for every shipped
+    camera, equal an independent numpy integration of the same data file (1 nm midpoints over
+    360–830 nm, the file interpolated linearly and zero outside it; patches and illuminants from
+    colour-science) to 1e-4 relative."""
+    colour = pytest.importorskip("colour")
+    files = _camera_files()
+    sens = colour.MSDS_CAMERA_SENSITIVITIES
+    for name, key in (("nikon_d5100", "Nikon 5100 (NPL)"), ("sigma_sd_merrill", "Sigma SDMerill (NPL)")):
+        files[name] = (sens[key].wavelengths, sens[key].values)
+    assert len(files) >= 50 and set(files) <= set(spectra.OBSERVERS)
+    mid = np.arange(360.0, 830.0) + 0.5
+    interp = lambda lam, v: np.interp(mid, lam, v, left=0.0, right=0.0)  # noqa: E731
+    patches = [interp(sd.wavelengths, sd.values) for sd in colour.SDS_COLOURCHECKERS["ColorChecker N Ohta"].values()]
+    for ill, key in (("D65", "D65"), ("F11", "FL11")):
+        sd = colour.SDS_ILLUMINANTS[key]
+        e = interp(sd.wavelengths, sd.values)
+        for name, (lam, vals) in files.items():
+            s = np.stack([interp(lam, vals[:, c]) for c in range(3)], axis=1)
+            want = np.array([(r * e) @ s for r in patches])
+            got = spectra.chart(name, ill)
+            np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-12 * want.max(), err_msg=f"{name} {ill}")
+            white = e @ s
+            np.testing.assert_allclose(spectra.chart(name, ill, balanced=True), want / white, rtol=1e-4)
+
+
+def test_camspec_tool_writes_files_observer_reads(tmp_path):
+    """tools/camspec_to_csv.py on a file in the Jiang et al. 2013 layout (name, then R, G, B rows
+    at 400–720 nm): each camera's CSV is read by `--observer FILE` as those values; a malformed
+    file is refused with its line number."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("camspec", ROOT / "tools" / "camspec_to_csv.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    lam = np.arange(400.0, 721.0, 10.0)
+    rng = np.random.default_rng(7)
+    cams = {"Canon 5D Mark II": rng.random((3, 33)), "Nikon D40": rng.random((3, 33))}
+    text = "".join(f"{n}\n" + "".join("\t".join(f"{v:.6f}" for v in row) + "\n" for row in m) for n, m in cams.items())
+    paths = tool.write(tool.parse(text), tmp_path)
+    assert [p.name for p in paths] == ["Canon_5D_Mark_II.csv", "Nikon_D40.csv"]
+    for (name, m), path in zip(cams.items(), paths):
+        np.testing.assert_allclose(spectra.observer(str(path), lam), np.round(m, 6).T, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="line 3: 2 values"):
+        tool.parse("Cam\n" + "\t".join(["0.1"] * 33) + "\n0.1 0.2\n")
+    with pytest.raises(ValueError, match="'Cam' has 1 rows"):
+        tool.parse("Cam\n" + "\t".join(["0.1"] * 33) + "\nOther\n")

@@ -7,6 +7,7 @@ pub mod colorspace;
 pub mod data;
 pub mod delta_e;
 pub mod error;
+pub mod film;
 pub mod illuminant;
 pub mod input;
 pub mod lab;

@@ -150,6 +150,7 @@ impl Observer {
         match self.name.as_str() {
             "cie1931" | "cie1964" | "cie2015_2" | "cie2015_10" => ObserverKind::CieXyz,
             "nikon_d5100" | "sigma_sd_merrill" | "canon_5d_mark_ii" | "aces_ricd" => ObserverKind::CameraRgb,
+            n if Self::camera(n).is_some() => ObserverKind::CameraRgb,
             // A file (`--observer FILE.csv`): most such files are cameras.
             n if crate::observer_file::is_file_name(n) => ObserverKind::CameraRgb,
             _ => ObserverKind::Receptors,
@@ -261,11 +262,39 @@ impl Observer {
         "dog",
     ];
 
-    /// Looks an observer up by name (any of [`Self::NAMES`] or a short alias; case-insensitive),
-    /// or reads it from a CSV file when `name` is a path (`crate::observer_file`).
+    /// The camera database's entry called `name` (crates/color/data/cameras, `data::cameras`).
+    pub fn camera(name: &str) -> Option<&'static crate::data::cameras::Camera> {
+        let n = name.trim().to_ascii_lowercase().replace('-', "_");
+        crate::data::cameras::CAMERAS.iter().find(|c| c.name == n)
+    }
+
+    /// Every name [`Self::by_name`] knows: [`Self::NAMES`], then the camera database's.
+    pub fn names() -> Vec<&'static str> {
+        Self::NAMES.iter().copied().chain(crate::data::cameras::CAMERAS.iter().map(|c| c.name)).collect()
+    }
+
+    /// Where the observer called `name` comes from ([`Self::SOURCES`], or the database's
+    /// record), or `None` for a name [`Self::names`] does not list.
+    pub fn source(name: &str) -> Option<String> {
+        if let Some(i) = Self::NAMES.iter().position(|n| *n == name) {
+            return Some(Self::SOURCES[i].to_string());
+        }
+        Self::camera(name).map(|c| {
+            format!("{} {} raw RGB, {}: rawtoaces-data {} (Apache-2.0)", c.make, c.model, c.measured, c.file)
+        })
+    }
+
+    /// Looks an observer up by name (any of [`Self::names`] or a short alias; case-insensitive),
+    /// or reads it from a file when `name` is a path (`crate::observer_file`: CSV, or the
+    /// rawtoaces JSON of the camera database).
     pub fn by_name(name: &str) -> Result<Self> {
         if crate::observer_file::is_file_name(name) {
             return crate::observer_file::read(std::path::Path::new(name.trim()));
+        }
+        if let Some(c) = Self::camera(name) {
+            let mut o = crate::observer_file::parse_json(c.json, c.name)?;
+            o.name = c.name.to_string();
+            return Ok(o);
         }
         match name.trim().to_ascii_lowercase().as_str() {
             "cie1931" | "cie1931_2" | "1931" => Ok(Self::cie1931()),
@@ -285,8 +314,16 @@ impl Observer {
                 kind: "observer",
                 name: name.into(),
                 known: format!(
-                    "{}, or a CSV file (wavelength and three sensitivities)",
-                    Self::NAMES.join(", ")
+                    "{}, one of the {} cameras `spectra observers` lists (e.g. {}), or a file: CSV \
+                     (wavelength and three sensitivities) or rawtoaces camera JSON",
+                    Self::NAMES.join(", "),
+                    crate::data::cameras::CAMERAS.len(),
+                    crate::data::cameras::CAMERAS
+                        .iter()
+                        .take(3)
+                        .map(|c| c.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
             }),
         }
@@ -321,7 +358,8 @@ mod tests {
     #[test]
     fn every_builtin_has_a_source_and_a_support() {
         assert_eq!(Observer::SOURCES.len(), Observer::NAMES.len());
-        for name in Observer::NAMES {
+        for name in Observer::names() {
+            assert!(Observer::source(name).is_some_and(|s| !s.is_empty()), "{name}");
             let o = Observer::by_name(name).unwrap();
             let (a, b) = o.support().unwrap_or_else(|| panic!("{name}: no support"));
             assert!((LAMBDA_MIN..450.0).contains(&a) && b > 650.0 && b <= LAMBDA_MAX, "{name}: {a}–{b}");
@@ -334,7 +372,7 @@ mod tests {
 
     #[test]
     fn by_name_round_trips_every_observer() {
-        for &name in Observer::NAMES {
+        for name in Observer::names() {
             let o = Observer::by_name(name).unwrap();
             assert_eq!(o.name, name);
             assert_eq!(Observer::by_name(&name.to_ascii_uppercase()).unwrap(), o);
@@ -346,7 +384,7 @@ mod tests {
     #[test]
     fn equal_energy_white_gives_three_positive_channels() {
         let e = illuminant::by_name("E").unwrap();
-        for &name in Observer::NAMES {
+        for name in Observer::names() {
             let o = Observer::by_name(name).unwrap();
             let w = o.white_balance(&e);
             assert!(w.iter().all(|c| c.is_finite() && *c > 0.0), "{name}: {w:?}");
@@ -355,6 +393,27 @@ mod tests {
         // 106.857 (CIE 015:2018), and the cameras peak-normalised to 1 integrate to tens of nm.
         let y = Observer::cie1931().white_balance(&e)[1];
         assert!((y - 106.857).abs() < 0.01, "{y}");
+    }
+
+    /// The database: names unique and apart from the built-ins', every file a camera that the
+    /// ColorChecker can characterise (its least-squares fit to XYZ under D65 within the
+    /// residuals of measured cameras), named in its source with its licence.
+    #[test]
+    fn the_camera_database() {
+        let names = Observer::names();
+        let unique: std::collections::HashSet<_> = names.iter().collect();
+        assert_eq!(unique.len(), names.len());
+        let cams = crate::data::cameras::CAMERAS;
+        assert!(cams.len() >= 50, "{}", cams.len());
+        let d65 = illuminant::by_name("D65").unwrap();
+        for c in cams {
+            let o = Observer::by_name(c.name).unwrap();
+            assert_eq!((o.name.as_str(), o.kind()), (c.name, ObserverKind::CameraRgb));
+            assert_eq!(Observer::by_name(&c.name.replace('_', "-").to_uppercase()).unwrap(), o);
+            assert!(Observer::source(c.name).unwrap().contains("Apache-2.0"));
+            let (_, rms) = o.fit_to_xyz(&d65).unwrap();
+            assert!(rms < 0.05, "{}: fit residual {rms}", c.name);
+        }
     }
 
     #[test]

@@ -1,10 +1,16 @@
-//! Observers from a file (`--observer FILE.csv`, issue 33): a camera's or any other three
-//! sensitivity curves, as a CSV of wavelength (nm) and three columns — the layout camera
-//! databases and `colour-science` export. Header and `#` comment lines are skipped; commas,
-//! semicolons, tabs or spaces separate the fields. Checked, each refusal naming the file, the
-//! row and the column: four fields per row, finite numbers, wavelengths increasing strictly,
-//! sensitivities ≥ 0, at least three rows, some overlap with 360–830 nm, no column all zero.
-//! Outside the file's range the sensitivities are zero; between rows they are linear.
+//! Observers from a file (`--observer FILE`, issue 33): a camera's or any other three
+//! sensitivity curves, as
+//! - a CSV of wavelength (nm) and three columns — the layout camera databases and
+//!   `colour-science` export. Header and `#` comment lines are skipped; commas, semicolons, tabs
+//!   or spaces separate the fields;
+//! - the Academy's rawtoaces camera JSON (AcademySoftwareFoundation/rawtoaces-data,
+//!   `schema/spectral_1.0.0.json`): `spectral_data.index.main` names the channels (R, G and B
+//!   are taken by name), `spectral_data.data.main` maps each wavelength to its values.
+//!
+//! Checked, each refusal naming the file and the row (CSV) or the wavelength's entry (JSON) and
+//! the column: finite numbers, wavelengths increasing strictly (CSV) or distinct (JSON),
+//! sensitivities ≥ 0, at least three samples, some overlap with 360–830 nm, no channel all zero.
+//! Outside the file's range the sensitivities are zero; between samples they are linear.
 
 use std::path::Path;
 
@@ -15,15 +21,22 @@ use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN, Spectrum};
 /// Whether an `--observer` value names a file rather than a built-in observer.
 pub fn is_file_name(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();
-    lower.ends_with(".csv") || lower.ends_with(".txt") || name.contains('/') || name.contains('\\')
+    lower.ends_with(".csv")
+        || lower.ends_with(".txt")
+        || lower.ends_with(".json")
+        || name.contains('/')
+        || name.contains('\\')
 }
 
-/// The observer in the CSV file at `path`, named by the path.
+/// The observer in the file at `path` (JSON when it ends in `.json` or starts with `{`, else
+/// CSV), named by the path.
 pub fn read(path: &Path) -> Result<Observer> {
     let shown = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .map_err(|e| ColorError::Table(format!("observer file {shown}: cannot read it: {e}")))?;
-    parse(&text, &shown)
+    let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        || text.trim_start_matches('\u{feff}').trim_start().starts_with('{');
+    if json { parse_json(&text, &shown) } else { parse(&text, &shown) }
 }
 
 /// The observer in CSV `text`; `source` names it in errors and becomes its name.
@@ -77,6 +90,83 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
             col.push(v);
         }
     }
+    finish(lambda, columns, source, |c| format!("column {}", c + 2))
+}
+
+/// The observer in rawtoaces camera JSON `text` (`spectral_data.index.main` and
+/// `spectral_data.data.main`); `source` names it in errors and becomes its name.
+pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
+    let err = |what: String| ColorError::Table(format!("observer file {source}: {what}"));
+    let doc: serde_json::Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
+        .map_err(|e| err(format!("not valid JSON: {e}")))?;
+    let field = |path: &[&str]| -> Result<&serde_json::Value> {
+        let mut v = &doc;
+        for (i, key) in path.iter().enumerate() {
+            v = v.get(key).ok_or_else(|| err(format!("field {} is missing", path[..=i].join("."))))?;
+        }
+        Ok(v)
+    };
+    let index: Vec<String> = field(&["spectral_data", "index", "main"])?
+        .as_array()
+        .ok_or_else(|| err("field spectral_data.index.main is not a list of channel names".into()))?
+        .iter()
+        .map(|c| c.as_str().map(str::to_string))
+        .collect::<Option<_>>()
+        .ok_or_else(|| err("field spectral_data.index.main holds a name that is not a string".into()))?;
+    let channels: [usize; 3] = {
+        let mut at = [0usize; 3];
+        for (slot, name) in at.iter_mut().zip(["R", "G", "B"]) {
+            *slot = index.iter().position(|c| c.eq_ignore_ascii_case(name)).ok_or_else(|| {
+                err(format!(
+                    "field spectral_data.index.main: no channel '{name}' (it names {}); a camera needs R, G and B",
+                    if index.is_empty() { "none".to_string() } else { index.join(", ") }
+                ))
+            })?;
+        }
+        at
+    };
+    let data = field(&["spectral_data", "data", "main"])?
+        .as_object()
+        .ok_or_else(|| err("field spectral_data.data.main is not an object of wavelength → values".into()))?;
+    let mut rows: Vec<(f64, [f64; 3])> = Vec::with_capacity(data.len());
+    for (key, values) in data {
+        let at = |what: String| err(format!("spectral_data.data.main entry \"{key}\": {what}"));
+        let l = match key.trim().parse::<f64>() {
+            Ok(l) if l.is_finite() => l,
+            _ => return Err(at("the wavelength is not a finite number".into())),
+        };
+        let list = values.as_array().ok_or_else(|| at("the values are not a list".into()))?;
+        if list.len() != index.len() {
+            return Err(at(format!("{} values for the {} channels of the index", list.len(), index.len())));
+        }
+        let mut v = [0.0; 3];
+        for (c, (&i, name)) in channels.iter().zip(["R", "G", "B"]).enumerate() {
+            v[c] = match list[i].as_f64() {
+                Some(x) if x.is_finite() && x >= 0.0 => x,
+                Some(x) if x.is_finite() => {
+                    return Err(at(format!("channel {name}: sensitivity {x} is negative")));
+                }
+                _ => return Err(at(format!("channel {name}: {} is not a finite number", list[i]))),
+            };
+        }
+        rows.push((l, v));
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let Some(w) = rows.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(err(format!("spectral_data.data.main: wavelength {} nm is given twice", w[0].0)));
+    }
+    let lambda = rows.iter().map(|r| r.0).collect();
+    let columns = [0, 1, 2].map(|c| rows.iter().map(|r| r.1[c]).collect());
+    finish(lambda, columns, source, |c| format!("channel {}", ["R", "G", "B"][c]))
+}
+
+/// The checks on the whole file and the observer, shared by both formats.
+fn finish(
+    lambda: Vec<f64>,
+    columns: [Vec<f64>; 3],
+    source: &str,
+    column_name: impl Fn(usize) -> String,
+) -> Result<Observer> {
     let whole = |what: String| ColorError::Table(format!("observer file {source}: {what}"));
     if lambda.len() < 3 {
         return Err(whole(format!("{} data rows; at least 3 are needed", lambda.len())));
@@ -89,7 +179,7 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
     }
     for (c, col) in columns.iter().enumerate() {
         if col.iter().all(|&v| v == 0.0) {
-            return Err(whole(format!("column {} is zero at every wavelength", c + 2)));
+            return Err(whole(format!("{} is zero at every wavelength", column_name(c))));
         }
     }
     let bar = columns.map(|values| Spectrum::piecewise(lambda.clone(), values));
@@ -143,5 +233,74 @@ mod tests {
         }
         let e = read(Path::new("/nonexistent/cam.csv")).unwrap_err().to_string();
         assert!(e.contains("/nonexistent/cam.csv") && e.contains("cannot read"), "{e}");
+        let e = read(Path::new("/nonexistent/cam.json")).unwrap_err().to_string();
+        assert!(e.contains("/nonexistent/cam.json") && e.contains("cannot read"), "{e}");
+    }
+
+    fn json(index: &str, rows: &str) -> String {
+        format!(
+            r#"{{"header": {{"license": "Apache-2.0"}}, "spectral_data": {{"units": "relative",
+               "index": {{"main": {index}}}, "data": {{"main": {{{rows}}}}}}}}}"#
+        )
+    }
+
+    /// The rawtoaces layout: channels taken by name in any order, wavelengths in any order.
+    #[test]
+    fn rawtoaces_json() {
+        let o = parse_json(
+            &json(
+                r#"["B", "G", "R"]"#,
+                r#""500": [0.7, 0.6, 0.5], "400": [0.3, 0.2, 0.1], "600": [0.0, 0.1, 0.2]"#,
+            ),
+            "cam.json",
+        )
+        .unwrap();
+        assert_eq!(o.eval(400.0), [0.1, 0.2, 0.3]);
+        assert_eq!(o.eval(500.0), [0.5, 0.6, 0.7]);
+        assert_eq!(o.eval(700.0), [0.0; 3]);
+        assert_eq!(o.name, "cam.json");
+    }
+
+    #[test]
+    fn bad_json_is_an_error_naming_the_field_and_the_entry() {
+        let rows = r#""400": [1, 2, 3], "500": [1, 2, 3], "600": [1, 2, 3]"#;
+        let cases = [
+            ("{".to_string(), "not valid JSON"),
+            (r#"{"spectral_data": {}}"#.to_string(), "field spectral_data.index is missing"),
+            (
+                json(r#"["R", "G"]"#, r#""400": [1, 2], "500": [1, 2], "600": [1, 2]"#),
+                "no channel 'B' (it names R, G)",
+            ),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "500": [1, 2], "600": [1, 2, 3]"#),
+                "entry \"500\": 2 values",
+            ),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "x": [1, 2, 3], "600": [1, 2, 3]"#),
+                "entry \"x\": the wavelength",
+            ),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, -2, 3], "500": [1, 2, 3], "600": [1, 2, 3]"#),
+                "entry \"400\": channel G: sensitivity -2",
+            ),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, 2, null], "500": [1, 2, 3], "600": [1, 2, 3]"#),
+                "channel B: null",
+            ),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "400.0": [1, 2, 3], "600": [1, 2, 3]"#),
+                "400 nm is given twice",
+            ),
+            (json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "500": [1, 2, 3]"#), "2 data rows"),
+            (
+                json(r#"["R", "G", "B"]"#, r#""400": [1, 0, 3], "500": [1, 0, 3], "600": [1, 0, 3]"#),
+                "channel G is zero",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = parse_json(&text, "cam.json").unwrap_err().to_string();
+            assert!(e.contains("observer file cam.json") && e.contains(want), "{text}: {e}");
+        }
+        assert!(parse_json(&json(r#"["R", "G", "B"]"#, rows), "cam.json").is_ok());
     }
 }

@@ -85,27 +85,6 @@ impl SpectralIntegrator {
     }
 }
 
-/// The 3×3 matrix taking an observer's tristimulus values to linear sRGB, by spectra's convention
-/// ([`crate::observer::ObserverKind`]): CIE XYZ through the sRGB matrix (no adaptation: the
-/// scene white is taken to be sRGB's D65, as the path tracer does); any other observer's channels
-/// divided by their response to the scene white, `white_response` (the integrator's value of the
-/// white spectrum), and shown as linear display RGB. Errors if a channel does not see the white.
-pub fn tristimulus_to_linear_srgb(observer: &Observer, white_response: [f64; 3]) -> Result<glam::DMat3> {
-    use crate::observer::ObserverKind;
-    match observer.kind() {
-        ObserverKind::CieXyz => Ok(crate::RgbColorSpace::srgb().from_xyz),
-        _ => {
-            if white_response.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
-                return Err(crate::ColorError::BadSpectrum(format!(
-                    "observer '{}' has a zero or invalid response to the white ({white_response:?})",
-                    observer.name
-                )));
-            }
-            Ok(glam::DMat3::from_diagonal(glam::DVec3::from(white_response.map(|w| 1.0 / w))))
-        }
-    }
-}
-
 /// CIE xy chromaticity of an XYZ triple.
 pub fn xyz_to_xy(xyz: [f64; 3]) -> [f64; 2] {
     let s = xyz[0] + xyz[1] + xyz[2];

@@ -94,19 +94,39 @@ impl SpectralImage {
 
     /// Integrates every pixel with `observer` against `white` (for emissive images the white
     /// normalises: a radiance equal to `white` has Y = 1; for reflective ones it is the
-    /// illuminant) and converts to linear sRGB by [`color::xyz::tristimulus_to_linear_srgb`].
+    /// illuminant) and converts to linear sRGB by [`color::film::to_linear_srgb`] (a camera's
+    /// channels balanced and shown as they are).
     pub fn to_linear_srgb(&self, observer: &Observer, white: &Spectrum) -> Result<Image> {
+        self.to_display(observer, white, color::film::CameraView::Balanced)
+    }
+
+    /// [`Self::to_linear_srgb`] with a camera shown as `view` says (`--camera-to-display`).
+    pub fn to_display(
+        &self,
+        observer: &Observer,
+        white: &Spectrum,
+        view: color::film::CameraView,
+    ) -> Result<Image> {
         self.validate()?;
         let wl = self.wavelengths()?;
         let integ = match self.kind {
             SpectralKind::Emissive => SpectralIntegrator::emission(observer, white, &wl),
             SpectralKind::Reflective => SpectralIntegrator::reflectance(observer, white, &wl),
         };
-        let white_response = match self.kind {
-            SpectralKind::Emissive => integ.integrate(|l| white.eval(l)),
-            SpectralKind::Reflective => integ.white(),
+        // A camera is balanced by the white an RGB (1, 1, 1) light emits, as the path tracer
+        // that wrote the bands balances it (`truth::spectral::display_matrix`): the colour
+        // space's illuminant at the scene white's CIE luminance (the scene white itself when
+        // that is D65); a reflectance image by the illuminant.
+        let srgb = color::RgbColorSpace::srgb();
+        let (white_response, balance_white) = match self.kind {
+            SpectralKind::Emissive => {
+                let cie = SpectralIntegrator::emission(&Observer::cie1931(), white, &wl);
+                let rgb_white = srgb.emission_white(white, |s| cie.integrate(|l| s.eval(l))[1]);
+                (integ.integrate(|l| rgb_white.eval(l)), rgb_white)
+            }
+            SpectralKind::Reflective => (integ.white(), white.clone()),
         };
-        let m = color::xyz::tristimulus_to_linear_srgb(observer, white_response)
+        let m = color::film::to_linear_srgb(observer, white_response, &balance_white, view)
             .map_err(|e| CompareError::InvalidOption(e.to_string()))?;
         let n = self.bands();
         let mut values = vec![0.0f64; n];
@@ -462,7 +482,17 @@ mod tests {
         for obs in [Observer::cie1931(), Observer::cie1964(), Observer::nikon_d5100()] {
             let rgb = img.to_linear_srgb(&obs, &e).unwrap();
             let want = if obs.name == "nikon_d5100" {
-                [1.0; 3]
+                // A camera is balanced by the white an RGB (1, 1, 1) light emits (D65's shape at
+                // the white's luminance, as in both renderers): a flat emitter is not white to
+                // it, as it is not to CIE 1931 through sRGB.
+                let d65 = color::illuminant::by_name("D65").unwrap();
+                let on_bands = |o: &Observer, s: &Spectrum| {
+                    SpectralIntegrator::emission(o, &e, &wl).integrate(|l| s.eval(l))
+                };
+                let (r, w) = (on_bands(&obs, &e), on_bands(&obs, &d65));
+                let cie = Observer::cie1931();
+                let y = on_bands(&cie, &e)[1] / on_bands(&cie, &d65)[1];
+                [0, 1, 2].map(|c| r[c] / (w[c] * y))
             } else {
                 let xyz = SpectralIntegrator::emission(&obs, &e, &wl).integrate(|_| 1.0);
                 color::RgbColorSpace::srgb().xyz_to_rgb(xyz)

@@ -45,6 +45,8 @@ pub fn projection(camera: &scene::Camera, aspect: f32) -> Mat4 {
 #[derive(Clone, Debug, PartialEq)]
 struct SpectralKey {
     observer: String,
+    white: String,
+    camera_view: color::film::CameraView,
     range: (u64, u64),
     n: usize,
     jitter: Option<u32>,
@@ -826,6 +828,8 @@ impl Renderer {
     fn update_spectral(&mut self, settings: &RenderSettings) -> Result<()> {
         let key = SpectralKey {
             observer: settings.observer.to_ascii_lowercase(),
+            white: settings.white.clone(),
+            camera_view: settings.camera_view,
             range: (settings.range.min.to_bits(), settings.range.max.to_bits()),
             n: settings.wavelengths,
             jitter: settings.jitter.map(f32::to_bits),

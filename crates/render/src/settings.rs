@@ -166,6 +166,9 @@ pub struct RenderSettings {
     /// (`spectra.white`, default D65): the units of the XYZ normalisation, with RGB emission
     /// following it ([`color::RgbColorSpace::emission_white`], as in the path tracer).
     pub white: String,
+    /// How a camera's (any non-CIE observer's) balanced channels are shown
+    /// ([`color::film`]; `--camera-to-display`). CIE observers ignore it.
+    pub camera_view: color::film::CameraView,
     /// Exposure in stops: the HDR colour is multiplied by 2^EV before tone mapping.
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
@@ -204,6 +207,7 @@ impl Default for RenderSettings {
             range: WavelengthRange::VISIBLE,
             observer: "cie1931".into(),
             white: scene::DEFAULT_WHITE.into(),
+            camera_view: color::film::CameraView::Balanced,
             exposure_ev: 0.0,
             tonemap: Tonemap::None,
             shadows: true,

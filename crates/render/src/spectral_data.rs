@@ -62,7 +62,8 @@ pub struct SpectralSetup {
     /// without it, small N tints everything by the quadrature error of the white (midpoint) or
     /// by the part of the white outside the range (both). With jitter the correction uses the
     /// dense white instead, so it is the same for every frame (and only the average of frames
-    /// is white).
+    /// is white). That is for a CIE observer; any other is balanced by this quadrature's
+    /// response to the white and shown as [`color::film`] says (`RenderSettings::camera_view`).
     pub xyz_to_rgb: DMat3,
     pub space: RgbColorSpace,
     quad: NodeQuadrature,
@@ -133,7 +134,13 @@ impl SpectralSetup {
         let correction = DVec3::from_array(std::array::from_fn(|c| {
             if sampled_white[c] > 1e-12 { target_white[c] / sampled_white[c] } else { 1.0 }
         }));
-        let xyz_to_rgb = space.from_xyz * DMat3::from_diagonal(correction);
+        // Any other observer: balanced by this quadrature's own response to the white, which
+        // makes the white (1, 1, 1) at every N as the correction does for XYZ.
+        let xyz_to_rgb = if observer.kind() == color::observer::ObserverKind::CieXyz {
+            space.from_xyz * DMat3::from_diagonal(correction)
+        } else {
+            color::film::to_linear_srgb(&observer, sampled_white, &white, settings.camera_view)?
+        };
         let dense_wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470)?;
         let dense = SpectralIntegrator::emission(&observer, &white, &dense_wl);
         Ok(SpectralSetup {

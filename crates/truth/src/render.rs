@@ -119,6 +119,12 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// The matrix from this render's tristimulus values to linear sRGB
+    /// ([`crate::spectral::display_matrix`]).
+    pub fn display_matrix(&self, view: color::film::CameraView) -> Result<glam::DMat3> {
+        Ok(crate::spectral::display_matrix(&self.observer, &self.white, self.range, view)?)
+    }
+
     pub fn new(width: u32, height: u32, spp: u32) -> Result<Self> {
         Ok(Settings {
             width,
@@ -235,9 +241,24 @@ pub struct XyzImage {
 
 impl XyzImage {
     /// Linear RGB in `space` (no chromatic adaptation: the scene white is taken to be the
-    /// colour space's white, D65 for sRGB).
+    /// colour space's white, D65 for sRGB). For a CIE observer only: see [`Self::to_display`].
     pub fn to_rgb(&self, space: &color::RgbColorSpace) -> Vec<[f32; 3]> {
         self.xyz.iter().map(|p| space.xyz_to_rgb(p.map(|c| c as f64)).map(|c| c as f32)).collect()
+    }
+
+    /// Linear sRGB by the display convention every renderer shares ([`color::film`]): CIE XYZ
+    /// through the sRGB matrix, any other observer white balanced (and with
+    /// [`color::film::CameraView::Display`] through its fitted matrix to XYZ).
+    pub fn to_display(&self, settings: &Settings, view: color::film::CameraView) -> Result<Vec<[f32; 3]>> {
+        let m = settings.display_matrix(view)?;
+        Ok(self
+            .xyz
+            .iter()
+            .map(|p| {
+                let rgb = m * glam::DVec3::from_array(p.map(|c| c as f64));
+                [rgb.x as f32, rgb.y as f32, rgb.z as f32]
+            })
+            .collect())
     }
 
     /// Mean XYZ over the image.

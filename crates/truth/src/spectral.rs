@@ -62,18 +62,45 @@ pub struct XyzSensor {
     cmf: [DenseSpectrum; 3],
 }
 
+/// ∫ observer(λ)·s(λ) dλ over `range`, each channel, on a 0.1 nm midpoint grid: fine enough
+/// that its quadrature error is far below the tracer's noise.
+pub fn observer_integral(observer: &Observer, s: &Spectrum, range: WavelengthRange) -> [f64; 3] {
+    let n = (range.width() * 10.0).round().max(1.0) as usize;
+    let d = range.width() / n as f64;
+    (0..n).fold([0.0; 3], |mut acc, i| {
+        let l = range.min + (i as f64 + 0.5) * d;
+        let (o, w) = (observer.eval(l), s.eval(l));
+        (0..3).for_each(|c| acc[c] += o[c] * w * d);
+        acc
+    })
+}
+
+/// The normalisation of [`XyzSensor`]: the white's second channel (Y for a CIE observer).
+fn white_k(observer: &Observer, white: &Spectrum, range: WavelengthRange) -> f64 {
+    let k = observer_integral(observer, white, range)[1];
+    if k > 0.0 { k } else { 1.0 }
+}
+
+/// The matrix from the tracer's tristimulus values to linear sRGB ([`color::film`], the
+/// convention the real-time renderer and `compare` share): a non-CIE observer is balanced by
+/// its response to the RGB white — the colour space's illuminant at the scene white's
+/// luminance, which an RGB (1, 1, 1) light emits — in the sensor's units.
+pub fn display_matrix(
+    observer: &Observer,
+    white: &Spectrum,
+    range: WavelengthRange,
+    view: color::film::CameraView,
+) -> color::Result<glam::DMat3> {
+    let rgb_white = color::RgbColorSpace::srgb()
+        .emission_white(white, |s| crate::lights::y_integral(&|l| s.eval(l), range));
+    let k = white_k(observer, white, range);
+    let response = observer_integral(observer, &rgb_white, range).map(|v| v / k);
+    color::film::to_linear_srgb(observer, response, &rgb_white, view)
+}
+
 impl XyzSensor {
     pub fn new(observer: &Observer, white: &Spectrum, range: WavelengthRange) -> Self {
-        // k on a 0.1 nm midpoint grid: fine enough that its quadrature error is far below noise.
-        let n = (range.width() * 10.0).round() as usize;
-        let d = range.width() / n as f64;
-        let k: f64 = (0..n)
-            .map(|i| {
-                let l = range.min + (i as f64 + 0.5) * d;
-                observer.eval(l)[1] * white.eval(l) * d
-            })
-            .sum();
-        let k = if k > 0.0 { k } else { 1.0 };
+        let k = white_k(observer, white, range);
         let scale = range.width() / k;
         let cmf = [0, 1, 2].map(|c| DenseSpectrum::from_fn(range, |l| observer.eval(l)[c] * scale));
         XyzSensor { range, cmf }

@@ -39,14 +39,18 @@ pub struct Args {
     block: u32,
     /// Observer integrating a spectral EXR input (one with S0.<λ>nm or T.<λ>nm channels, e.g.
     /// from `truth --spectral-out`, pbrt-v4 or Mitsuba): cie1931 (default), cie1964, a camera
-    /// (nikon_d5100, canon_5d_mark_ii, …; white balanced and shown as linear RGB) or any other
-    /// `--observer` name spectra knows.
+    /// (nikon_d5100, canon_eos_r5, …, `spectra observers`; white balanced and shown as linear
+    /// RGB) or any other `--observer` name or file spectra takes.
     #[arg(long)]
     observer: Option<String>,
     /// White of a spectral input: normalises radiance (a radiance equal to it has Y = 1) and
     /// lights reflectance. Default: the file's `spectra.white` attribute, else D65.
     #[arg(long)]
     white: Option<String>,
+    /// Show a camera observer through its least-squares matrix to CIE XYZ (the ColorChecker
+    /// under the white) and sRGB instead of its balanced channels (as render and truth do).
+    #[arg(long)]
+    camera_to_display: bool,
     /// An extra metric beside ΔE2000 and MAE: `flip` (NVIDIA's perceptual difference, computed
     /// by its reference C++ code, FLIP 1.7; LDR- or HDR-FLIP, see --flip).
     #[arg(long, value_name = "NAME")]
@@ -95,7 +99,7 @@ fn load(path: &std::path::Path, what: &str, args: &Args) -> anyhow::Result<(Imag
     let white_name = args.white.clone().or(spec.white.clone()).unwrap_or_else(|| "D65".into());
     let white = color::illuminant::by_name(&white_name).with_context(|| format!("white {white_name}"))?;
     let img = spec
-        .to_linear_srgb(&observer, &white)
+        .to_display(&observer, &white, color::film::CameraView::from_flag(args.camera_to_display))
         .with_context(|| format!("integrating the {what} image {}", path.display()))?;
     let edges = &spec.edges;
     let note = format!(

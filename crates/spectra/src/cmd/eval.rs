@@ -2,7 +2,7 @@
 //! directory with an HTML report. See `crate::eval` and docs/evaluation.md.
 
 use crate::eval::{self, Config, suite};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
 use std::path::PathBuf;
 
@@ -36,6 +36,12 @@ pub struct Args {
     /// with `spectra truth --truth-cache` (docs/ground-truth.md).
     #[arg(long, value_name = "DIR")]
     pub truth_cache: Option<PathBuf>,
+    /// Evaluate for this observer instead of CIE 1931: a camera (`spectra observers`) or a
+    /// file, as --observer elsewhere. Both renderers integrate with it and a camera is shown
+    /// through its least-squares matrix to CIE XYZ over the ColorChecker (--camera-to-display),
+    /// so ΔE2000 compares colours a person sees and the rgb mode's sRGB is comparable.
+    #[arg(long)]
+    pub observer: Option<String>,
     /// Output directory (created); gets index.html, results.json, results.csv, images, charts.
     #[arg(long)]
     pub out: PathBuf,
@@ -61,6 +67,13 @@ pub fn config(a: &Args) -> Result<Config> {
         a.scenes.clone()
     };
     let notes = suite::notes(&ids);
+    if let Some(o) = &a.observer {
+        let obs = color::Observer::by_name(o).with_context(|| format!("--observer '{o}'"))?;
+        let view = crate::eval::measure::view_of(&obs);
+        let d65 = color::illuminant::by_name("D65")?;
+        color::film::to_linear_srgb(&obs, obs.white_balance(&d65), &d65, view)
+            .with_context(|| format!("--observer '{o}': the evaluation shows it through its fit to XYZ"))?;
+    }
     Ok(Config {
         out: a.out.clone(),
         quick: a.quick,
@@ -69,6 +82,7 @@ pub fn config(a: &Args) -> Result<Config> {
         notes,
         table: a.table.table.clone(),
         truth_cache: a.truth_cache.clone(),
+        observer: a.observer.clone(),
     })
 }
 

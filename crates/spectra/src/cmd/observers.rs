@@ -22,10 +22,10 @@ fn kind_name(k: ObserverKind) -> &'static str {
 
 pub fn run(a: Args) -> Result<()> {
     let mut rows = Vec::new();
-    for (name, source) in Observer::NAMES.iter().zip(Observer::SOURCES) {
+    for name in Observer::names() {
         let o = Observer::by_name(name)?;
         let (from, to) = o.support().unwrap_or((f64::NAN, f64::NAN));
-        rows.push((*name, kind_name(o.kind()), from, to, *source));
+        rows.push((name, kind_name(o.kind()), from, to, Observer::source(name).unwrap_or_default()));
     }
     if a.json {
         let v: Vec<_> = rows
@@ -35,10 +35,13 @@ pub fn run(a: Args) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!("{:<18} {:<11} {:>11}  source", "name", "kind", "data (nm)");
+    println!("{:<24} {:<11} {:>11}  source", "name", "kind", "data (nm)");
     for (n, k, f, t, s) in &rows {
-        println!("{n:<18} {k:<11} {:>11}  {s}", format!("{f:.0}–{t:.0}"));
+        println!("{n:<24} {k:<11} {:>11}  {s}", format!("{f:.0}–{t:.0}"));
     }
-    println!("\nor a file: --observer my_camera.csv (wavelength and three columns; docs/scene-format.md)");
+    println!(
+        "\nor a file: --observer my_camera.csv (wavelength and three columns) or a rawtoaces camera .json \
+         (docs/cameras.md)"
+    );
     Ok(())
 }

@@ -181,6 +181,7 @@ impl LookArgs {
             range: sp.range,
             observer: sp.observer,
             white: sp.white,
+            camera_view: sp.camera_view,
             exposure_ev: self.exposure,
             tonemap: self.tonemap,
             shadows,
@@ -279,6 +280,11 @@ pub struct SpectrumArgs {
     /// spectra.white, else D65).
     #[arg(long)]
     pub white: Option<String>,
+    /// Show a camera (any non-CIE observer) through its least-squares matrix to CIE XYZ over
+    /// the ColorChecker under the white, then sRGB — roughly its photograph — instead of its
+    /// white-balanced channels as display RGB. CIE observers are shown as they are.
+    #[arg(long)]
+    pub camera_to_display: bool,
 }
 
 /// [`SpectrumArgs`] with the scene's defaults and the renderers' filled in, checked.
@@ -289,6 +295,8 @@ pub struct Spectrum {
     pub observer: String,
     /// A name `color::illuminant::by_name` knows.
     pub white: String,
+    /// How a camera's channels are shown (`--camera-to-display`).
+    pub camera_view: color::film::CameraView,
 }
 
 impl SpectrumArgs {
@@ -329,7 +337,14 @@ impl SpectrumArgs {
         }
         let white = self.white.clone().unwrap_or_else(|| scene.spectral.white_name().to_string());
         color::illuminant::by_name(&white).with_context(|| from("--white", &self.white))?;
-        Ok(Spectrum { range, observer, white })
+        let camera_view = color::film::CameraView::from_flag(self.camera_to_display);
+        if camera_view == color::film::CameraView::Display {
+            // Fitted here so that an observer the chart cannot fit is refused before any work.
+            let w = color::illuminant::by_name(&white)?;
+            color::film::to_linear_srgb(&obs, obs.white_balance(&w), &w, camera_view)
+                .with_context(|| format!("--camera-to-display with observer {observer}"))?;
+        }
+        Ok(Spectrum { range, observer, white, camera_view })
     }
 }
 
@@ -653,6 +668,7 @@ mod tests {
             range: Some("390:720".into()),
             observer: Some("cie1931".into()),
             white: Some("A".into()),
+            ..Default::default()
         };
         let s = flags.resolve(&scene).unwrap();
         assert_eq!(

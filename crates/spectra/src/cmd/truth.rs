@@ -3,7 +3,7 @@
 use super::setup::{RgbMediumArgs, SceneArgs, SpectrumArgs, TableArgs, WaterArgs, parse_size};
 use anyhow::{Context, Result, bail};
 use clap::Args as ClapArgs;
-use color::{Observer, RgbColorSpace};
+use color::Observer;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -194,7 +194,16 @@ fn record(
     spectral: bool,
 ) -> Result<Vec<(String, String)>> {
     let mut fields = sum_fields(scene, st, table, &a.scene.input_files(scene), spectral)?;
-    fields.push(("channels".into(), if a.xyz { "CIE XYZ" } else { "linear sRGB" }.into()));
+    // What the colour channels hold (a camera's by the view `color::film` shows it in).
+    let camera = st.observer.kind() != color::observer::ObserverKind::CieXyz;
+    let channels = match (a.xyz, camera, a.spectrum.camera_to_display) {
+        (true, false, _) => "CIE XYZ",
+        (true, true, _) => "observer tristimulus",
+        (false, false, _) => "linear sRGB",
+        (false, true, false) => "white-balanced observer channels as linear display RGB",
+        (false, true, true) => "linear sRGB (camera to display)",
+    };
+    fields.push(("channels".into(), channels.into()));
     Ok(wrap_record(fields, st, spectral))
 }
 
@@ -492,7 +501,11 @@ pub fn run(a: Args) -> Result<()> {
     if cancel.load(Ordering::Relaxed) {
         bail!("interrupted; nothing written");
     }
-    let data = if a.xyz { img.xyz.clone() } else { img.to_rgb(&RgbColorSpace::srgb()) };
+    let data = if a.xyz {
+        img.xyz.clone()
+    } else {
+        img.to_display(&st, color::film::CameraView::from_flag(a.spectrum.camera_to_display))?
+    };
     let image = compare::image::Image::new(img.width, img.height, data)?;
     let win = st.window();
     let frame = compare::ExrFrame {

@@ -3,8 +3,8 @@
 //! jittered accumulation against equal spacing.
 
 use anyhow::{Context, Result, bail};
+use color::WavelengthRange;
 use color::metrics::Stats;
-use color::{RgbColorSpace, WavelengthRange};
 use compare::{DiffMaps, DiffOptions, Image};
 use render::{Mode, RenderSettings, Renderer};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -71,7 +71,25 @@ pub fn truth_settings(scene: &scene::Scene, job: TruthJob) -> Result<truth::Sett
         st.medium = Some(truth::water::medium(&w, scene.camera.position()));
     }
     st.white = color::illuminant::by_name(scene.spectral.white_name())?;
+    st.observer = observer_of(scene)?;
     Ok(st)
+}
+
+/// The observer a case is evaluated for: its scene's (`spectra eval --observer` sets it on
+/// every case, `Config::case`), else CIE 1931.
+pub fn observer_of(scene: &scene::Scene) -> Result<color::Observer> {
+    let name = scene.spectral.observer.as_deref().unwrap_or("cie1931");
+    color::Observer::by_name(name).with_context(|| format!("observer {name}"))
+}
+
+/// How the evaluation shows an observer: a camera through its ColorChecker fit to XYZ and sRGB
+/// (`--camera-to-display`), so that ΔE2000 measures colours a person sees and the rgb mode's
+/// sRGB is comparable; CIE observers as they are.
+pub fn view_of(observer: &color::Observer) -> color::film::CameraView {
+    match observer.kind() {
+        color::observer::ObserverKind::CieXyz => color::film::CameraView::Balanced,
+        _ => color::film::CameraView::Display,
+    }
 }
 
 /// The sums of samples `first` … `first + samples − 1` of a case's ground truth (the same
@@ -178,7 +196,8 @@ pub fn truth(
         }
     }
     let img = acc.finish(&st);
-    Ok((Image::new(width, height, img.to_rgb(&RgbColorSpace::srgb()))?, TruthSource { cached, rendered }))
+    let rgb = img.to_display(&st, view_of(&st.observer))?;
+    Ok((Image::new(width, height, rgb)?, TruthSource { cached, rendered }))
 }
 
 /// The real-time renderer's linear HDR image of the scene's camera.
@@ -192,6 +211,21 @@ pub fn realtime(r: &mut Renderer, scene: &scene::Scene, settings: &RenderSetting
 /// Settings for a mode at N over `range`, everything else default (no tone map, shadows on).
 pub fn settings(mode: Mode, n: usize, range: WavelengthRange) -> RenderSettings {
     RenderSettings { mode, wavelengths: n, range, ..RenderSettings::default() }
+}
+
+/// [`settings`] for `scene`'s case: its observer ([`observer_of`]) shown as [`view_of`] says.
+pub fn settings_for(
+    scene: &scene::Scene,
+    mode: Mode,
+    n: usize,
+    range: WavelengthRange,
+) -> Result<RenderSettings> {
+    let observer = observer_of(scene)?;
+    Ok(RenderSettings {
+        camera_view: view_of(&observer),
+        observer: observer.name,
+        ..settings(mode, n, range)
+    })
 }
 
 /// Pixels near an edge of the ground-truth image: the 3×3 neighbourhood's luminance varies by

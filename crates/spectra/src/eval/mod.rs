@@ -49,6 +49,20 @@ pub struct Config {
     pub table: Option<PathBuf>,
     /// Keep the ground truths here and start from the ones kept (`--truth-cache`).
     pub truth_cache: Option<PathBuf>,
+    /// Evaluate for this observer instead of CIE 1931 (`--observer`): a camera is shown through
+    /// its fitted matrix (`measure::view_of`).
+    pub observer: Option<String>,
+}
+
+impl Config {
+    /// The case `id` as this evaluation renders it (its observer set on the scene).
+    pub fn case(&self, id: &str) -> Result<suite::Case> {
+        let mut c = suite::case(id)?;
+        if let Some(o) = &self.observer {
+            c.scene.spectral.observer = Some(o.clone());
+        }
+        Ok(c)
+    }
 }
 
 /// One mode's result in one case.
@@ -147,6 +161,9 @@ pub struct Results {
     pub quick: bool,
     pub budget: suite::Budget,
     pub adapter: String,
+    /// The observer every case was rendered for (`--observer`; a camera shown through its
+    /// ColorChecker fit to XYZ).
+    pub observer: String,
     pub machine: String,
     pub seconds: f64,
     pub notes: Vec<String>,
@@ -199,7 +216,7 @@ pub struct PlannedTruth {
 pub fn truth_plan(cfg: &Config) -> Result<Vec<PlannedTruth>> {
     let mut plan = Vec::new();
     for id in &cfg.ids {
-        let c = suite::case(id)?;
+        let c = cfg.case(id)?;
         let range = scene_range(&c.scene)?;
         let (width, height, spp) = cfg.budget.for_case(&c);
         for seed in [1, 2] {
@@ -243,7 +260,7 @@ pub fn run(cfg: Config) -> Result<Results> {
         let (width, height, spp) = b.for_case(c);
         measure::TruthJob { width, height, spp, seed, range }
     };
-    let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| suite::case(id)).collect::<Result<_>>()?;
+    let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| cfg.case(id)).collect::<Result<_>>()?;
 
     let mut results = Vec::new();
     for c in &cases {
@@ -275,7 +292,8 @@ pub fn run(cfg: Config) -> Result<Results> {
         r.resize(width, height)?;
         let mut maps = Vec::new();
         for (mode, name) in MODES {
-            let img = measure::realtime(&mut r, &c.scene, &measure::settings(*mode, n, range))?;
+            let img =
+                measure::realtime(&mut r, &c.scene, &measure::settings_for(&c.scene, *mode, n, range)?)?;
             let png = format!("{}_{}.png", c.id, name);
             save_png(&cfg.out.join(&png), &img)?;
             let ppd = compare::flip::DEFAULT_PIXELS_PER_DEGREE;
@@ -339,15 +357,22 @@ pub fn run(cfg: Config) -> Result<Results> {
     let configs = (SPECTRAL_MODES.len() * Quadrature::ALL.len() * b.bench_counts.len()) as u64;
     let pb = bar(1 + configs, "frame time");
     let mut frame_times = Vec::new();
-    let ms =
-        measure::frame_ms(&mut r, &ft_case.scene, &measure::settings(Mode::Rgb, 1, range), b.bench_frames)?;
+    let ms = measure::frame_ms(
+        &mut r,
+        &ft_case.scene,
+        &measure::settings_for(&ft_case.scene, Mode::Rgb, 1, range)?,
+        b.bench_frames,
+    )?;
     frame_times.push(FrameTime { mode: "rgb".into(), wavelengths: None, quadrature: None, median_ms: ms });
     pb.inc(1);
     for &n in &b.bench_counts {
         for (mode, name) in SPECTRAL_MODES {
             for q in Quadrature::ALL {
                 check()?;
-                let s = RenderSettings { quadrature: q, ..measure::settings(*mode, n, range) };
+                let s = RenderSettings {
+                    quadrature: q,
+                    ..measure::settings_for(&ft_case.scene, *mode, n, range)?
+                };
                 let ms = measure::frame_ms(&mut r, &ft_case.scene, &s, b.bench_frames)?;
                 frame_times.push(FrameTime {
                     mode: (*name).into(),
@@ -380,8 +405,11 @@ pub fn run(cfg: Config) -> Result<Results> {
     for &k in &b.jitter_frames {
         check()?;
         let total = k * b.jitter_per_frame;
-        let eq =
-            measure::realtime(&mut r, &ft_case.scene, &measure::settings(Mode::Spectral, total, jrange))?;
+        let eq = measure::realtime(
+            &mut r,
+            &ft_case.scene,
+            &measure::settings_for(&ft_case.scene, Mode::Spectral, total, jrange)?,
+        )?;
         let acc = measure::accumulate(&mut r, &ft_case.scene, b.jitter_per_frame, jrange, k, 17)?;
         jitter.push(JitterPoint {
             total_wavelengths: total,
@@ -395,6 +423,7 @@ pub fn run(cfg: Config) -> Result<Results> {
         quick: cfg.quick,
         budget: cfg.budget.clone(),
         adapter,
+        observer: cfg.observer.clone().unwrap_or_else(|| "cie1931".into()),
         machine: machine(),
         seconds: t_start.elapsed().as_secs_f64(),
         notes: cfg.notes.clone(),
@@ -431,7 +460,7 @@ fn sweep(
         for q in Quadrature::ALL {
             for &n in counts {
                 check()?;
-                let s = RenderSettings { quadrature: q, ..measure::settings(*mode, n, range) };
+                let s = RenderSettings { quadrature: q, ..measure::settings_for(&c.scene, *mode, n, range)? };
                 let img = measure::realtime(r, &c.scene, &s)?;
                 let e = Errors::of(&measure::diff(t0, &img)?, mask)?;
                 out.push(SweepPoint {
