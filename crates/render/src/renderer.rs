@@ -298,10 +298,11 @@ impl Renderer {
         }
     }
 
-    /// Emissive polygons lit with as area lights, and (count, fraction of emitted power) of those
-    /// left out because the renderer handles at most `MAX_LIGHTS` lights in all.
+    /// The area lights emissive surfaces are lit with, the emitting polygons they stand for (more
+    /// than the lights when clustered: `scene::emitters::area_lights`), and the fraction of the
+    /// emitted power left out (more emitting materials than the `MAX_LIGHTS` budget).
     pub fn emitter_summary(&self) -> Option<(usize, usize, f64)> {
-        self.scene.as_ref().map(|s| (s.emitters.len(), s.dropped_emitters.0, s.dropped_emitters.1))
+        self.scene.as_ref().map(|s| (s.emitters.len(), s.emitter_polygons.0, s.emitter_polygons.1))
     }
 
     /// The environment in use, if any.

@@ -394,11 +394,13 @@ pub struct GpuScene {
     pub draws: Vec<Draw>,
     pub materials: Vec<wgpu::BindGroup>,
     pub lights: Vec<scene::Light>,
-    /// Emissive polygons lit with as area lights (after `lights` in the GPU light list), the
-    /// brightest that fit in [`MAX_LIGHTS`].
+    /// Emissive surfaces lit with as area lights (after `lights` in the GPU light list): the
+    /// emitting polygons, or clusters of them when they are more than fit in [`MAX_LIGHTS`]
+    /// (`scene::emitters::area_lights`).
     pub emitters: Vec<scene::emitters::Emitter>,
-    /// Emissive polygons left out by the cap, and the fraction of the emitted power they carry.
-    pub dropped_emitters: (usize, f64),
+    /// The emitting polygons they stand for, and the fraction of the emitted power left out
+    /// (only with more emitting materials than lights fit).
+    pub emitter_polygons: (usize, f64),
     pub camera: scene::Camera,
     /// World-space bounding box of all geometry.
     pub bounds: (Vec3, Vec3),
@@ -550,17 +552,9 @@ impl GpuScene {
         if chunks.is_empty() {
             return Err(bad("the scene has no geometry".into()));
         }
-        let mut emitters = scene::emitters::emitters(s);
-        let room = MAX_LIGHTS - s.lights.len();
-        let dropped_emitters = if emitters.len() > room {
-            let total: f64 = emitters.iter().map(|e| e.power()).sum();
-            let kept: f64 = emitters[..room].iter().map(|e| e.power()).sum();
-            let n = emitters.len() - room;
-            emitters.truncate(room);
-            (n, if total > 0.0 { 1.0 - kept / total } else { 0.0 })
-        } else {
-            (0, 0.0)
-        };
+        let area = scene::emitters::area_lights(s, MAX_LIGHTS.saturating_sub(s.lights.len()));
+        let emitter_polygons = (area.polygons, area.dropped_power);
+        let emitters = area.lights;
         let mut warnings = Vec::new();
         let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
@@ -654,7 +648,7 @@ impl GpuScene {
             materials,
             lights: s.lights.clone(),
             emitters,
-            dropped_emitters,
+            emitter_polygons,
             camera: s.camera,
             bounds: (lo, hi),
             warnings,

@@ -5,13 +5,20 @@
 //! Each emissive mesh that no punctual light stands in for (`Light::stands_in_for`) becomes
 //! polygons of uniform radiance, one-sided (emitting towards the side its vertex normals point
 //! to, as in the path tracer): a mesh of exactly two coplanar triangles forming a convex quad
-//! becomes one quad, any other mesh one polygon per triangle. The radiance is the material's
-//! `emissive` (× `KHR_materials_emissive_strength`, already applied) times the mean of its
-//! emissive texture over the whole image (a textured emitter is approximated by its average).
+//! becomes one quad, any other mesh one polygon per triangle ([`emitters`]). The radiance is the
+//! material's `emissive` (× `KHR_materials_emissive_strength`, already applied) times the mean of
+//! its emissive texture over the polygon's own texture footprint (stratified samples of the
+//! triangle, [`texture_mean`]); a polygon that emits nothing is left out.
+//!
+//! A renderer with a light budget takes [`area_lights`]: the polygons as they are when they fit,
+//! else clustered — per material (one emission spectrum each), then by position and normal —
+//! into at most the budget's lights, each a quad with the cluster's total area, its power-weighted
+//! centre and normal, its spread's aspect, and its mean radiance, so that the emitted power
+//! (π·L·A per polygon) is kept exactly.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use crate::{Emission, Scene, srgb};
+use crate::{Emission, Scene, Texture, TextureRef, Wrap, srgb};
 
 /// One emitting polygon (3 or 4 vertices, counter-clockwise seen from the emitting side).
 #[derive(Clone, Debug)]
@@ -46,30 +53,37 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
         if mat.emissive.max_element() <= 0.0 || stood_in.contains(&mi) {
             continue;
         }
-        let mean = mat
-            .emissive_texture
-            .and_then(|t| scene.textures.get(t.index))
-            .map(|t| {
-                let n = (t.width as usize * t.height as usize).max(1);
-                let sum: Vec3 = t
-                    .rgba8
-                    .chunks_exact(4)
-                    .map(|p| {
-                        if t.srgb {
-                            srgb::srgb8_to_linear([p[0], p[1], p[2]])
-                        } else {
-                            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0
-                        }
-                    })
-                    .sum();
-                sum / n as f32
-            })
-            .unwrap_or(Vec3::ONE);
-        let rgb = mat.emissive * mean;
-        if rgb.max_element() <= 0.0 {
-            continue;
-        }
-        let emission = Emission { rgb, intensity: 1.0, spectrum: mat.emission_spectrum.clone() };
+        let texture = mat.emissive_texture.and_then(|r| scene.textures.get(r.index).map(|t| (r, t)));
+        let uvs = |r: &TextureRef| if r.tex_coord == 1 { &mesh.uvs1 } else { &mesh.uvs };
+        // The polygon's radiance: the factor × its texture's mean over the polygon.
+        let radiance = |idx: &[u32]| -> Vec3 {
+            match texture {
+                None => mat.emissive,
+                Some((r, t)) => {
+                    let uv = |i: u32| {
+                        r.transform.map_or_else(
+                            || uvs(&r).get(i as usize).copied().unwrap_or(Vec2::ZERO),
+                            |tf| tf.apply(uvs(&r).get(i as usize).copied().unwrap_or(Vec2::ZERO)),
+                        )
+                    };
+                    let p = |i: u32| mesh.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+                    // A quad's two triangles, each weighted by its area.
+                    let halves: Vec<[u32; 3]> = match idx {
+                        [a, b, c] => vec![[*a, *b, *c]],
+                        [a, b, c, d] => vec![[*a, *b, *c], [*a, *c, *d]],
+                        _ => vec![],
+                    };
+                    let (mut sum, mut area) = (Vec3::ZERO, 0.0f32);
+                    for [a, b, c] in halves {
+                        let w = (p(b) - p(a)).cross(p(c) - p(a)).length().max(1e-30);
+                        sum += w * texture_mean(t, [uv(a), uv(b), uv(c)]);
+                        area += w;
+                    }
+                    mat.emissive * (sum / area.max(1e-30))
+                }
+            }
+        };
+        let emission = |rgb: Vec3| Emission { rgb, intensity: 1.0, spectrum: mat.emission_spectrum.clone() };
         let tri = |t: &[u32]| -> Option<[Vec3; 3]> {
             let p = |i: u32| mesh.positions.get(i as usize).copied();
             Some([p(t[0])?, p(t[1])?, p(t[2])?])
@@ -82,22 +96,30 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
         let tris: Vec<&[u32]> = mesh.indices.chunks_exact(3).collect();
         if let [a, b] = tris[..]
             && let (Some(ta), Some(tb)) = (tri(a), tri(b))
-            && let Some(quad) = as_quad(a, b, &ta, &tb)
+            && let Some((quad, corners)) = as_quad(a, b, &ta, &tb)
         {
+            let rgb = radiance(&corners);
             let ng = (quad[1] - quad[0]).cross(quad[2] - quad[0]);
             let area = 0.5 * ng.length() + 0.5 * (quad[2] - quad[0]).cross(quad[3] - quad[0]).length();
+            if rgb.max_element() <= 0.0 {
+                continue;
+            }
             if let Some(n) = ng.try_normalize() {
                 let s = facing(a, n);
                 let mut vertices = quad.to_vec();
                 if s < 0.0 {
                     vertices.reverse();
                 }
-                out.push(Emitter { mesh: mi, vertices, emission: emission.clone(), normal: n * s, area });
+                out.push(Emitter { mesh: mi, vertices, emission: emission(rgb), normal: n * s, area });
                 continue;
             }
         }
         for t in tris {
             let Some(v) = tri(t) else { continue };
+            let rgb = radiance(t);
+            if rgb.max_element() <= 0.0 {
+                continue;
+            }
             let c = (v[1] - v[0]).cross(v[2] - v[0]);
             let Some(n) = c.try_normalize() else { continue };
             let s = facing(t, n);
@@ -108,7 +130,7 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
             out.push(Emitter {
                 mesh: mi,
                 vertices,
-                emission: emission.clone(),
+                emission: emission(rgb),
                 normal: n * s,
                 area: 0.5 * c.length(),
             });
@@ -119,8 +141,8 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
 }
 
 /// Two triangles sharing an edge, coplanar, forming a convex quad: its four corners in the
-/// winding of the first triangle.
-fn as_quad(a: &[u32], b: &[u32], ta: &[Vec3; 3], tb: &[Vec3; 3]) -> Option<[Vec3; 4]> {
+/// winding of the first triangle, and their vertex indices.
+fn as_quad(a: &[u32], b: &[u32], ta: &[Vec3; 3], tb: &[Vec3; 3]) -> Option<([Vec3; 4], [u32; 4])> {
     // The vertex of b not in a, and where a's shared edge is.
     let extra: Vec<usize> = (0..3).filter(|&i| !a.contains(&b[i])).collect();
     let [e] = extra[..] else { return None };
@@ -135,7 +157,243 @@ fn as_quad(a: &[u32], b: &[u32], ta: &[Vec3; 3], tb: &[Vec3; 3]) -> Option<[Vec3
     }
     // Convex: every corner turns the same way.
     let turn = |i: usize| (q[(i + 1) % 4] - q[i]).cross(q[(i + 2) % 4] - q[(i + 1) % 4]).dot(n);
-    (0..4).all(|i| turn(i) > 0.0).then_some(q)
+    let corners = [a[l], a[(l + 1) % 3], b[e], a[(l + 2) % 3]];
+    (0..4).all(|i| turn(i) > 0.0).then_some((q, corners))
+}
+
+/// The mean colour (linear) of texture `t` over the triangle with texture coordinates `uv`:
+/// nearest texels at stratified points of the triangle (their number grows with the texels it
+/// covers, 16 to 4096), wrapped as the texture's sampler says. The path tracer reads the texture
+/// at every hit; this is what a polygon of uniform radiance can carry of it.
+pub fn texture_mean(t: &Texture, uv: [Vec2; 3]) -> Vec3 {
+    let (w, h) = (t.width as usize, t.height as usize);
+    if w == 0 || h == 0 || t.rgba8.len() < 4 * w * h {
+        return Vec3::ONE;
+    }
+    let size = Vec2::new(w as f32, h as f32);
+    let texels = 0.5 * ((uv[1] - uv[0]) * size).perp_dot((uv[2] - uv[0]) * size).abs();
+    // k × k cells of the unit square, folded onto the triangle: k² samples.
+    let k = (texels.sqrt().ceil() as usize).clamp(4, 64);
+    let wrap = |i: i64, n: usize, mode: Wrap| -> usize {
+        let n = n as i64;
+        (match mode {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+        }) as usize
+    };
+    let mut sum = Vec3::ZERO;
+    for i in 0..k {
+        for j in 0..k {
+            let (mut a, mut b) = ((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
+            if a + b > 1.0 {
+                (a, b) = (1.0 - a, 1.0 - b);
+            }
+            let at = uv[0] + a * (uv[1] - uv[0]) + b * (uv[2] - uv[0]);
+            let x = wrap((at.x * size.x).clamp(-1e9, 1e9).floor() as i64, w, t.sampler.wrap_s);
+            let y = wrap((at.y * size.y).clamp(-1e9, 1e9).floor() as i64, h, t.sampler.wrap_t);
+            let o = 4 * (y * w + x);
+            let px = [t.rgba8[o], t.rgba8[o + 1], t.rgba8[o + 2]];
+            sum += if t.srgb {
+                srgb::srgb8_to_linear(px)
+            } else {
+                Vec3::new(px[0] as f32, px[1] as f32, px[2] as f32) / 255.0
+            };
+        }
+    }
+    sum / (k * k) as f32
+}
+
+/// The emissive surfaces as at most `budget` lights ([`area_lights`]).
+#[derive(Clone, Debug, Default)]
+pub struct AreaLights {
+    /// Brightest first.
+    pub lights: Vec<Emitter>,
+    /// The emitting polygons they stand for ([`emitters`]).
+    pub polygons: usize,
+    /// Whether polygons were merged into clusters.
+    pub clustered: bool,
+    /// The share of the emitted power left out (only when there are more emitting materials
+    /// than the budget).
+    pub dropped_power: f64,
+}
+
+/// Every emitting polygon of `scene` ([`emitters`]) when they are at most `budget`; else
+/// clusters of them — the budget shared by the materials in proportion to their power (at least
+/// one each; the dimmest materials are left out, and counted in `dropped_power`, only when there
+/// are more of them than the budget), each material's polygons split in two along the widest
+/// axis of their positions and normals, the cluster of most power × spread first, until its share
+/// is reached — each cluster one quad keeping its total area and power.
+pub fn area_lights(scene: &Scene, budget: usize) -> AreaLights {
+    let all = emitters(scene);
+    let polygons = all.len();
+    if polygons <= budget {
+        return AreaLights { lights: all, polygons, clustered: false, dropped_power: 0.0 };
+    }
+    let total: f64 = all.iter().map(Emitter::power).sum();
+    // Per material: one emission spectrum each.
+    let mut groups: Vec<(usize, Vec<Emitter>)> = Vec::new();
+    for e in all {
+        let m = scene.meshes[e.mesh].material;
+        match groups.iter_mut().find(|g| g.0 == m) {
+            Some(g) => g.1.push(e),
+            None => groups.push((m, vec![e])),
+        }
+    }
+    let power = |g: &[Emitter]| g.iter().map(Emitter::power).sum::<f64>();
+    groups.sort_by(|a, b| power(&b.1).total_cmp(&power(&a.1)));
+    let mut dropped = 0.0;
+    if groups.len() > budget {
+        dropped = groups[budget..].iter().map(|g| power(&g.1)).sum::<f64>();
+        groups.truncate(budget);
+    }
+    // Shares: one each, the rest by largest remainder of power, never more than a group has.
+    let kept: f64 = groups.iter().map(|g| power(&g.1)).sum();
+    let mut share: Vec<usize> = vec![1; groups.len()];
+    let spare = budget.saturating_sub(groups.len());
+    let want: Vec<f64> =
+        groups.iter().map(|g| if kept > 0.0 { spare as f64 * power(&g.1) / kept } else { 0.0 }).collect();
+    for (s, w) in share.iter_mut().zip(&want) {
+        *s += w.floor() as usize;
+    }
+    let mut order: Vec<usize> = (0..groups.len()).collect();
+    order.sort_by(|&a, &b| (want[b] - want[b].floor()).total_cmp(&(want[a] - want[a].floor())));
+    let mut left = budget.saturating_sub(share.iter().sum());
+    while left > 0 {
+        let before = left;
+        for &i in &order {
+            if left > 0 && share[i] < groups[i].1.len() {
+                share[i] += 1;
+                left -= 1;
+            }
+        }
+        if left == before {
+            break;
+        }
+    }
+    let mut lights = Vec::new();
+    for ((_, g), k) in groups.into_iter().zip(share) {
+        let k = k.min(g.len());
+        lights.extend(split(g, k).into_iter().map(merge));
+    }
+    lights.sort_by(|a, b| b.power().total_cmp(&a.power()));
+    AreaLights {
+        lights,
+        polygons,
+        clustered: true,
+        dropped_power: if total > 0.0 { dropped / total } else { 0.0 },
+    }
+}
+
+/// A polygon's place for clustering: its centroid (over `scale`, the group's size) and its
+/// normal at half weight (opposite normals are as far apart as the group is wide).
+fn feature(e: &Emitter, scale: f32) -> [f32; 6] {
+    let c = e.centroid() / scale;
+    let n = 0.5 * e.normal;
+    [c.x, c.y, c.z, n.x, n.y, n.z]
+}
+
+/// `g` in `k` clusters: the cluster of most power × extent split at its median along its widest
+/// feature axis, until there are `k` (or no cluster has two polygons).
+fn split(g: Vec<Emitter>, k: usize) -> Vec<Vec<Emitter>> {
+    let (lo, hi) = g
+        .iter()
+        .flat_map(|e| e.vertices.iter())
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    let scale = (hi - lo).length().max(1e-12);
+    type Item = ([f32; 6], f64, Emitter);
+    // The widest axis of a cluster's features, and its width.
+    let extent = |c: &[Item]| -> (usize, f32) {
+        let mut lo = [f32::INFINITY; 6];
+        let mut hi = [f32::NEG_INFINITY; 6];
+        for (f, ..) in c {
+            for a in 0..6 {
+                lo[a] = lo[a].min(f[a]);
+                hi[a] = hi[a].max(f[a]);
+            }
+        }
+        (0..6).map(|a| (a, hi[a] - lo[a])).fold((0, 0.0), |b, x| if x.1 > b.1 { x } else { b })
+    };
+    let cost = |c: &[Item]| -> f64 {
+        if c.len() < 2 {
+            -1.0
+        } else {
+            c.iter().map(|i| i.1).sum::<f64>().max(1e-30) * f64::from(extent(c).1)
+        }
+    };
+    let items: Vec<Item> = g.into_iter().map(|e| (feature(&e, scale), e.power(), e)).collect();
+    let mut clusters: Vec<(f64, Vec<Item>)> = vec![(cost(&items), items)];
+    while clusters.len() < k {
+        let Some(i) = (0..clusters.len()).max_by(|&a, &b| clusters[a].0.total_cmp(&clusters[b].0)) else {
+            break;
+        };
+        if clusters[i].1.len() < 2 {
+            break;
+        }
+        let (_, mut c) = clusters.swap_remove(i);
+        let (axis, _) = extent(&c);
+        c.sort_by(|a, b| a.0[axis].total_cmp(&b.0[axis]));
+        let rest = c.split_off(c.len() / 2);
+        clusters.push((cost(&c), c));
+        clusters.push((cost(&rest), rest));
+    }
+    clusters.into_iter().map(|(_, c)| c.into_iter().map(|i| i.2).collect()).collect()
+}
+
+/// One quad for a cluster: its total area, its radiance the area-weighted mean (the power
+/// π·L·A summed), centred at the power-weighted centroid, facing the power-weighted normal, its
+/// sides in the ratio of the cluster's spread along its principal axes (at most 8:1). A cluster of
+/// one polygon is that polygon.
+fn merge(mut c: Vec<Emitter>) -> Emitter {
+    if c.len() == 1 {
+        return c.pop().expect("one");
+    }
+    let area: f32 = c.iter().map(|e| e.area).sum();
+    let rgb = c.iter().map(|e| e.emission.rgb * e.area).sum::<Vec3>() / area.max(1e-30);
+    let weight = |e: &Emitter| (e.power() as f32).max(0.0) + 1e-30 * e.area;
+    let wsum: f32 = c.iter().map(weight).sum();
+    let centre = c.iter().map(|e| e.centroid() * weight(e)).sum::<Vec3>() / wsum;
+    let brightest = c.iter().max_by(|a, b| a.power().total_cmp(&b.power())).expect("two or more");
+    let normal =
+        c.iter().map(|e| e.normal * weight(e)).sum::<Vec3>().try_normalize().unwrap_or(brightest.normal);
+    // The spread in the quad's plane: second moments of the polygons' vertices.
+    let t1 = normal.any_orthonormal_vector();
+    let t2 = normal.cross(t1);
+    let (mut sxx, mut sxy, mut syy, mut wt) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+    for e in &c {
+        let w = e.area / e.vertices.len() as f32;
+        for v in &e.vertices {
+            let d = *v - centre;
+            let (x, y) = (d.dot(t1), d.dot(t2));
+            sxx += w * x * x;
+            sxy += w * x * y;
+            syy += w * y * y;
+            wt += w;
+        }
+    }
+    let (sxx, sxy, syy) = (sxx / wt.max(1e-30), sxy / wt.max(1e-30), syy / wt.max(1e-30));
+    let half_tr = 0.5 * (sxx + syy);
+    let root = (0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy).sqrt();
+    let (l1, l2) = (half_tr + root, (half_tr - root).max(0.0));
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let u = (t1 * angle.cos() + t2 * angle.sin()).normalize();
+    let v = normal.cross(u);
+    let aspect = if l2 > 0.0 { (l1 / l2).sqrt().clamp(1.0, 8.0) } else { 8.0 };
+    let a = (area * aspect).sqrt();
+    let b = area / a;
+    let corner = |su: f32, sv: f32| centre + u * (0.5 * a * su) + v * (0.5 * b * sv);
+    Emitter {
+        mesh: brightest.mesh,
+        vertices: vec![corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)],
+        emission: Emission { rgb, intensity: 1.0, spectrum: brightest.emission.spectrum.clone() },
+        normal,
+        area,
+    }
 }
 
 #[cfg(test)]
@@ -185,6 +443,104 @@ mod tests {
         assert!(n.dot(Vec3::NEG_Y) > 0.0, "winding follows the emitting side");
         let up = emitters(&scene_with(quad_mesh(true), Vec3::splat(2.0)));
         assert!((up[0].normal - Vec3::Y).length() < 1e-6);
+    }
+
+    /// A glowing sphere of 2 400 triangles in 8 lights: every bit of its area and power kept,
+    /// each light a quad facing its normal (counter-clockwise seen from it), spread over the
+    /// sphere (the lights' normals cover both hemispheres).
+    #[test]
+    fn many_triangles_cluster_into_the_budget_keeping_area_and_power() {
+        let mesh = crate::builtin::shapes::sphere(Vec3::new(0.0, 1.0, 0.0), 0.5, 30, 40, 0);
+        let scene = scene_with(mesh, Vec3::new(3.0, 2.0, 1.0));
+        let polys = emitters(&scene);
+        assert_eq!(polys.len(), 30 * 40 * 2 - 2 * 40);
+        let (area, power): (f32, f64) =
+            (polys.iter().map(|e| e.area).sum(), polys.iter().map(|e| e.power()).sum());
+        let lights = area_lights(&scene, 8);
+        assert!(lights.clustered && lights.lights.len() == 8 && lights.polygons == polys.len());
+        assert_eq!(lights.dropped_power, 0.0);
+        let a2: f32 = lights.lights.iter().map(|e| e.area).sum();
+        let p2: f64 = lights.lights.iter().map(|e| e.power()).sum();
+        assert!(
+            (a2 / area - 1.0).abs() < 1e-5 && (p2 / power - 1.0).abs() < 1e-5,
+            "{a2}/{area} {p2}/{power}"
+        );
+        for l in &lights.lights {
+            assert_eq!(l.vertices.len(), 4);
+            let v = &l.vertices;
+            let n = (v[1] - v[0]).cross(v[2] - v[0]);
+            assert!(n.dot(l.normal) > 0.0 && (l.normal.length() - 1.0).abs() < 1e-5);
+            assert!((0.5 * n.length() * 2.0 / l.area - 1.0).abs() < 1e-4, "a quad of the cluster's area");
+            assert!(
+                (l.centroid() - Vec3::new(0.0, 1.0, 0.0)).length() < 0.5 + 1e-3,
+                "inside the sphere's bounds"
+            );
+        }
+        assert!(
+            lights.lights.iter().any(|l| l.normal.y > 0.3) && lights.lights.iter().any(|l| l.normal.y < -0.3)
+        );
+        // Within the budget nothing is merged.
+        let all = area_lights(&scene, polys.len());
+        assert!(!all.clustered && all.lights.len() == polys.len());
+    }
+
+    /// The budget shared by material power: with more materials than lights the dimmest are
+    /// left out and their share of the power reported.
+    #[test]
+    fn the_budget_is_shared_by_material_and_the_left_out_power_is_counted() {
+        let mut scene =
+            scene_with(crate::builtin::shapes::sphere(Vec3::ZERO, 0.5, 8, 8, 0), Vec3::splat(4.0));
+        for (k, e) in [(1usize, 1.0f32), (2, 0.5)] {
+            scene.materials.push(Material {
+                emissive: Vec3::splat(e),
+                base_color: Vec4::ONE,
+                ..Default::default()
+            });
+            scene.meshes.push(crate::builtin::shapes::sphere(Vec3::X * 2.0 * k as f32, 0.5, 8, 8, k));
+        }
+        let total: f64 = emitters(&scene).iter().map(|e| e.power()).sum();
+        let l = area_lights(&scene, 6);
+        assert_eq!(l.lights.len(), 6);
+        assert_eq!(l.dropped_power, 0.0);
+        let kept: f64 = l.lights.iter().map(|e| e.power()).sum();
+        assert!((kept / total - 1.0).abs() < 1e-5);
+        // The brightest material gets most of the lights.
+        let per = |m: usize| l.lights.iter().filter(|e| scene.meshes[e.mesh].material == m).count();
+        assert!(per(0) >= per(1) && per(1) >= per(2) && per(2) >= 1, "{} {} {}", per(0), per(1), per(2));
+        let two = area_lights(&scene, 2);
+        assert_eq!(two.lights.len(), 2);
+        let dim: f64 =
+            emitters(&scene).iter().filter(|e| scene.meshes[e.mesh].material == 2).map(|e| e.power()).sum();
+        assert!((two.dropped_power - dim / total).abs() < 1e-9, "{}", two.dropped_power);
+    }
+
+    /// A textured emitter's polygons carry their own part of the texture: a quad mapped to the
+    /// black half of a black-and-white image emits nothing and is left out.
+    #[test]
+    fn each_polygon_takes_its_own_part_of_the_emissive_texture() {
+        let t = Texture {
+            name: "bw".into(),
+            width: 2,
+            height: 1,
+            rgba8: vec![0, 0, 0, 255, 255, 255, 255, 255],
+            srgb: true,
+            sampler: Default::default(),
+        };
+        let tri = |u0: f32, u1: f32| [Vec2::new(u0, 0.0), Vec2::new(u1, 0.0), Vec2::new(u0, 1.0)];
+        assert_eq!(texture_mean(&t, tri(0.0, 0.5)), Vec3::ZERO);
+        assert_eq!(texture_mean(&t, tri(0.5, 1.0)), Vec3::ONE);
+        let whole = texture_mean(&t, [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)]);
+        assert!(whole.x > 0.2 && whole.x < 0.8, "{whole}");
+        let mut m = quad_mesh(false);
+        m.uvs = vec![Vec2::new(0.0, 0.0), Vec2::new(0.5, 0.0), Vec2::new(0.5, 1.0), Vec2::new(0.0, 1.0)];
+        let mut scene = scene_with(m, Vec3::ONE);
+        scene.textures.push(t);
+        scene.materials[0].emissive_texture = Some(TextureRef::new(0));
+        assert!(emitters(&scene).is_empty());
+        let mut m = quad_mesh(false);
+        m.uvs = vec![Vec2::new(0.5, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.5, 1.0)];
+        scene.meshes[0] = m;
+        assert_eq!(emitters(&scene)[0].emission.rgb, Vec3::ONE);
     }
 
     #[test]

@@ -187,10 +187,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (None, _) => under,
     };
     let under = match r.emitter_summary() {
-        Some((n, 0, _)) if n > 0 => format!("{under}, {n} emissive polygon light(s)"),
-        Some((n, dropped, frac)) if dropped > 0 => format!(
-            "{under}, {n} emissive polygon lights (warning: {dropped} more left out, {:.1} % of the emitted power)",
+        Some((n, polygons, _)) if n > 0 && n == polygons => format!("{under}, {n} emissive polygon light(s)"),
+        Some((n, polygons, frac)) if n > 0 && frac > 0.0 => format!(
+            "{under}, {n} emissive area lights for {polygons} emitting polygons (warning: {:.1} % of the emitted \
+             power left out: more emitting materials than lights)",
             100.0 * frac
+        ),
+        Some((n, polygons, _)) if n > 0 => format!(
+            "{under}, {n} emissive area lights: {polygons} emitting polygons clustered, all of their power \
+             (their shape approximated)"
         ),
         _ => under,
     };
