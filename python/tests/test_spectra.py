@@ -510,3 +510,24 @@ def test_camspec_tool_writes_files_observer_reads(tmp_path):
         tool.parse("Cam\n" + "\t".join(["0.1"] * 33) + "\n0.1 0.2\n")
     with pytest.raises(ValueError, match="'Cam' has 1 rows"):
         tool.parse("Cam\n" + "\t".join(["0.1"] * 33) + "\nOther\n")
+
+
+def test_a_camera_balanced_and_through_its_fit_equals_the_cli(tmp_path, cornell, renderer):
+    """`observer=` a database camera, with and without `camera_to_display`, in both renderers:
+    the images `spectra render` / `spectra truth` write with the same flags, and the two views
+    differ (the flag is not ignored)."""
+    exe = spectra_bin()
+    env = {**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))}
+    views = {}
+    for flag in (False, True):
+        extra = ["--camera-to-display"] if flag else []
+        out, tout = tmp_path / f"r{flag}.exr", tmp_path / f"t{flag}.exr"
+        common = ["cornell", "--size", f"{W}x{H}", "--observer", "canon_eos_r5"] + extra
+        subprocess.run([exe, "render", *common, "--out", str(out)], check=True, env=env)
+        subprocess.run([exe, "truth", *common, "--spp", "4", "--out", str(tout)], check=True, env=env)
+        py = renderer.render(observer="canon_eos_r5", camera_to_display=flag)
+        assert np.array_equal(read_exr(out).view(np.uint32), py.view(np.uint32))
+        t = spectra.truth(cornell, spp=4, size=(W, H), observer="canon_eos_r5", camera_to_display=flag)
+        assert np.array_equal(read_exr(tout).view(np.uint32), t.view(np.uint32))
+        views[flag] = py
+    assert np.abs(views[True] - views[False]).max() > 1e-3
