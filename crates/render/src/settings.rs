@@ -248,8 +248,12 @@ impl RenderSettings {
         {
             return Err(RenderError::Settings(format!("the wavelength jitter must be in [0, 1) (got {u})")));
         }
-        color::Observer::by_name(&self.observer)?;
-        color::illuminant::by_name(&self.white)?;
+        let observer = color::Observer::by_name(&self.observer)?;
+        let white = color::illuminant::by_name(&self.white)?;
+        if self.camera_view == color::film::CameraView::Display {
+            // A dichromat's repeated receptor cannot be fitted to XYZ: refused here, not mid-frame.
+            color::film::to_linear_srgb(&observer, observer.white_balance(&white), &white, self.camera_view)?;
+        }
         Ok(())
     }
 }
@@ -257,6 +261,17 @@ impl RenderSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_camera_view_the_chart_cannot_fit_is_refused() {
+        let display = color::film::CameraView::Display;
+        let s = RenderSettings { observer: "dog".into(), camera_view: display, ..Default::default() };
+        assert!(s.validate().unwrap_err().to_string().contains("dog"));
+        assert!(RenderSettings { observer: "dog".into(), ..Default::default() }.validate().is_ok());
+        let s =
+            RenderSettings { observer: "canon_eos_r5".into(), camera_view: display, ..Default::default() };
+        assert!(s.validate().is_ok());
+    }
 
     #[test]
     fn parse_and_validate() {

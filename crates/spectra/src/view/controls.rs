@@ -154,11 +154,20 @@ impl Controls {
             w.range.min = lo;
             w.range.max = hi;
         }
+        // Every observer and camera of the database (the O key cycles the built-in set).
         egui::ComboBox::from_label("observer").selected_text(w.observer.clone()).show_ui(ui, |ui| {
-            for name in color::Observer::NAMES {
-                ui.selectable_value(&mut w.observer, name.to_string(), *name);
+            for name in color::Observer::names() {
+                ui.selectable_value(&mut w.observer, name.to_string(), name);
             }
         });
+        let mut to_display = w.camera_view == color::film::CameraView::Display;
+        if ui
+            .checkbox(&mut to_display, "camera to display")
+            .on_hover_text("a camera through its ColorChecker fit to XYZ and sRGB, not its balanced channels")
+            .changed()
+        {
+            w.camera_view = color::film::CameraView::from_flag(to_display);
+        }
         ui.add(egui::Slider::new(&mut w.exposure_ev, -8.0..=8.0).step_by(0.25).text("exposure EV"));
         ui.horizontal(|ui| {
             ui.label("tone map");
