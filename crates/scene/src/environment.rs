@@ -350,6 +350,117 @@ impl Environment {
     }
 }
 
+/// Angular radius (degrees) around the brightest texel within which a sun is looked for.
+pub const SUN_MAX_RADIUS_DEG: f32 = 6.0;
+/// A texel belongs to the sun when its luminance is at least this fraction of the brightest's.
+pub const SUN_THRESHOLD: f32 = 0.02;
+/// A map has a sun when that region gives at least this share of the map's ∫ Y dω.
+pub const SUN_MIN_SHARE: f32 = 0.15;
+/// ... and when it is at most this solid angle (sr; a disc of 1.45° radius): a wider bright
+/// region (a studio's soft box) is an area light, not a sun, and is left in the map.
+pub const SUN_MAX_SOLID_ANGLE: f32 = 0.002;
+
+/// The compact bright region of an environment map that a renderer without shadowed environment
+/// light should light with as a shadowed directional light, its energy taken out of the map
+/// ([`Environment::sun`], [`Environment::without_sun`]; issue 34 item 1 — the real-time renderer
+/// does not use it yet; the path tracer samples the full map and never will).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sun {
+    /// Unit direction towards the sun (rotation applied): the power-weighted mean of its texels'.
+    pub direction: Vec3,
+    /// ∫ L dω over the region, linear RGB, intensity not applied: the irradiance it gives a face
+    /// turned to it (the region is small: cos ≈ 1 over it).
+    pub irradiance: Vec3,
+    /// Its solid angle, sr.
+    pub solid_angle: f32,
+    /// Its share of the map's ∫ Y dω.
+    pub share: f32,
+    /// Its texels (indices into `texels`).
+    pub texels: Vec<usize>,
+}
+
+impl Environment {
+    /// The map's sun, if it has one: the texels within [`SUN_MAX_RADIUS_DEG`] of the brightest
+    /// (by luminance) whose luminance is at least [`SUN_THRESHOLD`] of its, when they give at least
+    /// [`SUN_MIN_SHARE`] of the map's ∫ Y dω within at most [`SUN_MAX_SOLID_ANGLE`]. A uniform or
+    /// overcast sky has none; neither has a studio's soft box (wider) or a sun so low that the sky
+    /// outshines it.
+    pub fn sun(&self) -> Option<Sun> {
+        let y = |t: Vec3| 0.2126 * t.x + 0.7152 * t.y + 0.0722 * t.z;
+        let (peak, peak_y) =
+            self.texels.iter().enumerate().map(|(i, t)| (i, y(*t))).max_by(|a, b| a.1.total_cmp(&b.1))?;
+        if peak_y <= 0.0 {
+            return None;
+        }
+        let centre = |i: usize| {
+            let (x, yy) = (i as u32 % self.width, i as u32 / self.width);
+            self.direction(Vec2::new(
+                (x as f32 + 0.5) / self.width as f32,
+                (yy as f32 + 0.5) / self.height as f32,
+            ))
+        };
+        let axis = centre(peak);
+        let cos_max = SUN_MAX_RADIUS_DEG.to_radians().cos();
+        let (mut total, mut power, mut irradiance, mut omega, mut dir) =
+            (0.0f64, 0.0f64, Vec3::ZERO, 0.0f32, Vec3::ZERO);
+        let mut texels = Vec::new();
+        for row in 0..self.height {
+            let w = self.row_solid_angle(row);
+            for x in 0..self.width {
+                let i = (row * self.width + x) as usize;
+                let t = self.texels[i];
+                let ly = y(t);
+                total += f64::from(ly * w);
+                if ly >= SUN_THRESHOLD * peak_y && centre(i).dot(axis) >= cos_max {
+                    power += f64::from(ly * w);
+                    irradiance += t * w;
+                    omega += w;
+                    dir += centre(i) * ly * w;
+                    texels.push(i);
+                }
+            }
+        }
+        let share = (power / total.max(1e-30)) as f32;
+        (share >= SUN_MIN_SHARE && omega <= SUN_MAX_SOLID_ANGLE).then(|| Sun {
+            direction: dir.try_normalize().unwrap_or(axis),
+            irradiance,
+            solid_angle: omega,
+            share,
+            texels,
+        })
+    }
+
+    /// This map with `sun`'s texels replaced by the mean of the texels around it (a ring as wide
+    /// again), so that a renderer lighting with the sun as a light and the rest as the map counts
+    /// its energy once.
+    pub fn without_sun(&self, sun: &Sun) -> Environment {
+        let inside: std::collections::HashSet<usize> = sun.texels.iter().copied().collect();
+        let r = sun.solid_angle.max(1e-8).sqrt() * 2.0;
+        let cos_ring = r.min(std::f32::consts::PI).cos();
+        let (mut sum, mut wsum) = (Vec3::ZERO, 0.0f32);
+        for row in 0..self.height {
+            let w = self.row_solid_angle(row);
+            for x in 0..self.width {
+                let i = (row * self.width + x) as usize;
+                let d = self.direction(Vec2::new(
+                    (x as f32 + 0.5) / self.width as f32,
+                    (row as f32 + 0.5) / self.height as f32,
+                ));
+                if !inside.contains(&i) && d.dot(sun.direction) >= cos_ring {
+                    sum += self.texels[i] * w;
+                    wsum += w;
+                }
+            }
+        }
+        let fill = if wsum > 0.0 { sum / wsum } else { Vec3::ZERO };
+        let mut out = self.clone();
+        for &i in &sun.texels {
+            out.texels[i] = fill;
+        }
+        out
+    }
+}
+
 /// Mean irradiance (in the units where the default sky gives π on an upward face) below which
 /// emissive surfaces are glow, not lighting: 1 % of the default sky's.
 pub const EMISSIVE_LIGHTING_THRESHOLD: f64 = 0.01 * std::f64::consts::PI;
@@ -768,5 +879,38 @@ mod tests {
         assert!(Environment::load(&bad_exr).unwrap_err().to_string().contains("corrupt.exr"));
         assert!(Environment::load(&dir).unwrap_err().to_string().contains("a directory"));
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// The shipped HDRs: rooitou_park's low sun (4 texels, 0.0006 sr, 65 % of ∫ Y dω) is one;
+    /// venice_sunset's sun at the horizon gives 2.4 % (the sky outshines it) and studio_small_03's
+    /// brightest soft box is 0.0185 sr wide: neither; nor the default sky. The sun's energy goes
+    /// to its light and out of the map.
+    #[test]
+    fn the_sun_of_a_map() {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/environments/");
+        for (file, has) in
+            [("rooitou_park.hdr", true), ("venice_sunset.hdr", false), ("studio_small_03.hdr", false)]
+        {
+            let e = Environment::load(&std::path::PathBuf::from(root).join(file)).unwrap();
+            let sun = e.sun();
+            eprintln!(
+                "{file}: {:?}",
+                sun.as_ref().map(|s| (s.direction, s.irradiance, s.solid_angle, s.share, s.texels.len()))
+            );
+            assert_eq!(sun.is_some(), has, "{file}");
+            if let Some(s) = sun {
+                let rest = e.without_sun(&s);
+                let y = |v: Vec3| 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z;
+                let (before, after) = (y(e.integral()), y(rest.integral()));
+                let sun_y = y(s.irradiance);
+                assert!(
+                    after < before && (after + sun_y) > before * 0.98,
+                    "{file}: {before} → {after} + {sun_y}"
+                );
+                assert!(rest.sun().is_none_or(|t| t.share < s.share), "{file}: the sun is gone");
+            }
+        }
+        assert!(Environment::default_sky().sun().is_none());
+        assert!(Environment::uniform(Vec3::ONE).sun().is_none());
     }
 }
