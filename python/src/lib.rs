@@ -226,7 +226,12 @@ fn load(
         let args = setup::SceneArgs {
             scene: name.clone(),
             files: setup::SceneFileArgs { allow_outside_scene_dir },
-            env: setup::EnvArgs { env: h.env, env_intensity: h.env_intensity, env_rotation: h.env_rotation },
+            env: setup::EnvArgs {
+                env: h.env,
+                env_intensity: h.env_intensity,
+                env_rotation: h.env_rotation,
+                ..Default::default()
+            },
         };
         args.load().map_err(|e| {
             // The loader's message names the missing file; its type says so too.

@@ -41,6 +41,32 @@ pub fn projection(camera: &scene::Camera, aspect: f32) -> Mat4 {
     }
 }
 
+/// The environment's sun as the renderer lights with it: its place in the scene's lights, and
+/// what it was found as (direction at `rotation`, irradiance before the map's intensity).
+#[derive(Clone, Debug)]
+struct SunState {
+    index: usize,
+    direction: glam::Vec3,
+    rotation: f32,
+    irradiance: glam::Vec3,
+}
+
+impl SunState {
+    /// The directional light for the map at `intensity` and `rotation` (radians about +Y, the
+    /// map's convention: a turn by Δ takes (x, z) to (x cos Δ − z sin Δ, z cos Δ + x sin Δ)).
+    fn light(&self, intensity: f32, rotation: f32) -> scene::Light {
+        let (s, c) = (rotation - self.rotation).sin_cos();
+        let d = self.direction;
+        let towards = glam::Vec3::new(d.x * c - d.z * s, d.y, d.z * c + d.x * s);
+        scene::Light {
+            name: "the environment's sun".into(),
+            kind: scene::LightKind::Directional { direction: -towards },
+            emission: scene::Emission { rgb: self.irradiance * intensity, intensity: 1.0, spectrum: None },
+            stands_in_for: None,
+        }
+    }
+}
+
 /// What the per-wavelength buffers were built for; a change triggers a re-upload.
 #[derive(Clone, Debug, PartialEq)]
 struct SpectralKey {
@@ -151,6 +177,8 @@ pub struct Renderer {
     scene: Option<GpuScene>,
     scene_generation: u64,
     environment: GpuEnvironment,
+    /// The environment's sun, lit with as a directional light ([`Self::set_environment`]).
+    sun: Option<SunState>,
     env_buffer: wgpu::Buffer,
     spectral: Option<SpectralState>,
     targets: Option<(Targets, TargetBindings)>,
@@ -233,6 +261,7 @@ impl Renderer {
             scene: None,
             scene_generation: 0,
             environment,
+            sun: None,
             env_buffer,
             spectral: None,
             targets: None,
@@ -283,18 +312,58 @@ impl Renderer {
     }
 
     /// Replaces the environment light (prefilters it: tens of milliseconds for a 512-wide map,
-    /// more the first time it is shown in spectral mode). `None`: no environment.
+    /// more the first time it is shown in spectral mode). `None`: no environment. A map with a
+    /// sun (`scene::Environment::sun`, unless `sun_light` is off) is lit with as the sun — a
+    /// directional light after the scene's own, with a shadow map — and the map without it
+    /// (`without_sun`), so that its energy counts once; the environment is not shadowed here,
+    /// and the sun is most of what a shadow would hide.
     pub fn set_environment(&mut self, env: Option<&scene::Environment>) {
-        self.environment = GpuEnvironment::new(&self.gpu.device, &self.gpu.queue, env);
+        if let (Some(old), Some(gs)) = (self.sun.take(), self.scene.as_mut()) {
+            gs.lights.remove(old.index);
+        }
+        let sun = env.filter(|e| e.sun_light).and_then(|e| e.sun().map(|s| (e, s)));
+        let rest = match (sun, self.scene.as_mut()) {
+            (Some((e, s)), Some(gs))
+                if gs.lights.len() + gs.emitters.len() < crate::scene_gpu::MAX_LIGHTS =>
+            {
+                let state = SunState {
+                    index: gs.lights.len(),
+                    direction: s.direction,
+                    rotation: e.rotation,
+                    irradiance: s.irradiance,
+                };
+                gs.lights.push(state.light(e.intensity, e.rotation));
+                self.sun = Some(state);
+                Some(e.without_sun(&s))
+            }
+            _ => None,
+        };
+        self.environment = GpuEnvironment::new(&self.gpu.device, &self.gpu.queue, rest.as_ref().or(env));
         self.scene_generation += 1;
     }
 
+    /// The environment's sun as the directional light it is lit with: (direction towards it,
+    /// irradiance as linear RGB, intensity applied), or `None`.
+    pub fn environment_sun(&self) -> Option<(glam::Vec3, glam::Vec3)> {
+        let s = self.sun.as_ref()?;
+        let l = &self.scene.as_ref()?.lights[s.index];
+        match l.kind {
+            scene::LightKind::Directional { direction } => Some((-direction, l.emission.rgb)),
+            _ => None,
+        }
+    }
+
     /// Changes the environment's intensity and rotation (radians about +Y) without
-    /// prefiltering again. Ignored when there is no environment.
+    /// prefiltering again (its sun's light follows). Ignored when there is no environment.
     pub fn set_environment_transform(&mut self, intensity: f32, rotation: f32) {
         if let Some(e) = self.environment.source.as_mut() {
             e.intensity = intensity;
             e.rotation = rotation;
+        }
+        if let (Some(s), Some(gs)) = (self.sun.as_ref(), self.scene.as_mut()) {
+            gs.lights[s.index] = s.light(intensity, rotation);
+            // The lights and the sun's shadow map are rebuilt for the new direction.
+            self.scene_generation += 1;
         }
     }
 

@@ -552,7 +552,9 @@ impl GpuScene {
         if chunks.is_empty() {
             return Err(bad("the scene has no geometry".into()));
         }
-        let area = scene::emitters::area_lights(s, MAX_LIGHTS.saturating_sub(s.lights.len()));
+        // One light kept for an environment's sun (`Renderer::set_environment`).
+        let reserved = s.lights.len() + usize::from(s.environment.is_some());
+        let area = scene::emitters::area_lights(s, MAX_LIGHTS.saturating_sub(reserved));
         let emitter_polygons = (area.polygons, area.dropped_power);
         let emitters = area.lights;
         let mut warnings = Vec::new();

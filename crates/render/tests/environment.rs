@@ -282,3 +282,52 @@ fn the_spectral_basis_reproduces_the_shipped_environments() {
         assert!(mean < 0.3 && p99 < 1.5, "{}: mean {mean:.3}, p99 {p99:.3}", f.display());
     }
 }
+
+/// A sky of 1 with a 2×2-texel sun 45° up: the renderer lights with the sun as a directional
+/// light (its direction and ∫L dω) and the rest of the map, so a white sphere's point facing the
+/// sun gets what the whole map gives it (energy counted once); the light turns with the map and
+/// is gone with `sun_light` off.
+#[test]
+fn an_environment_sun_becomes_a_directional_light_and_keeps_the_energy() {
+    let (w, h) = (256u32, 128u32);
+    let mut texels = vec![Vec3::ONE; (w * h) as usize];
+    // Rows 31–32 of 128 sit 45° above the horizon; columns 128–129 face −Z (the camera looks at it).
+    for (x, y) in [(128, 31), (129, 31), (128, 32), (129, 32)] {
+        texels[(y * w + x) as usize] = Vec3::splat(2.0e4);
+    }
+    let env = Environment::from_rgb("sun", w, h, texels).unwrap();
+    let sun = env.sun().expect("a sun");
+    let mut scene = sphere_scene(env.clone());
+    scene.camera = Camera::look_at(Vec3::new(0.0, 2.0, -3.0), Vec3::ZERO, Vec3::Y, 0.6);
+    let mut r = renderer();
+    r.set_scene(&scene).unwrap();
+    let (towards, e) = r.environment_sun().expect("lit with as a light");
+    assert!((towards - sun.direction).length() < 1e-5 && towards.y > 0.68 && towards.z < -0.68, "{towards}");
+    assert!((e - sun.irradiance).abs().max_element() < 1e-3 * e.x, "{e} vs {}", sun.irradiance);
+    // The sphere's point facing the sun, as seen from the camera.
+    r.resize(SIZE, SIZE).unwrap();
+    let s = RenderSettings { shadows: true, ..settings(Mode::Rgb, 16) };
+    let look = |r: &mut render::Renderer| {
+        r.render(&scene.camera, &s).unwrap();
+        let img = r.read_hdr().unwrap();
+        // The brightest pixel of the sphere: where it faces the sun.
+        img.iter().map(|p| p[1]).fold(0.0f32, f32::max)
+    };
+    let with_sun = look(&mut r);
+    let mut whole = scene.clone();
+    whole.environment.as_mut().unwrap().sun_light = false;
+    let mut r2 = renderer();
+    r2.set_scene(&whole).unwrap();
+    assert!(r2.environment_sun().is_none());
+    r2.resize(SIZE, SIZE).unwrap();
+    let without = look(&mut r2);
+    assert!(
+        (with_sun / without - 1.0).abs() < 0.05,
+        "facing the sun: {with_sun} as a light, {without} in the map"
+    );
+    // A quarter turn of the map turns the light with it: (x, z) → (x cos − z sin, z cos + x sin).
+    r.set_environment_transform(1.0, std::f32::consts::FRAC_PI_2);
+    let (turned, _) = r.environment_sun().unwrap();
+    let want = Vec3::new(-towards.z, towards.y, towards.x);
+    assert!((turned - want).length() < 1e-4, "{turned} vs {want}");
+}

@@ -82,6 +82,10 @@ pub struct Environment {
     /// Rotation about +Y, radians (positive turns the image towards +X... counter-clockwise seen
     /// from above).
     pub rotation: f32,
+    /// Whether a renderer that cannot shadow environment light lights with the map's sun
+    /// ([`Environment::sun`]) as a shadowed directional light, the rest as the map (default;
+    /// `--no-env-sun`: false). The path tracer samples the whole map either way.
+    pub sun_light: bool,
 }
 
 impl Environment {
@@ -124,8 +128,15 @@ impl Environment {
                 texels[i]
             )));
         }
-        let env =
-            Environment { source: source.to_string(), width, height, texels, intensity: 1.0, rotation: 0.0 };
+        let env = Environment {
+            source: source.to_string(),
+            width,
+            height,
+            texels,
+            intensity: 1.0,
+            rotation: 0.0,
+            sun_light: true,
+        };
         Ok(env.reduced(WORKING_WIDTH))
     }
 
@@ -226,6 +237,7 @@ impl Environment {
             texels: vec![rgb; 32],
             intensity: 1.0,
             rotation: 0.0,
+            sun_light: true,
         }
     }
 
@@ -241,7 +253,15 @@ impl Environment {
                 std::iter::repeat_n(Vec3::splat(v), w as usize)
             })
             .collect();
-        Environment { source: "default".into(), width: w, height: h, texels, intensity: 1.0, rotation: 0.0 }
+        Environment {
+            source: "default".into(),
+            width: w,
+            height: h,
+            texels,
+            intensity: 1.0,
+            rotation: 0.0,
+            sun_light: true,
+        }
     }
 
     pub fn with_intensity(mut self, k: f32) -> Result<Self, EnvironmentError> {
@@ -526,6 +546,8 @@ pub struct EnvironmentChoice {
     pub intensity: Option<f32>,
     /// Degrees about +Y.
     pub rotation: Option<f32>,
+    /// `--no-env-sun`: renderers light with the whole map, the sun included, unshadowed.
+    pub no_sun: bool,
 }
 
 impl EnvironmentChoice {
@@ -567,6 +589,9 @@ impl EnvironmentChoice {
                 None => env,
             };
             scene.environment = Some(env);
+        }
+        if let Some(env) = scene.environment.as_mut() {
+            env.sun_light = !self.no_sun;
         }
         if !LightSources::of(scene).any() {
             note = Some(format!(
@@ -700,8 +725,15 @@ mod tests {
     fn reduction_keeps_the_integral() {
         let (w, h) = (WORKING_WIDTH * 3, WORKING_WIDTH * 3 / 2);
         let texels = (0..w * h).map(|i| Vec3::splat(((i as u64 * 7919) % 13) as f32)).collect();
-        let big =
-            Environment { source: "t".into(), width: w, height: h, texels, intensity: 1.0, rotation: 0.0 };
+        let big = Environment {
+            source: "t".into(),
+            width: w,
+            height: h,
+            texels,
+            intensity: 1.0,
+            rotation: 0.0,
+            sun_light: true,
+        };
         let want = big.integral();
         let small = big.reduced(WORKING_WIDTH);
         assert!(small.width <= WORKING_WIDTH);
@@ -746,8 +778,12 @@ mod tests {
         let mut kept = lit.clone();
         assert!(EnvironmentChoice::default().apply(&mut kept).unwrap().is_none());
         assert!(kept.environment.is_none());
-        let turned =
-            EnvironmentChoice { env: Some("default".into()), intensity: Some(2.0), rotation: Some(90.0) };
+        let turned = EnvironmentChoice {
+            env: Some("default".into()),
+            intensity: Some(2.0),
+            rotation: Some(90.0),
+            no_sun: false,
+        };
         let mut t = lit.clone();
         turned.apply(&mut t).unwrap();
         let e = t.environment.unwrap();
@@ -779,7 +815,12 @@ mod tests {
             m.emissive_texture = Some(crate::TextureRef::new(t));
         });
         assert!(!LightSources::of(&textured).emitters_light());
-        let orphan = EnvironmentChoice { env: Some("none".into()), intensity: Some(2.0), rotation: None };
+        let orphan = EnvironmentChoice {
+            env: Some("none".into()),
+            intensity: Some(2.0),
+            rotation: None,
+            no_sun: false,
+        };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
     }
 

@@ -127,6 +127,55 @@ fn a_glowing_sphere_of_many_triangles_lights_the_box_as_in_truth() {
     }
 }
 
+/// Spheres on a ColorChecker floor (the built-in glass scene made opaque, its spot light off)
+/// under rooitou_park, whose low sun gives 65 % of its light: real time lights with the sun as a
+/// shadowed directional light and the rest of the map (issue 34 item 1), so the spheres' shadows
+/// fall where the path tracer's do. Against `--no-env-sun` (the whole map, unshadowed) and the
+/// truth (direct lighting).
+#[test]
+fn an_hdr_sun_casts_shadows_in_real_time_as_in_truth() {
+    let d = dir("sun");
+    let mut s = scene::builtin("glass").unwrap();
+    s.lights.clear();
+    for m in &mut s.materials {
+        m.transmission = None;
+    }
+    let file = d.join("spheres.gltf");
+    scene::write_gltf(&s, &file).unwrap();
+    let f = file.display().to_string();
+    let hdr = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/environments/rooitou_park.hdr");
+    let truth = p(&d, "truth.exr");
+    spectra(&[
+        "truth",
+        &f,
+        "--env",
+        hdr,
+        "--direct-only",
+        "--spp",
+        "256",
+        "--size",
+        "96x72",
+        "--out",
+        &truth,
+    ]);
+    let mut de = Vec::new();
+    for extra in [&[][..], &["--no-env-sun"][..]] {
+        let rt = p(&d, &format!("rt{}.exr", extra.len()));
+        let mut a = vec!["render", &f, "--env", hdr, "--size", "96x72", "--out", &rt];
+        a.extend(extra);
+        spectra(&a);
+        de.push(block_de(&truth, &rt));
+    }
+    eprintln!(
+        "spheres under rooitou_park, spectral vs truth (direct): block-mean ΔE2000 {:.3} with the sun as a light, {:.3} without",
+        de[0], de[1]
+    );
+    assert!(de[0] < de[1], "the sun as a light did not bring real time closer: {de:?}");
+    if std::env::var_os("SPECTRA_KEEP").is_none() {
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}
+
 /// The ColorChecker without its light: the default environment lights it (with a note), and an
 /// HDR environment too; the real-time renderer (rgb and spectral) agrees with the path tracer's
 /// direct lighting. A flat chart sees the whole sky, so the real-time renderer's missing

@@ -454,6 +454,7 @@ mod tests {
             texels: vec![Vec3::splat(1e38); 8],
             intensity: 1e6,
             rotation: 0.0,
+            sun_light: true,
         };
         assert!(EnvMap::new(&huge, &units(), &GreyOnly).err().unwrap().to_string().contains("huge"));
     }

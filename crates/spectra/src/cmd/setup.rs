@@ -614,6 +614,11 @@ pub struct EnvArgs {
     /// Turns the environment about +Y, degrees.
     #[arg(long, value_name = "DEGREES", allow_negative_numbers = true)]
     pub env_rotation: Option<f32>,
+    /// Real time: light with the whole map, its sun unshadowed, instead of the sun (a compact
+    /// region of ≥ 15 % of the map's light, docs/environment.md) as a shadowed directional light
+    /// and the rest as the map. The path tracer samples the whole map either way.
+    #[arg(long)]
+    pub no_env_sun: bool,
 }
 
 impl EnvArgs {
@@ -624,6 +629,7 @@ impl EnvArgs {
             env: self.env.clone(),
             intensity: self.env_intensity,
             rotation: self.env_rotation,
+            no_sun: self.no_env_sun,
         };
         if let Some(note) = choice.apply(scene)? {
             eprintln!("{note}");
