@@ -381,9 +381,9 @@ pub const SUN_MIN_SHARE: f32 = 0.15;
 pub const SUN_MAX_SOLID_ANGLE: f32 = 0.002;
 
 /// The compact bright region of an environment map that a renderer without shadowed environment
-/// light should light with as a shadowed directional light, its energy taken out of the map
-/// ([`Environment::sun`], [`Environment::without_sun`]; issue 34 item 1 — the real-time renderer
-/// does not use it yet; the path tracer samples the full map and never will).
+/// light lights with as a shadowed directional light, its energy taken out of the map
+/// ([`Environment::sun`], [`Environment::without_sun`]; the real-time renderer's
+/// `set_environment`). The path tracer samples the full map.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sun {
     /// Unit direction towards the sun (rotation applied): the power-weighted mean of its texels'.
