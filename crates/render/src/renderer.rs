@@ -286,8 +286,10 @@ impl Renderer {
     /// [`Self::set_scene`] with vertex and index buffers of at most `max_buffer_bytes` each
     /// (large meshes are split over several; tests use a small limit to exercise that).
     pub fn set_scene_with_buffer_limit(&mut self, scene: &scene::Scene, max_buffer_bytes: u64) -> Result<()> {
-        // The old scene's buffers go first: two multi-gigabyte scenes need not coexist.
+        // The old scene's buffers go first: two multi-gigabyte scenes need not coexist. Its
+        // sun's light went with it.
         self.scene = None;
+        self.sun = None;
         self.scene = Some(GpuScene::upload_with_buffer_limit(
             &self.gpu.device,
             &self.gpu.queue,

@@ -300,7 +300,10 @@ fn an_environment_sun_becomes_a_directional_light_and_keeps_the_energy() {
     let mut scene = sphere_scene(env.clone());
     scene.camera = Camera::look_at(Vec3::new(0.0, 2.0, -3.0), Vec3::ZERO, Vec3::Y, 0.6);
     let mut r = renderer();
+    // A scene set twice (the viewer reloading it) and its map set again: one sun light each time.
     r.set_scene(&scene).unwrap();
+    r.set_scene(&scene).unwrap();
+    r.set_environment(scene.environment.as_ref());
     let (towards, e) = r.environment_sun().expect("lit with as a light");
     assert!((towards - sun.direction).length() < 1e-5 && towards.y > 0.68 && towards.z < -0.68, "{towards}");
     assert!((e - sun.irradiance).abs().max_element() < 1e-3 * e.x, "{e} vs {}", sun.irradiance);
