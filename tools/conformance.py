@@ -12,6 +12,13 @@ per model; exits 1 if a listed model fails to load or render, or any of its imag
     tools/conformance.py ~/khronos --out conformance-out        # run on models already there
     tools/conformance.py PATH/glTF-Sample-Assets/Models --all   # every model found
     tools/conformance.py ~/khronos --set core --size 160x120     # the glTF conformance set (issue 12)
+    tools/conformance.py ~/khronos --envs default,rooitou_park,venice_sunset --out conf-envs   # issue 34
+
+With --envs the whole list runs once per environment (OUT/<environment>/) and
+OUT/conformance-envs.md tabulates the spectral render's block-mean ΔE2000 over the model per
+environment. Every table has the share of the emitted power the real-time lights keep (from
+`spectra render`'s line on its emissive area lights; 100 % when they are clustered, less when
+emitting materials outnumber the lights, or with a binary from before the clusters).
 
 Per model it also records the loader's `warning:` lines, the first line of any error, whether
 the files a .gltf refers to are all there ("incomplete" otherwise: nothing is rendered), and
@@ -30,6 +37,7 @@ docs/conformance.md explains the table; docs/gltf-conformance.md has the glTF co
 import argparse
 import json
 import math
+import re
 import os
 import shlex
 import signal
@@ -505,6 +513,34 @@ def list_models(root):
     return names
 
 
+def emitters_of(stderr):
+    """What `spectra render` said of the emissive surfaces: {"lights", "polygons", "kept"} (kept: the
+    share of the emitted power the real-time lights carry), or None when it lit with none."""
+    text = stderr or ""
+    m = re.search(r"(\d+) emissive area lights: (\d+) emitting polygons clustered, all of their power", text)
+    if m:
+        return {"lights": int(m[1]), "polygons": int(m[2]), "kept": 1.0}
+    m = re.search(r"(\d+) emissive area lights for (\d+) emitting polygons \(warning: ([\d.]+) % of the emitted", text)
+    if m:
+        return {"lights": int(m[1]), "polygons": int(m[2]), "kept": 1.0 - float(m[3]) / 100.0}
+    # Binaries before the clusters (session 18) kept the brightest polygons and dropped the rest.
+    m = re.search(r"(\d+) emissive polygon lights \(warning: (\d+) more left out, ([\d.]+) % of the emitted", text)
+    if m:
+        return {"lights": int(m[1]), "polygons": int(m[1]) + int(m[2]), "kept": 1.0 - float(m[3]) / 100.0}
+    m = re.search(r"(\d+) emissive polygon light", text)
+    if m:
+        return {"lights": int(m[1]), "polygons": int(m[1]), "kept": 1.0}
+    return None
+
+
+# Short names for --envs (the HDRs in assets/environments/).
+ENV_ALIASES = {
+    "rooitou_park": os.path.join(REPO_ROOT, "assets", "environments", "rooitou_park.hdr"),
+    "venice_sunset": os.path.join(REPO_ROOT, "assets", "environments", "venice_sunset.hdr"),
+    "studio_small_03": os.path.join(REPO_ROOT, "assets", "environments", "studio_small_03.hdr"),
+}
+
+
 def env_args(a):
     args = []
     if a.env != "auto":
@@ -549,6 +585,8 @@ def run_model(a, runner, name, path, outdir):
         for wn in warnings_of(err, path):
             if wn not in res["warnings"]:
                 res["warnings"].append(wn)
+        if key == "spectral":
+            res["emitters"] = emitters_of(err)
         if code != 0 or not os.path.isfile(img):
             r["error"] = error_message(err, code)
             r["error_first_line"] = first_error_line(err, code)
@@ -681,6 +719,57 @@ def black_cell(r):
     return "?" if b is None else ("**yes**" if b else "no")
 
 
+def power_cell(r):
+    e = r.get("emitters")
+    if not e:
+        return "–"
+    return f"{100 * e['kept']:.1f} % ({e['lights']} / {e['polygons']})"
+
+
+def model_de(r, block):
+    """Block-mean ΔE2000 spectral vs truth over the model (over the image without a mask)."""
+    d = r.get("diffs", {}).get("spectral_vs_truth", {}).get(f"block{block}", {})
+    v = d.get("model_delta_e2000_mean")
+    return v if v is not None else d.get("delta_e2000_mean")
+
+
+def write_env_summary(out, block, runs, command):
+    """OUT/conformance-envs.md: per model and environment, spectral vs truth block-mean ΔE2000 over
+    the model and the emitted power kept."""
+    labels = [label for label, _ in runs]
+    models = []
+    for _, results in runs:
+        for r in results:
+            if r["model"] not in models:
+                models.append(r["model"])
+    lines = [
+        "# Conformance under several environments",
+        "",
+        f"`{command}`",
+        "",
+        f"Spectral real time vs truth, {block}×{block} block-mean ΔE2000 over the model (over the image when no"
+        " mask could be made); emitted power kept by the real-time lights. Each environment's full table:"
+        " OUT/<environment>/conformance.md.",
+        "",
+        "| model | " + " | ".join(labels) + " | emitted power kept |",
+        "|---|" + "---|" * len(labels) + "---|",
+    ]
+    for m in models:
+        cells, power = [], "–"
+        for _, results in runs:
+            r = next((x for x in results if x["model"] == m), None)
+            cells.append("–" if r is None else fmt(model_de(r, block)))
+            if r is not None and r.get("emitters"):
+                power = power_cell(r)
+        lines.append(f"| {m} | " + " | ".join(cells) + f" | {power} |")
+    lines.append("")
+    os.makedirs(out, exist_ok=True)
+    tmp = os.path.join(out, "conformance-envs.md.tmp")
+    with open(tmp, "w") as f:
+        f.write("\n".join(lines))
+    os.replace(tmp, os.path.join(out, "conformance-envs.md"))
+
+
 def write_reports(a, results, meta):
     os.makedirs(a.out, exist_ok=True)
     doc = {**meta, "models": results}
@@ -710,8 +799,9 @@ def write_reports(a, results, meta):
         "",
         "| model | load | model px | black rgb / spectral / truth | mean Y rgb / spectral / truth |"
         " ΔE00 spectral–truth: image | ΔE00 spectral–truth: model | ΔE00 rgb–truth: image | ΔE00 rgb–truth: model"
-        " | truth noise: image / model | seconds rgb / spectral / truth | warnings |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        " | truth noise: image / model | emitted power kept (lights / polygons) | seconds rgb / spectral / truth"
+        " | warnings |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     def short(text):
         return (text or "").replace(meta["root"] + os.sep, "").replace("|", "\\|")
@@ -721,7 +811,7 @@ def write_reports(a, results, meta):
         if r["status"] != "ok" and not any(x.get("exit_code") == 0 for x in rs.values()):
             err = short(r.get("error"))
             what = "incomplete" if r["status"] == "incomplete" else "error"
-            lines.append(f"| {r['model']} | {what}: {err} | – | – | – | – | – | – | – | – | – | "
+            lines.append(f"| {r['model']} | {what}: {err} | – | – | – | – | – | – | – | – | – | – | "
                          f"{len(r.get('warnings', []))} |")
             continue
         load = "ok" if r["status"] == "ok" else "error: " + short(r.get("error"))
@@ -742,7 +832,7 @@ def write_reports(a, results, meta):
         des = f"{de('spectral_vs_truth')} | {de('rgb_vs_truth')} | {noise}"
         cov = r.get("model_coverage")
         cov = "–" if cov is None else f"{cov:.0%}"
-        lines.append(f"| {r['model']} | {load} | {cov} | {blacks} | {means} | {des} | {secs} | "
+        lines.append(f"| {r['model']} | {load} | {cov} | {blacks} | {means} | {des} | {power_cell(r)} | {secs} | "
                      f"{len(r.get('warnings', []))} |")
     lines.append("")
     n_ok = sum(1 for r in results if r["status"] == "ok")
@@ -874,6 +964,11 @@ def main():
     ap.add_argument("--env", default="default",
                     help="environment for every render: default, none, a .hdr/.exr file, or auto (pass no --env: "
                          "the renderers' own choice) (default: default)")
+    ap.add_argument("--envs", metavar="LIST",
+                    help="run the whole list under each of these environments in turn (comma-separated: default, "
+                         "rooitou_park, venice_sunset, studio_small_03 or paths), each into OUT/<name>/, and write "
+                         "OUT/conformance-envs.md (per model and environment: spectral vs truth block-mean ΔE2000 "
+                         "over the model, emitted power kept); overrides --env")
     ap.add_argument("--env-intensity", type=float)
     ap.add_argument("--env-rotation", type=float, help="passed through to --env-rotation")
     ap.add_argument("--size", default="320x240", help="image size WxH (default: 320x240)")
@@ -961,6 +1056,50 @@ def main():
         "interrupted": False,
     }
     runner = Runner(a.spectra, a.timeout)
+    envs = [("", None)]
+    if a.envs:
+        envs = []
+        for e in (x.strip() for x in a.envs.split(",")):
+            if not e:
+                continue
+            path = ENV_ALIASES.get(e, e)
+            if path not in ("default", "none") and not os.path.isfile(path):
+                ap.error(f"--envs: {e}: no such environment file (or one of default, {', '.join(ENV_ALIASES)})")
+            label = e if e in ENV_ALIASES or e in ("default", "none") else os.path.splitext(os.path.basename(e))[0]
+            envs.append((label, path))
+    out_root = a.out
+    runs = []
+    all_results = []
+    for label, env in envs:
+        if env is not None:
+            a.env = env
+            a.out = os.path.join(out_root, label)
+            meta = {**meta, "env": env}
+            log(f"== environment {label}: {env} → {a.out}")
+        code, results = run_list(a, runner, models, root, meta)
+        runs.append((label, results))
+        all_results += results
+        if code is not None:
+            return code
+    if a.envs:
+        write_env_summary(out_root, a.block, runs, meta["command"])
+        log(f"wrote {os.path.join(out_root, 'conformance-envs.md')}")
+    bad = []
+    for r in all_results:
+        if r["status"] != "ok":
+            bad.append(f"{r['model']}: {r.get('error_first_line') or r['error']}")
+        for k, x in r.get("renders", {}).items():
+            if x.get("black"):
+                bad.append(f"{r['model']}: {k} render is black (mean luminance {x['mean_luminance']:.3g})")
+    for b in bad:
+        log(f"FAIL {b}")
+    if bad and not a.allow_fail:
+        return 1
+    return 0
+
+
+def run_list(a, runner, models, root, meta):
+    """Every model of `models` under `a.env` into `a.out`: (exit code when interrupted, results)."""
     results = []
     t_start = time.monotonic()
     try:
@@ -989,23 +1128,11 @@ def main():
         meta["interrupted"] = True
         write_reports(a, results, meta)
         log(f"interrupted: {len(results)} models in {os.path.join(a.out, 'conformance.md')}")
-        return 130
+        return 130, results
     meta["seconds"] = round(time.monotonic() - t_start, 1)
     write_reports(a, results, meta)
-
-    bad = []
-    for r in results:
-        if r["status"] != "ok":
-            bad.append(f"{r['model']}: {r.get('error_first_line') or r['error']}")
-        for k, x in r.get("renders", {}).items():
-            if x.get("black"):
-                bad.append(f"{r['model']}: {k} render is black (mean luminance {x['mean_luminance']:.3g})")
     log(f"wrote {os.path.join(a.out, 'conformance.md')} and conformance.json ({meta['seconds']} s)")
-    for b in bad:
-        log(f"FAIL {b}")
-    if bad and not a.allow_fail:
-        return 1
-    return 0
+    return None, results
 
 
 if __name__ == "__main__":
