@@ -186,9 +186,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (Some(e), None) => format!("{under}, environment {} × {}", e.source, e.intensity),
         (None, _) => under,
     };
+    let under = match r.environment_sun() {
+        Some((towards, _)) => format!(
+            "{under}, its sun a shadowed directional light ({:.1}° up; --no-env-sun: off)",
+            towards.y.clamp(-1.0, 1.0).asin().to_degrees()
+        ),
+        None => under,
+    };
     let under = match r.emitter_summary() {
         Some((n, polygons, _)) if n > 0 && n == polygons => format!("{under}, {n} emissive polygon light(s)"),
-        Some((n, polygons, frac)) if n > 0 && frac > 0.0 => format!(
+        Some((n, polygons, frac)) if frac > 0.0 => format!(
             "{under}, {n} emissive area lights for {polygons} emitting polygons (warning: {:.1} % of the emitted \
              power left out: more emitting materials than lights)",
             100.0 * frac
