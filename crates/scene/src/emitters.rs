@@ -174,17 +174,7 @@ pub fn texture_mean(t: &Texture, uv: [Vec2; 3]) -> Vec3 {
     let texels = 0.5 * ((uv[1] - uv[0]) * size).perp_dot((uv[2] - uv[0]) * size).abs();
     // k × k cells of the unit square, folded onto the triangle: k² samples.
     let k = (texels.sqrt().ceil() as usize).clamp(4, 64);
-    let wrap = |i: i64, n: usize, mode: Wrap| -> usize {
-        let n = n as i64;
-        (match mode {
-            Wrap::Repeat => i.rem_euclid(n),
-            Wrap::ClampToEdge => i.clamp(0, n - 1),
-            Wrap::MirroredRepeat => {
-                let m = i.rem_euclid(2 * n);
-                if m < n { m } else { 2 * n - 1 - m }
-            }
-        }) as usize
-    };
+    let wrap = |i: i64, n: usize, mode: Wrap| mode.index(i, n as i64) as usize;
     let mut sum = Vec3::ZERO;
     for i in 0..k {
         for j in 0..k {

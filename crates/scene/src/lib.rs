@@ -325,6 +325,22 @@ pub enum Wrap {
     MirroredRepeat,
 }
 
+impl Wrap {
+    /// Texel index `i` (any integer) of an axis of `n` texels under this mode: what a GPU
+    /// sampler addresses (the path tracer's lookups and the emitters' texture means use it).
+    #[inline]
+    pub fn index(self, i: i64, n: i64) -> u32 {
+        (match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let k = i.rem_euclid(2 * n);
+                if k < n { k } else { 2 * n - 1 - k }
+            }
+        }) as u32
+    }
+}
+
 /// Texture filter (glTF sampler `magFilter`/`minFilter`; mipmapped minification filters are
 /// `Linear`/`Nearest` with [`Sampler::mipmaps`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

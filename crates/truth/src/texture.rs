@@ -15,17 +15,10 @@ pub struct Footprint {
     pub weights: [f32; 4],
 }
 
-/// Texel index `i` (any integer) of an axis of `n` texels under `wrap`.
+/// Texel index `i` (any integer) of an axis of `n` texels under `wrap` ([`Wrap::index`]).
 #[inline]
 fn wrap_index(i: i64, n: i64, wrap: Wrap) -> u32 {
-    (match wrap {
-        Wrap::Repeat => i.rem_euclid(n),
-        Wrap::ClampToEdge => i.clamp(0, n - 1),
-        Wrap::MirroredRepeat => {
-            let k = i.rem_euclid(2 * n);
-            if k < n { k } else { 2 * n - 1 - k }
-        }
-    }) as u32
+    wrap.index(i, n)
 }
 
 /// Which texels surround `uv` (glTF: origin at the image's top-left, v down), wrapped and
