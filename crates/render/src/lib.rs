@@ -35,6 +35,7 @@ mod film_tests;
 pub mod gpu;
 #[cfg(test)]
 mod layout_tests;
+pub mod ltc;
 pub mod material_spectra;
 pub mod passes;
 mod readback;

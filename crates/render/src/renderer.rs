@@ -177,6 +177,8 @@ pub struct Renderer {
     scene: Option<GpuScene>,
     scene_generation: u64,
     environment: GpuEnvironment,
+    /// The polygon lights' specular table (src/ltc.rs), uploaded once.
+    ltc: wgpu::TextureView,
     /// The environment's sun, lit with as a directional light ([`Self::set_environment`]).
     sun: Option<SunState>,
     env_buffer: wgpu::Buffer,
@@ -226,6 +228,7 @@ impl Renderer {
         let timer =
             gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| Timer::new(device, &gpu.queue));
         let environment = GpuEnvironment::new(device, &gpu.queue, None);
+        let ltc = crate::ltc::upload(device, &gpu.queue);
         let env_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("environment uniforms"),
             size: std::mem::size_of::<EnvUniforms>() as u64,
@@ -261,6 +264,7 @@ impl Renderer {
             scene: None,
             scene_generation: 0,
             environment,
+            ltc,
             sun: None,
             env_buffer,
             spectral: None,
@@ -1016,6 +1020,7 @@ impl Renderer {
                 env_sampler: &self.environment.sampler,
                 env_uniforms: &self.env_buffer,
                 material_spectra: &material_spectra,
+                ltc: &self.ltc,
             },
         );
 

@@ -320,3 +320,108 @@ fn bad_environment_files_are_errors_naming_the_file() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A horizontal square of side 2·`half` at height `y`, facing `up` (+Y) or down.
+fn square(centre: glam::Vec3, half_x: f32, half_z: f32, up: bool, material: usize) -> scene::Mesh {
+    let (x, z) = (glam::Vec3::X * half_x, glam::Vec3::Z * half_z);
+    let positions = vec![centre - x - z, centre + x - z, centre + x + z, centre - x + z];
+    let n = if up { glam::Vec3::Y } else { -glam::Vec3::Y };
+    // Counter-clockwise seen from the side the normal points to.
+    let indices = if up { vec![0, 2, 1, 0, 3, 2] } else { vec![0, 1, 2, 0, 2, 3] };
+    scene::Mesh {
+        positions,
+        normals: vec![n; 4],
+        uvs: vec![glam::Vec2::ZERO; 4],
+        uvs1: vec![],
+        tangents: vec![],
+        colors: vec![],
+        indices,
+        material,
+    }
+}
+
+/// Mean luminance (Rec. 709 Y of linear sRGB) of `test` and `reference` over the pixels where
+/// the reference is at least half as bright as its 98th percentile: the highlight.
+fn highlight_luminance(reference: &str, test: &str) -> (f64, f64, usize) {
+    let y = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let r = compare::io::read_image(reference).unwrap();
+    let t = compare::io::read_image(test).unwrap();
+    let (w, h) = r.size();
+    let ys: Vec<f64> =
+        (0..h).flat_map(|j| (0..w).map(move |i| (i, j))).map(|(i, j)| y(r.get(i, j))).collect();
+    let mut sorted = ys.clone();
+    sorted.sort_by(f64::total_cmp);
+    let threshold = 0.5 * sorted[(0.98 * (sorted.len() - 1) as f64) as usize];
+    let (mut sr, mut st, mut n) = (0.0, 0.0, 0usize);
+    for j in 0..h {
+        for i in 0..w {
+            if ys[(j * w + i) as usize] >= threshold {
+                sr += ys[(j * w + i) as usize];
+                st += y(t.get(i, j));
+                n += 1;
+            }
+        }
+    }
+    (st / n as f64, sr / n as f64, n)
+}
+
+/// LTC (issue 34 item 3): a rough GGX plane under a rectangular light (1.2 × 0.6, 1 above the
+/// plane), the highlight's mean luminance in real time against the path tracer's (direct
+/// lighting), over roughness, material and view angle (the highlight seen at about 41° and 66°
+/// from the normal). Within 3 %, except a rough metal (0.75) seen at grazing angles, where the
+/// transformed cosine cannot follow a lobe cut by the horizon (+5.9 % when written; the
+/// representative-point specular it replaced gave 10–85 % of the truth's highlight here).
+#[test]
+fn a_rough_plane_under_a_rectangular_light_has_the_truths_highlight() {
+    let d = dir("ltc");
+    let cameras = [
+        ("41°", glam::Vec3::new(0.0, 2.0, 0.6), glam::Vec3::new(0.0, 0.0, -1.1)),
+        ("66°", glam::Vec3::new(0.0, 0.8, 2.0), glam::Vec3::new(0.0, 0.0, -0.2)),
+    ];
+    let materials = [(1.0f32, 0.9f32, 0.3f32), (1.0, 0.9, 0.5), (1.0, 0.9, 0.75), (0.0, 0.2, 0.4)];
+    let mut failures = Vec::new();
+    for (view, eye, target) in cameras {
+        let camera = scene::Camera::look_at(eye, target, glam::Vec3::Y, 40f32.to_radians());
+        for (k, &(metallic, base, roughness)) in materials.iter().enumerate() {
+            let mut s = scene::Scene::empty("ltc test", camera);
+            s.materials.push(scene::Material {
+                name: "plane".into(),
+                base_color: glam::Vec4::new(base, base, base, 1.0),
+                metallic,
+                roughness,
+                ..Default::default()
+            });
+            s.materials.push(scene::Material {
+                name: "light".into(),
+                base_color: glam::Vec4::new(0.0, 0.0, 0.0, 1.0),
+                emissive: glam::Vec3::splat(3.0),
+                ..Default::default()
+            });
+            s.meshes.push(square(glam::Vec3::ZERO, 3.0, 3.0, true, 0));
+            s.meshes.push(square(glam::Vec3::new(0.0, 1.0, -2.0), 0.6, 0.3, false, 1));
+            let name = format!("plane-{}-{k}", &view[..2]);
+            let file = d.join(format!("{name}.gltf"));
+            scene::write_gltf(&s, &file).unwrap();
+            let f = file.display().to_string();
+            let (truth, rt) = (p(&d, &format!("{name}-truth.exr")), p(&d, &format!("{name}-rt.exr")));
+            let size = ["--size", "96x64", "--env", "none"];
+            spectra(&[&["truth", &f, "--direct-only", "--spp", "256", "--out", &truth][..], &size].concat());
+            spectra(&[&["render", &f, "--out", &rt][..], &size].concat());
+            let (ours, theirs, n) = highlight_luminance(&truth, &rt);
+            let ratio = ours / theirs;
+            eprintln!(
+                "view {view}, metallic {metallic} base {base} roughness {roughness}: highlight ({n} px) real time {ours:.4} / truth {theirs:.4} = {ratio:.4}"
+            );
+            let bound = if view == "66°" && roughness > 0.7 { 0.07 } else { 0.03 };
+            if (ratio - 1.0).abs() > bound {
+                failures.push(format!(
+                    "view {view}, roughness {roughness}, metallic {metallic}: ratio {ratio:.4}"
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+    if std::env::var_os("SPECTRA_KEEP").is_none() {
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}

@@ -87,6 +87,17 @@ impl SharedLayouts {
                 },
                 uniform_entry(10, wgpu::ShaderStages::FRAGMENT),
                 storage_entry(11),
+                // The polygon lights' linearly transformed cosines (src/ltc.rs).
+                wgpu::BindGroupLayoutEntry {
+                    binding: 12,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let custom = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -123,6 +134,7 @@ impl SharedLayouts {
                 wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(i.env_sampler) },
                 buffer_entry(10, i.env_uniforms),
                 buffer_entry(11, i.material_spectra),
+                view_entry(12, i.ltc),
             ],
         })
     }
@@ -158,6 +170,8 @@ pub struct SpectralInputs<'a> {
     pub env_uniforms: &'a wgpu::Buffer,
     /// Per material, the coefficients of its constant colours (src/material_spectra.rs).
     pub material_spectra: &'a wgpu::Buffer,
+    /// The linearly transformed cosines of the polygon lights' specular lobe (src/ltc.rs).
+    pub ltc: &'a wgpu::TextureView,
 }
 
 pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {

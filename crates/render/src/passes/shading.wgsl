@@ -59,9 +59,11 @@ fn capture_group(px: vec2<i32>, g: u32, m: mat3x4<f32>) {
 }
 
 // Fraction of a light that reaches `p` according to its shadow map `layer` (1 outside the
-// light's frustum): one hardware 2×2 comparison sample.
+// light's frustum): one hardware 2×2 comparison sample, or for an emissive polygon's layer
+// (whose light has a size) the percentage-closer soft shadow of `soft_visibility`.
 fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let s = shadows.view_proj[layer] * vec4<f32>(p + n * shadows.bias[layer].x, 1.0);
+    let b = shadows.bias[layer];
+    let s = shadows.view_proj[layer] * vec4<f32>(p + n * b.x, 1.0);
     if (s.w <= 0.0) { return 1.0; }
     let ndc = s.xyz / s.w;
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
@@ -70,6 +72,8 @@ fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     }
     return textureSampleCompareLevel(shadow_maps, shadow_sampler, uv, i32(layer), ndc.z);
 }
+
+
 
 // Fraction of light `li` that reaches `p` (offset along `n` against acne; zero for points in
 // a medium): its shadow map, or 1 for a light without one. Part of the custom-shader API.
@@ -133,10 +137,11 @@ fn factors_of(t: LightTerms, metallic: f32, f0: f32) -> vec2<f32> {
     return vec2<f32>(a, b);
 }
 
-// E/L of a polygon light at p with normal n: ∫ max(n·l, 0) dl over the polygon clipped to
-// the hemisphere of n (Lambert's formula, exact: the cosine-weighted solid angle), i.e. the
-// irradiance per unit radiance.
-fn polygon_irradiance(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+// ∫ max(z, 0) dl over polygon light li seen from p, with the polygon's vertices taken to
+// m·(vertex − p) and clipped to z > 0 (Lambert's formula, exact). With m the world-to-shading
+// frame (z = n) this is the irradiance per unit radiance E/L; with M⁻¹ of the specular lobe's
+// linearly transformed cosine (src/ltc.rs) composed in, π times the lobe's share over the light.
+fn polygon_cosine(li: u32, p: vec3<f32>, m: mat3x3<f32>) -> f32 {
     // Clipped edge by edge as the polygon is walked (no local array: a dynamically indexed one
     // cost the RGB pass 1.7× on a CPU driver even for scenes without polygon lights). An edge
     // leaving the hemisphere records its exit point, one entering it its entry point; the clipped
@@ -147,95 +152,87 @@ fn polygon_irradiance(li: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     var entry_pt = vec3<f32>(0.0);
     var crossings = 0u;
     var above = 0u;
+    var a = m * (polygon_vertex(li, 0u) - p);
     for (var i = 0u; i < count; i++) {
-        let a = polygon_vertex(li, i) - p;
-        let b = polygon_vertex(li, (i + 1u) % count) - p;
-        let da = dot(n, a);
-        let db = dot(n, b);
+        let b = m * (polygon_vertex(li, (i + 1u) % count) - p);
+        let da = a.z;
+        let db = b.z;
         if (da > 0.0) { above++; }
         if (da > 0.0 && db > 0.0) {
-            sum += edge_integral(a, b, n);
+            sum += edge_integral(a, b);
         } else if (da > 0.0) {
             exit_pt = a + (b - a) * (da / (da - db));
-            sum += edge_integral(a, exit_pt, n);
+            sum += edge_integral(a, exit_pt);
             crossings++;
         } else if (db > 0.0) {
             entry_pt = a + (b - a) * (da / (da - db));
-            sum += edge_integral(entry_pt, b, n);
+            sum += edge_integral(entry_pt, b);
             crossings++;
         }
+        a = b;
     }
     if (above == 0u) { return 0.0; }
     if (crossings == 2u) {
-        sum += edge_integral(exit_pt, entry_pt, n);
+        sum += edge_integral(exit_pt, entry_pt);
     }
     return 0.5 * abs(sum);
 }
 
-// One edge's term of Lambert's formula: the angle it subtends times the cosine of its plane's
-// normal with n.
-fn edge_integral(a: vec3<f32>, b: vec3<f32>, n: vec3<f32>) -> f32 {
+// One edge's term of Lambert's formula: the angle it subtends times the z of its plane's
+// normal.
+fn edge_integral(a: vec3<f32>, b: vec3<f32>) -> f32 {
     let ua = normalize(a);
     let ub = normalize(b);
     let c = cross(ua, ub);
     let s = length(c);
     if (s <= 1e-7) { return 0.0; }
-    return atan2(s, dot(ua, ub)) * dot(n, c) / s;
+    return atan2(s, dot(ua, ub)) * c.z / s;
 }
 
+// Linearly transformed cosines (src/ltc.rs): per (roughness, √(1 − n·v)) cell, layer 0 holds
+// the specular lobe's M⁻¹ entries (0,0), (0,2), (2,0), (2,2) over its (1,1), layer 1 the lobe's
+// split-sum albedo (A, B).
+@group(2) @binding(12) var ltc_table: texture_2d_array<f32>;
+
 // `light_terms` for a polygon light (an emissive surface, src/scene_gpu.rs): diffuse exactly
-// (polygon_irradiance), specular by the representative point (Karis 2013: the point of the
-// polygon nearest the mirror ray, with the lobe widened by the light's size), shadowed by one
-// shadow map from the centroid.
+// (the clipped cosine over the polygon), specular by linearly transformed cosines (Heitz et al.
+// 2016: the GGX lobe's integral over the polygon, with the Fresnel term the lobe's mean, so
+// that `factors_of` weighs it by F0·A + B); shadowed by one shadow map from the centroid.
 fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> LightTerms {
     let none = LightTerms(0.0, 0.0, 1.0);
     let ln = polygon_normal(li);
-    let v0 = polygon_vertex(li, 0u);
     // One-sided: nothing reaches points behind the emitting side.
-    if (dot(p - v0, ln) <= 0.0) { return none; }
-    let g = polygon_irradiance(li, p, n);
+    if (dot(p - polygon_vertex(li, 0u), ln) <= 0.0) { return none; }
+    // The shading frame (t1, n × t1, n), t1 towards the viewer: the table's frame.
+    let nv = dot(n, v);
+    var t1 = v - n * nv;
+    if (dot(t1, t1) < 1e-12) {
+        t1 = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9) ;
+        t1 -= n * dot(n, t1);
+    }
+    t1 = normalize(t1);
+    let to_local = transpose(mat3x3<f32>(t1, cross(n, t1), n));
+    let g = polygon_cosine(li, p, to_local);
     if (g <= 0.0) { return none; }
     let vis = light_visibility(li, p, n);
     if (lambert_only()) {
         return LightTerms(g * vis, 0.0, 1.0);
     }
-    // Representative point: where the mirror ray meets the light's plane, else the centroid,
-    // pulled into the polygon's bounding sphere.
-    let c = polygon_centroid(li);
-    let r = reflect(-v, n);
-    let denom = dot(ln, r);
-    var q = c;
-    if (denom < -1e-6) {
-        let t = dot(ln, v0 - p) / denom;
-        if (t > 0.0) { q = p + r * t; }
-    }
-    let area = lights[li].cone.w;
-    let radius = sqrt(area / PI);
-    let off = q - c;
-    let ol = length(off);
-    if (ol > radius) { q = c + off * (radius / ol); }
-    let d = q - p;
-    let dist2 = max(dot(d, d), 1e-8);
-    let wi = d * inverseSqrt(dist2);
-    let nl = dot(n, wi);
-    let nv = max(dot(n, v), 1e-4);
-    let h = normalize(wi + v);
-    let nh = max(dot(n, h), 0.0);
-    let vh = max(dot(v, h), 0.0);
-    let alpha = max(roughness * roughness, 1e-3);
-    // Widened lobe and its energy normalisation (α/α')².
-    let alpha_w = clamp(alpha + radius / (2.0 * sqrt(dist2)), alpha, 1.0);
-    let a2 = alpha_w * alpha_w;
-    let dd = nh * nh * (a2 - 1.0) + 1.0;
-    let dist_d = a2 / (PI * dd * dd) * (alpha / alpha_w) * (alpha / alpha_w);
-    let a2v = alpha * alpha;
-    let nlc = max(nl, 1e-4);
-    let vis_s = 0.5 / (nlc * sqrt(nv * nv * (1.0 - a2v) + a2v) + nv * sqrt(nlc * nlc * (1.0 - a2v) + a2v));
-    // Solid angle of the polygon from p (as a disc of its area seen at the light's cosine).
-    let omega = min(area * max(dot(ln, -wi), 0.0) / dist2, 2.0 * PI);
-    let dv = select(0.0, dist_d * vis_s * nl * omega, nl > 0.0);
-    return LightTerms(vis * g, vis * dv, vh);
+    let cells = f32(LTC_SIZE - 1u);
+    let half_texel = 0.5 / f32(LTC_SIZE);
+    let uv = vec2<f32>(clamp(roughness, 0.0, 1.0), sqrt(1.0 - clamp(nv, 0.0, 1.0))) * (cells / f32(LTC_SIZE)) + half_texel;
+    let c = textureSampleLevel(ltc_table, env_sampler, uv, 0, 0.0);
+    let ab = textureSampleLevel(ltc_table, env_sampler, uv, 1, 0.0).xy;
+    let minv = mat3x3<f32>(vec3<f32>(c.x, 0.0, c.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(c.y, 0.0, c.w));
+    let share = polygon_cosine(li, p, minv * to_local) / PI;
+    let albedo = ab.x + ab.y;
+    // The lobe's mean Schlick weight B / (A + B) as the (1 − v·h)⁵ of one half vector.
+    let fres = select(0.0, ab.y / albedo, albedo > 0.0);
+    return LightTerms(vis * g, vis * share * albedo, 1.0 - pow(fres, 0.2));
 }
+
+// Cells per axis of `ltc_table` (src/ltc.rs `SIZE`).
+const LTC_SIZE: u32 = 64u;
 
 // Screen-space occlusion of the environment at pixel `pix` (world position p, normal n): the
 // fraction of the cosine-weighted hemisphere not hidden by what the depth buffer shows within
