@@ -53,12 +53,15 @@ def load(
     env: Optional[str] = None,
     env_intensity: Optional[float] = None,
     env_rotation: Optional[float] = None,
+    env_sun: bool = True,
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
     without lights gets the default environment. `allow_outside_scene_dir`: let the file's
     references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"
-    (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y. Raises
+    (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y; `env_sun`:
+    the map's sun, where it has one, as a shadowed directional light in real time (False:
+    `--no-env-sun`). Raises
     ValueError (bad scene), FileNotFoundError."""
 
 class Renderer:

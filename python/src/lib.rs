@@ -115,6 +115,7 @@ struct LoadArgs {
     env: Option<String>,
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
+    env_sun: bool,
 }
 
 #[pymethods]
@@ -145,9 +146,15 @@ impl Scene {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
         let load = py.import("spectra")?.getattr("_load_cached")?;
         let h = &self.how;
-        let args =
-            (h.name.clone(), h.allow_outside_scene_dir, h.env.clone(), h.env_intensity, h.env_rotation)
-                .into_pyobject(py)?;
+        let args = (
+            h.name.clone(),
+            h.allow_outside_scene_dir,
+            h.env.clone(),
+            h.env_intensity,
+            h.env_rotation,
+            h.env_sun,
+        )
+            .into_pyobject(py)?;
         Ok((load, args))
     }
 
@@ -180,10 +187,11 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Arc<scene::Scene>> {
 /// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
 /// environment when the scene has no lights. `env_intensity` multiplies it, `env_rotation`
-/// turns it about +Y (degrees).
+/// turns it about +Y (degrees). `env_sun`: light the map's sun, where it has one, in real time
+/// as a shadowed directional light (`False`: `--no-env-sun`, the whole map unshadowed).
 #[pyfunction]
 #[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false, env = None, env_intensity = None,
-                    env_rotation = None))]
+                    env_rotation = None, env_sun = true))]
 fn load(
     py: Python<'_>,
     path_or_builtin: PathBuf,
@@ -191,6 +199,7 @@ fn load(
     env: Option<String>,
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
+    env_sun: bool,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
@@ -214,7 +223,8 @@ fn load(
             .and_then(|p| p.to_str().map(String::from))
             .unwrap_or_else(|| e.clone()),
     });
-    let how = LoadArgs { name: abs, allow_outside_scene_dir, env: env_abs, env_intensity, env_rotation };
+    let how =
+        LoadArgs { name: abs, allow_outside_scene_dir, env: env_abs, env_intensity, env_rotation, env_sun };
     let h = LoadArgs { env, ..how.clone() };
     let scene = py.detach(move || -> Result<scene::Scene, PyErr> {
         let lower = name.to_ascii_lowercase();
@@ -230,7 +240,7 @@ fn load(
                 env: h.env,
                 env_intensity: h.env_intensity,
                 env_rotation: h.env_rotation,
-                ..Default::default()
+                no_env_sun: !h.env_sun,
             },
         };
         args.load().map_err(|e| {

@@ -276,6 +276,22 @@ def test_scene_pickles_as_a_reload(tmp_path):
     assert not np.array_equal(a, spectra.truth(spectra.load("cornell"), spp=1, size=(16, 12)))
 
 
+def test_env_sun_switch_is_the_clis_and_survives_pickling():
+    """`env_sun=False` is `--no-env-sun`: rooitou_park's sun is then not a shadowed light, and
+    the real-time image changes; a pickled scene keeps the choice."""
+    import pickle
+
+    sky = str(ROOT / "assets" / "environments" / "rooitou_park.hdr")
+    with_sun = spectra.load("colorchecker", env=sky)
+    without = spectra.load("colorchecker", env=sky, env_sun=False)
+    a = spectra.Renderer(with_sun, size=(24, 16)).render()
+    b = spectra.Renderer(without, size=(24, 16)).render()
+    assert np.isfinite(a).all() and np.isfinite(b).all()
+    assert not np.array_equal(a, b)
+    c = spectra.Renderer(pickle.loads(pickle.dumps(without)), size=(24, 16)).render()
+    assert np.array_equal(b, c)
+
+
 def test_env_options():
     with pytest.raises(FileNotFoundError, match="no_such_sky.hdr"):
         spectra.load("cornell", env="no_such_sky.hdr")

@@ -70,10 +70,89 @@ fn shadow_visibility(layer: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || ndc.z > 1.0 || ndc.z < 0.0) {
         return 1.0;
     }
+    if (HAS_POLYGONS && b.w > 0.0) {
+        return soft_visibility(layer, p + n * b.x, n, uv, ndc.z, s.w, b);
+    }
     return textureSampleCompareLevel(shadow_maps, shadow_sampler, uv, i32(layer), ndc.z);
 }
 
+// tan(½ · 150°): the emissive polygons' shadow frusta (src/passes/shadow.rs `EMITTER_FOV`).
+const EMITTER_TAN_HALF_FOV: f32 = 3.7320508;
+// Depth texels read in the blocker search (8 measured worse: block ΔE2000 0.44 against 0.24
+// for the side-1 light of the lighting test), and comparison samples averaged over the penumbra.
+const BLOCKER_SAMPLES: u32 = 16u;
+const SOFT_SAMPLES: u32 = 16u;
 
+// Point k of n on a Vogel spiral over the unit disc, turned by `turn` radians.
+fn spiral(k: u32, n: u32, turn: f32) -> vec2<f32> {
+    let r = sqrt((f32(k) + 0.5) / f32(n));
+    let a = f32(k) * 2.3999632 + turn;
+    return r * vec2<f32>(cos(a), sin(a));
+}
+
+// Map coordinates and depth of world point q in shadow layer `layer`.
+fn shadow_coords(layer: u32, q: vec3<f32>) -> vec3<f32> {
+    let s = shadows.view_proj[layer] * vec4<f32>(q, 1.0);
+    let ndc = s.xyz / s.w;
+    return vec3<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5, ndc.z);
+}
+
+// Percentage-closer soft shadows (Fernando 2005) for a light of radius b.w (the disc of the
+// polygon's area) at the apex of a perspective shadow map whose depth range is b.y … b.z: the
+// mean depth of the blockers that can hide some of the disc from the receiver (world point q
+// with normal n, map coordinates uv, map depth z, depth d_r) sets the penumbra,
+// (R / 2·tan ½fov)·(1/d_b − 1/d_r) in map units, over which comparison samples are averaged.
+// Each sample compares with the receiver's own plane at its offset (receiver-plane depth bias),
+// so a surface seen obliquely from the light does not shadow itself.
+fn soft_visibility(layer: u32, q: vec3<f32>, n: vec3<f32>, uv: vec2<f32>, z: f32, d_r: f32, b: vec4<f32>) -> f32 {
+    let near = b.y;
+    let far = b.z;
+    let size = vec2<f32>(textureDimensions(shadow_maps).xy);
+    // The receiver's plane in map space: depth as a linear function of the map offset.
+    var t1 = cross(n, vec3<f32>(0.0, 1.0, 0.0));
+    if (dot(t1, t1) < 1e-6) { t1 = cross(n, vec3<f32>(1.0, 0.0, 0.0)); }
+    t1 = normalize(t1);
+    let t2 = cross(n, t1);
+    let step = 1e-3 * d_r;
+    let c1 = shadow_coords(layer, q + t1 * step) - vec3<f32>(uv, z);
+    let c2 = shadow_coords(layer, q + t2 * step) - vec3<f32>(uv, z);
+    let det = c1.x * c2.y - c1.y * c2.x;
+    var grad = vec2<f32>(0.0);
+    if (abs(det) > 1e-12) {
+        // dz/duv = (dz along t1, t2) · J⁻¹ with J the map offsets of t1 and t2.
+        grad = vec2<f32>(c1.z * c2.y - c2.z * c1.y, c2.z * c1.x - c1.z * c2.x) / det;
+    }
+    // A texel's depth error on the plane, and the comparison's margin.
+    let margin = 2.0 * (abs(grad.x) + abs(grad.y)) / size.x;
+    let scale = b.w / (2.0 * EMITTER_TAN_HALF_FOV);
+    // Blockers nearer the light than a quarter of the receiver's depth are not searched for.
+    let search = min(scale * 3.0 / d_r, 0.2);
+    // The pattern turned per pixel: noise where one pattern for all pixels shows its 16 samples
+    // as blocks (measured: block ΔE2000 0.27 against 0.24 for this, side-1 light below).
+    let turn = 6.2831853 * fract(sin(dot(uv * size, vec2<f32>(12.9898, 78.233))) * 43758.5453);
+    var blockers = 0.0;
+    var depth_sum = 0.0;
+    let count = select(BLOCKER_SAMPLES, 1u, search * size.x < 1.0);
+    for (var k = 0u; k < count; k++) {
+        let off = spiral(k, count, turn) * search;
+        let texel = vec2<i32>(clamp(uv + off, vec2<f32>(0.0), vec2<f32>(0.99999)) * size);
+        let zb = textureLoad(shadow_maps, texel, i32(layer), 0);
+        if (zb < z + dot(grad, off) - margin) {
+            blockers += 1.0;
+            depth_sum += near * far / (far - zb * (far - near));
+        }
+    }
+    if (blockers == 0.0) { return 1.0; }
+    let d_b = depth_sum / blockers;
+    let radius = min(scale * max(1.0 / d_b - 1.0 / d_r, 0.0), 0.2);
+    let taps = select(SOFT_SAMPLES, 1u, radius * size.x < 1.0);
+    var lit = 0.0;
+    for (var k = 0u; k < taps; k++) {
+        let off = spiral(k, taps, turn) * radius;
+        lit += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + off, i32(layer), z + dot(grad, off) - margin);
+    }
+    return lit / f32(taps);
+}
 
 // Fraction of light `li` that reaches `p` (offset along `n` against acne; zero for points in
 // a medium): its shadow map, or 1 for a light without one. Part of the custom-shader API.

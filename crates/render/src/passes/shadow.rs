@@ -45,8 +45,10 @@ pub const NO_SHADOW: u32 = u32::MAX;
 pub struct ShadowUniforms {
     /// World → clip of each layer's light.
     pub view_proj: [[[f32; 4]; 4]; MAX_SHADOWS],
-    /// x: normal-offset bias (world units) of each layer; yzw unused (uniform arrays have a
-    /// 16-byte stride).
+    /// x: normal-offset bias (world units) of each layer; for an emissive polygon's layer
+    /// y and z the frustum's near and far distances and w the radius of the disc of the
+    /// polygon's area (the soft shadow's light size, `soft_visibility` in shading.wgsl); zero
+    /// for punctual lights (hard shadows).
     pub bias: [[f32; 4]; MAX_SHADOWS],
     /// Layer of light `i` at `[i / 4][i % 4]`, or [`NO_SHADOW`].
     pub layer_of_light: [[u32; 4]; MAX_LIGHTS / 4],
@@ -390,7 +392,8 @@ fn assign(
         let Some((view_proj, bias)) = emitter_view_proj(e, bounds) else { continue };
         let layer = layers.len();
         u.view_proj[layer] = view_proj.to_cols_array_2d();
-        u.bias[layer][0] = bias;
+        let (near, far) = emitter_depth_range(e, bounds);
+        u.bias[layer] = [bias, near, far, (e.area.max(0.0) / std::f32::consts::PI).sqrt()];
         u.layer_of_light[li / 4][li % 4] = layer as u32;
         layers.push(Layer { skip_mesh: Some(e.mesh) });
     }
@@ -433,18 +436,30 @@ pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Ma
 }
 
 /// The shadow frustum of an emissive polygon: a 150° perspective from its centroid along its
-/// emitting normal (what lies outside it is treated as lit; the polygon's extent is ignored, so
-/// shadows are as hard as a point light's at the centroid).
+/// emitting normal (what lies outside it is treated as lit); the shading pass softens its
+/// shadows by the polygon's size (`soft_visibility` in shading.wgsl, from `ShadowUniforms::bias`).
 pub fn emitter_view_proj(e: &scene::emitters::Emitter, bounds: (Vec3, Vec3)) -> Option<(Mat4, f32)> {
-    let centre = (bounds.0 + bounds.1) * 0.5;
     let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
     let texel = 2.0 * radius / SHADOW_SIZE as f32;
     let d = e.normal.try_normalize()?;
     let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let eye = e.centroid() + d * (1e-4 * radius);
-    let far = (eye - centre).length() + radius * 2.0;
+    let (near, far) = emitter_depth_range(e, bounds);
     let view = Mat4::look_at_rh(eye, eye + d, up);
-    Some((Mat4::perspective_rh(150f32.to_radians(), 1.0, far * 1e-3, far) * view, texel * 1.5))
+    Some((Mat4::perspective_rh(EMITTER_FOV, 1.0, near, far) * view, texel * 1.5))
+}
+
+/// The field of view of an emissive polygon's shadow frustum.
+pub const EMITTER_FOV: f32 = 150.0 * std::f32::consts::PI / 180.0;
+
+/// Near and far distances of an emissive polygon's shadow frustum.
+fn emitter_depth_range(e: &scene::emitters::Emitter, bounds: (Vec3, Vec3)) -> (f32, f32) {
+    let centre = (bounds.0 + bounds.1) * 0.5;
+    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let d = e.normal.try_normalize().unwrap_or(Vec3::Y);
+    let eye = e.centroid() + d * (1e-4 * radius);
+    let far = (eye - centre).length() + radius * 2.0;
+    (far * 1e-3, far)
 }
 
 // `layer_of_light` packs four lights per vec4<u32>.
