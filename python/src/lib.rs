@@ -241,6 +241,7 @@ fn load(
                 env_intensity: h.env_intensity,
                 env_rotation: h.env_rotation,
                 no_env_sun: !h.env_sun,
+                env_sun_share: None,
             },
         };
         args.load().map_err(|e| {

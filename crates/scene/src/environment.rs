@@ -86,6 +86,9 @@ pub struct Environment {
     /// ([`Environment::sun`]) as a shadowed directional light, the rest as the map (default;
     /// `--no-env-sun`: false). The path tracer samples the whole map either way.
     pub sun_light: bool,
+    /// The share of the map's light a compact bright region must give to be its sun
+    /// ([`SUN_MIN_SHARE`] unless `--env-sun-share` says otherwise).
+    pub sun_min_share: f32,
 }
 
 impl Environment {
@@ -136,6 +139,7 @@ impl Environment {
             intensity: 1.0,
             rotation: 0.0,
             sun_light: true,
+            sun_min_share: SUN_MIN_SHARE,
         };
         Ok(env.reduced(WORKING_WIDTH))
     }
@@ -238,6 +242,7 @@ impl Environment {
             intensity: 1.0,
             rotation: 0.0,
             sun_light: true,
+            sun_min_share: SUN_MIN_SHARE,
         }
     }
 
@@ -261,6 +266,7 @@ impl Environment {
             intensity: 1.0,
             rotation: 0.0,
             sun_light: true,
+            sun_min_share: SUN_MIN_SHARE,
         }
     }
 
@@ -272,6 +278,18 @@ impl Environment {
             });
         }
         self.intensity = k;
+        Ok(self)
+    }
+
+    /// The share of the map's light that makes a compact bright region its sun, in (0, 1].
+    pub fn with_sun_min_share(mut self, share: f32) -> Result<Self, EnvironmentError> {
+        if !(share.is_finite() && share > 0.0 && share <= 1.0) {
+            return Err(EnvironmentError {
+                file: PathBuf::from(&self.source),
+                message: format!("the sun's share of the map's light must be in (0, 1] (got {share})"),
+            });
+        }
+        self.sun_min_share = share;
         Ok(self)
     }
 
@@ -402,7 +420,8 @@ pub struct Sun {
 impl Environment {
     /// The map's sun, if it has one: the texels within [`SUN_MAX_RADIUS_DEG`] of the brightest
     /// (by luminance) whose luminance is at least [`SUN_THRESHOLD`] of its, when they give at least
-    /// [`SUN_MIN_SHARE`] of the map's ∫ Y dω within at most [`SUN_MAX_SOLID_ANGLE`]. A uniform or
+    /// `sun_min_share` ([`SUN_MIN_SHARE`] by default) of the map's ∫ Y dω within at most
+    /// [`SUN_MAX_SOLID_ANGLE`]. A uniform or
     /// overcast sky has none; neither has a studio's soft box (wider) or a sun so low that the sky
     /// outshines it.
     pub fn sun(&self) -> Option<Sun> {
@@ -441,7 +460,7 @@ impl Environment {
             }
         }
         let share = (power / total.max(1e-30)) as f32;
-        (share >= SUN_MIN_SHARE && omega <= SUN_MAX_SOLID_ANGLE).then(|| Sun {
+        (share >= self.sun_min_share && omega <= SUN_MAX_SOLID_ANGLE).then(|| Sun {
             direction: dir.try_normalize().unwrap_or(axis),
             irradiance,
             solid_angle: omega,
@@ -548,6 +567,8 @@ pub struct EnvironmentChoice {
     pub rotation: Option<f32>,
     /// `--no-env-sun`: renderers light with the whole map, the sun included, unshadowed.
     pub no_sun: bool,
+    /// `--env-sun-share`: the share of the map's light that makes a region its sun.
+    pub sun_share: Option<f32>,
 }
 
 impl EnvironmentChoice {
@@ -571,13 +592,14 @@ impl EnvironmentChoice {
                 }
             }
         }
-        if self.intensity.is_some() || self.rotation.is_some() {
+        if self.intensity.is_some() || self.rotation.is_some() || self.sun_share.is_some() {
             let Some(env) = scene.environment.take() else {
                 return Err(EnvironmentError {
                     file: PathBuf::from(self.env.as_deref().unwrap_or("none")),
-                    message: "--env-intensity / --env-rotation given, but the scene has no environment \
-                              (give --env FILE or --env default)"
-                        .into(),
+                    message:
+                        "--env-intensity / --env-rotation / --env-sun-share given, but the scene has no \
+                              environment (give --env FILE or --env default)"
+                            .into(),
                 });
             };
             let env = match self.intensity {
@@ -586,6 +608,10 @@ impl EnvironmentChoice {
             };
             let env = match self.rotation {
                 Some(r) => env.with_rotation_degrees(r)?,
+                None => env,
+            };
+            let env = match self.sun_share {
+                Some(share) => env.with_sun_min_share(share)?,
                 None => env,
             };
             scene.environment = Some(env);
@@ -733,6 +759,7 @@ mod tests {
             intensity: 1.0,
             rotation: 0.0,
             sun_light: true,
+            sun_min_share: SUN_MIN_SHARE,
         };
         let want = big.integral();
         let small = big.reduced(WORKING_WIDTH);
@@ -783,6 +810,7 @@ mod tests {
             intensity: Some(2.0),
             rotation: Some(90.0),
             no_sun: false,
+            sun_share: None,
         };
         let mut t = lit.clone();
         turned.apply(&mut t).unwrap();
@@ -820,6 +848,7 @@ mod tests {
             intensity: Some(2.0),
             rotation: None,
             no_sun: false,
+            sun_share: None,
         };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
     }
@@ -952,6 +981,16 @@ mod tests {
             }
         }
         assert!(Environment::default_sky().sun().is_none());
+        // The share that makes a sun (`--env-sun-share`): venice_sunset's 2.4 % is one at 0.02,
+        // rooitou_park's 65 % is none at 0.7; out of (0, 1] is refused naming the value.
+        let venice = Environment::load(&std::path::PathBuf::from(root).join("venice_sunset.hdr")).unwrap();
+        assert!(venice.clone().with_sun_min_share(0.02).unwrap().sun().is_some());
+        let park = Environment::load(&std::path::PathBuf::from(root).join("rooitou_park.hdr")).unwrap();
+        assert!(park.clone().with_sun_min_share(0.7).unwrap().sun().is_none());
+        for bad in [0.0f32, -0.1, 1.5, f32::NAN, f32::INFINITY] {
+            let m = park.clone().with_sun_min_share(bad).unwrap_err().to_string();
+            assert!(m.contains("rooitou_park.hdr") && m.contains(&format!("(got {bad})")), "{m}");
+        }
         assert!(Environment::uniform(Vec3::ONE).sun().is_none());
     }
 }

@@ -93,6 +93,7 @@ fn the_table_states_the_bounds_the_code_enforces() {
     has("--exposure", format!("±{}", render::settings::MAX_EXPOSURE_EV));
     has("--env-intensity", format!("0–{:e}", scene::environment::MAX_INTENSITY));
     has("--env-rotation", format!("±{:e}", scene::environment::MAX_ROTATION_DEGREES));
+    has("--env-sun-share", "(0, 1]".into());
     has("--frames", format!("1–{}", crate::cmd::bench::MAX_FRAMES));
     has("--warmup", format!("0–{}", crate::cmd::bench::MAX_FRAMES));
     has("--checkpoint-every", format!("–{:e} s", crate::cmd::truth::MAX_CHECKPOINT_SECONDS));

@@ -92,6 +92,9 @@ fn absurd_counts_and_sizes_are_refused() {
         ("--exposure", "-200", "±64"),
         ("--env-rotation", "1e30", "rotation"),
         ("--env-intensity", "-1", "between 0 and"),
+        ("--env-sun-share", "1.5", "(got 1.5)"),
+        ("--env-sun-share", "0", "(0, 1]"),
+        ("--env-sun-share", "-0.2", "(got -0.2)"),
     ] {
         refused(&[&r[..], &["--env", "default", flag, v]].concat(), &[needle]);
     }

@@ -455,6 +455,7 @@ mod tests {
             intensity: 1e6,
             rotation: 0.0,
             sun_light: true,
+            sun_min_share: scene::environment::SUN_MIN_SHARE,
         };
         assert!(EnvMap::new(&huge, &units(), &GreyOnly).err().unwrap().to_string().contains("huge"));
     }

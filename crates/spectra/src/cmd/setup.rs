@@ -619,6 +619,10 @@ pub struct EnvArgs {
     /// and the rest as the map. The path tracer samples the whole map either way.
     #[arg(long)]
     pub no_env_sun: bool,
+    /// Real time: the share of the map's light (∫ luminance dω) that a compact bright region
+    /// must give to be lit with as the sun, in (0, 1]. Default 0.15.
+    #[arg(long, value_name = "SHARE", allow_negative_numbers = true)]
+    pub env_sun_share: Option<f32>,
 }
 
 impl EnvArgs {
@@ -630,6 +634,7 @@ impl EnvArgs {
             intensity: self.env_intensity,
             rotation: self.env_rotation,
             no_sun: self.no_env_sun,
+            sun_share: self.env_sun_share,
         };
         if let Some(note) = choice.apply(scene)? {
             eprintln!("{note}");
