@@ -97,9 +97,9 @@ struct TargetBindings {
     shading: wgpu::BindGroup,
     custom: wgpu::BindGroup,
     post: wgpu::BindGroup,
-    accumulate: wgpu::BindGroup,
-    /// Post reading the accumulated mean instead of the current frame.
-    post_accumulated: wgpu::BindGroup,
+    /// The accumulation pass's inputs, and post reading the accumulated mean instead of the
+    /// current frame: made with the accumulation targets (`Targets::accum`).
+    accumulated: Option<(wgpu::BindGroup, wgpu::BindGroup)>,
 }
 
 /// The spectral capture of one frame (see [`Renderer::set_spectral_capture`]).
@@ -645,6 +645,9 @@ impl Renderer {
             let bind_group = self.shading.bind_inputs(&self.gpu.device, targets, &self.shadow, &buffer);
             self.capture = Some(Capture { buffer, bind_group, width, height, settings: settings.clone() });
         }
+        if self.accumulating {
+            self.ensure_accumulation_targets();
+        }
         self.update_spectral(settings)?;
         let spectral = self.spectral.as_ref().expect("update_spectral sets it");
         let scene = self.scene.as_ref().expect("checked above");
@@ -807,13 +810,14 @@ impl Renderer {
         }
         let draw = Draw { target: &targets.hdr_view, inputs: &bindings.custom, timestamps: ts(3) };
         self.custom_pass.record(&mut encoder, &shared, draw);
-        let post_inputs = if self.accumulating {
-            self.accumulated = self.accumulated.saturating_add(1);
-            self.accumulate.set_frame(&self.gpu.queue, self.accumulated);
-            self.accumulate.record(&mut encoder, targets, &bindings.accumulate);
-            &bindings.post_accumulated
-        } else {
-            &bindings.post
+        let post_inputs = match (self.accumulating, targets.accum.as_ref(), bindings.accumulated.as_ref()) {
+            (true, Some(a), Some((accumulate, post_accumulated))) => {
+                self.accumulated = self.accumulated.saturating_add(1);
+                self.accumulate.set_frame(&self.gpu.queue, self.accumulated);
+                self.accumulate.record(&mut encoder, a, accumulate);
+                post_accumulated
+            }
+            _ => &bindings.post,
         };
         let draw = Draw { target: &targets.ldr_view, inputs: post_inputs, timestamps: ts(4) };
         self.post.record(&mut encoder, &self.frame_bind_group, draw);
@@ -863,6 +867,12 @@ impl Renderer {
             .collect())
     }
 
+    /// Whether the accumulation's targets (two RGBA f32 and one RGBA f16 image at the frame's
+    /// size) are held: made at the first accumulated frame, not before.
+    pub fn accumulation_targets_made(&self) -> bool {
+        self.targets.as_ref().is_some_and(|(t, _)| t.accum.is_some())
+    }
+
     /// The accumulated mean (see [`Self::set_accumulation`]) as RGBA f32 pixels. An error when
     /// no frame has been accumulated since the last reset.
     pub fn read_accumulated(&self) -> Result<Vec<[f32; 4]>> {
@@ -873,7 +883,10 @@ impl Renderer {
                 "no accumulated frame: turn accumulation on and render".into(),
             ));
         }
-        let bytes = readback::read_texture(&self.gpu.device, &self.gpu.queue, &t.accum, 16)?;
+        let a = t.accum.as_ref().ok_or_else(|| {
+            RenderError::Settings("no accumulated frame: turn accumulation on and render".into())
+        })?;
+        let bytes = readback::read_texture(&self.gpu.device, &self.gpu.queue, &a.accum, 16)?;
         Ok(bytes
             .chunks_exact(16)
             .map(|p| {
@@ -890,12 +903,23 @@ impl Renderer {
             shading: self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy),
             custom: self.custom_pass.bind_inputs(device, t),
             post: self.post.bind_inputs(device, &t.hdr_view, "post inputs"),
-            accumulate: self.accumulate.bind_inputs(device, t),
-            post_accumulated: self.post.bind_inputs(
-                device,
-                &t.accum_display_view,
-                "post inputs (accumulated)",
-            ),
+            accumulated: None,
+        }
+    }
+
+    /// Makes the accumulation targets and their bind groups if they are not made yet.
+    fn ensure_accumulation_targets(&mut self) {
+        let device = &self.gpu.device;
+        let Some((t, b)) = self.targets.as_mut() else { return };
+        if t.accum.is_none() {
+            t.accum = Some(crate::targets::AccumTargets::new(device, t.width, t.height));
+        }
+        if b.accumulated.is_none() {
+            let a = t.accum.as_ref().expect("made above");
+            b.accumulated = Some((
+                self.accumulate.bind_inputs(device, t, a),
+                self.post.bind_inputs(device, &a.accum_display_view, "post inputs (accumulated)"),
+            ));
         }
     }
 

@@ -25,15 +25,9 @@ pub struct Targets {
     /// Custom-pass output (pass 3): the linear HDR image EXR output stores.
     pub hdr: wgpu::Texture,
     pub hdr_view: wgpu::TextureView,
-    /// Running mean of `hdr` over the accumulated frames (f32), and the previous frame's mean
-    /// (copied aside each frame, read by the accumulation pass).
-    pub accum: wgpu::Texture,
-    pub accum_view: wgpu::TextureView,
-    pub accum_prev: wgpu::Texture,
-    pub accum_prev_view: wgpu::TextureView,
-    /// The running mean in the HDR format: post's input while accumulating.
-    pub accum_display: wgpu::Texture,
-    pub accum_display_view: wgpu::TextureView,
+    /// The accumulation's, made at the first accumulated frame (most renderers never
+    /// accumulate: at 1920×1080 these are 83 MB).
+    pub accum: Option<AccumTargets>,
     /// Tone-mapped, sRGB-encoded display image (pass 4).
     pub ldr: wgpu::Texture,
     pub ldr_view: wgpu::TextureView,
@@ -72,9 +66,6 @@ impl Targets {
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
-        let (accum, accum_view) = make("accum", ACCUM_FORMAT, none);
-        let (accum_prev, accum_prev_view) = make("accum prev", ACCUM_FORMAT, wgpu::TextureUsages::COPY_DST);
-        let (accum_display, accum_display_view) = make("accum display", HDR_FORMAT, none);
         let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);
         Targets {
             width,
@@ -91,16 +82,50 @@ impl Targets {
             hdr_shaded_view,
             hdr,
             hdr_view,
-            accum,
-            accum_view,
-            accum_prev,
-            accum_prev_view,
-            accum_display,
-            accum_display_view,
+            accum: None,
             ldr,
             ldr_view,
             layer: None,
         }
+    }
+}
+
+/// The running mean of `hdr` over the accumulated frames (f32), the previous frame's mean
+/// (copied aside each frame, read by the accumulation pass), and the mean in the HDR format
+/// (post's input while accumulating).
+pub struct AccumTargets {
+    pub accum: wgpu::Texture,
+    pub accum_view: wgpu::TextureView,
+    pub accum_prev: wgpu::Texture,
+    pub accum_prev_view: wgpu::TextureView,
+    pub accum_display: wgpu::Texture,
+    pub accum_display_view: wgpu::TextureView,
+}
+
+impl AccumTargets {
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
+            let t = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC
+                    | extra,
+                view_formats: &[],
+            });
+            let v = t.create_view(&Default::default());
+            (t, v)
+        };
+        let none = wgpu::TextureUsages::empty();
+        let (accum, accum_view) = make("accum", ACCUM_FORMAT, none);
+        let (accum_prev, accum_prev_view) = make("accum prev", ACCUM_FORMAT, wgpu::TextureUsages::COPY_DST);
+        let (accum_display, accum_display_view) = make("accum display", HDR_FORMAT, none);
+        AccumTargets { accum, accum_view, accum_prev, accum_prev_view, accum_display, accum_display_view }
     }
 }
 

@@ -68,12 +68,15 @@ fn running_mean_equals_the_cpu_average_of_the_frames_and_resets() {
     r.render(&cam, &settings(offset(0))).unwrap();
     let single_ldr = r.read_ldr().unwrap();
     let single_hdr = r.read_hdr().unwrap();
+    // A renderer that does not accumulate holds no accumulation targets (issue 27 item 4).
+    assert!(!r.accumulation_targets_made());
 
     r.set_accumulation(true);
     let k = 8;
     let offsets: Vec<f32> = (0..k).map(offset).collect();
     let cpu = accumulate(&mut r, &offsets[..1]);
     assert_eq!(r.accumulated_frames(), 1);
+    assert!(r.accumulation_targets_made());
     assert_eq!(r.read_accumulated().unwrap(), single_hdr, "the first frame's mean is the frame");
     assert_eq!(r.read_ldr().unwrap(), single_ldr, "post shows the one-frame mean like the frame");
     assert!(max_rel_err(&r.read_accumulated().unwrap(), &cpu) == 0.0);

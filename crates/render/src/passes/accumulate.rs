@@ -10,7 +10,7 @@ use super::{
 };
 use crate::error::Result;
 use crate::shader;
-use crate::targets::Targets;
+use crate::targets::{AccumTargets, Targets};
 
 /// The accumulated mean's format: f32 so that rounding does not build up over many frames.
 pub const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -55,13 +55,13 @@ impl AccumulatePass {
     }
 
     /// Group 0: the current frame, the previous mean and the weight.
-    pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
+    pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets, a: &AccumTargets) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("accumulate inputs"),
             layout: &self.input_layout,
             entries: &[
                 view_entry(0, &t.hdr_view),
-                view_entry(1, &t.accum_prev_view),
+                view_entry(1, &a.accum_prev_view),
                 buffer_entry(2, &self.uniforms),
             ],
         })
@@ -70,7 +70,7 @@ impl AccumulatePass {
     /// Copies the current mean aside (`accum` → `accum_prev`, read by `inputs`, from
     /// [`Self::bind_inputs`]), then writes the new mean to `accum` and to `accum_display` (HDR
     /// format, post's input).
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, t: &Targets, inputs: &wgpu::BindGroup) {
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, t: &AccumTargets, inputs: &wgpu::BindGroup) {
         encoder.copy_texture_to_texture(
             t.accum.as_image_copy(),
             t.accum_prev.as_image_copy(),

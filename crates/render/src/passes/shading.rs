@@ -401,7 +401,7 @@ impl ShadingPass {
                 view_entry(9, &t.gbuffer_film_view),
                 // Not read outside the transmissive layer: any filterable texture the pass does
                 // not write.
-                view_entry(10, &t.accum_display_view),
+                view_entry(10, &t.ldr_view),
             ],
         })
     }
