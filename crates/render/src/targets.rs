@@ -5,6 +5,28 @@ use crate::passes::{
     DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
 
+/// A 2D render target that passes also sample, with its view.
+fn target(
+    device: &wgpu::Device,
+    (width, height): (u32, u32),
+    label: &str,
+    format: wgpu::TextureFormat,
+    extra: wgpu::TextureUsages,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let t = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
+        view_formats: &[],
+    });
+    let v = t.create_view(&Default::default());
+    (t, v)
+}
+
 /// G-buffer, depth, HDR and display targets at one size. Recreated on resize.
 pub struct Targets {
     pub width: u32,
@@ -38,21 +60,7 @@ pub struct Targets {
 impl Targets {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
-            let t = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC
-                    | extra,
-                view_formats: &[],
-            });
-            let v = t.create_view(&Default::default());
-            (t, v)
+            target(device, (width, height), label, format, wgpu::TextureUsages::COPY_SRC | extra)
         };
         let none = wgpu::TextureUsages::empty();
         let g: [(wgpu::Texture, wgpu::TextureView); 3] = [
@@ -105,21 +113,7 @@ pub struct AccumTargets {
 impl AccumTargets {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
-            let t = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC
-                    | extra,
-                view_formats: &[],
-            });
-            let v = t.create_view(&Default::default());
-            (t, v)
+            target(device, (width, height), label, format, wgpu::TextureUsages::COPY_SRC | extra)
         };
         let none = wgpu::TextureUsages::empty();
         let (accum, accum_view) = make("accum", ACCUM_FORMAT, none);
@@ -144,18 +138,7 @@ pub struct LayerTargets {
 impl LayerTargets {
     pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let make = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
-            let t = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | extra,
-                view_formats: &[],
-            });
-            let v = t.create_view(&Default::default());
-            (t, v)
+            target(device, (width, height), label, format, extra)
         };
         let none = wgpu::TextureUsages::empty();
         let views = [
