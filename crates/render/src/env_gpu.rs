@@ -143,23 +143,14 @@ impl GpuEnvironment {
             .into_iter()
             .map(|ab| [f16::from_f32(ab[0]), f16::from_f32(ab[1]), f16::ZERO, f16::ZERO])
             .collect();
-        let lut = device
-            .create_texture_with_data(
-                queue,
-                &wgpu::TextureDescriptor {
-                    label: Some("split-sum table"),
-                    size: wgpu::Extent3d { width: LUT_SIZE, height: LUT_SIZE, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: wgpu::TextureFormat::Rgba16Float,
-                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                },
-                wgpu::util::TextureDataOrder::LayerMajor,
-                bytemuck::cast_slice(&lut),
-            )
-            .create_view(&Default::default());
+        let lut = crate::gpu::rgba16f_table(
+            device,
+            queue,
+            "split-sum table",
+            (LUT_SIZE, LUT_SIZE, 1),
+            &lut,
+            wgpu::TextureViewDimension::D2,
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("environment"),
             address_mode_u: wgpu::AddressMode::Repeat,

@@ -69,3 +69,33 @@ impl Gpu {
         NO_ADAPTER_HELP
     }
 }
+
+/// A small lookup table (the split-sum table, the LTC table) uploaded as an RGBA16F texture of
+/// `layers` layers, `texels` layer major, sampled through a view of dimension `view`.
+pub(crate) fn rgba16f_table(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    (width, height, layers): (u32, u32, u32),
+    texels: &[[half::f16; 4]],
+    view: wgpu::TextureViewDimension,
+) -> wgpu::TextureView {
+    use wgpu::util::DeviceExt;
+    device
+        .create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(texels),
+        )
+        .create_view(&wgpu::TextureViewDescriptor { dimension: Some(view), ..Default::default() })
+}

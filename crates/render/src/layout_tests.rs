@@ -82,6 +82,18 @@ fn const_u32(module: &Module, name: &str) -> u32 {
     }
 }
 
+fn const_f32(module: &Module, name: &str) -> f32 {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no WGSL constant {name}"));
+    match module.global_expressions[c.init] {
+        Expression::Literal(Literal::F32(v)) => v,
+        ref e => panic!("WGSL constant {name} is not an f32 literal: {e:?}"),
+    }
+}
+
 fn shading_module(custom: &CustomShader) -> Module {
     let hooks = custom.assembled();
     parse(&[
@@ -167,6 +179,9 @@ fn shared_constants_match_the_rust_constants() {
     assert_eq!(const_u32(&shading, "MAX_SHADOWS") as usize, shadow::MAX_SHADOWS);
     assert_eq!(const_u32(&shading, "NO_SHADOW"), shadow::NO_SHADOW);
     assert_eq!(const_u32(&shading, "AXIS_INDEX") as usize, crate::coeff_table::AXIS_INDEX);
+    assert_eq!(const_u32(&shading, "LTC_SIZE") as usize, crate::ltc::SIZE);
+    let tan = (shadow::EMITTER_FOV / 2.0).tan();
+    assert!((const_f32(&shading, "EMITTER_TAN_HALF_FOV") - tan).abs() < 1e-6 * tan);
 
     let hooks = format!("{MEDIUM_COMMON}\n{}", underwater::HOOKS);
     let water = shading_module(&CustomShader::new(hooks));

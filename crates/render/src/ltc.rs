@@ -43,31 +43,19 @@ pub fn cells() -> Vec<Cell> {
 /// The table as a two-layer RGBA16F texture (layer 0: M⁻¹, layer 1: (A, B, 0, 0)), sampled
 /// bilinearly by the shading pass.
 pub fn upload(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::TextureView {
-    use wgpu::util::DeviceExt;
     let cells = cells();
     let h = f16::from_f32;
     let mut texels: Vec<[f16; 4]> = cells.iter().map(|c| c.minv.map(h)).collect();
     texels.extend(cells.iter().map(|c| [h(c.a), h(c.b), f16::ZERO, f16::ZERO]));
-    device
-        .create_texture_with_data(
-            queue,
-            &wgpu::TextureDescriptor {
-                label: Some("linearly transformed cosines"),
-                size: wgpu::Extent3d { width: SIZE as u32, height: SIZE as u32, depth_or_array_layers: 2 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba16Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            bytemuck::cast_slice(&texels),
-        )
-        .create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        })
+    let size = SIZE as u32;
+    crate::gpu::rgba16f_table(
+        device,
+        queue,
+        "linearly transformed cosines",
+        (size, size, 2),
+        &texels,
+        wgpu::TextureViewDimension::D2Array,
+    )
 }
 
 /// The table bilinearly interpolated at (roughness, n·v), as the shader samples it (in f32).

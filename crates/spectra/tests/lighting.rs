@@ -340,6 +340,19 @@ fn square(centre: glam::Vec3, half_x: f32, half_z: f32, up: bool, material: usiz
     }
 }
 
+/// Writes `s` to NAME.gltf in `d` and renders it at 96×64 without an environment, in the path
+/// tracer (direct lighting, 256 spp) and in real time: the two EXR files.
+fn truth_and_render(d: &Path, s: &scene::Scene, name: &str) -> (String, String) {
+    let file = d.join(format!("{name}.gltf"));
+    scene::write_gltf(s, &file).unwrap();
+    let f = file.display().to_string();
+    let (truth, rt) = (p(d, &format!("{name}-truth.exr")), p(d, &format!("{name}-rt.exr")));
+    let size = ["--size", "96x64", "--env", "none"];
+    spectra(&[&["truth", &f, "--direct-only", "--spp", "256", "--out", &truth][..], &size].concat());
+    spectra(&[&["render", &f, "--out", &rt][..], &size].concat());
+    (truth, rt)
+}
+
 /// Mean luminance (Rec. 709 Y of linear sRGB) of `test` and `reference` over the pixels where
 /// the reference is at least half as bright as its 98th percentile: the highlight.
 fn highlight_luminance(reference: &str, test: &str) -> (f64, f64, usize) {
@@ -399,14 +412,7 @@ fn a_rough_plane_under_a_rectangular_light_has_the_truths_highlight() {
             });
             s.meshes.push(square(glam::Vec3::ZERO, 3.0, 3.0, true, 0));
             s.meshes.push(square(glam::Vec3::new(0.0, 1.0, -2.0), 0.6, 0.3, false, 1));
-            let name = format!("plane-{}-{k}", &view[..2]);
-            let file = d.join(format!("{name}.gltf"));
-            scene::write_gltf(&s, &file).unwrap();
-            let f = file.display().to_string();
-            let (truth, rt) = (p(&d, &format!("{name}-truth.exr")), p(&d, &format!("{name}-rt.exr")));
-            let size = ["--size", "96x64", "--env", "none"];
-            spectra(&[&["truth", &f, "--direct-only", "--spp", "256", "--out", &truth][..], &size].concat());
-            spectra(&[&["render", &f, "--out", &rt][..], &size].concat());
+            let (truth, rt) = truth_and_render(&d, &s, &format!("plane-{}-{k}", &view[..2]));
             let (ours, theirs, n) = highlight_luminance(&truth, &rt);
             let ratio = ours / theirs;
             eprintln!(
@@ -489,13 +495,7 @@ fn a_box_under_a_rectangular_light_casts_the_truths_penumbra() {
         s.meshes.push(square(glam::Vec3::ZERO, 3.0, 3.0, true, 0));
         s.meshes.push(cube(glam::Vec3::new(0.0, 0.0, 0.0), 0.2, 0));
         s.meshes.push(square(glam::Vec3::new(0.0, 1.2, -0.4), half, half, false, 1));
-        let file = d.join(format!("box{k}.gltf"));
-        scene::write_gltf(&s, &file).unwrap();
-        let f = file.display().to_string();
-        let (truth, rt) = (p(&d, &format!("box{k}-truth.exr")), p(&d, &format!("box{k}-rt.exr")));
-        let size = ["--size", "96x64", "--env", "none"];
-        spectra(&[&["truth", &f, "--direct-only", "--spp", "256", "--out", &truth][..], &size].concat());
-        spectra(&[&["render", &f, "--out", &rt][..], &size].concat());
+        let (truth, rt) = truth_and_render(&d, &s, &format!("box{k}"));
         let de = block_de(&truth, &rt);
         eprintln!(
             "box under a light of side {}: real time vs truth (direct) block-mean ΔE2000 {de:.3}",
