@@ -161,6 +161,8 @@ pub struct Renderer {
     gbuffer: GBufferPass,
     shadow: ShadowPass,
     shading: ShadingPass,
+    /// Made at the first frame with see-through materials.
+    back_faces: Option<crate::passes::back_faces::BackFacesPass>,
     custom_pass: CustomPass,
     post: PostPass,
     accumulate: AccumulatePass,
@@ -250,6 +252,7 @@ impl Renderer {
             gbuffer,
             shadow,
             shading,
+            back_faces: None,
             custom_pass,
             post,
             accumulate,
@@ -713,6 +716,10 @@ impl Renderer {
             if t.layer.is_none() {
                 t.layer = Some(crate::targets::LayerTargets::new(&self.gpu.device, t.width, t.height));
             }
+            if self.back_faces.is_none() {
+                self.back_faces =
+                    Some(crate::passes::back_faces::BackFacesPass::new(&self.gpu.device, &self.shared)?);
+            }
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
@@ -793,9 +800,17 @@ impl Renderer {
                     GBufferLayer::Transmissive,
                     None,
                 );
+                self.back_faces.as_ref().expect("made with the layer").record(
+                    &mut encoder,
+                    &layer.back_faces_view,
+                    &layer.back_depth_view,
+                    &self.frame_bind_group,
+                    scene,
+                );
                 let layer_inputs = self.shading.bind_layer_inputs(
                     &self.gpu.device,
                     layer,
+                    &targets.depth_view,
                     &self.shadow,
                     &self.capture_dummy,
                 );

@@ -1,6 +1,7 @@
 //! The size-dependent render targets of one frame.
 
 use crate::passes::accumulate::ACCUM_FORMAT;
+use crate::passes::back_faces::BACK_FACES_FORMAT;
 use crate::passes::{
     DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
@@ -133,6 +134,9 @@ pub struct LayerTargets {
     pub depth_view: wgpu::TextureView,
     pub background: wgpu::Texture,
     pub background_view: wgpu::TextureView,
+    /// The see-through meshes' nearest back faces (`passes::back_faces`) and their depth.
+    pub back_faces_view: wgpu::TextureView,
+    pub back_depth_view: wgpu::TextureView,
 }
 
 impl LayerTargets {
@@ -150,6 +154,16 @@ impl LayerTargets {
         ];
         let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);
         let (background, background_view) = make("background", HDR_FORMAT, wgpu::TextureUsages::COPY_DST);
-        LayerTargets { gbuffer_views: views, depth, depth_view, background, background_view }
+        let back_faces_view = make("back faces", BACK_FACES_FORMAT, none).1;
+        let back_depth_view = make("back-face depth", DEPTH_FORMAT, none).1;
+        LayerTargets {
+            gbuffer_views: views,
+            depth,
+            depth_view,
+            background,
+            background_view,
+            back_faces_view,
+            back_depth_view,
+        }
     }
 }

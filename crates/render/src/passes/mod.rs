@@ -6,6 +6,7 @@
 //! per-wavelength data and the coefficient table, 3 = the custom shader's parameters.
 
 pub mod accumulate;
+pub mod back_faces;
 pub mod custom;
 pub mod gbuffer;
 pub mod post;

@@ -223,8 +223,11 @@ impl ShadingPass {
                 },
                 // The films (`gbuf_film`).
                 texture_entry(9),
-                // The transmissive layer's background (`background`, transmission.wgsl).
+                // The transmissive layer's background (`background`, transmission.wgsl), its
+                // back faces (`back_faces`) and the opaque layer's depth (`opaque_depth`).
                 super::filterable_entry(10),
+                texture_entry(11),
+                super::depth_entry(12),
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -399,19 +402,23 @@ impl ShadingPass {
                 buffer_entry(7, capture),
                 view_entry(8, &t.gbuffer_slot_view),
                 view_entry(9, &t.gbuffer_film_view),
-                // Not read outside the transmissive layer: any filterable texture the pass does
-                // not write.
+                // Not read outside the transmissive layer: any textures of their kinds the pass
+                // does not write.
                 view_entry(10, &t.ldr_view),
+                view_entry(11, &g[0]),
+                view_entry(12, &t.depth_view),
             ],
         })
     }
 
-    /// Group 1 of the transmissive layer: its G-buffer and depth, the shadow maps, and the
-    /// opaque layer's shaded image as the background.
+    /// Group 1 of the transmissive layer: its G-buffer and depth, the shadow maps, the
+    /// opaque layer's shaded image as the background and its depth `opaque_depth`, and the
+    /// see-through meshes' back faces.
     pub fn bind_layer_inputs(
         &self,
         device: &wgpu::Device,
         layer: &crate::targets::LayerTargets,
+        opaque_depth: &wgpu::TextureView,
         shadow: &ShadowPass,
         capture: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
@@ -434,6 +441,8 @@ impl ShadingPass {
                 view_entry(8, &g[3]),
                 view_entry(9, &g[4]),
                 view_entry(10, &layer.background_view),
+                view_entry(11, &layer.back_faces_view),
+                view_entry(12, opaque_depth),
             ],
         })
     }
