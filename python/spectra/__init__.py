@@ -51,8 +51,14 @@ __all__ = [
 
 @functools.lru_cache(maxsize=8)
 def _load_cached(
-    path_or_builtin, allow_outside_scene_dir=False, env=None, env_intensity=None, env_rotation=None, env_sun=True
+    path_or_builtin,
+    allow_outside_scene_dir=False,
+    env=None,
+    env_intensity=None,
+    env_rotation=None,
+    env_sun=True,
+    env_sun_share=None,
 ):
     """`load`, kept per process: what an unpickled `Scene` is (a Ray worker loads a scene
     once, however many tasks it runs with it)."""
-    return load(path_or_builtin, allow_outside_scene_dir, env, env_intensity, env_rotation, env_sun)
+    return load(path_or_builtin, allow_outside_scene_dir, env, env_intensity, env_rotation, env_sun, env_sun_share)

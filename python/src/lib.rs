@@ -116,6 +116,7 @@ struct LoadArgs {
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
     env_sun: bool,
+    env_sun_share: Option<f32>,
 }
 
 #[pymethods]
@@ -153,6 +154,7 @@ impl Scene {
             h.env_intensity,
             h.env_rotation,
             h.env_sun,
+            h.env_sun_share,
         )
             .into_pyobject(py)?;
         Ok((load, args))
@@ -188,10 +190,13 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Arc<scene::Scene>> {
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
 /// environment when the scene has no lights. `env_intensity` multiplies it, `env_rotation`
 /// turns it about +Y (degrees). `env_sun`: light the map's sun, where it has one, in real time
-/// as a shadowed directional light (`False`: `--no-env-sun`, the whole map unshadowed).
+/// as a shadowed directional light (`False`: `--no-env-sun`, the whole map unshadowed);
+/// `env_sun_share`: the share of the map's light a compact bright region must give to be that
+/// sun, in (0, 1] (`--env-sun-share`; default 0.15).
 #[pyfunction]
 #[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false, env = None, env_intensity = None,
-                    env_rotation = None, env_sun = true))]
+                    env_rotation = None, env_sun = true, env_sun_share = None))]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
 fn load(
     py: Python<'_>,
     path_or_builtin: PathBuf,
@@ -200,6 +205,7 @@ fn load(
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
     env_sun: bool,
+    env_sun_share: Option<f32>,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
@@ -223,8 +229,15 @@ fn load(
             .and_then(|p| p.to_str().map(String::from))
             .unwrap_or_else(|| e.clone()),
     });
-    let how =
-        LoadArgs { name: abs, allow_outside_scene_dir, env: env_abs, env_intensity, env_rotation, env_sun };
+    let how = LoadArgs {
+        name: abs,
+        allow_outside_scene_dir,
+        env: env_abs,
+        env_intensity,
+        env_rotation,
+        env_sun,
+        env_sun_share,
+    };
     let h = LoadArgs { env, ..how.clone() };
     let scene = py.detach(move || -> Result<scene::Scene, PyErr> {
         let lower = name.to_ascii_lowercase();
@@ -241,7 +254,7 @@ fn load(
                 env_intensity: h.env_intensity,
                 env_rotation: h.env_rotation,
                 no_env_sun: !h.env_sun,
-                env_sun_share: None,
+                env_sun_share: h.env_sun_share,
             },
         };
         args.load().map_err(|e| {

@@ -292,6 +292,26 @@ def test_env_sun_switch_is_the_clis_and_survives_pickling():
     assert np.array_equal(b, c)
 
 
+def test_env_sun_share_is_the_clis():
+    """`env_sun_share` is `--env-sun-share`: asking more of a sun than rooitou_park's gives
+    (65 % of its light) makes the map sunless, as `env_sun=False` does; out of range is the
+    CLI's error, naming the value; a pickled scene keeps the share."""
+    import pickle
+
+    sky = str(ROOT / "assets" / "environments" / "rooitou_park.hdr")
+    strict = spectra.load("colorchecker", env=sky, env_sun_share=0.9)
+    a = spectra.Renderer(strict, size=(24, 16)).render()
+    b = spectra.Renderer(spectra.load("colorchecker", env=sky, env_sun=False), size=(24, 16)).render()
+    c = spectra.Renderer(spectra.load("colorchecker", env=sky, env_sun_share=0.5), size=(24, 16)).render()
+    assert np.array_equal(a, b)
+    assert not np.array_equal(a, c)
+    d = spectra.Renderer(pickle.loads(pickle.dumps(strict)), size=(24, 16)).render()
+    assert np.array_equal(a, d)
+    for bad in (0.0, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="share"):
+            spectra.load("colorchecker", env=sky, env_sun_share=bad)
+
+
 def test_env_options():
     with pytest.raises(FileNotFoundError, match="no_such_sky.hdr"):
         spectra.load("cornell", env="no_such_sky.hdr")
