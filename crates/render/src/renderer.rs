@@ -709,8 +709,7 @@ impl Renderer {
             && !(settings.mode != Mode::Rgb && self.custom.spectral());
         if layered {
             // Prepared first: `select` leaves the pipeline it makes last current.
-            let layer_variant =
-                Variant { film: false, emission: variant.emission, transmission: true, ..variant };
+            let layer_variant = Variant { film: scene.has_transmission_film, transmission: true, ..variant };
             self.shading.select(&self.gpu.device, layer_variant, settings.mode == Mode::Rgb)?;
             let (t, _) = self.targets.as_mut().expect("checked above");
             if t.layer.is_none() {

@@ -121,8 +121,9 @@ impl MaterialUniforms {
 
 /// The material's transmission as the real-time renderer draws it: the transmissive layer
 /// (`passes::gbuffer::Layer::Transmissive`) for a lit material with a factor above 0. Such a
-/// material's thin film, if any, is not drawn in real time (its G-buffer channels hold the
-/// transmission); the path tracer draws both.
+/// material's thin film, if any, is drawn with its factor and maximum thickness, without its
+/// textures (its G-buffer channels hold the transmission; [`refraction_record`]); the path
+/// tracer draws both in full.
 pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmission> {
     m.transmission.as_ref().filter(|t| !m.unlit && t.factor > 0.0)
 }
@@ -427,6 +428,9 @@ pub struct GpuScene {
     /// Whether some material is see-through ([`transmission`]): only then is the transmissive
     /// layer drawn and shaded.
     pub has_transmission: bool,
+    /// Whether some see-through material has a thin film: only then does the transmissive
+    /// layer's shading carry the film's code.
+    pub has_transmission_film: bool,
     /// Per material, `MaterialSpectrum::refraction` and `::absorption` ([`refraction_record`]).
     pub material_refraction: Vec<[[f32; 4]; 2]>,
 }
@@ -666,6 +670,10 @@ impl GpuScene {
                 .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
+            has_transmission_film: s
+                .materials
+                .iter()
+                .any(|m| transmission(m).is_some() && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
             material_refraction: s.materials.iter().map(refraction_record).collect(),
             material_films: s
                 .materials
@@ -1038,7 +1046,7 @@ impl DefaultTextures {
 
 /// A material's refraction for the shading pass: (index at the d line, dispersion (20 / Abbe
 /// number), thickness in scene units (0: thin-walled), 0) and the interior's absorption
-/// coefficient per scene unit in linear RGB (0 when clear), which the spectral modes upsample
+/// coefficient per scene unit in linear RGB (0 when clear; w: its thin film's factor), which the spectral modes upsample
 /// as a box spectrum per channel: `color::upsample::medium::Attenuation::DEFAULT`, the path
 /// tracer's upsampling of the same `scene::transmission::Volume::medium`.
 pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
@@ -1048,7 +1056,10 @@ pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
         None => (0.0, [0.0; 3]),
     };
     let dispersion = if t.disperses() { t.dispersion } else { 0.0 };
-    [[m.ior, dispersion, thickness, 0.0], [sigma[0], sigma[1], sigma[2], 0.0]]
+    // A see-through material's thin film is drawn with its factor and its maximum thickness
+    // (the thickness texture's default): the layer's G-buffer channels hold the transmission.
+    let film = m.iridescence.as_ref().map_or(0.0, |f| f.factor.clamp(0.0, 1.0));
+    [[m.ior, dispersion, thickness, 0.0], [sigma[0], sigma[1], sigma[2], film]]
 }
 
 #[cfg(test)]

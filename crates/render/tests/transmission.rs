@@ -364,3 +364,48 @@ fn a_glass_ball_inverts_what_lies_behind_it() {
 fn at_w(img: &[[f64; 3]], w: u32, (x, y): (u32, u32)) -> [f64; 3] {
     img[(y * w + x) as usize]
 }
+
+/// A see-through material's thin film (KHR_materials_iridescence on a transmissive material) is
+/// drawn in real time: under a light shining along the view onto a rough grey pane, its
+/// reflection takes the film's colour (a 300 nm film of index 1.33 over the pane's 1.5), in RGB
+/// (the extension's Belcour–Barla film) and spectral (the exact film per node) modes; a film of
+/// factor 0 is no film, to the bit; half the factor gives a different image.
+#[test]
+fn a_see_through_film_colours_the_reflection() {
+    let film = |factor: f32| {
+        let mut m = glass(0.5, 1.5, 0.5, None, 0.0);
+        m.roughness = 0.4;
+        m.iridescence = Some(scene::Iridescence {
+            factor,
+            texture: None,
+            ior: 1.33,
+            thickness_min: 100.0,
+            thickness_max: 300.0,
+            thickness_texture: None,
+        });
+        let mut s = scene(Some(m), false);
+        s.lights.push(scene::Light {
+            name: "along the view".into(),
+            kind: scene::LightKind::Directional { direction: Vec3::NEG_Z },
+            emission: scene::Emission { rgb: Vec3::ONE, intensity: 2.0, spectrum: None },
+            stands_in_for: None,
+        });
+        s
+    };
+    let mut r = renderer();
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        let plain = {
+            let mut s = film(0.0);
+            s.materials[2].iridescence = None;
+            at(&render(&mut r, &s, mode), CENTRE)
+        };
+        let zero = at(&render(&mut r, &film(0.0), mode), CENTRE);
+        let full = at(&render(&mut r, &film(1.0), mode), CENTRE);
+        let half = at(&render(&mut r, &film(0.5), mode), CENTRE);
+        assert_eq!(zero, plain, "{mode:?}: a film of factor 0");
+        let hue = |p: [f64; 3]| p.map(|c| c / (p[0] + p[1] + p[2]));
+        let shift = (0..3).map(|c| (hue(full)[c] - hue(plain)[c]).abs()).fold(0.0, f64::max);
+        assert!(shift > 0.02, "{mode:?}: the film does not colour the reflection ({plain:?} → {full:?})");
+        assert_ne!(half, full, "{mode:?}: the film's factor is not used");
+    }
+}

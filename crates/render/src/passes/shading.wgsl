@@ -463,8 +463,14 @@ fn load_film(px: vec2<i32>) -> FilmSurface {
     if (!HAS_FILM || lambert_only()) {
         return FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
     }
-    let f = textureLoad(gbuf_film, px, 0);
-    let m = material_at(px).film;
+    var f = textureLoad(gbuf_film, px, 0);
+    let mat = material_at(px);
+    if (HAS_TRANSMISSION) {
+        // The see-through layer's film channels hold its transmission: the film is the
+        // material's factor at its maximum thickness (`scene_gpu::refraction_record`).
+        f = vec4<f32>(mat.absorption.w, 1.0, 0.0, 0.0);
+    }
+    let m = mat.film;
     var f0 = 0.04;
     var base_ior = 1.5;
     if (HAS_IOR) {
@@ -587,7 +593,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         rgb = fma(s.base, sum_a, sum_b) + s.emission;
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
-            if (HAS_TRANSMISSION) {
+            if (HAS_TRANSMISSION && !filmed) {
                 et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
             } else if (!filmed) {
                 et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
@@ -601,7 +607,7 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
                     fm = mix(s.base * a + b, film_rgb(l.nv, film.thickness_nm, film.ior, s.base) * (a + b), film.weight);
                 }
                 et.a = vec4<f32>(0.0);
-                et.b = vec4<f32>((1.0 - s.metallic) / PI * (1.0 - fd) * s.base * l.irr.rgb
+                et.b = vec4<f32>((1.0 - s.metallic) / PI * (1.0 - fd) * keep * s.base * l.irr.rgb
                     + ((1.0 - s.metallic) * fd + s.metallic * fm) * l.spec.rgb, 0.0);
             }
             var env_rgb = (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
@@ -794,7 +800,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if (has_env && !s.unlit) {
         if (film_env) {
             lobes = env_lobes(s.normal, v, s.roughness);
-            lobes.irr *= vis;
+            // A see-through surface's diffuse layer is what its transmission leaves.
+            lobes.irr *= vis * keep;
             lobes.spec *= vis;
         } else {
             if (HAS_TRANSMISSION) {
