@@ -383,21 +383,86 @@ fn assign(
         layers.push(Layer { skip_mesh: light.stands_in_for });
     }
     // Emissive polygons follow the punctual lights in the GPU list: each shadowed from its
-    // centroid, looking along its normal (150° wide), without its own mesh.
-    for (ei, e) in emitters.iter().enumerate() {
-        let li = lights.len() + ei;
-        if layers.len() == MAX_SHADOWS || li >= MAX_LIGHTS {
+    // centroid, looking along its normal (150° wide), without its own mesh — when they all fit.
+    let in_list = emitters.len().min(MAX_LIGHTS.saturating_sub(lights.len()));
+    if in_list <= MAX_SHADOWS - layers.len() {
+        for (ei, e) in emitters.iter().enumerate().take(in_list) {
+            let li = lights.len() + ei;
+            let Some((view_proj, bias)) = emitter_view_proj(e, bounds) else { continue };
+            let layer = layers.len();
+            u.view_proj[layer] = view_proj.to_cols_array_2d();
+            let (near, far) = emitter_depth_range(e, bounds);
+            u.bias[layer] = [bias, near, far, (e.area.max(0.0) / std::f32::consts::PI).sqrt()];
+            u.layer_of_light[li / 4][li % 4] = layer as u32;
+            layers.push(Layer { skip_mesh: Some(e.mesh) });
+        }
+        return (u, layers);
+    }
+    // More area lights than maps: the lights of one emitting mesh share a map from the mesh's
+    // emitting centre (`mesh_view_proj`), brightest meshes first, so that a few glowing objects
+    // cut into many lights (a cube's six faces, a sphere's clusters) are all shadowed instead
+    // of the first eight lights only — unshadowed lights leak through walls.
+    let mut meshes: Vec<(usize, Vec<usize>, f64)> = Vec::new();
+    for (ei, e) in emitters.iter().enumerate().take(in_list) {
+        match meshes.iter_mut().find(|m| m.0 == e.mesh) {
+            Some(m) => {
+                m.1.push(ei);
+                m.2 += e.power();
+            }
+            None => meshes.push((e.mesh, vec![ei], e.power())),
+        }
+    }
+    meshes.sort_by(|a, b| b.2.total_cmp(&a.2));
+    for (mesh, members, _) in meshes {
+        if layers.len() == MAX_SHADOWS {
             break;
         }
-        let Some((view_proj, bias)) = emitter_view_proj(e, bounds) else { continue };
+        let group: Vec<&scene::emitters::Emitter> = members.iter().map(|&ei| &emitters[ei]).collect();
+        let Some((view_proj, bias, near, far, radius)) = mesh_view_proj(&group, bounds) else { continue };
         let layer = layers.len();
         u.view_proj[layer] = view_proj.to_cols_array_2d();
-        let (near, far) = emitter_depth_range(e, bounds);
-        u.bias[layer] = [bias, near, far, (e.area.max(0.0) / std::f32::consts::PI).sqrt()];
-        u.layer_of_light[li / 4][li % 4] = layer as u32;
-        layers.push(Layer { skip_mesh: Some(e.mesh) });
+        u.bias[layer] = [bias, near, far, radius];
+        for ei in members {
+            let li = lights.len() + ei;
+            u.layer_of_light[li / 4][li % 4] = layer as u32;
+        }
+        layers.push(Layer { skip_mesh: Some(mesh) });
     }
     (u, layers)
+}
+
+/// The shadow frustum shared by the area lights of one emitting mesh: a 150° perspective from
+/// their power-weighted centre, looking along their power-weighted mean normal (an open emitter,
+/// e.g. a panel) or, where the normals cancel (a closed one: a cube, a sphere), towards the
+/// scene's centre; with the map's bias, depth range and the light's radius for the soft shadows
+/// (the disc of the mesh's projected area: total area / π for an open emitter, / 4π for a closed
+/// one, as a sphere's).
+fn mesh_view_proj(
+    group: &[&scene::emitters::Emitter],
+    bounds: (Vec3, Vec3),
+) -> Option<(Mat4, f32, f32, f32, f32)> {
+    let centre = (bounds.0 + bounds.1) * 0.5;
+    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let texel = 2.0 * radius / SHADOW_SIZE as f32;
+    let power: f64 = group.iter().map(|e| e.power()).sum();
+    let weight = |e: &scene::emitters::Emitter| {
+        if power > 0.0 { (e.power() / power) as f32 } else { 1.0 / group.len() as f32 }
+    };
+    let eye = group.iter().map(|e| e.centroid() * weight(e)).sum::<Vec3>();
+    let mean_normal = group.iter().map(|e| e.normal * weight(e)).sum::<Vec3>();
+    let area: f32 = group.iter().map(|e| e.area.max(0.0)).sum();
+    let closed = mean_normal.length() < 0.5;
+    let d = if closed {
+        (centre - eye).try_normalize().unwrap_or(Vec3::NEG_Y)
+    } else {
+        mean_normal.try_normalize()?
+    };
+    let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let far = (eye - centre).length() + radius * 2.0;
+    let near = far * 1e-3;
+    let view = Mat4::look_at_rh(eye, eye + d, up);
+    let disc = (area / if closed { 4.0 * std::f32::consts::PI } else { std::f32::consts::PI }).sqrt();
+    Some((Mat4::perspective_rh(EMITTER_FOV, 1.0, near, far) * view, texel * 1.5, near, far, disc))
 }
 
 /// View-projection from the light and a normal-offset bias (world units), or `None` when the
@@ -513,5 +578,63 @@ mod tests {
         assert!(layers[1..].iter().all(|l| l.skip_mesh.is_none()));
         let (u, layers) = assign(&lights, &[], bounds, false);
         assert!(layers.is_empty() && u.layer_of_light.iter().flatten().all(|&l| l == NO_SHADOW));
+    }
+
+    /// A unit square face of cube `mesh` centred at `c` with outward normal `n`.
+    fn face(mesh: usize, c: Vec3, n: Vec3, strength: f32) -> scene::emitters::Emitter {
+        let t = if n.y.abs() > 0.9 { Vec3::X } else { Vec3::Y };
+        let b = n.cross(t);
+        let p = c + n * 0.5;
+        scene::emitters::Emitter {
+            mesh,
+            vertices: vec![
+                p - t * 0.5 - b * 0.5,
+                p + t * 0.5 - b * 0.5,
+                p + t * 0.5 + b * 0.5,
+                p - t * 0.5 + b * 0.5,
+            ],
+            emission: scene::Emission { rgb: Vec3::ONE, intensity: strength, spectrum: None },
+            normal: n,
+            area: 1.0,
+        }
+    }
+
+    #[test]
+    fn area_lights_that_outnumber_the_maps_share_one_per_mesh() {
+        let bounds = (Vec3::splat(-10.0), Vec3::splat(10.0));
+        let normals = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+        // Five glowing cubes of strengths 1, 2, 4, 8, 16 (EmissiveStrengthTest): 30 lights.
+        let mut emitters = Vec::new();
+        for (mesh, x) in [-6.0f32, -3.0, 0.0, 3.0, 6.0].into_iter().enumerate() {
+            for n in normals {
+                emitters.push(face(mesh, Vec3::new(x, 0.0, 0.0), n, (1u32 << mesh) as f32));
+            }
+        }
+        let (u, layers) = assign(&[], &emitters, bounds, true);
+        let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
+        assert_eq!(layers.len(), 5, "one map per cube");
+        for (ei, e) in emitters.iter().enumerate() {
+            let l = layer(ei) as usize;
+            assert_ne!(l as u32, NO_SHADOW, "light {ei} unshadowed");
+            assert_eq!(layers[l].skip_mesh, Some(e.mesh), "light {ei} shares its own cube's map");
+        }
+        // Brightest cube first; the closed cube's radius is the sphere of its six faces' area.
+        assert_eq!(layer(24), 0);
+        assert!((u.bias[0][3] - (6.0 / (4.0 * std::f32::consts::PI)).sqrt()).abs() < 1e-6);
+        // Sixteen two-sided emitters (32 lights): the eight brightest get maps, the rest none.
+        let many: Vec<_> = (0..16)
+            .flat_map(|mesh| {
+                [Vec3::X, Vec3::NEG_X]
+                    .map(|n| face(mesh, Vec3::new(mesh as f32 - 8.0, 0.0, 0.0), n, 1.0 + mesh as f32))
+            })
+            .collect();
+        let (u, layers) = assign(&[], &many, bounds, true);
+        assert_eq!(layers.len(), MAX_SHADOWS);
+        let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
+        assert_eq!((layer(0), layer(1)), (NO_SHADOW, NO_SHADOW), "the dimmest emitter's lights");
+        assert_eq!((layer(30), layer(31)), (0, 0), "the brightest's share the first map");
+        // Few enough lights keep a map each (as before).
+        let (_, layers) = assign(&[], &emitters[..6], bounds, true);
+        assert_eq!(layers.len(), 6);
     }
 }
