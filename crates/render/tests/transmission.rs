@@ -227,43 +227,6 @@ fn dispersion_refracts_the_colours_apart() {
     }
 }
 
-/// A smooth UV sphere (radial normals, counter-clockwise outside).
-fn sphere_mesh(centre: Vec3, radius: f32, rings: u32, segments: u32, material: usize) -> Mesh {
-    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..=rings {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..=segments {
-            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-            positions.push(centre + radius * n);
-            normals.push(n);
-        }
-    }
-    let row = segments + 1;
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b, c, d) = (i * row + j, (i + 1) * row + j, (i + 1) * row + j + 1, i * row + j + 1);
-            // Degenerate triangles at the poles are left out.
-            if i + 1 < rings {
-                indices.extend_from_slice(&[a, c, b]);
-            }
-            if i > 0 {
-                indices.extend_from_slice(&[a, d, c]);
-            }
-        }
-    }
-    Mesh {
-        colors: vec![],
-        uvs1: vec![],
-        positions,
-        normals,
-        tangents: vec![],
-        uvs: vec![],
-        indices,
-        material,
-    }
-}
-
 /// Snell's law in vector form (unit `d`, `n` facing against `d`), `None` past the critical angle.
 fn snell(d: glam::DVec3, n: glam::DVec3, eta: f64) -> Option<glam::DVec3> {
     let c = -n.dot(d);
@@ -302,7 +265,7 @@ fn a_glass_ball_inverts_what_lies_behind_it() {
         attenuation_distance: f32::INFINITY,
     };
     s.materials.push(glass(1.0, ior as f32, 1.0, Some(vol), 0.0));
-    s.meshes.push(sphere_mesh(Vec3::ZERO, radius as f32, 48, 96, 3));
+    s.meshes.push(Mesh::uv_sphere(Vec3::ZERO, radius as f32, 48, 96, 3));
     s.camera.ortho = Some((1.0, 0.2));
     let y = 0.0;
     // Column x's centre in the scene, and where the view ray through it lands on the background.

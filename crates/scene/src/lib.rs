@@ -118,6 +118,12 @@ impl Mesh {
     pub fn quad(o: Vec3, u: Vec3, v: Vec3, material: usize) -> Mesh {
         builtin::shapes::quad(o, u, v, material)
     }
+
+    /// A smooth UV sphere of `rings` × `segments` quads sharing their vertices, normals radial,
+    /// counter-clockwise outside (the built-in scenes' spheres).
+    pub fn uv_sphere(centre: Vec3, radius: f32, rings: u32, segments: u32, material: usize) -> Mesh {
+        builtin::shapes::sphere(centre, radius, rings, segments, material)
+    }
 }
 
 /// A triangle mesh in world space.
