@@ -8,7 +8,7 @@
 //! Inputs: the frame uniforms, the see-through draws' vertices. Outputs: the back-face target
 //! (cleared to w = −1: no back face) and its own depth.
 
-use super::{DEPTH_FORMAT, SharedLayouts, pipeline_layout};
+use super::{SharedLayouts, depth_state, pipeline_layout};
 use crate::error::Result;
 use crate::scene_gpu::{GpuScene, Vertex};
 use crate::shader;
@@ -37,13 +37,7 @@ impl BackFacesPass {
                     buffers: &[Some(Vertex::layout())],
                 },
                 primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Front), ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
+                depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, true)),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,

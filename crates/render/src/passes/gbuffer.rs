@@ -10,7 +10,7 @@
 //! film adds a fifth in every mode, the film's values ([`GBUFFER_FILM_FORMAT`]), so that a scene
 //! without one samples no film texture and writes no film target.
 
-use super::{DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
+use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -205,13 +205,7 @@ fn build(
                     cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
                     ..Default::default()
                 },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
+                depth_stencil: Some(super::depth_state(wgpu::CompareFunction::Less, true)),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module,

@@ -39,6 +39,17 @@ pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uin
 /// guarantees (3 × 8 + 4 + 4).
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// A [`DEPTH_FORMAT`] depth test with `compare`, writing depth when `write`.
+pub fn depth_state(compare: wgpu::CompareFunction, write: bool) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
 /// Display output: the hardware does the sRGB encoding on store.
 pub const LDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 

@@ -313,13 +313,7 @@ impl ShadingPass {
                 buffers: &[Some(crate::scene_gpu::Vertex::layout())],
             },
             primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: super::DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: Some(super::depth_state(wgpu::CompareFunction::LessEqual, false)),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &self.module,
