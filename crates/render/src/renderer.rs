@@ -657,7 +657,24 @@ impl Renderer {
         // The number this frame will have in the running mean (see `accumulate` below): the
         // salt of the stochastic transparency, so that its noise averages out over frames.
         let frame_index = if self.accumulating { self.accumulated.saturating_add(1) } else { 0 };
-        self.shadow.update(&self.gpu.queue, scene, self.scene_generation, settings.shadows, frame_index);
+        let remade = self.shadow.update(
+            &self.gpu.device,
+            &self.gpu.queue,
+            scene,
+            self.scene_generation,
+            settings.shadows,
+            frame_index,
+        );
+        if remade {
+            // The shading inputs hold the old depth array.
+            let device = &self.gpu.device;
+            if let Some((t, b)) = self.targets.as_mut() {
+                b.shading = self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy);
+                if let Some(c) = self.capture.as_mut() {
+                    c.bind_group = self.shading.bind_inputs(device, t, &self.shadow, &c.buffer);
+                }
+            }
+        }
 
         let aspect = width as f32 / height as f32;
         let view = camera.transform.inverse();

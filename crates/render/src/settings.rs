@@ -172,9 +172,9 @@ pub struct RenderSettings {
     /// Exposure in stops: the HDR colour is multiplied by 2^EV before tone mapping.
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
-    /// Render a shadow map for each light, stand-ins included (the first
-    /// [`crate::passes::shadow::MAX_SHADOWS`] with a frustum, in scene order; any further
-    /// lights are unshadowed).
+    /// Render a shadow map for each light, stand-ins and emissive polygons included (every
+    /// light with a frustum: [`crate::passes::shadow::MAX_SHADOWS`] is the shading pass's
+    /// light limit).
     pub shadows: bool,
     /// Measure each pass with GPU timestamp queries (when the adapter supports them).
     pub timestamps: bool,

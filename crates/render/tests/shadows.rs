@@ -1,7 +1,7 @@
 //! Shadows from several lights: each light has its own shadow map, so an occluder that blocks
 //! light B but not light A leaves exactly A's analytic contribution; a stand-in light shadows
-//! like any other but not through its own emissive mesh; lights beyond
-//! `passes::shadow::MAX_SHADOWS` are unshadowed (documented limit).
+//! like any other but not through its own emissive mesh; every light up to
+//! `passes::shadow::MAX_SHADOWS` (all the lights the shading pass draws) has its map.
 
 mod common;
 
@@ -145,11 +145,15 @@ fn analytic(albedo: [f32; 3], d: Vec3, lights: &[(Vec3, f32)]) -> [f64; 3] {
 /// Renders the scene with `n_a` A lights and compares every classified pixel with the analytic
 /// value where B is blocked in `ShadowB` pixels iff `b_shadowed`. Returns pixel counts per zone.
 fn check(name: &str, n_a: usize, b_shadowed: bool) -> [usize; 3] {
+    check_on(&mut renderer(), name, n_a, b_shadowed)
+}
+
+/// `check` with renderer `r` (which may have drawn other scenes before).
+fn check_on(r: &mut Renderer, name: &str, n_a: usize, b_shadowed: bool) -> [usize; 3] {
     let (s, chart) = scene(n_a);
-    let mut r = renderer();
     r.set_scene(&s).unwrap();
     r.resize(W, H).unwrap();
-    let actual = render(&mut r, true);
+    let actual = render(r, true);
     let mut counts = [0; 3];
     let expected: Vec<Option<[f64; 3]>> = (0..W * H)
         .map(|i| {
@@ -174,10 +178,16 @@ fn every_light_casts_its_own_shadow() {
 }
 
 #[test]
-fn lights_beyond_the_maximum_are_unshadowed() {
-    // MAX_SHADOWS A lights take every layer, so B (the last) has no map and lights ShadowB fully.
-    let counts = check("shadows-beyond-max", MAX_SHADOWS, false);
+fn every_light_up_to_the_maximum_has_its_map() {
+    // MAX_SHADOWS − 1 A lights and B: B's is the last layer. The same renderer drew a scene of
+    // two maps first, so its depth array is made again with more layers (and the shading
+    // pass's inputs with it); a renderer that kept the old array leaves B unshadowed.
+    let mut r = renderer();
+    check_on(&mut r, "shadows-two-layers-first", 1, true);
+    let counts = check_on(&mut r, "shadows-every-layer", MAX_SHADOWS - 1, true);
     assert!(counts[0] >= 15, "pixels in B's shadow zone: {counts:?}");
+    // And back to fewer layers.
+    check_on(&mut r, "shadows-two-layers-again", 1, true);
 }
 
 #[test]

@@ -15,7 +15,7 @@
 // MAX_LIGHTS, MAX_SHADOWS and NO_SHADOW are the Rust constants of src/scene_gpu.rs and
 // src/passes/shadow.rs; src/layout_tests.rs checks them and the structs below.
 const MAX_LIGHTS: u32 = 32u;
-const MAX_SHADOWS: u32 = 8u;
+const MAX_SHADOWS: u32 = 32u;
 // Value of `layer_of_light` for a light without a shadow map.
 const NO_SHADOW: u32 = 0xffffffffu;
 
