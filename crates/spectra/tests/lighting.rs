@@ -507,3 +507,57 @@ fn a_box_under_a_rectangular_light_casts_the_truths_penumbra() {
         let _ = std::fs::remove_dir_all(&d);
     }
 }
+
+/// A thin-walled see-through pane (KHR_materials_transmission without a volume) glows where a
+/// point light behind it shines through, as in the path tracer: its transmission lobe is the
+/// reflection lobe mirrored through the pane (a lamp's shade lit from inside). The highlight's
+/// mean luminance, real time over truth (direct lighting), across roughness and tint; without
+/// the light from behind the real-time pane is black there.
+#[test]
+fn a_thin_pane_lit_from_behind_glows_as_in_truth() {
+    let d = dir("backlit");
+    let camera = scene::Camera::look_at(
+        glam::Vec3::new(0.0, 2.2, 1.4),
+        glam::Vec3::new(0.0, 0.5, 0.0),
+        glam::Vec3::Y,
+        45f32.to_radians(),
+    );
+    let mut failures = Vec::new();
+    for (k, &(roughness, tint)) in [(0.3f32, [1.0f32, 1.0, 1.0]), (0.6, [1.0, 0.6, 0.3])].iter().enumerate() {
+        let mut s = scene::Scene::empty("backlit pane", camera);
+        s.materials.push(scene::Material {
+            name: "pane".into(),
+            base_color: glam::Vec4::new(tint[0], tint[1], tint[2], 1.0),
+            roughness,
+            transmission: Some(scene::transmission::Transmission {
+                factor: 1.0,
+                texture: None,
+                volume: None,
+                dispersion: 0.0,
+            }),
+            ..Default::default()
+        });
+        s.meshes.push(square(glam::Vec3::new(0.0, 0.5, 0.0), 1.5, 1.5, true, 0));
+        s.lights.push(scene::Light::point("below", glam::Vec3::new(0.0, 0.1, -0.2), 1.0));
+        let (truth, rt) = truth_and_render(&d, &s, &format!("pane-{k}"));
+        let rgb = p(&d, &format!("pane-{k}-rgb.exr"));
+        let f = p(&d, &format!("pane-{k}.gltf"));
+        spectra(&["render", &f, "--mode", "rgb", "--size", "96x64", "--env", "none", "--out", &rgb]);
+        for (mode, image) in [("spectral", &rt), ("rgb", &rgb)] {
+            let (ours, theirs, n) = highlight_luminance(&truth, image);
+            let ratio = ours / theirs;
+            let de = block_de(&truth, image);
+            eprintln!(
+                "backlit pane, {mode}, roughness {roughness}, tint {tint:?}: highlight ({n} px) real time {ours:.4} / truth {theirs:.4} = {ratio:.4}; block ΔE2000 {de:.3}"
+            );
+            if (ratio - 1.0).abs() > 0.05 || de > 1.0 {
+                failures
+                    .push(format!("{mode}, roughness {roughness}: ratio {ratio:.4}, block ΔE2000 {de:.3}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+    if std::env::var_os("SPECTRA_KEEP").is_none() {
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}

@@ -556,8 +556,9 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
         let s = load_surface(px);
         ctx.normal = s.normal;
         var keep = 1.0;
+        var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
         if (HAS_TRANSMISSION) {
-            let tr = load_transmissive(px, s);
+            tr = load_transmissive(px, s);
             keep = 1.0 - tr.weight;
             through = transmitted_rgb(in.pos.xy, ctx, s, tr);
         }
@@ -575,17 +576,21 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
+            // Light from behind a thin-walled see-through surface, tinted by the base colour.
+            var behind = 0.0;
             if (HAS_TRANSMISSION) {
                 t.kd *= keep;
+                behind = thin_transmission(li, ctx.world_pos, s, -ctx.view_dir, tr) * k;
             }
             if (filmed) {
                 // The film's Fresnel terms are colours: the whole reflection goes into sum_b.
                 let fr = film_fresnel_rgb(film, s.base, s.metallic, t.vh);
                 let spec = (1.0 - s.metallic) * fr[0] + s.metallic * fr[1];
-                let r = t.kd * (1.0 - s.metallic) / PI * (1.0 - fr[0]) * s.base + t.ks * spec;
+                let r = (t.kd * (1.0 - s.metallic) / PI * (1.0 - fr[0]) + behind) * s.base + t.ks * spec;
                 sum_b = fma(r, e, sum_b);
             } else {
-                let f = factors_of(t, s.metallic, s.f0);
+                var f = factors_of(t, s.metallic, s.f0);
+                f.x += behind;
                 sum_a = fma(vec3<f32>(f.x), e, sum_a);
                 sum_b = fma(vec3<f32>(f.y), e, sum_b);
             }
@@ -770,17 +775,21 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         let k = custom_light_surface(li, ctx);
         t.kd *= k;
         t.ks *= k;
+        // Light from behind a thin-walled see-through surface, tinted like the reflectance.
+        var through = 0.0;
         if (HAS_TRANSMISSION) {
             t.kd *= keep;
+            through = thin_transmission(li, p, s, v, tr) * k;
         }
         if (filmed) {
             // Under a film the specular part depends on λ too: all of it through the nodes.
             for (var g = 0u; g < ng; g++) {
                 let rho = node_reflectance(c_base, s.base, g);
-                xyz += film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda) * light_w(li, g, ng);
+                xyz += (film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda) + through * rho) * light_w(li, g, ng);
             }
         } else {
-            let f = factors_of(t, s.metallic, s.f0);
+            var f = factors_of(t, s.metallic, s.f0);
+            f.x += through;
             // The specular part does not depend on the reflectance: the light's XYZ once.
             var reflected = vec3<f32>(0.0);
             for (var g = 0u; g < ng; g++) {

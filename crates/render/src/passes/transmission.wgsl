@@ -316,6 +316,25 @@ fn background_at(at: vec2<f32>, roughness: f32) -> vec3<f32> {
     return sum / f32(BLUR_TAPS);
 }
 
+// What light `li` brings through a thin-walled see-through surface from behind it, per unit of
+// its irradiance and of the base colour (the tint): the path tracer's thin sheet
+// (truth::dielectric) has for transmission lobe its reflection lobe mirrored through the
+// surface, with 1 − F of the light — which is the reflection of the mirrored view off the
+// surface turned over (normal −n), so `light_terms` gives it, LTC for polygon lights included,
+// and the shadow map is read on the far side. Zero on a volume (a light behind it lies behind
+// its far side too, whose shadow stops it in the path tracer as well), for lights in front, and
+// for emissive polygons: an emitter behind the surface is in the background the refracted view
+// ray already reads (`transmitted_xyz`), blurred by the roughness — counted once.
+fn thin_transmission(li: u32, p: vec3<f32>, s: GSurface, v: vec3<f32>, tr: Transmissive) -> f32 {
+    if (tr.weight <= 0.0 || tr.thickness > 0.0 || u32(lights[li].pos_kind.w) == 3u) {
+        return 0.0;
+    }
+    let n = s.normal;
+    let t = light_terms(li, p, -n, v - 2.0 * dot(n, v) * n, s.roughness);
+    let f = s.f0 + (1.0 - s.f0) * pow(1.0 - t.vh, 5.0);
+    return tr.weight * t.ks * (1.0 - f);
+}
+
 // What the see-through surface lets through of the light behind it, before the base colour
 // and the absorption: T·(1 − F(n·v)).
 fn transmitted_share(s: GSurface, tr: Transmissive, v: vec3<f32>) -> f32 {
