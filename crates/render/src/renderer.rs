@@ -750,8 +750,7 @@ impl Renderer {
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         if layered {
-            // The see-through layer's film target holds its transmission.
-            self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Film)?;
+            self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Layer)?;
         }
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
@@ -764,7 +763,8 @@ impl Renderer {
         let colour = match gbuffer_targets {
             GBufferTargets::Plain => &all[..3],
             GBufferTargets::Slot => &all[..4],
-            GBufferTargets::Film => &all[..],
+            // (The transmissive layer's targets are its own, below.)
+            GBufferTargets::Film | GBufferTargets::Layer => &all[..],
         };
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
         self.gbuffer.record(

@@ -49,7 +49,7 @@ impl Vertex {
 
 /// Texture slots of a material, in binding order (textures at bindings 1..=7, their samplers at
 /// 8..=14; the order of `TEX_*` in `wgsl/material.wgsl`).
-pub const TEXTURE_SLOTS: usize = 7;
+pub const TEXTURE_SLOTS: usize = 9;
 
 /// `MaterialUniforms` in `wgsl/material.wgsl` (checked by `layout_tests`).
 #[repr(C)]
@@ -75,6 +75,10 @@ pub struct MaterialUniforms {
     /// texture's G, whose default texture is white: without one the thickness is the maximum,
     /// as the extension says).
     pub film: [f32; 4],
+    /// `KHR_materials_transmission`: x the factor (0: opaque; [`transmission`]), which the
+    /// transmissive layer's G-buffer writes × the texture's R, beside the volume's thickness
+    /// texture's G and the film's two values (`passes::gbuffer::Targets::Layer`); yzw unused.
+    pub transmission: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -108,47 +112,43 @@ impl MaterialUniforms {
             alpha: [mode, cutoff, m.double_sided as u8 as f32, m.unlit as u8 as f32],
             uv,
             slot: [u32::try_from(index).map_or(u32::MAX, |i| i.saturating_add(1)), 0, 0, 0],
-            film: match (transmission(m), &m.iridescence) {
-                // The transmissive layer's G-buffer writes the factor and the thickness texture's
-                // G where a film's weight and thickness would be (module `passes::gbuffer`).
-                (Some(t), _) => [t.factor, 0.0, 0.0, 0.0],
-                (None, Some(f)) if !m.unlit => [f.factor, f.ior, f.thickness_min, f.thickness_max],
+            film: match &m.iridescence {
+                Some(f) if !m.unlit => [f.factor, f.ior, f.thickness_min, f.thickness_max],
                 _ => [0.0; 4],
             },
+            transmission: [transmission(m).map_or(0.0, |t| t.factor), 0.0, 0.0, 0.0],
         }
     }
 }
 
 /// The material's transmission as the real-time renderer draws it: the transmissive layer
-/// (`passes::gbuffer::Layer::Transmissive`) for a lit material with a factor above 0. Such a
-/// material's thin film, if any, is drawn with its factor and maximum thickness, without its
-/// textures (its G-buffer channels hold the transmission; [`refraction_record`]); the path
-/// tracer draws both in full.
+/// (`passes::gbuffer::Layer::Transmissive`) for a lit material with a factor above 0, its thin
+/// film, if any, with its textures (the layer's G-buffer holds both).
 pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmission> {
     m.transmission.as_ref().filter(|t| !m.unlit && t.factor > 0.0)
 }
 
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
-/// occlusion, the film's weight (iridescence texture, R) and thickness (G).
+/// occlusion, the film's weight (iridescence texture, R) and thickness (G), the transmission
+/// (R) and the volume's thickness (G).
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
-    let (weight, thickness) = match transmission(m) {
-        Some(t) => (t.texture, t.volume.as_ref().and_then(|v| v.thickness_texture)),
-        None => (film.and_then(|f| f.texture), film.and_then(|f| f.thickness_texture)),
-    };
+    let t = transmission(m);
     [
         m.base_color_texture,
         m.metallic_roughness_texture,
         m.normal_texture,
         m.emissive_texture,
         m.occlusion_texture,
-        weight,
-        thickness,
+        film.and_then(|f| f.texture),
+        film.and_then(|f| f.thickness_texture),
+        t.and_then(|t| t.texture),
+        t.and_then(|t| t.volume.as_ref()).and_then(|v| v.thickness_texture),
     ]
 }
 
 /// The material bind group's layout (group 1 of the G-buffer and shadow passes): uniforms at
-/// 0, the seven textures at 1..=7 and their samplers at 8..=14.
+/// 0, the nine textures at 1..=9 and their samplers at 10..=18.
 pub fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![crate::passes::uniform_entry(0, visibility)];
@@ -604,6 +604,8 @@ impl GpuScene {
                 &defaults.white_linear,
                 &defaults.white_linear,
                 &defaults.white_linear,
+                &defaults.white_linear,
+                &defaults.white_linear,
             ];
             let views: Vec<wgpu::TextureView> = refs
                 .iter()
@@ -1046,7 +1048,7 @@ impl DefaultTextures {
 
 /// A material's refraction for the shading pass: (index at the d line, dispersion (20 / Abbe
 /// number), thickness in scene units (0: thin-walled), 0) and the interior's absorption
-/// coefficient per scene unit in linear RGB (0 when clear; w: its thin film's factor), which the spectral modes upsample
+/// coefficient per scene unit in linear RGB (0 when clear; w unused), which the spectral modes upsample
 /// as a box spectrum per channel: `color::upsample::medium::Attenuation::DEFAULT`, the path
 /// tracer's upsampling of the same `scene::transmission::Volume::medium`.
 pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
@@ -1056,10 +1058,7 @@ pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
         None => (0.0, [0.0; 3]),
     };
     let dispersion = if t.disperses() { t.dispersion } else { 0.0 };
-    // A see-through material's thin film is drawn with its factor and its maximum thickness
-    // (the thickness texture's default): the layer's G-buffer channels hold the transmission.
-    let film = m.iridescence.as_ref().map_or(0.0, |f| f.factor.clamp(0.0, 1.0));
-    [[m.ior, dispersion, thickness, 0.0], [sigma[0], sigma[1], sigma[2], film]]
+    [[m.ior, dispersion, thickness, 0.0], [sigma[0], sigma[1], sigma[2], 0.0]]
 }
 
 #[cfg(test)]

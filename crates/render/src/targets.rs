@@ -3,7 +3,8 @@
 use crate::passes::accumulate::ACCUM_FORMAT;
 use crate::passes::back_faces::BACK_FACES_FORMAT;
 use crate::passes::{
-    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, HDR_FORMAT, LDR_FORMAT,
+    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SLOT_FORMAT,
+    HDR_FORMAT, LDR_FORMAT,
 };
 
 /// A 2D render target that passes also sample, with its view.
@@ -150,7 +151,7 @@ impl LayerTargets {
             make("layer gbuffer normal", GBUFFER_FORMATS[1], none).1,
             make("layer gbuffer emission", GBUFFER_FORMATS[2], none).1,
             make("layer gbuffer slot", GBUFFER_SLOT_FORMAT, none).1,
-            make("layer gbuffer transmission", GBUFFER_FILM_FORMAT, none).1,
+            make("layer gbuffer transmission and film", GBUFFER_LAYER_FORMAT, none).1,
         ];
         let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);
         let (background, background_view) = make("background", HDR_FORMAT, wgpu::TextureUsages::COPY_DST);

@@ -370,5 +370,32 @@ fn a_see_through_film_colours_the_reflection() {
         let shift = (0..3).map(|c| (hue(full)[c] - hue(plain)[c]).abs()).fold(0.0, f64::max);
         assert!(shift > 0.02, "{mode:?}: the film does not colour the reflection ({plain:?} → {full:?})");
         assert_ne!(half, full, "{mode:?}: the film's factor is not used");
+        // Its textures are drawn too: a weight texture of 128/255 is about the half factor, and
+        // a thickness texture of 0 puts the film at its minimum thickness, another colour.
+        let mut textured = |rg: [u8; 2]| {
+            let mut s = film(1.0);
+            s.textures.push(scene::Texture {
+                sampler: Default::default(),
+                name: "film".into(),
+                width: 2,
+                height: 2,
+                rgba8: [rg[0], rg[1], 0, 255].repeat(4),
+                srgb: false,
+            });
+            let t = Some(scene::TextureRef { transform: None, index: 0, tex_coord: 0 });
+            let f = s.materials[2].iridescence.as_mut().unwrap();
+            (f.texture, f.thickness_texture) = (t, t);
+            at(&render(&mut r, &s, mode), CENTRE)
+        };
+        let weighted = textured([128, 255]);
+        for c in 0..3 {
+            assert!(
+                (weighted[c] - half[c]).abs() <= 0.02 * half[c],
+                "{mode:?}: a film texture of weight ½ gives {weighted:?}, the factor ½ {half:?}"
+            );
+        }
+        let thin = textured([255, 0]);
+        let shift = (0..3).map(|c| (hue(thin)[c] - hue(full)[c]).abs()).fold(0.0, f64::max);
+        assert!(shift > 0.01, "{mode:?}: the thickness texture is not used ({full:?} → {thin:?})");
     }
 }

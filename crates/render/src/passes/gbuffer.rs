@@ -10,7 +10,7 @@
 //! film adds a fifth in every mode, the film's values ([`GBUFFER_FILM_FORMAT`]), so that a scene
 //! without one samples no film texture and writes no film target.
 
-use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_SLOT_FORMAT, SharedLayouts};
+use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SLOT_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -27,6 +27,8 @@ pub struct GBufferPass {
     spectral_pipelines: Option<Pipelines>,
     /// With the slot and the film, for scenes with a thin film ([`Self::prepare_film`]).
     film_pipelines: Option<Pipelines>,
+    /// The transmissive layer's ([`Targets::Layer`]).
+    layer_pipelines: Option<Pipelines>,
 }
 
 /// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
@@ -41,8 +43,7 @@ pub enum Layer {
     /// Every draw but the see-through ones.
     Opaque,
     /// Only the see-through ones, depth-tested against the opaque layer's depth, which the
-    /// caller copied into `depth`. The film target then holds the transmission factor and the
-    /// thickness texture's G (`scene_gpu::MaterialUniforms::film`).
+    /// caller copied into `depth`, into [`Targets::Layer`].
     Transmissive,
 }
 
@@ -55,6 +56,9 @@ pub enum Targets {
     Slot,
     /// + the slot and the film.
     Film,
+    /// + the slot and, in four channels, the transmission factor × texture, the volume's
+    /// thickness texture and the film's two values: the transmissive layer's.
+    Layer,
 }
 
 impl GBufferPass {
@@ -78,6 +82,7 @@ impl GBufferPass {
             pipelines,
             spectral_pipelines: None,
             film_pipelines: None,
+            layer_pipelines: None,
         })
     }
 
@@ -87,6 +92,7 @@ impl GBufferPass {
             Targets::Plain => return Ok(()),
             Targets::Slot => &mut self.spectral_pipelines,
             Targets::Film => &mut self.film_pipelines,
+            Targets::Layer => &mut self.layer_pipelines,
         };
         if slot.is_none() {
             *slot = Some(build(device, &self.module, &self.layout, targets)?);
@@ -107,9 +113,12 @@ impl GBufferPass {
         layer: Layer,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let pipelines = match colour.len() {
-            3 => &self.pipelines,
-            4 => self.spectral_pipelines.as_ref().expect("prepare(Slot) before a spectral G-buffer"),
+        let pipelines = match (colour.len(), layer) {
+            (3, _) => &self.pipelines,
+            (4, _) => self.spectral_pipelines.as_ref().expect("prepare(Slot) before a spectral G-buffer"),
+            (_, Layer::Transmissive) => {
+                self.layer_pipelines.as_ref().expect("prepare(Layer) before the transmissive layer")
+            }
             _ => self.film_pipelines.as_ref().expect("prepare(Film) before a G-buffer with films"),
         };
         let attachments: Vec<_> = colour
@@ -175,6 +184,7 @@ fn build(
         Targets::Plain => &GBUFFER_FORMATS,
         Targets::Slot => &[base, normal, emission, GBUFFER_SLOT_FORMAT],
         Targets::Film => &[base, normal, emission, GBUFFER_SLOT_FORMAT, GBUFFER_FILM_FORMAT],
+        Targets::Layer => &[base, normal, emission, GBUFFER_SLOT_FORMAT, GBUFFER_LAYER_FORMAT],
     };
     let targets: Vec<_> = formats
         .iter()
@@ -190,6 +200,8 @@ fn build(
             (true, Targets::Slot) => "fs_alpha_spectral",
             (false, Targets::Film) => "fs_main_film",
             (true, Targets::Film) => "fs_alpha_film",
+            (false, Targets::Layer) => "fs_main_layer",
+            (true, Targets::Layer) => "fs_alpha_layer",
         };
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -155,3 +155,40 @@ fn fs_alpha_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFil
     let f = film_values(v);
     return with_film(gbuffer(v, front, true), f);
 }
+
+// The transmissive layer (passes/gbuffer.rs `Targets::Layer`): the film's values beside the
+// see-through material's own, packed in one 32-bit target (`layer_values` in the shading pass) —
+// x the transmission factor × its texture's R, y the volume's thickness texture's G (the share of
+// the thickness factor), z and w the film's weight and thickness fraction as `film_values`.
+struct GBufferLayerOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) slot: u32,
+    @location(4) layer: u32,
+};
+
+fn transmission_values(v: VertexOut) -> vec2<f32> {
+    let t = textureSample(transmission_tex, transmission_smp, material_uv(TEX_TRANSMISSION, v.uv, v.uv1)).r * material.transmission.x;
+    let d = textureSample(volume_thickness_tex, volume_thickness_smp, material_uv(TEX_VOLUME_THICKNESS, v.uv, v.uv1)).g;
+    return vec2<f32>(clamp(t, 0.0, 1.0), clamp(d, 0.0, 1.0));
+}
+
+fn with_layer(o: GBufferOut, t: vec2<f32>, f: vec2<f32>) -> GBufferLayerOut {
+    let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
+    return GBufferLayerOut(o.base, o.normal, o.emission, material.slot.x, pack4x8unorm(vec4<f32>(t, film)));
+}
+
+@fragment
+fn fs_main_layer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerOut {
+    let t = transmission_values(v);
+    let f = film_values(v);
+    return with_layer(gbuffer(v, front, false), t, f);
+}
+
+@fragment
+fn fs_alpha_layer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerOut {
+    let t = transmission_values(v);
+    let f = film_values(v);
+    return with_layer(gbuffer(v, front, true), t, f);
+}

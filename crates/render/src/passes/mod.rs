@@ -38,6 +38,11 @@ pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uin
 /// Two channels because the G-buffer's five targets must fit the 32 bytes per sample WebGPU
 /// guarantees (3 × 8 + 4 + 4).
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+/// The transmissive layer's fifth G-buffer target: transmission, volume thickness, and the
+/// film's weight and thickness (`passes::gbuffer::Targets::Layer`), each in [0, 1] and from
+/// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,
+/// the other four take 28, and WebGPU counts an Rgba8Unorm target as 8.
+pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// A [`DEPTH_FORMAT`] depth test with `compare`, writing depth when `write`.

@@ -228,6 +228,17 @@ impl ShadingPass {
                 super::filterable_entry(10),
                 texture_entry(11),
                 super::depth_entry(12),
+                // The transmissive layer's transmission and film, packed (`layer_packed`).
+                wgpu::BindGroupLayoutEntry {
+                    binding: 13,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -401,11 +412,13 @@ impl ShadingPass {
                 view_entry(10, &t.ldr_view),
                 view_entry(11, &g[0]),
                 view_entry(12, &t.depth_view),
+                view_entry(13, &t.gbuffer_slot_view),
             ],
         })
     }
 
-    /// Group 1 of the transmissive layer: its G-buffer and depth, the shadow maps, the
+    /// Group 1 of the transmissive layer: its G-buffer (the fifth target, transmission and
+    /// film packed, at 13) and depth, the shadow maps, the
     /// opaque layer's shaded image as the background and its depth `opaque_depth`, and the
     /// see-through meshes' back faces.
     pub fn bind_layer_inputs(
@@ -433,10 +446,12 @@ impl ShadingPass {
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
                 view_entry(8, &g[3]),
-                view_entry(9, &g[4]),
+                // The layer's film is in `layer_packed`: any float texture here.
+                view_entry(9, &g[0]),
                 view_entry(10, &layer.background_view),
                 view_entry(11, &layer.back_faces_view),
                 view_entry(12, opaque_depth),
+                view_entry(13, &g[4]),
             ],
         })
     }

@@ -466,9 +466,8 @@ fn load_film(px: vec2<i32>) -> FilmSurface {
     var f = textureLoad(gbuf_film, px, 0);
     let mat = material_at(px);
     if (HAS_TRANSMISSION) {
-        // The see-through layer's film channels hold its transmission: the film is the
-        // material's factor at its maximum thickness (`scene_gpu::refraction_record`).
-        f = vec4<f32>(mat.absorption.w, 1.0, 0.0, 0.0);
+        // The see-through layer's film is packed beside its transmission.
+        f = vec4<f32>(layer_values(px).zw, 0.0, 0.0);
     }
     let m = mat.film;
     var f0 = 0.04;

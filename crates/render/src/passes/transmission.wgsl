@@ -28,6 +28,12 @@
 @group(1) @binding(11) var back_faces: texture_2d<f32>;
 // The opaque layer's depth: what a ray leaving the glass can land on.
 @group(1) @binding(12) var opaque_depth: texture_depth_2d;
+// The layer's transmission (xy) and film (zw), four 8-bit values (gbuffer.wgsl `with_layer`).
+@group(1) @binding(13) var layer_packed: texture_2d<u32>;
+
+fn layer_values(px: vec2<i32>) -> vec4<f32> {
+    return unpack4x8unorm(textureLoad(layer_packed, px, 0).x);
+}
 override HAS_TRANSMISSION: bool = false;
 
 // The transmissive layer's shading is drawn over the see-through meshes themselves, not over the
@@ -55,7 +61,7 @@ struct Transmissive {
 };
 
 fn load_transmissive(px: vec2<i32>, s: GSurface) -> Transmissive {
-    let t = textureLoad(gbuf_film, px, 0).xy;
+    let t = layer_values(px).xy;
     let m = material_at(px);
     let w = select(t.x * (1.0 - s.metallic), 0.0, s.unlit || lambert_only());
     return Transmissive(w, m.refraction.z * t.y, m.refraction.x, m.refraction.y, m.absorption.xyz);
