@@ -56,7 +56,7 @@ pub enum Targets {
     Slot,
     /// + the slot and the film.
     Film,
-    /// + the slot and, in four channels, the transmission factor × texture, the volume's
+    /// The slot, and in four packed channels the transmission factor × texture, the volume's
     /// thickness texture and the film's two values: the transmissive layer's.
     Layer,
 }
