@@ -219,37 +219,29 @@ pub(crate) fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 
 /// A non-filterable 2D float texture (G-buffer inputs are read with textureLoad).
 pub fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
+    texture_2d_entry(binding, wgpu::TextureSampleType::Float { filterable: false })
 }
 
 pub(crate) fn filterable_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
+    texture_2d_entry(binding, wgpu::TextureSampleType::Float { filterable: true })
 }
 
 pub(crate) fn depth_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_2d_entry(binding, wgpu::TextureSampleType::Depth)
+}
+
+/// A 2D unsigned-integer texture (material slots, packed values).
+pub(crate) fn uint_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_2d_entry(binding, wgpu::TextureSampleType::Uint)
+}
+
+/// A 2D texture of `sample_type` read by the fragment stage.
+fn texture_2d_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Depth,
+            sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         },

@@ -211,16 +211,7 @@ impl ShadingPass {
                     count: None,
                 },
                 // The spectral G-buffer's material slots (`gbuf_slot`).
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                super::uint_entry(8),
                 // The films (`gbuf_film`).
                 texture_entry(9),
                 // The transmissive layer's background (`background`, transmission.wgsl), its
@@ -229,16 +220,7 @@ impl ShadingPass {
                 texture_entry(11),
                 super::depth_entry(12),
                 // The transmissive layer's transmission and film, packed (`layer_packed`).
-                wgpu::BindGroupLayoutEntry {
-                    binding: 13,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                super::uint_entry(13),
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
