@@ -405,6 +405,9 @@ pub struct GpuScene {
     pub camera: scene::Camera,
     /// World-space bounding box of all geometry.
     pub bounds: (Vec3, Vec3),
+    /// Per scene mesh, its world-space bounding box (empty, min > max, for a mesh without
+    /// positions).
+    pub mesh_bounds: Vec<(Vec3, Vec3)>,
     /// What the upload had to change to fit the device (textures downscaled, …).
     pub warnings: Vec<String>,
     /// Whether any material emits or is unlit (its colour is drawn as emission): without one the
@@ -496,6 +499,7 @@ impl GpuScene {
         let mut chunks = Chunks::new(device, max_buffer_bytes);
         let mut draws = Vec::new();
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        let mut mesh_bounds = Vec::with_capacity(s.meshes.len());
         for (mi, m) in s.meshes.iter().enumerate() {
             let n = m.positions.len();
             if m.material >= s.materials.len() {
@@ -524,10 +528,11 @@ impl GpuScene {
             }
             let mat = &s.materials[m.material];
             let mut vertices = Vec::with_capacity(n);
+            let (mut mesh_lo, mut mesh_hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
             for i in 0..n {
                 let p = m.positions[i];
-                lo = lo.min(p);
-                hi = hi.max(p);
+                mesh_lo = mesh_lo.min(p);
+                mesh_hi = mesh_hi.max(p);
                 vertices.push(Vertex {
                     position: p.to_array(),
                     normal: m.normals.get(i).copied().unwrap_or(Vec3::Z).to_array(),
@@ -539,6 +544,9 @@ impl GpuScene {
                     uv1: m.uvs1.get(i).copied().unwrap_or(Vec2::ZERO).to_array(),
                 });
             }
+            lo = lo.min(mesh_lo);
+            hi = hi.max(mesh_hi);
+            mesh_bounds.push((mesh_lo, mesh_hi));
             let template = Draw {
                 chunk: 0,
                 mesh: mi,
@@ -659,6 +667,7 @@ impl GpuScene {
             emitter_polygons,
             camera: s.camera,
             bounds: (lo, hi),
+            mesh_bounds,
             warnings,
             has_emission: s.materials.iter().any(|m| m.unlit || m.emissive.max_element() > 0.0),
             varying_colours: (

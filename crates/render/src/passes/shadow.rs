@@ -226,7 +226,8 @@ impl ShadowPass {
             return false;
         }
         self.pending = Some(key);
-        let (uniforms, layers) = assign(&scene.lights, &scene.emitters, scene.bounds, enabled);
+        let (uniforms, layers) =
+            assign(&scene.lights, &scene.emitters, scene.bounds, &scene.mesh_bounds, enabled);
         let needed = layers.len().max(1);
         let remade = needed != self.layer_views.len();
         if remade {
@@ -375,11 +376,15 @@ fn layer_indices(
 }
 
 /// Gives every light that has a frustum a layer, in scene order: the punctual lights, then the
-/// emissive polygons that follow them in the GPU list (at most [`MAX_LIGHTS`] in all).
+/// emissive polygons that follow them in the GPU list (at most [`MAX_LIGHTS`] in all) — except
+/// a light whose frustum holds no mesh that its map would draw (`mesh_bounds`, per scene mesh):
+/// nothing can shadow it, so it is lit without a map (an emissive helmet's own clusters, whose
+/// mesh their maps leave out, would read 32 empty layers per pixel).
 fn assign(
     lights: &[scene::Light],
     emitters: &[scene::emitters::Emitter],
     bounds: (Vec3, Vec3),
+    mesh_bounds: &[(Vec3, Vec3)],
     enabled: bool,
 ) -> (ShadowUniforms, Vec<Layer>) {
     let mut u = ShadowUniforms {
@@ -393,6 +398,9 @@ fn assign(
     }
     for (li, light) in lights.iter().enumerate().take(MAX_LIGHTS) {
         let Some((view_proj, bias)) = light_view_proj(light, bounds) else { continue };
+        if !casts(view_proj, light.stands_in_for, mesh_bounds) {
+            continue;
+        }
         let layer = layers.len();
         u.view_proj[layer] = view_proj.to_cols_array_2d();
         u.bias[layer][0] = bias;
@@ -405,6 +413,9 @@ fn assign(
     for (ei, e) in emitters.iter().enumerate().take(in_list) {
         let li = lights.len() + ei;
         let Some((view_proj, bias)) = emitter_view_proj(e, bounds) else { continue };
+        if !casts(view_proj, Some(e.mesh), mesh_bounds) {
+            continue;
+        }
         let layer = layers.len();
         u.view_proj[layer] = view_proj.to_cols_array_2d();
         let (near, far) = emitter_depth_range(e, bounds);
@@ -413,6 +424,32 @@ fn assign(
         layers.push(Layer { skip_mesh: Some(e.mesh) });
     }
     (u, layers)
+}
+
+/// Whether some mesh but `skip` has a bounding box that is not wholly outside the clip volume
+/// of `view_proj` (wgpu's: −w ≤ x, y ≤ w, 0 ≤ z ≤ w): what the map would draw.
+fn casts(view_proj: Mat4, skip: Option<usize>, mesh_bounds: &[(Vec3, Vec3)]) -> bool {
+    mesh_bounds.iter().enumerate().any(|(mi, &(lo, hi))| {
+        if Some(mi) == skip || lo.cmpgt(hi).any() {
+            return false;
+        }
+        let corners = (0..8).map(|k| {
+            let c = Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            view_proj * c.extend(1.0)
+        });
+        let corners: Vec<_> = corners.collect();
+        let outside = |f: &dyn Fn(glam::Vec4) -> bool| corners.iter().all(|&c| f(c));
+        !(outside(&|c| c.x > c.w)
+            || outside(&|c| c.x < -c.w)
+            || outside(&|c| c.y > c.w)
+            || outside(&|c| c.y < -c.w)
+            || outside(&|c| c.z > c.w)
+            || outside(&|c| c.z < 0.0))
+    })
 }
 
 /// View-projection from the light and a normal-offset bias (world units), or `None` when the
@@ -515,7 +552,7 @@ mod tests {
         let degenerate = LightKind::Directional { direction: Vec3::ZERO };
         let mut lights = vec![light(degenerate, None), light(sun.clone(), Some(3))];
         lights.extend((2..MAX_LIGHTS).map(|_| light(sun.clone(), None)));
-        let (u, layers) = assign(&lights, &[], bounds, true);
+        let (u, layers) = assign(&lights, &[], bounds, &[bounds], true);
         let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
         assert_eq!(layer(0), NO_SHADOW, "no frustum, no map");
         assert_eq!(
@@ -525,7 +562,7 @@ mod tests {
         assert_eq!(layers.len(), MAX_LIGHTS - 1);
         assert_eq!(layers[0].skip_mesh, Some(3), "a stand-in skips its own mesh");
         assert!(layers[1..].iter().all(|l| l.skip_mesh.is_none()));
-        let (u, layers) = assign(&lights, &[], bounds, false);
+        let (u, layers) = assign(&lights, &[], bounds, &[bounds], false);
         assert!(layers.is_empty() && u.layer_of_light.iter().flatten().all(|&l| l == NO_SHADOW));
     }
 
@@ -561,7 +598,12 @@ mod tests {
         }
         let sun = LightKind::Directional { direction: Vec3::NEG_Y };
         let lights = vec![light(sun.clone(), None), light(sun, None)];
-        let (u, layers) = assign(&lights, &emitters, bounds, true);
+        // The five cubes' meshes and the walled bays around them (mesh 5).
+        let mut meshes: Vec<_> = [-6.0f32, -3.0, 0.0, 3.0, 6.0]
+            .map(|x| (Vec3::new(x - 0.5, -0.5, -0.5), Vec3::new(x + 0.5, 0.5, 0.5)))
+            .to_vec();
+        meshes.push(bounds);
+        let (u, layers) = assign(&lights, &emitters, bounds, &meshes, true);
         let layer = |i: usize| u.layer_of_light[i / 4][i % 4];
         assert_eq!(layers.len(), MAX_LIGHTS, "a map per light");
         for (ei, e) in emitters.iter().enumerate() {
@@ -580,7 +622,25 @@ mod tests {
         // Emitters beyond the GPU's light list have neither a light nor a map.
         let mut more = emitters.clone();
         more.extend(emitters[..4].iter().cloned());
-        let (_, layers) = assign(&lights, &more, bounds, true);
+        let (_, layers) = assign(&lights, &more, bounds, &meshes, true);
         assert_eq!(layers.len(), MAX_LIGHTS);
+    }
+
+    #[test]
+    fn a_light_with_nothing_to_shadow_it_has_no_map() {
+        let bounds = (Vec3::splat(-10.0), Vec3::splat(10.0));
+        let up = face(0, Vec3::ZERO, Vec3::Y, 1.0);
+        let box_at = |y: f32| (Vec3::new(-1.0, y, -1.0), Vec3::new(1.0, y + 1.0, 1.0));
+        let layers = |meshes: &[(Vec3, Vec3)]| assign(&[], std::slice::from_ref(&up), bounds, meshes, true);
+        // Only the emitter's own mesh: its map would be empty.
+        assert!(layers(&[box_at(-0.5)]).1.is_empty());
+        // A box above the upward face is in its frustum; one below it is not.
+        assert_eq!(layers(&[box_at(-0.5), box_at(3.0)]).1.len(), 1);
+        assert!(layers(&[box_at(-0.5), box_at(-5.0)]).1.is_empty());
+        // An empty mesh casts nothing.
+        let empty = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        assert!(layers(&[box_at(-0.5), empty]).1.is_empty());
+        let (u, _) = layers(&[box_at(-0.5)]);
+        assert_eq!(u.layer_of_light[0][0], NO_SHADOW);
     }
 }
