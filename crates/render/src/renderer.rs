@@ -717,6 +717,7 @@ impl Renderer {
             film: scene.has_film,
             ior: scene.has_ior,
             transmission: false,
+            thin_walls: scene.has_thin_walls,
         };
         // See-through materials get a layer of their own, shaded over the opaque one
         // (`passes::gbuffer::Layer`), except where the shading runs its general node loop (a

@@ -434,6 +434,9 @@ pub struct GpuScene {
     /// Whether some see-through material has a thin film: only then does the transmissive
     /// layer's shading carry the film's code.
     pub has_transmission_film: bool,
+    /// Whether some see-through material is thin-walled (no volume): only then does the
+    /// transmissive layer's shading carry the light from behind (`thin_transmission`).
+    pub has_thin_walls: bool,
     /// Per material, `MaterialSpectrum::refraction` and `::absorption` ([`refraction_record`]).
     pub material_refraction: Vec<[[f32; 4]; 2]>,
 }
@@ -685,6 +688,7 @@ impl GpuScene {
                 .materials
                 .iter()
                 .any(|m| transmission(m).is_some() && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
+            has_thin_walls: s.materials.iter().any(|m| transmission(m).is_some_and(|t| t.volume.is_none())),
             material_refraction: s.materials.iter().map(refraction_record).collect(),
             material_films: s
                 .materials

@@ -84,6 +84,9 @@ pub struct Variant {
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
     /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
     pub transmission: bool,
+    /// Some see-through material is thin-walled (`HAS_THIN_WALLS`): the lights behind it shine
+    /// through (`thin_transmission`).
+    pub thin_walls: bool,
 }
 
 impl Variant {
@@ -99,11 +102,13 @@ impl Variant {
         film: true,
         ior: true,
         transmission: false,
+        thin_walls: true,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, film, ior); its pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 10] {
+    /// environment, film, ior, transmission, thin walls); its pipelines are keyed by
+    /// [`Self::rgb`].
+    fn constants(&self) -> [(&'static str, f64); 11] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -116,6 +121,7 @@ impl Variant {
             ("HAS_FILM", b(self.film)),
             ("HAS_IOR", b(self.ior)),
             ("HAS_TRANSMISSION", b(self.transmission)),
+            ("HAS_THIN_WALLS", b(self.thin_walls)),
         ]
     }
 
@@ -127,6 +133,7 @@ impl Variant {
             film: self.film,
             ior: self.ior,
             transmission: self.transmission,
+            thin_walls: self.thin_walls,
             ..Variant::ALL
         }
     }

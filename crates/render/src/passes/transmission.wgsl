@@ -35,6 +35,8 @@ fn layer_values(px: vec2<i32>) -> vec4<f32> {
     return unpack4x8unorm(textureLoad(layer_packed, px, 0).x);
 }
 override HAS_TRANSMISSION: bool = false;
+// Some see-through material is thin-walled (`thin_transmission`).
+override HAS_THIN_WALLS: bool = true;
 
 // The transmissive layer's shading is drawn over the see-through meshes themselves, not over the
 // whole screen (the frame's other pixels already hold the background, copied there): a CPU
@@ -332,7 +334,7 @@ fn background_at(at: vec2<f32>, roughness: f32) -> vec3<f32> {
 // for emissive polygons: an emitter behind the surface is in the background the refracted view
 // ray already reads (`transmitted_xyz`), blurred by the roughness — counted once.
 fn thin_transmission(li: u32, p: vec3<f32>, s: GSurface, v: vec3<f32>, tr: Transmissive) -> f32 {
-    if (tr.weight <= 0.0 || tr.thickness > 0.0 || u32(lights[li].pos_kind.w) == 3u) {
+    if (!HAS_THIN_WALLS || tr.weight <= 0.0 || tr.thickness > 0.0 || u32(lights[li].pos_kind.w) == 3u) {
         return 0.0;
     }
     let n = s.normal;
