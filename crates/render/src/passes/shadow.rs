@@ -24,7 +24,8 @@
 //! shadow each in its own direction (sharing one map per mesh, as before, left the walls beside
 //! a closed emitter outside its single frustum and lit). The depth array has as many layers as
 //! the scene's lights use (one 4 MiB layer for a single light, 128 MiB for 32), made again when
-//! a new scene needs another count. Stand-in lights (`Light::stands_in_for`) cast shadows like
+//! a new scene needs another count; a light whose frustum holds nothing its map would draw
+//! gets none (nothing can shadow it). Stand-in lights (`Light::stands_in_for`) cast shadows like
 //! any other, but their own emissive mesh is left out of their map: the lamp they approximate
 //! does not occlude itself.
 
@@ -433,15 +434,10 @@ fn casts(view_proj: Mat4, skip: Option<usize>, mesh_bounds: &[(Vec3, Vec3)]) -> 
         if Some(mi) == skip || lo.cmpgt(hi).any() {
             return false;
         }
-        let corners = (0..8).map(|k| {
-            let c = Vec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            );
+        let corners: [glam::Vec4; 8] = std::array::from_fn(|k| {
+            let c = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
             view_proj * c.extend(1.0)
         });
-        let corners: Vec<_> = corners.collect();
         let outside = |f: &dyn Fn(glam::Vec4) -> bool| corners.iter().all(|&c| f(c));
         !(outside(&|c| c.x > c.w)
             || outside(&|c| c.x < -c.w)
