@@ -16,7 +16,7 @@ pub struct RenderArgs {
     /// Image size WIDTHxHEIGHT (or WIDTHXHEIGHT, WIDTH*HEIGHT).
     #[arg(long, default_value = "640x480")]
     pub size: String,
-    /// Disable shadow maps (otherwise each of the first eight lights casts shadows).
+    /// Disable shadow maps (otherwise every light, up to 32, casts shadows through a map of its own).
     #[arg(long)]
     pub no_shadows: bool,
     /// Output file: .png (tone-mapped, sRGB) or .exr (linear HDR).
