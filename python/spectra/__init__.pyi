@@ -92,6 +92,7 @@ class Renderer:
         exposure: float = 0.0,
         spectral: bool = False,
         camera_to_display: bool = False,
+        samples: int = 1,
     ) -> Any:
         """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
 
@@ -103,6 +104,9 @@ class Renderer:
         sRGB. white: an illuminant name (default: the scene's, else D65).
         spectral=True: the tuple (image, node radiances float32 (H, W, N), node wavelengths
         float64 (N,)), as `--spectral-out` writes them (not in rgb mode).
+        samples: antialiasing, the mean of 1–256 frames each looking at another place in every
+        pixel (`--samples`): the image box-filtered over each pixel, as the path tracer's are
+        (not with spectral=True).
         Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
         is released while rendering."""
     @property

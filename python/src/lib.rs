@@ -367,8 +367,12 @@ impl Renderer {
     /// float64, nm). With the midpoint rule a node's value is L(λₖ); with the prefiltered rule
     /// it is the node's share of the integral as a radiance (docs/spectral-exr.md). Not in rgb
     /// mode.
+    /// samples: antialiasing, the mean of this many frames each looking at another place in
+    /// every pixel (`spectra render --samples`): the image box-filtered over each pixel, as the
+    /// path tracer's are; 1–256, default 1 (the pixel centres). Not with spectral=True.
     #[pyo3(signature = (mode = "spectral", *, wavelengths = None, quadrature = "prefiltered", range = None,
-                        observer = None, white = None, exposure = 0.0, spectral = false, camera_to_display = false))]
+                        observer = None, white = None, exposure = 0.0, spectral = false, camera_to_display = false,
+                        samples = 1))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -382,7 +386,20 @@ impl Renderer {
         exposure: f32,
         spectral: bool,
         camera_to_display: bool,
+        samples: i64,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let max = spectra::cmd::render::MAX_SAMPLES;
+        let samples = match u32::try_from(samples) {
+            Ok(k) if (1..=max).contains(&k) => k,
+            _ => {
+                return Err(PyValueError::new_err(format!("samples {samples}: must be between 1 and {max}")));
+            }
+        };
+        if spectral && samples > 1 {
+            return Err(PyValueError::new_err(format!(
+                "spectral=True returns one frame's node radiances: it cannot be combined with samples={samples}"
+            )));
+        }
         let mut look = default_look();
         look.mode = render::Mode::parse(mode).map_err(|e| PyValueError::new_err(e.to_string()))?;
         look.wavelengths = match wavelengths {
@@ -416,8 +433,10 @@ impl Renderer {
                 inner.renderer.check_spectral_capture(w, h, settings.wavelengths).map_err(value)?;
             }
             inner.renderer.set_spectral_capture(spectral);
-            inner.renderer.render(&inner.scene.camera, &settings).map_err(runtime)?;
-            let hdr = inner.renderer.read_hdr().map_err(runtime)?;
+            let never = || Ok(());
+            spectra::cmd::render::draw(&mut inner.renderer, &inner.scene.camera, &settings, samples, &never)
+                .map_err(runtime)?;
+            let hdr = spectra::cmd::render::read_linear(&inner.renderer, samples).map_err(runtime)?;
             // As `spectra render --out x.exr` writes them.
             let k = settings.exposure_ev.exp2();
             let data = hdr.iter().flat_map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();

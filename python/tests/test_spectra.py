@@ -103,6 +103,30 @@ def test_render_equals_the_cli(tmp_path, renderer):
     assert np.array_equal(spectra.read_image(out), cli)
 
 
+def test_render_samples_equals_the_cli(tmp_path, renderer):
+    exe = spectra_bin()
+    out = tmp_path / "x.exr"
+    subprocess.run(
+        [exe, "render", "cornell", "--size", f"{W}x{H}", "--samples", "4", "--out", str(out)],
+        check=True,
+        env={**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))},
+    )
+    cli = read_exr(out)
+    py = renderer.render(samples=4)
+    np.testing.assert_allclose(py, cli, rtol=1e-3, atol=1e-6)
+    one = renderer.render()
+    # The edges change, the image as a whole stays (the same scene, filtered over each pixel).
+    assert not np.array_equal(py, one)
+    assert abs(py.mean() - one.mean()) < 0.02 * one.mean()
+    # And a single frame afterwards is the single frame again.
+    assert np.array_equal(renderer.render(), one)
+    for bad in (0, 257, -1):
+        with pytest.raises(ValueError, match="samples"):
+            renderer.render(samples=bad)
+    with pytest.raises(ValueError, match="samples"):
+        renderer.render(spectral=True, samples=2)
+
+
 def test_render_options_change_the_image(renderer):
     base = renderer.render()
     assert not np.array_equal(renderer.render("rgb"), base)

@@ -133,6 +133,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             table_res,
             flags,
             frame_index,
+            lod_bias,
+            _pad,
         }),
     );
     check(

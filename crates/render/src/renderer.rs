@@ -678,7 +678,17 @@ impl Renderer {
 
         let aspect = width as f32 / height as f32;
         let view = camera.transform.inverse();
-        let proj = projection(camera, aspect);
+        let mut proj = projection(camera, aspect);
+        if let Some([dx, dy]) = settings.pixel_offset {
+            // The scene point that the pixel centre should see, (dx, dy) pixels away, moved onto
+            // it: a shift in clip space by the offset in NDC times w (pixel y runs down).
+            let shift = Mat4::from_translation(glam::Vec3::new(
+                -2.0 * dx / width as f32,
+                2.0 * dy / height as f32,
+                0.0,
+            ));
+            proj = shift * proj;
+        }
         let view_proj = proj * view;
         let m = spectral.setup.xyz_to_rgb;
         let uniforms = FrameUniforms {
@@ -697,6 +707,8 @@ impl Renderer {
                 | if camera.ortho.is_some() { 2 } else { 0 }
                 | if self.capture.is_some() { 4 } else { 0 },
             frame_index,
+            lod_bias: settings.texture_lod_bias,
+            _pad: [0; 3],
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         // Screen-space occlusion of the environment searches half the scene's bounding radius.

@@ -188,6 +188,18 @@ pub struct RenderSettings {
     /// prefiltered grid cannot be unbiased: docs/quadrature.md). `None` (the default) keeps the
     /// nodes at the bin centres with per-N normalisation, which makes white exact at every N.
     pub jitter: Option<f32>,
+    /// Where in each pixel the frame samples the scene, in pixels from the pixel's centre (x
+    /// right, y down; each in [−½, ½]): the projection is shifted by that much, so every pass
+    /// (G-buffer, shading, screen-space occlusion and refraction) sees the same moved view. The
+    /// mean of frames at offsets spread over the pixel (with accumulation on) is the image
+    /// box-filtered over each pixel — antialiased, as the path tracer's pixels are
+    /// (`spectra render --samples`). `None` (the default) samples the centre.
+    pub pixel_offset: Option<[f32; 2]>,
+    /// Added to the level of detail at which material textures are read (0: the pixel's own
+    /// footprint). A mean of K frames at offsets over the pixel samples it 1/√K pixel apart, so
+    /// `spectra render --samples K` reads at −½·log₂ K (one level finer per doubling of the
+    /// sample spacing's density), as the path tracer reads its textures per sample; within ±8.
+    pub texture_lod_bias: f32,
     /// Replace the glTF BRDF by Lambert (base colour / π, no specular) for every surface and
     /// light, as the path tracer's `lambert` does: for comparisons with renderers that lack the
     /// glTF BRDF, and the white furnace.
@@ -213,6 +225,8 @@ impl Default for RenderSettings {
             shadows: true,
             timestamps: false,
             jitter: None,
+            pixel_offset: None,
+            texture_lod_bias: 0.0,
             lambert: false,
             env_occlusion: true,
         }
@@ -247,6 +261,19 @@ impl RenderSettings {
             && !(0.0..1.0).contains(&u)
         {
             return Err(RenderError::Settings(format!("the wavelength jitter must be in [0, 1) (got {u})")));
+        }
+        if let Some(o) = self.pixel_offset
+            && !o.iter().all(|c| (-0.5..=0.5).contains(c))
+        {
+            return Err(RenderError::Settings(format!(
+                "the pixel offset must be within ±0.5 pixel on each axis (got {o:?})"
+            )));
+        }
+        if !(-8.0..=8.0).contains(&self.texture_lod_bias) {
+            return Err(RenderError::Settings(format!(
+                "the texture level-of-detail bias must be within ±8 (got {})",
+                self.texture_lod_bias
+            )));
         }
         let observer = color::Observer::by_name(&self.observer)?;
         let white = color::illuminant::by_name(&self.white)?;
@@ -292,6 +319,11 @@ mod tests {
         for u in [1.0, -0.1, f32::NAN] {
             let bad = RenderSettings { jitter: Some(u), ..Default::default() };
             assert!(bad.validate().unwrap_err().to_string().contains("jitter"), "{u}");
+        }
+        assert!(RenderSettings { pixel_offset: Some([0.5, -0.5]), ..Default::default() }.validate().is_ok());
+        for o in [[0.6, 0.0], [0.0, -0.51], [f32::NAN, 0.0], [0.0, f32::INFINITY]] {
+            let bad = RenderSettings { pixel_offset: Some(o), ..Default::default() };
+            assert!(bad.validate().unwrap_err().to_string().contains("pixel offset"), "{o:?}");
         }
     }
 }

@@ -21,4 +21,7 @@ pub struct FrameUniforms {
     /// Salt of the stochastic (`BLEND`) transparency hash: the frame's number in the running
     /// mean when accumulating, 0 otherwise (the same noise every frame).
     pub frame_index: u32,
+    /// Added to the level of detail of every material texture read (`RenderSettings::texture_lod_bias`).
+    pub lod_bias: f32,
+    pub _pad: [u32; 3],
 }

@@ -51,13 +51,13 @@ struct GBufferOut {
 // without discard, which keeps early depth testing.
 fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     // Every texture is sampled before the discard (derivatives need uniform control flow).
-    let base = textureSample(base_color_tex, base_color_smp, material_uv(TEX_BASE, v.uv, v.uv1))
+    let base = textureSampleBias(base_color_tex, base_color_smp, material_uv(TEX_BASE, v.uv, v.uv1), frame.lod_bias)
         * material.base_color * v.color;
-    let mr = textureSample(metal_rough_tex, metal_rough_smp, material_uv(TEX_METAL_ROUGH, v.uv, v.uv1));
-    let emissive = textureSample(emissive_tex, emissive_smp, material_uv(TEX_EMISSIVE, v.uv, v.uv1)).rgb
+    let mr = textureSampleBias(metal_rough_tex, metal_rough_smp, material_uv(TEX_METAL_ROUGH, v.uv, v.uv1), frame.lod_bias);
+    let emissive = textureSampleBias(emissive_tex, emissive_smp, material_uv(TEX_EMISSIVE, v.uv, v.uv1), frame.lod_bias).rgb
         * material.emissive.rgb;
-    let tn_sample = textureSample(normal_tex, normal_smp, material_uv(TEX_NORMAL, v.uv, v.uv1)).xyz;
-    let occlusion = textureSample(occlusion_tex, occlusion_smp, material_uv(TEX_OCCLUSION, v.uv, v.uv1)).r;
+    let tn_sample = textureSampleBias(normal_tex, normal_smp, material_uv(TEX_NORMAL, v.uv, v.uv1), frame.lod_bias).xyz;
+    let occlusion = textureSampleBias(occlusion_tex, occlusion_smp, material_uv(TEX_OCCLUSION, v.uv, v.uv1), frame.lod_bias).r;
     if (alpha_test && alpha_discards(base.a, v.clip.xy, v.clip.z, frame.frame_index)) {
         discard;
     }
@@ -133,8 +133,8 @@ struct GBufferFilmOut {
 // The film's values (sampled before `gbuffer`, whose discard would leave the derivatives of
 // later samples undefined): weight and thickness fraction.
 fn film_values(v: VertexOut) -> vec2<f32> {
-    let weight = textureSample(film_tex, film_smp, material_uv(TEX_FILM, v.uv, v.uv1)).r * material.film.x;
-    let t = textureSample(film_thickness_tex, film_thickness_smp, material_uv(TEX_FILM_THICKNESS, v.uv, v.uv1)).g;
+    let weight = textureSampleBias(film_tex, film_smp, material_uv(TEX_FILM, v.uv, v.uv1), frame.lod_bias).r * material.film.x;
+    let t = textureSampleBias(film_thickness_tex, film_thickness_smp, material_uv(TEX_FILM_THICKNESS, v.uv, v.uv1), frame.lod_bias).g;
     return vec2<f32>(clamp(weight, 0.0, 1.0), clamp(t, 0.0, 1.0));
 }
 
@@ -169,8 +169,8 @@ struct GBufferLayerOut {
 };
 
 fn transmission_values(v: VertexOut) -> vec2<f32> {
-    let t = textureSample(transmission_tex, transmission_smp, material_uv(TEX_TRANSMISSION, v.uv, v.uv1)).r * material.transmission.x;
-    let d = textureSample(volume_thickness_tex, volume_thickness_smp, material_uv(TEX_VOLUME_THICKNESS, v.uv, v.uv1)).g;
+    let t = textureSampleBias(transmission_tex, transmission_smp, material_uv(TEX_TRANSMISSION, v.uv, v.uv1), frame.lod_bias).r * material.transmission.x;
+    let d = textureSampleBias(volume_thickness_tex, volume_thickness_smp, material_uv(TEX_VOLUME_THICKNESS, v.uv, v.uv1), frame.lod_bias).g;
     return vec2<f32>(clamp(t, 0.0, 1.0), clamp(d, 0.0, 1.0));
 }
 

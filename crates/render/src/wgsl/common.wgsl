@@ -27,6 +27,11 @@ struct FrameUniforms {
     // Salt of the stochastic transparency hash (wgsl/material.wgsl): the frame's number in the
     // accumulated mean, 0 without accumulation.
     frame_index: u32,
+    // Added to the material textures' level of detail (RenderSettings::texture_lod_bias).
+    lod_bias: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 const FLAG_LAMBERT: u32 = 1u;

@@ -30,6 +30,31 @@ pub struct RenderArgs {
     /// naive mode.
     #[arg(long, value_name = "FILE.exr")]
     pub spectral_out: Option<PathBuf>,
+    /// Antialiasing: the mean of this many frames, each sampling the scene at another place in
+    /// every pixel (a √K × √K grid when K is a square, else a low-discrepancy set), which is the
+    /// image box-filtered over each pixel, as the path tracer's pixels are. 1 (the default)
+    /// samples the pixel centres once; at most 256.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
+    pub samples: u32,
+}
+
+/// The most frames `--samples` averages.
+pub const MAX_SAMPLES: u32 = 256;
+
+/// Where sample `i` of `k` looks in its pixel, in pixels from the centre: the centres of a
+/// √k × √k grid of equal cells when k is a square (the box filter's midpoint rule), else
+/// Roberts' R2 sequence (the plastic number's low-discrepancy set), which covers the pixel
+/// evenly for any k.
+pub fn pixel_offset(i: u32, k: u32) -> [f32; 2] {
+    let n = (f64::from(k).sqrt().round() as u32).max(1);
+    if n * n == k {
+        let cell = |j: u32| ((f64::from(j) + 0.5) / f64::from(n) - 0.5) as f32;
+        return [cell(i % n), cell(i / n)];
+    }
+    const G: f64 = 1.324_717_957_244_746;
+    let frac = |x: f64| x - x.floor();
+    let t = f64::from(i);
+    [(frac(0.5 + t / G) - 0.5) as f32, (frac(0.5 + t / (G * G)) - 0.5) as f32]
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -48,6 +73,41 @@ fn out_format(path: &Path) -> Result<OutFormat> {
             other.map(|e| format!("'.{e}'")).unwrap_or_else(|| "(none)".into())
         ),
     }
+}
+
+/// Draws the image: one frame at the pixel centres (`samples` = 1), or the mean of `samples`
+/// frames at offsets spread over each pixel (`pixel_offset`), accumulated on the GPU in f32 —
+/// post then tone-maps the mean for `read_ldr`. `interrupted` is asked before every frame.
+pub fn draw(
+    r: &mut Renderer,
+    camera: &scene::Camera,
+    settings: &RenderSettings,
+    samples: u32,
+    interrupted: &dyn Fn() -> Result<(), render::RenderError>,
+) -> Result<(), render::RenderError> {
+    if samples <= 1 {
+        r.set_accumulation(false);
+        return r.render(camera, settings);
+    }
+    r.set_accumulation(true);
+    r.reset_accumulation();
+    // Texture reads as fine as the samples are dense (`RenderSettings::texture_lod_bias`).
+    let bias = settings.texture_lod_bias - 0.5 * (samples as f32).log2();
+    for i in 0..samples {
+        interrupted()?;
+        let s = RenderSettings {
+            pixel_offset: Some(pixel_offset(i, samples)),
+            texture_lod_bias: bias,
+            ..settings.clone()
+        };
+        r.render(camera, &s)?;
+    }
+    Ok(())
+}
+
+/// The linear HDR image `draw` made.
+pub fn read_linear(r: &Renderer, samples: u32) -> Result<Vec<[f32; 4]>, render::RenderError> {
+    if samples <= 1 { r.read_hdr() } else { r.read_accumulated() }
 }
 
 /// Renders the frame and writes `args.out`.
@@ -77,15 +137,16 @@ fn render_frame(
     if args.spectral_out.is_some() {
         r.set_spectral_capture(true);
     }
-    r.render(&scene.camera, settings)?;
     // Encoding a large image takes seconds; Ctrl-C meanwhile must not be followed by a write.
     let interrupted =
         || if color::cancel::is_cancelled() { Err(render::RenderError::Cancelled) } else { Ok(()) };
+    let samples = args.samples;
+    draw(r, &scene.camera, settings, samples, &interrupted)?;
     let k = settings.exposure_ev.exp2();
     // Linear outputs hold the HDR values themselves, so their clipping is worth a warning (a PNG
     // is tone mapped: a clipped pixel is white either way).
     let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
-    let hdr = if linear_out { r.read_hdr()? } else { Vec::new() };
+    let hdr = if linear_out { read_linear(r, samples)? } else { Vec::new() };
     let clipped = render::passes::hdr_clipped(&hdr);
     if clipped > 0 {
         eprintln!(
@@ -143,6 +204,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
             bail!(
                 "--spectral-out {}: a spectral image is an OpenEXR file; give it a .exr name",
                 sp.display()
+            );
+        }
+        if args.samples > 1 {
+            bail!(
+                "--spectral-out writes one frame's node radiances: it cannot be combined with --samples {} (drop one)",
+                args.samples
             );
         }
         if args.look.mode == Mode::Rgb {
@@ -221,6 +288,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             }
         );
     }
+    let under = if args.samples > 1 { format!("{under}, {} samples per pixel", args.samples) } else { under };
     eprintln!(
         "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
         args.out.display(),
@@ -239,6 +307,39 @@ pub fn run(args: RenderArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sample_offsets_cover_the_pixel_evenly() {
+        assert_eq!(pixel_offset(0, 1), [0.0, 0.0]);
+        let grid: Vec<_> = (0..16).map(|i| pixel_offset(i, 16)).collect();
+        for (i, o) in grid.iter().enumerate() {
+            let want = |j: usize| (j as f32 + 0.5) / 4.0 - 0.5;
+            assert_eq!(*o, [want(i % 4), want(i / 4)]);
+        }
+        // Not a square: every offset inside the pixel, their mean near its centre, and each
+        // quarter of the pixel holding about a quarter of them.
+        for k in [2u32, 5, 10, 24, 100] {
+            let o: Vec<_> = (0..k).map(|i| pixel_offset(i, k)).collect();
+            assert!(o.iter().flatten().all(|c| (-0.5..0.5).contains(c)), "{k}: {o:?}");
+            let mean = o.iter().fold([0.0f32; 2], |m, p| [m[0] + p[0] / k as f32, m[1] + p[1] / k as f32]);
+            assert!(
+                mean[0].abs() < 0.5 / k as f32 + 0.05 && mean[1].abs() < 0.5 / k as f32 + 0.05,
+                "{k}: {mean:?}"
+            );
+            if k >= 24 {
+                for q in 0..4 {
+                    let n = o
+                        .iter()
+                        .filter(|p| (p[0] >= 0.0) == (q & 1 == 1) && (p[1] >= 0.0) == (q & 2 == 2))
+                        .count();
+                    assert!(
+                        (n as f32 - k as f32 / 4.0).abs() <= 0.1 * k as f32 + 1.0,
+                        "{k}: quarter {q} has {n}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn extensions() {

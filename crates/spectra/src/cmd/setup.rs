@@ -187,6 +187,8 @@ impl LookArgs {
             shadows,
             timestamps,
             jitter: None,
+            pixel_offset: None,
+            texture_lod_bias: 0.0,
             quadrature: self.quadrature,
             lambert: self.lambert,
             env_occlusion: !self.no_env_occlusion,
