@@ -31,7 +31,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.exr")]
     pub spectral_out: Option<PathBuf>,
     /// Antialiasing: the mean of this many frames, each sampling the scene at another place in
-    /// every pixel (a √K × √K grid when K is a square, else a low-discrepancy set), which is the
+    /// every pixel (a √K × √K grid when K is a square, else a Hammersley set), which is the
     /// image box-filtered over each pixel, as the path tracer's pixels are. 1 (the default)
     /// samples the pixel centres once; at most 256.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
@@ -42,19 +42,19 @@ pub struct RenderArgs {
 pub const MAX_SAMPLES: u32 = 256;
 
 /// Where sample `i` of `k` looks in its pixel, in pixels from the centre: the centres of a
-/// √k × √k grid of equal cells when k is a square (the box filter's midpoint rule), else
-/// Roberts' R2 sequence (the plastic number's low-discrepancy set), which covers the pixel
-/// evenly for any k.
+/// √k × √k grid of equal cells when k is a square (the box filter's midpoint rule), else the
+/// Hammersley set — x at the centres of k equal columns, y the base-2 radical inverse of i —
+/// which covers the pixel evenly for any k and keeps the offsets' mean at the pixel centre
+/// (exactly in x; within about log₂k / 2k in y), so the mean image is not shifted.
 pub fn pixel_offset(i: u32, k: u32) -> [f32; 2] {
     let n = (f64::from(k).sqrt().round() as u32).max(1);
     if n * n == k {
         let cell = |j: u32| ((f64::from(j) + 0.5) / f64::from(n) - 0.5) as f32;
         return [cell(i % n), cell(i / n)];
     }
-    const G: f64 = 1.324_717_957_244_746;
-    let frac = |x: f64| x - x.floor();
-    let t = f64::from(i);
-    [(frac(0.5 + t / G) - 0.5) as f32, (frac(0.5 + t / (G * G)) - 0.5) as f32]
+    let k = f64::from(k);
+    let radical_inverse = f64::from(i.reverse_bits()) / 2f64.powi(32);
+    [((f64::from(i) + 0.5) / k - 0.5) as f32, (radical_inverse + 0.5 / k - 0.5) as f32]
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
