@@ -49,6 +49,8 @@ struct SunState {
     direction: glam::Vec3,
     rotation: f32,
     irradiance: glam::Vec3,
+    /// `scene::Sun::angular_radius`: its light's specular lobe is widened by it.
+    angular_radius: f32,
 }
 
 impl SunState {
@@ -340,6 +342,7 @@ impl Renderer {
                     direction: s.direction,
                     rotation: e.rotation,
                     irradiance: s.irradiance,
+                    angular_radius: s.angular_radius(),
                 };
                 gs.lights.push(state.light(e.intensity, e.rotation));
                 self.sun = Some(state);
@@ -1017,6 +1020,9 @@ impl Renderer {
                 light_weights.extend(std::iter::repeat_n([[0f32; 4]; 3], ng));
             }
             lights.push(gpu);
+        }
+        if let Some(s) = &self.sun {
+            lights[s.index].cone[1] = s.angular_radius;
         }
         let n_lights = lights.len() as u32;
         // Storage buffers may not be empty.

@@ -202,7 +202,9 @@ impl GpuLight {
             LightKind::Directional { direction } => GpuLight {
                 pos_kind: direction.normalize().extend(0.0).to_array(),
                 // Diffuse sky light under water (scene::sky), drawn as a zenith light: the
-                // underwater hooks scatter it isotropically instead of as a beam.
+                // underwater hooks scatter it isotropically instead of as a beam. y: the
+                // angular radius of the disc it stands for (radians; the environment's sun sets
+                // it, `Renderer::set_environment`), 0 for a glTF directional light.
                 cone: [0.0, 0.0, if scene::sky::is_stand_in(light) { 1.0 } else { 0.0 }, 0.0],
                 rgb,
                 ..Default::default()

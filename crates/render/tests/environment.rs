@@ -334,3 +334,67 @@ fn an_environment_sun_becomes_a_directional_light_and_keeps_the_energy() {
     let want = Vec3::new(-towards.z, towards.y, towards.x);
     assert!((turned - want).length() < 1e-4, "{turned} vs {want}");
 }
+
+/// A mirror shows the sun at the sun's own radiance: a smooth metal floor (roughness 0, white,
+/// so F = 1) seen at 45° where it reflects the 2×2-texel sun of a map of radiance 1. Lit with
+/// as a directional light, the sun would be squeezed into the lobe's peak, D ~ 1/πα² with α at
+/// its floor of 10⁻³ — hundreds of times the sun's 2·10⁴; the light stands for the region's disc
+/// (`scene::Sun::angular_radius`), which widens the lobe to the disc's reflection, so the peak is
+/// the sun's radiance. Rough lobes, much wider than the disc, are left as they were.
+#[test]
+fn a_mirror_shows_the_sun_at_its_radiance() {
+    let (w, h) = (256u32, 128u32);
+    let l_sun = 2.0e4;
+    let mut texels = vec![Vec3::ONE; (w * h) as usize];
+    for (x, y) in [(128, 31), (129, 31), (128, 32), (129, 32)] {
+        texels[(y * w + x) as usize] = Vec3::splat(l_sun);
+    }
+    let env = Environment::from_rgb("sun", w, h, texels).unwrap();
+    let sun = env.sun().expect("a sun");
+    // The disc of the region's solid angle: about 1.4° (two texels of 1.4° at 45° up).
+    let rho = sun.angular_radius();
+    assert!((rho - (sun.solid_angle / std::f32::consts::PI).sqrt()).abs() < 1e-4 && rho > 0.015, "{rho}");
+    let towards = sun.direction;
+    // The camera looks along the sun's mirror image in the floor (normal +Y).
+    let view = Vec3::new(towards.x, -towards.y, towards.z);
+    let mut scene = sphere_scene(env);
+    scene.meshes = vec![quad(Vec3::ZERO, 4.0, false)];
+    let mut scene_rough = scene.clone();
+    scene.materials =
+        vec![Material { base_color: Vec4::ONE, metallic: 1.0, roughness: 0.0, ..Default::default() }];
+    scene_rough.materials =
+        vec![Material { base_color: Vec4::ONE, metallic: 1.0, roughness: 0.5, ..Default::default() }];
+    for s in [&mut scene, &mut scene_rough] {
+        s.camera = Camera::look_at(-3.0 * view, Vec3::ZERO, Vec3::Y, 0.15);
+    }
+    let s = RenderSettings { lambert: false, ..settings(Mode::Rgb, 16) };
+    let peak = |scene: &Scene| {
+        let img = render(scene, &s);
+        img.iter().map(|p| p[1]).fold(0.0f32, f32::max)
+    };
+    let mirror = peak(&scene);
+    // The map's own reflection adds about 1; pixel centres sit up to 0.15/96 rad off the peak.
+    assert!((mirror / l_sun - 1.0).abs() < 0.08, "the mirror's brightest pixel {mirror}, the sun {l_sun}");
+    // A rough lobe (α = 0.25) is widened by (ρ²/4nv)/α² ≈ 0.4 % in α² at most: at the image's
+    // centre, with the map's share (the same floor under a map of 1 without the sun) taken off,
+    // it is what GGX gives for the sun as a point, within 2 %.
+    let centre = |scene: &Scene| {
+        let img = render(scene, &s);
+        let at = |x: u32, y: u32| img[(y * SIZE + x) as usize][1];
+        let c = SIZE / 2;
+        0.25 * (at(c - 1, c - 1) + at(c, c - 1) + at(c - 1, c) + at(c, c))
+    };
+    let rough = centre(&scene_rough);
+    let mut no_sun = scene_rough.clone();
+    no_sun.environment = Some(Environment::uniform(Vec3::ONE));
+    let map_share = centre(&no_sun);
+    let e = sun.irradiance.y;
+    let (a2, nv) = (0.0625f32, view.y.abs());
+    let d = 1.0 / (std::f32::consts::PI * a2);
+    let vis = 0.5 / (2.0 * nv * (nv * nv * (1.0 - a2) + a2).sqrt());
+    let want = e * nv * d * vis;
+    assert!(
+        ((rough - map_share) / want - 1.0).abs() < 0.02,
+        "rough metal: {rough} − {map_share} from the map, GGX for a point sun {want}"
+    );
+}

@@ -417,6 +417,15 @@ pub struct Sun {
     pub texels: Vec<usize>,
 }
 
+impl Sun {
+    /// The angular radius (radians) of the disc of the region's solid angle, Ω = 2π(1 − cos ρ):
+    /// what a renderer that lights with the sun as a direction widens its specular lobes by,
+    /// since a smooth surface mirrors the whole disc, not a point.
+    pub fn angular_radius(&self) -> f32 {
+        (1.0 - self.solid_angle / std::f32::consts::TAU).clamp(-1.0, 1.0).acos()
+    }
+}
+
 impl Environment {
     /// The map's sun, if it has one: the texels within [`SUN_MAX_RADIUS_DEG`] of the brightest
     /// (by luminance) whose luminance is at least [`SUN_THRESHOLD`] of its, when they give at least

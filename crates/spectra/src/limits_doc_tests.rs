@@ -95,6 +95,7 @@ fn the_table_states_the_bounds_the_code_enforces() {
     has("--env-rotation", format!("±{:e}", scene::environment::MAX_ROTATION_DEGREES));
     has("--env-sun-share", "(0, 1]".into());
     has("--frames", format!("1–{}", crate::cmd::bench::MAX_FRAMES));
+    has("--samples", format!("render: 1–{} frames", crate::cmd::render::MAX_SAMPLES));
     has("--warmup", format!("0–{}", crate::cmd::bench::MAX_FRAMES));
     has("--checkpoint-every", format!("–{:e} s", crate::cmd::truth::MAX_CHECKPOINT_SECONDS));
     has("--sample-offset", format!("+ spp ≤ 2^{}", truth::render::MAX_SAMPLE_INDEX.trailing_zeros()));

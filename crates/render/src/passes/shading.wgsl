@@ -193,7 +193,19 @@ fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32
     let nv = max(dot(n, v), 1e-4);
     let nh = max(dot(n, h), 0.0);
     let vh = max(dot(v, h), 0.0);
-    let alpha = max(roughness * roughness, 1e-3);
+    // A directional light that stands for a disc of angular radius ρ (the environment's sun;
+    // 0 otherwise) widens the lobe by the disc's image in half-vector space, an ellipse of
+    // semi-axes ρ/2 and ρ/(2 n·v), taken as the round one of its area, radius ρ/(2√(n·v)), and
+    // added in quadrature (the widths of a lobe convolved with the disc). A mirror then shows the
+    // disc at its own radiance at the lobe's peak, where a delta light squeezes it into a point
+    // ~ρ²/4α² as bright; rough lobes are left as they are, and D stays normalised (energy kept).
+    // Scenes without such a light take the branch never (bit-identical images).
+    let rho = select(0.0, lights[li].cone.y, u32(lights[li].pos_kind.w) == 0u);
+    let alpha0 = max(roughness * roughness, 1e-3);
+    var alpha = alpha0;
+    if (rho > 0.0) {
+        alpha = min(sqrt(alpha0 * alpha0 + rho * rho / (4.0 * nv)), 1.0);
+    }
     let a2 = alpha * alpha;
     let dd = nh * nh * (a2 - 1.0) + 1.0;
     let dist = a2 / (PI * dd * dd);

@@ -462,8 +462,8 @@ impl Running {
         Ok(())
     }
 
-    /// This frame's settings: the applied ones, plus (when accumulating) the next jitter offset
-    /// of the running mean, which restarts whenever the camera or the settings changed. (A
+    /// This frame's settings: the applied ones, plus (when accumulating) the next wavelength
+    /// jitter and place in the pixel of the running mean (textures one level finer), which restarts whenever the camera or the settings changed. (A
     /// window resize restarts it inside the renderer.)
     fn accumulation_settings(&mut self, camera: &scene::Camera) -> RenderSettings {
         let applied = &self.controls.applied;
@@ -473,11 +473,16 @@ impl Running {
             self.renderer.reset_accumulation();
             self.last_view = Some((*camera, applied.clone()));
         }
-        let jitter = match self.controls.accumulate {
-            true => Some(super::controls::jitter_offset(self.renderer.accumulated_frames())),
-            false => applied.jitter,
-        };
-        RenderSettings { jitter, ..applied.clone() }
+        if !self.controls.accumulate {
+            return applied.clone();
+        }
+        let k = self.renderer.accumulated_frames();
+        RenderSettings {
+            jitter: Some(super::controls::jitter_offset(k)),
+            pixel_offset: Some(super::controls::pixel_jitter(k)),
+            texture_lod_bias: super::controls::ACCUMULATED_LOD_BIAS,
+            ..applied.clone()
+        }
     }
 
     /// Writes the renderer's display image (without the panel) to `screenshot-<n>.png`.

@@ -16,7 +16,7 @@ const TONEMAPS: [Tonemap; 3] = Tonemap::ALL;
 /// Shortcuts, shown in the panel and printed at start.
 pub const HELP: &str = "left drag: orbit · right drag: look · wheel: zoom · WASD/QE: fly (Shift ×4) · \
 R: reset camera · M or 1/2/3: mode · [ ]: N −/+1 · { }: N ÷/×2 · I: quadrature · T: tone map · O: observer · \
-- =: exposure · J: accumulate jittered λ · F12 or P: screenshot · Esc: quit";
+- =: exposure · J: accumulate (jittered λ, antialiased) · F12 or P: screenshot · Esc: quit";
 
 /// The wavelength jitter of accumulated frame `k` (0-based since the last reset): the
 /// golden-ratio additive recurrence u_k = frac(½ + k/φ), whose first K values fall one in each
@@ -26,6 +26,20 @@ pub fn jitter_offset(k: u32) -> f32 {
     const INV_PHI: f64 = 0.618_033_988_749_894_9;
     ((0.5 + k as f64 * INV_PHI).fract() as f32).min(1.0 - f32::EPSILON)
 }
+
+/// Where accumulated frame `k` looks inside each pixel, in pixels from its centre: Roberts' R2
+/// sequence (the plastic number's additive recurrence, open-ended like [`jitter_offset`]), so
+/// that the running mean is the image box-filtered over the pixel — antialiased — however many
+/// frames the user waits for. Frame 0 looks at the centre.
+pub fn pixel_jitter(k: u32) -> [f32; 2] {
+    const G: f64 = 1.324_717_957_244_746;
+    let t = f64::from(k);
+    [((0.5 + t / G).fract() - 0.5) as f32, ((0.5 + t / (G * G)).fract() - 0.5) as f32]
+}
+
+/// The texture LOD bias of accumulated frames: one level finer than a single frame's, since
+/// the mean covers the pixel with many samples (`spectra render --samples 4` takes the same).
+pub const ACCUMULATED_LOD_BIAS: f32 = -1.0;
 
 /// What the user asked for and what is on screen.
 pub struct Controls {
@@ -39,7 +53,8 @@ pub struct Controls {
     pub status: String,
     pub screenshot_requested: bool,
     pub reset_camera_requested: bool,
-    /// Accumulate frames with jittered wavelengths ([`jitter_offset`]) until the view changes.
+    /// Accumulate frames with jittered wavelengths ([`jitter_offset`]) and places in the pixel
+    /// ([`pixel_jitter`]) until the view changes.
     pub accumulate: bool,
     /// Frames in the displayed mean (set by the window each frame, shown in the panel).
     pub accumulated_frames: u32,
@@ -177,7 +192,7 @@ impl Controls {
         });
         ui.checkbox(&mut w.shadows, "shadow maps");
         ui.horizontal(|ui| {
-            ui.checkbox(&mut self.accumulate, "accumulate (jittered λ) (J)");
+            ui.checkbox(&mut self.accumulate, "accumulate (jittered λ, antialiased) (J)");
             if self.accumulate {
                 ui.monospace(format!("{} frames", self.accumulated_frames));
             }
@@ -299,6 +314,22 @@ mod tests {
             assert!(counts.iter().filter(|&&c| c == 0).count() <= k / 3, "K = {k}: {counts:?}");
         }
         assert_eq!(jitter_offset(0), 0.5);
+    }
+
+    #[test]
+    fn pixel_jitter_covers_the_pixel() {
+        assert_eq!(pixel_jitter(0), [0.0, 0.0]);
+        // Every prefix of 16 or more frames puts between 1/8 and 3/8 of its samples in each
+        // quarter of the pixel, all inside it.
+        for k in [16u32, 40, 100, 1000] {
+            let mut quarters = [0u32; 4];
+            for i in 0..k {
+                let [x, y] = pixel_jitter(i);
+                assert!((-0.5..0.5).contains(&x) && (-0.5..0.5).contains(&y), "{x}, {y}");
+                quarters[usize::from(x >= 0.0) + 2 * usize::from(y >= 0.0)] += 1;
+            }
+            assert!(quarters.iter().all(|&q| q * 8 >= k && q * 8 <= 3 * k), "{k}: {quarters:?}");
+        }
     }
 
     #[test]
