@@ -564,9 +564,12 @@ def run_model(a, runner, name, path, outdir):
         log(f"    {res['error']}")
         return res
     common = ["--size", a.size, *env_args(a)]
+    # The truth's pixels are box-filtered (the mean over each pixel); real time's are too with
+    # --samples K, so that the comparison is of lighting, not of point sampling.
+    aa = ["--samples", str(a.samples)] if a.samples != 1 else []
     jobs = [
-        ("rgb", ["render", path, "--mode", "rgb", *common, *shlex.split(a.render_args)]),
-        ("spectral", ["render", path, "--mode", "spectral", *common, *shlex.split(a.render_args)]),
+        ("rgb", ["render", path, "--mode", "rgb", *common, *aa, *shlex.split(a.render_args)]),
+        ("spectral", ["render", path, "--mode", "spectral", *common, *aa, *shlex.split(a.render_args)]),
         ("truth", ["truth", path, *common, "--spp", str(a.spp), *shlex.split(a.truth_args)]),
     ]
     images = {}
@@ -787,6 +790,7 @@ def write_reports(a, results, meta):
         "",
         f"{meta['size']} px, environment `{a.env}`"
         + (f" × {a.env_intensity}" if a.env_intensity is not None else "")
+        + f", real time {a.samples} frame{'s' if a.samples != 1 else ''} per image (`--samples`)"
         + f", truth {a.spp} spp (`{' '.join(meta['truth_flags'])}`); ΔE2000 = mean CIEDE2000 against the truth"
         f" on {a.block}×{a.block} block means (per pixel in brackets), over the whole image and over the model"
         f" (the blocks at least half covered by it; the pixels of it); truth noise = the same block-mean ΔE00"
@@ -975,6 +979,10 @@ def main():
     ap.add_argument("--spp", type=int, default=64, help="truth samples per pixel (default: 64)")
     ap.add_argument("--truth-args", default="--direct-only",
                     help="extra flags for spectra truth (default: --direct-only)")
+    ap.add_argument("--samples", type=int, default=16,
+                    help="frames averaged per real-time render (spectra render --samples, 1-256): the truth "
+                         "integrates each pixel, so the default 16 antialiases real time to match; 1 = single "
+                         "frames at the pixel centres (default: 16)")
     ap.add_argument("--render-args", default="", help="extra flags for both spectra render runs")
     ap.add_argument("--no-mask", action="store_true",
                     help="under an environment other than the default: skip the extra rgb render under the default "
@@ -1036,6 +1044,10 @@ def main():
         ap.error(f"{a.spectra}: no spectra binary there (cargo build --release -p spectra, or --spectra PATH)")
     if a.block < 1:
         ap.error("--block must be at least 1")
+    if not 1 <= a.samples <= 256:
+        ap.error(f"--samples {a.samples}: frames per real-time render must be 1-256")
+    if any(f == "--samples" or f.startswith("--samples=") for f in shlex.split(a.render_args)):
+        ap.error("--render-args: give the frames per image as the tool's own --samples K, not inside --render-args")
 
     meta = {
         "command": "tools/conformance.py " + " ".join(shlex.quote(x) for x in sys.argv[1:]),
@@ -1046,6 +1058,7 @@ def main():
         "env_intensity": a.env_intensity,
         "spp": a.spp,
         "truth_flags": shlex.split(a.truth_args),
+        "render_samples": a.samples,
         "render_flags": shlex.split(a.render_args),
         "block": a.block,
         "black_threshold": a.black_threshold,
