@@ -115,9 +115,15 @@ def test_render_samples_equals_the_cli(tmp_path, renderer):
     py = renderer.render(samples=4)
     np.testing.assert_allclose(py, cli, rtol=1e-3, atol=1e-6)
     one = renderer.render()
-    # The edges change, the image as a whole stays (the same scene, filtered over each pixel).
+    # The edges change, the image as a whole stays (the same scene, filtered over each pixel):
+    # its mean away from the lamp, whose edge pixels (radiance 40, partly covered once
+    # filtered) would swing an HDR mean by 20 %; 64×48 pixels of edges move it by 2 %.
     assert not np.array_equal(py, one)
-    assert abs(py.mean() - one.mean()) < 0.02 * one.mean()
+    lamp = np.pad(one.max(axis=-1) > 1.0, 1)
+    near_lamp = np.lib.stride_tricks.sliding_window_view(lamp, (3, 3)).any(axis=(-1, -2))
+    away = ~near_lamp
+    assert away.sum() > 0.9 * away.size
+    assert abs(py[away].mean() - one[away].mean()) < 0.03 * one[away].mean()
     # And a single frame afterwards is the single frame again.
     assert np.array_equal(renderer.render(), one)
     for bad in (0, 257, -1):
