@@ -9,9 +9,9 @@
 mod common;
 
 use common::*;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use render::{Mode, RenderSettings};
-use scene::{Camera, Material, Mesh, Scene, SpectralSettings};
+use scene::{Material, Mesh, Scene, SpectralSettings};
 
 const W: u32 = 40;
 const H: u32 = 32;
@@ -41,14 +41,7 @@ fn scene() -> Scene {
         }],
         textures: vec![],
         lights: vec![],
-        camera: Camera {
-            transform: Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)),
-            yfov: 0.5,
-            znear: 0.1,
-            zfar: 10.0,
-            aspect: None,
-            ortho: Some((1.0, 0.8)),
-        },
+        camera: common::front_ortho_camera(),
         spectral: SpectralSettings::default(),
         water: None,
         environment: None,

@@ -11,7 +11,7 @@
 mod common;
 
 use common::*;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Vec3, Vec4};
 use render::{Mode, RenderSettings, Renderer};
 use scene::transmission::{Transmission, Volume};
 use scene::{Camera, Material, Mesh, Scene, SpectralSettings};
@@ -63,14 +63,7 @@ fn scene(pane: Option<Material>, stripe: bool) -> Scene {
         s.materials.push(m);
         s.meshes.push(Mesh::quad(Vec3::new(-0.5, -0.4, 0.0), Vec3::X, Vec3::Y * 0.8, 2));
     }
-    s.camera = Camera {
-        transform: Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)),
-        yfov: 0.5,
-        znear: 0.1,
-        zfar: 10.0,
-        aspect: None,
-        ortho: Some((1.0, 0.8)),
-    };
+    s.camera = common::front_ortho_camera();
     s
 }
 

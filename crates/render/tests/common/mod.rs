@@ -139,6 +139,18 @@ pub fn chart_camera() -> Camera {
     Camera::look_at(Vec3::new(0.0, 0.0, CAMERA_DISTANCE), Vec3::ZERO, Vec3::Y, CAMERA_YFOV)
 }
 
+/// An orthographic camera at z = 2 looking down −Z at the window x ∈ [−1, 1], y ∈ [−0.8, 0.8].
+pub fn front_ortho_camera() -> Camera {
+    Camera {
+        transform: Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0)),
+        yfov: 0.5,
+        znear: 0.1,
+        zfar: 10.0,
+        aspect: None,
+        ortho: Some((1.0, 0.8)),
+    }
+}
+
 /// World (x, y) on the z = 0 plane seen through the centre of pixel (px, py).
 pub fn pixel_to_chart(px: u32, py: u32, w: u32, h: u32) -> (Vec2, Vec3) {
     let cam = chart_camera();
