@@ -5,7 +5,7 @@
 //! in shading.wgsl is the record below.
 
 use crate::scene_gpu::ConstantColour;
-use crate::spectral_data::WavelengthGroup;
+use crate::spectral_data::{GroupWeights, WavelengthGroup};
 use color::upsample::CoeffTable;
 
 /// Byte for byte `MaterialSpectrum` in shading.wgsl (src/layout_tests.rs checks it).
@@ -104,5 +104,141 @@ impl MaterialSpectrum {
             v.push(MaterialSpectrum::default());
         }
         v
+    }
+}
+
+/// The most lights the shading pass shades (`MAX_LIGHTS` in shading.wgsl).
+pub const MAX_SHADED_LIGHTS: usize = 32;
+
+/// Entries of [`reflected_xyz`] per material for `n_lights` lights: a column per light, three
+/// to an entry, then one for the environment.
+pub fn reflected_stride(n_lights: usize) -> usize {
+    n_lights.min(MAX_SHADED_LIGHTS).div_ceil(3) + 1
+}
+
+/// What a material of constant base colour reflects, integrated on the CPU once per frame
+/// setting instead of per pixel and light: the XYZ Σᵢ ρ(λᵢ)·Wᵢ of its reflectance (the sigmoid
+/// of `record.base`, at the frame's nodes) under each shaded light's node weights `lights[l]`,
+/// and under each of the environment's basis spectra `basis[j]` (empty without one). The
+/// shading pass's node loop computes exactly this sum for such a material, the same at every
+/// pixel of it; summed here in f64, it costs a pixel one load per light, as the RGB mode's
+/// light colour does.
+///
+/// Layout, `reflected_stride(lights.len())` [`GroupWeights`] per material record, appended to
+/// the light weights (`light_weights[n_lights · n_groups + record · stride + k]` in
+/// shading.wgsl): entry k < stride − 1 holds lights 3k, 3k + 1, 3k + 2 as its columns' XYZ
+/// (w = 0); the last one holds the environment's basis j in lane j of column c = X, Y, Z. A
+/// material whose base colour varies (`record.base[3] == 0`) has zeros: the shader fetches
+/// and loops for it.
+pub fn reflected_xyz(
+    records: &[MaterialSpectrum],
+    lights: &[Vec<[f64; 3]>],
+    basis: &[Vec<[f64; 3]>],
+    groups: &[WavelengthGroup],
+) -> Vec<GroupWeights> {
+    let lights = &lights[..lights.len().min(MAX_SHADED_LIGHTS)];
+    let stride = reflected_stride(lights.len());
+    let mut out = vec![[[0f32; 4]; 3]; records.len() * stride];
+    for (m, rec) in records.iter().enumerate() {
+        if rec.base[3] == 0.0 {
+            continue;
+        }
+        let [c0, c1, c2, _] = rec.base.map(f64::from);
+        // As the shader evaluates it (`sigmoid4`), at the f32 nodes it reads.
+        let rho = |i: usize| {
+            let l = f64::from(groups[i / 4].lambda[i % 4]);
+            let x = ((c0 * l + c1) * l + c2).clamp(-1e18, 1e18);
+            0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+        };
+        let integrate = |w: &[[f64; 3]]| {
+            let mut xyz = [0f64; 3];
+            for (i, wi) in w.iter().enumerate() {
+                let r = rho(i);
+                for c in 0..3 {
+                    xyz[c] += r * wi[c];
+                }
+            }
+            xyz
+        };
+        let row = &mut out[m * stride..(m + 1) * stride];
+        for (l, w) in lights.iter().enumerate() {
+            let xyz = integrate(w);
+            for c in 0..3 {
+                row[l / 3][l % 3][c] = xyz[c] as f32;
+            }
+        }
+        for (j, w) in basis.iter().enumerate().take(4) {
+            let xyz = integrate(w);
+            for c in 0..3 {
+                row[stride - 1][c][j] = xyz[c] as f32;
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn groups(lambda: &[f32]) -> Vec<WavelengthGroup> {
+        lambda
+            .chunks(4)
+            .map(|c| {
+                let mut g = WavelengthGroup::default();
+                g.lambda[..c.len()].copy_from_slice(c);
+                g
+            })
+            .collect()
+    }
+
+    /// The entries hold Σᵢ ρ(λᵢ)·Wᵢ where the shader reads them: light l in column l % 3 of
+    /// entry l / 3, basis j in lane j of the last; a varying colour's row is zero; lights past
+    /// the shaded 32 have no column.
+    #[test]
+    fn reflected_xyz_sums_the_nodes_into_the_shaders_layout() {
+        let lambda = [400.0, 450.0, 500.0, 550.0, 600.0, 650.0];
+        let g = groups(&lambda);
+        let grey = MaterialSpectrum { base: [0.0, 0.0, 0.0, 1.0], ..Default::default() };
+        let ramp = MaterialSpectrum { base: [0.0, 0.01, -5.5, 1.0], ..Default::default() };
+        let varying = MaterialSpectrum { base: [0.0, 0.01, -5.5, 0.0], ..Default::default() };
+        let weights = |k: f64| -> Vec<[f64; 3]> {
+            (0..lambda.len()).map(|i| [k + i as f64, 2.0 * k, 0.5 * i as f64]).collect()
+        };
+        let lights: Vec<_> = (0..40).map(|l| weights(l as f64)).collect();
+        let basis: Vec<_> = (0..4).map(|j| weights(10.0 * j as f64 + 1.0)).collect();
+        let out = reflected_xyz(&[grey, ramp, varying], &lights, &basis, &g);
+        let stride = reflected_stride(40);
+        assert_eq!(stride, 11 + 1);
+        assert_eq!(out.len(), 3 * stride);
+        let sig = |x: f64| 0.5 + 0.5 * x / (1.0 + x * x).sqrt();
+        let expect = |rho: &dyn Fn(f64) -> f64, w: &[[f64; 3]]| -> [f64; 3] {
+            let mut s = [0.0; 3];
+            for (l, wi) in lambda.iter().zip(w) {
+                for c in 0..3 {
+                    s[c] += rho(f64::from(*l)) * wi[c];
+                }
+            }
+            s
+        };
+        let close = |a: f32, b: f64| ((f64::from(a) - b) / b.abs().max(1e-6)).abs() < 1e-6;
+        for (m, rho) in [(0usize, &(|_: f64| 0.5) as &dyn Fn(f64) -> f64), (1, &|l: f64| sig(0.01 * l - 5.5))]
+        {
+            let row = &out[m * stride..(m + 1) * stride];
+            for l in [0usize, 2, 3, 31] {
+                let e = expect(rho, &lights[l]);
+                for c in 0..3 {
+                    assert!(close(row[l / 3][l % 3][c], e[c]), "material {m}, light {l}, channel {c}");
+                }
+                assert_eq!(row[l / 3][l % 3][3], 0.0);
+            }
+            for j in 0..4 {
+                let e = expect(rho, &basis[j]);
+                for c in 0..3 {
+                    assert!(close(row[stride - 1][c][j], e[c]), "material {m}, basis {j}, channel {c}");
+                }
+            }
+        }
+        assert!(out[2 * stride..].iter().all(|e| *e == [[0.0; 4]; 3]));
     }
 }

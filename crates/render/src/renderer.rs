@@ -1002,6 +1002,8 @@ impl Renderer {
         let mut lights = Vec::new();
         // light_weights[light · n_groups + group]: the light's node weights (mat3x4 in WGSL).
         let mut light_weights: Vec<crate::spectral_data::GroupWeights> = Vec::new();
+        // Each light's weights per node (spectral modes), for the materials' reflected XYZ.
+        let mut light_node_weights: Vec<Vec<[f64; 3]>> = Vec::new();
         // Punctual lights, then the emissive polygons: each a GPU light and its emission.
         let sources =
             scene.lights.iter().map(|l| (GpuLight::new(l, setup.light_rgb(&l.emission)), &l.emission)).chain(
@@ -1016,6 +1018,7 @@ impl Renderer {
                 let total = SpectralSetup::light_total(&w);
                 gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
                 light_weights.extend(setup.gpu_weights(&w));
+                light_node_weights.push(w);
             } else {
                 light_weights.extend(std::iter::repeat_n([[0f32; 4]; 3], ng));
             }
@@ -1029,9 +1032,6 @@ impl Renderer {
         if lights.is_empty() {
             lights.push(GpuLight::default());
         }
-        if light_weights.is_empty() {
-            light_weights.push([[0f32; 4]; 3]);
-        }
         let storage = |label: &str, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -1042,6 +1042,7 @@ impl Renderer {
         // The environment's basis spectra: node weights [j · n_groups + g] and XYZ totals.
         let mut env_weights: Vec<crate::spectral_data::GroupWeights> = Vec::new();
         let mut env_totals = [[0f32; 4]; 4];
+        let mut env_basis: Vec<Vec<[f64; 3]>> = Vec::new();
         if self.environment.source.is_some() && settings.mode != Mode::Rgb {
             let white = &setup.white;
             let basis: Vec<Vec<[f64; 3]>> = match (settings.mode, &self.environment.spectral) {
@@ -1063,22 +1064,34 @@ impl Renderer {
                 env_totals[j] = [t[0] as f32, t[1] as f32, t[2] as f32, 0.0];
                 env_weights.extend(setup.gpu_weights(w));
             }
+            env_basis = basis;
         }
         let env_weight_buf = GpuEnvironment::storage(device, &env_weights);
         let env_tex = self.environment.textures(settings.mode == Mode::Spectral);
+        let records = MaterialSpectrum::of_scene(
+            &scene.constant_colours,
+            &scene.material_films,
+            &scene.material_refraction,
+            &self.table,
+            &groups,
+        );
+        // After the lights' weights, what each constant-colour material reflects under each
+        // light and basis spectrum (the spectral mode's; the naive mode loops over boxes).
+        if settings.mode == Mode::Spectral {
+            light_weights.extend(crate::material_spectra::reflected_xyz(
+                &records,
+                &light_node_weights,
+                &env_basis,
+                &groups,
+            ));
+        }
+        if light_weights.is_empty() {
+            light_weights.push([[0f32; 4]; 3]);
+        }
         let wl_buf = storage("wavelengths", bytemuck::cast_slice(&groups));
         let light_buf = storage("lights", bytemuck::cast_slice(&lights));
         let light_spec_buf = storage("light weights", bytemuck::cast_slice(&light_weights));
-        let material_spectra = storage(
-            "material spectra",
-            bytemuck::cast_slice(&MaterialSpectrum::of_scene(
-                &scene.constant_colours,
-                &scene.material_films,
-                &scene.material_refraction,
-                &self.table,
-                &groups,
-            )),
-        );
+        let material_spectra = storage("material spectra", bytemuck::cast_slice(&records));
         let bind_group = self.shared.spectral_group(
             device,
             &SpectralInputs {

@@ -4,12 +4,18 @@
 //! is, where every colour is constant, and with white vertex colours on every mesh, which sends
 //! every pixel through the shader's fetch of the G-buffer's colours. The colours are exact in
 //! f16, so that the G-buffer holds them unrounded and both paths start from the same numbers.
+//!
+//! A constant colour's reflection is also integrated on the CPU (`material_spectra::
+//! reflected_xyz`: its XYZ under each light and the environment's basis spectra), where the
+//! fetched one goes through the shader's node loop: four lights of different spectra (three to
+//! a table entry, so the fourth starts the next) and an environment check the table's layout.
 
 mod common;
 
 use common::*;
 use glam::{Vec3, Vec4};
 use render::{Mode, RenderSettings};
+use scene::{Emission, Environment, Light, LightKind};
 
 #[test]
 fn constant_material_coefficients_match_the_per_pixel_fetch() {
@@ -19,6 +25,35 @@ fn constant_material_coefficients_match_the_per_pixel_fetch() {
         *c = c.map(f16);
     }
     let mut scene = chart.scene(white_light(3.0, None), 0.5, 0.0);
+    let f11 = color::illuminant::by_name("F11").unwrap();
+    for (i, (direction, emission)) in [
+        (Vec3::new(0.3, -0.2, -1.0), white_light(1.0, Some(f11))),
+        (
+            Vec3::new(-0.4, 0.3, -1.0),
+            Emission { rgb: Vec3::new(1.0, 0.5, 0.2), intensity: 1.5, spectrum: None },
+        ),
+        (
+            Vec3::new(0.1, 0.5, -1.0),
+            Emission { rgb: Vec3::new(0.2, 0.4, 1.0), intensity: 2.0, spectrum: None },
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        scene.lights.push(Light {
+            name: format!("light {i}"),
+            kind: LightKind::Directional { direction: direction.normalize() },
+            emission,
+            stands_in_for: None,
+        });
+    }
+    scene.environment = Some(Environment::default_sky());
+    // Metals too: their reflectance tints the specular lobe, which the table holds as well.
+    for (i, m) in scene.materials.iter_mut().enumerate() {
+        if i % 4 == 2 {
+            m.metallic = 1.0;
+        }
+    }
     // Emission over the whole colour range (dim, saturated, near white and past 1), and unlit
     // surfaces, whose colour the G-buffer carries as emission.
     for (i, m) in scene.materials.iter_mut().enumerate() {
@@ -32,6 +67,7 @@ fn constant_material_coefficients_match_the_per_pixel_fetch() {
     let mut r = renderer();
     let mut render = |scene: &scene::Scene, n: usize| {
         r.set_scene(scene).unwrap();
+        r.set_environment(scene.environment.as_ref());
         let cam = r.scene_camera().unwrap();
         let s = RenderSettings { mode: Mode::Spectral, wavelengths: n, shadows: false, ..Default::default() };
         r.resize(96, 64).unwrap();

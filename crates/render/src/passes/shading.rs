@@ -8,7 +8,10 @@
 //! four node wavelengths, with the light's node weights W (which hold its emission, the
 //! observer and the quadrature rule, `color::quadrature`); then one pass over the nodes for the
 //! environment and a varying emission (a constant one is its XYZ, from the CPU); finally
-//! XYZ → linear RGB. Nothing is kept per light, so the pass has no private arrays.
+//! XYZ → linear RGB. Nothing is kept per light, so the pass has no private arrays. Where the
+//! base colour is the material's constant one, `Σ_g ρ_g · W_g` of every light and of the
+//! environment's basis spectra are read, summed once on the CPU
+//! (`crate::material_spectra::reflected_xyz`), and no node loop runs for that pixel.
 //!
 //! Per node wavelength (one lane of the vec4 ops), for a pixel lit by L lights, without a
 //! spectral hook:

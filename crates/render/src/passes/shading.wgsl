@@ -436,10 +436,14 @@ fn load_surface(px: vec2<i32>) -> GSurface {
     return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0, surface_f0(px));
 }
 
-// The material's record (src/material_spectra.rs) at pixel px, by its slot.
-fn material_at(px: vec2<i32>) -> MaterialSpectrum {
+// The index of the material's record (src/material_spectra.rs) at pixel px, by its slot.
+fn material_index(px: vec2<i32>) -> u32 {
     let slot = textureLoad(gbuf_slot, px, 0).x;
-    return material_spectra[min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u)];
+    return min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u);
+}
+
+fn material_at(px: vec2<i32>) -> MaterialSpectrum {
+    return material_spectra[material_index(px)];
 }
 
 fn surface_f0(px: vec2<i32>) -> f32 {
@@ -707,14 +711,38 @@ struct SurfaceCoeffs {
     emission: vec4<f32>,
     emission_known: bool,
     emission_xyz: vec3<f32>,
+    // Whether the base colour is the material's constant one, and where in `light_weights`
+    // what it reflects under each light and the environment's basis spectra starts
+    // (`material_spectra::reflected_xyz`): such a pixel needs no node loop for them.
+    base_known: bool,
+    reflected: u32,
 };
+
+// Entries of the reflected XYZs per material: a column per shaded light, three to an entry,
+// then the environment's (`material_spectra::reflected_stride`).
+fn reflected_stride() -> u32 {
+    return (min(frame.n_lights, MAX_LIGHTS) + 2u) / 3u + 1u;
+}
+
+// What the pixel's material reflects under light li, when `SurfaceCoeffs::base_known`.
+fn reflected_light(sc: SurfaceCoeffs, li: u32) -> vec3<f32> {
+    return light_weights[sc.reflected + li / 3u][li % 3u].xyz;
+}
+
+// What it reflects of the environment's coefficients c.
+fn reflected_env(sc: SurfaceCoeffs, c: vec4<f32>) -> vec3<f32> {
+    return c * light_weights[sc.reflected + reflected_stride() - 1u];
+}
 
 // The spectral mode's coefficients at pixel `px`: the material's precomputed ones where its
 // colours are constant, else fetched from the G-buffer's colours. Emission is upsampled with the
 // "illuminant" variant, s·sigmoid(rgb / s)·white(λ) with s = 2·max(rgb), so that an emissive
 // (1, 1, 1) is exactly the white illuminant; a surface that emits nothing is not fetched.
 fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
-    let m = material_at(px);
+    let index = material_index(px);
+    let m = material_spectra[index];
+    let base_known = !FETCH_BASE || m.base.w != 0.0;
+    let reflected = frame.n_lights * frame.n_groups + index * reflected_stride();
     var base = m.base.xyz;
     var emission = select(vec4<f32>(0.0), m.emission, m.emission.w >= 0.0);
     // A scene whose colours are all constant has no fetch compiled in.
@@ -734,10 +762,10 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
         emission = select(vec4<f32>(fetched.b, scale), emission, em_known);
     }
     if (!HAS_EMISSION) {
-        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0));
+        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected);
     }
     let known = m.emission.w >= 0.0;
-    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known));
+    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known), base_known, reflected);
 }
 
 // Spectral and naive modes.
@@ -767,11 +795,15 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     ctx.normal = s.normal;
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
-    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0));
+    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u);
     if (!NAIVE) {
         sc = surface_coeffs(px, s);
     }
     let c_base = sc.base;
+    // A constant colour's reflected XYZs are read, not looped for (a loop that no pixel of a
+    // group runs costs nothing even where both sides of a branch are executed).
+    let known = !NAIVE && sc.base_known;
+    let ng_unknown = select(ng, 0u, known);
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
     let film = load_film(px);
@@ -802,8 +834,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             var f = factors_of(t, s.metallic, s.f0);
             f.x += through;
             // The specular part does not depend on the reflectance: the light's XYZ once.
-            var reflected = vec3<f32>(0.0);
-            for (var g = 0u; g < ng; g++) {
+            var reflected = select(vec3<f32>(0.0), reflected_light(sc, li), known);
+            for (var g = 0u; g < ng_unknown; g++) {
                 reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
             }
             xyz = fma(vec3<f32>(f.x), reflected, fma(vec3<f32>(f.y), lights[li].xyz.xyz, xyz));
@@ -841,12 +873,22 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let em_scale = select(em.w, 0.0, sc.emission_known);
     let em_nodes = HAS_EMISSION && (NAIVE || FETCH_EMISSION);
     xyz += sc.emission_xyz;
-    for (var g = 0u; g < ng; g++) {
+    let env_known = known && has_env && !s.unlit && !film_env;
+    if (env_known) {
+        xyz += reflected_env(sc, et.a);
+    }
+    // The loop is needed for what the reflected XYZs do not hold: a varying colour, a film, a
+    // varying emission, a hook's irradiance.
+    var ng_rest = ng;
+    if (!em_nodes && !CUSTOM_IRRADIANCE) {
+        ng_rest = select(ng, 0u, known && !film_env);
+    }
+    for (var g = 0u; g < ng_rest; g++) {
         let rho = node_reflectance(c_base, s.base, g);
         if (film_env) {
             let fe = film_env_node(lobes, film, rho, s.metallic, wavelengths[g].lambda);
             xyz += fe.irr * env_w(lobes.irr, g, ng) + fe.spec * env_w(lobes.spec, g, ng);
-        } else if (has_env) {
+        } else if (has_env && !env_known) {
             xyz += rho * env_w(et.a, g, ng);
         }
         if (em_nodes) {
