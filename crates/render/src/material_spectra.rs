@@ -6,7 +6,7 @@
 
 use crate::scene_gpu::ConstantColour;
 use crate::spectral_data::{GroupWeights, WavelengthGroup};
-use color::upsample::CoeffTable;
+use color::upsample::{CoeffTable, SigmoidPolynomial};
 
 /// Byte for byte `MaterialSpectrum` in shading.wgsl (src/layout_tests.rs checks it).
 #[repr(C)]
@@ -66,11 +66,10 @@ impl MaterialSpectrum {
         let mut xyz = [0.0f64; 3];
         if emission[3] > 0.0 {
             let [c0, c1, c2, scale] = emission.map(f64::from);
+            let poly = SigmoidPolynomial::new(c0, c1, c2);
             for g in groups {
                 for lane in 0..4 {
-                    let l = f64::from(g.lambda[lane]);
-                    let x = ((c0 * l + c1) * l + c2).clamp(-1e18, 1e18);
-                    let e = scale * (0.5 + 0.5 * x / (1.0 + x * x).sqrt());
+                    let e = scale * poly.eval(f64::from(g.lambda[lane]));
                     for (c, w) in xyz.iter_mut().zip([g.white_x, g.white_y, g.white_z]) {
                         *c += e * f64::from(w[lane]);
                     }
@@ -144,12 +143,9 @@ pub fn reflected_xyz(
             continue;
         }
         let [c0, c1, c2, _] = rec.base.map(f64::from);
-        // As the shader evaluates it (`sigmoid4`), at the f32 nodes it reads.
-        let rho = |i: usize| {
-            let l = f64::from(groups[i / 4].lambda[i % 4]);
-            let x = ((c0 * l + c1) * l + c2).clamp(-1e18, 1e18);
-            0.5 + 0.5 * x / (1.0 + x * x).sqrt()
-        };
+        let poly = SigmoidPolynomial::new(c0, c1, c2);
+        // At the f32 nodes the shader reads.
+        let rho = |i: usize| poly.eval(f64::from(groups[i / 4].lambda[i % 4]));
         let integrate = |w: &[[f64; 3]]| {
             let mut xyz = [0f64; 3];
             for (i, wi) in w.iter().enumerate() {
