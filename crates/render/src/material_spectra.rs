@@ -4,7 +4,7 @@
 //! colour. The spectral G-buffer writes each pixel's material slot; `material_spectra[slot − 1]`
 //! in shading.wgsl is the record below.
 
-use crate::scene_gpu::ConstantColour;
+use crate::scene_gpu::{ConstantColour, MAX_LIGHTS};
 use crate::spectral_data::{GroupWeights, WavelengthGroup};
 use color::upsample::{CoeffTable, SigmoidPolynomial};
 
@@ -106,13 +106,10 @@ impl MaterialSpectrum {
     }
 }
 
-/// The most lights the shading pass shades (`MAX_LIGHTS` in shading.wgsl).
-pub const MAX_SHADED_LIGHTS: usize = 32;
-
 /// Entries of [`reflected_xyz`] per material for `n_lights` lights: a column per light, three
 /// to an entry, then one for the environment.
 pub fn reflected_stride(n_lights: usize) -> usize {
-    n_lights.min(MAX_SHADED_LIGHTS).div_ceil(3) + 1
+    n_lights.min(MAX_LIGHTS).div_ceil(3) + 1
 }
 
 /// What a material of constant base colour reflects, integrated on the CPU once per frame
@@ -135,7 +132,7 @@ pub fn reflected_xyz(
     basis: &[Vec<[f64; 3]>],
     groups: &[WavelengthGroup],
 ) -> Vec<GroupWeights> {
-    let lights = &lights[..lights.len().min(MAX_SHADED_LIGHTS)];
+    let lights = &lights[..lights.len().min(MAX_LIGHTS)];
     let stride = reflected_stride(lights.len());
     let mut out = vec![[[0f32; 4]; 3]; records.len() * stride];
     for (m, rec) in records.iter().enumerate() {
