@@ -98,6 +98,7 @@ fn shading_module(custom: &CustomShader) -> Module {
     let hooks = custom.assembled();
     parse(&[
         shader::COMMON,
+        shader::HASH,
         shader::SPECTRAL,
         shader::ENVIRONMENT,
         shader::FILM,
@@ -163,13 +164,14 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(&shading, "GpuLight", rust_layout!(GpuLight { pos_kind, dir_range, cone, rgb, xyz, extra }));
     check(&shading, "CustomUniforms", rust_layout!(CustomUniforms { params, n_spectra, _pad }));
 
-    let gbuffer = parse(&[shader::COMMON, shader::MATERIAL, include_str!("passes/gbuffer.wgsl")]);
+    let gbuffer =
+        parse(&[shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("passes/gbuffer.wgsl")]);
     check(
         &gbuffer,
         "MaterialUniforms",
         rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv, slot, film, transmission }),
     );
-    let shadow_pass = parse(&[shader::MATERIAL, include_str!("passes/shadow.wgsl")]);
+    let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);
     check(&shadow_pass, "ShadowLayer", rust_layout!(shadow::LayerUniforms { view_proj, params }));
 }
 

@@ -7,6 +7,9 @@ pub(crate) const COMMON: &str = include_str!("wgsl/common.wgsl");
 pub(crate) const SPECTRAL: &str = include_str!("wgsl/spectral.wgsl");
 pub(crate) const ENVIRONMENT: &str = include_str!("wgsl/environment.wgsl");
 pub(crate) const CUSTOM_API: &str = include_str!("wgsl/custom_api.wgsl");
+/// `pcg_hash` and friends: integer hashes, identical on every driver.
+pub(crate) const HASH: &str = include_str!("wgsl/hash.wgsl");
+/// Needs [`HASH`] before it.
 pub(crate) const MATERIAL: &str = include_str!("wgsl/material.wgsl");
 /// Thin-film interference: `scene::film` in WGSL, and the RGB mode's Belcour–Barla film.
 pub(crate) const FILM: &str = include_str!("wgsl/film.wgsl");

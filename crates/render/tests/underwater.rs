@@ -8,7 +8,7 @@ mod common;
 
 use color::water::WaterType;
 use color::{Quadrature, WavelengthRange};
-use common::{rel_err, render_custom as render};
+use common::{rel_err, render_custom as render, render_custom_captured as captured};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
 use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
@@ -91,6 +91,11 @@ fn one_wavelength(lambda: f64, shadows: bool) -> RenderSettings {
     }
 }
 
+/// Relative error allowed where both frames are read in f32 (`render_custom_captured`): what
+/// f32 arithmetic and the drivers' exp/pow leave (lavapipe's worst: 1.1·10⁻⁴). Read from the f16
+/// image these comparisons allowed 10⁻³, nearly all of it the image's two roundings.
+const CAPTURED_TOLERANCE: f64 = 2.5e-4;
+
 /// The worst error of a GPU-vs-CPU comparison and how many pixel-wavelengths of each kind it
 /// covered (surface hits, background looking down, background looking up).
 #[derive(Default)]
@@ -102,7 +107,7 @@ struct Tally {
 }
 
 impl Tally {
-    /// Checks one pixel to 1e-3 (`what` names it in the failure) and counts it.
+    /// Checks one pixel to [`CAPTURED_TOLERANCE`] (`what` names it in the failure) and counts it.
     fn check(
         &mut self,
         got: [f64; 3],
@@ -113,7 +118,7 @@ impl Tally {
     ) {
         let e = rel_err(got, want);
         assert!(
-            e <= 1e-3,
+            e <= CAPTURED_TOLERANCE,
             "{} dir {dir:?} hit {hit:?}: gpu {got:?} cpu {want:?} (relative error {e:.2e})",
             what()
         );
@@ -137,7 +142,7 @@ impl Tally {
 }
 
 #[test]
-fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
+fn spectral_hooks_match_cpu_pixel_terms_to_2_5e_4() {
     let scene = floor_scene();
     let mut r = common::renderer();
     r.set_scene(&scene).unwrap();
@@ -148,16 +153,17 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
         let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         for lambda in [430.0, 500.0, 560.0, 640.0] {
             let settings = one_wavelength(lambda, false);
-            let dry = render(&mut r, &scene, &settings, CustomShader::default());
-            let wet = render(
+            let setup = SpectralSetup::new(&settings).unwrap();
+            // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
+            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
+            let wet = captured(
                 &mut r,
                 &scene,
                 &settings,
                 underwater::shader_with(&medium, &underwater::Options::paper()).unwrap(),
+                unit,
             );
-            let setup = SpectralSetup::new(&settings).unwrap();
-            // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
-            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
             let e0 = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0]
                 * (-light_dir().y as f64);
             for py in 0..H {
@@ -166,11 +172,11 @@ fn spectral_hooks_match_cpu_pixel_terms_to_1e_3() {
                     let dist = hit.map_or(f64::INFINITY, |t| t as f64 * scale);
                     let t = medium.pixel_terms(&[lambda], dir, dist).unwrap()[0];
                     let i = (py * W + px) as usize;
-                    let dry_rgb = DVec3::from(common::rgb_of(&dry[i]));
+                    let dry_rgb = DVec3::from(dry[i]);
                     let want =
                         dry_rgb * (t.surface_attenuation * t.transmittance) + unit * (e0 * t.in_scatter);
                     let what = || format!("{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
-                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
+                    tally.check(wet[i], want.to_array(), dir, hit, what);
                 }
             }
         }
@@ -245,7 +251,7 @@ fn rgb_hook_uses_the_coefficients_at_three_wavelengths() {
 /// and the same cut, per wavelength, per pixel, with shadow maps on (nothing occludes the
 /// water, so every march sample must come out lit).
 #[test]
-fn single_scattering_matches_cpu_reference_to_1e_3() {
+fn single_scattering_matches_cpu_reference_to_2_5e_4() {
     use scene::water::single;
     let mut scene = floor_scene();
     let lamp = Vec3::new(2.5, 3.0, -7.0);
@@ -294,10 +300,16 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
         let c_min = underwater::params_with(&medium, &options)[7] as f64;
         for lambda in [450.0, 530.0, 610.0] {
             let settings = one_wavelength(lambda, true);
-            let dry = render(&mut r, &scene, &settings, CustomShader::default());
-            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
+            let wet = captured(
+                &mut r,
+                &scene,
+                &settings,
+                underwater::shader_with(&medium, &options).unwrap(),
+                unit,
+            );
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
             let i_lamp = setup.light_samples(&scene.lights[1].emission, Mode::Spectral, &table).unwrap()[0];
             let e_sky = setup.light_samples(&scene.lights[2].emission, Mode::Spectral, &table).unwrap()[0];
@@ -338,13 +350,13 @@ fn single_scattering_matches_cpu_reference_to_1e_3() {
                     let surface = match hit {
                         Some(_) => {
                             let t = medium.pixel_terms(&[lambda], dir, d).unwrap()[0];
-                            DVec3::from(common::rgb_of(&dry[i])) * (t.surface_attenuation * t.transmittance)
+                            DVec3::from(dry[i]) * (t.surface_attenuation * t.transmittance)
                         }
                         None => DVec3::ZERO,
                     };
                     let want = surface + unit * scatter;
                     let what = || format!("{ty} z0={depth} scale={scale} λ={lambda} pixel ({px},{py})");
-                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
+                    tally.check(wet[i], want.to_array(), dir, hit, what);
                 }
             }
         }
@@ -370,10 +382,10 @@ fn single_scattering_is_shadowed_under_a_roof() {
     let (depth, lambda) = (6.0, 500.0);
     let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
     let settings = one_wavelength(lambda, true);
-    let dry = render(&mut r, &scene, &settings, CustomShader::default());
-    let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
     let setup = SpectralSetup::new(&settings).unwrap();
     let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+    let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
+    let wet = captured(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap(), unit);
     let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
     let k = medium.coefficients(lambda);
     let to_sun = -light_dir().as_dvec3();
@@ -398,12 +410,14 @@ fn single_scattering_is_shadowed_under_a_roof() {
                 d,
             );
             let beam = single::beam(k.b, k.c, options.phase_g as f64, to_sun, e_sun, w, depth, d);
-            let want = DVec3::from(common::rgb_of(&dry[i]))
-                * (terms.surface_attenuation * terms.transmittance)
-                + unit * diffuse;
-            let got = common::rgb_of(&wet[i]);
+            let want =
+                DVec3::from(dry[i]) * (terms.surface_attenuation * terms.transmittance) + unit * diffuse;
+            let got = wet[i];
             let e = rel_err(got, want.to_array());
-            assert!(e <= 1e-3, "pixel ({px},{py}): gpu {got:?} cpu without the beam {want:?} ({e:.2e})");
+            assert!(
+                e <= CAPTURED_TOLERANCE,
+                "pixel ({px},{py}): gpu {got:?} cpu without the beam {want:?} ({e:.2e})"
+            );
             worst = worst.max(e);
             beam_share = beam_share.max(beam / (beam + diffuse));
             n += 1;
@@ -412,7 +426,7 @@ fn single_scattering_is_shadowed_under_a_roof() {
     eprintln!(
         "shadowed single scattering: {n} floor pixels, worst {worst:.2e}; unshadowed beam share up to {beam_share:.2}"
     );
-    // Ignoring the shadow would add the beam: at 2 % it is 20× the tolerance.
+    // Ignoring the shadow would add the beam: at 2 % it is 80× the tolerance.
     assert!(n > 100 && beam_share > 0.02, "{n} pixels, beam share {beam_share}");
 }
 
@@ -474,7 +488,7 @@ fn prefiltered_weights_pass_through_the_hook_node_by_node() {
 /// (`single::beam`, unshadowed here). A coarse table (few photons) is enough: both sides read
 /// the same numbers.
 #[test]
-fn light_field_hook_matches_cpu_to_1e_3() {
+fn light_field_hook_matches_cpu_to_2_5e_4() {
     use scene::water::light_field::{log_interp, ray_integral_by};
     use scene::water::single;
     let scene = floor_scene();
@@ -511,10 +525,16 @@ fn light_field_hook_matches_cpu_to_1e_3() {
             // Lambert only, so that the dry render is ρ/π·E·cos and gives ρ·E/π for the
             // column's irradiance term.
             let settings = RenderSettings { lambert: true, ..one_wavelength(lambda, true) };
-            let dry = render(&mut r, &scene, &settings, CustomShader::default());
-            let wet = render(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let setup = SpectralSetup::new(&settings).unwrap();
             let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
+            let wet = captured(
+                &mut r,
+                &scene,
+                &settings,
+                underwater::shader_with(&medium, &options).unwrap(),
+                unit,
+            );
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
             let k = medium.coefficients(lambda);
             // Along view rays the light-field model attenuates by c minus the forward cone's
@@ -591,7 +611,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                             // irradiance on its normal (up), both seen through d metres.
                             let zs = depth - d * w.y;
                             let t = if over(end.x, end.z) { &lf } else { &deep };
-                            let dry = DVec3::from(common::rgb_of(&dry[i]));
+                            let dry = DVec3::from(dry[i]);
                             let mu = -light_dir().y as f64;
                             if irradiance {
                                 let diffuse = t.irradiance_at(zs, DVec3::Y, sun_h, lambda) / mu;
@@ -620,7 +640,7 @@ fn light_field_hook_matches_cpu_to_1e_3() {
                              {table_part:.6}, beam part {beam_part:.6}, cut {cut:?})"
                         )
                     };
-                    tally.check(common::rgb_of(&wet[i]), want.to_array(), dir, hit, what);
+                    tally.check(wet[i], want.to_array(), dir, hit, what);
                 }
             }
         }

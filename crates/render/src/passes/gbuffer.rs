@@ -67,7 +67,7 @@ impl GBufferPass {
         let module = shader::compile(
             device,
             "gbuffer",
-            &[shader::COMMON, shader::MATERIAL, include_str!("gbuffer.wgsl")],
+            &[shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl")],
         )?;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),

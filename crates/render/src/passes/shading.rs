@@ -150,6 +150,7 @@ impl ShadingPass {
             shared,
             &[
                 shader::COMMON,
+                shader::HASH,
                 shader::SPECTRAL,
                 shader::ENVIRONMENT,
                 shader::FILM,

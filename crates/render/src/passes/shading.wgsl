@@ -129,7 +129,7 @@ fn soft_visibility(layer: u32, q: vec3<f32>, n: vec3<f32>, uv: vec2<f32>, z: f32
     let search = min(scale * 3.0 / d_r, 0.2);
     // The pattern turned per pixel: noise where one pattern for all pixels shows its 16 samples
     // as blocks (measured: block ΔE2000 0.27 against 0.24 for this, side-1 light below).
-    let turn = 6.2831853 * fract(sin(dot(uv * size, vec2<f32>(12.9898, 78.233))) * 43758.5453);
+    let turn = 6.2831853 * hash2_unit(bitcast<vec2<u32>>(uv * size), 0x50f70000u + frame.frame_index).x;
     var blockers = 0.0;
     var depth_sum = 0.0;
     let count = select(BLOCKER_SAMPLES, 1u, search * size.x < 1.0);
@@ -378,8 +378,11 @@ fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     // neighbour on each axis (interpolated normals tilt off the facets, and on a convex mesh a
     // neighbouring facet would then rise above the tangent plane and count as an occluder).
     let ng = depth_normal(pix, p, n);
-    let hash = fract(sin(dot(pix, vec2<f32>(12.9898, 78.233))) * 43758.5453);
-    let hash2 = fract(hash * 7.31 + 0.123);
+    // A new pattern in each accumulated frame, so that the mean converges (frame_index is 0
+    // without accumulation).
+    let h = hash2_unit(vec2<u32>(pix), 0x0cc10000u + frame.frame_index);
+    let hash = h.x;
+    let hash2 = h.y;
     var hidden = 0.0;
     let dirs = 8u;
     let steps = 6u;
@@ -394,7 +397,11 @@ fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
             if (any(q < vec2<f32>(0.0)) || q.x >= frame.viewport.x || q.y >= frame.viewport.y) { break; }
             let depth = textureLoad(gbuf_depth, vec2<i32>(q), 0);
             if (depth >= 1.0) { continue; }
-            let wq = world_from_depth(q, depth, frame);
+            // The depth is that of the texel's centre: placing it at q instead would move the
+            // point sideways by up to half a pixel, which at a silhouette, where depth changes
+            // fast across the screen, tilts v by tenths of a radian (a convex sphere's rim
+            // occluded itself by 1 % in the white furnace).
+            let wq = world_from_depth(floor(q) + 0.5, depth, frame);
             let v = wq - p;
             let len = length(v);
             if (len < 1e-6 || len > radius) { continue; }

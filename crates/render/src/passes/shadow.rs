@@ -113,7 +113,11 @@ pub struct MapsKey {
 impl ShadowPass {
     /// `material_layout`: the material bind group's (group 1), shared with the G-buffer pass.
     pub fn new(device: &wgpu::Device, material_layout: &wgpu::BindGroupLayout) -> Result<Self> {
-        let module = shader::compile(device, "shadow", &[shader::MATERIAL, include_str!("shadow.wgsl")])?;
+        let module = shader::compile(
+            device,
+            "shadow",
+            &[shader::HASH, shader::MATERIAL, include_str!("shadow.wgsl")],
+        )?;
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow light"),
             entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],

@@ -65,13 +65,6 @@ fn material_uv(slot: u32, uv0: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(dot(r0.xyz, uv), dot(r1.xyz, uv));
 }
 
-// PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering").
-fn pcg_hash(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
 // A uniform number in [0, 1) from a pixel, its depth (so that stacked surfaces are
 // independent) and a salt (the frame index when accumulating, and the shadow layer).
 fn coverage_hash(pixel: vec2<f32>, depth: f32, salt: u32) -> f32 {
