@@ -17,6 +17,10 @@ use wgpu::util::DeviceExt;
 /// `MAX_LIGHTS` in `passes/shading.wgsl` and the media hooks (checked by `layout_tests`).
 pub const MAX_LIGHTS: usize = 32;
 
+/// Materials a scene may have: the G-buffer's 16-bit material slot holds index + 1
+/// ([`crate::passes::GBUFFER_SLOT_FORMAT`]).
+pub const MAX_MATERIALS: usize = u16::MAX as usize - 1;
+
 /// Interleaved vertex, 72 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -499,6 +503,12 @@ impl GpuScene {
             return Err(bad(format!(
                 "{} lights; the real-time renderer handles at most {MAX_LIGHTS}",
                 s.lights.len()
+            )));
+        }
+        if s.materials.len() > MAX_MATERIALS {
+            return Err(bad(format!(
+                "{} materials; the real-time renderer handles at most {MAX_MATERIALS}",
+                s.materials.len()
             )));
         }
         let mut chunks = Chunks::new(device, max_buffer_bytes);

@@ -262,3 +262,37 @@ fn bad_input_is_an_error_not_a_panic() {
     let e = r.render(&cam, &RenderSettings { wavelengths: 0, ..Default::default() }).unwrap_err().to_string();
     assert!(e.contains("got 0"), "{e}");
 }
+
+/// The G-buffer's material slot is 16 bits: a material far past 255 still finds its own
+/// spectra (the chart drawn with 300 unused materials before its own is the same image), and a
+/// scene with more materials than the slot can name is refused with the count.
+#[test]
+fn material_slots_past_eight_bits_and_the_limit() {
+    let chart = Chart::colorchecker();
+    let scene = chart.scene(white_light(1.0, None), 1.0, 0.0);
+    let mut shifted = scene.clone();
+    let pad = 300;
+    let grey = Material { base_color: Vec4::new(0.2, 0.2, 0.2, 1.0), ..Default::default() };
+    shifted.materials = std::iter::repeat_n(grey, pad).chain(scene.materials.iter().cloned()).collect();
+    for m in &mut shifted.meshes {
+        m.material += pad;
+    }
+    let s = RenderSettings { shadows: false, wavelengths: 8, ..Default::default() };
+    let mut images = Vec::new();
+    for sc in [&scene, &shifted] {
+        let mut r = renderer();
+        r.set_scene(sc).unwrap();
+        r.resize(W, H).unwrap();
+        images.push(hdr(&mut r, &s));
+    }
+    let differ = images[0].iter().zip(&images[1]).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "pixels that differ with {pad} materials before the chart's own");
+
+    let mut too_many = scene.clone();
+    too_many.materials = vec![Material::default(); render::scene_gpu::MAX_MATERIALS + 1];
+    for m in &mut too_many.meshes {
+        m.material = 0;
+    }
+    let err = renderer().set_scene(&too_many).unwrap_err().to_string();
+    assert!(err.contains("65535 materials") && err.contains("at most 65534"), "{err}");
+}

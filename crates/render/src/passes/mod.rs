@@ -29,19 +29,22 @@ pub fn hdr_clipped(pixels: &[[f32; 4]]) -> usize {
 /// G-buffer colour targets: base colour + metallic, normal + roughness, emission.
 pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
     [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float];
-/// The spectral G-buffer's fourth target: the material's slot (`MaterialUniforms::slot`).
-pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The spectral G-buffer's fourth target: the material's slot (`MaterialUniforms::slot`: its
+/// index + 1, 0 where no surface is). 16 bits: the spectral G-buffer writes 2 bytes a pixel more
+/// than RGB's instead of 4 (on an H200 the 32-bit slot made the pass 14 % slower than RGB's,
+/// docs/benchmark.md "H200"), so a scene has at most [`crate::scene_gpu::MAX_MATERIALS`].
+pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Uint;
 /// The thin film per pixel (written only when the scene has one): weight and where the
 /// thickness lies between the material's minimum and maximum (f16: exact at the ends, 2⁻¹¹ of
 /// the range near the maximum; the thickness texture itself has 8 bits); the film's index and
 /// thickness range are the material's (`MaterialSpectrum::film`).
 /// Two channels because the G-buffer's five targets must fit the 32 bytes per sample WebGPU
-/// guarantees (3 × 8 + 4 + 4).
+/// guarantees (3 × 8 + 2 + 4).
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 /// The transmissive layer's fifth G-buffer target: transmission, volume thickness, and the
 /// film's weight and thickness (`passes::gbuffer::Targets::Layer`), each in [0, 1] and from
 /// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,
-/// the other four take 28, and WebGPU counts an Rgba8Unorm target as 8.
+/// the other four take 26, and WebGPU counts an Rgba8Unorm target as 8.
 pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 

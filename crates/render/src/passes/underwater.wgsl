@@ -391,12 +391,35 @@ fn uw_rate(a: vec4<f32>, b: vec4<f32>, i: u32) -> vec4<f32> {
 
 // ∫ J(z(t), view)·e^{−c·t} dt along the view ray, exponential in depth within each piece and
 // integrated in closed form (CPU reference: light_field::ray_integral).
+// Consecutive pieces share a node (going down piece p ends at the node where p + 1 starts, going
+// up it starts where p + 1 ends), so the last piece's two nodes are kept: one table read of four
+// directions per piece instead of two, where the table does not change between them.
 fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
     var sum = vec4<f32>(0.0);
+    // Keys (table · 1024 + node) of the previous piece's ends, and their values.
+    var key_a = 0xffffffffu;
+    var key_b = 0xffffffffu;
+    var prev_a = vec4<f32>(0.0);
+    var prev_b = vec4<f32>(0.0);
     for (var p = 0u; p < uw_np; p++) {
         let i = uw_pn[p];
-        let ja = uw_j_node(uw_pd[p], i, group, rgb);
-        let jb = uw_j_node(uw_pd[p], i + 1u, group, rgb);
+        let ka = uw_pd[p] * 1024u + i;
+        var ja: vec4<f32>;
+        var jb: vec4<f32>;
+        if (ka == key_b) {
+            ja = prev_b;
+        } else {
+            ja = uw_j_node(uw_pd[p], i, group, rgb);
+        }
+        if (ka + 1u == key_a) {
+            jb = prev_a;
+        } else {
+            jb = uw_j_node(uw_pd[p], i + 1u, group, rgb);
+        }
+        key_a = ka;
+        key_b = ka + 1u;
+        prev_a = ja;
+        prev_b = jb;
         var k = uw_rate(ja, jb, i);
         var j0 = ja * exp(-k * uw_pz[p]);
         // Below the table the field never grows with depth, from the last node on
@@ -430,21 +453,34 @@ fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f
 // The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
 // normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
 // light_field::LightFieldTable::irradiance_at).
+// The pixel's cells, weights and depth segment in the irradiance table: the same for every
+// group, so found once (`uw_irradiance` is called per group with the pixel's own z and n).
+var<private> uw_irr_ready: bool = false;
+var<private> uw_irr_cells: vec4<u32>;
+var<private> uw_irr_w: vec4<f32>;
+var<private> uw_irr_i: u32;
+
 fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec4<f32> {
-    let hn = vec3<f32>(n.x, 0.0, n.z);
-    let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
-    var ph = 0.0;
-    if (length(hn) > 1e-6 && dot(uw_sun_h, uw_sun_h) > 0.5) {
-        ph = uw_angle(abs(cross(uw_sun_h, hn).y), dot(uw_sun_h, hn));
+    if (!uw_irr_ready) {
+        uw_irr_ready = true;
+        let hn = vec3<f32>(n.x, 0.0, n.z);
+        let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
+        var ph = 0.0;
+        if (length(hn) > 1e-6 && dot(uw_sun_h, uw_sun_h) > 0.5) {
+            ph = uw_angle(abs(cross(uw_sun_h, hn).y), dot(uw_sun_h, hn));
+        }
+        let fk = ph / 3.14159265358979 * f32(UW_NNA - 1u);
+        let e0 = min(u32(floor(fe)), UW_NNE - 2u);
+        let k0 = min(u32(floor(fk)), UW_NNA - 2u);
+        let te = fe - f32(e0);
+        let tk = fk - f32(k0);
+        uw_irr_cells = vec4<u32>(e0 * UW_NNA + k0, e0 * UW_NNA + k0 + 1u, (e0 + 1u) * UW_NNA + k0, (e0 + 1u) * UW_NNA + k0 + 1u);
+        uw_irr_w = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
+        uw_irr_i = uw_segment(z);
     }
-    let fk = ph / 3.14159265358979 * f32(UW_NNA - 1u);
-    let e0 = min(u32(floor(fe)), UW_NNE - 2u);
-    let k0 = min(u32(floor(fk)), UW_NNA - 2u);
-    let te = fe - f32(e0);
-    let tk = fk - f32(k0);
-    let cells = vec4<u32>(e0 * UW_NNA + k0, e0 * UW_NNA + k0 + 1u, (e0 + 1u) * UW_NNA + k0, (e0 + 1u) * UW_NNA + k0 + 1u);
-    let w = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
-    let i = uw_segment(z);
+    let cells = uw_irr_cells;
+    let w = uw_irr_w;
+    let i = uw_irr_i;
     var a = vec4<f32>(0.0);
     var b = vec4<f32>(0.0);
     for (var c = 0u; c < 4u; c++) {
