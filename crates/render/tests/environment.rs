@@ -414,6 +414,7 @@ fn occlusion_leaves_a_convex_sphere_unoccluded_under_every_pattern() {
     r.set_scene(&scene).unwrap();
     r.resize(SIZE, SIZE).unwrap();
     r.set_accumulation(true);
+    let mut worst = 0.0f32;
     for k in 0..16 {
         let s = RenderSettings {
             env_occlusion: true,
@@ -423,6 +424,8 @@ fn occlusion_leaves_a_convex_sphere_unoccluded_under_every_pattern() {
         r.render(&scene.camera, &s).unwrap();
         for (i, px) in r.read_hdr().unwrap().iter().enumerate() {
             assert!((px[0] - 1.0).abs() < 0.01, "frame {k}: pixel {i} = {}", px[0]);
+            worst = worst.max((px[0] - 1.0).abs());
         }
     }
+    eprintln!("occlusion on a convex sphere, 16 patterns: worst |pixel − 1| = {worst:.5}");
 }

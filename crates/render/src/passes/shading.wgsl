@@ -841,7 +841,12 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             var f = factors_of(t, s.metallic, s.f0);
             f.x += through;
             // The specular part does not depend on the reflectance: the light's XYZ once.
-            var reflected = select(vec3<f32>(0.0), reflected_light(sc, li), known);
+            // A branch, not a select, which would load for every pixel: a textured material's
+            // pixels skip the load where the GPU branches per material.
+            var reflected = vec3<f32>(0.0);
+            if (known) {
+                reflected = reflected_light(sc, li);
+            }
             for (var g = 0u; g < ng_unknown; g++) {
                 reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
             }
