@@ -2,7 +2,8 @@
 # The benchmark suite, the render crate's GPU tests and `spectra eval --quick` on a lent GPU
 # machine, in one prepared run (docs/benchmark.md "A real GPU"). Not used by CI.
 #
-# Prepare, in the repository root of a checkout (x86-64, the binaries built here):
+# Prepare with `tools/device_pack.sh OLD_BINARY DAMAGED_HELMET_DIR [TEST ...]`, which does this,
+# in the repository root of a checkout (x86-64, the binaries built here):
 #   mkdir -p .dev .gl; printf '/.gl/\n/.dev/\n' >> .git/info/exclude
 #   (Vulkan loader debs into .gl: /work/.library/device/README.md)
 #   cargo build --release -p spectra; cargo test --release -p render --no-run
