@@ -11,7 +11,7 @@ use color::{Quadrature, WavelengthRange};
 use common::{rel_err, render_custom as render, render_custom_captured as captured};
 use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use render::passes::underwater;
-use render::{CustomShader, Mode, RenderSettings, SpectralSetup};
+use render::{CustomShader, Mode, RenderSettings, Renderer, SpectralSetup};
 use scene::water::{WATER_IOR, WaterMedium};
 use scene::{Camera, Emission, Light, LightKind, Material, Mesh, Scene};
 
@@ -91,6 +91,21 @@ fn one_wavelength(lambda: f64, shadows: bool) -> RenderSettings {
     }
 }
 
+/// The frame without water and with `custom` (the water's hooks), read from the f32 capture at
+/// the settings' single node, with the frame's spectral setup and the colour of unit radiance.
+fn dry_and_wet(
+    r: &mut Renderer,
+    scene: &Scene,
+    settings: &RenderSettings,
+    custom: CustomShader,
+) -> (SpectralSetup, DVec3, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let setup = SpectralSetup::new(settings).unwrap();
+    let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
+    let dry = captured(r, scene, settings, CustomShader::default(), unit);
+    let wet = captured(r, scene, settings, custom, unit);
+    (setup, unit, dry, wet)
+}
+
 /// Relative error allowed where both frames are read in f32 (`render_custom_captured`): what
 /// f32 arithmetic and the drivers' exp/pow leave (lavapipe's worst: 1.1·10⁻⁴). Read from the f16
 /// image these comparisons allowed 10⁻³, nearly all of it the image's two roundings.
@@ -153,17 +168,9 @@ fn spectral_hooks_match_cpu_pixel_terms_to_2_5e_4() {
         let medium = WaterMedium::new(WaterType::parse(ty).unwrap(), depth, Vec3::Y, scale).unwrap();
         for lambda in [430.0, 500.0, 560.0, 640.0] {
             let settings = one_wavelength(lambda, false);
-            let setup = SpectralSetup::new(&settings).unwrap();
-            // Colour of unit radiance at λ, and the downwelling irradiance in the GPU's units.
-            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
-            let wet = captured(
-                &mut r,
-                &scene,
-                &settings,
-                underwater::shader_with(&medium, &underwater::Options::paper()).unwrap(),
-                unit,
-            );
+            let shader = underwater::shader_with(&medium, &underwater::Options::paper()).unwrap();
+            let (setup, unit, dry, wet) = dry_and_wet(&mut r, &scene, &settings, shader);
+            // The downwelling irradiance in the GPU's units.
             let e0 = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0]
                 * (-light_dir().y as f64);
             for py in 0..H {
@@ -300,16 +307,8 @@ fn single_scattering_matches_cpu_reference_to_2_5e_4() {
         let c_min = underwater::params_with(&medium, &options)[7] as f64;
         for lambda in [450.0, 530.0, 610.0] {
             let settings = one_wavelength(lambda, true);
-            let setup = SpectralSetup::new(&settings).unwrap();
-            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
-            let wet = captured(
-                &mut r,
-                &scene,
-                &settings,
-                underwater::shader_with(&medium, &options).unwrap(),
-                unit,
-            );
+            let (setup, unit, dry, wet) =
+                dry_and_wet(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
             let i_lamp = setup.light_samples(&scene.lights[1].emission, Mode::Spectral, &table).unwrap()[0];
             let e_sky = setup.light_samples(&scene.lights[2].emission, Mode::Spectral, &table).unwrap()[0];
@@ -382,10 +381,8 @@ fn single_scattering_is_shadowed_under_a_roof() {
     let (depth, lambda) = (6.0, 500.0);
     let medium = WaterMedium::new(WaterType::parse("IB").unwrap(), depth, Vec3::Y, 1.0).unwrap();
     let settings = one_wavelength(lambda, true);
-    let setup = SpectralSetup::new(&settings).unwrap();
-    let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-    let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
-    let wet = captured(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap(), unit);
+    let (setup, unit, dry, wet) =
+        dry_and_wet(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
     let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
     let k = medium.coefficients(lambda);
     let to_sun = -light_dir().as_dvec3();
@@ -525,16 +522,8 @@ fn light_field_hook_matches_cpu_to_2_5e_4() {
             // Lambert only, so that the dry render is ρ/π·E·cos and gives ρ·E/π for the
             // column's irradiance term.
             let settings = RenderSettings { lambert: true, ..one_wavelength(lambda, true) };
-            let setup = SpectralSetup::new(&settings).unwrap();
-            let unit = setup.xyz_to_rgb * DVec3::from(setup.integrator.integrate_samples(&[1.0]));
-            let dry = captured(&mut r, &scene, &settings, CustomShader::default(), unit);
-            let wet = captured(
-                &mut r,
-                &scene,
-                &settings,
-                underwater::shader_with(&medium, &options).unwrap(),
-                unit,
-            );
+            let (setup, unit, dry, wet) =
+                dry_and_wet(&mut r, &scene, &settings, underwater::shader_with(&medium, &options).unwrap());
             let e_sun = setup.light_samples(&scene.lights[0].emission, Mode::Spectral, &table).unwrap()[0];
             let k = medium.coefficients(lambda);
             // Along view rays the light-field model attenuates by c minus the forward cone's

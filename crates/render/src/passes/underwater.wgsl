@@ -241,6 +241,31 @@ fn uw_angle(s: f32, c: f32) -> f32 {
     return select(th, 3.14159265358979 - th, c < 0.0);
 }
 
+// The four cells of a direction table (ne elevations × na azimuths, elevation-major) around the
+// fractional node (fe, fk), and their bilinear weights.
+struct UwCells {
+    index: vec4<u32>,
+    w: vec4<f32>,
+};
+
+fn uw_cells(fe: f32, fk: f32, ne: u32, na: u32) -> UwCells {
+    let e0 = min(u32(floor(fe)), ne - 2u);
+    let k0 = min(u32(floor(fk)), na - 2u);
+    let te = fe - f32(e0);
+    let tk = fk - f32(k0);
+    let index = vec4<u32>(e0 * na + k0, e0 * na + k0 + 1u, (e0 + 1u) * na + k0, (e0 + 1u) * na + k0 + 1u);
+    return UwCells(index, vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk));
+}
+
+// The angle in [0, π] between a horizontal direction h and the first sun's (`uw_sun_h`); 0 for
+// a vertical direction or without a sun.
+fn uw_sun_azimuth(h: vec3<f32>) -> f32 {
+    if (length(h) > 1e-6 && dot(uw_sun_h, uw_sun_h) > 0.5) {
+        return uw_angle(abs(cross(uw_sun_h, h).y), dot(uw_sun_h, h));
+    }
+    return 0.0;
+}
+
 // Fractional elevation node of the polar angle th (light_field::elevation_coord): nodes are
 // denser near the horizon.
 fn uw_elev_coord(th: f32) -> f32 {
@@ -296,20 +321,9 @@ fn uw_prepare_table(w: vec3<f32>, z0: f32) {
     uw_sun_h = sun_h;
     let hw = vec3<f32>(w.x, 0.0, w.z);
     let fe = uw_elev_coord(uw_angle(length(hw), w.y));
-    var ph = 0.0;
-    if (length(hw) > 1e-6 && dot(sun_h, sun_h) > 0.5) {
-        ph = uw_angle(abs(cross(sun_h, hw).y), dot(sun_h, hw));
-    }
-    let fk = ph / 3.14159265358979 * f32(UW_NA - 1u);
-    let e0 = min(u32(floor(fe)), UW_NE - 2u);
-    let k0 = min(u32(floor(fk)), UW_NA - 2u);
-    let te = fe - f32(e0);
-    let tk = fk - f32(k0);
-    uw_cell[0] = e0 * UW_NA + k0;
-    uw_cell[1] = e0 * UW_NA + k0 + 1u;
-    uw_cell[2] = (e0 + 1u) * UW_NA + k0;
-    uw_cell[3] = (e0 + 1u) * UW_NA + k0 + 1u;
-    uw_cw = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
+    let cell = uw_cells(fe, uw_sun_azimuth(hw) / 3.14159265358979 * f32(UW_NA - 1u), UW_NE, UW_NA);
+    uw_cell = array<u32, 4>(cell.index.x, cell.index.y, cell.index.z, cell.index.w);
+    uw_cw = cell.w;
     // Pieces between the node depths the ray crosses, in order along the ray, also cut where
     // the ray leaves the floored column (the floor's extent, or its depth): each piece reads
     // one table, chosen at its midpoint.
@@ -465,17 +479,10 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
         uw_irr_ready = true;
         let hn = vec3<f32>(n.x, 0.0, n.z);
         let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
-        var ph = 0.0;
-        if (length(hn) > 1e-6 && dot(uw_sun_h, uw_sun_h) > 0.5) {
-            ph = uw_angle(abs(cross(uw_sun_h, hn).y), dot(uw_sun_h, hn));
-        }
-        let fk = ph / 3.14159265358979 * f32(UW_NNA - 1u);
-        let e0 = min(u32(floor(fe)), UW_NNE - 2u);
-        let k0 = min(u32(floor(fk)), UW_NNA - 2u);
-        let te = fe - f32(e0);
-        let tk = fk - f32(k0);
-        uw_irr_cells = vec4<u32>(e0 * UW_NNA + k0, e0 * UW_NNA + k0 + 1u, (e0 + 1u) * UW_NNA + k0, (e0 + 1u) * UW_NNA + k0 + 1u);
-        uw_irr_w = vec4<f32>((1.0 - te) * (1.0 - tk), (1.0 - te) * tk, te * (1.0 - tk), te * tk);
+        let fk = uw_sun_azimuth(hn) / 3.14159265358979 * f32(UW_NNA - 1u);
+        let cell = uw_cells(fe, fk, UW_NNE, UW_NNA);
+        uw_irr_cells = cell.index;
+        uw_irr_w = cell.w;
         uw_irr_i = uw_segment(z);
     }
     let cells = uw_irr_cells;
