@@ -76,6 +76,8 @@ fn real_time_and_truth_agree_for_cameras_as_for_cie() {
         // The two views are different pictures of the same render.
         assert!(difference(&b_img, &d_img).1 > 1e-3, "{cam}: --camera-to-display changed nothing");
     }
+    // Kept where an assertion failed, for the images.
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A database camera's rawtoaces JSON, read from a file, is that camera: the identical image in
@@ -123,6 +125,7 @@ fn a_rawtoaces_json_file_is_the_camera_and_bad_ones_are_refused() {
         );
         assert!(!Path::new(&out_file).exists(), "{cmd} wrote an output");
     }
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Every camera of the database renders the Cornell box in real time and in the path tracer:

@@ -108,4 +108,6 @@ fn a_csv_of_a_built_in_camera_renders_as_that_camera_and_bad_files_are_refused()
         "{err}"
     );
     assert!(!Path::new(&out_file).exists());
+    // Kept where an assertion failed, for the files.
+    let _ = std::fs::remove_dir_all(&d);
 }
