@@ -464,9 +464,6 @@ fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f
     return total;
 }
 
-// The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
-// normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
-// light_field::LightFieldTable::irradiance_at).
 // The pixel's cells, weights and depth segment in the irradiance table: the same for every
 // group, so found once (`uw_irradiance` is called per group with the pixel's own z and n).
 var<private> uw_irr_ready: bool = false;
@@ -474,6 +471,9 @@ var<private> uw_irr_cells: vec4<u32>;
 var<private> uw_irr_w: vec4<f32>;
 var<private> uw_irr_i: u32;
 
+// The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
+// normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
+// light_field::LightFieldTable::irradiance_at). Only the first call of a pixel reads z and n.
 fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec4<f32> {
     if (!uw_irr_ready) {
         uw_irr_ready = true;
