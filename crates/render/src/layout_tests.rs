@@ -159,7 +159,19 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &shading,
         "WavelengthGroup",
-        rust_layout!(WavelengthGroup { lambda, white_x, white_y, white_z, band_r, band_g, band_b, _pad }),
+        rust_layout!(WavelengthGroup {
+            lambda,
+            white_x,
+            white_y,
+            white_z,
+            band_r,
+            band_g,
+            band_b,
+            _pad,
+            band_white_r,
+            band_white_g,
+            band_white_b
+        }),
     );
     check(&shading, "GpuLight", rust_layout!(GpuLight { pos_kind, dir_range, cone, rgb, xyz, extra }));
     check(&shading, "CustomUniforms", rust_layout!(CustomUniforms { params, n_spectra, _pad }));

@@ -35,6 +35,14 @@ pub struct WavelengthGroup {
     pub band_g: [f32; 4],
     pub band_b: [f32; 4],
     pub _pad: [f32; 4],
+    /// The white's node weights split by the naive bands (red, green, blue): column c of
+    /// band b's matrix holds channel c's weights of `W(λ)·1_b(λ)`, so that a box spectrum
+    /// (an absorption upsampled per channel) times a smooth one integrates exactly, steps
+    /// included, instead of being sampled at the nodes. `Σ_b band_white[b]` = the white's
+    /// weights. (`band_white_r`, `_g`, `_b`.)
+    pub band_white_r: GroupWeights,
+    pub band_white_g: GroupWeights,
+    pub band_white_b: GroupWeights,
 }
 
 /// One light's node weights for four nodes: column c holds channel c (X, Y, Z). Matches the
@@ -194,6 +202,13 @@ impl SpectralSetup {
         let n = self.len();
         let (blue_max, green_max) = naive_band_edges();
         let white = self.white_weights();
+        let band_white: Vec<Vec<[f64; 3]>> = (0..3)
+            .map(|b| {
+                self.weights_of(|l| {
+                    if naive_band(l, blue_max, green_max) == b { self.white.eval(l) } else { 0.0 }
+                })
+            })
+            .collect();
         let mut groups = vec![WavelengthGroup::default(); self.groups()];
         let last = self.wavelengths.lambda[n - 1];
         for (i, grp_lane) in (0..self.groups() * 4).map(|i| (i, (i / 4, i % 4))) {
@@ -209,6 +224,14 @@ impl SpectralSetup {
                 grp.band_r[lane] = (band == 0) as u8 as f32;
                 grp.band_g[lane] = (band == 1) as u8 as f32;
                 grp.band_b[lane] = (band == 2) as u8 as f32;
+                for (m, bw) in [&mut grp.band_white_r, &mut grp.band_white_g, &mut grp.band_white_b]
+                    .into_iter()
+                    .zip(&band_white)
+                {
+                    for c in 0..3 {
+                        m[c][lane] = bw[i][c] as f32;
+                    }
+                }
             }
         }
         groups

@@ -14,6 +14,10 @@ struct WavelengthGroup {
     band_g: vec4<f32>,
     band_b: vec4<f32>,
     _pad: vec4<f32>,
+    // The white's weights split by those bands (see `box_white_weights`).
+    band_white_r: mat3x4<f32>,
+    band_white_g: mat3x4<f32>,
+    band_white_b: mat3x4<f32>,
 };
 
 // A light. Its node weights live in `light_weights[light * n_groups + group]`.
@@ -292,6 +296,15 @@ fn light_w(li: u32, g: u32, n_groups: u32) -> mat3x4<f32> {
 fn white_weights(g: u32) -> mat3x4<f32> {
     let w = wavelengths[g];
     return mat3x4<f32>(w.white_x, w.white_y, w.white_z);
+}
+
+// The white's node weights with a box spectrum (one value per naive band, e.g. a per-channel
+// transmittance) folded in: Σ_b box[b]·(weights of W·1_b). A smooth node spectrum times these
+// integrates the product exactly where `box4` at the nodes would smear each band's step over
+// the nodes around it (at N = 8 they are 44 nm apart).
+fn box_white_weights(box: vec3<f32>, g: u32) -> mat3x4<f32> {
+    let w = wavelengths[g];
+    return w.band_white_r * box.r + w.band_white_g * box.g + w.band_white_b * box.b;
 }
 
 // Node radiance in weighted form: `m[c]` holds channel c's weighted node values, so a

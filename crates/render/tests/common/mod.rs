@@ -342,6 +342,8 @@ pub struct CpuSpectral {
     light: Vec<[f64; 3]>,
     /// D65's normalised node weights (for emission).
     white: Vec<[f64; 3]>,
+    /// The same split by the naive bands (red, green, blue): D65·1_b.
+    white_bands: [Vec<[f64; 3]>; 3],
     to_rgb: DMat3,
 }
 
@@ -354,6 +356,12 @@ impl CpuSpectral {
         let white_xyz = sum_weights(&white_raw);
         let k = white_xyz[1];
         let raw = quad.weights(|l| light_spectrum.eval(l));
+        let white_bands = std::array::from_fn(|b| {
+            let mut unit = [0.0; 3];
+            unit[b] = 1.0;
+            let band = color::upsample::boxes::BoxSpectrum { rgb: unit };
+            quad.weights(|l| d65.eval(l) * band.eval(l)).iter().map(|w| w.map(|c| c / k)).collect()
+        });
         let scale = luminance / sum_weights(&raw)[1];
         let space = RgbColorSpace::srgb();
         let t = space.white_xyz();
@@ -366,6 +374,7 @@ impl CpuSpectral {
             lambda: quad.nodes.lambda.clone(),
             light: raw.iter().map(|w| w.map(|c| c * scale)).collect(),
             white: white_raw.iter().map(|w| w.map(|c| c / k)).collect(),
+            white_bands,
             to_rgb: space.from_xyz * corr,
         }
     }
@@ -396,6 +405,29 @@ impl CpuSpectral {
         let s = 2.0 * e[0].max(e[1]).max(e[2]);
         let poly = table.fetch(e.map(|c| c / s));
         let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
+        (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
+    }
+
+    /// That emitter seen through a box spectrum (`boxed`, one value per naive band, e.g. a
+    /// per-channel transmittance), the box taken into the weights: Σ_b boxed_b·Σᵢ eᵢ·W^b_i, exact
+    /// for the box's steps.
+    pub fn emitter_through_box(&self, table: &CoeffTable, e: [f64; 3], boxed: [f64; 3]) -> [f64; 3] {
+        let s = 2.0 * e[0].max(e[1]).max(e[2]);
+        let poly = table.fetch(e.map(|c| c / s));
+        let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
+        let xyz = (0..3).fold(DVec3::ZERO, |acc, b| {
+            acc + boxed[b] * DVec3::from(integrate_nodes(&self.white_bands[b], &values))
+        });
+        (self.to_rgb * xyz).to_array()
+    }
+
+    /// The same with the box sampled at the nodes instead (what the renderer did before).
+    pub fn emitter_through_box_at_nodes(&self, table: &CoeffTable, e: [f64; 3], boxed: [f64; 3]) -> [f64; 3] {
+        let s = 2.0 * e[0].max(e[1]).max(e[2]);
+        let poly = table.fetch(e.map(|c| c / s));
+        let b = color::upsample::boxes::BoxSpectrum { rgb: boxed };
+        let values: Vec<f64> =
+            self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l) * b.eval(l)).collect();
         (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
     }
 }
