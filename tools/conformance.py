@@ -12,6 +12,7 @@ per model; exits 1 if a listed model fails to load or render, or any of its imag
     tools/conformance.py ~/khronos --out conformance-out        # run on models already there
     tools/conformance.py PATH/glTF-Sample-Assets/Models --all   # every model found
     tools/conformance.py ~/khronos --set core --size 160x120     # the glTF conformance set (issue 12)
+    tools/conformance.py --fetch ~/khronos --set materials --size 160x120 --spp 256   # films, glass (issue 30)
     tools/conformance.py ~/khronos --envs default,rooitou_park,venice_sunset --out conf-envs   # issue 34
 
 With --envs the whole list runs once per environment (OUT/<environment>/) and
@@ -67,7 +68,14 @@ CORE_MODELS = ISSUE_MODELS + [
     "Box", "BoxTextured", "Duck", "Avocado", "DamagedHelmet", "WaterBottle", "Lantern", "BoomBox", "Fox", "CesiumMan",
     "CesiumMilkTruck", "Sponza", "MetalRoughSpheres", "FlightHelmet", "SciFiHelmet",
 ]
-MODEL_SETS = {"default": DEFAULT_MODELS, "issue": ISSUE_MODELS, "core": CORE_MODELS}
+# Wavelength-dependent materials (issue 30): thin films, transmission, volumes, dispersion.
+# `--set materials`; docs/gltf-conformance.md has the verdicts.
+MATERIAL_MODELS = [
+    "IridescenceSuzanne", "IridescenceDielectricSpheres", "IridescenceMetallicSpheres", "IridescentDishWithOlives",
+    "IridescenceLamp", "TransmissionTest", "TransmissionRoughnessTest", "AttenuationTest", "DispersionTest",
+    "DragonDispersion",
+]
+MODEL_SETS = {"default": DEFAULT_MODELS, "issue": ISSUE_MODELS, "core": CORE_MODELS, "materials": MATERIAL_MODELS}
 FETCH_BASE = "https://raw.githubusercontent.com/KhronosGroup/glTF-Sample-Assets/main/Models"
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LUMA = (0.2126, 0.7152, 0.0722)  # linear sRGB / Rec. 709 -> Y
@@ -955,7 +963,8 @@ def main():
     ap.add_argument("--set", choices=sorted(MODEL_SETS), default=None,
                     help="a named list of models: default (" + ",".join(DEFAULT_MODELS) + "), issue (the glTF test "
                          "assets issue 12 names), core (those, the other core/extension test assets and the classic "
-                         "showcase models); --models overrides")
+                         "showcase models), materials (the thin-film, transmission, volume and dispersion assets issue 30 "
+                         "names); --models overrides")
     ap.add_argument("--all", action="store_true", help="every model found under the root")
     ap.add_argument("--no-sheets", action="store_true", help="do not write the contact sheets OUT/sheets/<Model>.png")
     ap.add_argument("--resume", action="store_true",
