@@ -31,6 +31,11 @@ pub struct Budget {
     pub water_width: u32,
     pub water_height: u32,
     pub water_spp: u32,
+    /// Ground-truth samples of cases with see-through materials (`glass`): their truth is
+    /// noisier per sample than an opaque scene's — rough refraction, and through dispersive
+    /// glass one wavelength per path (the others cannot follow its direction) — and its noise
+    /// floor is what a mode must beat rgb by, so they get four times the samples (half the noise).
+    pub transmissive_spp: u32,
     /// Jerlov types of the underwater cases in the default suite.
     pub water_types: Vec<String>,
     /// Camera depths (m) of the underwater cases; empty = the built-in's own depth (10 m).
@@ -58,6 +63,7 @@ impl Budget {
             water_width: 128,
             water_height: 96,
             water_spp: 4096,
+            transmissive_spp: 4096,
             water_types: vec!["I".into()],
             water_depths: vec![],
         }
@@ -80,16 +86,21 @@ impl Budget {
             water_width: 160,
             water_height: 120,
             water_spp: 4096,
+            // The glass case: 2 × 13 min of truth here (2 cores) beyond the 4096 spp.
+            transmissive_spp: 16384,
             water_types: ["I", "IB", "II", "3C"].iter().map(|s| s.to_string()).collect(),
             // The original implementation's evaluation depths (issue 13).
             water_depths: vec![1.0, 5.0, 10.0, 20.0, 50.0],
         }
     }
 
-    /// Size and truth samples per pixel of a case: the underwater budget for cases with water.
+    /// Size and truth samples per pixel of a case: the underwater budget for cases with water,
+    /// the see-through samples for cases with see-through materials.
     pub fn for_case(&self, c: &Case) -> (u32, u32, u32) {
         if c.scene.water.is_some() {
             (self.water_width, self.water_height, self.water_spp)
+        } else if c.scene.materials.iter().any(|m| m.transmission.is_some()) {
+            (self.width, self.height, self.transmissive_spp)
         } else {
             (self.width, self.height, self.truth_spp)
         }
@@ -101,7 +112,7 @@ impl Budget {
             (self.width, self.height, self.water_width, self.water_height) = (w, h, w, h);
         }
         if let Some(s) = spp {
-            (self.truth_spp, self.water_spp) = (s, s);
+            (self.truth_spp, self.water_spp, self.transmissive_spp) = (s, s, s);
         }
     }
 }
@@ -288,10 +299,13 @@ mod tests {
         assert_eq!(uw.scene.water.as_ref().unwrap().water_type, "I");
         assert_eq!(b.for_case(&uw), (b.water_width, b.water_height, b.water_spp));
         assert_eq!(b.for_case(&case("metamerism").unwrap()), (b.width, b.height, b.truth_spp));
+        assert_eq!(b.for_case(&case("glass").unwrap()), (b.width, b.height, b.transmissive_spp));
+        assert_eq!(b.for_case(&case("iridescence-d65").unwrap()), (b.width, b.height, b.truth_spp));
         let mut o = Budget::full();
         o.override_with(Some((64, 48)), Some(256));
         assert_eq!(o.for_case(&uw), (64, 48, 256));
         assert_eq!(o.for_case(&case("metamerism").unwrap()), (64, 48, 256));
+        assert_eq!(o.for_case(&case("glass").unwrap()), (64, 48, 256));
         assert_eq!(notes(&q).len(), 1);
         // The error-vs-frame-time curve needs N values that are both swept and timed.
         for b in [Budget::quick(), Budget::full()] {
