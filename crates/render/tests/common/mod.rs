@@ -402,19 +402,23 @@ impl CpuSpectral {
 
     /// An emitter of linear RGB `e` with the illuminant variant: s·ρ(e/s)(λ)·D65(λ), s = 2·max.
     pub fn emitter(&self, table: &CoeffTable, e: [f64; 3]) -> [f64; 3] {
+        let values = self.emitter_nodes(table, e);
+        (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
+    }
+
+    /// The illuminant-variant emitter's spectrum s·ρ(e/s)(λ) at the nodes (the white's factor
+    /// is in the weights).
+    fn emitter_nodes(&self, table: &CoeffTable, e: [f64; 3]) -> Vec<f64> {
         let s = 2.0 * e[0].max(e[1]).max(e[2]);
         let poly = table.fetch(e.map(|c| c / s));
-        let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
-        (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
+        self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect()
     }
 
     /// That emitter seen through a box spectrum (`boxed`, one value per naive band, e.g. a
     /// per-channel transmittance), the box taken into the weights: Σ_b boxed_b·Σᵢ eᵢ·W^b_i, exact
     /// for the box's steps.
     pub fn emitter_through_box(&self, table: &CoeffTable, e: [f64; 3], boxed: [f64; 3]) -> [f64; 3] {
-        let s = 2.0 * e[0].max(e[1]).max(e[2]);
-        let poly = table.fetch(e.map(|c| c / s));
-        let values: Vec<f64> = self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l)).collect();
+        let values = self.emitter_nodes(table, e);
         let xyz = (0..3).fold(DVec3::ZERO, |acc, b| {
             acc + boxed[b] * DVec3::from(integrate_nodes(&self.white_bands[b], &values))
         });
@@ -423,11 +427,9 @@ impl CpuSpectral {
 
     /// The same with the box sampled at the nodes instead (what the renderer did before).
     pub fn emitter_through_box_at_nodes(&self, table: &CoeffTable, e: [f64; 3], boxed: [f64; 3]) -> [f64; 3] {
-        let s = 2.0 * e[0].max(e[1]).max(e[2]);
-        let poly = table.fetch(e.map(|c| c / s));
         let b = color::upsample::boxes::BoxSpectrum { rgb: boxed };
         let values: Vec<f64> =
-            self.lambda.iter().map(|&l| s * poly.to_f32_poly_eval(l) * b.eval(l)).collect();
+            self.emitter_nodes(table, e).iter().zip(&self.lambda).map(|(v, &l)| v * b.eval(l)).collect();
         (self.to_rgb * DVec3::from(integrate_nodes(&self.white, &values))).to_array()
     }
 }
