@@ -398,11 +398,10 @@ fn background_nodes(bg: vec3<f32>, c: vec4<f32>, g: u32) -> vec4<f32> {
 // exactly the box of the per-channel exp(−σ·d)) and the spectrum of what the ray meets. The
 // spectral mode integrates the absorption's steps exactly (`box_white_weights`: the smooth
 // factors at the nodes, the box in the weights); the naive mode samples every box at the nodes,
-// as it does its reflectances. Under
-// dispersion each group of four nodes is traced with the index at its mean wavelength: N/4
-// directions, each a trace, a background read and a coefficient fetch (a trace per node cost
-// the glass scene's spectral frame 1.1–1.25× at N = 16 and changed its error by 0.003 ΔE at
-// N = 8); without, one of each for the pixel.
+// as it does its reflectances. Under dispersion each group of four nodes is traced with the
+// index at its mean wavelength: N/4 directions, each a trace, a background read and a
+// coefficient fetch (a trace per node cost the glass scene's spectral frame 1.1–1.25× at
+// N = 16 and changed its error by 0.003 ΔE at N = 8); without, one of each for the pixel.
 fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>) -> vec3<f32> {
     let k = transmitted_share(s, tr, -ctx.view_dir);
     if (k <= 0.0) {
