@@ -3,79 +3,98 @@
 into the four balls' discs and the floor (each region's share of the image mean, so the columns
 add up to the first).
 
-    tools/glass_regions.py TRUTH.exr IMAGE.exr [IMAGE.exr ...]
+    tools/glass_regions.py [--spectra BIN] TRUTH.exr IMAGE.exr [IMAGE.exr ...]
 
 The images are linear sRGB EXRs of the built-in `glass` scene at one size (`spectra render
 glass --out X.exr`, `spectra truth glass --direct-only --out T.exr`, or the eval's
-glass_truth.exr). The discs are the spheres of crates/scene/src/builtin/glass.rs projected
-through its camera, 8 % wider than the silhouette. ΔE2000 with CIELAB white Y = 1 (D65), as
-`spectra eval` computes it. Needs numpy, OpenEXR and colour-science (the oracle scripts' deps).
+glass_truth.exr). The per-pixel ΔE2000 is `spectra diff --per-pixel-out`'s (the metric `spectra
+eval` reports); this script only adds the regions: the spheres of
+crates/scene/src/builtin/glass.rs projected through its camera, discs 8 % wider than the
+silhouette. Python 3 standard library only.
 """
+import argparse
+import csv
+import math
+import os
+import subprocess
 import sys
-import warnings
+import tempfile
 
-import numpy as np
-import OpenEXR
-
-warnings.filterwarnings("ignore")
-import colour  # noqa: E402
-
+REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # crates/scene/src/builtin/glass.rs
-EYE, TARGET, FOV_Y = np.array([0.0, 0.55, 1.45]), np.array([0.0, 0.1, 0.0]), np.radians(38.0)
+EYE, TARGET, FOV_Y = (0.0, 0.55, 1.45), (0.0, 0.1, 0.0), math.radians(38.0)
 RADIUS = 0.12
 BALLS = ["clear", "flint", "green", "frosted"]
-SRGB_TO_XYZ = np.array([[0.4124564, 0.3575761, 0.1804375],
-                        [0.2126729, 0.7151522, 0.0721750],
-                        [0.0193339, 0.1191920, 0.9503041]])
 
 
-def load(path):
-    ch = OpenEXR.File(path).channels()
-    if "RGB" in ch:
-        return np.asarray(ch["RGB"].pixels, dtype=np.float64)
-    return np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+def sub(a, b):
+    return [x - y for x, y in zip(a, b)]
 
 
-def lab(rgb):
-    white = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
-    return colour.XYZ_to_Lab(rgb @ SRGB_TO_XYZ.T, white)
+def dot(a, b):
+    return sum(x * y for x, y in zip(a, b))
 
 
-def regions(w, h):
-    fwd = (TARGET - EYE) / np.linalg.norm(TARGET - EYE)
-    right = np.cross(fwd, [0.0, 1.0, 0.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
-    t = np.tan(FOV_Y / 2)
-    yy, xx = np.mgrid[0:h, 0:w]
-    out = {}
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def unit(a):
+    n = math.sqrt(dot(a, a))
+    return [x / n for x in a]
+
+
+def discs(w, h):
+    """(name, centre x, centre y, radius) in pixels of each ball."""
+    fwd = unit(sub(TARGET, EYE))
+    right = unit(cross(fwd, [0.0, 1.0, 0.0]))
+    up = cross(right, fwd)
+    t = math.tan(FOV_Y / 2)
+    out = []
     for i, name in enumerate(BALLS):
-        d = np.array([(i - 1.5) * 0.3, RADIUS, 0.0]) - EYE
-        z = d @ fwd
-        px = (d @ right / z / (t * w / h) * 0.5 + 0.5) * w
-        py = (0.5 - 0.5 * (d @ up) / z / t) * h
-        r = RADIUS / z / t * h / 2 * 1.08
-        out[name] = (xx - px) ** 2 + (yy - py) ** 2 < r * r
-    out["floor"] = ~np.any(list(out.values()), axis=0)
+        d = sub([(i - 1.5) * 0.3, RADIUS, 0.0], EYE)
+        z = dot(d, fwd)
+        px = (dot(d, right) / z / (t * w / h) * 0.5 + 0.5) * w
+        py = (0.5 - 0.5 * dot(d, up) / z / t) * h
+        out.append((name, px, py, RADIUS / z / t * h / 2 * 1.08))
     return out
 
 
+def per_pixel(spectra, truth, image, tmp):
+    out = os.path.join(tmp, "pp.csv")
+    r = subprocess.run([spectra, "diff", truth, image, "--per-pixel-out", out], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"spectra diff {truth} {image}: {r.stderr.strip()}")
+    with open(out, newline="") as f:
+        return [(int(row["x"]), int(row["y"]), float(row["delta_e2000"])) for row in csv.DictReader(f)]
+
+
 def main():
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    truth = load(sys.argv[1])
-    h, w, _ = truth.shape
-    masks = regions(w, h)
-    reference = lab(truth)
-    print("%-28s" % "image", " ".join("%8s" % k for k in ["all"] + list(masks)))
-    print("%-28s" % "pixel share", " ".join("%8.3f" % v for v in [1.0] + [m.mean() for m in masks.values()]))
-    for path in sys.argv[2:]:
-        img = load(path)
-        if img.shape != truth.shape:
-            sys.exit(f"{path}: {img.shape[1]}x{img.shape[0]}, the truth is {w}x{h}")
-        de = colour.delta_E(reference, lab(img), method="CIE 2000")
-        row = [de.mean()] + [de[m].sum() / de.size for m in masks.values()]
-        print("%-28s" % path.split("/")[-1][-28:], " ".join("%8.4f" % v for v in row))
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--spectra", default=os.path.join(REPO_ROOT, "target", "release", "spectra"),
+                    help="the spectra binary (default: target/release/spectra of this repository)")
+    ap.add_argument("truth")
+    ap.add_argument("images", nargs="+")
+    a = ap.parse_args()
+    if not os.path.isfile(a.spectra):
+        ap.error(f"{a.spectra}: no spectra binary there (cargo build --release -p spectra, or --spectra PATH)")
+    names = ["all"] + BALLS + ["floor"]
+    print("%-28s" % "image", " ".join("%8s" % k for k in names))
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in a.images:
+            px = per_pixel(a.spectra, a.truth, path, tmp)
+            w, h = max(p[0] for p in px) + 1, max(p[1] for p in px) + 1
+            ds = discs(w, h)
+            sums = dict.fromkeys(names, 0.0)
+            counts = dict.fromkeys(names, 0)
+            for x, y, de in px:
+                region = next((n for n, cx, cy, r in ds if (x - cx) ** 2 + (y - cy) ** 2 < r * r), "floor")
+                for k in ("all", region):
+                    sums[k] += de
+                    counts[k] += 1
+            if path == a.images[0]:
+                print("%-28s" % "pixel share", " ".join("%8.3f" % (counts[k] / len(px)) for k in names))
+            print("%-28s" % path.split("/")[-1][-28:], " ".join("%8.4f" % (sums[k] / len(px)) for k in names))
 
 
 if __name__ == "__main__":
