@@ -14,11 +14,29 @@
 
 use crate::error::{RenderError, Result};
 use crate::settings::{Mode, RenderSettings};
-use color::quadrature::{NodeQuadrature, Nodes, Quadrature, sum_weights};
+use color::quadrature::{Basis, NodeQuadrature, Nodes, Quadrature, sum_weights};
 use color::upsample::CoeffTable;
 use color::{Observer, RgbColorSpace, SampledWavelengths, SpectralIntegrator, Spectrum, WavelengthRange};
 use glam::{DMat3, DVec3};
 use scene::Emission;
+
+/// The node count from which the prefiltered rule interpolates the node values with the
+/// not-a-knot cubic spline instead of Catmull–Rom ([`node_quadrature`]).
+pub const SPLINE_FROM: usize = 8;
+
+/// The real-time renderer's node quadrature, which every weight of a frame comes from (and the
+/// GPU tests' CPU references too). The prefiltered rule's interpolant of the node values is
+/// Catmull–Rom below [`SPLINE_FROM`] nodes and the global not-a-knot spline from there on:
+/// over random upsampled colours the spline's mean error is lower at every N ≥ 8 under a
+/// spiky, a peaked and a smooth light (`quadrature_study`; docs/quadrature.md), while at
+/// N = 4–6 it rings (max 36 ΔE2000 at N = 4). The choice lives here, not in
+/// [`color::quadrature`], because only the real-time renderer integrates at nodes: the path
+/// tracer samples wavelengths continuously, and its code hash (the truth cache's key) does not
+/// depend on this.
+pub fn node_quadrature(rule: Quadrature, nodes: Nodes, observer: &Observer) -> NodeQuadrature {
+    let basis = if nodes.len() >= SPLINE_FROM { Basis::Spline } else { Basis::CatmullRom };
+    NodeQuadrature::with_basis(rule, nodes, observer, basis)
+}
 
 /// Four node wavelengths and what the shader needs at them. `WavelengthGroup` in
 /// `wgsl/spectral.wgsl` (checked by `layout_tests`).
@@ -92,7 +110,7 @@ impl SpectralSetup {
         let scene_white = color::illuminant::by_name(&settings.white)?;
         let offset = settings.jitter.map_or(0.5, f64::from);
         let nodes = Nodes::new(settings.range, settings.wavelengths, offset)?;
-        let quad = NodeQuadrature::new(settings.quadrature, nodes, &observer);
+        let quad = node_quadrature(settings.quadrature, nodes, &observer);
         let wavelengths = SampledWavelengths {
             lambda: quad.nodes.lambda.clone(),
             weight: vec![quad.nodes.spacing; quad.len()],
@@ -375,6 +393,60 @@ mod tests {
         // A dark light with the same spectrum is not an error: there is nothing to scale.
         let dark = Emission { intensity: 0.0, ..e };
         assert!(setup.light_weights(&dark, Mode::Spectral, &table()).is_ok());
+    }
+
+    /// Why the renderer's rule switches basis at `SPLINE_FROM`: over random upsampled colours
+    /// (not the evaluation's scenes) its mean ΔE2000 against the dense integral is at least 5 %
+    /// below Catmull–Rom's from 8 nodes on (10 % at N = 8 under F11, 2× from N = 12), under a line spectrum and a smooth light; below 8 it is
+    /// Catmull–Rom, whose spline rival rings there.
+    #[test]
+    fn the_renderers_basis_beats_catmull_rom_from_eight_nodes_and_is_it_below() {
+        use color::quadrature::integrate_nodes;
+        use color::{ciede2000, xyz_to_lab};
+        let table = table();
+        let obs = Observer::cie1931();
+        let range = WavelengthRange::VISIBLE;
+        let polys: Vec<_> =
+            color::upsample::roundtrip::random_colours(400, 3).iter().map(|&c| table.fetch(c)).collect();
+        for light in ["F11", "D65"] {
+            let e = color::illuminant::by_name(light).unwrap();
+            let truth: Vec<[f64; 3]> = polys
+                .iter()
+                .map(|p| {
+                    let white = dense_integral(range, &obs, |l| e.eval(l));
+                    xyz_to_lab(dense_integral(range, &obs, |l| p.eval(l) * e.eval(l)), white)
+                })
+                .collect();
+            let mean_error = |q: &NodeQuadrature| {
+                let w = q.weights(|l| e.eval(l));
+                let white = sum_weights(&w);
+                let sum: f64 = polys
+                    .iter()
+                    .zip(&truth)
+                    .map(|(p, t)| {
+                        let v: Vec<f64> = q.nodes.lambda.iter().map(|&l| p.eval(l)).collect();
+                        ciede2000(xyz_to_lab(integrate_nodes(&w, &v), white), *t)
+                    })
+                    .sum();
+                sum / polys.len() as f64
+            };
+            for n in [4, 6, 8, 12, 16, 24] {
+                let nodes = || Nodes::new(range, n, 0.5).unwrap();
+                let ours = mean_error(&node_quadrature(Quadrature::Prefiltered, nodes(), &obs));
+                let cr = mean_error(&NodeQuadrature::with_basis(
+                    Quadrature::Prefiltered,
+                    nodes(),
+                    &obs,
+                    Basis::CatmullRom,
+                ));
+                eprintln!("{light} N = {n}: renderer {ours:.4}, Catmull–Rom {cr:.4}");
+                if n < SPLINE_FROM {
+                    assert_eq!(ours, cr, "{light} N = {n}");
+                } else {
+                    assert!(ours < 0.95 * cr, "{light} N = {n}: renderer {ours} vs Catmull–Rom {cr}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 #![allow(dead_code)]
 
-use color::quadrature::{NodeQuadrature, Nodes, Quadrature, integrate_nodes, sum_weights};
+use color::quadrature::{Nodes, Quadrature, integrate_nodes, sum_weights};
 use color::upsample::CoeffTable;
 use color::{Observer, RgbColorSpace, Spectrum};
 use glam::{DMat3, DVec3, Mat4, Vec2, Vec3, Vec4};
@@ -350,7 +350,7 @@ pub struct CpuSpectral {
 impl CpuSpectral {
     pub fn new(n: usize, rule: Quadrature, light_spectrum: &Spectrum, luminance: f64) -> Self {
         let nodes = Nodes::new(color::WavelengthRange::VISIBLE, n, 0.5).unwrap();
-        let quad = NodeQuadrature::new(rule, nodes, &Observer::cie1931());
+        let quad = render::spectral_data::node_quadrature(rule, nodes, &Observer::cie1931());
         let d65 = color::illuminant::by_name("D65").unwrap();
         let white_raw = quad.weights(|l| d65.eval(l));
         let white_xyz = sum_weights(&white_raw);
