@@ -191,6 +191,12 @@ impl GpuEnvironment {
         }
     }
 
+    /// How many of the spectral basis' components the coefficient maps use
+    /// ([`SpectralBasis::used`]); all K before the basis is built.
+    pub fn spectral_bases(&self) -> usize {
+        self.spectral.as_ref().map_or(environment::K, |(b, _)| b.used)
+    }
+
     /// The textures for `spectral` (PCA basis) or RGB coefficients.
     pub fn textures(&self, spectral: bool) -> &EnvTextures {
         match (&self.spectral, spectral) {

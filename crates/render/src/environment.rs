@@ -143,7 +143,18 @@ pub struct SpectralBasis {
     /// The largest relative error of a texel's spectral shape after projection on the K
     /// components, ‖x − Σⱼ αⱼφⱼ‖ / ‖x‖ in the observer-weighted norm (0 = every texel exact).
     pub residual: f64,
+    /// How many leading components any texel uses (1..=K): the ones after are zero in every
+    /// texel (set so where they held less than [`UNUSED_COMPONENT`] of the first's largest
+    /// coefficient), and the shader need not weigh them per node (`ENV_BASES`). One for an
+    /// environment of one spectral shape, such as the default sky and ground.
+    pub used: usize,
 }
+
+/// A trailing component whose largest coefficient is below this share of the first
+/// component's is numerical noise of a rank-deficient PCA (the default environment's leave
+/// ~10⁻¹⁶): it is dropped. 10⁻⁶ is far below what the half-float maps resolve (2⁻¹¹ of a
+/// texel's value), so dropping it changes no stored texel's meaning.
+pub const UNUSED_COMPONENT: f64 = 1e-6;
 
 impl SpectralBasis {
     /// φ_j(λ), linear between grid points, 0 outside 360–830 nm.
@@ -225,7 +236,13 @@ pub fn spectral_basis(rgb: &Map, table: &color::upsample::CoeffTable) -> (Spectr
     let project = |x: &[f64; GRID_N]| -> [f64; K] {
         std::array::from_fn(|j| (0..GRID_N).map(|i| x[i] * vecs[j][i]).sum::<f64>())
     };
-    let texels = samples.par_iter().map(|x| Vec4::from_array(project(x).map(|a| a as f32))).collect();
+    let coeffs: Vec<[f64; K]> = samples.par_iter().map(&project).collect();
+    let largest: [f64; K] = std::array::from_fn(|j| coeffs.iter().map(|a| a[j].abs()).fold(0.0, f64::max));
+    let used = (1..K).rev().find(|&j| largest[j] > UNUSED_COMPONENT * largest[0]).map_or(1, |j| j + 1);
+    let texels = coeffs
+        .iter()
+        .map(|a| Vec4::from_array(std::array::from_fn(|j| if j < used { a[j] as f32 } else { 0.0 })))
+        .collect();
     // Relative error of each texel's shape, ‖x − Σ αⱼ vⱼ‖ / ‖x‖ in the weighted norm.
     let residual = samples
         .par_iter()
@@ -239,7 +256,7 @@ pub fn spectral_basis(rgb: &Map, table: &color::upsample::CoeffTable) -> (Spectr
             ((n2 - captured).max(0.0) / n2).sqrt()
         })
         .reduce(|| 0.0, f64::max);
-    (SpectralBasis { phi, residual }, Map { width: rgb.width, height: rgb.height, texels })
+    (SpectralBasis { phi, residual, used }, Map { width: rgb.width, height: rgb.height, texels })
 }
 
 fn rayleigh(c: &[f64], v: &[f64]) -> f64 {
@@ -474,6 +491,10 @@ mod tests {
         let table = color::upsample::table("srgb").unwrap();
         let (basis, coeffs) = spectral_basis(&rgb_map(&Environment::default_sky()), &table);
         assert!(basis.residual < 1e-6, "{}", basis.residual);
+        // One spectral shape: one component used, the others zero in every texel, so the
+        // shader weighs one basis per node (`ENV_BASES`).
+        assert_eq!(basis.used, 1);
+        assert!(coeffs.texels.iter().all(|t| t.y == 0.0 && t.z == 0.0 && t.w == 0.0));
         // Reconstruct a ground texel's smooth part: 0.25 grey → s·ρ = 2·0.125·ρ(½) = 0.25.
         let t = coeffs.texels.last().unwrap();
         let x: f64 = (0..K).map(|j| t[j] as f64 * basis.eval(j, 550.0)).sum();
@@ -490,5 +511,12 @@ mod tests {
         let env = Environment::from_rgb("wheel", w, h, texels).unwrap();
         let (basis, _) = spectral_basis(&rgb_map(&env), &table);
         assert!(basis.residual < 0.1, "residual {}", basis.residual);
+        assert_eq!(basis.used, K, "every component carries some of a hue wheel");
+        // Two shapes (a white sky over a saturated red ground): two components.
+        let two: Vec<Vec3> =
+            (0..w * h).map(|i| if i < w * h / 2 { Vec3::ONE } else { Vec3::new(0.8, 0.05, 0.02) }).collect();
+        let env = Environment::from_rgb("two", w, h, two).unwrap();
+        let (basis, _) = spectral_basis(&rgb_map(&env), &table);
+        assert_eq!(basis.used, 2, "residual {}", basis.residual);
     }
 }

@@ -733,6 +733,11 @@ impl Renderer {
             ior: scene.has_ior,
             transmission: false,
             thin_walls: scene.has_thin_walls,
+            // The naive mode's basis is the three bands (the fourth's weights are zero).
+            env_bases: match settings.mode {
+                Mode::Spectral => self.environment.spectral_bases() as u32,
+                _ => 3,
+            },
         };
         // See-through materials get a layer of their own, shaded over the opaque one
         // (`passes::gbuffer::Layer`), except where the shading runs its general node loop (a

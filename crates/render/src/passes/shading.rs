@@ -90,6 +90,10 @@ pub struct Variant {
     /// Some see-through material is thin-walled (`HAS_THIN_WALLS`): the lights behind it shine
     /// through (`thin_transmission`).
     pub thin_walls: bool,
+    /// The environment's basis spectra that its coefficients use (`ENV_BASES`, 1..=4;
+    /// `environment::SpectralBasis::used` in the spectral mode): the per-node environment
+    /// weights of the others are not read.
+    pub env_bases: u32,
 }
 
 impl Variant {
@@ -106,12 +110,13 @@ impl Variant {
         ior: true,
         transmission: false,
         thin_walls: true,
+        env_bases: crate::environment::K as u32,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
     /// environment, film, ior, transmission, thin walls); its pipelines are keyed by
     /// [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 11] {
+    fn constants(&self) -> [(&'static str, f64); 12] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -125,6 +130,7 @@ impl Variant {
             ("HAS_IOR", b(self.ior)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
+            ("ENV_BASES", f64::from(self.env_bases)),
         ]
     }
 

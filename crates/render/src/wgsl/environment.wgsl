@@ -95,10 +95,24 @@ fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lam
     return t;
 }
 
+// How many basis spectra the environment's texels use (src/environment.rs,
+// `SpectralBasis::used`; 1 for an environment of one spectral shape such as the default sky):
+// the coefficients after them are zero, so their node weights are not read.
+override ENV_BASES: u32 = 4u;
+
 // Node weights of coefficients c for group g: Σ_j c_j · B_{j,g}.
 fn env_w(c: vec4<f32>, g: u32, n_groups: u32) -> mat3x4<f32> {
-    return env_weights[g] * c.x + env_weights[n_groups + g] * c.y + env_weights[2u * n_groups + g] * c.z
-        + env_weights[3u * n_groups + g] * c.w;
+    var m = env_weights[g] * c.x;
+    if (ENV_BASES > 1u) {
+        m += env_weights[n_groups + g] * c.y;
+    }
+    if (ENV_BASES > 2u) {
+        m += env_weights[2u * n_groups + g] * c.z;
+    }
+    if (ENV_BASES > 3u) {
+        m += env_weights[3u * n_groups + g] * c.w;
+    }
+    return m;
 }
 
 // XYZ of coefficients c seen by a reflectance of one.
