@@ -78,7 +78,8 @@ fn constant_material_coefficients_match_the_per_pixel_fetch() {
     for m in &mut coloured.meshes {
         m.colors = vec![Vec4::ONE; m.positions.len()];
     }
-    for n in [4, 16] {
+    // N = 32: past the four groups whose reflectance the shader keeps per pixel.
+    for n in [4, 16, 32] {
         let constant = render(&scene, n);
         let fetched = render(&coloured, n);
         let mut worst = 0.0f64;

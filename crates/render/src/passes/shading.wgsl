@@ -795,8 +795,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     }
     // Lights outermost: each light's factors are used as soon as they are computed, so nothing
     // per light is kept (a private array per light cost a CPU driver its zero-initialisation and
-    // memory traffic on every pixel); the reflectance is re-evaluated per light and group instead
-    // (7 operations per node).
+    // memory traffic on every pixel); a varying reflectance is kept for the first four groups
+    // (below) and re-evaluated per light past them (7 operations per node).
     let p = ctx.world_pos;
     let s = load_surface(px);
     ctx.normal = s.normal;
@@ -813,6 +813,22 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let ng_unknown = select(ng, 0u, known);
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+    // A varying colour's reflectance at the first four groups (N ≤ 16) once per pixel, in four
+    // registers, instead of once per light and group (a sigmoid per node against three selects
+    // per group). Loops, not branches, bound by the group count: a CPU driver, which runs both
+    // sides of a branch, stops a loop early, and no private array is indexed.
+    var r0 = vec4<f32>(0.0);
+    var r1 = vec4<f32>(0.0);
+    var r2 = vec4<f32>(0.0);
+    var r3 = vec4<f32>(0.0);
+    let ng_kept = select(min(ng_unknown, 4u), 0u, n_lights == 0u);
+    for (var g = 0u; g < ng_kept; g++) {
+        let r = node_reflectance(c_base, s.base, g);
+        r0 = select(r0, r, g == 0u);
+        r1 = select(r1, r, g == 1u);
+        r2 = select(r2, r, g == 2u);
+        r3 = select(r3, r, g == 3u);
+    }
     let film = load_film(px);
     let filmed = HAS_FILM && film.weight > 0.0;
     var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
@@ -847,7 +863,11 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
             if (known) {
                 reflected = reflected_light(sc, li);
             }
-            for (var g = 0u; g < ng_unknown; g++) {
+            for (var g = 0u; g < ng_kept; g++) {
+                let r = select(select(r0, r1, g == 1u), select(r2, r3, g == 3u), g >= 2u);
+                reflected += r * light_w(li, g, ng);
+            }
+            for (var g = 4u; g < ng_unknown; g++) {
                 reflected += node_reflectance(c_base, s.base, g) * light_w(li, g, ng);
             }
             xyz = fma(vec3<f32>(f.x), reflected, fma(vec3<f32>(f.y), lights[li].xyz.xyz, xyz));
