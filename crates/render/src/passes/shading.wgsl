@@ -813,15 +813,18 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let ng_unknown = select(ng, 0u, known);
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
+    let film = load_film(px);
+    let filmed = HAS_FILM && film.weight > 0.0;
     // A varying colour's reflectance at the first four groups (N ≤ 16) once per pixel, in four
     // registers, instead of once per light and group (a sigmoid per node against three selects
-    // per group). Loops, not branches, bound by the group count: a CPU driver, which runs both
-    // sides of a branch, stops a loop early, and no private array is indexed.
+    // per group); a filmed pixel has its own loop. Loops, not branches, bound by the group
+    // count: a CPU driver, which runs both sides of a branch, stops a loop early, and no private
+    // array is indexed.
     var r0 = vec4<f32>(0.0);
     var r1 = vec4<f32>(0.0);
     var r2 = vec4<f32>(0.0);
     var r3 = vec4<f32>(0.0);
-    let ng_kept = select(min(ng_unknown, 4u), 0u, n_lights == 0u);
+    let ng_kept = select(min(ng_unknown, 4u), 0u, n_lights == 0u || filmed);
     for (var g = 0u; g < ng_kept; g++) {
         let r = node_reflectance(c_base, s.base, g);
         r0 = select(r0, r, g == 0u);
@@ -829,8 +832,6 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         r2 = select(r2, r, g == 2u);
         r3 = select(r3, r, g == 3u);
     }
-    let film = load_film(px);
-    let filmed = HAS_FILM && film.weight > 0.0;
     var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
     if (HAS_TRANSMISSION) {
         tr = load_transmissive(px, s);
