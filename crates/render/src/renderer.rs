@@ -97,6 +97,7 @@ struct SpectralState {
 /// Bind groups that reference the size-dependent targets.
 struct TargetBindings {
     shading: wgpu::BindGroup,
+    occlusion: wgpu::BindGroup,
     custom: wgpu::BindGroup,
     post: wgpu::BindGroup,
     /// The accumulation pass's inputs, and post reading the accumulated mean instead of the
@@ -163,6 +164,7 @@ pub struct Renderer {
     gbuffer: GBufferPass,
     shadow: ShadowPass,
     shading: ShadingPass,
+    occlusion: crate::passes::occlusion::OcclusionPass,
     /// Made at the first frame with see-through materials.
     back_faces: Option<crate::passes::back_faces::BackFacesPass>,
     custom_pass: CustomPass,
@@ -218,6 +220,7 @@ impl Renderer {
         let gbuffer = GBufferPass::new(device, &shared)?;
         let shadow = ShadowPass::new(device, &gbuffer.material_layout)?;
         let shading = ShadingPass::new(device, &shared, &custom)?;
+        let occlusion = crate::passes::occlusion::OcclusionPass::new(device, &shared)?;
         let custom_pass = CustomPass::new(device, &shared, &custom)?;
         let post = PostPass::new(device, &shared)?;
         let accumulate = AccumulatePass::new(device)?;
@@ -254,6 +257,7 @@ impl Renderer {
             gbuffer,
             shadow,
             shading,
+            occlusion,
             back_faces: None,
             custom_pass,
             post,
@@ -719,6 +723,11 @@ impl Renderer {
             if settings.env_occlusion { 0.5 * (scene.bounds.1 - scene.bounds.0).length() * 0.5 } else { 0.0 };
         let env_uniforms =
             self.environment.uniforms(spectral.env_totals, settings.mode == Mode::Spectral, occlusion_radius);
+        // Ambient light to occlude (the environment's, a hook's irradiance): the occlusion pass
+        // runs first and the shading reads its result.
+        let occlusion = occlusion_radius > 0.0
+            && (env_uniforms.flags[0] != 0 || self.custom.irradiance())
+            && self.shading.reads_occlusion();
         self.gpu.queue.write_buffer(&self.env_buffer, 0, bytemuck::bytes_of(&env_uniforms));
 
         let variant = Variant {
@@ -738,6 +747,7 @@ impl Renderer {
                 Mode::Spectral => self.environment.spectral_bases() as u32,
                 _ => 3,
             },
+            occlusion_map: occlusion,
         };
         // See-through materials get a layer of their own, shaded over the opaque one
         // (`passes::gbuffer::Layer`), except where the shading runs its general node loop (a
@@ -747,7 +757,13 @@ impl Renderer {
             && !(settings.mode != Mode::Rgb && self.custom.spectral());
         if layered {
             // Prepared first: `select` leaves the pipeline it makes last current.
-            let layer_variant = Variant { film: scene.has_transmission_film, transmission: true, ..variant };
+            // The layer searches its occlusion on its own depth.
+            let layer_variant = Variant {
+                film: scene.has_transmission_film,
+                transmission: true,
+                occlusion_map: false,
+                ..variant
+            };
             self.shading.select(&self.gpu.device, layer_variant, settings.mode == Mode::Rgb)?;
             let (t, _) = self.targets.as_mut().expect("checked above");
             if t.layer.is_none() {
@@ -807,13 +823,23 @@ impl Renderer {
             custom: &spectral.custom_bind_group,
         };
         let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
+        // The shading pass's time includes the occlusion pass's, which starts it.
+        if occlusion {
+            let draw = Draw {
+                target: &targets.occlusion_view,
+                inputs: &bindings.occlusion,
+                timestamps: timer.map(|t| t.begins(2)),
+            };
+            self.occlusion.record(&mut encoder, &self.frame_bind_group, &spectral.bind_group, draw);
+        }
         // An identity custom pass is skipped: shading writes what the custom pass would.
         let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };
         match (layered, targets.layer.as_ref()) {
             (true, Some(layer)) => {
                 // The opaque layer, kept aside as the background; the see-through one over it.
                 // The shading's time spans both layers (the first's start, the second's end).
-                let draw = Draw { target: shaded, inputs, timestamps: timer.map(|t| t.begins(2)) };
+                let timestamps = timer.filter(|_| !occlusion).map(|t| t.begins(2));
+                let draw = Draw { target: shaded, inputs, timestamps };
                 self.shading.record(&mut encoder, &shared, draw);
                 let shaded_texture =
                     if self.custom_pass.skipped() { &targets.hdr } else { &targets.hdr_shaded };
@@ -856,7 +882,8 @@ impl Renderer {
                 self.shading.record_layer(&mut encoder, &shared, draw, &layer.depth_view, scene, layer_key);
             }
             _ => {
-                let draw = Draw { target: shaded, inputs, timestamps: ts(2) };
+                let timestamps = if occlusion { timer.map(|t| t.ends(2)) } else { ts(2) };
+                let draw = Draw { target: shaded, inputs, timestamps };
                 self.shading.record(&mut encoder, &shared, draw);
             }
         }
@@ -953,6 +980,7 @@ impl Renderer {
         let device = &self.gpu.device;
         TargetBindings {
             shading: self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy),
+            occlusion: self.occlusion.bind_inputs(device, t),
             custom: self.custom_pass.bind_inputs(device, t),
             post: self.post.bind_inputs(device, &t.hdr_view, "post inputs"),
             accumulated: None,

@@ -43,6 +43,10 @@ pub struct Targets {
     pub gbuffer_film_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
+    /// The ambient light's screen-space occlusion (`passes::occlusion`), written only in frames
+    /// with ambient light to occlude.
+    pub occlusion: wgpu::Texture,
+    pub occlusion_view: wgpu::TextureView,
     /// Shading output (pass 2).
     pub hdr_shaded: wgpu::Texture,
     pub hdr_shaded_view: wgpu::TextureView,
@@ -74,6 +78,7 @@ impl Targets {
         let (gbuffer_slot, gbuffer_slot_view) = make("gbuffer material slot", GBUFFER_SLOT_FORMAT, none);
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
+        let (occlusion, occlusion_view) = make("occlusion", crate::passes::occlusion::OCCLUSION_FORMAT, none);
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
         let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);
@@ -88,6 +93,8 @@ impl Targets {
             gbuffer_film_view,
             depth,
             depth_view,
+            occlusion,
+            occlusion_view,
             hdr_shaded,
             hdr_shaded_view,
             hdr,

@@ -429,3 +429,51 @@ fn occlusion_leaves_a_convex_sphere_unoccluded_under_every_pattern() {
     }
     eprintln!("occlusion on a convex sphere, 16 patterns: worst |pixel − 1| = {worst:.5}");
 }
+
+/// The occlusion pass (`passes::occlusion`) runs before the shading of every frame that has
+/// ambient light: a renderer that drew another view first shows exactly what a new one shows
+/// (nothing of the last frame's occlusion is read), in both modes, and where a sphere meets the
+/// floor the occlusion darkens the ambient light (so the map is read, not a constant) and leaves the open floor as it is.
+#[test]
+fn the_occlusion_pass_is_redone_for_every_frame_and_darkens_contact() {
+    let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    let floor = Mesh {
+        positions: vec![
+            Vec3::new(-4.0, -1.0, -4.0),
+            Vec3::new(4.0, -1.0, -4.0),
+            Vec3::new(4.0, -1.0, 4.0),
+            Vec3::new(-4.0, -1.0, 4.0),
+        ],
+        normals: vec![Vec3::Y; 4],
+        uvs: vec![Vec2::ZERO; 4],
+        indices: vec![0, 2, 1, 0, 3, 2],
+        ..Default::default()
+    };
+    scene.meshes.push(floor);
+    let a = Camera::look_at(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, -0.5, 0.0), Vec3::Y, 0.8);
+    let b = Camera::look_at(Vec3::new(3.5, 0.5, 3.5), Vec3::new(0.0, -0.7, 0.0), Vec3::Y, 0.8);
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        let s = RenderSettings { env_occlusion: true, ..settings(mode, 8) };
+        let frame = |cameras: &[&Camera], s: &RenderSettings| {
+            let mut r = renderer();
+            r.set_scene(&scene).unwrap();
+            r.resize(SIZE, SIZE).unwrap();
+            for c in cameras {
+                r.render(c, s).unwrap();
+            }
+            r.read_hdr().unwrap()
+        };
+        let fresh = frame(&[&b], &s);
+        let after = frame(&[&a, &b], &s);
+        assert!(fresh == after, "{mode:?}: the second view differs from a new renderer's");
+        let open = frame(&[&b], &RenderSettings { env_occlusion: false, ..s });
+        let ratios: Vec<f32> = fresh.iter().zip(&open).map(|(o, u)| o[1] / u[1].max(1e-6)).collect();
+        let darkest = ratios.iter().copied().fold(f32::INFINITY, f32::min);
+        let brightest = ratios.iter().copied().fold(0.0, f32::max);
+        assert!(fresh.iter().all(|p| p[..3].iter().all(|v| v.is_finite())), "{mode:?}: not finite");
+        assert!(darkest < 0.8, "{mode:?}: the contact is not occluded (darkest ratio {darkest})");
+        // The open floor and the sky see nothing to hide.
+        assert!((brightest - 1.0).abs() < 1e-3, "{mode:?}: nothing unoccluded (brightest ratio {brightest})");
+        eprintln!("{mode:?}: occluded / unoccluded from {darkest:.3} to {brightest:.4}");
+    }
+}

@@ -147,9 +147,15 @@ impl CustomShader {
         out.push_str(&format!("const CUSTOM_LIGHT_T: bool = {transmittance};\n"));
         out.push_str(&format!("const CUSTOM_ENV_T: bool = {env_transmittance};\n"));
         // The irradiance hooks come as a pair; either one turns on the diffuse term's code.
-        let irradiance = self.defines("custom_irradiance") || self.defines("custom_irradiance_rgb");
+        let irradiance = self.irradiance();
         out.push_str(&format!("const CUSTOM_IRRADIANCE: bool = {irradiance};\n"));
         out
+    }
+
+    /// Whether the shader defines the irradiance hooks (`CUSTOM_IRRADIANCE`): light from all
+    /// sides, which the shading occludes like the environment's.
+    pub(crate) fn irradiance(&self) -> bool {
+        self.defines("custom_irradiance") || self.defines("custom_irradiance_rgb")
     }
 
     /// [`Self::constants`] as wgpu takes them.

@@ -2,13 +2,14 @@
 //! passes share.
 //!
 //! Frame order: shadow (depth from each shadow-casting light, one layer each) → G-buffer →
-//! spectral shading → custom → (accumulate, only with `Renderer::set_accumulation`) → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
+//! (occlusion, only where the frame has ambient light to occlude) → spectral shading → custom → (accumulate, only with `Renderer::set_accumulation`) → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
 //! per-wavelength data and the coefficient table, 3 = the custom shader's parameters.
 
 pub mod accumulate;
 pub mod back_faces;
 pub mod custom;
 pub mod gbuffer;
+pub mod occlusion;
 pub mod post;
 pub mod rgb_medium;
 pub mod shading;

@@ -94,6 +94,9 @@ pub struct Variant {
     /// `environment::SpectralBasis::used` in the spectral mode): the per-node environment
     /// weights of the others are not read.
     pub env_bases: u32,
+    /// The ambient light's occlusion comes from the occlusion pass (`OCCLUSION_MAP`,
+    /// `passes::occlusion`) instead of being searched in this pass.
+    pub occlusion_map: bool,
 }
 
 impl Variant {
@@ -111,12 +114,13 @@ impl Variant {
         transmission: false,
         thin_walls: true,
         env_bases: crate::environment::K as u32,
+        occlusion_map: false,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, film, ior, transmission, thin walls); its pipelines are keyed by
+    /// environment, film, ior, transmission, thin walls) and the occlusion's; its pipelines are keyed by
     /// [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 12] {
+    fn constants(&self) -> [(&'static str, f64); 13] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -131,10 +135,12 @@ impl Variant {
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
             ("ENV_BASES", f64::from(self.env_bases)),
+            ("OCCLUSION_MAP", b(self.occlusion_map)),
         ]
     }
 
-    /// What the RGB entry point depends on, the rest at its defaults.
+    /// What the RGB entry point depends on (the scene's features and the occlusion's source),
+    /// the rest at its defaults.
     fn rgb(self) -> Variant {
         Variant {
             polygons: self.polygons,
@@ -143,6 +149,7 @@ impl Variant {
             ior: self.ior,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
+            occlusion_map: self.occlusion_map,
             ..Variant::ALL
         }
     }
@@ -163,6 +170,7 @@ impl ShadingPass {
                 shader::CUSTOM_API,
                 &custom.assembled(),
                 include_str!("shading.wgsl"),
+                include_str!("occlusion.wgsl"),
                 include_str!("transmission.wgsl"),
             ],
             "fs_rgb",
@@ -409,7 +417,8 @@ impl ShadingPass {
                 // Not read outside the transmissive layer: any textures of their kinds the pass
                 // does not write.
                 view_entry(10, &t.ldr_view),
-                view_entry(11, &g[0]),
+                // The occlusion pass's output (`aux_map`, read with `OCCLUSION_MAP`).
+                view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),
                 view_entry(13, &t.gbuffer_slot_view),
             ],
@@ -419,7 +428,7 @@ impl ShadingPass {
     /// Group 1 of the transmissive layer: its G-buffer (the fifth target, transmission and
     /// film packed, at 13) and depth, the shadow maps, the
     /// opaque layer's shaded image as the background and its depth `opaque_depth`, and the
-    /// see-through meshes' back faces.
+    /// see-through meshes' back faces (at 11, `aux_map`; the layer searches its own occlusion).
     pub fn bind_layer_inputs(
         &self,
         device: &wgpu::Device,
@@ -453,6 +462,12 @@ impl ShadingPass {
                 view_entry(13, &g[4]),
             ],
         })
+    }
+
+    /// Whether the pass lights with ambient light, and so reads the occlusion pass's output
+    /// (the benchmark's reference shader does not).
+    pub fn reads_occlusion(&self) -> bool {
+        self.has_variants
     }
 
     /// The pipeline [`Self::select`] made current, for [`Self::record_with`].

@@ -23,9 +23,8 @@
 // Pixels without a see-through surface in front pass the background through.
 
 @group(1) @binding(10) var background: texture_2d<f32>;
-// The see-through meshes' nearest back faces: xyz the outward normal, w the linear depth
-// (`linear_depth`; −1 where there is none).
-@group(1) @binding(11) var back_faces: texture_2d<f32>;
+// The see-through meshes' nearest back faces are `aux_map` (shading.wgsl): xyz the outward
+// normal, w the linear depth (`linear_depth`; −1 where there is none).
 // The opaque layer's depth: what a ray leaving the glass can land on.
 @group(1) @binding(12) var opaque_depth: texture_depth_2d;
 // The layer's transmission (xy) and film (zw), four 8-bit values (gbuffer.wgsl `with_layer`).
@@ -108,7 +107,7 @@ const REFINE_STEPS: u32 = 5u;
 // screen, outside the see-through meshes' silhouette, or behind the nearest back face there.
 fn left_volume(c: vec4<f32>) -> bool {
     let q = clip_to_pixel(c);
-    let b = textureLoad(back_faces, vec2<i32>(clamp(q, vec2<f32>(0.0), frame.viewport.xy - 1.0)), 0);
+    let b = textureLoad(aux_map, vec2<i32>(clamp(q, vec2<f32>(0.0), frame.viewport.xy - 1.0)), 0);
     return c.w <= 0.0 || !on_screen(q) || b.w < 0.0 || linear_depth(c) >= b.w;
 }
 
@@ -136,7 +135,7 @@ fn volume_exit(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>, view_dir: vec3<f32>, 
     let eta = max(ior, 1.0);
     let r1 = refract(view_dir, n, 1.0 / eta);
     let slab = Exit(p + r1 * thickness, view_dir, 1.0, thickness, false);
-    let own = textureLoad(back_faces, vec2<i32>(pix), 0);
+    let own = textureLoad(aux_map, vec2<i32>(pix), 0);
     let cp = frame.view_proj * vec4<f32>(p, 1.0);
     let depth_p = linear_depth(cp);
     // The depth gap to the back face seen through this pixel sets the search's reach (a ray
@@ -171,7 +170,7 @@ fn volume_exit(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>, view_dir: vec3<f32>, 
     // The normal of the back face the ray was last inside of.
     let c = cp + dc * lo;
     let q = clamp(clip_to_pixel(c), vec2<f32>(0.0), frame.viewport.xy - 1.0);
-    var nb = textureLoad(back_faces, vec2<i32>(q), 0).xyz;
+    var nb = textureLoad(aux_map, vec2<i32>(q), 0).xyz;
     if (dot(nb, r1) <= 0.0) {
         nb = own.xyz;
     }

@@ -1,0 +1,77 @@
+//! Pass 2a (before the shading, only where a frame has ambient light to occlude): the
+//! screen-space occlusion of ambient light per pixel (`occlusion.wgsl`: 8 screen directions × 6
+//! depth samples, plus the facet's normal from four neighbours' depths), written to
+//! [`OCCLUSION_FORMAT`] for the shading pass to read with one load (`OCCLUSION_MAP`).
+//!
+//! Its own pass, not a function of the shading: the same work for every mode, done once, and
+//! the shading shader — the largest of the frame, largest in the spectral modes — carries
+//! neither the search's 56 depth loads nor its registers. The value is the one the shading pass
+//! computed itself before (the same function on the same depth and normals, stored in f32), so
+//! images are unchanged. The transmissive layer, whose depth buffer is its own, still searches
+//! in its shading pass.
+
+use super::{
+    Draw, FullscreenPipeline, SharedLayouts, depth_entry, draw_fullscreen, pipeline_layout, texture_entry,
+    view_entry,
+};
+use crate::error::Result;
+use crate::shader;
+use crate::targets::Targets;
+
+/// The occlusion per pixel: f32, so that the shading reads exactly what it would have computed.
+pub const OCCLUSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+pub struct OcclusionPass {
+    input_layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl OcclusionPass {
+    pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
+        let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("occlusion inputs"),
+            entries: &[texture_entry(1), depth_entry(3)],
+        });
+        let module = shader::compile(
+            device,
+            "occlusion",
+            &[
+                shader::COMMON,
+                shader::HASH,
+                shader::SPECTRAL,
+                shader::ENVIRONMENT,
+                include_str!("occlusion.wgsl"),
+                include_str!("occlusion_pass.wgsl"),
+            ],
+        )?;
+        let pipeline = shader::checked(device, "occlusion pipeline", || {
+            let layout =
+                pipeline_layout(device, "occlusion", &[&shared.frame, &input_layout, &shared.spectral]);
+            FullscreenPipeline::simple("occlusion", &module, &layout, &[OCCLUSION_FORMAT]).build(device)
+        })?;
+        Ok(OcclusionPass { input_layout, pipeline })
+    }
+
+    /// Group 1: the G-buffer's normals and depth.
+    pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("occlusion inputs"),
+            layout: &self.input_layout,
+            entries: &[view_entry(1, &t.gbuffer_views[1]), view_entry(3, &t.depth_view)],
+        })
+    }
+
+    /// Records the pass into `draw.target` (the targets' `occlusion_view`); `frame` and
+    /// `spectral` are the shared groups 0 and 2 (the frame's camera, the environment's search
+    /// radius).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &wgpu::BindGroup,
+        spectral: &wgpu::BindGroup,
+        draw: Draw,
+    ) {
+        let groups = [frame, draw.inputs, spectral];
+        draw_fullscreen(encoder, "occlusion", &[draw.target], &self.pipeline, &groups, draw.timestamps);
+    }
+}
