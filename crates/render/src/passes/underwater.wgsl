@@ -154,6 +154,28 @@ fn uw_emission(li: u32, group: u32, rgb: bool) -> mat3x4<f32> {
 
 const UW_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
 
+// The suns' light summed (directional lights that are not sky stand-ins, shining down), in
+// weighted form: the light-field table's terms are per unit sun irradiance, so every sun
+// multiplies the same factor. Summed once per group and pixel (`uw_sun_group` says which
+// group `uw_sun_w` holds) and shared by the in-scattering, the surface's reflection and the
+// column's irradiance, instead of a loop over the lights in each.
+var<private> uw_sun_group: u32 = 0xffffffffu;
+var<private> uw_sun_w: mat3x4<f32>;
+
+fn uw_suns(group: u32, rgb: bool) -> mat3x4<f32> {
+    if (uw_sun_group != group) {
+        uw_sun_group = group;
+        var total = UW_ZERO;
+        for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+            let l = lights[li].pos_kind;
+            if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
+            total += uw_emission(li, group, rgb);
+        }
+        uw_sun_w = total;
+    }
+    return uw_sun_w;
+}
+
 // Per-pixel part of the light-field integral, filled by `uw_prepare_table`: the four table
 // directions around the view (cell offsets within one depth slice) and their bilinear
 // weights; the ray cut at the depth nodes it crosses into pieces, each with its segment i,
@@ -454,14 +476,7 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
 // holds the sky, so the sky stand-ins add nothing here; other suns reuse the first one's
 // table, a documented approximation).
 fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f32> {
-    let f = uw_table_integral(c, group, rgb, wy);
-    var total = UW_ZERO;
-    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
-        let l = lights[li].pos_kind;
-        if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
-        total += s3_scale(uw_emission(li, group, rgb), f);
-    }
-    return total;
+    return s3_scale(uw_suns(group, rgb), uw_table_integral(c, group, rgb, wy));
 }
 
 // The pixel's cells, weights and depth segment in the irradiance table: the same for every
@@ -508,13 +523,7 @@ fn uw_surface_irradiance(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool, ctx:
     let hit = ctx.origin + ctx.view_dir * ctx.distance;
     let cv = c - UW_FWD * b;
     let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb) * exp(-cv * uw_d);
-    var total = UW_ZERO;
-    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
-        let l = lights[li].pos_kind;
-        if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
-        total += s3_scale(uw_emission(li, group, rgb), e);
-    }
-    return total;
+    return s3_scale(uw_suns(group, rgb), e);
 }
 
 fn custom_light_surface(li: u32, ctx: SurfaceContext) -> f32 {
@@ -718,14 +727,7 @@ fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, 
     }
     let window = sky * ((1.0 - r) * UW_N * UW_N * UW_SKY_NORM);
     if (UW_TABLE) {
-        var reflected = UW_ZERO;
-        let f = uw_surface_node(group, rgb, floor);
-        for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
-            let l = lights[li].pos_kind;
-            if (u32(l.w) != 0u || l.y >= 0.0 || lights[li].cone.z > 0.5) { continue; }
-            reflected += s3_scale(uw_emission(li, group, rgb), f);
-        }
-        return window + reflected;
+        return window + s3_scale(uw_suns(group, rgb), uw_surface_node(group, rgb, floor));
     }
     return window + uw_in_scatter(b, c, kd, group, rgb, -wy, 0.0, 0.0, true) * r;
 }
