@@ -96,17 +96,7 @@ fn const_f32(module: &Module, name: &str) -> f32 {
 
 fn shading_module(custom: &CustomShader) -> Module {
     let hooks = custom.assembled();
-    parse(&[
-        shader::COMMON,
-        shader::HASH,
-        shader::SPECTRAL,
-        shader::ENVIRONMENT,
-        shader::FILM,
-        shader::CUSTOM_API,
-        &hooks,
-        include_str!("passes/shading.wgsl"),
-        include_str!("passes/transmission.wgsl"),
-    ])
+    parse(&crate::passes::shading::sources(&hooks))
 }
 
 #[test]

@@ -205,7 +205,8 @@ pub struct RenderSettings {
     /// glTF BRDF, and the white furnace.
     pub lambert: bool,
     /// Screen-space occlusion of ambient light, the environment and a custom hook's diffuse
-    /// irradiance (the water column's; horizon-based, from the depth buffer; `shading.wgsl`):
+    /// irradiance (the water column's; horizon-based, from the depth buffer; the occlusion pass,
+    /// `passes/occlusion.rs`):
     /// concave parts and contact regions see less of the sky or the water around them.
     pub env_occlusion: bool,
 }

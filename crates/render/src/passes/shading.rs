@@ -155,28 +155,27 @@ impl Variant {
     }
 }
 
+/// The shading module's parts in order, with `hooks` the custom shader as assembled
+/// ([`CustomShader::assembled`]); `layout_tests` parses the same.
+pub(crate) fn sources(hooks: &str) -> [&str; 10] {
+    [
+        shader::COMMON,
+        shader::HASH,
+        shader::SPECTRAL,
+        shader::ENVIRONMENT,
+        shader::FILM,
+        shader::CUSTOM_API,
+        hooks,
+        include_str!("shading.wgsl"),
+        include_str!("occlusion.wgsl"),
+        include_str!("transmission.wgsl"),
+    ]
+}
+
 impl ShadingPass {
     /// Builds the pipeline with `custom` (the custom hooks) compiled in.
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom: &CustomShader) -> Result<Self> {
-        Self::build(
-            device,
-            shared,
-            &[
-                shader::COMMON,
-                shader::HASH,
-                shader::SPECTRAL,
-                shader::ENVIRONMENT,
-                shader::FILM,
-                shader::CUSTOM_API,
-                &custom.assembled(),
-                include_str!("shading.wgsl"),
-                include_str!("occlusion.wgsl"),
-                include_str!("transmission.wgsl"),
-            ],
-            "fs_rgb",
-            true,
-            custom.constants.clone(),
-        )
+        Self::build(device, shared, &sources(&custom.assembled()), "fs_rgb", true, custom.constants.clone())
     }
 
     /// The benchmark's minimal single-light RGB shader (`shading_reference.wgsl`) with the same

@@ -496,8 +496,10 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     var rgb = vec3<f32>(0.0);
     var through = vec3<f32>(0.0);
+    // Loaded once: the hook's irradiance below reads it too.
+    var s: GSurface;
     if (!ctx.background) {
-        let s = load_surface(px);
+        s = load_surface(px);
         ctx.normal = s.normal;
         var keep = 1.0;
         var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
@@ -570,7 +572,6 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     }
     var out = custom_rgb(rgb, ctx) + through;
     if (CUSTOM_IRRADIANCE && !ctx.background) {
-        let s = load_surface(px);
         let lobe = diffuse_lobe(s);
         if (lobe > 0.0) {
             out += s.base * (lobe * ambient_visibility(in.pos.xy, ctx.world_pos, s)) * custom_irradiance_rgb(ctx);
@@ -883,8 +884,10 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var ft: array<LightTerms, MAX_LIGHTS>;
     var lobes: EnvLobes;
     var metallic = 0.0;
+    // Loaded once: the coefficients below are fetched from it too.
+    var s: GSurface;
     if (!background) {
-        let s = load_surface(px);
+        s = load_surface(px);
         film = load_film(px);
         metallic = s.metallic;
         var vis = 1.0;
@@ -927,7 +930,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var c_base = vec3<f32>(0.0);
     var em = vec4<f32>(0.0);
     if (!background && !NAIVE) {
-        let sc = surface_coeffs(px, load_surface(px));
+        let sc = surface_coeffs(px, s);
         c_base = sc.base;
         em = sc.emission;
     }
