@@ -791,6 +791,9 @@ impl Renderer {
         }
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
+        if let Some(t) = timer {
+            t.start_frame();
+        }
         let ts = |i: usize| timer.map(|t| t.writes(i));
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -823,12 +826,11 @@ impl Renderer {
             custom: &spectral.custom_bind_group,
         };
         let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
-        // The shading pass's time includes the occlusion pass's, which starts it.
         if occlusion {
             let draw = Draw {
                 target: &targets.occlusion_view,
                 inputs: &bindings.occlusion,
-                timestamps: timer.map(|t| t.begins(2)),
+                timestamps: ts(crate::timing::OCCLUSION),
             };
             self.occlusion.record(&mut encoder, &self.frame_bind_group, &spectral.bind_group, draw);
         }
@@ -838,8 +840,7 @@ impl Renderer {
             (true, Some(layer)) => {
                 // The opaque layer, kept aside as the background; the see-through one over it.
                 // The shading's time spans both layers (the first's start, the second's end).
-                let timestamps = timer.filter(|_| !occlusion).map(|t| t.begins(2));
-                let draw = Draw { target: shaded, inputs, timestamps };
+                let draw = Draw { target: shaded, inputs, timestamps: timer.map(|t| t.begins(2)) };
                 self.shading.record(&mut encoder, &shared, draw);
                 let shaded_texture =
                     if self.custom_pass.skipped() { &targets.hdr } else { &targets.hdr_shaded };
@@ -882,8 +883,7 @@ impl Renderer {
                 self.shading.record_layer(&mut encoder, &shared, draw, &layer.depth_view, scene, layer_key);
             }
             _ => {
-                let timestamps = if occlusion { timer.map(|t| t.ends(2)) } else { ts(2) };
-                let draw = Draw { target: shaded, inputs, timestamps };
+                let draw = Draw { target: shaded, inputs, timestamps: ts(2) };
                 self.shading.record(&mut encoder, &shared, draw);
             }
         }

@@ -2,13 +2,19 @@
 
 use crate::error::{RenderError, Result};
 
-/// Pass names in frame order.
-pub const PASSES: [&str; 5] = ["shadow", "gbuffer", "shading", "custom", "post"];
+/// Pass names: the frame order is shadow, G-buffer, occlusion, shading, custom, post; the
+/// occlusion pass (session 28) comes last here so that the tables' and CSVs' columns before it
+/// keep their places.
+pub const PASSES: [&str; 6] = ["shadow", "gbuffer", "shading", "custom", "post", "occlusion"];
 
-/// GPU time of each pass of the last frame rendered with `timestamps: true`, milliseconds.
+/// Index of the occlusion pass in [`PASSES`].
+pub(crate) const OCCLUSION: usize = 5;
+
+/// GPU time of each pass of the last frame rendered with `timestamps: true`, milliseconds; 0
+/// for a pass the frame did not run (the occlusion pass without ambient light).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PassTimings {
-    pub ms: [f64; 5],
+    pub ms: [f64; PASSES.len()],
 }
 
 impl PassTimings {
@@ -28,6 +34,9 @@ pub(crate) struct Timer {
     /// Nanoseconds per tick.
     period: f64,
     pub(crate) pending: bool,
+    /// Bit i: pass i wrote its timestamps in the frame being recorded (or last recorded); the
+    /// others' queries hold nothing of that frame.
+    ran: std::cell::Cell<u32>,
 }
 
 const COUNT: u32 = 2 * PASSES.len() as u32;
@@ -52,10 +61,23 @@ impl Timer {
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
-        Timer { queries, resolve, readback, period: queue.get_timestamp_period() as f64, pending: false }
+        Timer {
+            queries,
+            resolve,
+            readback,
+            period: queue.get_timestamp_period() as f64,
+            pending: false,
+            ran: std::cell::Cell::new(0),
+        }
+    }
+
+    /// Starts recording a frame's timestamps: no pass has run yet.
+    pub fn start_frame(&self) {
+        self.ran.set(0);
     }
 
     pub fn writes(&self, pass: usize) -> wgpu::RenderPassTimestampWrites<'_> {
+        self.ran.set(self.ran.get() | 1 << pass);
         wgpu::RenderPassTimestampWrites {
             query_set: &self.queries,
             beginning_of_pass_write_index: Some(2 * pass as u32),
@@ -85,6 +107,9 @@ impl Timer {
         self.pending = false;
         let mut t = PassTimings::default();
         for (i, ms) in t.ms.iter_mut().enumerate() {
+            if self.ran.get() & 1 << i == 0 {
+                continue;
+            }
             let (a, b) = (ticks[2 * i], ticks[2 * i + 1]);
             if b < a {
                 return Err(RenderError::Readback(format!("timestamps of pass {} go backwards", PASSES[i])));

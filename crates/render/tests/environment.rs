@@ -477,3 +477,27 @@ fn the_occlusion_pass_is_redone_for_every_frame_and_darkens_contact() {
         eprintln!("{mode:?}: occluded / unoccluded from {darkest:.3} to {brightest:.4}");
     }
 }
+
+/// The occlusion pass has its own timestamps: a frame with ambient light to occlude reports its
+/// time, one without (occlusion off) reports 0 for it and runs it not at all.
+#[test]
+fn the_occlusion_pass_is_timed_only_where_it_runs() {
+    let scene = sphere_scene(Environment::uniform(Vec3::ONE));
+    let mut r = renderer();
+    if !r.gpu().features.contains(wgpu::Features::TIMESTAMP_QUERY) {
+        panic!("adapter {} has no timestamp queries", r.gpu().describe());
+    }
+    r.set_scene(&scene).unwrap();
+    r.resize(SIZE, SIZE).unwrap();
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        for occlusion in [true, false, true] {
+            let s = RenderSettings { env_occlusion: occlusion, timestamps: true, ..settings(mode, 8) };
+            r.render(&scene.camera, &s).unwrap();
+            let t = r.read_timings().unwrap().expect("timings of the frame");
+            let ms = t.get("occlusion").unwrap();
+            assert!(t.ms.iter().all(|v| v.is_finite() && *v >= 0.0), "{t:?}");
+            assert_eq!(ms > 0.0, occlusion, "{mode:?}, occlusion {occlusion}: {t:?}");
+            assert!(t.get("shading").unwrap() > 0.0, "{t:?}");
+        }
+    }
+}

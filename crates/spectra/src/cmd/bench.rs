@@ -210,7 +210,7 @@ impl Row {
 
 /// The per-pass columns the normal CSV appends after its original ones (the shading pass has
 /// its column there already).
-const EXTRA_PASSES: [&str; 4] = ["shadow", "gbuffer", "custom", "post"];
+const EXTRA_PASSES: [&str; 5] = ["shadow", "gbuffer", "custom", "post", "occlusion"];
 
 /// The least-squares ms-per-wavelength line of one mode's rows under one rule.
 pub fn slope(rows: &[Row], mode: Mode, rule: Quadrature) -> Option<LineFit> {
@@ -583,7 +583,7 @@ mod tests {
             n,
             gpu: Some(summary(ms)),
             shading: Some(summary(ms / 2.0)),
-            passes: Some([ms / 8.0, ms / 4.0, ms / 2.0, 0.0, ms / 8.0]),
+            passes: Some([ms / 8.0, ms / 4.0, ms / 2.0, 0.0, ms / 8.0, ms / 16.0]),
             cpu: summary(ms + 5.0),
         };
         let mut rows = vec![row(Mode::Rgb, None, None, 20.0)];
@@ -606,19 +606,20 @@ mod tests {
         assert!(lines[0].starts_with("mode,wavelengths,gpu_median_ms,"), "{}", lines[0]);
         assert!(
             lines[0].ends_with(
-                ",ratio_to_rgb,shadow_gpu_median_ms,gbuffer_gpu_median_ms,custom_gpu_median_ms,post_gpu_median_ms"
+                ",ratio_to_rgb,shadow_gpu_median_ms,gbuffer_gpu_median_ms,custom_gpu_median_ms,post_gpu_median_ms,\
+                 occlusion_gpu_median_ms"
             ),
             "{}",
             lines[0]
         );
         assert_eq!(
             lines[1],
-            "rgb,,20.0000,19.0000,21.0000,10.0000,25.0000,24.0000,26.0000,1.0000,2.5000,5.0000,0.0000,2.5000"
+            "rgb,,20.0000,19.0000,21.0000,10.0000,25.0000,24.0000,26.0000,1.0000,2.5000,5.0000,0.0000,2.5000,1.2500"
         );
         // N = 8: 40 ms / 20 ms.
         assert_eq!(
             lines[5],
-            "spectral/prefiltered,8,40.0000,39.0000,41.0000,20.0000,45.0000,44.0000,46.0000,2.0000,5.0000,10.0000,0.0000,5.0000"
+            "spectral/prefiltered,8,40.0000,39.0000,41.0000,20.0000,45.0000,44.0000,46.0000,2.0000,5.0000,10.0000,0.0000,5.0000,2.5000"
         );
         assert!(table(&rows).contains("spectral/prefiltered: 2.500 ms per wavelength + 20.00 ms"));
         assert_eq!(parse_rules(" midpoint,prefiltered,midpoint").unwrap(), Quadrature::ALL.to_vec());
@@ -646,14 +647,14 @@ mod tests {
         }
         let lines: Vec<String> = csv(&rows).lines().map(String::from).collect();
         // 45 ms / 25 ms, and no GPU columns.
-        assert_eq!(lines[5], "spectral/prefiltered,8,,,,,45.0000,44.0000,46.0000,1.8000,,,,");
+        assert_eq!(lines[5], "spectral/prefiltered,8,,,,,45.0000,44.0000,46.0000,1.8000,,,,,");
     }
 
     #[test]
     fn pass_medians_per_pass() {
-        let t = |k: f64| PassTimings { ms: [k, 2.0 * k, 3.0 * k, 0.0, 1.0] };
+        let t = |k: f64| PassTimings { ms: [k, 2.0 * k, 3.0 * k, 0.0, 1.0, 0.5 * k] };
         assert_eq!(pass_medians(&[]), None);
-        assert_eq!(pass_medians(&[t(1.0), t(9.0), t(2.0)]), Some([2.0, 4.0, 6.0, 0.0, 1.0]));
+        assert_eq!(pass_medians(&[t(1.0), t(9.0), t(2.0)]), Some([2.0, 4.0, 6.0, 0.0, 1.0, 1.0]));
         let row = Row {
             mode: Mode::Rgb,
             quadrature: None,
@@ -665,5 +666,6 @@ mod tests {
             cpu: summary(3.0),
         };
         assert_eq!((row.pass("gbuffer"), row.pass("post"), row.pass("nope")), (Some(2.0), Some(1.0), None));
+        assert_eq!(row.pass("occlusion"), Some(0.5));
     }
 }

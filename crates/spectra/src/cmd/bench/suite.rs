@@ -472,7 +472,7 @@ mod tests {
                 n,
                 gpu: Some(s(ms)),
                 shading: Some(s(ms / 2.0)),
-                passes: Some([1.0, 2.0, ms / 2.0, 0.0, 0.5]),
+                passes: Some([1.0, 2.0, ms / 2.0, 0.0, 0.5, 0.25]),
                 cpu: s(ms + 2.0),
             },
         };
@@ -495,12 +495,12 @@ mod tests {
             lines[0],
             "scene,size,mode,wavelengths,gpu_median_ms,gpu_p10_ms,gpu_p90_ms,cpu_median_ms,cpu_p10_ms,\
              cpu_p90_ms,ratio_to_rgb,shadow_gpu_median_ms,gbuffer_gpu_median_ms,shading_gpu_median_ms,\
-             custom_gpu_median_ms,post_gpu_median_ms,adapter"
+             custom_gpu_median_ms,post_gpu_median_ms,occlusion_gpu_median_ms,adapter"
         );
         assert_eq!(
             lines[1],
             "cornell,64x48,rgb,,10.0000,9.0000,11.0000,12.0000,11.0000,13.0000,1.0000,\
-             1.0000,2.0000,5.0000,0.0000,0.5000,\"GPU (Vulkan, DiscreteGpu)\""
+             1.0000,2.0000,5.0000,0.0000,0.5000,0.2500,\"GPU (Vulkan, DiscreteGpu)\""
         );
         // The ratio is to the same scene and size's RGB row: 50 / 40.
         assert!(lines[4].starts_with("cornell,128x96,spectral/prefiltered,4,50.0000,"), "{}", lines[4]);
@@ -519,7 +519,7 @@ mod tests {
         let text = csv(&r, "cpu");
         assert_eq!(
             text.lines().nth(1).unwrap(),
-            "cornell,64x48,rgb,,,,,12.0000,11.0000,13.0000,1.0000,,,,,,cpu"
+            "cornell,64x48,rgb,,,,,12.0000,11.0000,13.0000,1.0000,,,,,,,cpu"
         );
     }
 
@@ -531,15 +531,15 @@ mod tests {
         assert_eq!(lines[0], "spectra bench --suite on GPU");
         assert_eq!(
             lines[2],
-            "| scene | size | mode | N | GPU med | p10 | p90 | CPU med | p10 | p90 | ×RGB | shadow | gbuffer | shading | custom | post |"
+            "| scene | size | mode | N | GPU med | p10 | p90 | CPU med | p10 | p90 | ×RGB | shadow | gbuffer | shading | custom | post | occlusion |"
         );
         assert_eq!(
             lines[3],
-            "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+            "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
         );
         assert_eq!(
             lines[4],
-            "| cornell | 64x48 | rgb | – | 10.00 | 9.00 | 11.00 | 12.00 | 11.00 | 13.00 | 1.00 | 1.00 | 2.00 | 5.00 | 0.00 | 0.50 |"
+            "| cornell | 64x48 | rgb | – | 10.00 | 9.00 | 11.00 | 12.00 | 11.00 | 13.00 | 1.00 | 1.00 | 2.00 | 5.00 | 0.00 | 0.50 | 0.25 |"
         );
         assert!(
             lines[5].contains("| spectral/prefiltered | 4 | 15.00 |") && lines[5].contains("| 1.50 |"),
@@ -547,7 +547,7 @@ mod tests {
         );
         assert!(lines[8].contains("| 30.00 |") && lines[8].contains("| – |"), "{md}");
         let cols = |l: &str| l.replace("\\|", "").matches('|').count();
-        assert!(lines[2..9].iter().all(|l| cols(l) == 17), "{md}");
+        assert!(lines[2..9].iter().all(|l| cols(l) == 18), "{md}");
         assert!(md.contains("Skipped:\n\n- scene x (y.gltf): loading \\| failed\n"), "{md}");
         assert!(!markdown(&rows(), "h", &[]).contains("Skipped"));
 
@@ -555,7 +555,7 @@ mod tests {
         let lines: Vec<&str> = t.lines().collect();
         assert_eq!(lines.len(), 6);
         assert!(lines[0].starts_with("scene    size    mode "), "{t}");
-        assert!(lines[0].ends_with("shadow  gbuffer  shading  custom  post"), "{t}");
+        assert!(lines[0].ends_with("shadow  gbuffer  shading  custom  post  occlusion"), "{t}");
         // Right-aligned numbers: every row ends at the same column.
         let width = lines[0].chars().count();
         assert!(lines.iter().all(|l| l.chars().count() == width), "{t}");
