@@ -833,6 +833,8 @@ impl Renderer {
                 timestamps: ts(crate::timing::OCCLUSION),
             };
             self.occlusion.record(&mut encoder, &self.frame_bind_group, &spectral.bind_group, draw);
+        } else if let Some(t) = timer {
+            t.idle(&mut encoder, crate::timing::OCCLUSION);
         }
         // An identity custom pass is skipped: shading writes what the custom pass would.
         let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };

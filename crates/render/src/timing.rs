@@ -34,8 +34,8 @@ pub(crate) struct Timer {
     /// Nanoseconds per tick.
     period: f64,
     pub(crate) pending: bool,
-    /// Bit i: pass i wrote its timestamps in the frame being recorded (or last recorded); the
-    /// others' queries hold nothing of that frame.
+    /// Bit i: pass i ran in the frame being recorded (or last recorded); the others wrote their
+    /// timestamps around an empty pass ([`Self::idle`]) and read as 0.
     ran: std::cell::Cell<u32>,
 }
 
@@ -83,6 +83,21 @@ impl Timer {
             beginning_of_pass_write_index: Some(2 * pass as u32),
             end_of_pass_write_index: Some(2 * pass as u32 + 1),
         }
+    }
+
+    /// Writes pass `pass`'s two timestamps around an empty compute pass, for a frame that does
+    /// not run it: every query the frame resolves must be written in it (the copy of the results
+    /// waits for each; one never written would never be ready). Its time reads as 0.
+    pub fn idle(&self, encoder: &mut wgpu::CommandEncoder, pass: usize) {
+        let writes = wgpu::ComputePassTimestampWrites {
+            query_set: &self.queries,
+            beginning_of_pass_write_index: Some(2 * pass as u32),
+            end_of_pass_write_index: Some(2 * pass as u32 + 1),
+        };
+        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(PASSES[pass]),
+            timestamp_writes: Some(writes),
+        });
     }
 
     /// Only the start of pass `pass`'s time: a pass recorded in two parts starts with this one.

@@ -1,4 +1,4 @@
-//! The five passes, one file each with its WGSL beside it, plus the bind-group layouts several
+//! The passes, one file each with its WGSL beside it, plus the bind-group layouts several
 //! passes share.
 //!
 //! Frame order: shadow (depth from each shadow-casting light, one layer each) → G-buffer →
