@@ -5,9 +5,9 @@
 //!
 //! Its own pass, not a function of the shading: the same work for every mode, done once, and
 //! the shading shader — the largest of the frame, largest in the spectral modes — carries
-//! neither the search's 56 depth loads nor its registers. The value is the one the shading pass
-//! computed itself before (the same function on the same depth and normals, stored in f32), so
-//! images are unchanged. The transmissive layer, whose depth buffer is its own, still searches
+//! neither the search's 52 depth loads (48 samples, 4 neighbours) nor its registers. The value
+//! is the one the shading pass computed itself before (the same function on the same depth and
+//! normals, stored in f32), so images are unchanged. The transmissive layer, whose depth buffer is its own, still searches
 //! in its shading pass.
 
 use super::{

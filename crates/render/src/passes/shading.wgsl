@@ -331,9 +331,9 @@ const LTC_SIZE: u32 = 64u;
 // ran them over the same depth and normals before this pass; the transmissive layer, whose
 // depth is its own, searches them here.
 override OCCLUSION_MAP: bool = false;
-// Binding 11 holds the transmissive layer's back faces there (transmission.wgsl) and the
-// occlusion pass's output in the opaque pass: the pass samples the 16 textures per stage that
-// WebGPU guarantees, so the two share a slot.
+// Binding 11 holds the see-through meshes' back faces in the transmissive layer's pass
+// (transmission.wgsl) and the occlusion pass's output in the opaque pass: the pass samples the
+// 16 textures per stage that WebGPU guarantees, so the two share a slot.
 @group(1) @binding(11) var aux_map: texture_2d<f32>;
 
 fn ambient_visibility(pix: vec2<f32>, p: vec3<f32>, s: GSurface) -> f32 {
