@@ -32,6 +32,8 @@ pub mod environment;
 pub mod error;
 #[cfg(test)]
 mod film_tests;
+#[cfg(test)]
+mod gbuffer_tests;
 pub mod gpu;
 #[cfg(test)]
 mod layout_tests;

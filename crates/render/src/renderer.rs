@@ -776,15 +776,7 @@ impl Renderer {
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        // The spectral mode reads the material slots, and every mode does for the films and
-        // the indices of refraction.
-        let gbuffer_targets = if scene.has_film {
-            GBufferTargets::Film
-        } else if settings.mode == Mode::Spectral || scene.has_ior {
-            GBufferTargets::Slot
-        } else {
-            GBufferTargets::Plain
-        };
+        let gbuffer_targets = if scene.has_film { GBufferTargets::Film } else { GBufferTargets::Plain };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         if layered {
             self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Layer)?;
@@ -799,10 +791,9 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_slot_view, &targets.gbuffer_film_view];
+        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_film_view];
         let colour = match gbuffer_targets {
             GBufferTargets::Plain => &all[..3],
-            GBufferTargets::Slot => &all[..4],
             // (The transmissive layer's targets are its own, below.)
             GBufferTargets::Film | GBufferTargets::Layer => &all[..],
         };

@@ -18,7 +18,7 @@ use wgpu::util::DeviceExt;
 pub const MAX_LIGHTS: usize = 32;
 
 /// Materials a scene may have: the G-buffer's 16-bit material slot holds index + 1
-/// ([`crate::passes::GBUFFER_SLOT_FORMAT`]).
+/// ([`crate::passes::GBUFFER_FORMATS`]).
 pub const MAX_MATERIALS: usize = u16::MAX as usize - 1;
 
 /// Interleaved vertex, 72 bytes.

@@ -3,8 +3,7 @@
 use crate::passes::accumulate::ACCUM_FORMAT;
 use crate::passes::back_faces::BACK_FACES_FORMAT;
 use crate::passes::{
-    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SLOT_FORMAT,
-    HDR_FORMAT, LDR_FORMAT,
+    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, HDR_FORMAT, LDR_FORMAT,
 };
 
 /// A 2D render target that passes also sample, with its view.
@@ -35,9 +34,6 @@ pub struct Targets {
     pub height: u32,
     pub gbuffer: [wgpu::Texture; 3],
     pub gbuffer_views: [wgpu::TextureView; 3],
-    /// The spectral G-buffer's material slots (written in the spectral mode only).
-    pub gbuffer_slot: wgpu::Texture,
-    pub gbuffer_slot_view: wgpu::TextureView,
     /// The thin film per pixel (written only for scenes with a film).
     pub gbuffer_film: wgpu::Texture,
     pub gbuffer_film_view: wgpu::TextureView,
@@ -75,7 +71,6 @@ impl Targets {
             make("gbuffer emission", GBUFFER_FORMATS[2], none),
         ];
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
-        let (gbuffer_slot, gbuffer_slot_view) = make("gbuffer material slot", GBUFFER_SLOT_FORMAT, none);
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (occlusion, occlusion_view) = make("occlusion", crate::passes::occlusion::OCCLUSION_FORMAT, none);
@@ -87,8 +82,6 @@ impl Targets {
             height,
             gbuffer: [g0, g1, g2],
             gbuffer_views: [v0, v1, v2],
-            gbuffer_slot,
-            gbuffer_slot_view,
             gbuffer_film,
             gbuffer_film_view,
             depth,
@@ -133,11 +126,11 @@ impl AccumTargets {
 }
 
 /// The transmissive layer's targets (`passes::gbuffer::Layer::Transmissive`), made at the
-/// first frame of a scene with see-through materials: its own G-buffer (all five targets, the
-/// film's holding the transmission) and depth, and the background — the opaque layer's shaded
+/// first frame of a scene with see-through materials: its own G-buffer (four targets, the
+/// fourth holding the transmission and the film) and depth, and the background — the opaque layer's shaded
 /// image, which the transmissive layer's shading samples where refracted rays leave the surface.
 pub struct LayerTargets {
-    pub gbuffer_views: [wgpu::TextureView; 5],
+    pub gbuffer_views: [wgpu::TextureView; 4],
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     pub background: wgpu::Texture,
@@ -157,7 +150,6 @@ impl LayerTargets {
             make("layer gbuffer base", GBUFFER_FORMATS[0], none).1,
             make("layer gbuffer normal", GBUFFER_FORMATS[1], none).1,
             make("layer gbuffer emission", GBUFFER_FORMATS[2], none).1,
-            make("layer gbuffer slot", GBUFFER_SLOT_FORMAT, none).1,
             make("layer gbuffer transmission and film", GBUFFER_LAYER_FORMAT, none).1,
         ];
         let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);

@@ -37,7 +37,9 @@
 //!   `Spectrum::Constant` fills all four lanes, which is how the RGB hook reads a table.
 //! - `wavelengths[group]` — node λ and the white's node weights; `light_w(li, group,
 //!   frame.n_groups)` — a light's node weights; `s3_scale`, `s3_xyz` for weighted radiance;
-//!   `frame` — matrices, camera, mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3.
+//!   `frame` — matrices, camera, mode, `n_groups`; `gbuf_depth`/`gbuf_normal` in pass 3 (the
+//!   normal packed with the roughness and the material's slot: read it with
+//!   `gbuffer_normal(textureLoad(gbuf_normal, px, 0))`, or take `ctx.normal`).
 //!
 //! Weighted radiance: the renderer integrates `XYZ = Σ_nodes ρ(λᵢ)·W_{l,i}` with node weights
 //! W that carry the light, the observer and the quadrature rule ([`color::quadrature`]). A
@@ -208,7 +210,7 @@ impl CustomPass {
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom: &CustomShader) -> Result<Self> {
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("custom inputs"),
-            entries: &[texture_entry(0), texture_entry(1), depth_entry(2)],
+            entries: &[texture_entry(0), super::uint_entry(1), depth_entry(2)],
         });
         if !custom.defines("custom_pixel") {
             return Ok(CustomPass { input_layout, pipeline: None });

@@ -3,7 +3,7 @@
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(1) @binding(0) var hdr_in: texture_2d<f32>;
-@group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
+@group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(2) var gbuf_depth: texture_depth_2d;
 
 // Pass 3 has no shadow maps: every light counts as unoccluded here (the custom-shader API's
@@ -17,7 +17,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     if (!ctx.background) {
-        ctx.normal = normalize(textureLoad(gbuf_normal, px, 0).xyz);
+        ctx.normal = gbuffer_normal(textureLoad(gbuf_normal, px, 0));
     }
     let c = custom_pixel(textureLoad(hdr_in, px, 0), ctx);
     return vec4<f32>(hdr_out(c.rgb).rgb, c.a);

@@ -5,12 +5,13 @@
 //! `doubleSided: false`), double-sided ones do not and flip the normal of back faces towards
 //! the viewer; `MASK` and `BLEND` materials use the fragment entry point that may discard
 //! (below the cutoff, or stochastically for `BLEND`, see `wgsl/material.wgsl`), opaque ones one
-//! without discard so that early depth testing stays on. The spectral mode's four add a fourth
-//! target, the material's slot ([`GBUFFER_SLOT_FORMAT`]), built on first use; a scene with a thin
-//! film adds a fifth in every mode, the film's values ([`GBUFFER_FILM_FORMAT`]), so that a scene
-//! without one samples no film texture and writes no film target.
+//! without discard so that early depth testing stays on. Every mode writes the same three
+//! targets (the material's slot travels with the normal: `gbuffer_pack_normal` in
+//! wgsl/common.wgsl); a scene with a thin film adds a fourth, the film's values
+//! ([`GBUFFER_FILM_FORMAT`]), built on first use, so that a scene without one samples no film
+//! texture and writes no film target.
 
-use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SLOT_FORMAT, SharedLayouts};
+use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -23,9 +24,7 @@ pub struct GBufferPass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     pipelines: Pipelines,
-    /// With the material slot, for the spectral mode ([`Self::prepare`]).
-    spectral_pipelines: Option<Pipelines>,
-    /// With the slot and the film, for scenes with a thin film ([`Self::prepare_film`]).
+    /// With the film, for scenes with a thin film ([`Self::prepare`]).
     film_pipelines: Option<Pipelines>,
     /// The transmissive layer's ([`Targets::Layer`]).
     layer_pipelines: Option<Pipelines>,
@@ -50,14 +49,12 @@ pub enum Layer {
 /// Which targets a G-buffer pass writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Targets {
-    /// Base, normal, emission.
+    /// Base, normal (with the material's slot), emission.
     Plain,
-    /// + the material slot.
-    Slot,
-    /// + the slot and the film.
+    /// And the film.
     Film,
-    /// The slot, and in four packed channels the transmission factor × texture, the volume's
-    /// thickness texture and the film's two values: the transmissive layer's.
+    /// And in four packed channels the transmission factor × texture, the volume's thickness
+    /// texture and the film's two values: the transmissive layer's.
     Layer,
 }
 
@@ -80,7 +77,6 @@ impl GBufferPass {
             module,
             layout,
             pipelines,
-            spectral_pipelines: None,
             film_pipelines: None,
             layer_pipelines: None,
         })
@@ -90,7 +86,6 @@ impl GBufferPass {
     pub fn prepare(&mut self, device: &wgpu::Device, targets: Targets) -> Result<()> {
         let slot = match targets {
             Targets::Plain => return Ok(()),
-            Targets::Slot => &mut self.spectral_pipelines,
             Targets::Film => &mut self.film_pipelines,
             Targets::Layer => &mut self.layer_pipelines,
         };
@@ -100,8 +95,8 @@ impl GBufferPass {
         Ok(())
     }
 
-    /// Records the pass into `colour`: the three G-buffer targets, the slot target as a fourth
-    /// and the film target as a fifth, as many as the [`Targets`] prepared ([`Self::prepare`]).
+    /// Records the pass into `colour`: the three G-buffer targets, and the film's or the
+    /// transmissive layer's as a fourth, as the [`Targets`] prepared ([`Self::prepare`]).
     #[allow(clippy::too_many_arguments)] // a pass's inputs, each its own kind
     pub fn record(
         &self,
@@ -115,7 +110,6 @@ impl GBufferPass {
     ) {
         let pipelines = match (colour.len(), layer) {
             (3, _) => &self.pipelines,
-            (4, _) => self.spectral_pipelines.as_ref().expect("prepare(Slot) before a spectral G-buffer"),
             (_, Layer::Transmissive) => {
                 self.layer_pipelines.as_ref().expect("prepare(Layer) before the transmissive layer")
             }
@@ -182,9 +176,8 @@ fn build(
     let [base, normal, emission] = GBUFFER_FORMATS;
     let formats: &[wgpu::TextureFormat] = match which {
         Targets::Plain => &GBUFFER_FORMATS,
-        Targets::Slot => &[base, normal, emission, GBUFFER_SLOT_FORMAT],
-        Targets::Film => &[base, normal, emission, GBUFFER_SLOT_FORMAT, GBUFFER_FILM_FORMAT],
-        Targets::Layer => &[base, normal, emission, GBUFFER_SLOT_FORMAT, GBUFFER_LAYER_FORMAT],
+        Targets::Film => &[base, normal, emission, GBUFFER_FILM_FORMAT],
+        Targets::Layer => &[base, normal, emission, GBUFFER_LAYER_FORMAT],
     };
     let targets: Vec<_> = formats
         .iter()
@@ -196,8 +189,6 @@ fn build(
         let entry = match (alpha, which) {
             (false, Targets::Plain) => "fs_main",
             (true, Targets::Plain) => "fs_alpha",
-            (false, Targets::Slot) => "fs_main_spectral",
-            (true, Targets::Slot) => "fs_alpha_spectral",
             (false, Targets::Film) => "fs_main_film",
             (true, Targets::Film) => "fs_alpha_film",
             (false, Targets::Layer) => "fs_main_layer",

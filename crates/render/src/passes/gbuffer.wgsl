@@ -40,8 +40,8 @@ struct GBufferOut {
     // rgb linear base colour, a metallic; a = UNLIT_MARK (negative) marks an unlit surface,
     // whose colour is then in `emission`.
     @location(0) base: vec4<f32>,
-    // xyz unit world normal, w roughness.
-    @location(1) normal: vec4<f32>,
+    // The unit world normal, the roughness and the material's slot (`gbuffer_pack_normal`).
+    @location(1) normal: vec4<u32>,
     // rgb linear emission, a ambient occlusion (glTF occlusionTexture × strength; 1 = none),
     // applied to the environment light only.
     @location(2) emission: vec4<f32>,
@@ -74,7 +74,7 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     }
     var o: GBufferOut;
     o.base = vec4<f32>(base.rgb, clamp(material.params.x * mr.b, 0.0, 1.0));
-    o.normal = vec4<f32>(n, clamp(material.params.y * mr.g, 0.0, 1.0));
+    o.normal = gbuffer_pack_normal(n, clamp(material.params.y * mr.g, 0.0, 1.0), material.slot.x);
     let ao = 1.0 + material.params.w * (occlusion - 1.0);
     o.emission = vec4<f32>(emissive, clamp(ao, 0.0, 1.0));
     if (material.alpha.w > 0.5) {
@@ -95,39 +95,15 @@ fn fs_alpha(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
     return gbuffer(v, front, true);
 }
 
-// The spectral modes' G-buffer adds the material's slot, where the shading pass finds the
-// coefficients of colours that are constant over the material (src/material_spectra.rs).
-struct GBufferSpectralOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<f32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) slot: u32,
-};
-
-fn with_slot(o: GBufferOut) -> GBufferSpectralOut {
-    return GBufferSpectralOut(o.base, o.normal, o.emission, material.slot.x);
-}
-
-@fragment
-fn fs_main_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferSpectralOut {
-    return with_slot(gbuffer(v, front, false));
-}
-
-@fragment
-fn fs_alpha_spectral(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferSpectralOut {
-    return with_slot(gbuffer(v, front, true));
-}
-
 // Scenes with a thin film (KHR_materials_iridescence) add its per-pixel values, in RGB mode as
-// in the spectral ones (the slot is written in both then, and read only by the spectral modes).
+// in the spectral ones.
 struct GBufferFilmOut {
     @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<f32>,
+    @location(1) normal: vec4<u32>,
     @location(2) emission: vec4<f32>,
-    @location(3) slot: u32,
     // x weight (factor × texture R; 0: no film), y the thickness texture's G: where the thickness
     // lies between the material's minimum and maximum.
-    @location(4) film: vec2<f32>,
+    @location(3) film: vec2<f32>,
 };
 
 // The film's values (sampled before `gbuffer`, whose discard would leave the derivatives of
@@ -141,7 +117,7 @@ fn film_values(v: VertexOut) -> vec2<f32> {
 fn with_film(o: GBufferOut, f: vec2<f32>) -> GBufferFilmOut {
     // An unlit surface (UNLIT_MARK) reflects nothing, so it has no film either.
     let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
-    return GBufferFilmOut(o.base, o.normal, o.emission, material.slot.x, film);
+    return GBufferFilmOut(o.base, o.normal, o.emission, film);
 }
 
 @fragment
@@ -162,10 +138,9 @@ fn fs_alpha_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFil
 // the thickness factor), z and w the film's weight and thickness fraction as `film_values`.
 struct GBufferLayerOut {
     @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<f32>,
+    @location(1) normal: vec4<u32>,
     @location(2) emission: vec4<f32>,
-    @location(3) slot: u32,
-    @location(4) layer: u32,
+    @location(3) layer: u32,
 };
 
 fn transmission_values(v: VertexOut) -> vec2<f32> {
@@ -176,7 +151,7 @@ fn transmission_values(v: VertexOut) -> vec2<f32> {
 
 fn with_layer(o: GBufferOut, t: vec2<f32>, f: vec2<f32>) -> GBufferLayerOut {
     let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
-    return GBufferLayerOut(o.base, o.normal, o.emission, material.slot.x, pack4x8unorm(vec4<f32>(t, film)));
+    return GBufferLayerOut(o.base, o.normal, o.emission, pack4x8unorm(vec4<f32>(t, film)));
 }
 
 @fragment

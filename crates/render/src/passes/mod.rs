@@ -27,25 +27,23 @@ pub const HDR_MAX: f32 = 65504.0;
 pub fn hdr_clipped(pixels: &[[f32; 4]]) -> usize {
     pixels.iter().filter(|p| p[..3].iter().any(|c| c.abs() >= HDR_MAX)).count()
 }
-/// G-buffer colour targets: base colour + metallic, normal + roughness, emission.
+/// G-buffer colour targets: base colour + metallic, normal + roughness + the material's slot
+/// (packed: `gbuffer_pack_normal` in wgsl/common.wgsl), emission. The slot (the material's
+/// index + 1, 0 where no surface is) is 16 bits, so a scene has at most
+/// [`crate::scene_gpu::MAX_MATERIALS`].
 pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
-    [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Float];
-/// The spectral G-buffer's fourth target: the material's slot (`MaterialUniforms::slot`: its
-/// index + 1, 0 where no surface is). 16 bits: the spectral G-buffer writes 2 bytes a pixel more
-/// than RGB's instead of 4 (on an H200 the 32-bit slot made the pass 14 % slower than RGB's,
-/// docs/benchmark.md "H200"), so a scene has at most [`crate::scene_gpu::MAX_MATERIALS`].
-pub const GBUFFER_SLOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Uint;
+    [wgpu::TextureFormat::Rgba16Float, wgpu::TextureFormat::Rgba16Uint, wgpu::TextureFormat::Rgba16Float];
 /// The thin film per pixel (written only when the scene has one): weight and where the
 /// thickness lies between the material's minimum and maximum (f16: exact at the ends, 2⁻¹¹ of
 /// the range near the maximum; the thickness texture itself has 8 bits); the film's index and
 /// thickness range are the material's (`MaterialSpectrum::film`).
-/// Two channels because the G-buffer's five targets must fit the 32 bytes per sample WebGPU
-/// guarantees (3 × 8 + 2 + 4).
+/// Two channels: the colour attachments of a sample may hold 32 bytes (WebGPU's guarantee),
+/// and the layer's target below takes the place of this one beside the other three's 24.
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
-/// The transmissive layer's fifth G-buffer target: transmission, volume thickness, and the
+/// The transmissive layer's fourth G-buffer target: transmission, volume thickness, and the
 /// film's weight and thickness (`passes::gbuffer::Targets::Layer`), each in [0, 1] and from
 /// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,
-/// the other four take 26, and WebGPU counts an Rgba8Unorm target as 8.
+/// the other three take 24, and WebGPU counts an Rgba8Unorm target as 8.
 pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 

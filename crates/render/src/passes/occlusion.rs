@@ -11,7 +11,7 @@
 //! in its shading pass.
 
 use super::{
-    Draw, FullscreenPipeline, SharedLayouts, depth_entry, draw_fullscreen, pipeline_layout, texture_entry,
+    Draw, FullscreenPipeline, SharedLayouts, depth_entry, draw_fullscreen, pipeline_layout, uint_entry,
     view_entry,
 };
 use crate::error::Result;
@@ -30,7 +30,7 @@ impl OcclusionPass {
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("occlusion inputs"),
-            entries: &[texture_entry(1), depth_entry(3)],
+            entries: &[uint_entry(1), depth_entry(3)],
         });
         let module = shader::compile(
             device,

@@ -5,7 +5,7 @@
 // occlusion.wgsl.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
-@group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
+@group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
 
 @fragment
@@ -18,6 +18,6 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     // The position and normal exactly as the shading pass has them (`surface_context`,
     // `load_surface`), so that the value it reads is the one it would have computed.
     let p = world_from_depth(in.pos.xy, depth, frame);
-    let n = normalize(textureLoad(gbuf_normal, px, 0).xyz);
+    let n = gbuffer_normal(textureLoad(gbuf_normal, px, 0));
     return vec4<f32>(env_occlusion(in.pos.xy, p, n));
 }

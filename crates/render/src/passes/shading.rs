@@ -68,7 +68,7 @@ pub struct Variant {
     pub polygons: bool,
     /// An environment light (`HAS_ENV`).
     pub environment: bool,
-    /// A material that emits or is unlit (`HAS_EMISSION`; spectral and naive modes).
+    /// A material that emits or is unlit (`HAS_EMISSION`; every mode).
     pub emission: bool,
     /// Box upsampling instead of the sigmoid (`NAIVE`: the naive mode).
     pub naive: bool,
@@ -118,8 +118,8 @@ impl Variant {
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, film, ior, transmission, thin walls) and the occlusion's; its pipelines are keyed by
-    /// [`Self::rgb`].
+    /// environment, emission, film, ior, transmission, thin walls) and the occlusion's; its
+    /// pipelines are keyed by [`Self::rgb`].
     fn constants(&self) -> [(&'static str, f64); 13] {
         let b = |v: bool| f64::from(u8::from(v));
         [
@@ -145,6 +145,7 @@ impl Variant {
         Variant {
             polygons: self.polygons,
             environment: self.environment,
+            emission: self.emission,
             film: self.film,
             ior: self.ior,
             transmission: self.transmission,
@@ -203,7 +204,8 @@ impl ShadingPass {
             label: Some("shading inputs"),
             entries: &[
                 texture_entry(0),
-                texture_entry(1),
+                // The normal, roughness and material slot (`gbuffer_normal` and its siblings).
+                super::uint_entry(1),
                 texture_entry(2),
                 depth_entry(3),
                 wgpu::BindGroupLayoutEntry {
@@ -234,8 +236,6 @@ impl ShadingPass {
                     },
                     count: None,
                 },
-                // The spectral G-buffer's material slots (`gbuf_slot`).
-                super::uint_entry(8),
                 // The films (`gbuf_film`).
                 texture_entry(9),
                 // The transmissive layer's background (`background`, transmission.wgsl), its
@@ -411,7 +411,6 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
-                view_entry(8, &t.gbuffer_slot_view),
                 view_entry(9, &t.gbuffer_film_view),
                 // Not read outside the transmissive layer: any textures of their kinds the pass
                 // does not write.
@@ -419,12 +418,12 @@ impl ShadingPass {
                 // The occlusion pass's output (`aux_map`, read with `OCCLUSION_MAP`).
                 view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),
-                view_entry(13, &t.gbuffer_slot_view),
+                view_entry(13, &g[1]),
             ],
         })
     }
 
-    /// Group 1 of the transmissive layer: its G-buffer (the fifth target, transmission and
+    /// Group 1 of the transmissive layer: its G-buffer (the fourth target, transmission and
     /// film packed, at 13) and depth, the shadow maps, the
     /// opaque layer's shaded image as the background and its depth `opaque_depth`, and the
     /// see-through meshes' back faces (at 11, `aux_map`; the layer searches its own occlusion).
@@ -452,13 +451,12 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
-                view_entry(8, &g[3]),
                 // The layer's film is in `layer_packed`: any float texture here.
                 view_entry(9, &g[0]),
                 view_entry(10, &layer.background_view),
                 view_entry(11, &layer.back_faces_view),
                 view_entry(12, opaque_depth),
-                view_entry(13, &g[4]),
+                view_entry(13, &g[3]),
             ],
         })
     }

@@ -6,7 +6,8 @@
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 
 @group(1) @binding(0) var gbuf_base: texture_2d<f32>;
-@group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
+// Normal, roughness and material slot, packed (`gbuffer_normal`, wgsl/common.wgsl).
+@group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(2) var gbuf_emission: texture_2d<f32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
 @group(1) @binding(4) var shadow_maps: texture_depth_2d_array;
@@ -332,8 +333,9 @@ const LTC_SIZE: u32 = 64u;
 // depth is its own, searches them here.
 override OCCLUSION_MAP: bool = false;
 // Binding 11 holds the see-through meshes' back faces in the transmissive layer's pass
-// (transmission.wgsl) and the occlusion pass's output in the opaque pass: the pass samples the
-// 16 textures per stage that WebGPU guarantees, so the two share a slot.
+// (transmission.wgsl) and the occlusion pass's output in the opaque pass: the two came to share
+// a slot when the pass sampled the 16 textures per stage that WebGPU guarantees (15 since the
+// material slot moved into the normal's target).
 @group(1) @binding(11) var aux_map: texture_2d<f32>;
 
 fn ambient_visibility(pix: vec2<f32>, p: vec3<f32>, s: GSurface) -> f32 {
@@ -362,12 +364,12 @@ fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let e = textureLoad(gbuf_emission, px, 0);
-    return GSurface(b.rgb, e.rgb, normalize(nr.xyz), max(b.a, 0.0), nr.w, e.a, b.a < 0.0, surface_f0(px));
+    return GSurface(b.rgb, e.rgb, gbuffer_normal(nr), max(b.a, 0.0), gbuffer_roughness(nr), e.a, b.a < 0.0, surface_f0(px));
 }
 
 // The index of the material's record (src/material_spectra.rs) at pixel px, by its slot.
 fn material_index(px: vec2<i32>) -> u32 {
-    let slot = textureLoad(gbuf_slot, px, 0).x;
+    let slot = gbuffer_slot(textureLoad(gbuf_normal, px, 0));
     return min(max(slot, 1u) - 1u, arrayLength(&material_spectra) - 1u);
 }
 
@@ -490,7 +492,7 @@ fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> m
 @fragment
 fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
-    if (HAS_TRANSMISSION && textureLoad(gbuf_slot, px, 0).x == 0u) {
+    if (HAS_TRANSMISSION && gbuffer_slot(textureLoad(gbuf_normal, px, 0)) == 0u) {
         return textureLoad(background, px, 0);
     }
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
@@ -541,7 +543,12 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
                 sum_b = fma(vec3<f32>(f.y), e, sum_b);
             }
         }
-        rgb = fma(s.base, sum_a, sum_b) + s.emission;
+        rgb = fma(s.base, sum_a, sum_b);
+        if (HAS_EMISSION) {
+            // Without emission in the scene, and without ambient light (whose occlusion shares
+            // the texel), the emission target is not read.
+            rgb += s.emission;
+        }
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
             if (HAS_TRANSMISSION && !filmed) {
@@ -583,7 +590,8 @@ fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
 // The spectral entry point's pipeline constants (`Variant` in src/passes/shading.rs), so that a
 // frame's shader holds only the code its settings use: box upsampling instead of the
 // Jakob–Hanika sigmoid (the naive mode), the spectral capture, and emission (no emissive or
-// unlit material in the scene: no emission fetch and no emission term per node).
+// unlit material in the scene: no emission fetch and no emission term per node; the RGB entry
+// point reads HAS_EMISSION too).
 override NAIVE: bool = false;
 override CAPTURE: bool = false;
 override HAS_EMISSION: bool = true;
@@ -610,10 +618,9 @@ fn node_emission(c: vec3<f32>, scale: f32, emission: vec3<f32>, g: u32) -> vec4<
     return scale * sigmoid4(c, wavelengths[g].lambda);
 }
 
-// The spectral G-buffer's material slot per pixel (the material's index + 1; 0 on the
-// background) and each material's coefficients of its constant colours (src/material_spectra.rs:
-// `MaterialSpectrum`, byte for byte), fetched once on the CPU.
-@group(1) @binding(8) var gbuf_slot: texture_2d<u32>;
+// Each material's coefficients of its constant colours (src/material_spectra.rs:
+// `MaterialSpectrum`, byte for byte), fetched once on the CPU, found by the G-buffer's slot
+// (`material_index`).
 struct MaterialSpectrum {
     // The base colour's coefficients; w = 1 when the colour is constant over the material.
     base: vec4<f32>,
@@ -705,7 +712,7 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
         return hdr_out(shade_nodes(in));
     }
     let px = vec2<i32>(in.pos.xy);
-    if (HAS_TRANSMISSION && textureLoad(gbuf_slot, px, 0).x == 0u) {
+    if (HAS_TRANSMISSION && gbuffer_slot(textureLoad(gbuf_normal, px, 0)) == 0u) {
         return textureLoad(background, px, 0);
     }
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);

@@ -5,7 +5,7 @@
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(1) @binding(0) var gbuf_base: texture_2d<f32>;
-@group(1) @binding(1) var gbuf_normal: texture_2d<f32>;
+@group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
 
 @fragment
@@ -18,14 +18,15 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let p = world_from_depth(in.pos.xy, depth, frame);
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
-    let n = normalize(nr.xyz);
+    let n = gbuffer_normal(nr);
+    let roughness = gbuffer_roughness(nr);
     let v = normalize(view_origin(in.pos.xy, p, frame) - p);
     let inc = light_incidence(0u, p);
     let nl = max(dot(n, inc.xyz), 0.0);
     let h = normalize(inc.xyz + v);
     let nv = max(dot(n, v), 1e-4);
     let nh = max(dot(n, h), 0.0);
-    let a2 = max(nr.w * nr.w, 1e-3) * max(nr.w * nr.w, 1e-3);
+    let a2 = max(roughness * roughness, 1e-3) * max(roughness * roughness, 1e-3);
     let dd = nh * nh * (a2 - 1.0) + 1.0;
     let spec = a2 / (PI * dd * dd) * 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2) + 1e-7);
     let f = 0.04 + 0.96 * pow(1.0 - max(dot(v, h), 0.0), 5.0);

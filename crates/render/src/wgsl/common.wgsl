@@ -85,3 +85,49 @@ const HDR_MAX: f32 = 65504.0;
 fn hdr_out(c: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(clamp(c, vec3<f32>(-HDR_MAX), vec3<f32>(HDR_MAX)), 1.0);
 }
+
+// The G-buffer's second target (passes::GBUFFER_FORMATS[1], Rgba16Uint): the unit normal in
+// octahedral form, each coordinate in 16 bits (at most 6.5·10⁻⁵ rad off, src/gbuffer_tests.rs;
+// the three f16 components it replaced were each rounded by up to 2.4·10⁻⁴), the roughness as
+// the f16 it was (`gbuffer_f16_unit`), and the material's slot
+// (`MaterialUniforms::slot`: its index + 1, 0 where no surface is), which the spectral modes,
+// films and indices of refraction read. One 8-byte target for the three in every mode: the
+// spectral G-buffer used to write the slot to a fourth target, and a fourth target (32-bit
+// then) made its pass 14 % slower than RGB's on an H200 (docs/benchmark.md).
+fn gbuffer_pack_normal(n: vec3<f32>, roughness: f32, slot: u32) -> vec4<u32> {
+    var o = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if (n.z < 0.0) {
+        o = (1.0 - abs(o.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), o >= vec2<f32>(0.0));
+    }
+    // q = 32767·(o + 1): the steps are 1/32767, and 0 and ±1 (the axes) are exact.
+    let q = vec2<u32>(round((clamp(o, vec2<f32>(-1.0), vec2<f32>(1.0)) + 1.0) * 32767.0));
+    return vec4<u32>(q, gbuffer_f16_unit(roughness), slot);
+}
+
+// x in [0, 1] as f16 bits, rounded to nearest even as pack2x16float does, with what lies below
+// f16's normal range (2⁻¹⁴) flushed to 0 (a roughness that small is a mirror either way: the
+// GGX width is clamped below 2⁻⁵). In integer arithmetic: pack2x16float and unpack2x16float
+// cost a CPU driver 2–3 ms each of a 1280×720 RGB frame of 67 ms.
+fn gbuffer_f16_unit(x: f32) -> u32 {
+    let b = bitcast<u32>(clamp(x, 0.0, 1.0));
+    if (b < 0x38800000u) { return 0u; }
+    return ((b + 0x0fffu + ((b >> 13u) & 1u)) >> 13u) - (112u << 10u);
+}
+
+fn gbuffer_normal(t: vec4<u32>) -> vec3<f32> {
+    let o = vec2<f32>(t.xy) * (1.0 / 32767.0) - 1.0;
+    var n = vec3<f32>(o, 1.0 - abs(o.x) - abs(o.y));
+    let f = max(-n.z, 0.0);
+    n.x += select(f, -f, n.x >= 0.0);
+    n.y += select(f, -f, n.y >= 0.0);
+    return normalize(n);
+}
+
+fn gbuffer_roughness(t: vec4<u32>) -> f32 {
+    let h = t.z;
+    return select(0.0, bitcast<f32>((h << 13u) + (112u << 23u)), h != 0u);
+}
+
+fn gbuffer_slot(t: vec4<u32>) -> u32 {
+    return t.w;
+}

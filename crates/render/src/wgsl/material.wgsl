@@ -15,7 +15,7 @@ struct MaterialUniforms {
     // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
     // (m10, m11, m12, 0); uv' = M · (u, v, 1).
     uv_rows: array<vec4<f32>, 18>,
-    // x: the material's index + 1 (`MaterialUniforms::slot`), written by the spectral G-buffer.
+    // x: the material's index + 1 (`MaterialUniforms::slot`), written by the G-buffer beside the normal.
     slot: vec4<u32>,
     // KHR_materials_iridescence: x factor (0: none), y film index, z/w thickness min/max (nm).
     film: vec4<f32>,
