@@ -126,17 +126,28 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
 // checks it). The indices follow the chroma weight's constants in coeff_scale.
 const AXIS_INDEX: u32 = 1024u;
 
-// Largest n with coeff_scale[first + n] <= v, clamped to [0, res - 2]: the interval index
+// Largest n with coeff_scale[first + n] <= v, clamped to [0, res - 2], and the interval's two
+// nodes (the weights need them: returned rather than loaded again): the interval index
 // `index` (at coeff_scale[index]: brightness or chroma, coeff_table::interval_index) gives the
 // interval at floor(v · AXIS_INDEX) / AXIS_INDEX, then a step up per node between that and v —
 // none or one on spectra's grids, against the six dependent loads of a binary search.
-fn find_interval(v: f32, first: u32, index: u32, res: u32) -> u32 {
+struct Interval {
+    n: u32,
+    lo: f32,
+    hi: f32,
+};
+
+fn find_interval(v: f32, first: u32, index: u32, res: u32) -> Interval {
     let vv = select(0.0, min(v, 1.0), v > 0.0);
     var n = u32(coeff_scale[index + min(u32(vv * f32(AXIS_INDEX)), AXIS_INDEX - 1u)]);
-    while (n < res - 2u && coeff_scale[first + n + 1u] <= v) {
+    var lo = coeff_scale[first + n];
+    var hi = coeff_scale[first + n + 1u];
+    while (n < res - 2u && hi <= v) {
         n++;
+        lo = hi;
+        hi = coeff_scale[first + n + 1u];
     }
-    return n;
+    return Interval(n, lo, hi);
 }
 
 // σ⁻¹(z) clamped to [1e-6, 1 − 2e-4]: color::upsample::table::z_logit (same constants).
@@ -253,10 +264,10 @@ fn fetch_coeffs_direct(rgb: vec3<f32>, res: u32) -> vec3<f32> {
     let xi = find_interval(x, res, chroma_index, res);
     let yi = find_interval(y, res, chroma_index, res);
     let zi = find_interval(z, 0u, z_index, res);
-    let x1 = chroma_weight(x, coeff_scale[res + xi], coeff_scale[res + xi + 1u], y, res);
-    let y1 = chroma_weight(y, coeff_scale[res + yi], coeff_scale[res + yi + 1u], x, res);
-    let z1 = z_weight(z, coeff_scale[zi], coeff_scale[zi + 1u]);
-    let base = vec3<i32>(i32(xi), i32(yi), i32(l * res + zi));
+    let x1 = chroma_weight(x, xi.lo, xi.hi, y, res);
+    let y1 = chroma_weight(y, yi.lo, yi.hi, x, res);
+    let z1 = z_weight(z, zi.lo, zi.hi);
+    let base = vec3<i32>(i32(xi.n), i32(yi.n), i32(l * res + zi.n));
     let c000 = textureLoad(coeff_table, base, 0).xyz;
     let c100 = textureLoad(coeff_table, base + vec3<i32>(1, 0, 0), 0).xyz;
     let c010 = textureLoad(coeff_table, base + vec3<i32>(0, 1, 0), 0).xyz;
