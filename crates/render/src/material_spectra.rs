@@ -1,8 +1,8 @@
 //! The Jakob–Hanika coefficients of the colours that are constant over a material
 //! ([`ConstantColour`]), fetched once on the CPU when the scene's spectral data is built, so that
 //! the spectral shading pass fetches per pixel only where a texture or vertex colours vary the
-//! colour. The spectral G-buffer writes each pixel's material slot; `material_spectra[slot − 1]`
-//! in shading.wgsl is the record below.
+//! colour. The G-buffer writes each pixel's material slot (beside the normal, `gbuffer_slot` in
+//! wgsl/common.wgsl); `material_spectra[slot − 1]` in shading.wgsl is the record below.
 
 use crate::scene_gpu::{ConstantColour, MAX_LIGHTS};
 use crate::spectral_data::{GroupWeights, WavelengthGroup};

@@ -70,8 +70,9 @@ pub struct MaterialUniforms {
     /// Per texture slot, two rows of its `KHR_texture_transform` matrix: `(m00, m01, m02, set)`,
     /// `(m10, m11, m12, 0)` with `set` the UV set (0 or 1), so `uv' = M · (u, v, 1)`.
     pub uv: [[f32; 4]; 2 * TEXTURE_SLOTS],
-    /// x: the material's index + 1, which the spectral G-buffer writes for the shading pass to
-    /// find its [`ConstantColour`] coefficients (`material_spectra` in shading.wgsl); yzw unused.
+    /// x: the material's index + 1, which the G-buffer writes beside the normal for the shading
+    /// pass to find its [`ConstantColour`] coefficients (`material_spectra` in shading.wgsl); yzw
+    /// unused.
     pub slot: [u32; 4],
     /// `KHR_materials_iridescence`: x factor (0: no film); y, z, w the film's index and
     /// thickness minimum and maximum in nm, for reference (the shading pass reads them per

@@ -1,6 +1,6 @@
 //! Pass 2: spectral shading. Per pixel: the Jakob–Hanika coefficients of the base colour and
 //! the emission — the material's, fetched once on the CPU (`crate::material_spectra`, found
-//! through the spectral G-buffer's material slot) where the colour is constant over the
+//! through the G-buffer's material slot) where the colour is constant over the
 //! material, else fetched per pixel (manual trilinear over the table in a 3D texture, the axes'
 //! intervals from an index, both colours through one call site); then, lights outermost, each
 //! light's two BRDF factors (A for the reflectance-weighted part, B for the specular part that
