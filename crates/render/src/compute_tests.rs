@@ -49,3 +49,31 @@ pub(crate) fn run(
     queue.submit([enc.finish()]);
     crate::readback::map_buffer(device, &staging, |b| b.to_vec()).unwrap()
 }
+
+/// The common case of [`run`]: `src` reads `data` (storage, group 0 binding 0) and writes the
+/// output (binding 1).
+pub(crate) fn run_on(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    src: String,
+    n: usize,
+    out_bytes: u64,
+    data: &[u8],
+) -> Vec<u8> {
+    use wgpu::util::DeviceExt;
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: data,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    run(device, queue, src, n, out_bytes, |p, output| {
+        vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &p.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+            ],
+        })]
+    })
+}

@@ -3,7 +3,6 @@
 //! index 1.2–2.0 and 0–1200 nm, 380–780 nm, 0–89°.
 
 use crate::gpu::Gpu;
-use wgpu::util::DeviceExt;
 
 /// (λ, cos θ, thickness, film IOR, base IOR) cases and their f64 reflectance.
 fn cases() -> Vec<([f32; 5], f64)> {
@@ -45,22 +44,14 @@ fn wgsl_film_matches_the_cpu() {
         crate::shader::FILM,
     );
     let args: Vec<f32> = cases.iter().flat_map(|(a, _)| *a).collect();
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&args),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let bytes =
-        crate::compute_tests::run(device, queue, src, cases.len(), (cases.len() * 4) as u64, |p, output| {
-            vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &p.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-                ],
-            })]
-        });
+    let bytes = crate::compute_tests::run_on(
+        device,
+        queue,
+        src,
+        cases.len(),
+        (cases.len() * 4) as u64,
+        bytemuck::cast_slice(&args),
+    );
     let out: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
     let mut worst = (0.0f64, [0.0f32; 5]);
     for ((a, cpu), gpu) in cases.iter().zip(&out) {
@@ -94,22 +85,14 @@ fn run_rgb(args: &[[f32; 4]], body: &str) -> Vec<[f32; 3]> {
         crate::shader::FILM,
     );
     let flat: Vec<f32> = args.iter().flatten().copied().collect();
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&flat),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let bytes =
-        crate::compute_tests::run(device, queue, src, args.len(), (args.len() * 12) as u64, |p, output| {
-            vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &p.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-                ],
-            })]
-        });
+    let bytes = crate::compute_tests::run_on(
+        device,
+        queue,
+        src,
+        args.len(),
+        (args.len() * 12) as u64,
+        bytemuck::cast_slice(&flat),
+    );
     let out: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
     out.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
 }

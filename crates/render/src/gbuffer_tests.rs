@@ -10,7 +10,6 @@
 //! √18/65534 = 6.5·10⁻⁵ rad, plus f32 rounding.
 
 use crate::gpu::Gpu;
-use wgpu::util::DeviceExt;
 
 /// Directions: a Fibonacci sphere, the axes, the octahedron's edges and folds (where the lower
 /// hemisphere's mapping turns over), and points a hair off them.
@@ -63,22 +62,14 @@ fn the_packed_normal_roughness_and_slot_come_back() {
         slots.len(),
         slots.len(),
     );
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&args),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let bytes =
-        crate::compute_tests::run(device, queue, src, args.len(), (args.len() * 32) as u64, |p, output| {
-            vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &p.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-                ],
-            })]
-        });
+    let bytes = crate::compute_tests::run_on(
+        device,
+        queue,
+        src,
+        args.len(),
+        (args.len() * 32) as u64,
+        bytemuck::cast_slice(&args),
+    );
     let out: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec::<u8, f32>(&bytes)
         .chunks_exact(4)
         .map(|c| [c[0], c[1], c[2], c[3]])
