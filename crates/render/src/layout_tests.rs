@@ -186,6 +186,7 @@ fn shared_constants_match_the_rust_constants() {
     assert_eq!(const_u32(&shading, "NO_SHADOW"), shadow::NO_SHADOW);
     assert_eq!(const_u32(&shading, "AXIS_INDEX") as usize, crate::coeff_table::AXIS_INDEX);
     assert_eq!(const_u32(&shading, "LTC_SIZE") as usize, crate::ltc::SIZE);
+    assert_eq!(const_u32(&shading, "SCREEN_GROUP"), crate::passes::SCREEN_GROUP);
     let tan = (shadow::EMITTER_FOV / 2.0).tan();
     assert!((const_f32(&shading, "EMITTER_TAN_HALF_FOV") - tan).abs() < 1e-6 * tan);
 

@@ -53,6 +53,7 @@ pub mod uniforms;
 pub use error::{NO_ADAPTER_HELP, RenderError, Result};
 pub use gpu::Gpu;
 pub use passes::custom::CustomShader;
+pub use passes::shading::ShadingStage;
 pub use renderer::{Renderer, SpectralCapture};
 pub use settings::{Mode, RenderSettings, Tonemap};
 pub use spectral_data::SpectralSetup;

@@ -11,7 +11,7 @@ use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
 use crate::passes::gbuffer::{Layer as GBufferLayer, Targets as GBufferTargets};
 use crate::passes::post::PostPass;
-use crate::passes::shading::{ShadingPass, Variant};
+use crate::passes::shading::{ShadingPass, ShadingStage, Variant};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::{Draw, SharedGroups, SharedLayouts, SpectralInputs};
 use crate::readback;
@@ -96,7 +96,8 @@ struct SpectralState {
 
 /// Bind groups that reference the size-dependent targets.
 struct TargetBindings {
-    shading: wgpu::BindGroup,
+    /// The shading's inputs with each of its outputs (`Renderer::shading_output`).
+    shading: [wgpu::BindGroup; 2],
     occlusion: wgpu::BindGroup,
     custom: wgpu::BindGroup,
     post: wgpu::BindGroup,
@@ -108,7 +109,7 @@ struct TargetBindings {
 /// The spectral capture of one frame (see [`Renderer::set_spectral_capture`]).
 struct Capture {
     buffer: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
+    bind_group: [wgpu::BindGroup; 2],
     width: u32,
     height: u32,
     /// The frame's wavelength settings, read back with it.
@@ -164,6 +165,8 @@ pub struct Renderer {
     gbuffer: GBufferPass,
     shadow: ShadowPass,
     shading: ShadingPass,
+    /// Whether `shading` is the benchmark's reference shader ([`Self::set_reference_shading`]).
+    reference_shading: bool,
     occlusion: crate::passes::occlusion::OcclusionPass,
     /// Made at the first frame with see-through materials.
     back_faces: Option<crate::passes::back_faces::BackFacesPass>,
@@ -219,7 +222,8 @@ impl Renderer {
         let custom = CustomShader::default();
         let gbuffer = GBufferPass::new(device, &shared)?;
         let shadow = ShadowPass::new(device, &gbuffer.material_layout)?;
-        let shading = ShadingPass::new(device, &shared, &custom)?;
+        let shading =
+            ShadingPass::new(device, &shared, &custom, ShadingStage::from_env(&gpu.adapter.get_info())?)?;
         let occlusion = crate::passes::occlusion::OcclusionPass::new(device, &shared)?;
         let custom_pass = CustomPass::new(device, &shared, &custom)?;
         let post = PostPass::new(device, &shared)?;
@@ -257,6 +261,7 @@ impl Renderer {
             gbuffer,
             shadow,
             shading,
+            reference_shading: false,
             occlusion,
             back_faces: None,
             custom_pass,
@@ -411,9 +416,10 @@ impl Renderer {
     pub fn set_custom_shader(&mut self, custom: CustomShader) -> Result<()> {
         custom.validate()?;
         let device = &self.gpu.device;
-        let shading = ShadingPass::new(device, &self.shared, &custom)?;
+        let shading = ShadingPass::new(device, &self.shared, &custom, self.shading.stage())?;
         let custom_pass = CustomPass::new(device, &self.shared, &custom)?;
         self.shading = shading;
+        self.reference_shading = false;
         self.custom_pass = custom_pass;
         self.custom = custom;
         self.custom_generation += 1;
@@ -425,12 +431,40 @@ impl Renderer {
     /// so that its GPU time can be compared with the real pass's; `false` restores the real
     /// pass with the current custom hooks. Not for images: the reference ignores the mode.
     pub fn set_reference_shading(&mut self, on: bool) -> Result<()> {
+        self.rebuild_shading(on, self.shading.stage())
+    }
+
+    /// Where the opaque layer's shading runs: a compute pass over the screen or a fullscreen
+    /// triangle's fragments. The default is [`ShadingStage::from_env`] (the adapter's); the
+    /// images are the same either way.
+    pub fn set_shading_stage(&mut self, stage: ShadingStage) -> Result<()> {
+        if stage == self.shading.stage() {
+            return Ok(());
+        }
+        self.rebuild_shading(self.reference_shading, stage)
+    }
+
+    /// Where the opaque layer's shading runs ([`Self::set_shading_stage`]).
+    pub fn shading_stage(&self) -> ShadingStage {
+        self.shading.stage()
+    }
+
+    /// Remakes the shading pass (the reference shader when `reference`) in `stage`, and its
+    /// inputs, which name the stage's output.
+    fn rebuild_shading(&mut self, reference: bool, stage: ShadingStage) -> Result<()> {
         let device = &self.gpu.device;
-        self.shading = if on {
-            ShadingPass::reference(device, &self.shared)?
+        self.shading = if reference {
+            ShadingPass::reference(device, &self.shared, stage)?
         } else {
-            ShadingPass::new(device, &self.shared, &self.custom)?
+            ShadingPass::new(device, &self.shared, &self.custom, stage)?
         };
+        self.reference_shading = reference;
+        if let Some((t, b)) = self.targets.as_mut() {
+            b.shading = self.shading.bind_both(device, t, &self.shadow, &self.capture_dummy);
+            if let Some(c) = self.capture.as_mut() {
+                c.bind_group = self.shading.bind_both(device, t, &self.shadow, &c.buffer);
+            }
+        }
         Ok(())
     }
 
@@ -652,7 +686,7 @@ impl Renderer {
                 mapped_at_creation: false,
             });
             let (targets, _) = self.targets.as_ref().expect("checked above");
-            let bind_group = self.shading.bind_inputs(&self.gpu.device, targets, &self.shadow, &buffer);
+            let bind_group = self.shading.bind_both(&self.gpu.device, targets, &self.shadow, &buffer);
             self.capture = Some(Capture { buffer, bind_group, width, height, settings: settings.clone() });
         }
         if self.accumulating {
@@ -676,9 +710,9 @@ impl Renderer {
             // The shading inputs hold the old depth array.
             let device = &self.gpu.device;
             if let Some((t, b)) = self.targets.as_mut() {
-                b.shading = self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy);
+                b.shading = self.shading.bind_both(device, t, &self.shadow, &self.capture_dummy);
                 if let Some(c) = self.capture.as_mut() {
-                    c.bind_group = self.shading.bind_inputs(device, t, &self.shadow, &c.buffer);
+                    c.bind_group = self.shading.bind_both(device, t, &self.shadow, &c.buffer);
                 }
             }
         }
@@ -816,7 +850,9 @@ impl Renderer {
             spectral: &spectral.bind_group,
             custom: &spectral.custom_bind_group,
         };
-        let inputs = self.capture.as_ref().map_or(&bindings.shading, |c| &c.bind_group);
+        // An identity custom pass is skipped: shading writes what the custom pass would.
+        let output = usize::from(!self.custom_pass.skipped());
+        let inputs = self.capture.as_ref().map_or(&bindings.shading[output], |c| &c.bind_group[output]);
         if occlusion {
             let draw = Draw {
                 target: &targets.occlusion_view,
@@ -827,8 +863,7 @@ impl Renderer {
         } else if let Some(t) = timer {
             t.idle(&mut encoder, crate::timing::OCCLUSION);
         }
-        // An identity custom pass is skipped: shading writes what the custom pass would.
-        let shaded = if self.custom_pass.skipped() { &targets.hdr_view } else { &targets.hdr_shaded_view };
+        let shaded = [&targets.hdr_view, &targets.hdr_shaded_view][output];
         match (layered, targets.layer.as_ref()) {
             (true, Some(layer)) => {
                 // The opaque layer, kept aside as the background; the see-through one over it.
@@ -972,7 +1007,7 @@ impl Renderer {
     fn target_bindings(&self, t: &Targets) -> TargetBindings {
         let device = &self.gpu.device;
         TargetBindings {
-            shading: self.shading.bind_inputs(device, t, &self.shadow, &self.capture_dummy),
+            shading: self.shading.bind_both(device, t, &self.shadow, &self.capture_dummy),
             occlusion: self.occlusion.bind_inputs(device, t),
             custom: self.custom_pass.bind_inputs(device, t),
             post: self.post.bind_inputs(device, &t.hdr_view, "post inputs"),

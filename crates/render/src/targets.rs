@@ -7,7 +7,7 @@ use crate::passes::{
 };
 
 /// A 2D render target that passes also sample, with its view.
-fn target(
+pub(crate) fn target(
     device: &wgpu::Device,
     (width, height): (u32, u32),
     label: &str,
@@ -74,8 +74,10 @@ impl Targets {
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         let (occlusion, occlusion_view) = make("occlusion", crate::passes::occlusion::OCCLUSION_FORMAT, none);
-        let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, none);
-        let (hdr, hdr_view) = make("hdr", HDR_FORMAT, none);
+        // Written by the shading's compute pass (either, as the custom pass runs or not).
+        let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, storage);
+        let (hdr, hdr_view) = make("hdr", HDR_FORMAT, storage);
         let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);
         Targets {
             width,

@@ -16,6 +16,14 @@ pub mod shading;
 pub mod shadow;
 pub mod underwater;
 
+/// The stages that read the passes' inputs: the fragment shaders of the draws, and the compute
+/// passes that run a fullscreen pass's code over the screen (the shading's opaque layer).
+pub(crate) const READERS: wgpu::ShaderStages =
+    wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE);
+/// Side of the square workgroups of those compute passes (`SCREEN_GROUP` in wgsl/common.wgsl;
+/// src/layout_tests.rs checks it): 8 × 8 pixels.
+pub const SCREEN_GROUP: u32 = 8;
+
 /// HDR colour targets (shading output, custom output).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The largest finite value of [`HDR_FORMAT`], where the passes clamp what they write
@@ -74,7 +82,10 @@ impl SharedLayouts {
     pub fn new(device: &wgpu::Device) -> Self {
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+            entries: &[uniform_entry(
+                0,
+                wgpu::ShaderStages::VERTEX_FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
+            )],
         });
         let spectral = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("spectral"),
@@ -84,7 +95,7 @@ impl SharedLayouts {
                 storage_entry(2),
                 wgpu::BindGroupLayoutEntry {
                     binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: false },
                         view_dimension: wgpu::TextureViewDimension::D3,
@@ -100,16 +111,16 @@ impl SharedLayouts {
                 filterable_entry(8),
                 wgpu::BindGroupLayoutEntry {
                     binding: 9,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
-                uniform_entry(10, wgpu::ShaderStages::FRAGMENT),
+                uniform_entry(10, READERS),
                 storage_entry(11),
                 // The polygon lights' linearly transformed cosines (src/ltc.rs).
                 wgpu::BindGroupLayoutEntry {
                     binding: 12,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: true },
                         view_dimension: wgpu::TextureViewDimension::D2Array,
@@ -121,7 +132,7 @@ impl SharedLayouts {
         });
         let custom = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("custom"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT), storage_entry(1)],
+            entries: &[uniform_entry(0, READERS), storage_entry(1)],
         });
         SharedLayouts { frame, spectral, custom }
     }
@@ -209,7 +220,7 @@ pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgp
 pub(crate) fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
+        visibility: READERS,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: true },
             has_dynamic_offset: false,
@@ -237,11 +248,11 @@ pub(crate) fn uint_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture_2d_entry(binding, wgpu::TextureSampleType::Uint)
 }
 
-/// A 2D texture of `sample_type` read by the fragment stage.
+/// A 2D texture of `sample_type` read by the fragment or compute stage.
 fn texture_2d_entry(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
+        visibility: READERS,
         ty: wgpu::BindingType::Texture {
             sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,

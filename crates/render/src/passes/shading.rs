@@ -33,25 +33,89 @@
 use super::custom::CustomShader;
 use super::shadow::ShadowPass;
 use super::{
-    Draw, FullscreenPipeline, HDR_FORMAT, SharedGroups, SharedLayouts, buffer_entry, depth_entry,
-    draw_fullscreen, texture_entry, uniform_entry, view_entry,
+    Draw, FullscreenPipeline, HDR_FORMAT, READERS, SCREEN_GROUP, SharedGroups, SharedLayouts, buffer_entry,
+    depth_entry, draw_fullscreen, texture_entry, uniform_entry, view_entry,
 };
 use crate::error::Result;
 use crate::shader;
 use crate::targets::Targets;
 use std::collections::HashMap;
 
+/// Where the opaque layer's shading runs; the transmissive layer's is always its meshes'
+/// fragments. The same WGSL functions either way (`shade_rgb`, `shade_spectral`), and the same
+/// images (`tests/shading_stage.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShadingStage {
+    /// The fragments of a fullscreen triangle.
+    Fragment,
+    /// A compute pass over the screen, in workgroups of [`super::SCREEN_GROUP`]² pixels.
+    Compute,
+}
+
+impl ShadingStage {
+    /// A GPU's compute passes run on every shader core, its fragments only on the cores with
+    /// raster hardware, which on data-centre GPUs are a small part of them (docs/benchmark.md,
+    /// "Shading in a compute pass"); a CPU driver (lavapipe) runs the fragment pass 5–10 %
+    /// faster than the compute pass.
+    pub fn default_for(adapter: &wgpu::AdapterInfo) -> ShadingStage {
+        if adapter.device_type == wgpu::DeviceType::Cpu {
+            ShadingStage::Fragment
+        } else {
+            ShadingStage::Compute
+        }
+    }
+
+    /// `SPECTRA_SHADING_STAGE` (`compute` or `fragment`) where it is set, else
+    /// [`Self::default_for`] the adapter: how every command (render, eval, view, bench) can be
+    /// run in either stage.
+    pub fn from_env(adapter: &wgpu::AdapterInfo) -> crate::Result<ShadingStage> {
+        match std::env::var("SPECTRA_SHADING_STAGE") {
+            Err(_) => Ok(Self::default_for(adapter)),
+            Ok(v) => Self::parse(&v).ok_or_else(|| {
+                crate::RenderError::Settings(format!(
+                    "SPECTRA_SHADING_STAGE must be compute or fragment, got {v:?}"
+                ))
+            }),
+        }
+    }
+
+    /// The stage [`Self::name`] names.
+    pub fn parse(name: &str) -> Option<ShadingStage> {
+        [ShadingStage::Fragment, ShadingStage::Compute].into_iter().find(|s| s.name() == name)
+    }
+
+    /// The name `spectra bench --shading-stage` takes and prints.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadingStage::Fragment => "fragment",
+            ShadingStage::Compute => "compute",
+        }
+    }
+}
+
+/// A shading pipeline: the compute pass over the screen, or a draw (the fullscreen triangle,
+/// the transmissive layer's meshes).
+enum Pipeline {
+    Screen(wgpu::ComputePipeline),
+    Draw(wgpu::RenderPipeline),
+}
+
 pub struct ShadingPass {
     pub input_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
     pipeline_layout: wgpu::PipelineLayout,
-    rgb_entry: &'static str,
+    stage: ShadingStage,
+    /// The RGB mode's entry points: the compute pass's and the fragment shader.
+    rgb_entry: (&'static str, &'static str),
+    /// Bound as the compute pass's output where the pass draws instead (its fragment stage, the
+    /// transmissive layer): the target it draws into cannot be bound too.
+    unused_output: wgpu::TextureView,
     /// Whether the module declares the [`Variant`] overrides (the reference shader does not).
     has_variants: bool,
     /// Built on first use, per variant and entry point (`true`: RGB mode). RGB has its own
     /// entry point so that the JIT-compiled RGB shader carries none of the spectral path's loops
     /// (a CPU driver paid for them even when a uniform branch skipped them).
-    pipelines: HashMap<(Variant, bool), wgpu::RenderPipeline>,
+    pipelines: HashMap<(Variant, bool), Pipeline>,
     current: (Variant, bool),
     /// The custom hooks' pipeline-overridable constants ([`CustomShader::constants`]).
     hook_constants: Vec<(String, f64)>,
@@ -174,19 +238,34 @@ pub(crate) fn sources(hooks: &str) -> [&str; 10] {
 }
 
 impl ShadingPass {
-    /// Builds the pipeline with `custom` (the custom hooks) compiled in.
-    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, custom: &CustomShader) -> Result<Self> {
-        Self::build(device, shared, &sources(&custom.assembled()), "fs_rgb", true, custom.constants.clone())
+    /// Builds the pipeline with `custom` (the custom hooks) compiled in, the opaque layer's shading
+    /// running in `stage`.
+    pub fn new(
+        device: &wgpu::Device,
+        shared: &SharedLayouts,
+        custom: &CustomShader,
+        stage: ShadingStage,
+    ) -> Result<Self> {
+        Self::build(
+            device,
+            shared,
+            &sources(&custom.assembled()),
+            stage,
+            ("cs_rgb", "fs_rgb"),
+            true,
+            custom.constants.clone(),
+        )
     }
 
     /// The benchmark's minimal single-light RGB shader (`shading_reference.wgsl`) with the same
     /// inputs, to time in place of the real pass ([`crate::Renderer::set_reference_shading`]).
-    pub fn reference(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
+    pub fn reference(device: &wgpu::Device, shared: &SharedLayouts, stage: ShadingStage) -> Result<Self> {
         Self::build(
             device,
             shared,
             &[shader::COMMON, shader::SPECTRAL, include_str!("shading_reference.wgsl")],
-            "fs_main",
+            stage,
+            ("cs_main", "fs_main"),
             false,
             Vec::new(),
         )
@@ -196,7 +275,8 @@ impl ShadingPass {
         device: &wgpu::Device,
         shared: &SharedLayouts,
         sources: &[&str],
-        rgb_entry: &'static str,
+        stage: ShadingStage,
+        rgb_entry: (&'static str, &'static str),
         has_variants: bool,
         hook_constants: Vec<(String, f64)>,
     ) -> Result<Self> {
@@ -210,7 +290,7 @@ impl ShadingPass {
                 depth_entry(3),
                 wgpu::BindGroupLayoutEntry {
                     binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Depth,
                         view_dimension: wgpu::TextureViewDimension::D2Array,
@@ -220,15 +300,15 @@ impl ShadingPass {
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                     count: None,
                 },
-                uniform_entry(6, wgpu::ShaderStages::FRAGMENT),
+                uniform_entry(6, READERS),
                 // The spectral capture (`capture` in shading.wgsl).
                 wgpu::BindGroupLayoutEntry {
                     binding: 7,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    visibility: READERS,
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Storage { read_only: false },
                         has_dynamic_offset: false,
@@ -245,6 +325,17 @@ impl ShadingPass {
                 super::depth_entry(12),
                 // The transmissive layer's transmission and film, packed (`layer_packed`).
                 super::uint_entry(13),
+                // The opaque layer's shaded image (`shading_out`).
+                wgpu::BindGroupLayoutEntry {
+                    binding: 14,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: HDR_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -258,11 +349,21 @@ impl ShadingPass {
             ],
             immediate_size: 0,
         });
+        let unused_output = crate::targets::target(
+            device,
+            (1, 1),
+            "shading output (unused)",
+            HDR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+        )
+        .1;
         let mut pass = ShadingPass {
             input_layout,
             module,
             pipeline_layout,
+            stage,
             rgb_entry,
+            unused_output,
             has_variants,
             pipelines: HashMap::new(),
             current: (Variant::ALL, false),
@@ -289,21 +390,42 @@ impl ShadingPass {
                 .into_iter()
                 .chain(self.hook_constants.iter().map(|(name, value)| (name.as_str(), *value)))
                 .collect();
-            let (label, entry) = if rgb {
+            // The compute pass's entry point and the fragment shader's.
+            let (label, (screen_entry, layer_entry)) = if rgb {
                 ("shading pipeline (rgb)", self.rgb_entry)
             } else {
-                ("shading pipeline", "fs_main")
+                ("shading pipeline", ("cs_main", "fs_main"))
             };
             let pipeline = shader::checked(device, label, || {
                 if variant.transmission {
-                    return self.layer_pipeline(device, entry, &constants);
+                    return Pipeline::Draw(self.layer_pipeline(device, layer_entry, &constants));
                 }
-                FullscreenPipeline {
-                    fragment: entry,
-                    constants: &constants,
-                    ..FullscreenPipeline::simple(label, &self.module, &self.pipeline_layout, &[HDR_FORMAT])
+                if self.stage == ShadingStage::Fragment {
+                    return Pipeline::Draw(
+                        FullscreenPipeline {
+                            fragment: layer_entry,
+                            constants: &constants,
+                            ..FullscreenPipeline::simple(
+                                label,
+                                &self.module,
+                                &self.pipeline_layout,
+                                &[HDR_FORMAT],
+                            )
+                        }
+                        .build(device),
+                    );
                 }
-                .build(device)
+                Pipeline::Screen(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&self.pipeline_layout),
+                    module: &self.module,
+                    entry_point: Some(screen_entry),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                }))
             })?;
             self.pipelines.insert(key, pipeline);
         }
@@ -377,7 +499,10 @@ impl ShadingPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipelines[&key]);
+        let Pipeline::Draw(pipeline) = &self.pipelines[&key] else {
+            unreachable!("the layer's key is a transmission variant")
+        };
+        pass.set_pipeline(pipeline);
         for (i, g) in [shared.frame, draw.inputs, shared.spectral, shared.custom].into_iter().enumerate() {
             pass.set_bind_group(i as u32, g, &[]);
         }
@@ -386,14 +511,16 @@ impl ShadingPass {
         }
     }
 
-    /// Group 1: the G-buffer, its depth, the shadow maps and `capture` as the spectral capture
-    /// buffer (a dummy when not capturing).
+    /// Group 1: the G-buffer, its depth, the shadow maps, `capture` as the spectral capture
+    /// buffer (a dummy when not capturing), and `output`, where the pass writes (`Draw::target`
+    /// must be its view).
     pub fn bind_inputs(
         &self,
         device: &wgpu::Device,
         t: &Targets,
         shadow: &ShadowPass,
         capture: &wgpu::Buffer,
+        output: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
         let g = &t.gbuffer_views;
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -419,8 +546,26 @@ impl ShadingPass {
                 view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),
                 view_entry(13, &g[1]),
+                view_entry(14, output),
             ],
         })
+    }
+
+    /// [`Self::bind_inputs`] with each output the frame may shade into: `t.hdr` (index 0,
+    /// where the custom pass is skipped) and `t.hdr_shaded` (1, the custom pass's input); in
+    /// the fragment stage, which draws into them, neither.
+    pub fn bind_both(
+        &self,
+        device: &wgpu::Device,
+        t: &Targets,
+        shadow: &ShadowPass,
+        capture: &wgpu::Buffer,
+    ) -> [wgpu::BindGroup; 2] {
+        let outputs = match self.stage {
+            ShadingStage::Compute => [&t.hdr_view, &t.hdr_shaded_view],
+            ShadingStage::Fragment => [&self.unused_output; 2],
+        };
+        outputs.map(|output| self.bind_inputs(device, t, shadow, capture, output))
     }
 
     /// Group 1 of the transmissive layer: its G-buffer (the fourth target, transmission and
@@ -457,6 +602,8 @@ impl ShadingPass {
                 view_entry(11, &layer.back_faces_view),
                 view_entry(12, opaque_depth),
                 view_entry(13, &g[3]),
+                // The layer draws into its target.
+                view_entry(14, &self.unused_output),
             ],
         })
     }
@@ -465,6 +612,11 @@ impl ShadingPass {
     /// (the benchmark's reference shader does not).
     pub fn reads_occlusion(&self) -> bool {
         self.has_variants
+    }
+
+    /// Where the opaque layer's shading runs.
+    pub fn stage(&self) -> ShadingStage {
+        self.stage
     }
 
     /// The pipeline [`Self::select`] made current, for [`Self::record_with`].
@@ -485,8 +637,28 @@ impl ShadingPass {
         draw: Draw,
         key: (Variant, bool),
     ) {
-        let pipeline = &self.pipelines[&key];
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
-        draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
+        let pipeline = match &self.pipelines[&key] {
+            Pipeline::Screen(pipeline) => pipeline,
+            Pipeline::Draw(pipeline) => {
+                draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
+                return;
+            }
+        };
+        let timestamps = draw.timestamps.map(|t| wgpu::ComputePassTimestampWrites {
+            query_set: t.query_set,
+            beginning_of_pass_write_index: t.beginning_of_pass_write_index,
+            end_of_pass_write_index: t.end_of_pass_write_index,
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("shading"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(pipeline);
+        for (i, g) in groups.into_iter().enumerate() {
+            pass.set_bind_group(i as u32, g, &[]);
+        }
+        let size = draw.target.texture().size();
+        pass.dispatch_workgroups(size.width.div_ceil(SCREEN_GROUP), size.height.div_ceil(SCREEN_GROUP), 1);
     }
 }

@@ -487,10 +487,9 @@ fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> m
     return mat2x3<f32>(fd, fm);
 }
 
-// RGB mode: one pass over the lights, nothing kept. Its own entry point (a pipeline of its
+// RGB mode: one pass over the lights, nothing kept. Its own entry points (pipelines of their
 // own), so that RGB pays only for what RGB needs.
-@fragment
-fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     if (HAS_TRANSMISSION && gbuffer_slot(textureLoad(gbuf_normal, px, 0)) == 0u) {
         return textureLoad(background, px, 0);
@@ -706,8 +705,7 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
 }
 
 // Spectral and naive modes.
-@fragment
-fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     if (CUSTOM_SPECTRAL || CAPTURE) {
         return hdr_out(shade_nodes(in));
     }
@@ -1041,4 +1039,35 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         }
     }
     return frame.xyz_to_rgb * xyz;
+}
+
+// The entry points. The opaque layer is shaded by a compute pass over the screen (`cs_*`, into
+// `shading_out`), the transmissive layer by its meshes' fragments (`fs_*`, see
+// transmission.wgsl): the same functions either way. A compute pass runs on every shader core,
+// where fragments run only on those with raster hardware — on some GPUs a small part of them
+// (docs/benchmark.md, "Shading in a compute pass").
+@group(1) @binding(14) var shading_out: texture_storage_2d<rgba16float, write>;
+
+@fragment
+fn fs_rgb(in: FullscreenOut) -> @location(0) vec4<f32> {
+    return shade_rgb(in);
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    return shade_spectral(in);
+}
+
+@compute @workgroup_size(SCREEN_GROUP, SCREEN_GROUP)
+fn cs_rgb(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (all(id.xy < textureDimensions(shading_out))) {
+        textureStore(shading_out, id.xy, shade_rgb(fullscreen_at(id.xy)));
+    }
+}
+
+@compute @workgroup_size(SCREEN_GROUP, SCREEN_GROUP)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (all(id.xy < textureDimensions(shading_out))) {
+        textureStore(shading_out, id.xy, shade_spectral(fullscreen_at(id.xy)));
+    }
 }

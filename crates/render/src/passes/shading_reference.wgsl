@@ -8,8 +8,7 @@
 @group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
 
-@fragment
-fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn shade(in: FullscreenOut) -> vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     let depth = textureLoad(gbuf_depth, px, 0);
     if (depth >= 1.0 || frame.n_lights == 0u) {
@@ -32,4 +31,19 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let f = 0.04 + 0.96 * pow(1.0 - max(dot(v, h), 0.0), 5.0);
     let rgb = (b.rgb * (1.0 - b.a) * (1.0 - f) / PI + spec * mix(vec3<f32>(f), b.rgb, b.a)) * nl * inc.w;
     return vec4<f32>(rgb * lights[0].rgb.rgb, 1.0);
+}
+
+// The entry points of either stage, as the real pass's (shading.wgsl).
+@group(1) @binding(14) var shading_out: texture_storage_2d<rgba16float, write>;
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    return shade(in);
+}
+
+@compute @workgroup_size(SCREEN_GROUP, SCREEN_GROUP)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (all(id.xy < textureDimensions(shading_out))) {
+        textureStore(shading_out, id.xy, shade(fullscreen_at(id.xy)));
+    }
 }

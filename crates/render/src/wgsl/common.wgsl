@@ -68,6 +68,17 @@ struct FullscreenOut {
     @builtin(position) pos: vec4<f32>,
 };
 
+// What a fragment of the fullscreen triangle receives at pixel `px`, for the compute passes that
+// run a fullscreen pass's code over the screen instead (one invocation per pixel, in square
+// workgroups of SCREEN_GROUP² = passes::SCREEN_GROUP²).
+const SCREEN_GROUP: u32 = 8u;
+
+fn fullscreen_at(px: vec2<u32>) -> FullscreenOut {
+    var o: FullscreenOut;
+    o.pos = vec4<f32>(vec2<f32>(px) + 0.5, 0.0, 1.0);
+    return o;
+}
+
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
     let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));

@@ -100,6 +100,31 @@ pub struct Args {
     /// With --suite: also write the table as Markdown to this file (atomically).
     #[arg(long, value_name = "FILE")]
     pub markdown: Option<PathBuf>,
+    /// Where the shading pass runs: `compute` (a compute pass over the screen) or `fragment`
+    /// (a fullscreen triangle). Default: $SPECTRA_SHADING_STAGE, else compute on a GPU and
+    /// fragment on a CPU driver (the images are the same; docs/benchmark.md, "Shading in a
+    /// compute pass").
+    #[arg(long, value_name = "STAGE", value_parser = parse_stage)]
+    pub shading_stage: Option<render::ShadingStage>,
+}
+
+fn parse_stage(s: &str) -> std::result::Result<render::ShadingStage, String> {
+    render::ShadingStage::parse(s).ok_or_else(|| format!("expected compute or fragment, got {s:?}"))
+}
+
+/// A renderer for the benchmark with the shading in `stage` (or the adapter's default), and the
+/// line that names the adapter and the stage, printed first and written with the tables.
+pub(crate) fn bench_renderer(
+    coeffs: std::sync::Arc<color::upsample::CoeffTable>,
+    stage: Option<render::ShadingStage>,
+) -> Result<(Renderer, String)> {
+    let mut r = Renderer::with_table(coeffs)?;
+    if let Some(stage) = stage {
+        r.set_shading_stage(stage)?;
+    }
+    let adapter = format!("{}; shading pass: {}", r.gpu().describe(), r.shading_stage().name());
+    println!("adapter: {adapter}");
+    Ok((r, adapter))
 }
 
 impl Args {
@@ -468,8 +493,7 @@ pub fn run(args: Args) -> Result<()> {
     super::check_outputs(&[("--csv", args.csv.as_deref())], &inputs)?;
     let coeffs = args.table.load()?;
     let (custom, under) = bench_media(&scene, args.rgb_medium.arg(), &coeffs)?;
-    let mut r = Renderer::with_table(coeffs)?;
-    println!("adapter: {}", r.gpu().describe());
+    let (mut r, _) = bench_renderer(coeffs, args.shading_stage)?;
     r.set_scene(&scene)?;
     if let Some(c) = custom {
         r.set_custom_shader(c)?;

@@ -18,7 +18,7 @@ use crate::cmd::setup::{EnvArgs, SceneArgs, parse_size};
 use anyhow::{Context, Result, bail};
 use color::Quadrature;
 use render::timing::PASSES;
-use render::{Mode, RenderSettings, Renderer};
+use render::{Mode, RenderSettings};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -258,9 +258,7 @@ pub fn run(args: Args) -> Result<()> {
     )?;
     let (scenes, note) = scenes(args.suite_asset.as_deref());
     let coeffs = args.table.load()?;
-    let mut r = Renderer::with_table(coeffs.clone())?;
-    let adapter = r.gpu().describe();
-    println!("adapter: {adapter}");
+    let (mut r, adapter) = super::bench_renderer(coeffs.clone(), args.shading_stage)?;
     let (has_ts, timing) = timing_of(&r);
     let configs = configs(&counts);
     let size_list = sizes.iter().map(|(w, h)| format!("{w}×{h}")).collect::<Vec<_>>().join(", ");
