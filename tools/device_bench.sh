@@ -51,12 +51,12 @@ if ! grep -qi nvidia $R/probe.txt; then
 fi
 pack
 
-suite() { # label binary size
+suite() { # label binary size [bench flags, e.g. --shading-stage fragment]
     local t=$(( $(left) - 20 ))
     [ $t -gt 30 ] || { log "skip $1 (no time)"; return; }
     [ $t -gt 200 ] && t=200
-    log "suite $1 ($2, $3, timeout $t)"
-    timeout $t "$2" bench --suite --suite-asset "$ASSET" --suite-sizes "$3" \
+    log "suite $1 ($2, $3 ${*:4}, timeout $t)"
+    timeout $t "$2" bench --suite --suite-asset "$ASSET" --suite-sizes "$3" "${@:4}" \
         --csv $R/suite-$1.csv --markdown $R/suite-$1.md > $R/suite-$1.log 2>&1
     echo "exit $?" >> $R/suite-$1.log
     pack
@@ -73,14 +73,21 @@ done
 grep -E "^### |^test result|FAILED|panicked|^exit" $R/tests.log > $R/tests-summary.txt
 pack
 
+# The new binary shades in a compute pass on a GPU (its default there) and, for the same run's
+# comparison, in the fragment stage the old binary uses (docs/benchmark.md, "Shading in a
+# compute pass").
 suite new-720 $NEW $S720
+suite new-720-fragment $NEW $S720 --shading-stage fragment
 suite old-720 $OLD $S720
-suite new-1080 $NEW $S1080
 
 log reference
-timeout 60 $NEW bench cornell --env none --size $S720 --frames 60 --warmup 10 --wavelengths 1 --reference \
-    --csv $R/reference.csv > $R/reference.log 2>&1
+for st in compute fragment; do
+    timeout 60 $NEW bench cornell --env none --size $S720 --frames 60 --warmup 10 --wavelengths 1 --reference \
+        --shading-stage $st --csv $R/reference-$st.csv > $R/reference-$st.log 2>&1
+done
 pack
+
+suite new-1080 $NEW $S1080
 
 t=$(( $(left) - 15 ))
 if [ $t -gt 60 ]; then

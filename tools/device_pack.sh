@@ -10,7 +10,7 @@ old=${1:?old spectra binary}
 asset=${2:?directory holding DamagedHelmet.gltf}
 shift 2
 tests=("$@")
-[ ${#tests[@]} -gt 0 ] || tests=(environment underwater pipeline material_spectra films transmission shadows gltf_features accumulation)
+[ ${#tests[@]} -gt 0 ] || tests=(shading_stage environment underwater pipeline material_spectra films transmission shadows gltf_features accumulation)
 cd "$(git rev-parse --show-toplevel)"
 [ -f "$asset/DamagedHelmet.gltf" ] || { echo "no DamagedHelmet.gltf in $asset" >&2; exit 1; }
 table=${SPECTRA_CACHE_DIR:-$HOME/.cache/spectra}/srgb-64-v8.coeff

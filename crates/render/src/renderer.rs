@@ -224,7 +224,7 @@ impl Renderer {
         let shadow = ShadowPass::new(device, &gbuffer.material_layout)?;
         let shading =
             ShadingPass::new(device, &shared, &custom, ShadingStage::from_env(&gpu.adapter.get_info())?)?;
-        let occlusion = crate::passes::occlusion::OcclusionPass::new(device, &shared)?;
+        let occlusion = crate::passes::occlusion::OcclusionPass::new(device, &shared, shading.stage())?;
         let custom_pass = CustomPass::new(device, &shared, &custom)?;
         let post = PostPass::new(device, &shared)?;
         let accumulate = AccumulatePass::new(device)?;
@@ -449,18 +449,23 @@ impl Renderer {
         self.shading.stage()
     }
 
-    /// Remakes the shading pass (the reference shader when `reference`) in `stage`, and its
-    /// inputs, which name the stage's output.
+    /// Remakes the shading pass (the reference shader when `reference`) and the occlusion pass
+    /// in `stage`, and their inputs, which name the stage's output.
     fn rebuild_shading(&mut self, reference: bool, stage: ShadingStage) -> Result<()> {
         let device = &self.gpu.device;
-        self.shading = if reference {
+        let shading = if reference {
             ShadingPass::reference(device, &self.shared, stage)?
         } else {
             ShadingPass::new(device, &self.shared, &self.custom, stage)?
         };
+        if stage != self.shading.stage() {
+            self.occlusion = crate::passes::occlusion::OcclusionPass::new(device, &self.shared, stage)?;
+        }
+        self.shading = shading;
         self.reference_shading = reference;
         if let Some((t, b)) = self.targets.as_mut() {
             b.shading = self.shading.bind_both(device, t, &self.shadow, &self.capture_dummy);
+            b.occlusion = self.occlusion.bind_inputs(device, t);
             if let Some(c) = self.capture.as_mut() {
                 c.bind_group = self.shading.bind_both(device, t, &self.shadow, &c.buffer);
             }

@@ -73,9 +73,11 @@ impl Targets {
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
-        let (occlusion, occlusion_view) = make("occlusion", crate::passes::occlusion::OCCLUSION_FORMAT, none);
-        // Written by the shading's compute pass (either, as the custom pass runs or not).
+        // Written by the occlusion pass in its compute stage, like the HDR targets below.
         let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let (occlusion, occlusion_view) =
+            make("occlusion", crate::passes::occlusion::OCCLUSION_FORMAT, storage);
+        // Written by the shading's compute pass (either, as the custom pass runs or not).
         let (hdr_shaded, hdr_shaded_view) = make("hdr shaded", HDR_FORMAT, storage);
         let (hdr, hdr_view) = make("hdr", HDR_FORMAT, storage);
         let (ldr, ldr_view) = make("ldr", LDR_FORMAT, none);

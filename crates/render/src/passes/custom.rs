@@ -41,6 +41,11 @@
 //!   normal packed with the roughness and the material's slot: read it with
 //!   `gbuffer_normal(textureLoad(gbuf_normal, px, 0))`, or take `ctx.normal`).
 //!
+//! The pass-2 hooks are compiled into both stages of the shading pass
+//! ([`super::shading::ShadingStage`]: a compute pass over the screen on GPUs, a fullscreen
+//! triangle's fragments on CPU drivers), so they must be valid in a compute shader: no
+//! derivatives (`dpdx`, `fwidth`), no implicitly-levelled `textureSample`, no `discard`.
+//!
 //! Weighted radiance: the renderer integrates `XYZ = Σ_nodes ρ(λᵢ)·W_{l,i}` with node weights
 //! W that carry the light, the observer and the quadrature rule ([`color::quadrature`]). A
 //! spectral hook therefore sees, per channel, the node radiance already multiplied by its

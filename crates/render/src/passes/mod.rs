@@ -400,6 +400,33 @@ pub fn draw_fullscreen(
     pass.draw(0..3, 0..1);
 }
 
+/// Records a compute pass of `pipeline` over `draw.target`'s pixels, one invocation each in
+/// [`SCREEN_GROUP`]² workgroups, with `groups` bound in order: a fullscreen pass's code in the
+/// compute stage (the shader writes the target, bound in `draw.inputs`).
+pub fn dispatch_screen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    groups: &[&wgpu::BindGroup],
+    draw: Draw,
+) {
+    let timestamps = draw.timestamps.map(|t| wgpu::ComputePassTimestampWrites {
+        query_set: t.query_set,
+        beginning_of_pass_write_index: t.beginning_of_pass_write_index,
+        end_of_pass_write_index: t.end_of_pass_write_index,
+    });
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: timestamps,
+    });
+    pass.set_pipeline(pipeline);
+    for (index, group) in groups.iter().enumerate() {
+        pass.set_bind_group(index as u32, *group, &[]);
+    }
+    let size = draw.target.texture().size();
+    pass.dispatch_workgroups(size.width.div_ceil(SCREEN_GROUP), size.height.div_ceil(SCREEN_GROUP), 1);
+}
+
 /// A bind-group entry for a texture view.
 pub(crate) fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) }

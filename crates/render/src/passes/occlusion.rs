@@ -10,6 +10,7 @@
 //! normals, stored in f32), so images are unchanged. The transmissive layer, whose depth buffer is its own, still searches
 //! in its shading pass.
 
+use super::shading::ShadingStage;
 use super::{
     Draw, FullscreenPipeline, SharedLayouts, depth_entry, draw_fullscreen, pipeline_layout, uint_entry,
     view_entry,
@@ -21,17 +22,42 @@ use crate::targets::Targets;
 /// The occlusion per pixel: f32, so that the shading reads exactly what it would have computed.
 pub const OCCLUSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
+/// Runs in the shading's stage ([`ShadingStage`]): a compute pass over the screen into the
+/// target bound as a storage texture (`occlusion_out`), or a fullscreen triangle drawing into it.
 pub struct OcclusionPass {
     input_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+    pipeline: Pipeline,
+}
+
+enum Pipeline {
+    Screen(wgpu::ComputePipeline),
+    Draw(wgpu::RenderPipeline),
 }
 
 impl OcclusionPass {
-    pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
+    pub fn new(device: &wgpu::Device, shared: &SharedLayouts, stage: ShadingStage) -> Result<Self> {
+        let mut entries = vec![uint_entry(1), depth_entry(3)];
+        if stage == ShadingStage::Compute {
+            entries.push(wgpu::BindGroupLayoutEntry {
+                binding: 4,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: OCCLUSION_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            });
+        }
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("occlusion inputs"),
-            entries: &[uint_entry(1), depth_entry(3)],
+            entries: &entries,
         });
+        // The compute entry point's output binding is declared only where it is bound.
+        let output = match stage {
+            ShadingStage::Compute => include_str!("occlusion_compute.wgsl"),
+            ShadingStage::Fragment => "",
+        };
         let module = shader::compile(
             device,
             "occlusion",
@@ -42,22 +68,42 @@ impl OcclusionPass {
                 shader::ENVIRONMENT,
                 include_str!("occlusion.wgsl"),
                 include_str!("occlusion_pass.wgsl"),
+                output,
             ],
         )?;
         let pipeline = shader::checked(device, "occlusion pipeline", || {
             let layout =
                 pipeline_layout(device, "occlusion", &[&shared.frame, &input_layout, &shared.spectral]);
-            FullscreenPipeline::simple("occlusion", &module, &layout, &[OCCLUSION_FORMAT]).build(device)
+            match stage {
+                ShadingStage::Compute => {
+                    Pipeline::Screen(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                        label: Some("occlusion"),
+                        layout: Some(&layout),
+                        module: &module,
+                        entry_point: Some("cs_main"),
+                        compilation_options: Default::default(),
+                        cache: None,
+                    }))
+                }
+                ShadingStage::Fragment => Pipeline::Draw(
+                    FullscreenPipeline::simple("occlusion", &module, &layout, &[OCCLUSION_FORMAT])
+                        .build(device),
+                ),
+            }
         })?;
         Ok(OcclusionPass { input_layout, pipeline })
     }
 
-    /// Group 1: the G-buffer's normals and depth.
+    /// Group 1: the G-buffer's normals and depth, and in the compute stage the output.
     pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
+        let mut entries = vec![view_entry(1, &t.gbuffer_views[1]), view_entry(3, &t.depth_view)];
+        if let Pipeline::Screen(_) = self.pipeline {
+            entries.push(view_entry(4, &t.occlusion_view));
+        }
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("occlusion inputs"),
             layout: &self.input_layout,
-            entries: &[view_entry(1, &t.gbuffer_views[1]), view_entry(3, &t.depth_view)],
+            entries: &entries,
         })
     }
 
@@ -72,6 +118,13 @@ impl OcclusionPass {
         draw: Draw,
     ) {
         let groups = [frame, draw.inputs, spectral];
-        draw_fullscreen(encoder, "occlusion", &[draw.target], &self.pipeline, &groups, draw.timestamps);
+        match &self.pipeline {
+            Pipeline::Draw(pipeline) => {
+                draw_fullscreen(encoder, "occlusion", &[draw.target], pipeline, &groups, draw.timestamps)
+            }
+            Pipeline::Screen(pipeline) => {
+                super::dispatch_screen(encoder, "occlusion", pipeline, &groups, draw)
+            }
+        }
     }
 }

@@ -8,8 +8,7 @@
 @group(1) @binding(1) var gbuf_normal: texture_2d<u32>;
 @group(1) @binding(3) var gbuf_depth: texture_depth_2d;
 
-@fragment
-fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+fn occlusion_at(in: FullscreenOut) -> vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     let depth = textureLoad(gbuf_depth, px, 0);
     if (depth >= 1.0) {
@@ -20,4 +19,9 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     let p = world_from_depth(in.pos.xy, depth, frame);
     let n = gbuffer_normal(textureLoad(gbuf_normal, px, 0));
     return vec4<f32>(env_occlusion(in.pos.xy, p, n));
+}
+
+@fragment
+fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
+    return occlusion_at(in);
 }

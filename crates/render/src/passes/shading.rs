@@ -33,8 +33,8 @@
 use super::custom::CustomShader;
 use super::shadow::ShadowPass;
 use super::{
-    Draw, FullscreenPipeline, HDR_FORMAT, READERS, SCREEN_GROUP, SharedGroups, SharedLayouts, buffer_entry,
-    depth_entry, draw_fullscreen, texture_entry, uniform_entry, view_entry,
+    Draw, FullscreenPipeline, HDR_FORMAT, READERS, SharedGroups, SharedLayouts, buffer_entry, depth_entry,
+    draw_fullscreen, texture_entry, uniform_entry, view_entry,
 };
 use crate::error::Result;
 use crate::shader;
@@ -638,27 +638,11 @@ impl ShadingPass {
         key: (Variant, bool),
     ) {
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
-        let pipeline = match &self.pipelines[&key] {
-            Pipeline::Screen(pipeline) => pipeline,
+        match &self.pipelines[&key] {
+            Pipeline::Screen(pipeline) => super::dispatch_screen(encoder, "shading", pipeline, &groups, draw),
             Pipeline::Draw(pipeline) => {
-                draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps);
-                return;
+                draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps)
             }
-        };
-        let timestamps = draw.timestamps.map(|t| wgpu::ComputePassTimestampWrites {
-            query_set: t.query_set,
-            beginning_of_pass_write_index: t.beginning_of_pass_write_index,
-            end_of_pass_write_index: t.end_of_pass_write_index,
-        });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("shading"),
-            timestamp_writes: timestamps,
-        });
-        pass.set_pipeline(pipeline);
-        for (i, g) in groups.into_iter().enumerate() {
-            pass.set_bind_group(i as u32, g, &[]);
         }
-        let size = draw.target.texture().size();
-        pass.dispatch_workgroups(size.width.div_ceil(SCREEN_GROUP), size.height.div_ceil(SCREEN_GROUP), 1);
     }
 }
