@@ -2,7 +2,9 @@
 //! passes share.
 //!
 //! Frame order: shadow (depth from each shadow-casting light, one layer each) → G-buffer →
-//! (occlusion, only where the frame has ambient light to occlude) → spectral shading → custom → (accumulate, only with `Renderer::set_accumulation`) → post. Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
+//! (occlusion, only where the frame has ambient light to occlude) → spectral shading → custom → (accumulate, only with `Renderer::set_accumulation`) → post.
+//! The occlusion and the shading's opaque layer are compute passes over the screen on a GPU and
+//! fullscreen triangles on a CPU driver (`shading::ShadingStage`). Bind groups: 0 = frame uniforms, 1 = pass inputs, 2 =
 //! per-wavelength data and the coefficient table, 3 = the custom shader's parameters.
 
 pub mod accumulate;
