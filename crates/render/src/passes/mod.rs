@@ -402,10 +402,67 @@ pub fn draw_fullscreen(
     pass.draw(0..3, 0..1);
 }
 
-/// Records a compute pass of `pipeline` over `draw.target`'s pixels, one invocation each in
-/// [`SCREEN_GROUP`]² workgroups, with `groups` bound in order: a fullscreen pass's code in the
-/// compute stage (the shader writes the target, bound in `draw.inputs`).
-pub fn dispatch_screen(
+/// A fullscreen pass's pipeline in either stage ([`shading::ShadingStage`]): a compute pass over
+/// the screen that writes its target as a storage texture (bound in its inputs), or a draw (the
+/// fullscreen triangle; the shading's transmissive layer draws its meshes).
+pub enum ScreenPipeline {
+    Compute(wgpu::ComputePipeline),
+    Draw(wgpu::RenderPipeline),
+}
+
+impl ScreenPipeline {
+    /// The compute stage's pipeline of `module`'s `entry` with `constants`.
+    pub fn compute(
+        device: &wgpu::Device,
+        label: &str,
+        layout: &wgpu::PipelineLayout,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> ScreenPipeline {
+        ScreenPipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+            cache: None,
+        }))
+    }
+
+    /// Records the pass over `draw.target` with `groups` bound in order (group i at index i):
+    /// the fullscreen triangle, or one invocation per pixel in [`SCREEN_GROUP`]² workgroups.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        groups: &[&wgpu::BindGroup],
+        draw: Draw,
+    ) {
+        match self {
+            ScreenPipeline::Draw(pipeline) => {
+                draw_fullscreen(encoder, label, &[draw.target], pipeline, groups, draw.timestamps)
+            }
+            ScreenPipeline::Compute(pipeline) => dispatch_screen(encoder, label, pipeline, groups, draw),
+        }
+    }
+}
+
+/// The compute stage's output binding: `format`, written.
+pub(crate) fn storage_output_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
+fn dispatch_screen(
     encoder: &mut wgpu::CommandEncoder,
     label: &str,
     pipeline: &wgpu::ComputePipeline,

@@ -12,7 +12,7 @@
 
 use super::shading::ShadingStage;
 use super::{
-    Draw, FullscreenPipeline, SharedLayouts, depth_entry, draw_fullscreen, pipeline_layout, uint_entry,
+    Draw, FullscreenPipeline, ScreenPipeline, SharedLayouts, depth_entry, pipeline_layout, uint_entry,
     view_entry,
 };
 use crate::error::Result;
@@ -26,28 +26,14 @@ pub const OCCLUSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// target bound as a storage texture (`occlusion_out`), or a fullscreen triangle drawing into it.
 pub struct OcclusionPass {
     input_layout: wgpu::BindGroupLayout,
-    pipeline: Pipeline,
-}
-
-enum Pipeline {
-    Screen(wgpu::ComputePipeline),
-    Draw(wgpu::RenderPipeline),
+    pipeline: ScreenPipeline,
 }
 
 impl OcclusionPass {
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts, stage: ShadingStage) -> Result<Self> {
         let mut entries = vec![uint_entry(1), depth_entry(3)];
         if stage == ShadingStage::Compute {
-            entries.push(wgpu::BindGroupLayoutEntry {
-                binding: 4,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: OCCLUSION_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            });
+            entries.push(super::storage_output_entry(4, OCCLUSION_FORMAT));
         }
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("occlusion inputs"),
@@ -76,16 +62,9 @@ impl OcclusionPass {
                 pipeline_layout(device, "occlusion", &[&shared.frame, &input_layout, &shared.spectral]);
             match stage {
                 ShadingStage::Compute => {
-                    Pipeline::Screen(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some("occlusion"),
-                        layout: Some(&layout),
-                        module: &module,
-                        entry_point: Some("cs_main"),
-                        compilation_options: Default::default(),
-                        cache: None,
-                    }))
+                    ScreenPipeline::compute(device, "occlusion", &layout, &module, "cs_main", &[])
                 }
-                ShadingStage::Fragment => Pipeline::Draw(
+                ShadingStage::Fragment => ScreenPipeline::Draw(
                     FullscreenPipeline::simple("occlusion", &module, &layout, &[OCCLUSION_FORMAT])
                         .build(device),
                 ),
@@ -97,7 +76,7 @@ impl OcclusionPass {
     /// Group 1: the G-buffer's normals and depth, and in the compute stage the output.
     pub fn bind_inputs(&self, device: &wgpu::Device, t: &Targets) -> wgpu::BindGroup {
         let mut entries = vec![view_entry(1, &t.gbuffer_views[1]), view_entry(3, &t.depth_view)];
-        if let Pipeline::Screen(_) = self.pipeline {
+        if let ScreenPipeline::Compute(_) = self.pipeline {
             entries.push(view_entry(4, &t.occlusion_view));
         }
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -118,13 +97,6 @@ impl OcclusionPass {
         draw: Draw,
     ) {
         let groups = [frame, draw.inputs, spectral];
-        match &self.pipeline {
-            Pipeline::Draw(pipeline) => {
-                draw_fullscreen(encoder, "occlusion", &[draw.target], pipeline, &groups, draw.timestamps)
-            }
-            Pipeline::Screen(pipeline) => {
-                super::dispatch_screen(encoder, "occlusion", pipeline, &groups, draw)
-            }
-        }
+        self.pipeline.record(encoder, "occlusion", &groups, draw);
     }
 }

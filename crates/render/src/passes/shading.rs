@@ -33,8 +33,8 @@
 use super::custom::CustomShader;
 use super::shadow::ShadowPass;
 use super::{
-    Draw, FullscreenPipeline, HDR_FORMAT, READERS, SharedGroups, SharedLayouts, buffer_entry, depth_entry,
-    draw_fullscreen, texture_entry, uniform_entry, view_entry,
+    Draw, FullscreenPipeline, HDR_FORMAT, READERS, ScreenPipeline, SharedGroups, SharedLayouts, buffer_entry,
+    depth_entry, texture_entry, uniform_entry, view_entry,
 };
 use crate::error::Result;
 use crate::shader;
@@ -93,13 +93,6 @@ impl ShadingStage {
     }
 }
 
-/// A shading pipeline: the compute pass over the screen, or a draw (the fullscreen triangle,
-/// the transmissive layer's meshes).
-enum Pipeline {
-    Screen(wgpu::ComputePipeline),
-    Draw(wgpu::RenderPipeline),
-}
-
 pub struct ShadingPass {
     pub input_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
@@ -115,7 +108,7 @@ pub struct ShadingPass {
     /// Built on first use, per variant and entry point (`true`: RGB mode). RGB has its own
     /// entry point so that the JIT-compiled RGB shader carries none of the spectral path's loops
     /// (a CPU driver paid for them even when a uniform branch skipped them).
-    pipelines: HashMap<(Variant, bool), Pipeline>,
+    pipelines: HashMap<(Variant, bool), ScreenPipeline>,
     current: (Variant, bool),
     /// The custom hooks' pipeline-overridable constants ([`CustomShader::constants`]).
     hook_constants: Vec<(String, f64)>,
@@ -326,16 +319,7 @@ impl ShadingPass {
                 // The transmissive layer's transmission and film, packed (`layer_packed`).
                 super::uint_entry(13),
                 // The opaque layer's shaded image (`shading_out`).
-                wgpu::BindGroupLayoutEntry {
-                    binding: 14,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HDR_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                super::storage_output_entry(14, HDR_FORMAT),
             ],
         });
         let module = shader::compile(device, "shading", sources)?;
@@ -398,10 +382,10 @@ impl ShadingPass {
             };
             let pipeline = shader::checked(device, label, || {
                 if variant.transmission {
-                    return Pipeline::Draw(self.layer_pipeline(device, layer_entry, &constants));
+                    return ScreenPipeline::Draw(self.layer_pipeline(device, layer_entry, &constants));
                 }
                 if self.stage == ShadingStage::Fragment {
-                    return Pipeline::Draw(
+                    return ScreenPipeline::Draw(
                         FullscreenPipeline {
                             fragment: layer_entry,
                             constants: &constants,
@@ -415,17 +399,14 @@ impl ShadingPass {
                         .build(device),
                     );
                 }
-                Pipeline::Screen(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&self.pipeline_layout),
-                    module: &self.module,
-                    entry_point: Some(screen_entry),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &constants,
-                        ..Default::default()
-                    },
-                    cache: None,
-                }))
+                ScreenPipeline::compute(
+                    device,
+                    label,
+                    &self.pipeline_layout,
+                    &self.module,
+                    screen_entry,
+                    &constants,
+                )
             })?;
             self.pipelines.insert(key, pipeline);
         }
@@ -499,7 +480,7 @@ impl ShadingPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let Pipeline::Draw(pipeline) = &self.pipelines[&key] else {
+        let ScreenPipeline::Draw(pipeline) = &self.pipelines[&key] else {
             unreachable!("the layer's key is a transmission variant")
         };
         pass.set_pipeline(pipeline);
@@ -638,11 +619,6 @@ impl ShadingPass {
         key: (Variant, bool),
     ) {
         let groups = [shared.frame, draw.inputs, shared.spectral, shared.custom];
-        match &self.pipelines[&key] {
-            Pipeline::Screen(pipeline) => super::dispatch_screen(encoder, "shading", pipeline, &groups, draw),
-            Pipeline::Draw(pipeline) => {
-                draw_fullscreen(encoder, "shading", &[draw.target], pipeline, &groups, draw.timestamps)
-            }
-        }
+        self.pipelines[&key].record(encoder, "shading", &groups, draw);
     }
 }
