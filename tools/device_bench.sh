@@ -73,10 +73,10 @@ done
 grep -E "^### |^test result|FAILED|panicked|^exit" $R/tests.log > $R/tests-summary.txt
 pack
 
-# The new binary shades in a compute pass on a GPU (its default there) and, for the same run's
+# The new binary shades in a compute pass (its default on a GPU) and, for the same run's
 # comparison, in the fragment stage the old binary uses (docs/benchmark.md, "Shading in a
 # compute pass").
-suite new-720 $NEW $S720
+suite new-720 $NEW $S720 --shading-stage compute
 suite new-720-fragment $NEW $S720 --shading-stage fragment
 suite old-720 $OLD $S720
 
