@@ -96,7 +96,8 @@ struct SpectralState {
 
 /// Bind groups that reference the size-dependent targets.
 struct TargetBindings {
-    /// The shading's inputs with each of its outputs (`Renderer::shading_output`).
+    /// The shading's inputs with each of its outputs ([`ShadingPass::bind_both`]): index 0 where
+    /// the custom pass is skipped (the shading writes `hdr`), 1 where it runs (`hdr_shaded`).
     shading: [wgpu::BindGroup; 2],
     occlusion: wgpu::BindGroup,
     custom: wgpu::BindGroup,
