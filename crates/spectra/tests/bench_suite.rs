@@ -85,3 +85,52 @@ fn suite_without_any_row_fails_and_writes_nothing() {
     assert!(stderr.contains("no row of the suite could be measured"), "{stderr}");
     assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "something was written");
 }
+
+#[test]
+fn bench_runs_the_shading_and_its_reference_in_either_stage() {
+    for stage in ["compute", "fragment"] {
+        let out = bench(&[
+            "cornell",
+            "--env",
+            "default",
+            "--size",
+            "32x24",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+            "--wavelengths",
+            "4",
+            "--reference",
+            "--shading-stage",
+            stage,
+        ]);
+        let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success(), "{stage}: {stderr}\n(no GPU? {})", render::NO_ADAPTER_HELP);
+        assert!(stdout.contains(&format!("; shading pass: {stage}")), "{stage}: {stdout}");
+        for row in ["rgb ", "reference ", "spectral/prefiltered "] {
+            assert!(stdout.lines().any(|l| l.starts_with(row)), "{stage}: no {row}row in {stdout}");
+        }
+    }
+    let out = bench(&["cornell", "--shading-stage", "vertex"]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("expected compute or fragment, got \"vertex\""), "{stderr}");
+    // Every command's default comes from SPECTRA_SHADING_STAGE where it is set.
+    let tiny = ["cornell", "--size", "16x16", "--frames", "1", "--warmup", "0", "--wavelengths", "1"];
+    let with_env = |value: &str| {
+        Command::new(env!("CARGO_BIN_EXE_spectra"))
+            .env("SPECTRA_SHADING_STAGE", value)
+            .arg("bench")
+            .args(tiny)
+            .output()
+            .expect("running spectra bench")
+    };
+    let out = with_env("compute");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("; shading pass: compute"));
+    let out = with_env("vertex");
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("SPECTRA_SHADING_STAGE must be compute or fragment, got \"vertex\""), "{stderr}");
+}
