@@ -456,14 +456,14 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
         key_b = ka + 1u;
         prev_a = ja;
         prev_b = jb;
-        var k = uw_rate(ja, jb, i);
-        var j0 = ja * exp(-k * uw_pz[p]);
         // Below the table the field never grows with depth, from the last node on
-        // (light_field::beyond_rate).
-        if (((uw_beyond >> p) & 1u) != 0u) {
-            k = max(k, vec4<f32>(0.0));
-            j0 = jb * exp(-k * (uw_pz[p] - (uw_depth_node(i + 1u) - uw_depth_node(i))));
-        }
+        // (light_field::beyond_rate). Selects rather than a branch: one exponential where a
+        // CPU driver, running both sides of a branch, evaluated two.
+        let beyond = ((uw_beyond >> p) & 1u) != 0u;
+        let k0 = uw_rate(ja, jb, i);
+        let k = select(k0, max(k0, vec4<f32>(0.0)), beyond);
+        let z_from = select(0.0, uw_depth_node(i + 1u) - uw_depth_node(i), beyond);
+        let j0 = select(ja, jb, beyond) * exp(-k * (uw_pz[p] - z_from));
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
         let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
@@ -509,9 +509,18 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
         a += w[c] * uw_tab(table, UW_L_IRR + i * UW_NNE * UW_NNA + cells[c], group, rgb);
         b += w[c] * uw_tab(table, UW_L_IRR + (i + 1u) * UW_NNE * UW_NNA + cells[c], group, rgb);
     }
+    return uw_log_interp(a, b, i, z);
+}
+
+// Between depth nodes i and i + 1 with values a and b, ln-linear at depth z; below the table
+// never growing, from the last node on (light_field::log_interp). One exponential, where the
+// two sides of a branch were two for a CPU driver.
+fn uw_log_interp(a: vec4<f32>, b: vec4<f32>, i: u32, z: f32) -> vec4<f32> {
     let k = uw_rate(a, b, i);
-    if (z > UW_ZMAX) { return b * exp(-max(k, vec4<f32>(0.0)) * (z - UW_ZMAX)); }
-    return a * exp(-k * (z - uw_depth_node(i)));
+    let beyond = z > UW_ZMAX;
+    let kk = select(k, max(k, vec4<f32>(0.0)), beyond);
+    let z_from = select(uw_depth_node(i), UW_ZMAX, beyond);
+    return select(a, b, beyond) * exp(-kk * (z - z_from));
 }
 
 // The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
@@ -547,10 +556,7 @@ fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> 
     let i = uw_segment(z);
     let a = uw_ed_node(table, i, group, rgb);
     let b = uw_ed_node(table, i + 1u, group, rgb);
-    let k = uw_rate(a, b, i);
-    // Below the table: never growing, from the last node on (light_field::log_interp).
-    if (z > UW_ZMAX) { return b * exp(-max(k, vec4<f32>(0.0)) * (z - UW_ZMAX)); }
-    return a * exp(-k * (z - uw_depth_node(i)));
+    return uw_log_interp(a, b, i, z);
 }
 
 fn uw_prepare(ctx: SurfaceContext) {
