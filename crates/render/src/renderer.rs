@@ -82,6 +82,8 @@ struct SpectralKey {
     quadrature: color::Quadrature,
     scene_generation: u64,
     custom_generation: u64,
+    /// The spectral capture's own frame (`SpectralSetup::for_capture`).
+    capture: bool,
 }
 
 struct SpectralState {
@@ -128,8 +130,8 @@ pub struct SpectralCapture {
     pub edges: Vec<f64>,
     pub quadrature: color::Quadrature,
     /// `data[(y · width + x) · N + k]`: node k's radiance in the scene's relative units (a
-    /// radiance equal to the scene white has Y = 1), before exposure: L(λₖ) exactly with the
-    /// midpoint rule, the node's share of the integral as a radiance with the prefiltered rule
+    /// radiance equal to the scene white has Y = 1), before exposure, the same for every
+    /// observer: L(λₖ) exactly with the midpoint rule, ∫L·φₖ dλ / ∫φₖ dλ with the prefiltered rule
     /// (see [`Renderer::set_spectral_capture`]).
     pub data: Vec<f32>,
 }
@@ -200,6 +202,10 @@ pub struct Renderer {
     /// Bound in place of the capture buffer when not capturing.
     capture_dummy: wgpu::Buffer,
     capture: Option<Capture>,
+    /// The node radiances read back from the capture's own frame (see `render`).
+    captured: Option<SpectralCapture>,
+    /// While the capture's own frame renders: its spectral data (`SpectralSetup::for_capture`).
+    capture_frame: bool,
 }
 
 impl Renderer {
@@ -257,6 +263,8 @@ impl Renderer {
             capture_on: false,
             capture_dummy,
             capture: None,
+            captured: None,
+            capture_frame: false,
             gpu,
             shared,
             gbuffer,
@@ -570,18 +578,21 @@ impl Renderer {
     ///
     /// The shading pass accumulates each node's radiance in weighted form, its X, Y and Z
     /// weights (light × observer × quadrature, `color::quadrature`); the capture stores their
-    /// sum over X, Y and Z and divides it by the point-sampled observer's sum at the node,
-    /// s̄(λₖ)·Δλ (s̄ = x̄ + ȳ + z̄, normalised like the weights). With the midpoint rule every
-    /// weight of node k is the radiance at λₖ times x̄(λₖ)·Δλ, so this is L(λₖ) exactly, and the
-    /// N bins of width Δλ around the nodes integrate back (midpoint rule, the same observer) to
-    /// the frame's XYZ. With the prefiltered rule it is ∫L·s̄·φₖ dλ / (s̄(λₖ)·Δλ), φₖ the node's
-    /// cardinal function: the node's share of ∫L·s̄ expressed as a radiance at λₖ (L itself
-    /// where L and s̄ are flat around λₖ). Integrated back the same way the bins keep the
-    /// frame's X + Y + Z exactly, but not how it splits into X, Y and Z (docs/spectral-exr.md).
+    /// sum over X, Y and Z. So that the values are the scene's radiance whatever the frame's
+    /// observer, the capture comes from a frame of its own rendered with the flat observer
+    /// ([`color::Observer::flat`]: 1 at every wavelength), each node divided by that
+    /// observer's weights of a radiance of one. With the midpoint rule every weight of node k
+    /// is the radiance at λₖ times Δλ, so this is L(λₖ) exactly, and the N bins of width Δλ
+    /// around the nodes integrate back with any observer's midpoint rule to that observer's
+    /// frame. With the prefiltered rule it is ∫L·φₖ dλ / ∫φₖ dλ over the render range, φₖ the
+    /// node's cardinal function: L weighted around λₖ as the node's interpolant sees it (L
+    /// itself where L is smooth there; 1 for a flat spectrum). Dividing an observer's own weights instead (as before) gave
+    /// the node's share of ∫L·s̄ over s̄(λₖ), which a camera nearly blind at a node turned into
+    /// nonsense (−180 at 391 nm for a Nikon D5100).
     /// What the custom hooks add in the shading pass is included (they return weighted form);
     /// pass 3's `custom_pixel` is not (an RGB step, the identity for the built-in hooks). RGB
-    /// mode and jittered nodes are refused; frames cost one more storage write per group and
-    /// pixel.
+    /// mode and jittered nodes are refused. A render with the capture on costs two frames, and
+    /// its image is drawn by the general node loop (as the capture's frame is).
     pub fn set_spectral_capture(&mut self, on: bool) {
         self.capture_on = on;
         if !on {
@@ -595,20 +606,22 @@ impl Renderer {
         check_capture_size(&self.gpu.device.limits(), width, height, wavelengths)
     }
 
-    /// The last frame's spectral capture (see [`Self::set_spectral_capture`]); waits for it.
+    /// The last frame's spectral capture (see [`Self::set_spectral_capture`]).
     pub fn read_spectral_capture(&self) -> Result<SpectralCapture> {
-        let c = self.capture.as_ref().ok_or_else(|| {
+        self.captured.clone().ok_or_else(|| {
             RenderError::Settings("no spectral capture: call set_spectral_capture(true) and render".into())
-        })?;
-        let setup = SpectralSetup::new(&c.settings)?;
+        })
+    }
+
+    /// The capture buffer of the frame just rendered, as radiances (waits for it).
+    fn read_capture_buffer(&self) -> Result<SpectralCapture> {
+        let c = self.capture.as_ref().expect("a capture frame was rendered");
+        let setup = SpectralSetup::for_capture(&c.settings)?;
         let n = setup.len();
         let groups = setup.groups();
-        // The point-sampled observer at each node, (x̄ + ȳ + z̄)(λₖ)·Δλ / k: the midpoint rule's
-        // weights of a radiance of one, whichever rule rendered. (The prefiltered rule's own
-        // weights of a radiance of one are not usable: the first node's is negative, -9e-6 at
-        // N = 15 over 380–730 nm, since the observer is nearly zero where its cardinal function
-        // is positive.)
-        let divisor: Vec<f64> = setup.integrator.weights.iter().map(|w| w[0] + w[1] + w[2]).collect();
+        // The capture's weights of a radiance of one at each node (summed over its three equal
+        // channels): the node spacing, normalised like the frame's weights.
+        let divisor: Vec<f64> = setup.weights_of(|_| 1.0).iter().map(|w| w[0] + w[1] + w[2]).collect();
         let device = &self.gpu.device;
         readback::wait(device)?;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
@@ -648,7 +661,36 @@ impl Renderer {
     }
 
     /// Renders one frame from `camera`. Requires [`Self::set_scene`] and [`Self::resize`].
+    ///
+    /// With the spectral capture on (`set_spectral_capture`), two: the capture's own frame,
+    /// weighted by the flat observer ([`SpectralSetup::for_capture`]; not accumulated, not
+    /// timed), whose node radiances are read back, then the frame asked for, through the same
+    /// general node loop (so that its image is what the capture's loop draws).
     pub fn render(&mut self, camera: &scene::Camera, settings: &RenderSettings) -> Result<()> {
+        self.captured = None;
+        if !self.capture_on {
+            self.capture = None;
+            return self.render_frame(camera, settings, false);
+        }
+        let untimed = RenderSettings { timestamps: false, ..settings.clone() };
+        let accumulating = std::mem::replace(&mut self.accumulating, false);
+        self.capture_frame = true;
+        let radiance = self.render_frame(camera, &untimed, true).and_then(|()| self.read_capture_buffer());
+        self.capture_frame = false;
+        self.accumulating = accumulating;
+        let radiance = radiance?;
+        self.render_frame(camera, settings, true)?;
+        self.captured = Some(radiance);
+        Ok(())
+    }
+
+    /// One frame; `capture`: with the spectral capture's buffer and loop.
+    fn render_frame(
+        &mut self,
+        camera: &scene::Camera,
+        settings: &RenderSettings,
+        capture: bool,
+    ) -> Result<()> {
         if color::cancel::is_cancelled() {
             return Err(RenderError::Cancelled);
         }
@@ -671,7 +713,7 @@ impl Renderer {
             )));
         }
         self.capture = None;
-        if self.capture_on {
+        if capture {
             if settings.mode == Mode::Rgb {
                 return Err(RenderError::Settings(
                     "a spectral capture needs the spectral or naive mode: RGB mode has no wavelengths".into(),
@@ -1051,11 +1093,16 @@ impl Renderer {
             quadrature: settings.quadrature,
             scene_generation: self.scene_generation,
             custom_generation: self.custom_generation,
+            capture: self.capture_frame,
         };
         if self.spectral.as_ref().is_some_and(|s| s.key == key) {
             return Ok(());
         }
-        let setup = SpectralSetup::new(settings)?;
+        let setup = if self.capture_frame {
+            SpectralSetup::for_capture(settings)?
+        } else {
+            SpectralSetup::new(settings)?
+        };
         if settings.mode == Mode::Spectral {
             self.environment.ensure_spectral(&self.gpu.device, &self.gpu.queue, &self.table);
         }

@@ -93,6 +93,10 @@ pub struct SpectralSetup {
     pub xyz_to_rgb: DMat3,
     pub space: RgbColorSpace,
     quad: NodeQuadrature,
+    /// The spectral capture's frame ([`Self::for_capture`]): its weights in place of `quad`'s,
+    /// which still normalises (the white's Y, a spectral light's luminance), so that the
+    /// scene's radiance is the frame's.
+    capture: Option<CaptureWeights>,
     /// The white's Y as every normalisation sees it: this quadrature's, or with jitter the
     /// dense integral's over the render range.
     k: f64,
@@ -178,6 +182,7 @@ impl SpectralSetup {
             xyz_to_rgb,
             space,
             quad,
+            capture: None,
             k,
             dense,
             norm,
@@ -190,6 +195,36 @@ impl SpectralSetup {
 
     pub fn is_empty(&self) -> bool {
         self.wavelengths.is_empty()
+    }
+
+    /// The setup of the spectral capture's frame (`Renderer::set_spectral_capture`): `new`'s,
+    /// its node weights those of a flat observer (1 at every wavelength, in all three
+    /// channels), so that the weighted form of a node carries the radiance alone and the
+    /// capture is the same whatever the frame's observer; what the weights are normalised by
+    /// stays the frame's. With the midpoint rule a light's weight at node k is its emission
+    /// there times Δλ; with the prefiltered rule its integral over the node's bin (the N equal
+    /// bins around the nodes), so that a node's value is the mean over the bin of what the
+    /// lights send, times the surface's factors at the node (its reflectance, the hooks'
+    /// transmittances) — the path tracer's band means (`truth --spectral-out`) where those
+    /// factors are smooth across the bin.
+    pub fn for_capture(settings: &RenderSettings) -> Result<Self> {
+        let mut s = Self::new(settings)?;
+        let nodes = &s.quad.nodes;
+        s.capture = Some(match settings.quadrature {
+            Quadrature::Midpoint => {
+                CaptureWeights::Points { lambda: nodes.lambda.clone(), spacing: nodes.spacing }
+            }
+            Quadrature::Prefiltered => {
+                let (grid, d) = nodes.dense_grid();
+                let n = nodes.len();
+                let bin = grid
+                    .iter()
+                    .map(|&l| (((l - nodes.range.min) / nodes.spacing).floor().max(0.0) as usize).min(n - 1))
+                    .collect();
+                CaptureWeights::Bins { grid, d, bin, n }
+            }
+        });
+        Ok(s)
     }
 
     /// Number of vec4 groups (N rounded up to a multiple of four, over four).
@@ -206,7 +241,11 @@ impl SpectralSetup {
     /// the white illuminant has Y = 1.
     pub fn weights_of(&self, emission: impl Fn(f64) -> f64) -> Vec<[f64; 3]> {
         let k = self.k;
-        self.quad.weights(emission).into_iter().map(|w| w.map(|c| c / k)).collect()
+        let w = match &self.capture {
+            None => self.quad.weights(emission),
+            Some(c) => c.weights(emission),
+        };
+        w.into_iter().map(|w| w.map(|c| c / k)).collect()
     }
 
     /// The white illuminant's normalised node weights (for emissive surfaces).
@@ -345,6 +384,35 @@ impl SpectralSetup {
     /// Y of a linear RGB colour in the output colour space.
     pub fn luminance(&self, rgb: [f64; 3]) -> f64 {
         self.space.luminance(rgb)
+    }
+}
+
+/// The spectral capture's node weights ([`SpectralSetup::for_capture`]): the same in all three
+/// channels (a flat observer), unnormalised.
+#[derive(Clone, Debug)]
+enum CaptureWeights {
+    /// The emission at each node times the node spacing.
+    Points { lambda: Vec<f64>, spacing: f64 },
+    /// The emission integrated over each node's bin: `grid` the dense midpoint grid of step `d`
+    /// over the range, `bin[i]` the bin of its sample i.
+    Bins { grid: Vec<f64>, d: f64, bin: Vec<usize>, n: usize },
+}
+
+impl CaptureWeights {
+    fn weights(&self, emission: impl Fn(f64) -> f64) -> Vec<[f64; 3]> {
+        match self {
+            CaptureWeights::Points { lambda, spacing } => {
+                lambda.iter().map(|&l| [emission(l) * spacing; 3]).collect()
+            }
+            CaptureWeights::Bins { grid, d, bin, n } => {
+                let mut w = vec![[0.0; 3]; *n];
+                for (&l, &b) in grid.iter().zip(bin) {
+                    let e = emission(l) * d;
+                    w[b] = w[b].map(|c| c + e);
+                }
+                w
+            }
+        }
     }
 }
 
