@@ -94,17 +94,20 @@ pub struct SpectralSetup {
     pub space: RgbColorSpace,
     quad: NodeQuadrature,
     /// The spectral capture's frame ([`Self::for_capture`]): its weights in place of `quad`'s,
-    /// which still normalises (the white's Y, a spectral light's luminance), so that the
-    /// scene's radiance is the frame's.
+    /// normalised as the frame's (by `k`; lights scaled by `lum_quad`), so that the scene's
+    /// radiance is the frame's.
     capture: Option<CaptureWeights>,
     /// The white's Y as every normalisation sees it: this quadrature's, or with jitter the
     /// dense integral's over the render range.
     k: f64,
     /// Dense (1 nm over the observer range) integrator for converting spectral lights to RGB.
     dense: SpectralIntegrator,
-    /// With jitter: the dense (1 nm midpoint over the render range) emission integrator that
-    /// every normalisation uses instead of the frame's own nodes.
-    norm: Option<SpectralIntegrator>,
+    /// Luminance (CIE 1931 Y, whatever the frame's observer), as a spectral light's scale
+    /// sees it: on the frame's nodes and rule, over `k_lum` (the white's), or with jitter the
+    /// dense integral over the render range, normalised alike (`lum_norm`).
+    lum_quad: NodeQuadrature,
+    k_lum: f64,
+    lum_norm: Option<SpectralIntegrator>,
 }
 
 impl SpectralSetup {
@@ -122,35 +125,53 @@ impl SpectralSetup {
         // With jitter, normalise with the dense integral over the render range, not these
         // nodes: a ratio of two N-node estimates is biased, so frame averages would not
         // converge (see `RenderSettings::jitter`).
-        let raw = match settings.jitter {
-            None => None,
-            Some(_) => {
-                let n_dense = settings.range.width().round().max(1.0) as usize;
-                let dense_wl = SampledWavelengths::midpoint(settings.range, n_dense)?;
-                Some(SpectralIntegrator {
-                    lambda: dense_wl.lambda.clone(),
-                    weights: dense_wl
-                        .lambda
-                        .iter()
-                        .zip(&dense_wl.weight)
-                        .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl))
-                        .collect(),
-                })
+        let dense_over_range = |observer: &Observer| -> Result<Option<SpectralIntegrator>> {
+            if settings.jitter.is_none() {
+                return Ok(None);
             }
+            let n_dense = settings.range.width().round().max(1.0) as usize;
+            let dense_wl = SampledWavelengths::midpoint(settings.range, n_dense)?;
+            Ok(Some(SpectralIntegrator {
+                lambda: dense_wl.lambda.clone(),
+                weights: dense_wl
+                    .lambda
+                    .iter()
+                    .zip(&dense_wl.weight)
+                    .map(|(&l, &dl)| observer.eval(l).map(|c| c * dl))
+                    .collect(),
+            }))
         };
+        let raw = dense_over_range(&observer)?;
         let integrate = |s: &Spectrum| match &raw {
             None => quad.total(|l| s.eval(l)),
             Some(raw) => raw.integrate(|l| s.eval(l)),
         };
+        // Luminance is CIE 1931's Y whatever the frame's observer (the scene format's convention,
+        // and the path tracer's, `truth::lights`): measured with the frame's nodes and rule (or
+        // with jitter the dense integral), so that for a CIE 1931 frame it is that frame's Y.
+        let cie = Observer::cie1931();
+        let is_cie = observer == cie;
+        let lum_quad = if is_cie {
+            quad.clone()
+        } else {
+            node_quadrature(settings.quadrature, quad.nodes.clone(), &cie)
+        };
+        let lum_raw = dense_over_range(&cie)?;
+        let luminance = |s: &Spectrum| match &lum_raw {
+            None => lum_quad.total(|l| s.eval(l))[1],
+            Some(r) => r.integrate(|l| s.eval(l))[1],
+        };
         // RGB white as the scene white has it: the colour space's illuminant at the scene
         // white's luminance, so the normalisation below is the scene white's (as in truth).
-        let white = space.emission_white(&scene_white, |s| integrate(s)[1]);
-        let sampled_white = integrate(&white);
-        let k = if sampled_white[1] > 0.0 { sampled_white[1] } else { 1.0 };
-        let norm = raw.map(|raw| SpectralIntegrator {
-            weights: raw.weights.iter().map(|w| w.map(|c| c / k)).collect(),
+        let white = space.emission_white(&scene_white, luminance);
+        let white_y = luminance(&white);
+        let k_lum = if white_y > 0.0 { white_y } else { 1.0 };
+        let lum_norm = lum_raw.map(|raw| SpectralIntegrator {
+            weights: raw.weights.iter().map(|w| w.map(|c| c / k_lum)).collect(),
             ..raw
         });
+        let sampled_white = integrate(&white);
+        let k = if sampled_white[1] > 0.0 { sampled_white[1] } else { 1.0 };
         let sampled_white = sampled_white.map(|c| c / k);
         let weights = wavelengths
             .lambda
@@ -172,7 +193,8 @@ impl SpectralSetup {
             color::film::to_linear_srgb(&observer, sampled_white, &white, settings.camera_view)?
         };
         let dense_wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470)?;
-        let dense = SpectralIntegrator::emission(&observer, &white, &dense_wl);
+        // A measured light's colour in the RGB mode: its chromaticity, a CIE 1931 quantity.
+        let dense = SpectralIntegrator::emission(&cie, &white, &dense_wl);
         Ok(SpectralSetup {
             wavelengths,
             quadrature: settings.quadrature,
@@ -185,7 +207,9 @@ impl SpectralSetup {
             capture: None,
             k,
             dense,
-            norm,
+            lum_quad,
+            k_lum,
+            lum_norm,
         })
     }
 
@@ -310,8 +334,8 @@ impl SpectralSetup {
     ) -> Result<Box<dyn Fn(f64) -> f64 + 'a>> {
         let rgb = [e.rgb.x as f64, e.rgb.y as f64, e.rgb.z as f64].map(|c| c * e.intensity as f64);
         if let Some(s) = &e.spectrum {
-            let y = match &self.norm {
-                None => self.quad.total(|l| s.eval(l))[1] / self.k,
+            let y = match &self.lum_norm {
+                None => self.lum_quad.total(|l| s.eval(l))[1] / self.k_lum,
                 Some(norm) => norm.integrate(|l| s.eval(l))[1],
             };
             let want = self.luminance(rgb);
@@ -535,6 +559,48 @@ mod tests {
             }
             let groups = setup.gpu_weights(&setup.light_weights(&e, Mode::Spectral, &table()).unwrap());
             assert_eq!(groups.len(), n.div_ceil(4));
+        }
+    }
+
+    /// A measured light is scaled to its CIE 1931 luminance relative to the white's whatever
+    /// the frame's observer, as the path tracer scales it (`truth::lights`): it was scaled by
+    /// the observer's second channel, so that under a camera or CIE 1964 the two renderers lit
+    /// the scene differently (metamerism with a Nikon D5100 against truth: mean ΔE2000 5.0,
+    /// after 2.5; docs/observers.md).
+    #[test]
+    fn a_measured_light_has_its_cie_1931_luminance_under_every_observer() {
+        let f11 = color::illuminant::by_name("F11").unwrap();
+        let e = Emission { rgb: Vec3::new(0.8, 0.6, 0.3), intensity: 2.0, spectrum: Some(f11.clone()) };
+        let cie = color::Observer::cie1931();
+        let want = RgbColorSpace::srgb().luminance([1.6, 1.2, 0.6]);
+        for quadrature in [Quadrature::Prefiltered, Quadrature::Midpoint] {
+            let mut reference = None;
+            for observer in ["cie1931", "cie1964", "nikon_d5100", "dog"] {
+                let s = RenderSettings {
+                    observer: observer.into(),
+                    quadrature,
+                    white: "A".into(),
+                    ..Default::default()
+                };
+                let setup = SpectralSetup::new(&s).unwrap();
+                let light = setup.light_spectrum(&e, Mode::Spectral, &table()).unwrap();
+                let y = |f: &dyn Fn(f64) -> f64| dense_integral(s.range, &cie, f)[1];
+                let ratio = y(&|l| light(l)) / y(&|l| setup.white.eval(l));
+                eprintln!(
+                    "{observer} {quadrature:?}: the light's Y / the white's {ratio:.6}, rgb's luminance {want:.6}"
+                );
+                // The prefiltered rule integrates densely: the luminance exactly. The midpoint
+                // rule measures on the nodes (F11's lines: 40 % off at N = 16), as a CIE 1931
+                // frame with these nodes does: the same for every observer.
+                if quadrature == Quadrature::Prefiltered {
+                    assert!((ratio / want - 1.0).abs() < 1e-6, "{observer}: {ratio} vs {want}");
+                }
+                let r = *reference.get_or_insert(ratio);
+                assert!(
+                    (ratio / r - 1.0).abs() < 1e-12,
+                    "{observer} {quadrature:?}: {ratio} vs CIE 1931's {r}"
+                );
+            }
         }
     }
 }

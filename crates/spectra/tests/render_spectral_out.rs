@@ -160,15 +160,17 @@ fn prefiltered_bands_are_bin_means_that_reintegrate_to_the_frame() {
 
 /// The bands are the scene's radiance: the same for any observer the frame is rendered with
 /// (a camera nearly blind at the first node made it -180 there, the capture having divided the
-/// camera's own weights by its sensitivity at the node), with either rule. Scenes lit by RGB
-/// lights: a measured light spectrum is scaled to the luminance the frame's observer measures
-/// (`SpectralSetup::light_spectrum`), so there the scene itself changes with the observer.
+/// camera's own weights by its sensitivity at the node), with either rule; `metamerism`'s
+/// measured light spectra included (scaled to their CIE 1931 luminance under every observer).
 #[test]
 fn node_radiances_do_not_depend_on_the_observer() {
     let dir = tempfile::tempdir().unwrap();
-    for (scene, extra) in
-        [("cornell", &[][..]), ("colorchecker", &["--env", "default"][..]), ("underwater", &[][..])]
-    {
+    for (scene, extra) in [
+        ("cornell", &[][..]),
+        ("colorchecker", &["--env", "default"][..]),
+        ("underwater", &[][..]),
+        ("metamerism", &[][..]),
+    ] {
         for q in ["prefiltered", "midpoint"] {
             let mut reference: Option<Vec<f32>> = None;
             for observer in ["cie1931", "nikon_d5100", "canon_eos_r5", "dog"] {
