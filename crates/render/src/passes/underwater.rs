@@ -16,8 +16,8 @@
 //!   downwelling field E0 = Σ_j E_j·μ_j (directional lights j, μ_j the cosine of their direction
 //!   to the downward vertical), minus the unscattered beams inside it, clamped at 0. With
 //!   [`Options::steps`] = 0 the subtraction is off and `L_ss` = 0: exactly the paper's model.
-//! - `L_ss`: single scattering of every directional, point and spot light (the first
-//!   [`SS_LIGHTS`]), Henyey–Greenstein phase [`Options::phase_g`], shadowed through the lights'
+//! - `L_ss`: single scattering of every directional, point and spot light (at most
+//!   [`SS_LIGHTS`]: the brightest as seen from the camera, `uw_marched_lights`), Henyey–Greenstein phase [`Options::phase_g`], shadowed through the lights'
 //!   shadow maps. Directional beams reach depth z as E_j·e^{−c·z/μ_j} (the unscattered beam);
 //!   the ray is cut in M equal segments, visibility taken at each midpoint, the exponential
 //!   integrated exactly within each segment (so an unshadowed ray is exact); a ray to infinity
@@ -51,7 +51,7 @@ pub const HOOKS: &str = include_str!("underwater.wgsl");
 /// dominant wavelengths of the sRGB primaries under D65.
 pub const RGB_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 
-/// Lights that get single scattering (the first ones in the scene); `UW_SS_LIGHTS` in the
+/// Lights that get single scattering (the brightest seen from the camera); `UW_SS_LIGHTS` in the
 /// WGSL, checked by `layout_tests`.
 pub const SS_LIGHTS: usize = 4;
 /// Most march steps; `UW_MAX_STEPS` in the WGSL, checked by `layout_tests`.

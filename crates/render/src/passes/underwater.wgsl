@@ -559,6 +559,39 @@ fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> 
     return uw_log_interp(a, b, i, z);
 }
 
+// The lights that get single scattering, at most UW_SS_LIGHTS of those that can (suns, not
+// the sky stand-ins, and point, spot and polygon lights), 0xffffffff for an empty slot: all of
+// them when they are that few, else the brightest as seen from the camera — a sun by its
+// irradiance, any other light by its intensity at its distance, attenuated by the clearest
+// water's c over it (so a lamp inside the scene is not dropped for being fifth). The same for
+// every pixel (a set that changed from pixel to pixel would draw seams).
+fn uw_marched_lights(cam: vec3<f32>) -> vec4<u32> {
+    var index = vec4<u32>(0xffffffffu);
+    var score = vec4<f32>(-1.0);
+    let scale = uw_params().scale;
+    for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
+        let l = lights[li].pos_kind;
+        var s = dot(lights[li].rgb.rgb, vec3<f32>(0.2126729, 0.7151522, 0.0721750));
+        if (u32(l.w) == 0u) {
+            if (-l.y <= 0.0 || lights[li].cone.z > 0.5) { continue; }
+        } else {
+            let r = length(select(l.xyz, polygon_centroid(li), u32(l.w) == 3u) - cam) * scale;
+            s *= exp(-uw_params().c_min * r) / max(r * r, 1e-4);
+        }
+        // Into the slot of the dimmest kept light, if brighter (the first of equals stays).
+        let low = min(min(score.x, score.y), min(score.z, score.w));
+        if (s > low) {
+            var k = 3u;
+            for (var j = 0u; j < 4u; j++) {
+                if (score[j] == low) { k = j; break; }
+            }
+            index[k] = li;
+            score[k] = s;
+        }
+    }
+    return index;
+}
+
 fn uw_prepare(ctx: SurfaceContext) {
     if (uw_ready) { return; }
     uw_ready = true;
@@ -583,9 +616,11 @@ fn uw_prepare(ctx: SurfaceContext) {
     if (!UW_MARCH || m == 0u) { return; }
     let fm = f32(m);
     let cam = ctx.origin;
+    let marched = uw_marched_lights(cam);
     var n = 0u;
     for (var li = 0u; li < min(frame.n_lights, UW_MAX_LIGHTS); li++) {
         if (n == UW_SS_LIGHTS) { break; }
+        if (!any(marched == vec4<u32>(li))) { continue; }
         let l = lights[li].pos_kind;
         if (u32(l.w) == 0u) {
             // Beam towards the light: its optical path to a point at depth z is c·z/μ. Sky
