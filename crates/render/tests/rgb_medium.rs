@@ -355,6 +355,52 @@ fn rgb_medium_multiple_scattering_matches_the_cpu_model_to_1e_3() {
 /// red and green to zero; in spectral and naive modes a medium that absorbs at every wavelength
 /// leaves the wall black. Before the environment-transmittance hooks the wall kept the
 /// environment's light, attenuated only along the view.
+/// The same through glass: the RGB mode's see-through layer shows, where a refracted ray
+/// leaves the screen, the environment in its direction — which in a medium without end must
+/// pass the medium's hooks too (a glass ball under a uniform sky lit some pixels at full
+/// strength: the Khronos AttenuationTest under `--rgb-medium` had four such pixels, up to 0.23).
+#[test]
+fn the_environment_does_not_reach_through_glass_into_a_medium_without_end() {
+    let mut camera = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 1.0);
+    camera.yfov = 0.9;
+    let mut scene = Scene::empty("test:rgb-medium-glass", camera);
+    scene.meshes.push(Mesh::uv_sphere(Vec3::ZERO, 1.0, 24, 48, 0));
+    scene.materials.push(Material {
+        name: "glass".into(),
+        base_color: Vec4::ONE,
+        roughness: 0.0,
+        ior: 1.5,
+        transmission: Some(scene::transmission::Transmission {
+            factor: 1.0,
+            texture: None,
+            volume: Some(scene::transmission::Volume {
+                thickness: 2.0,
+                thickness_texture: None,
+                attenuation_color: [1.0; 3],
+                attenuation_distance: f32::INFINITY,
+            }),
+            dispersion: 0.0,
+        }),
+        ..Default::default()
+    });
+    scene.environment = Some(scene::Environment::uniform(Vec3::ONE));
+    let mut r = wall_renderer(&scene);
+    let table = common::table();
+    let rgb = RenderSettings { mode: Mode::Rgb, shadows: false, ..Default::default() };
+    let dry = render(&mut r, &scene, &rgb, CustomShader::default());
+    let lit = dry.iter().filter(|p| p[0] > 0.1).count();
+    assert!(lit > 100, "the dry ball shows the sky through it ({lit} pixels)");
+    let absorbing = medium([0.3, 0.15, 0.05], [0.0; 3], Attenuation::Unbounded);
+    let wet = render(
+        &mut r,
+        &scene,
+        &rgb,
+        rgb_medium::shader(&absorbing, &table, &rgb_medium::Options::default()).unwrap(),
+    );
+    let worst = wet.iter().map(|p| p[0].max(p[1]).max(p[2])).fold(0.0f32, f32::max);
+    assert!(worst < 1e-6, "light through the glass from an environment the medium absorbs: {worst}");
+}
+
 #[test]
 fn the_environment_does_not_reach_into_a_medium_without_end() {
     let mut scene = wall_scene();

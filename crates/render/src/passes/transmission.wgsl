@@ -259,8 +259,10 @@ fn landing_pixel(e: Exit) -> vec2<f32> {
 }
 
 // Linear RGB of what a ray leaving the volume sees: the background where it lands (blurred by
-// the roughness), else the environment's radiance in its direction (black without one).
-fn seen_through(e: Exit, roughness: f32) -> vec3<f32> {
+// the roughness), else the environment's radiance in its direction (black without one) times
+// `env_t`, what a medium's hooks let through of it (the background has had them already: in a
+// medium filling the scene the environment was drawn at full strength through the glass).
+fn seen_through(e: Exit, roughness: f32, env_t: vec3<f32>) -> vec3<f32> {
     let at = landing_pixel(e);
     if (at.x >= 0.0) {
         return background_at(at, roughness);
@@ -269,9 +271,9 @@ fn seen_through(e: Exit, roughness: f32) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     if (frame.mode == MODE_RGB) {
-        return env_background(e.dir).rgb;
+        return env_background(e.dir).rgb * env_t;
     }
-    return frame.xyz_to_rgb * env_xyz(env_background(e.dir));
+    return frame.xyz_to_rgb * env_xyz(env_background(e.dir)) * env_t;
 }
 
 // The light arriving at the front surface through the volume, at index `ior`, before the base
@@ -283,7 +285,7 @@ struct Through {
     length: f32,
 };
 
-fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>, ior: f32, thickness: f32) -> Through {
+fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>, ior: f32, thickness: f32, env_t: vec3<f32>) -> Through {
     let e = volume_exit(pix, p, s.normal, view_dir, ior, thickness);
     if (!e.traced) {
         // The slab model: the background behind the offset exit point, as seen from the camera.
@@ -296,7 +298,7 @@ fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>
         }
         return Through(background_at(at, s.roughness), 1.0, thickness);
     }
-    return Through(seen_through(e, s.roughness), e.share, e.length);
+    return Through(seen_through(e, s.roughness, env_t), e.share, e.length);
 }
 
 // Taps of the roughness blur: the centre and two rings of six.
@@ -359,15 +361,19 @@ fn transmitted_rgb(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
         return vec3<f32>(0.0);
     }
     let p = ctx.world_pos;
+    var env_t = vec3<f32>(1.0);
+    if (CUSTOM_ENV_T) {
+        env_t = custom_env_transmittance_rgb(ctx);
+    }
     var light: vec3<f32>;
     if (tr.dispersion > 0.0 && tr.thickness > 0.0) {
         let half_spread = (tr.ior - 1.0) * 0.025 * tr.dispersion;
         for (var c = 0; c < 3; c++) {
-            let th = through_volume(pix, p, s, ctx.view_dir, tr.ior + f32(c - 1) * half_spread, tr.thickness);
+            let th = through_volume(pix, p, s, ctx.view_dir, tr.ior + f32(c - 1) * half_spread, tr.thickness, env_t);
             light[c] = th.rgb[c] * th.share * exp(-tr.absorption[c] * th.length);
         }
     } else {
-        let th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness);
+        let th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness, env_t);
         light = th.rgb * th.share * exp(-tr.absorption * th.length);
     }
     return k * s.base * light;
@@ -412,7 +418,7 @@ fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
     var th = Through(vec3<f32>(0.0), 0.0, 0.0);
     var c_bg = vec4<f32>(0.0);
     if (!disperses) {
-        th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness);
+        th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness, vec3<f32>(1.0));
         c_bg = background_coeffs(th.rgb);
     }
     var xyz = vec3<f32>(0.0);
@@ -420,7 +426,7 @@ fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
         if (disperses) {
             let l = wavelengths[g].lambda;
             let ior = abbe_ior(tr.ior, tr.dispersion, 0.25 * (l.x + l.y + l.z + l.w));
-            th = through_volume(pix, p, s, ctx.view_dir, ior, tr.thickness);
+            th = through_volume(pix, p, s, ctx.view_dir, ior, tr.thickness, vec3<f32>(1.0));
             c_bg = background_coeffs(th.rgb);
         }
         let rho = node_reflectance(c_base, s.base, g);
