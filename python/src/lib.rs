@@ -257,7 +257,7 @@ fn load(
                 env_sun_share: h.env_sun_share,
             },
         };
-        args.load().map_err(|e| {
+        args.load(None).map_err(|e| {
             // The loader's message names the missing file; its type says so too.
             if (is_file && std::fs::symlink_metadata(&name).is_err()) || env_missing {
                 PyFileNotFoundError::new_err(format!("{e:#}"))

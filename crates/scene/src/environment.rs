@@ -578,6 +578,26 @@ pub struct EnvironmentChoice {
     pub no_sun: bool,
     /// `--env-sun-share`: the share of the map's light that makes a region its sun.
     pub sun_share: Option<f32>,
+    /// The scene will be rendered under water (`--water`; a scene's own water settings count
+    /// without it): a scene with no lights then gets a sun, not the default environment, which
+    /// the path tracer cannot let in through the water's surface.
+    pub under_water: bool,
+}
+
+/// The sun a scene with no lights gets under water ([`EnvironmentChoice::apply`]): the built-in
+/// underwater scene's, white (RGB 1, 1, 1) with irradiance π on a plane facing it, from the
+/// direction (0.45, 0.8, 0.3) above the surface, refracted into the water.
+pub fn default_sun_under_water() -> crate::Light {
+    let to_sun = glam::DVec3::new(0.45, 0.8, 0.3).normalize();
+    // Snell at the flat surface: the horizontal part shrinks by the index, the rest points down.
+    let h = glam::DVec3::new(-to_sun.x, 0.0, -to_sun.z) / crate::water::WATER_IOR;
+    let direction = (h - glam::DVec3::Y * (1.0 - h.length_squared()).sqrt()).as_vec3();
+    crate::Light {
+        name: "sun (default, under water)".into(),
+        kind: crate::LightKind::Directional { direction },
+        emission: crate::Emission { rgb: glam::Vec3::ONE, intensity: std::f32::consts::PI, spectrum: None },
+        stands_in_for: None,
+    }
 }
 
 impl EnvironmentChoice {
@@ -591,7 +611,20 @@ impl EnvironmentChoice {
             Some("default") => scene.environment = Some(Environment::default_sky()),
             Some(path) => scene.environment = Some(Environment::load(Path::new(path))?),
             None => {
-                if !LightSources::of(scene).any() {
+                if !LightSources::of(scene).any() && (self.under_water || scene.water.is_some()) {
+                    scene.lights.push(default_sun_under_water());
+                    crate::sky::sync(scene).map_err(|e| EnvironmentError {
+                        file: PathBuf::from(&scene.source),
+                        message: format!("water.sky: {e}"),
+                    })?;
+                    note = Some(format!(
+                        "note: {} has no lights: under water, lighting it with a sun overhead (white, \
+                         irradiance π; the built-in underwater scene's), not the default environment, which \
+                         no light reaches through the water's surface in the path tracer (--env default \
+                         for the real-time renderer's environment lighting)",
+                        scene.source
+                    ));
+                } else if !LightSources::of(scene).any() {
                     scene.environment = Some(Environment::default_sky());
                     note = Some(format!(
                         "note: {} has no lights: lighting it with the default environment (a uniform white \
@@ -798,6 +831,36 @@ mod tests {
         assert!(env.with_rotation_degrees(f32::INFINITY).is_err());
     }
 
+    /// Under water the path tracer lets no environment in through the surface (it refuses
+    /// one), so a scene with no lights gets a sun there — in both renderers, which read the same
+    /// scene — and keeps it out of the air. A sun refracted into water: steeper than in air,
+    /// still a unit vector.
+    #[test]
+    fn a_scene_without_lights_gets_a_sun_under_water() {
+        let mut s = crate::builtin("cornell").unwrap();
+        s.lights.clear();
+        s.materials.iter_mut().for_each(|m| m.emissive = Vec3::ZERO);
+        let mut wet = s.clone();
+        let choice = EnvironmentChoice { under_water: true, ..Default::default() };
+        let note = choice.apply(&mut wet).unwrap().unwrap();
+        assert!(note.contains("under water") && note.contains("sun"), "{note}");
+        assert!(wet.environment.is_none());
+        assert_eq!(wet.lights.len(), 1);
+        let crate::LightKind::Directional { direction } = wet.lights[0].kind else { panic!("a sun") };
+        assert!((direction.length() - 1.0).abs() < 1e-6 && direction.y < -0.8, "{direction}");
+        // The scene's own water counts as under water; an explicit choice is kept.
+        let mut own = crate::builtin("underwater").unwrap();
+        own.lights.clear();
+        own.materials.iter_mut().for_each(|m| m.emissive = Vec3::ZERO);
+        EnvironmentChoice::default().apply(&mut own).unwrap();
+        assert!(own.environment.is_none() && !own.lights.is_empty());
+        let mut asked = s.clone();
+        let choice =
+            EnvironmentChoice { under_water: true, env: Some("default".into()), ..Default::default() };
+        choice.apply(&mut asked).unwrap();
+        assert!(asked.environment.is_some() && asked.lights.is_empty());
+    }
+
     #[test]
     fn a_scene_without_lights_gets_the_default_environment_and_none_warns() {
         let mut s = crate::builtin("cornell").unwrap();
@@ -820,6 +883,7 @@ mod tests {
             rotation: Some(90.0),
             no_sun: false,
             sun_share: None,
+            under_water: false,
         };
         let mut t = lit.clone();
         turned.apply(&mut t).unwrap();
@@ -858,6 +922,7 @@ mod tests {
             rotation: None,
             no_sun: false,
             sun_share: None,
+            under_water: false,
         };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
     }

@@ -486,7 +486,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let name = args.scene.clone().context("give a scene, or --suite")?;
     let scene_args = SceneArgs { scene: name, files: args.files.clone(), env: args.env.clone() };
-    let scene = scene_args.load()?;
+    let scene = scene_args.load(None)?;
     let mut inputs = scene_args.input_files(&scene);
     inputs.extend(args.table.input_files());
     inputs.extend(args.rgb_medium.input_files());

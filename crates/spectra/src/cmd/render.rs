@@ -219,7 +219,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         super::check_output("--spectral-out", sp)?;
     }
-    let scene = args.scene.load()?;
+    let scene = args.scene.load(args.look.water.water.as_deref())?;
     let mut inputs = args.scene.input_files(&scene);
     inputs.extend(args.look.table.input_files());
     inputs.extend(args.look.rgb_medium.input_files());

@@ -55,11 +55,12 @@ impl SceneArgs {
         v
     }
 
-    /// Loads the scene, prints the loader's warnings and applies the environment flags.
-    pub fn load(&self) -> Result<scene::Scene> {
+    /// Loads the scene, prints the loader's warnings and applies the environment flags;
+    /// `water`: `--water`, if given (a scene with no lights is lit otherwise under water).
+    pub fn load(&self, water: Option<&str>) -> Result<scene::Scene> {
         let mut scene = self.files.load(&self.scene)?;
         print_warnings(&scene);
-        self.env.apply(&mut scene)?;
+        self.env.apply(&mut scene, water.is_some())?;
         Ok(scene)
     }
 }
@@ -607,7 +608,8 @@ impl SceneFileArgs {
 pub struct EnvArgs {
     /// Environment light: an equirectangular .hdr or .exr of linear radiance, `default` (a
     /// uniform white D65 sky over a grey ground) or `none`. Default: the scene's own
-    /// (extras.environment), else the default environment when the scene has no lights at all.
+    /// (extras.environment), else the default environment when the scene has no lights at all
+    /// (under water a sun overhead instead: the path tracer lets no environment in there).
     #[arg(long, value_name = "FILE|default|none")]
     pub env: Option<String>,
     /// Multiplies the environment's radiance.
@@ -630,13 +632,14 @@ pub struct EnvArgs {
 impl EnvArgs {
     /// Sets the scene's environment as asked; prints the note (default environment chosen) or
     /// warning (nothing lights the scene) on stderr.
-    pub fn apply(&self, scene: &mut scene::Scene) -> Result<()> {
+    pub fn apply(&self, scene: &mut scene::Scene, under_water: bool) -> Result<()> {
         let choice = scene::environment::EnvironmentChoice {
             env: self.env.clone(),
             intensity: self.env_intensity,
             rotation: self.env_rotation,
             no_sun: self.no_env_sun,
             sun_share: self.env_sun_share,
+            under_water,
         };
         if let Some(note) = choice.apply(scene)? {
             eprintln!("{note}");

@@ -370,7 +370,7 @@ pub fn run(a: Args) -> Result<()> {
             );
         }
     }
-    let scene = a.scene.load()?;
+    let scene = a.scene.load(a.water.water.as_deref())?;
     let mut inputs = a.scene.input_files(&scene);
     inputs.extend(a.table.input_files());
     inputs.extend(a.rgb_medium.input_files());
@@ -708,7 +708,7 @@ mod tests {
         {
             let a = args(flags);
             let mut scene = scene::builtin("cornell").unwrap();
-            a.scene.env.apply(&mut scene).unwrap();
+            a.scene.env.apply(&mut scene, false).unwrap();
             let st = settings(&a, &scene, &srgb_table()).unwrap();
             let w = World::new(&scene, &up, &st.white, st.range, None).unwrap();
             assert_eq!(w.env_map.is_some(), want, "{flags:?}");
@@ -716,7 +716,7 @@ mod tests {
         let mut a = args(&["--env", "default"]);
         a.scene.scene = "underwater".into();
         let mut scene = scene::builtin("underwater").unwrap();
-        a.scene.env.apply(&mut scene).unwrap();
+        a.scene.env.apply(&mut scene, false).unwrap();
         let st = settings(&a, &scene, &srgb_table()).unwrap();
         let e = World::new(&scene, &up, &st.white, st.range, st.medium.as_ref()).err().unwrap();
         assert!(e.to_string().contains("environment map"), "{e}");

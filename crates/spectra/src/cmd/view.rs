@@ -48,7 +48,7 @@ fn display_named(display: Option<std::ffi::OsString>) -> bool {
 
 pub fn run(args: Args) -> Result<()> {
     let size = parse_size(&args.size)?;
-    let scene = args.scene.load()?;
+    let scene = args.scene.load(args.look.water.water.as_deref())?;
     let settings = initial_settings(&args, &scene)?;
     // Bad water is refused before looking for a display (the media are built after it).
     args.look.water.medium(&scene)?;

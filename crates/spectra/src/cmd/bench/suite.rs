@@ -236,7 +236,7 @@ fn load(
     table: &color::upsample::CoeffTable,
 ) -> Result<(scene::Scene, Option<render::CustomShader>, String)> {
     let env = EnvArgs { env: sc.env.map(String::from), ..Default::default() };
-    let scene = SceneArgs { scene: sc.scene.clone(), files: args.files.clone(), env }.load()?;
+    let scene = SceneArgs { scene: sc.scene.clone(), files: args.files.clone(), env }.load(None)?;
     let (custom, under) = bench_media(&scene, None, table)?;
     Ok((scene, custom, under))
 }
