@@ -631,6 +631,14 @@ impl EnvironmentChoice {
                          sky over a grey ground; --env FILE.hdr for another, --env none for none)",
                         scene.source
                     ));
+                } else if LightSources::of(scene).punctual == 0 && !LightSources::of(scene).environment {
+                    // Not an error, but a dark image a user may not expect: say what lights it.
+                    note = Some(format!(
+                        "note: {} has no lights and no environment: it is lit by its emissive surfaces \
+                         alone (their light reaches only what they face; --env default adds the default \
+                         environment)",
+                        scene.source
+                    ));
                 }
             }
         }
@@ -895,7 +903,10 @@ mod tests {
         let mut lamp_only = lit.clone();
         lamp_only.lights.clear();
         assert!(LightSources::of(&lamp_only).emitters_light(), "{:?}", LightSources::of(&lamp_only));
-        assert!(EnvironmentChoice::default().apply(&mut lamp_only.clone()).unwrap().is_none());
+        let mut lit_by_lamp = lamp_only.clone();
+        let note = EnvironmentChoice::default().apply(&mut lit_by_lamp).unwrap().unwrap();
+        assert!(note.contains("emissive surfaces alone") && note.contains("--env default"), "{note}");
+        assert!(lit_by_lamp.environment.is_none());
         let mut glow = lamp_only.clone();
         glow.materials.iter_mut().for_each(|m| m.emissive *= 1e-4);
         assert!(!LightSources::of(&glow).emitters_light());

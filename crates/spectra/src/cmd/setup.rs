@@ -290,6 +290,28 @@ pub struct SpectrumArgs {
     pub camera_to_display: bool,
 }
 
+/// A warning when the render range holds less than 1 % of what the observer sees over
+/// 360–830 nm (its three sensitivities summed, 1 nm midpoint rule): such an image is black
+/// (780–830 nm under CIE 1931) or normalised up from almost nothing, never the scene's colour.
+pub fn range_warning(obs: &color::Observer, name: &str, range: WavelengthRange) -> Option<String> {
+    let seen = |lo: f64, hi: f64| -> f64 {
+        let n = (hi - lo).ceil().max(1.0) as usize;
+        let d = (hi - lo) / n as f64;
+        (0..n).map(|i| obs.eval(lo + (i as f64 + 0.5) * d).iter().sum::<f64>() * d).sum()
+    };
+    let all = seen(color::spectrum::LAMBDA_MIN, color::spectrum::LAMBDA_MAX);
+    let share = seen(range.min, range.max) / all;
+    (all > 0.0 && share < 0.01).then(|| {
+        format!(
+            "warning: observer {name} sees only {:.2} % of its 360–830 nm response inside the render range {}–{} nm: \
+             the image will be black or its colours meaningless; widen --range",
+            100.0 * share,
+            range.min,
+            range.max
+        )
+    })
+}
+
 /// [`SpectrumArgs`] with the scene's defaults and the renderers' filled in, checked.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Spectrum {
@@ -337,6 +359,9 @@ impl SpectrumArgs {
                     range.min, range.max
                 );
             }
+        }
+        if let Some(w) = range_warning(&obs, &observer, range) {
+            eprintln!("{w}");
         }
         let white = self.white.clone().unwrap_or_else(|| scene.spectral.white_name().to_string());
         color::illuminant::by_name(&white).with_context(|| from("--white", &self.white))?;
@@ -651,6 +676,17 @@ impl EnvArgs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_range_the_observer_barely_sees_is_warned_about() {
+        let cie = color::Observer::cie1931();
+        let r = |a, b| WavelengthRange::new(a, b).unwrap();
+        let w = range_warning(&cie, "cie1931", r(780.0, 830.0)).unwrap();
+        assert!(w.contains("780–830") && w.contains("--range"), "{w}");
+        assert!(range_warning(&cie, "cie1931", r(360.0, 361.0)).is_some());
+        assert!(range_warning(&cie, "cie1931", r(380.0, 730.0)).is_none());
+        assert!(range_warning(&cie, "cie1931", r(550.0, 560.0)).is_none());
+    }
 
     #[test]
     fn sizes() {
