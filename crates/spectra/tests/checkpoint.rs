@@ -111,6 +111,13 @@ fn checkpoints_that_do_not_fit_are_refused() {
         &["r.exr.checkpoint", "different render", "seed is 5 there and 6 here"],
     );
     refused(&["--resume", "--spp", "601"], &["r.exr.checkpoint", "601"]);
+    // Spectral bands the interrupted run did not have (or the other way round, where the
+    // checkpoint is the larger file): named as such, not as a hash.
+    let sp = dir.path().join("s.exr");
+    refused(
+        &["--resume", "--spectral-out", sp.to_str().unwrap()],
+        &["r.exr.checkpoint", "spectral bands (--spectral-out) is none there"],
+    );
     let bytes = std::fs::read(&ckpt).unwrap();
     std::fs::write(&ckpt, &bytes[..bytes.len() - 9]).unwrap();
     refused(&["--resume"], &["r.exr.checkpoint", "truncated"]);

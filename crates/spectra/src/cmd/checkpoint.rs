@@ -80,6 +80,39 @@ pub fn read(path: &Path, record: &[(String, String)], st: &Settings) -> Result<A
     read_sums(path, st, &bad, "remove it to start over", &check)
 }
 
+/// Spectral bands per pixel of a render's accumulator.
+fn bands_of(acc: &Accumulator) -> usize {
+    if acc.xyz.is_empty() { 0 } else { acc.bins.len() / acc.xyz.len() }
+}
+
+/// What separates a stored header's pixels or bands from this render's.
+fn differs(h: &Header, st: &Settings, fresh: &Accumulator) -> String {
+    if h.window != window(st) {
+        return format!(
+            "it holds the pixels {:?} (x, y, width, height), this render {:?}",
+            h.window,
+            window(st)
+        );
+    }
+    let here = bands_of(fresh);
+    format!(
+        "it holds {} spectral bands, this render {here}: give the interrupted run's --spectral-out and \
+         --spectral-bin (or none, if it had none)",
+        h.bands
+    )
+}
+
+/// The header of a file too large to read whole, unchecked (its signature covers the whole
+/// file): only to say why it does not fit, never to resume from.
+fn read_header(path: &Path) -> Option<Header> {
+    use std::io::Read;
+    let mut head = Vec::new();
+    std::fs::File::open(path).ok()?.take((MAGIC.len() + 8 + (1 << 20)) as u64).read_to_end(&mut head).ok()?;
+    let body = head.strip_prefix(MAGIC)?;
+    let len = u64::from_le_bytes(body.get(..8)?.try_into().ok()?) as usize;
+    serde_json::from_slice(body.get(8..8usize.checked_add(len)?)?).ok()
+}
+
 /// Accepts a stored record, the samples of the render it was written for and the samples done.
 pub type CheckStored<'a> = dyn Fn(&[(String, String)], u32, u32) -> Result<()> + 'a;
 
@@ -97,7 +130,20 @@ pub fn read_sums(
     let fresh = Accumulator::new(st)?;
     let floats = fresh.xyz.len() * 3 + fresh.bins.len();
     let cap = (MAGIC.len() + 8 + (1 << 20) + 8 * floats + color::signature::LEN) as u64;
-    let bytes = color::input::read_regular(path, cap).map_err(|e| bad(format!("cannot read it: {e}")))?;
+    let bytes = match color::input::read_regular(path, cap) {
+        Ok(b) => b,
+        Err(e) => {
+            // Larger than this render's: from its header, say which setting made it so (the
+            // usual one: spectral bands that this render was not asked for).
+            if let Some(h) = read_header(path) {
+                check(&h.record, h.spp, h.done)?;
+                if h.window != window(st) || h.bands != bands_of(&fresh) {
+                    return Err(bad(differs(&h, st, &fresh)));
+                }
+            }
+            return Err(bad(format!("cannot read it: {e}")));
+        }
+    };
     let damaged = || bad(format!("truncated or damaged (its signature does not match); {fix}"));
     let signed = color::signature::payload(&bytes, bytes.len().saturating_sub(color::signature::LEN))
         .ok_or_else(damaged)?;
@@ -106,16 +152,8 @@ pub fn read_sums(
     let json = body.get(8..8usize.saturating_add(len)).filter(|_| len <= 1 << 20).ok_or_else(damaged)?;
     let header: Header = serde_json::from_slice(json).map_err(|e| bad(format!("unreadable header: {e}")))?;
     check(&header.record, header.spp, header.done)?;
-    if header.window != window(st) {
-        return Err(bad(format!(
-            "it holds the pixels {:?} (x, y, width, height), this render {:?}",
-            header.window,
-            window(st)
-        )));
-    }
-    let expect_bands = if fresh.xyz.is_empty() { 0 } else { fresh.bins.len() / fresh.xyz.len() };
-    if header.bands != expect_bands {
-        return Err(bad(format!("it holds {} bands, this render {expect_bands}", header.bands)));
+    if header.window != window(st) || header.bands != bands_of(&fresh) {
+        return Err(bad(differs(&header, st, &fresh)));
     }
     let sums = &body[8 + len..];
     if sums.len() != 8 * floats {

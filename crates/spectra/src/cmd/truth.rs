@@ -311,7 +311,20 @@ pub fn record_difference(
     let differs = |k: &str| get(there, k) != get(here, k);
     let setting = keys.iter().find(|k| k.starts_with("spectra.setting.") && differs(k));
     let k = setting.or_else(|| keys.iter().find(|k| differs(k)))?;
-    Some((k.trim_start_matches("spectra.setting.").to_string(), get(there, k), get(here, k)))
+    let name = k.trim_start_matches("spectra.setting.");
+    // Hashes say only that something differs: name what it stands for.
+    if name == "bands" {
+        let said = |v: String| if v == "(absent)" { "none".to_string() } else { format!("some (bins {v})") };
+        return Some(("spectral bands (--spectral-out)".into(), said(get(there, k)), said(get(here, k))));
+    }
+    if let Some(i) = name.strip_prefix("input") {
+        return Some((
+            format!("the contents of the scene's input file {i} (content hash)"),
+            get(there, k),
+            get(here, k),
+        ));
+    }
+    Some((name.to_string(), get(there, k), get(here, k)))
 }
 
 /// Version of the `spectra.*` attributes' meaning.
