@@ -13,6 +13,10 @@
 //! the camera path, the 1/η² of the radiance's change of solid angle (pbrt-v4's convention:
 //! non-symmetric scattering, camera paths carry radiance).
 //!
+//! An *index-matched* interface (η = 1, `KHR_materials_ior` 1.0) reflects nothing and sends
+//! every microfacet's refraction straight on, whatever the roughness: a delta, sampled as
+//! such and evaluated as zero (pbrt-v4's `eta == 1` case).
+//!
 //! A *thin-walled* surface (no `KHR_materials_volume`) is a sheet whose two interfaces cancel:
 //! its transmission lobe is the reflection lobe mirrored through the surface, with 1 − F of
 //! the light (no 1/η², no inside).
@@ -36,7 +40,15 @@ pub struct DielectricSample {
     pub f: Vec4,
     pub pdf: f32,
     pub transmitted: bool,
+    /// A delta (an index-matched interface's straight pass): `f`·|cos θ|/`pdf` is its weight,
+    /// and neither [`Dielectric::eval`] nor [`Dielectric::pdf`] sees it.
+    pub specular: bool,
 }
+
+/// |η − 1| under which an interface counts as index-matched. Within it the rough refraction
+/// lobe is under 10⁻⁴ rad wide and reflects under 10⁻⁸, and nearer 1 its half vector
+/// wo + η·wi drowns in rounding (pdfs past 10¹⁹, lost samples).
+const INDEX_MATCHED: f32 = 1e-4;
 
 fn fresnel(cos_i: f32, eta: f32) -> f32 {
     scene::transmission::fresnel_dielectric(f64::from(cos_i), f64::from(eta)) as f32
@@ -55,6 +67,12 @@ pub fn refract(wo: Vec3, m: Vec3, eta: f32) -> Option<Vec3> {
 }
 
 impl Dielectric {
+    /// Equal indices on both sides (not a thin sheet, whose transmission is the mirrored
+    /// reflection lobe): wi = −wo, with no reflection.
+    pub fn index_matched(&self) -> bool {
+        !self.thin && (self.eta - 1.0).abs() < INDEX_MATCHED
+    }
+
     fn d(&self, m: Vec3) -> f32 {
         if m.z <= 0.0 {
             return 0.0;
@@ -89,9 +107,9 @@ impl Dielectric {
     }
 
     /// The microfacet normal between `wo` and `wi`, and whether `wi` is a transmission; `None`
-    /// for a pair no microfacet connects.
+    /// for a pair no microfacet connects (any pair, across an index-matched interface).
     fn half(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, bool)> {
-        if wi.z == 0.0 || wo.z <= 0.0 {
+        if wi.z == 0.0 || wo.z <= 0.0 || self.index_matched() {
             return None;
         }
         let transmitted = wi.z < 0.0;
@@ -156,6 +174,16 @@ impl Dielectric {
         if wo.z <= 0.0 {
             return None;
         }
+        if self.index_matched() {
+            let wi = -wo;
+            return Some(DielectricSample {
+                wi,
+                f: self.tint / (self.eta * self.eta * wi.z.abs()),
+                pdf: 1.0,
+                transmitted: true,
+                specular: true,
+            });
+        }
         let m = crate::bsdf::visible_normal(self.alpha, wo, u);
         let f = fresnel(wo.dot(m), self.eta);
         let r = 2.0 * wo.dot(m) * m - wo;
@@ -178,6 +206,7 @@ impl Dielectric {
             f: self.eval(wo, wi),
             pdf,
             transmitted,
+            specular: false,
         })
     }
 }
@@ -316,6 +345,41 @@ mod tests {
             let f2 = glass(0.4, 1.0 / 1.5, false).eval(-c, -a).x;
             assert!(f1 > 0.0, "no transmission for {a} → {c}");
             assert!((f1 * 1.5 * 1.5 - f2).abs() <= 1e-4 * f2, "{f1}·η² = {} vs {f2}", f1 * 2.25);
+        }
+    }
+
+    /// IOR 1.0 (η = 1), the pair a render of TransmissionRoughnessTest's IOR 1.0 row met: wi is
+    /// −wo but for one ulp in z. The refraction's half vector wo + η·wi was rounding noise and
+    /// its pdf 4.3·10¹⁹, which MIS against the environment's pdf squared past f32's range:
+    /// ∞/∞ = NaN. An index-matched interface is a delta no pair of directions evaluates.
+    #[test]
+    fn an_index_matched_pair_has_no_runaway_pdf() {
+        let b = glass(1e-3, 1.0, false);
+        let wo = Vec3::new(0.58109576, -0.6474817, 0.49304697);
+        let wi = Vec3::new(-0.58109576, 0.6474817, -0.49304703);
+        let pdf = b.pdf(wo, wi);
+        let mis = crate::sampling::power_heuristic(pdf, 0.03183099);
+        assert!(mis.is_finite(), "pdf {pdf}: MIS weight {mis}");
+        assert_eq!((pdf, b.eval(wo, wi)), (0.0, Vec4::ZERO));
+    }
+
+    /// Sampled, an index-matched interface (smooth or rough, at any angle) lets all the light
+    /// straight through as a delta of weight the tint; the rough model lost two thirds of it to
+    /// half vectors that rounded to zero.
+    #[test]
+    fn an_index_matched_interface_passes_light_straight_through() {
+        let tint = Vec4::new(0.5, 0.7, 0.9, 1.0);
+        let mut s = Sampler::new(11, 12);
+        for alpha in [1e-3, 0.3, 1.0] {
+            let b = Dielectric { tint, alpha, eta: 1.0, thin: false };
+            for theta in [0.0f32, 0.5, 1.0, 1.5] {
+                let wo = dir(theta, 0.7);
+                for _ in 0..1000 {
+                    let x = b.sample(wo, s.uniform(), s.next2()).expect("no sample");
+                    assert!(x.specular && x.transmitted && x.wi == -wo, "α {alpha} θ {theta}: {}", x.wi);
+                    assert!((x.f * x.wi.z.abs() / x.pdf - tint).abs().max_element() < 1e-6);
+                }
+            }
         }
     }
 }

@@ -394,8 +394,13 @@ impl Integrator<'_, '_> {
 
             let lo = frame.to_local(wo);
             let (wi, crossed) = if let Some((d, wt)) = glass {
+                // A delta lobe's weight, when the dielectric sampled one.
+                let mut delta = None;
                 let (wi, crossed) = if rng.uniform() < wt {
                     let Some(x) = d.sample(lo, rng.uniform(), rng.next2()) else { break };
+                    if x.specular {
+                        delta = Some(x.f * (x.wi.z.abs() / x.pdf));
+                    }
                     (frame.to_world(x.wi), x.transmitted)
                 } else {
                     let Some(x) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
@@ -404,13 +409,21 @@ impl Integrator<'_, '_> {
                 if (ng.dot(wi) <= 0.0) != crossed {
                     break;
                 }
-                // The mixture's value and pdf (a one-sample estimate of both lobes).
-                let (fv, pdf) = vtx.eval(wo, wi);
-                if pdf <= 0.0 || !pdf.is_finite() {
-                    break;
+                if let Some(weight) = delta {
+                    // Chosen with probability wt, weighing wt: its own weight. No other lobe
+                    // and no light sampling can find its direction (prev_pdf = 0, full MIS
+                    // weight to what it hits).
+                    f *= weight;
+                    prev_pdf = 0.0;
+                } else {
+                    // The mixture's value and pdf (a one-sample estimate of both lobes).
+                    let (fv, pdf) = vtx.eval(wo, wi);
+                    if pdf <= 0.0 || !pdf.is_finite() {
+                        break;
+                    }
+                    f *= fv / pdf;
+                    prev_pdf = pdf;
                 }
-                f *= fv / pdf;
-                prev_pdf = pdf;
                 (wi, crossed)
             } else {
                 let Some(bs) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };

@@ -64,18 +64,19 @@ fn mean_radiance(integ: &Integrator, o: Vec3, dirs: &[Vec3], wl: &Wavelengths, n
     (Vec4::from_array(mean.map(|v| v as f32)), Vec4::from_array(se.map(|v| v as f32)))
 }
 
-/// A clear glass sphere (smooth and rough, index 1.5, with and without a strong dispersion) in
-/// a uniform white environment: every path that leaves brings back the environment's radiance,
-/// so the sphere must look like the environment (a furnace) to within 1 %.
+/// A clear glass sphere (smooth and rough, index 1.5, with and without a strong dispersion, and
+/// rough at index 1.0: index-matched, invisible) in a uniform white environment: every path
+/// that leaves brings back the environment's radiance, so the sphere must look like the
+/// environment (a furnace) to within 1 %.
 #[test]
 fn a_glass_sphere_in_a_furnace_keeps_energy() {
     let range = WavelengthRange::VISIBLE;
     let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.4);
     let env = Vec4::from_array(wl.0.to_array().map(|l| d65().eval(f64::from(l)) as f32));
-    for (roughness, dispersion) in [(0.0, 0.0), (0.2, 0.0), (0.0, 2.0)] {
+    for (ior, roughness, dispersion) in [(1.5, 0.0, 0.0), (1.5, 0.2, 0.0), (1.5, 0.0, 2.0), (1.0, 0.3, 0.0)] {
         let scene = scene_with(
             vec![sphere(Vec3::ZERO, 1.0, 96, 0)],
-            vec![glass(1.5, roughness, Some(clear(2.0)), dispersion)],
+            vec![glass(ior, roughness, Some(clear(2.0)), dispersion)],
             vec![],
         );
         let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap().with_environment(&d65());
@@ -90,7 +91,7 @@ fn a_glass_sphere_in_a_furnace_keeps_energy() {
             let rel = (m[j] / env[j] - 1.0).abs();
             assert!(
                 rel <= 0.01 && (m[j] - env[j]).abs() <= 5.0 * se[j] + 0.005 * env[j],
-                "roughness {roughness}, dispersion {dispersion}, lane {j}: {} ± {} vs {} ({:.2} %)",
+                "η {ior}, roughness {roughness}, dispersion {dispersion}, lane {j}: {} ± {} vs {} ({:.2} %)",
                 m[j],
                 se[j],
                 env[j],
