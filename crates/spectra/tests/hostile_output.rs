@@ -202,3 +202,17 @@ fn outputs_never_overwrite_inputs_each_other_or_devices() {
     refused(&["render", "cornell", "--env", &env, "--size", "8x8", "--out", &env], &["--env file"]);
     assert_eq!(std::fs::read(&a).unwrap(), before);
 }
+
+/// The demo writes a folder: a file in its place is refused by name, and a scene that cannot
+/// be loaded leaves no empty folder behind.
+#[test]
+fn the_demo_refuses_a_file_for_its_folder_and_leaves_nothing_for_a_bad_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = p_(dir.path(), "taken");
+    std::fs::write(&file, b"mine").unwrap();
+    refused(&["demo", "--out", &file], &["--out", "taken", "folder"]);
+    assert_eq!(std::fs::read(&file).unwrap(), b"mine");
+    let folder = p_(dir.path(), "demo");
+    refused(&["demo", "--scene", &p_(dir.path(), "missing.gltf"), "--out", &folder], &["missing.gltf"]);
+    assert!(!std::path::Path::new(&folder).exists(), "an empty folder was left behind");
+}

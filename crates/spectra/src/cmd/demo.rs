@@ -54,6 +54,14 @@ fn path_str(p: &Path) -> Result<&str> {
 }
 
 pub fn run(a: Args) -> Result<()> {
+    if a.out.exists() && !a.out.is_dir() {
+        anyhow::bail!(
+            "--out {}: a file is there; the demo writes a folder of images (give a folder)",
+            a.out.display()
+        );
+    }
+    // A scene that cannot be loaded is refused before the folder is made.
+    a.files.load(&a.scene)?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let file = |name: &str| a.out.join(name);
     let spp = a.spp.to_string();
