@@ -635,8 +635,8 @@ impl EnvironmentChoice {
                     // Not an error, but a dark image a user may not expect: say what lights it.
                     note = Some(format!(
                         "note: {} has no lights and no environment: it is lit by its emissive surfaces \
-                         alone (their light reaches only what they face; --env default adds the default \
-                         environment)",
+                         alone (their light reaches only what they face; --env default adds a sky around \
+                         it)",
                         scene.source
                     ));
                 }
