@@ -57,8 +57,9 @@ def load(
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
-    without lights gets the default environment. `allow_outside_scene_dir`: let the file's
-    references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"
+    without lights gets the default environment (rendered with `water=`, by `Renderer` or
+    `truth`, a sun overhead instead, as `spectra render FILE --water` lights it).
+    `allow_outside_scene_dir`: let the file's references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"
     (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y; `env_sun`:
     the map's sun, where it has one, as a shadowed directional light in real time (False:
     `--no-env-sun`). Raises

@@ -102,6 +102,12 @@ fn rgb_array<'py>(
 #[pyclass(frozen, module = "spectra")]
 struct Scene {
     inner: Arc<scene::Scene>,
+    /// Whether `load` chose the environment because the scene has no lights (no `env` given):
+    /// rendered under water such a scene gets a sun instead, as `spectra render --water` and
+    /// `spectra truth --water` choose (`EnvironmentChoice::under_water`).
+    auto_env: bool,
+    /// The scene as chosen for a render under water, made on first use (`auto_env` only).
+    wet: std::sync::OnceLock<Arc<scene::Scene>>,
     /// `load`'s arguments, so that a pickled scene (a Ray task's argument) loads again where it
     /// is unpickled: the name or path, then the options in `load`'s order.
     how: LoadArgs,
@@ -117,6 +123,31 @@ struct LoadArgs {
     env_rotation: Option<f32>,
     env_sun: bool,
     env_sun_share: Option<f32>,
+}
+
+impl Scene {
+    /// The scene as `spectra render` / `truth` would have loaded it with or without `--water`:
+    /// only a scene whose environment `load` chose (it has no lights) differs, getting the
+    /// underwater sun in place of the default sky.
+    fn chosen_for(&self, under_water: bool) -> PyResult<Arc<scene::Scene>> {
+        if !under_water || !self.auto_env {
+            return Ok(self.inner.clone());
+        }
+        if let Some(s) = self.wet.get() {
+            return Ok(s.clone());
+        }
+        let mut s = (*self.inner).clone();
+        s.environment = None;
+        let env = setup::EnvArgs {
+            env: None,
+            env_intensity: self.how.env_intensity,
+            env_rotation: self.how.env_rotation,
+            no_env_sun: !self.how.env_sun,
+            env_sun_share: self.how.env_sun_share,
+        };
+        env.apply(&mut s, true).map_err(|e| PyErr::from(value(e)))?;
+        Ok(self.wet.get_or_init(|| Arc::new(s)).clone())
+    }
 }
 
 #[pymethods]
@@ -170,10 +201,11 @@ impl Scene {
     }
 }
 
-/// The scene `obj` (a `Scene`), or a `TypeError`.
-fn scene_of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Arc<scene::Scene>> {
+/// The scene `obj` (a `Scene`) as chosen for a render in water when `under_water` (the
+/// `water` argument was given), or a `TypeError`.
+fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<Arc<scene::Scene>> {
     match obj.extract::<PyRef<'_, Scene>>() {
-        Ok(s) => Ok(s.inner.clone()),
+        Ok(s) => s.chosen_for(under_water),
         Err(_) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
             "{what} must be a spectra.Scene (from spectra.load), not {}",
             obj.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "that".into())
@@ -188,7 +220,8 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Arc<scene::Scene>> {
 /// environment maps) leave its folder (off by default, as on the command line).
 /// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
-/// environment when the scene has no lights. `env_intensity` multiplies it, `env_rotation`
+/// environment when the scene has no lights (rendered with `water`, by `Renderer` or `truth`, the
+/// underwater sun instead, as `spectra render FILE --water` chooses). `env_intensity` multiplies it, `env_rotation`
 /// turns it about +Y (degrees). `env_sun`: light the map's sun, where it has one, in real time
 /// as a shadowed directional light (`False`: `--no-env-sun`, the whole map unshadowed);
 /// `env_sun_share`: the share of the map's light a compact bright region must give to be that
@@ -239,7 +272,7 @@ fn load(
         env_sun_share,
     };
     let h = LoadArgs { env, ..how.clone() };
-    let scene = py.detach(move || -> Result<scene::Scene, PyErr> {
+    let scene = py.detach(move || -> Result<(scene::Scene, bool), PyErr> {
         let lower = name.to_ascii_lowercase();
         let is_file = lower.ends_with(".gltf") || lower.ends_with(".glb");
         let env_missing = h.env.as_deref().is_some_and(|e| {
@@ -257,16 +290,25 @@ fn load(
                 env_sun_share: h.env_sun_share,
             },
         };
-        args.load(None).map_err(|e| {
+        let fail = |e: anyhow::Error| -> PyErr {
             // The loader's message names the missing file; its type says so too.
             if (is_file && std::fs::symlink_metadata(&name).is_err()) || env_missing {
                 PyFileNotFoundError::new_err(format!("{e:#}"))
             } else {
                 value(e).into()
             }
-        })
+        };
+        // `SceneArgs::load` in two steps, to know whether the environment is `load`'s choice.
+        let mut scene = args.files.load(&args.scene).map_err(fail)?;
+        setup::print_warnings(&scene);
+        let auto_env = args.env.env.is_none()
+            && scene.water.is_none()
+            && !scene::environment::LightSources::of(&scene).any();
+        args.env.apply(&mut scene, false).map_err(fail)?;
+        Ok((scene, auto_env))
     })?;
-    Ok(Scene { inner: Arc::new(scene), how })
+    let (scene, auto_env) = scene;
+    Ok(Scene { inner: Arc::new(scene), auto_env, wet: std::sync::OnceLock::new(), how })
 }
 
 /// The CLI's `LookArgs` with every default (`spectra render SCENE` without options).
@@ -318,7 +360,7 @@ impl Renderer {
         depth: Option<f64>,
         rgb_medium: Option<String>,
     ) -> PyResult<Self> {
-        let sc = scene_of(scene, "scene")?;
+        let sc = scene_of(scene, "scene", water.is_some())?;
         let scene_obj: Py<Scene> = scene.extract()?;
         let (w, h) = size_arg(size)?;
         let water = setup::WaterArgs { water, depth };
@@ -688,7 +730,7 @@ fn truth_image<'py>(
     spectral_bin: Option<f64>,
     camera_to_display: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let sc = scene_of(scene, "scene")?;
+    let sc = scene_of(scene, "scene", water.is_some())?;
     let a = TruthArgs::new(
         spp,
         size,
@@ -760,7 +802,7 @@ fn truth_sums<'py>(
     threads: Option<i64>,
     dry_run: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
-    let sc = scene_of(scene, "scene")?;
+    let sc = scene_of(scene, "scene", water.is_some())?;
     let a = TruthArgs::new(
         spp,
         size,

@@ -597,3 +597,63 @@ def test_a_camera_balanced_and_through_its_fit_equals_the_cli(tmp_path, cornell,
         assert np.array_equal(read_exr(tout).view(np.uint32), t.view(np.uint32))
         views[flag] = py
     assert np.abs(views[True] - views[False]).max() > 1e-3
+
+
+def _unlit_quad_gltf(path):
+    """A glTF with one quad facing a camera and no lights (the loader's default environment)."""
+    import base64
+    import json
+    import struct
+
+    pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
+    nrm = [0, 0, 1] * 4
+    idx = [0, 1, 2, 0, 2, 3]
+    data = struct.pack("<12f", *pos) + struct.pack("<12f", *nrm) + struct.pack("<6H", *idx)
+    gltf = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.5, 0.3, 1], "metallicFactor": 0}}],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 96, "byteLength": 12}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
+    path.write_text(json.dumps(gltf))
+    return path
+
+
+def test_a_scene_without_lights_under_water_is_lit_as_the_cli_lights_it(tmp_path):
+    """`load` picks the default sky for a scene without lights; rendered with `water=` it gets
+    the underwater sun instead, as `spectra render FILE --water` chooses (the choice is made
+    when the water is known, not at load)."""
+    import pickle
+
+    f = str(_unlit_quad_gltf(tmp_path / "quad.gltf"))
+    s = spectra.load(f)
+    exe = spectra_bin()
+    env = {**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))}
+    for water, out in ((None, tmp_path / "dry.exr"), ("IB", tmp_path / "wet.exr")):
+        args = [exe, "render", f, "--size", "16x12", "--wavelengths", "4", "--out", str(out)]
+        if water:
+            args += ["--water", water, "--depth", "5"]
+        subprocess.run(args, check=True, env=env)
+        for scene in (s, pickle.loads(pickle.dumps(s))):
+            py = spectra.Renderer(scene, size=(16, 12), water=water, depth=5 if water else None)
+            img = py.render(wavelengths=4)
+            cli = read_exr(out)
+            assert np.array_equal(cli.view(np.uint32), img.view(np.uint32)), (water, np.abs(cli - img).max())
+            assert img.mean() > 0
+    # The path tracer takes the same scene: a sun, which it can refract through the surface.
+    t = spectra.truth(s, spp=1, size=(8, 6), direct_only=True, water="IB", depth=5)
+    assert np.isfinite(t).all() and t.mean() > 0
