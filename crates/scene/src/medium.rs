@@ -264,6 +264,36 @@ impl RgbMedium {
         std::array::from_fn(|i| self.absorption[i] + self.scattering[i])
     }
 
+    /// A warning when this medium, filling `scene`, leaves it dark: the environment and
+    /// directional lights are infinitely far, so none of their light reaches into a medium
+    /// without end that has extinction in every channel (both renderers, docs/rgb-media.md); a
+    /// scene lit by them alone is black but for what glows. `None` when a point or spot light,
+    /// or an emissive surface bright enough to light it, is there, or nothing lights it at all
+    /// (the loader says so already).
+    pub fn unlit_warning(&self, scene: &crate::Scene) -> Option<String> {
+        if self.extinction().iter().any(|&k| k <= 0.0) {
+            return None;
+        }
+        let sources = crate::environment::LightSources::of(scene);
+        let reaches = scene.lights.iter().any(|l| !matches!(l.kind, crate::LightKind::Directional { .. }));
+        if reaches || sources.emitters_light() {
+            return None;
+        }
+        let suns = scene.lights.len();
+        let what = match (sources.environment, suns > 0) {
+            (true, true) => "the environment and directional lights",
+            (true, false) => "the environment",
+            (false, true) => "directional lights",
+            (false, false) => return None,
+        };
+        Some(format!(
+            "warning: {}: lit by {what} alone, whose light does not reach into the RGB medium (it fills \
+             the scene and has extinction in every channel): the image will be black but for what \
+             glows; add a point, spot or area light, or leave the medium out",
+            scene.source
+        ))
+    }
+
     /// (σ_a(λ), σ_s(λ)) per *scene unit*, upsampled through `table` (the scene colour space's
     /// Jakob–Hanika table) by [`Self::upsampling`].
     pub fn spectra(&self, table: &CoeffTable) -> color::Result<(Spectrum, Spectrum)> {
@@ -303,6 +333,36 @@ mod tests {
         assert!(close(k.extinction(), [l2 / 2.0, l2, 0.0]), "{:?}", k.extinction());
         assert!(close(k.scattering, [l2 / 4.0, l2, 0.0]));
         assert_eq!((k.scale, k.upsampling), (0.5, Attenuation::Unbounded));
+    }
+
+    /// A medium without end keeps the environment and suns out (docs/rgb-media.md): a scene lit
+    /// by them alone is warned about, one with a light inside, or a channel the medium leaves
+    /// clear, is not.
+    #[test]
+    fn a_scene_lit_only_from_infinity_is_warned_about() {
+        let fog = RgbMedium::from_json_str(r#"{"absorption": [0.1, 0.2, 0.3]}"#).unwrap();
+        let mut s = crate::builtin("cornell").unwrap();
+        assert!(fog.unlit_warning(&s).is_none(), "the box's lamp lights it");
+        s.lights.clear();
+        s.materials.iter_mut().for_each(|m| m.emissive = glam::Vec3::ZERO);
+        assert!(fog.unlit_warning(&s).is_none(), "nothing lights it: the loader's warning");
+        let mut sky = s.clone();
+        sky.environment = Some(crate::environment::Environment::default_sky());
+        let w = fog.unlit_warning(&sky).unwrap();
+        assert!(w.contains("the environment alone") && w.contains("black"), "{w}");
+        let mut sun = s.clone();
+        sun.lights.push(crate::environment::default_sun_under_water());
+        assert!(fog.unlit_warning(&sun).unwrap().contains("directional lights alone"));
+        let clear_blue = RgbMedium::from_json_str(r#"{"absorption": [0.1, 0.2, 0]}"#).unwrap();
+        assert!(clear_blue.unlit_warning(&sky).is_none());
+        let mut lamp = sky.clone();
+        lamp.lights.push(crate::Light {
+            name: "lamp".into(),
+            kind: crate::LightKind::Point { position: glam::Vec3::ZERO, range: None },
+            emission: crate::Emission { rgb: glam::Vec3::ONE, intensity: 1.0, spectrum: None },
+            stands_in_for: None,
+        });
+        assert!(fog.unlit_warning(&lamp).is_none());
     }
 
     /// Every bad input names its field.

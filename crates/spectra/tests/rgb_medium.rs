@@ -190,3 +190,27 @@ fn a_white_wall_through_an_rgb_medium_matches_the_path_tracer() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A scene lit only from infinity (here the default environment `render` and `truth` choose for
+/// a scene with no lights) is black in a medium without end, in both renderers: each says so.
+#[test]
+fn a_scene_lit_only_by_the_environment_in_a_medium_is_warned_about() {
+    let d = dir("unlit");
+    let mut s = wall_scene();
+    s.lights.clear();
+    let gltf = p(&d, "wall.gltf");
+    scene::write_gltf(&s, Path::new(&gltf)).unwrap();
+    let fog = r#"{"absorption": [0.1, 0.2, 0.3]}"#;
+    for cmd in [
+        vec!["render", &gltf, "--size", "8x6", "--wavelengths", "4", "--out", &p(&d, "r.exr")],
+        vec!["truth", &gltf, "--size", "8x6", "--spp", "1", "--out", &p(&d, "t.exr")],
+    ] {
+        let mut args = cmd.clone();
+        args.extend(["--rgb-medium", fog]);
+        let err = String::from_utf8_lossy(&spectra(&args).stderr).to_string();
+        assert!(err.contains("lit by the environment alone") && err.contains("black"), "{cmd:?}: {err}");
+        // Without the medium, no such warning.
+        let err = String::from_utf8_lossy(&spectra(&cmd).stderr).to_string();
+        assert!(!err.contains("alone"), "{err}");
+    }
+}

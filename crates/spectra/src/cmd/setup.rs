@@ -606,6 +606,9 @@ pub fn realtime_medium(
             "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
         );
     }
+    if let Some(w) = m.unlit_warning(scene) {
+        eprintln!("{w}");
+    }
     Ok(Some(::render::passes::rgb_medium::shader(&m, table, &opts)?))
 }
 

@@ -139,6 +139,9 @@ pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTa
         _ => None,
     };
     if let Some((m, origin)) = &rgb {
+        if let Some(w) = m.unlit_warning(scene) {
+            eprintln!("{w}");
+        }
         let m = Medium::from_rgb(m, table).with_context(|| origin.clone())?;
         m.validate(s.range).with_context(|| origin.clone())?;
         s.medium = Some(m);
