@@ -81,12 +81,40 @@ pub fn triangle_barycentrics(u: [f32; 2]) -> (f32, f32, f32) {
 #[inline]
 pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
     let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    if a + b == 0.0 { 0.0 } else { a / (a + b) }
+    if a + b == 0.0 {
+        0.0
+    } else if (a + b).is_infinite() {
+        // A pdf beyond ≈ 1.8·10¹⁹ (a near-delta lobe) squares past f32's range, and ∞/∞ is NaN:
+        // the same weight in f64; an infinite pdf takes it all, two share it.
+        let (a, b) = (f64::from(pdf_a).powi(2), f64::from(pdf_b).powi(2));
+        match (a.is_infinite(), b.is_infinite()) {
+            (true, true) => 0.5,
+            (true, false) => 1.0,
+            (false, true) => 0.0,
+            (false, false) => (a / (a + b)) as f32,
+        }
+    } else {
+        a / (a + b)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Pdfs whose squares overflow f32 still weigh as the ratio says (they gave NaN).
+    #[test]
+    fn power_heuristic_survives_huge_pdfs() {
+        assert_eq!(power_heuristic(4e19, 1.0), 1.0);
+        assert!(power_heuristic(1.0, 4e19) < 1e-30);
+        assert_eq!(power_heuristic(4e19, 4e19), 0.5);
+        assert!((power_heuristic(4e19, 2e19) - 0.8).abs() < 1e-6);
+        assert_eq!(power_heuristic(f32::INFINITY, 3.0), 1.0);
+        assert_eq!(power_heuristic(f32::INFINITY, f32::INFINITY), 0.5);
+        // Ordinary pdfs as before.
+        assert_eq!(power_heuristic(2.0, 1.0), 0.8);
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+    }
 
     #[test]
     fn frame_is_orthonormal() {
