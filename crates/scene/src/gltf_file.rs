@@ -208,6 +208,19 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
                 for w in &worlds {
                     let mut m = local.clone();
                     primitive::to_world(&mut m, *w);
+                    if let Some(k) =
+                        m.positions.iter().position(|p| p.abs().max_element() > crate::MAX_COORDINATE)
+                    {
+                        return Err(ctx.invalid(
+                            &at,
+                            format!(
+                                "{pat}: vertex {k} lies beyond ±{:e} scene units once placed (the \
+                                 node transforms applied), where the renderers' single precision fails; scale \
+                                 the scene down",
+                                crate::MAX_COORDINATE
+                            ),
+                        ));
+                    }
                     meshes.push(m);
                 }
             }
@@ -404,6 +417,15 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
             "the camera's node transform is degenerate (a scale of 0 somewhere in its hierarchy), so it has no direction",
         ));
     }
+    if pos.abs().max_element() > crate::MAX_COORDINATE {
+        return Err(ctx.invalid(
+            at,
+            format!(
+                "the camera lies beyond ±{:e} scene units, where the renderers' single precision fails",
+                crate::MAX_COORDINATE
+            ),
+        ));
+    }
     let transform = Mat4::from_rotation_translation(rot.normalize(), pos);
     let p = match cam.projection() {
         gltf::camera::Projection::Perspective(p) => p,
@@ -473,6 +495,15 @@ fn light_of(
 ) -> Result<(Light, Option<usize>), SceneError> {
     let at = format!("KHR_lights_punctual.lights[{}]", l.index());
     let position = world.transform_point3(Vec3::ZERO);
+    if position.abs().max_element() > crate::MAX_COORDINATE {
+        return Err(ctx.invalid(
+            format!("nodes[{}]", node.index()),
+            format!(
+                "{at} lies beyond ±{:e} scene units, where the renderers' single precision fails",
+                crate::MAX_COORDINATE
+            ),
+        ));
+    }
     let direction = world.transform_vector3(-Vec3::Z).try_normalize().ok_or_else(|| {
         ctx.invalid(format!("nodes[{}]", node.index()), "light node transform collapses its direction")
     })?;

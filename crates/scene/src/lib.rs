@@ -500,6 +500,12 @@ pub const MIN_NEAR_FAR_RATIO: f32 = 1e-6;
 pub const ORTHO_MAG_RANGE: (f32, f32) = (1e-6, 1e6);
 /// Narrowest vertical field of view accepted, radians (the projection holds 1/tan(yfov/2)).
 pub const MIN_YFOV: f32 = 1e-5;
+/// Largest world coordinate a loaded scene may have, in scene units (|x|, |y|, |z| of every
+/// vertex, camera and light once their nodes' transforms are applied): the renderers work in
+/// single precision, and far out the path tracer's hierarchy and intersections fail (a panic
+/// at 10²⁵, wrong images at 10¹²). The path tracer renders the Khronos Duck (±1 unit) scaled
+/// to span ±10¹⁰ units bit for bit as at its own size: the bound leaves a factor 10.
+pub const MAX_COORDINATE: f32 = 1e9;
 /// Largest |normalTexture.scale| accepted.
 pub const MAX_NORMAL_SCALE: f32 = 1000.0;
 

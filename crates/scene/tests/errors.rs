@@ -102,6 +102,28 @@ fn unsupported_geometry_and_structure() {
     );
 }
 
+/// Coordinates beyond what single precision renders (the path tracer's hierarchy panicked at
+/// 10²⁵) are refused once the node transforms are applied, naming the node and what lies out.
+#[test]
+fn coordinates_beyond_single_precision() {
+    expect(
+        &mutate(|d| d["nodes"][1]["scale"] = json!([1e12, 1, 1])),
+        &["nodes[1]", "meshes[0].primitives[0]", "beyond ±1e9 scene units"],
+    );
+    expect(
+        &mutate(|d| d["nodes"][0]["translation"] = json!([2e9, 0, 0])),
+        &["nodes[1]", "beyond ±1e9 scene units"],
+    );
+    expect(&mutate(|d| d["nodes"][3]["translation"] = json!([0, 1, 5e9])), &["cameras[0]", "beyond ±1e9"]);
+    expect(
+        &mutate(|d| d["nodes"][4]["translation"] = json!([0, -3e9, 0])),
+        &["nodes[4]", "lights[0]", "beyond ±1e9"],
+    );
+    // Large but within: loads.
+    let big = mutate(|d| d["nodes"][0]["translation"] = json!([1e8, 0, 0]));
+    assert!(scene::load_slice("big.gltf", big.to_string().as_bytes(), Some(&data(""))).is_ok());
+}
+
 #[test]
 fn bad_extras() {
     expect(
