@@ -566,6 +566,11 @@ fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> 
 // water's c over it (so a lamp inside the scene is not dropped for being fifth). The same for
 // every pixel (a set that changed from pixel to pixel would draw seams).
 fn uw_marched_lights(cam: vec3<f32>) -> vec4<u32> {
+    // No more lights than slots: every one that can scatter does (the caller skips the others
+    // as the ranking below would), without the ranking's loop in every pixel.
+    if (frame.n_lights <= UW_SS_LIGHTS) {
+        return vec4<u32>(0u, 1u, 2u, 3u);
+    }
     var index = vec4<u32>(0xffffffffu);
     var score = vec4<f32>(-1.0);
     let scale = uw_params().scale;
