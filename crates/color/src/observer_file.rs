@@ -18,6 +18,10 @@ use crate::error::{ColorError, Result};
 use crate::observer::Observer;
 use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN, Spectrum};
 
+/// Largest observer file read, bytes (a 1 nm table over 360–830 nm is ~20 kB; rawtoaces JSON
+/// files ~10 kB).
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
 /// Whether an `--observer` value names a file rather than a built-in observer.
 pub fn is_file_name(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();
@@ -32,7 +36,8 @@ pub fn is_file_name(name: &str) -> bool {
 /// CSV), named by the path.
 pub fn read(path: &Path) -> Result<Observer> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path)
+    // A regular file of bounded size: a FIFO or a device (/dev/zero) would hang or exhaust memory.
+    let text = crate::input::read_regular_string(path, MAX_FILE_BYTES)
         .map_err(|e| ColorError::Table(format!("observer file {shown}: cannot read it: {e}")))?;
     let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
         || text.trim_start_matches('\u{feff}').trim_start().starts_with('{');
@@ -190,6 +195,25 @@ fn finish(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A FIFO or a device is refused at once (it blocked, or /dev/zero was read until memory
+    /// ran out), and so is a file past the size cap.
+    #[cfg(unix)]
+    #[test]
+    fn only_regular_files_of_bounded_size_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("cam.csv");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let t = std::time::Instant::now();
+        let e = read(&fifo).unwrap_err().to_string();
+        assert!(e.contains("cam.csv") && e.contains("FIFO"), "{e}");
+        assert!(t.elapsed().as_secs() < 5);
+        let e = read(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("device"), "{e}");
+        let big = dir.path().join("big.csv");
+        std::fs::File::create(&big).unwrap().set_len(MAX_FILE_BYTES + 1).unwrap();
+        assert!(read(&big).unwrap_err().to_string().contains("larger than"));
+    }
 
     /// A CSV holding a built-in camera's samples is that camera.
     #[test]

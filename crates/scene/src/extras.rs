@@ -272,7 +272,16 @@ fn spectra(ctx: &Ctx, at: &str, v: &Value) -> Result<SpectralSettings, SceneErro
             .transpose()
     };
     if let Some(o) = string("observer")? {
-        Observer::by_name(&o).map_err(|e| ctx.extras(format!("{at}.observer"), e.to_string()))?;
+        let f = format!("{at}.observer");
+        // A file is a file reference like any other: beside the scene, confined to its folder
+        // (not read from wherever the command runs, nor from anywhere on the machine).
+        let o = if color::observer_file::is_file_name(&o) {
+            let p = ctx.resolve(&f, o.trim())?;
+            p.to_str().map(str::to_string).ok_or_else(|| ctx.extras(&f, "the file's path is not UTF-8"))?
+        } else {
+            o
+        };
+        Observer::by_name(&o).map_err(|e| ctx.extras(&f, e.to_string()))?;
         s.observer = Some(o);
     }
     if let Some(w) = string("white")? {

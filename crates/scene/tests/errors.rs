@@ -190,6 +190,19 @@ fn bad_extras() {
         &["spectra.observer", "cie2030"],
     );
     expect(&mutate(|d| d["extras"]["spectra"]["wavelengths"] = json!(0)), &["spectra.wavelengths"]);
+    // An observer file is a file reference like any other: confined to the scene's folder.
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("/etc/passwd.csv")),
+        &["spectra.observer", "absolute path", "inside the scene's folder"],
+    );
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("../../Cargo.toml.csv")),
+        &["spectra.observer", "'..'"],
+    );
+    expect(
+        &mutate(|d| d["extras"]["spectra"]["observer"] = json!("no_such_camera.csv")),
+        &["spectra.observer", "no_such_camera.csv", "cannot read"],
+    );
     expect(
         &mutate(|d| d["extras"]["water"] = json!({"type": "I", "depth": 3})),
         &["scenes[0].extras.water", "root.extras"],

@@ -201,6 +201,35 @@ fn outputs_never_overwrite_inputs_each_other_or_devices() {
     .unwrap();
     refused(&["render", "cornell", "--env", &env, "--size", "8x8", "--out", &env], &["--env file"]);
     assert_eq!(std::fs::read(&a).unwrap(), before);
+    // An observer file (any name: `--out` may end in .csv for diff's table or name an .exr).
+    let obs = p("camera.csv");
+    let rows: String = (380..=730).step_by(10).map(|l| format!("{l},0.5,0.6,0.4\n")).collect();
+    std::fs::write(&obs, &rows).unwrap();
+    refused(
+        &["diff", &a, &b, "--observer", &obs, "--per-pixel-out", &obs],
+        &["--per-pixel-out", "--observer file", "must not overwrite"],
+    );
+    // A path is a file whatever its extension: one named like an image.
+    let obs_exr = p("camera.exr");
+    std::fs::write(&obs_exr, &rows).unwrap();
+    refused(
+        &["render", "cornell", "--size", "8x8", "--observer", &obs_exr, "--out", &obs_exr],
+        &["--observer file"],
+    );
+    refused(
+        &["truth", "cornell", "--size", "8x8", "--spp", "1", "--observer", &obs_exr, "--out", &obs_exr],
+        &["--observer file"],
+    );
+    assert_eq!(std::fs::read_to_string(&obs).unwrap(), rows);
+    assert_eq!(std::fs::read_to_string(&obs_exr).unwrap(), rows);
+    // The truth cache is a folder made on first use: the same path as --out is refused before
+    // the render, not after it.
+    let t = p("t.exr");
+    refused(
+        &["truth", "cornell", "--size", "8x8", "--spp", "1", "--truth-cache", &t, "--out", &t],
+        &["--out", "--truth-cache folder"],
+    );
+    assert!(std::fs::symlink_metadata(&t).is_err(), "nothing made at {t}");
 }
 
 /// The demo writes a folder: a file in its place is refused by name, and a scene that cannot

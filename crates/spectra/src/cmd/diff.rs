@@ -197,8 +197,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ("--per-pixel-out", args.per_pixel_out.as_deref()),
         ("--flip-map", args.flip_map.as_deref()),
     ];
-    let inputs =
-        [("reference".to_string(), args.reference.clone()), ("test image".to_string(), args.test.clone())];
+    let mut inputs = vec![
+        ("reference".to_string(), args.reference.clone()),
+        ("test image".to_string(), args.test.clone()),
+    ];
+    inputs.extend(super::setup::observer_input(args.observer.as_deref()));
     super::check_outputs(&outputs, &inputs)?;
     for (flag, p) in outputs {
         if let Some(p) = p {

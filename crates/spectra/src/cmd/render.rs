@@ -223,6 +223,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let mut inputs = args.scene.input_files(&scene);
     inputs.extend(args.look.table.input_files());
     inputs.extend(args.look.rgb_medium.input_files());
+    inputs.extend(super::setup::observer_input(args.look.spectrum.observer.as_deref()));
     super::check_outputs(
         &[("--out", Some(&args.out)), ("--spectral-out", args.spectral_out.as_deref())],
         &inputs,

@@ -312,6 +312,15 @@ pub fn range_warning(obs: &color::Observer, name: &str, range: WavelengthRange) 
     })
 }
 
+/// `--observer FILE` as an input that no output may overwrite (nothing for a built-in name).
+pub fn observer_input(observer: Option<&str>) -> Vec<(String, PathBuf)> {
+    observer
+        .filter(|o| color::observer_file::is_file_name(o))
+        .map(|o| ("--observer file".to_string(), PathBuf::from(o.trim())))
+        .into_iter()
+        .collect()
+}
+
 /// [`SpectrumArgs`] with the scene's defaults and the renderers' filled in, checked.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Spectrum {

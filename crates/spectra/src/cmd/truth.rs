@@ -391,6 +391,7 @@ pub fn run(a: Args) -> Result<()> {
     inputs.extend(a.table.input_files());
     inputs.extend(a.rgb_medium.input_files());
     inputs.extend(a.medium.iter().map(|m| ("--medium file".to_string(), m.clone())));
+    inputs.extend(super::setup::observer_input(a.spectrum.observer.as_deref()));
     let ckpt = a.out.as_deref().map(super::checkpoint::path_for);
     super::check_outputs(
         &[
@@ -400,6 +401,16 @@ pub fn run(a: Args) -> Result<()> {
         ],
         &inputs,
     )?;
+    // The cache is a folder made on first use: the same path as an output would end a long
+    // render in "is a directory".
+    if let (Some(cache), Some(out)) = (&a.truth_cache, &a.out) {
+        let same = |p: &std::path::Path| std::path::absolute(p).ok() == std::path::absolute(cache).ok();
+        for (flag, p) in [("--out", Some(out.as_path())), ("--spectral-out", a.spectral_out.as_deref())] {
+            if let Some(p) = p.filter(|p| same(p)) {
+                bail!("{flag} {} is the --truth-cache folder; give each a path of its own", p.display());
+            }
+        }
+    }
     let table = a.table.load()?;
     let st = settings(&a, &scene, &table)?;
     let t0 = Instant::now();
