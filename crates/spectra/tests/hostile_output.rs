@@ -42,6 +42,16 @@ fn absurd_counts_and_sizes_are_refused() {
     );
     let exr = dir.path().join("t.exr").display().to_string();
     refused(&["truth", "cornell", "--size", "4294967295x1", "--out", &exr], &["4294967295", "too large"]);
+    // Too deep for the light-field table in every command (truth drew black at 10⁶ m); too many
+    // march steps named as the flag, not as a shader that does not compile.
+    for cmd in [&["truth", "cornell", "--spp", "1"][..], &["render", "cornell"][..]] {
+        let args = [cmd, &["--size", "8x8", "--water", "IB", "--depth", "1e6", "--out", &exr][..]].concat();
+        refused(&args, &["--depth 1000000", "too deep", "at most 980"]);
+    }
+    refused(
+        &["render", "fog", "--size", "8x8", "--scatter-steps", "1000", "--out", &exr],
+        &["--scatter-steps 1000", "0–32"],
+    );
     let missing = dir.path().join("no/such/dir/t.exr").display().to_string();
     refused(&["truth", "cornell", "--spp", "100000", "--out", &missing], &["--out", "does not exist"]);
     // Issue 29: numbers that aborted, ran for minutes or overflowed into garbage.

@@ -125,6 +125,10 @@ pub struct LightFieldKey {
     pub forward_cone: f64,
 }
 
+/// Deepest node a light-field table may have, metres (camera depths and sea floors beyond it
+/// are refused by every command: `spectra::cmd::setup::water_medium`).
+pub const MAX_Z: f64 = 1000.0;
+
 /// A flat Lambertian sea floor under the column. Near the bottom it dominates the light field
 /// in all but the clearest water: it reflects the downwelling light back up, the water scatters
 /// that light forward towards a camera looking down and back down onto the floor, and the
@@ -148,8 +152,11 @@ impl LightFieldKey {
         if !(self.sky.is_finite() && self.sky >= 0.0) {
             return bad(format!("light-field table: sky must be ≥ 0, got {}", self.sky));
         }
-        if !(self.z_max.is_finite() && self.z_max > 0.0 && self.z_max <= 1000.0) {
-            return bad(format!("light-field table: depth range must be in (0, 1000] m, got {}", self.z_max));
+        if !(self.z_max.is_finite() && self.z_max > 0.0 && self.z_max <= MAX_Z) {
+            return bad(format!(
+                "light-field table: depth range must be in (0, {MAX_Z}] m, got {}",
+                self.z_max
+            ));
         }
         if !(self.g.is_finite() && self.g.abs() < 1.0) {
             return bad(format!("light-field table: phase g must be in (−1, 1), got {}", self.g));

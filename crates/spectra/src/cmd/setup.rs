@@ -542,6 +542,29 @@ pub fn water_medium(
     // The floor under the camera closes the light-field model's water column.
     medium.floor = scene::water::floor::below_camera(scene, medium.scale)
         .map_err(|e| anyhow!("scene {}: {e}", scene.source))?;
+    // One bound for every command (the path tracer needs none, but a depth the real-time
+    // renderer refuses would make the two disagree): the light-field table's deepest node, 20 m
+    // below the camera rounded up to 20 m, or the sea floor, within its range.
+    let max_z = scene::water::light_field::MAX_Z;
+    let (z_max, why) = match &medium.floor {
+        Some(f) => {
+            (medium.depth + f.below_camera, format!("with the sea floor {:.2} m below it", f.below_camera))
+        }
+        None => {
+            (underwater::light_field_range(medium.depth), "20 m below it, rounded up to 20 m".to_string())
+        }
+    };
+    if z_max > max_z {
+        let what = match depth {
+            Some(d) => format!("--depth {d}"),
+            None => format!("scene {}: water.depth {}", scene.source, medium.depth),
+        };
+        bail!(
+            "{what}: too deep: the underwater light-field table reaches {z_max:.1} m ({why}), beyond its {max_z} m \
+             (here a camera at most {:.1} m deep)",
+            medium.floor.as_ref().map_or(max_z - 20.0, |f| max_z - f.below_camera)
+        );
+    }
     if let (Some(_), Some(to_sun)) = (&scene.water, sun) {
         let want = medium.sun_dir_underwater();
         let angle = to_sun.dot(want).clamp(-1.0, 1.0).acos().to_degrees();
@@ -614,6 +637,10 @@ pub fn realtime_medium(
         bail!(
             "--rgb-medium / the scene's medium and water (from --water or the scene) cannot be combined: pick one medium"
         );
+    }
+    let most = ::render::passes::rgb_medium::MAX_STEPS;
+    if opts.steps > most {
+        bail!("--scatter-steps {}: an RGB medium is marched in 0–{most} steps", opts.steps);
     }
     if let Some(w) = m.unlit_warning(scene) {
         eprintln!("{w}");
