@@ -6,6 +6,8 @@ use thiserror::Error;
 pub enum ColorError {
     #[error("wavelength range {min}–{max} nm is invalid: {why}")]
     BadRange { min: f64, max: f64, why: String },
+    #[error("wavelength range '{0}': expected MIN:MAX in nm, e.g. 380:730")]
+    BadRangeText(String),
     #[error("the number of wavelength samples must be at least 1 (got 0)")]
     NoSamples,
     #[error("invalid spectrum: {0}")]

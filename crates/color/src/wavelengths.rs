@@ -65,25 +65,21 @@ impl WavelengthRange {
         Ok(edges)
     }
 
-    /// Parses `380:730` (also accepts `380-730` and `380..730`).
+    /// Parses `380:730` (also accepts `380-730` and `380..730`; a minus sign is a sign only
+    /// with the `:` separator, as in `-10:700`, which the range then refuses by its bounds).
     pub fn parse(s: &str) -> Result<Self> {
-        let parts: Vec<&str> = s.splitn(2, [':', '-']).collect();
-        let parts = if parts.len() == 2 { parts } else { s.splitn(2, "..").collect() };
+        let t = s.trim();
+        let parts = if t.contains(':') {
+            t.split_once(':')
+        } else if t.contains("..") {
+            t.split_once("..")
+        } else {
+            t.get(1..).and_then(|rest| rest.find('-')).map(|i| (&t[..=i], &t[i + 2..]))
+        };
         let num = |p: &str| p.trim().parse::<f64>().ok();
-        match parts.as_slice() {
-            [a, b] => match (num(a), num(b.trim_start_matches('.'))) {
-                (Some(a), Some(b)) => Self::new(a, b),
-                _ => Err(ColorError::BadRange {
-                    min: f64::NAN,
-                    max: f64::NAN,
-                    why: format!("cannot parse '{s}' as MIN:MAX"),
-                }),
-            },
-            _ => Err(ColorError::BadRange {
-                min: f64::NAN,
-                max: f64::NAN,
-                why: format!("expected MIN:MAX, got '{s}'"),
-            }),
+        match parts.map(|(a, b)| (num(a), num(b))) {
+            Some((Some(a), Some(b))) => Self::new(a, b),
+            _ => Err(ColorError::BadRangeText(s.to_string())),
         }
     }
 
@@ -224,5 +220,13 @@ mod tests {
         assert_eq!(WavelengthRange::parse("380:730").unwrap(), WavelengthRange::VISIBLE);
         assert!(WavelengthRange::parse("380").is_err());
         assert!(WavelengthRange::parse("a:b").is_err());
+        assert_eq!(WavelengthRange::parse(" 380-730 ").unwrap(), WavelengthRange::VISIBLE);
+        assert_eq!(WavelengthRange::parse("380..730").unwrap(), WavelengthRange::VISIBLE);
+        // Text that is no range says so, not "NaN–NaN"; a negative bound is a number, refused
+        // by the range's own check.
+        let e = WavelengthRange::parse("500").unwrap_err().to_string();
+        assert!(e.contains("'500'") && e.contains("MIN:MAX") && !e.contains("NaN"), "{e}");
+        assert!(matches!(WavelengthRange::parse("-10:700"), Err(ColorError::BadRange { min: -10.0, .. })));
+        assert!(WavelengthRange::parse("-").is_err() && WavelengthRange::parse("").is_err());
     }
 }

@@ -20,8 +20,10 @@ pub enum RenderError {
     Scene { source_name: String, problem: String },
     #[error("custom shader does not compile: {0}")]
     CustomShader(String),
+    /// The message carries the cause's text, so the cause is not chained as well (`{:#}`
+    /// printers would repeat it).
     #[error("colour data: {0}")]
-    Color(#[from] color::ColorError),
+    Color(color::ColorError),
     #[error("GPU error: {0}")]
     Gpu(String),
     #[error("reading back from the GPU failed: {0}")]
@@ -29,6 +31,20 @@ pub enum RenderError {
     /// The process's cancellation token ([`color::cancel`]) was set while waiting for the GPU.
     #[error("interrupted")]
     Cancelled,
+}
+
+impl From<color::ColorError> for RenderError {
+    fn from(e: color::ColorError) -> Self {
+        RenderError::Color(e)
+    }
+}
+
+/// A colour error is shown once, not once more as its own cause.
+#[test]
+fn a_colour_error_is_not_its_own_cause() {
+    let e = RenderError::from(color::ColorError::NoSamples);
+    assert!(e.to_string().contains("at least 1"), "{e}");
+    assert!(std::error::Error::source(&e).is_none());
 }
 
 pub type Result<T, E = RenderError> = std::result::Result<T, E>;

@@ -92,6 +92,14 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     }
     let json = if bytes.starts_with(b"glTF") {
         gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.json.into_owned()
+    } else if ctx.path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        && !bytes.trim_ascii_start().starts_with(b"{")
+    {
+        // Read as JSON, a damaged GLB would be reported as "expected value at line 1 column 1".
+        return Err(ctx.invalid(
+            "GLB header",
+            "not a valid glTF 2.0 binary (GLB): it does not start with the 'glTF' magic",
+        ));
     } else {
         bytes.to_vec()
     };

@@ -43,6 +43,10 @@ fn garbage_and_truncated_files() {
     // The cause is in the message, not chained as well: `{:#}` printers would repeat it.
     assert!(std::error::Error::source(&err).is_none(), "{e}");
     let glb = std::fs::read(data("textured.glb")).unwrap();
+    let mut bad_magic = glb.clone();
+    bad_magic[..4].copy_from_slice(b"gltf");
+    let e = scene::load_slice("magic.glb", &bad_magic, None).unwrap_err().to_string();
+    assert!(e.contains("magic.glb") && e.contains("'glTF' magic") && !e.contains("line 1"), "{e}");
     for cut in [0, 11, 12, 20, 100, glb.len() / 2, glb.len() - 1] {
         let e = scene::load_slice("cut.glb", &glb[..cut], None).unwrap_err().to_string();
         assert!(e.starts_with("cut.glb"), "cut at {cut}: {e}");
