@@ -18,7 +18,18 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// The s-th point of the R2 sequence shifted by `shift`, in [0, 1)².
 fn r2(shift: [f32; 2], s: u64) -> [f32; 2] {
     const A: [f64; 2] = [0.754_877_666_246_692_8, 0.569_840_290_998_053_3];
-    std::array::from_fn(|i| ((shift[i] as f64 + s as f64 * A[i]).fract() as f32).min(0.999_999_94))
+    std::array::from_fn(|i| {
+        let x = if s < 1 << 32 {
+            shift[i] as f64 + s as f64 * A[i]
+        } else {
+            // s·A itself would keep no fraction near 2⁵³ (every sample on the pixel's corner):
+            // frac(s·A) = frac(hi·frac(2³²·A) + lo·A), each part with its fraction intact.
+            // 2³²·A is exact (a power of two), so this is the same sequence, not another.
+            let (hi, lo) = ((s >> 32) as f64, (s & 0xffff_ffff) as f64);
+            shift[i] as f64 + (hi * (A[i] * 4_294_967_296.0).fract()).fract() + lo * A[i]
+        };
+        (x.fract() as f32).min(0.999_999_94)
+    })
 }
 
 /// Owen's nested uniform scrambling of the binary fraction `x` (bit 31 first), keyed by
@@ -477,6 +488,32 @@ impl Bins {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Chunks far out in the sequence (`--sample-offset` up to 2⁵³) jitter as well as the first:
+    /// 4096 points from 2⁵² and from 2⁵³ − 4096 fill the pixel's 64 × 64 cells nearly as evenly
+    /// as the first 4096, where s·A in f64 had put them all on the pixel's corner.
+    #[test]
+    fn r2_is_exact_far_out_in_the_sequence() {
+        let cells = |start: u64| {
+            let mut hit = vec![false; 64 * 64];
+            for s in start..start + 4096 {
+                let [x, y] = r2([0.3, 0.7], s);
+                assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                hit[(y * 64.0) as usize * 64 + (x * 64.0) as usize] = true;
+            }
+            hit.iter().filter(|&&h| h).count()
+        };
+        let first = cells(0);
+        assert!(first > 2400, "{first}");
+        for start in [1 << 32, 1 << 40, 1 << 52, MAX_SAMPLE_INDEX - 4096] {
+            let n = cells(start);
+            assert!(n as f64 > 0.9 * first as f64, "from {start}: {n} cells of {first}");
+        }
+        // Below 2³² the points are the ones every stored truth was rendered with.
+        let s = (1u64 << 32) - 1;
+        let old = ((0.3f32 as f64 + s as f64 * 0.754_877_666_246_692_8).fract() as f32).min(0.999_999_94);
+        assert_eq!(r2([0.3, 0.7], s)[0], old);
+    }
     use crate::testing::{inward_box, quad, scene_with};
     use crate::upsample::GreyOnly;
     use glam::Vec3;
