@@ -1081,6 +1081,13 @@ impl Loader<'_> {
                     .ctx
                     .invalid(&iat, format!("is a {format} image, which is not supported; {advice}")));
             }
+            if image::guess_format(&bytes).ok() == Some(image::ImageFormat::Jpeg) && jpeg_truncated(&bytes) {
+                return Err(self.ctx.invalid(
+                    &iat,
+                    "the JPEG ends before its end-of-image marker (a truncated file; the decoder would \
+                     fill the rest in grey)",
+                ));
+            }
             let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
                 .with_guessed_format()
                 .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
@@ -1124,5 +1131,18 @@ impl Loader<'_> {
         self.textures.push(Texture { sampler, name, width, height, rgba8, srgb });
         self.tex_map.insert((t.index(), srgb), index);
         Ok(TextureRef { transform, index, tex_coord })
+    }
+}
+
+/// Whether a JPEG lacks the end-of-image marker (FF D9) after its last start-of-scan (FF DA):
+/// the JPEG decoder accepts such a file and makes up the missing image data. In the
+/// entropy-coded data an FF byte is always followed by 00 or a restart marker, so neither
+/// marker can appear there by chance; an embedded thumbnail's markers come before the main
+/// scan, and data after the end marker is allowed.
+fn jpeg_truncated(bytes: &[u8]) -> bool {
+    let find_last = |m: [u8; 2]| bytes.windows(2).rposition(|w| w == m);
+    match find_last([0xFF, 0xDA]) {
+        None => true,
+        Some(sos) => find_last([0xFF, 0xD9]).is_none_or(|eoi| eoi < sos),
     }
 }

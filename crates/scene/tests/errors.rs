@@ -55,6 +55,23 @@ fn garbage_and_truncated_files() {
     assert!(scene::load_slice("cut.gltf", &text[..text.len() / 2], Some(&data(""))).is_err());
 }
 
+/// A JPEG cut short decodes without complaint (the decoder makes the rest up): refused by
+/// name; the whole file loads.
+#[test]
+fn a_truncated_jpeg_texture_is_refused() {
+    let img = image::RgbImage::from_fn(32, 32, |x, y| image::Rgb([(x * 8) as u8, (y * 8) as u8, 128]));
+    let mut jpeg = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut jpeg), image::ImageFormat::Jpeg).unwrap();
+    use base64::Engine;
+    let uri =
+        |b: &[u8]| format!("data:image/jpeg;base64,{}", base64::engine::general_purpose::STANDARD.encode(b));
+    let whole = mutate(|d| d["images"][0]["uri"] = json!(uri(&jpeg)));
+    assert!(scene::load_slice("jpeg.gltf", whole.to_string().as_bytes(), Some(&data(""))).is_ok());
+    for cut in [jpeg.len() - 2, jpeg.len() / 2, 700.min(jpeg.len() / 3)] {
+        expect(&mutate(|d| d["images"][0]["uri"] = json!(uri(&jpeg[..cut]))), &["images[0]", "truncated"]);
+    }
+}
+
 #[test]
 fn missing_files() {
     expect(&mutate(|d| d["images"][0]["uri"] = json!("nope.png")), &["images[0].uri", "nope.png"]);
