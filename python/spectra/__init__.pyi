@@ -1,7 +1,7 @@
 """Type stub of the `spectra` package (the extension module spectra._spectra). See docs/python.md."""
 
 import os
-from typing import Any, Optional, Tuple, TypedDict, Union, overload
+from typing import Any, Literal, Optional, Tuple, TypedDict, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +17,12 @@ ILLUMINANTS: list[str]
 
 RGBImage = npt.NDArray[np.float32]
 """A linear RGB image: float32, shape (height, width, 3), C-contiguous."""
+_FloatImage = npt.NDArray[Union[np.float32, np.float64]]
+"""An image argument: a numpy float32 or float64 array of shape (height, width, 3)."""
+_Bands = npt.NDArray[np.float32]
+"""Per-pixel spectral values: float32, shape (height, width, N)."""
+_Wavelengths = npt.NDArray[np.float64]
+"""Wavelengths in nm (node wavelengths, band edges): float64, 1-D."""
 
 class Stats(TypedDict):
     mean: float
@@ -54,6 +60,7 @@ def load(
     env_intensity: Optional[float] = None,
     env_rotation: Optional[float] = None,
     env_sun: bool = True,
+    env_sun_share: Optional[float] = None,
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
@@ -62,7 +69,8 @@ def load(
     `allow_outside_scene_dir`: let the file's references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"
     (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y; `env_sun`:
     the map's sun, where it has one, as a shadowed directional light in real time (False:
-    `--no-env-sun`). Raises
+    `--no-env-sun`); `env_sun_share`: the share of the map's light a compact bright region must
+    give to be that sun, in (0, 1] (`--env-sun-share`; default 0.15). Raises
     ValueError (bad scene), FileNotFoundError."""
 
 class Renderer:
@@ -91,10 +99,10 @@ class Renderer:
         observer: Optional[str] = None,
         white: Optional[str] = None,
         exposure: float = 0.0,
-        spectral: bool = False,
+        spectral: Literal[False] = False,
         camera_to_display: bool = False,
         samples: int = 1,
-    ) -> Any:
+    ) -> RGBImage:
         """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
 
         mode: "spectral", "naive" or "rgb". wavelengths: 1–256 (default: the scene's, else 16).
@@ -110,6 +118,36 @@ class Renderer:
         (not with spectral=True).
         Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
         is released while rendering."""
+    @overload
+    def render(
+        self,
+        mode: str = "spectral",
+        *,
+        wavelengths: Optional[int] = None,
+        quadrature: str = "prefiltered",
+        range: Optional[Tuple[float, float]] = None,
+        observer: Optional[str] = None,
+        white: Optional[str] = None,
+        exposure: float = 0.0,
+        spectral: Literal[True],
+        camera_to_display: bool = False,
+        samples: int = 1,
+    ) -> Tuple[RGBImage, _Bands, _Wavelengths]: ...
+    @overload
+    def render(
+        self,
+        mode: str = "spectral",
+        *,
+        wavelengths: Optional[int] = None,
+        quadrature: str = "prefiltered",
+        range: Optional[Tuple[float, float]] = None,
+        observer: Optional[str] = None,
+        white: Optional[str] = None,
+        exposure: float = 0.0,
+        spectral: bool = False,
+        camera_to_display: bool = False,
+        samples: int = 1,
+    ) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
     @property
     def scene(self) -> Scene: ...
     @property
@@ -119,6 +157,55 @@ class Renderer:
     def device(self) -> str:
         """The GPU adapter and backend."""
 
+@overload
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Tuple[int, int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    range: Optional[Tuple[float, float]] = None,
+    observer: Optional[str] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[str] = None,
+    spectral_bin: None = None,
+    camera_to_display: bool = False,
+) -> RGBImage:
+    """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
+    options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
+    `sample_offset=K` renders samples K … K+spp−1 (the CLI's --sample-offset / --chunk). The
+    same seed gives the same image. water / depth / rgb_medium / observer / camera_to_display as
+    for `Renderer.render`.
+    spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
+    (`--spectral-out`). Ctrl-C raises KeyboardInterrupt; the GIL is released."""
+
+@overload
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Tuple[int, int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Tuple[int, int, int, int]] = None,
+    range: Optional[Tuple[float, float]] = None,
+    observer: Optional[str] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[str] = None,
+    spectral_bin: float,
+    camera_to_display: bool = False,
+) -> Tuple[RGBImage, _Bands, _Wavelengths]: ...
+@overload
 def truth(
     scene: Scene,
     spp: int = 64,
@@ -137,18 +224,11 @@ def truth(
     rgb_medium: Optional[str] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
-) -> Any:
-    """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
-    options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
-    `sample_offset=K` renders samples K … K+spp−1 (the CLI's --sample-offset / --chunk). The
-    same seed gives the same image. water / depth / rgb_medium / observer / camera_to_display as
-    for `Renderer.render`.
-    spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
-    (`--spectral-out`). Ctrl-C raises KeyboardInterrupt; the GIL is released."""
+) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
 
 def diff(
-    a: npt.ArrayLike,
-    b: npt.ArrayLike,
+    a: _FloatImage,
+    b: _FloatImage,
     *,
     white_y: float = 1.0,
     flip: Optional[str] = None,
@@ -162,12 +242,19 @@ def diff(
     `mae_srgb_map` (and `flip_map`). ValueError naming the argument for a wrong dtype or
     shape, or a non-finite pixel."""
 
-def upsample(
-    rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: Optional[npt.ArrayLike] = None
-) -> Any:
+@overload
+def upsample(rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: None = None) -> npt.NDArray[np.float64]:
     """Jakob–Hanika coefficients (c0, c1, c2), float64 (..., 3), of linear RGB reflectances
     (..., 3) in [0, 1] in `space` (srgb, p3, rec2020, acescg), the renderers' own fetch; with
     `wavelengths` (nm, 1-D) the tuple (coefficients, spectra (..., L))."""
+@overload
+def upsample(
+    rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: npt.ArrayLike
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+@overload
+def upsample(
+    rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: Optional[npt.ArrayLike] = None
+) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]: ...
 
 def observer(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """An observer's colour-matching functions or a camera's sensitivities at `wavelengths`
@@ -184,6 +271,6 @@ def chart(observer: str, illuminant: str = "D65", *, balanced: bool = False) -> 
 def read_image(path: Union[str, os.PathLike[str]]) -> RGBImage:
     """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""
 
-def write_image(path: Union[str, os.PathLike[str]], image: npt.ArrayLike) -> None:
+def write_image(path: Union[str, os.PathLike[str]], image: _FloatImage) -> None:
     """Writes an (H, W, 3) linear RGB array as `.exr` (float32) or `.png` (sRGB, 8-bit),
     atomically."""

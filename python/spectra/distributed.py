@@ -18,13 +18,16 @@ environment it is simply installed (`pip install ./python` on every node, or in 
 Otherwise ship the wheel with the job: `pip wheel ./python -w dist` and
 `ray.init(runtime_env={"py_modules": ["dist/spectra-….whl"]})` (or pass `runtime_env=` here
 when this call starts Ray). A scene given as a file is loaded again on each worker from the same
-path (absolute), so the file must be reachable there (a shared filesystem, or `working_dir`).
+path (absolute), so the file must be reachable there (a shared filesystem, or `working_dir`);
+so are an `observer=` or `rgb_medium=` file (and `eval`'s `table`), named absolutely for the
+workers whatever their working directory.
 `eval` runs `spectra eval` with its ground truths rendered the same way (stored in its truth
 cache, the real-time renders and the report on this machine). See docs/python.md.
 """
 
 from __future__ import annotations
 
+import operator
 import os
 import sys
 import time
@@ -46,18 +49,66 @@ def _ray():
     return ray
 
 
-def split(spp, size, chunks=8, tiles=(1, 1), sample_offset=0, crop=None):
+#: Sample chunks of a render when `chunks` is not given (fewer when it has fewer samples).
+CHUNKS = 8
+
+
+def _whole(name, value, least=1):
+    """`value` as an int ≥ `least`, or the ValueError naming `name`. Any integral type is one
+    (numpy's integers too, as the extension's own arguments take them); bool and float are not."""
+    try:
+        if isinstance(value, bool):
+            raise TypeError
+        n = operator.index(value)
+    except TypeError:
+        raise ValueError(f"{name} {value!r}: must be a whole number ≥ {least}") from None
+    if n < least:
+        raise ValueError(f"{name} {n}: must be a whole number ≥ {least}")
+    return n
+
+
+def _observer_file(name):
+    """Whether an `observer=` value names a file rather than a built-in observer: the rule of
+    the Rust side (`color::observer_file::is_file_name`)."""
+    lower = name.lower()
+    return lower.endswith((".csv", ".txt", ".json")) or "/" in name or "\\" in name
+
+
+def _absolute(path):
+    """`path` made absolute against this process's working directory, as `load` names a
+    scene file (no `..` or symlink resolved: `std::path::absolute`'s result)."""
+    return path if os.path.isabs(path) else os.path.join(os.getcwd(), path)
+
+
+def _for_workers(options):
+    """`options` with the files they name (`observer=`, `rgb_medium=`) as absolute paths: a
+    Ray worker's working directory need not be this process's (another node, or this process
+    changed its own after Ray started). Names and inline JSON are left as they are."""
+    options = dict(options)
+    observer, medium = options.get("observer"), options.get("rgb_medium")
+    if isinstance(observer, str) and _observer_file(observer):
+        options["observer"] = _absolute(observer)
+    if isinstance(medium, str) and not medium.lstrip().startswith("{"):
+        options["rgb_medium"] = _absolute(medium)
+    return options
+
+
+def split(spp, size, chunks=None, tiles=(1, 1), sample_offset=0, crop=None):
     """The pieces a render is split into: a list of (chunk index, sample_offset, spp, crop),
     chunks of as equal a number of samples as can be (the first ones one more), each over
-    every tile of a `tiles=(nx, ny)` grid of the window (the frame, or `crop`)."""
-    if isinstance(chunks, bool) or not isinstance(chunks, int) or chunks < 1:
-        raise ValueError(f"chunks {chunks!r}: must be a whole number ≥ 1")
-    if isinstance(spp, bool) or not isinstance(spp, int) or spp < 1:
-        raise ValueError(f"spp {spp!r}: must be a whole number ≥ 1")
+    every tile of a `tiles=(nx, ny)` grid of the window (the frame, or `crop`). `chunks`
+    defaults to `CHUNKS`, or `spp` when that is fewer; more chunks than `spp` given
+    explicitly is an error (a chunk would have no samples)."""
+    spp = _whole("spp", spp)
+    chunks = min(CHUNKS, spp) if chunks is None else _whole("chunks", chunks)
     if chunks > spp:
         raise ValueError(f"chunks {chunks}: more chunks than samples per pixel ({spp})")
+    sample_offset = _whole("sample_offset", sample_offset, 0)
     try:
-        nx, ny = (int(t) for t in tiles)
+        nx, ny = tiles
+        if isinstance(nx, bool) or isinstance(ny, bool):
+            raise TypeError
+        nx, ny = operator.index(nx), operator.index(ny)
     except (TypeError, ValueError):
         raise ValueError(f"tiles {tiles!r}: must be (nx, ny), two whole numbers ≥ 1") from None
     w, h = size
@@ -169,7 +220,7 @@ def submit(
     rgb_medium=None,
     spectral_bin=None,
     camera_to_display=False,
-    chunks=8,
+    chunks=None,
     tiles=(1, 1),
     threads_per_task=1,
     max_retries=3,
@@ -184,8 +235,8 @@ def submit(
     ray = _ray()
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a spectra.Scene (from spectra.load), not {type(scene).__name__}")
-    if isinstance(threads_per_task, bool) or not isinstance(threads_per_task, int) or threads_per_task < 1:
-        raise ValueError(f"threads_per_task {threads_per_task!r}: must be a whole number ≥ 1")
+    threads_per_task = _whole("threads_per_task", threads_per_task)
+    max_retries = _whole("max_retries", max_retries, -1)
     options = dict(
         size=size,
         direct_only=direct_only,
@@ -207,8 +258,9 @@ def submit(
         ray.init(address=address, runtime_env=runtime_env)
     task = ray.remote(_piece).options(num_cpus=threads_per_task, max_retries=max_retries)
     scene_ref = ray.put(scene)
+    options = _for_workers(options)
     refs = [task.remote(scene_ref, options, c, off, n, tile, threads_per_task) for c, off, n, tile in pieces]
-    return Job(ray, plan, pieces, refs, spp, progress, f" {label}" if label else "")
+    return Job(ray, plan, pieces, refs, plan["spp"], progress, f" {label}" if label else "")
 
 
 def truth(
@@ -218,7 +270,7 @@ def truth(
     direct_only=False,
     seed=0,
     *,
-    chunks=8,
+    chunks=None,
     tiles=(1, 1),
     threads_per_task=1,
     max_retries=3,
@@ -231,13 +283,16 @@ def truth(
     each a Ray task, and merged: the same arguments (`sample_offset`, `crop`, `range`,
     `observer`, `white`, `max_depth`, `water`, `depth`, `rgb_medium`, `spectral_bin`,
     `camera_to_display` as keywords) and the same result (an (h, w, 3) float32 linear sRGB array; with
-    `spectral_bin`, (image, bands, edges)).
+    `spectral_bin`, (image, bands, edges)). An `observer` or `rgb_medium` file given by a
+    relative path is found from this process's working directory, not the workers'.
 
-    threads_per_task: CPUs each task asks Ray for and uses (the tracer's threads); Ray runs as
-    many tasks at once as the cluster has CPUs for. max_retries: how often Ray runs a task
-    again whose worker died. address / runtime_env: passed to `ray.init` when Ray is not
-    running yet in this process (address None: a local instance, or the cluster of
-    $RAY_ADDRESS). progress: a line on stderr per finished task."""
+    chunks: default 8, or `spp` when that is fewer (more than `spp` given explicitly is an
+    error). threads_per_task: CPUs each task asks Ray for and uses (the tracer's threads); Ray
+    runs as many tasks at once as the cluster has CPUs for. max_retries: how often Ray runs a
+    task again whose worker died (-1: without limit). address / runtime_env: passed to
+    `ray.init` when Ray is not running yet in this process (address None: a local instance, or
+    the cluster of $RAY_ADDRESS). progress: a line on stderr per finished task. Counts may be
+    any integral type (numpy's integers too)."""
     return submit(
         scene,
         spp,
@@ -279,15 +334,25 @@ def eval(
     (`truth_cache`, a directory; a temporary one by default) exactly as `spectra eval
     --truth-cache` stores its own; then the evaluation runs here, on this machine's GPU, with
     every truth taken from the cache (it renders none). Truths the cache already holds are not
-    rendered again. Same arguments as the command (`quick`, `scenes` (a list of case ids),
-    `spp`, `size` "WxH", `sweep` "4,8,16", `table`, `observer`); returns `results.json` as a dict."""
+    rendered again. Same arguments as the command (`quick`, `scenes` (a case id, or a list of
+    them), `spp`, `size` "WxH", `sweep` "4,8,16", `table`, `observer`); returns `results.json` as
+    a dict. `chunks` is at most each truth's samples per pixel. Files given by relative paths
+    (`table`, an `observer` file) are found from this process's working directory, not the
+    workers'."""
     import json
     import tempfile
 
     ray = _ray()
+    chunks = _whole("chunks", chunks)
+    threads_per_task = _whole("threads_per_task", threads_per_task)
+    max_retries = _whole("max_retries", max_retries, -1)
     argv = ["eval", "--out", str(out)]
+    # Where argv names a file or directory (the workers get them absolute).
+    paths = [2]
     if quick:
         argv.append("--quick")
+    if isinstance(scenes, str):
+        scenes = [scenes] if scenes else []
     if scenes:
         argv += ["--scenes", ",".join(scenes)]
     if spp is not None:
@@ -298,11 +363,21 @@ def eval(
         argv += ["--sweep", sweep if isinstance(sweep, str) else ",".join(map(str, sweep))]
     if table is not None:
         argv += ["--table", str(table)]
+        paths.append(len(argv) - 1)
     if observer is not None:
         argv += ["--observer", str(observer)]
+        if _observer_file(argv[-1]):
+            paths.append(len(argv) - 1)
     with tempfile.TemporaryDirectory(prefix="spectra-truth-cache-") as tmp:
         cache = str(truth_cache) if truth_cache is not None else tmp
         argv += ["--truth-cache", cache]
+        paths.append(len(argv) - 1)
+        # The workers' working directory need not be this process's, so their copy names every
+        # file absolutely. This process keeps the paths as given: an observer file's name is
+        # part of a cached truth's key and of results.json, as it is for the command.
+        remote = list(argv)
+        for i in paths:
+            remote[i] = _absolute(argv[i])
         # The truths the evaluation will ask for, less those the cache holds in full.
         plan = _spectra._eval_plan(argv)
         if plan and not ray.is_initialized():
@@ -311,7 +386,7 @@ def eval(
         jobs = []
         for job in plan:
             pieces = split(job["spp"], (job["width"], job["height"]), min(chunks, job["spp"]))
-            refs = [task.remote(argv, job, off, n, threads_per_task) for _, off, n, _ in pieces]
+            refs = [task.remote(remote, job, off, n, threads_per_task) for _, off, n, _ in pieces]
             jobs.append((job, refs))
         t0 = time.perf_counter()
         total = sum(len(r) for _, r in jobs)

@@ -34,10 +34,12 @@ impl From<Fail> for PyErr {
     fn from(f: Fail) -> PyErr {
         match f {
             Fail::Value(e) => {
+                // The crates below often keep an I/O error only as text (a message naming the
+                // file and the field); ENOENT reads "(os error 2)" there on every platform.
                 let missing = e.chain().any(|c| {
                     c.downcast_ref::<std::io::Error>()
                         .is_some_and(|io| io.kind() == std::io::ErrorKind::NotFound)
-                });
+                }) || format!("{e:#}").contains("(os error 2)");
                 if missing {
                     PyFileNotFoundError::new_err(format!("{e:#}"))
                 } else {
@@ -750,7 +752,7 @@ fn truth_image<'py>(
     )?;
     let view = color::film::CameraView::from_flag(camera_to_display);
     let (rgb, bands, edges, (w, h)) = py.detach(move || -> Result<_, Fail> {
-        let (st, acc) = a.run(&sc)?;
+        let (st, acc) = fork_safe(|| a.run(&sc))?;
         let win = st.window();
         let display = st.display_matrix(view).map_err(value)?;
         let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp, display);
@@ -829,7 +831,7 @@ fn truth_sums<'py>(
         })?
     } else {
         let (st, acc) = py.detach(move || match threads {
-            None => a.run(&sc),
+            None => fork_safe(|| a.run(&sc)),
             Some(n) => rayon::ThreadPoolBuilder::new()
                 .num_threads(n as usize)
                 .build()
@@ -1007,32 +1009,37 @@ fn diff<'py>(
             "white_y {white_y:e}: the white luminance must be between {lo:e} and {hi:e}"
         )));
     }
-    let (json, dm, flip_map) = py.detach(move || -> Result<_, Fail> {
-        let dm =
-            compare::DiffMaps::compute(&reference, &test, compare::DiffOptions { white_luminance: white_y })
-                .map_err(value)?;
-        let mut v = serde_json::to_value(dm.summary()).map_err(runtime)?;
-        let mut flip_map = None;
-        if let Some(hdr) = hdr {
-            let map = if hdr {
-                compare::flip::hdr_flip(&reference, &test, ppd, &Default::default())
-                    .context("HDR-FLIP")
-                    .map_err(value)?
-            } else {
-                compare::flip::ldr_flip(&reference, &test, ppd).context("LDR-FLIP").map_err(value)?
-            };
-            let vals: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
-            // The mean as FLIP's own tool computes it, as `spectra diff` reports it.
-            let st = color::metrics::Stats::of(&vals)
-                .map(|st| color::metrics::Stats { mean: map.mean(), ..st })
-                .ok_or_else(|| runtime(anyhow::anyhow!("FLIP returned no pixels")))?;
-            let o = v.as_object_mut().expect("a struct serialises to an object");
-            o.insert("flip".into(), serde_json::to_value(st).map_err(runtime)?);
-            o.insert("flip_kind".into(), if hdr { "hdr" } else { "ldr" }.into());
-            o.insert("flip_ppd".into(), ppd.into());
-            flip_map = Some(map.values);
-        }
-        Ok((serde_json::to_string(&v).map_err(runtime)?, dm, flip_map))
+    let (json, dm, flip_map) = py.detach(move || {
+        fork_safe(move || -> Result<_, Fail> {
+            let dm = compare::DiffMaps::compute(
+                &reference,
+                &test,
+                compare::DiffOptions { white_luminance: white_y },
+            )
+            .map_err(value)?;
+            let mut v = serde_json::to_value(dm.summary()).map_err(runtime)?;
+            let mut flip_map = None;
+            if let Some(hdr) = hdr {
+                let map = if hdr {
+                    compare::flip::hdr_flip(&reference, &test, ppd, &Default::default())
+                        .context("HDR-FLIP")
+                        .map_err(value)?
+                } else {
+                    compare::flip::ldr_flip(&reference, &test, ppd).context("LDR-FLIP").map_err(value)?
+                };
+                let vals: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
+                // The mean as FLIP's own tool computes it, as `spectra diff` reports it.
+                let st = color::metrics::Stats::of(&vals)
+                    .map(|st| color::metrics::Stats { mean: map.mean(), ..st })
+                    .ok_or_else(|| runtime(anyhow::anyhow!("FLIP returned no pixels")))?;
+                let o = v.as_object_mut().expect("a struct serialises to an object");
+                o.insert("flip".into(), serde_json::to_value(st).map_err(runtime)?);
+                o.insert("flip_kind".into(), if hdr { "hdr" } else { "ldr" }.into());
+                o.insert("flip_ppd".into(), ppd.into());
+                flip_map = Some(map.values);
+            }
+            Ok((serde_json::to_string(&v).map_err(runtime)?, dm, flip_map))
+        })
     })?;
     let d = py.import("json")?.call_method1("loads", (json,))?;
     if maps {
@@ -1411,8 +1418,23 @@ fn eval_run(py: Python<'_>, argv: Vec<String>) -> PyResult<()> {
 }
 
 /// The extension module: `spectra/__init__.py` re-exports it.
+/// The process the module was loaded in: rayon's global thread pool lives there, and its
+/// threads do not survive `fork()` (a child made by multiprocessing's default start method on
+/// Linux would wait for them forever).
+static LOADED_IN: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+
+/// Runs `f`, whose rayon work goes to the global pool in the process the module was loaded in
+/// and to a pool of its own in a forked child.
+fn fork_safe<R: Send>(f: impl FnOnce() -> Result<R, Fail> + Send) -> Result<R, Fail> {
+    if LOADED_IN.get().is_none_or(|&pid| pid == std::process::id()) {
+        return f();
+    }
+    rayon::ThreadPoolBuilder::new().build().map_err(runtime)?.install(f)
+}
+
 #[pymodule]
 fn _spectra(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    LOADED_IN.get_or_init(std::process::id);
     m.add_class::<Scene>()?;
     m.add_class::<Renderer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;

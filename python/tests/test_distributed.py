@@ -38,6 +38,13 @@ def relative(a, b):
     return np.abs(a.astype(np.float64) - b) / np.maximum(np.abs(b.astype(np.float64)), 1e-30)
 
 
+def camera_csv(path):
+    """A camera's sensitivities as an observer file (`--observer FILE`)."""
+    lam = np.arange(380.0, 781.0, 5.0)
+    rows = "".join(f"{x},{r},{g},{b}\n" for x, (r, g, b) in zip(lam, spectra.observer("canon_eos_r5", lam)))
+    path.write_text("wavelength,r,g,b\n" + rows)
+
+
 def test_split():
     pieces = dist.split(10, (7, 5), chunks=3, tiles=(2, 1))
     assert [(c, o, n) for c, o, n, _ in pieces] == [(0, 0, 4), (0, 0, 4), (1, 4, 3), (1, 4, 3), (2, 7, 3), (2, 7, 3)]
@@ -46,6 +53,30 @@ def test_split():
         dist.split(10, (7, 5), chunks=11)
     with pytest.raises(ValueError, match="tiles"):
         dist.split(10, (7, 5), tiles=(8, 1))
+    # Without `chunks`: 8, or one a sample when there are fewer samples.
+    assert len(dist.split(10, (7, 5))) == 8
+    assert [(o, n) for _, o, n, _ in dist.split(3, (7, 5))] == [(0, 1), (1, 1), (2, 1)]
+
+
+def test_split_takes_numpy_integers_not_bools_or_floats():
+    """Counts from numpy (an `np.arange`, a config array) are whole numbers, as the extension's
+    own arguments take them; bool and float are still refused, with the same messages."""
+    want = dist.split(10, (7, 5), chunks=3, tiles=(2, 1), sample_offset=4)
+    got = dist.split(
+        np.int64(10), (7, 5), chunks=np.int32(3), tiles=(np.int64(2), np.uint8(1)), sample_offset=np.int64(4)
+    )
+    assert got == want and all(type(o) is int and type(n) is int for _, o, n, _ in got)
+    for kw, msg in [
+        (dict(chunks=True), "chunks True"),
+        (dict(chunks=2.0), "chunks 2.0"),
+        (dict(chunks=np.int64(0)), "chunks 0"),
+        (dict(tiles=(1.5, 1)), "tiles"),
+        (dict(tiles=(True, 1)), "tiles"),
+    ]:
+        with pytest.raises(ValueError, match=msg):
+            dist.split(10, (7, 5), **kw)
+    with pytest.raises(ValueError, match="spp 4.0"):
+        dist.split(4.0, (7, 5))
 
 
 def test_eight_chunks_equal_one_process(local_ray):
@@ -80,6 +111,56 @@ def test_bad_input_before_any_task(local_ray):
         dist.truth("cornell", spp=4)
     with pytest.raises(TypeError):
         dist.truth(scene, spp=4, no_such_option=1)
+    # More chunks than samples, asked for: no chunk may be empty.
+    with pytest.raises(ValueError, match="chunks 5: more chunks than samples"):
+        dist.truth(scene, spp=4, chunks=5)
+    for bad in (0, np.int64(0), True, 1.0):
+        with pytest.raises(ValueError, match="threads_per_task"):
+            dist.truth(scene, spp=4, threads_per_task=bad)
+
+
+def test_fewer_samples_than_the_default_chunks(local_ray):
+    """`spp` below the default 8 chunks renders in one chunk a sample, as `eval` splits its
+    truths, rather than failing on a default the caller never chose."""
+    scene = spectra.load("cornell")
+    kw = dict(spp=3, size=(12, 8), direct_only=True, seed=1)
+    assert relative(dist.truth(scene, progress=False, **kw), spectra.truth(scene, **kw)).max() <= 1e-6
+
+
+def test_numpy_integer_arguments(local_ray):
+    scene = spectra.load("cornell")
+    kw = dict(size=(12, 8), direct_only=True, seed=1)
+    one = spectra.truth(scene, spp=4, **kw)
+    many = dist.truth(
+        scene,
+        spp=np.int64(4),
+        chunks=np.int64(2),
+        tiles=(np.int64(2), np.int64(1)),
+        threads_per_task=np.int64(1),
+        max_retries=np.int64(3),
+        progress=False,
+        **kw,
+    )
+    assert relative(many, one).max() <= 1e-6
+
+
+def test_relative_files_are_the_drivers(local_ray, tmp_path, monkeypatch):
+    """An `observer=` or `rgb_medium=` file named relative to the driver's working directory,
+    which is not the workers' (Ray started before the driver moved, as a notebook's `os.chdir`
+    or a cluster node does): the workers read the driver's files. Built-in observer names and
+    inline JSON stay as given."""
+    camera_csv(tmp_path / "cam.csv")
+    (tmp_path / "medium.json").write_text('{"absorption": [0.05, 0.1, 0.2], "scattering": [0.3, 0.3, 0.3]}')
+    monkeypatch.chdir(tmp_path)
+    scene = spectra.load("cornell")
+    kw = dict(spp=2, size=(12, 8), seed=3, observer="cam.csv", rgb_medium="medium.json")
+    one = spectra.truth(scene, **kw)
+    assert relative(dist.truth(scene, chunks=2, progress=False, **kw), one).max() <= 1e-6
+
+    names = dict(observer="nikon_d5100", rgb_medium='{"absorption": [0.1, 0.1, 0.1], "scattering": [0, 0, 0]}')
+    assert dist._for_workers(names) == names
+    files = dist._for_workers(dict(observer="cams/a.JSON", rgb_medium="medium.json"))
+    assert files == dict(observer=str(tmp_path / "cams" / "a.JSON"), rgb_medium=str(tmp_path / "medium.json"))
 
 
 def test_eval_truths_as_tasks(local_ray, tmp_path, capfd):
@@ -120,3 +201,19 @@ def test_eval_truths_as_tasks(local_ray, tmp_path, capfd):
             assert x == pytest.approx(y, rel=1e-5, abs=1e-7), (ma["mode"], k)
     with pytest.raises(ValueError, match="--sweep"):
         dist.eval(tmp_path / "bad", quick=True, sweep="0")
+
+
+def test_eval_relative_observer_and_one_scene_name(local_ray, tmp_path, monkeypatch):
+    """`eval` with an observer file named relative to the driver's working directory (not the
+    workers') and `scenes` one case id as a string, not a list of its letters. The driver keeps
+    the name as given: it is in results.json, as the command writes it."""
+    camera_csv(tmp_path / "cam.csv")
+    monkeypatch.chdir(tmp_path)
+    got = dist.eval(
+        "out", quick=True, scenes="colorchecker-d65", spp=2, size="12x8", sweep="4", observer="cam.csv",
+        truth_cache="cache", chunks=2, progress=False,
+    )
+    assert [c["id"] for c in got["cases"]] == ["colorchecker-d65"] and got["observer"] == "cam.csv"
+    assert len(list((tmp_path / "cache").glob("*.truth"))) == 3
+    with pytest.raises(ValueError, match="no-such-case"):
+        dist.eval(tmp_path / "bad", quick=True, scenes="no-such-case")

@@ -657,3 +657,88 @@ def test_a_scene_without_lights_under_water_is_lit_as_the_cli_lights_it(tmp_path
     # The path tracer takes the same scene: a sun, which it can refract through the surface.
     t = spectra.truth(s, spp=1, size=(8, 6), direct_only=True, water="IB", depth=5)
     assert np.isfinite(t).all() and t.mean() > 0
+
+
+def test_type_stub_matches_the_extension(tmp_path):
+    """python/spectra/__init__.pyi against the runtime: a stub for every exported name, and
+    every function's and method's parameters (names, kinds, defaults) the extension's own
+    (`#[pyo3(signature = ...)]`, read back through `inspect`). An overload may narrow a default
+    away (`spectral: Literal[True]`), but one of a function's overloads takes every call the
+    runtime does; a lone overload is no overload (mypy refuses it). mypy checks the stub where
+    it is installed."""
+    import ast
+    import inspect
+
+    stub = ROOT / "python" / "spectra" / "__init__.pyi"
+    tree = ast.parse(stub.read_text())
+    P = inspect.Parameter
+
+    def params(fn):
+        a = fn.args
+        pos = a.posonlyargs + a.args
+        pos_defaults = [P.empty] * (len(pos) - len(a.defaults)) + [ast.literal_eval(d) for d in a.defaults]
+        out = [(p.arg, P.POSITIONAL_OR_KEYWORD, d) for p, d in zip(pos, pos_defaults)]
+        out += [
+            (p.arg, P.KEYWORD_ONLY, P.empty if d is None else ast.literal_eval(d))
+            for p, d in zip(a.kwonlyargs, a.kw_defaults)
+        ]
+        return [p for p in out if p[0] != "self"]
+
+    def runtime(obj):
+        # pyo3 cannot spell a tuple default in a text signature: it shows `...`.
+        return [
+            (p.name, p.kind, p.default)
+            for p in inspect.signature(obj).parameters.values()
+            if p.name != "self"
+        ]
+
+    def agrees(stubbed, actual, exact):
+        if [(n, k) for n, k, _ in stubbed] != [(n, k) for n, k, _ in actual]:
+            return False
+        for (_, _, d), (_, _, want) in zip(stubbed, actual):
+            if want is Ellipsis:
+                want = d if d is not P.empty else want
+            if d != want and (exact or d is not P.empty):
+                return False
+        return True
+
+    def check(body, owner, where):
+        seen = {}
+        for node in body:
+            if isinstance(node, ast.FunctionDef):
+                overload = any(getattr(d, "id", None) == "overload" for d in node.decorator_list)
+                seen.setdefault(node.name, []).append((params(node), overload))
+        for name, defs in seen.items():
+            if type(inspect.getattr_static(owner, name)).__name__ == "getset_descriptor":
+                continue  # a property
+            actual = runtime(owner if name == "__init__" else getattr(owner, name))
+            overloads = [p for p, o in defs if o]
+            assert len(overloads) != 1, f"{where}{name}: a lone @overload"
+            if overloads:
+                assert all(agrees(p, actual, exact=False) for p in overloads), f"{where}{name}: {actual}"
+                assert any(agrees(p, actual, exact=True) for p in overloads), f"{where}{name}: {actual}"
+            else:
+                assert len(defs) == 1 and agrees(defs[0][0], actual, exact=True), f"{where}{name}: {actual}"
+
+    names = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.AnnAssign):
+            names.add(node.target.id)
+    assert set(spectra.__all__) <= names, set(spectra.__all__) - names
+    check(tree.body, spectra, "")
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef) and node.name in spectra.__all__:
+            cls = getattr(spectra, node.name)
+            check(node.body, cls, f"{node.name}.")
+            getters = {n for n, v in vars(cls).items() if type(v).__name__ == "getset_descriptor"}
+            stubbed = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+            assert getters <= stubbed, f"{node.name}: {getters - stubbed} not in the stub"
+
+    try:
+        from mypy import api as mypy
+    except ImportError:
+        return
+    out, err, status = mypy.run(["--cache-dir", str(tmp_path / "mypy"), str(stub)])
+    assert status == 0, out + err

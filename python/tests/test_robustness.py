@@ -1,0 +1,52 @@
+"""Robustness of the Python package beyond its API tests (test_spectra.py): processes forked
+after the tracer ran, and the exception type of a missing file wherever one is named."""
+
+import multiprocessing
+import os
+
+import pytest
+
+import spectra
+
+
+def _truth_and_diff(q):
+    s = spectra.load("cornell")
+    a = spectra.truth(s, spp=1, size=(8, 6))
+    q.put(float(spectra.diff(a, a)["delta_e2000"]["mean"]))
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork() here")
+def test_a_forked_child_traces_and_diffs_after_its_parent_did():
+    """rayon's global pool does not survive fork(): a child made by multiprocessing's 'fork'
+    start method (Linux's default before Python 3.14) waited for it forever after the parent
+    had traced or diffed."""
+    s = spectra.load("cornell")
+    a = spectra.truth(s, spp=1, size=(8, 6))
+    spectra.diff(a, a)
+    ctx = multiprocessing.get_context("fork")
+    q = ctx.Queue()
+    p = ctx.Process(target=_truth_and_diff, args=(q,))
+    p.start()
+    p.join(60)
+    hung = p.is_alive()
+    if hung:
+        p.kill()
+    assert not hung, "the forked child did not finish within 60 s"
+    assert p.exitcode == 0 and q.get(timeout=5) == 0.0
+
+
+def test_a_missing_file_is_file_not_found_wherever_it_is_named(tmp_path):
+    """docs/python.md: FileNotFoundError for a missing file, whichever argument names it."""
+    s = spectra.load("cornell")
+    missing = str(tmp_path / "nope.csv")
+    calls = {
+        "read_image": lambda: spectra.read_image(str(tmp_path / "nope.exr")),
+        "observer": lambda: spectra.observer(missing, [550.0]),
+        "render(observer=)": lambda: spectra.Renderer(s, size=(8, 6)).render(observer=missing),
+        "truth(observer=)": lambda: spectra.truth(s, spp=1, size=(8, 6), observer=missing),
+        "load": lambda: spectra.load(str(tmp_path / "nope.gltf")),
+    }
+    for what, call in calls.items():
+        with pytest.raises(FileNotFoundError, match="nope"):
+            call()
+            pytest.fail(f"{what}: no error")
