@@ -254,4 +254,9 @@ fn the_demo_refuses_a_file_for_its_folder_and_leaves_nothing_for_a_bad_scene() {
     let folder = p_(dir.path(), "demo");
     refused(&["demo", "--scene", &p_(dir.path(), "missing.gltf"), "--out", &folder], &["missing.gltf"]);
     assert!(!std::path::Path::new(&folder).exists(), "an empty folder was left behind");
+    // eval likewise, for a size it refuses only once it runs.
+    let runs = p_(dir.path(), "eval");
+    let out = spectra(&["eval", "--quick", "--size", "100000x100000", "--out", &runs]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!std::path::Path::new(&runs).exists(), "eval left an empty folder behind");
 }

@@ -487,7 +487,9 @@ pub fn run(a: Args) -> Result<()> {
             (true, Some(t)) => ((0.5 * interval / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
         };
         let done = acc.done;
-        pb.set_message(format!("samples {}/{}", done, st.spp));
+        // The samples this pass renders (the bar moves with its rows): "1/256" for a whole
+        // render in one pass read as if it had stalled at the first sample.
+        pb.set_message(format!("samples {}–{} of {}", done + 1, done + n, st.spp));
         let t = Instant::now();
         let r = truth::render_pass(&world, &st, cancel, &mut acc, n, &|r| {
             pb.set_position(rows * u64::from(done) + r * u64::from(n))

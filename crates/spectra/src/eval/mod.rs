@@ -236,6 +236,18 @@ pub fn truth_plan(cfg: &Config) -> Result<Vec<PlannedTruth>> {
 /// error; files already finished stay, `results.json` and `index.html` are written last, so a
 /// directory without them is an interrupted run.
 pub fn run(cfg: Config) -> Result<Results> {
+    let out = cfg.out.clone();
+    let made = std::fs::symlink_metadata(&out).is_err();
+    let r = run_into(cfg);
+    // A run refused before it wrote anything (a size the GPU cannot make, a bad table) leaves
+    // no empty folder behind; an interrupted run keeps what it finished.
+    if r.is_err() && made && std::fs::read_dir(&out).is_ok_and(|mut d| d.next().is_none()) {
+        let _ = std::fs::remove_dir(&out);
+    }
+    r
+}
+
+fn run_into(cfg: Config) -> Result<Results> {
     let t_start = Instant::now();
     std::fs::create_dir_all(&cfg.out).with_context(|| format!("creating {}", cfg.out.display()))?;
     for stale in ["results.json", "index.html", "results.csv"] {
