@@ -827,7 +827,15 @@ fn truth_sums<'py>(
     let st = if dry_run {
         py.detach(|| -> Result<_, Fail> {
             let table = setup::load_table(None).map_err(runtime)?;
-            a.settings(&sc, &table).map_err(value)
+            let st = a.settings(&sc, &table).map_err(value)?;
+            // What `run` refuses before its first sample (an environment under water, a
+            // medium the scene cannot hold), refused here too: `distributed.submit` checks
+            // its arguments with this call before any task.
+            fork_safe(|| {
+                truth::World::new(&sc, table.as_ref(), &st.white, st.range, st.medium.as_ref()).map_err(value)
+            })?;
+            truth::Accumulator::new(&st).map_err(value)?;
+            Ok(st)
         })?
     } else {
         let (st, acc) = py.detach(move || match threads {

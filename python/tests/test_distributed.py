@@ -117,6 +117,10 @@ def test_bad_input_before_any_task(local_ray):
     for bad in (0, np.int64(0), True, 1.0):
         with pytest.raises(ValueError, match="threads_per_task"):
             dist.truth(scene, spp=4, threads_per_task=bad)
+    # Refused by the tracer's set-up rather than by the settings: still before any task.
+    lit = spectra.load("cornell", env="default")
+    with pytest.raises(ValueError, match="cannot light a scene under a water surface"):
+        dist.submit(lit, spp=4, size=(8, 6), water="IB")
 
 
 def test_fewer_samples_than_the_default_chunks(local_ray):
