@@ -63,8 +63,8 @@ fn runtime<E: Into<anyhow::Error>>(e: E) -> Fail {
 }
 
 /// A whole number ≥ `min` that fits a u32, or a `ValueError` naming `what`.
-fn whole(what: &str, v: i64, min: i64) -> PyResult<u32> {
-    if v < min || v > i64::from(u32::MAX) {
+fn whole(what: &str, v: i128, min: i128) -> PyResult<u32> {
+    if v < min || v > i128::from(u32::MAX) {
         return Err(PyValueError::new_err(format!(
             "{what} {v}: must be a whole number from {min} to {}",
             u32::MAX
@@ -74,9 +74,9 @@ fn whole(what: &str, v: i64, min: i64) -> PyResult<u32> {
 }
 
 /// `size=(W, H)`: both positive.
-fn size_arg(size: (i64, i64)) -> PyResult<(u32, u32)> {
+fn size_arg(size: (i128, i128)) -> PyResult<(u32, u32)> {
     let (w, h) = size;
-    if w <= 0 || h <= 0 || w > i64::from(u32::MAX) || h > i64::from(u32::MAX) {
+    if w <= 0 || h <= 0 || w > i128::from(u32::MAX) || h > i128::from(u32::MAX) {
         return Err(PyValueError::new_err(format!(
             "size ({w}, {h}): width and height must be positive integers"
         )));
@@ -357,7 +357,7 @@ impl Renderer {
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
-        size: (i64, i64),
+        size: (i128, i128),
         water: Option<String>,
         depth: Option<f64>,
         rgb_medium: Option<String>,
@@ -422,7 +422,7 @@ impl Renderer {
         &self,
         py: Python<'py>,
         mode: &str,
-        wavelengths: Option<i64>,
+        wavelengths: Option<i128>,
         quadrature: &str,
         range: Option<(f64, f64)>,
         observer: Option<String>,
@@ -430,7 +430,7 @@ impl Renderer {
         exposure: f32,
         spectral: bool,
         camera_to_display: bool,
-        samples: i64,
+        samples: i128,
     ) -> PyResult<Bound<'py, PyAny>> {
         let max = spectra::cmd::render::MAX_SAMPLES;
         let samples = match u32::try_from(samples) {
@@ -547,16 +547,16 @@ impl TruthArgs {
     /// Checks and converts `truth()`'s arguments; errors name the argument.
     #[allow(clippy::too_many_arguments)]
     fn new(
-        spp: i64,
-        size: (i64, i64),
+        spp: i128,
+        size: (i128, i128),
         direct_only: bool,
-        seed: i64,
-        sample_offset: i64,
-        crop: Option<(i64, i64, i64, i64)>,
+        seed: i128,
+        sample_offset: i128,
+        crop: Option<(i128, i128, i128, i128)>,
         range: Option<(f64, f64)>,
         observer: Option<String>,
         white: Option<String>,
-        max_depth: i64,
+        max_depth: i128,
         water: Option<String>,
         depth: Option<f64>,
         rgb_medium: Option<String>,
@@ -565,12 +565,17 @@ impl TruthArgs {
     ) -> PyResult<Self> {
         let spp = whole("spp", spp, 1)?;
         let size = size_arg(size)?;
-        if seed < 0 {
-            return Err(PyValueError::new_err(format!("seed {seed}: must be a whole number ≥ 0")));
-        }
-        if sample_offset < 0 {
+        // Python's integers are unbounded: every count is taken as i128 so that one too large
+        // for the machine is refused naming its argument (not an OverflowError naming none),
+        // and a seed may be any u64, as `spectra truth --seed` takes.
+        if !(0..=i128::from(u64::MAX)).contains(&seed) {
             return Err(PyValueError::new_err(format!(
-                "sample_offset {sample_offset}: must be a whole number ≥ 0"
+                "seed {seed}: must be a whole number from 0 to 2⁶⁴ − 1"
+            )));
+        }
+        if !(0..=i128::from(u64::MAX)).contains(&sample_offset) {
+            return Err(PyValueError::new_err(format!(
+                "sample_offset {sample_offset}: must be a whole number ≥ 0 (below 2⁵³ with spp)"
             )));
         }
         let crop = match crop {
@@ -716,16 +721,16 @@ fn finish(
 fn truth_image<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
-    spp: i64,
-    size: (i64, i64),
+    spp: i128,
+    size: (i128, i128),
     direct_only: bool,
-    seed: i64,
-    sample_offset: i64,
-    crop: Option<(i64, i64, i64, i64)>,
+    seed: i128,
+    sample_offset: i128,
+    crop: Option<(i128, i128, i128, i128)>,
     range: Option<(f64, f64)>,
     observer: Option<String>,
     white: Option<String>,
-    max_depth: i64,
+    max_depth: i128,
     water: Option<String>,
     depth: Option<f64>,
     rgb_medium: Option<String>,
@@ -786,22 +791,22 @@ fn truth_image<'py>(
 fn truth_sums<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
-    spp: i64,
-    size: (i64, i64),
+    spp: i128,
+    size: (i128, i128),
     direct_only: bool,
-    seed: i64,
-    sample_offset: i64,
-    crop: Option<(i64, i64, i64, i64)>,
+    seed: i128,
+    sample_offset: i128,
+    crop: Option<(i128, i128, i128, i128)>,
     range: Option<(f64, f64)>,
     observer: Option<String>,
     white: Option<String>,
-    max_depth: i64,
+    max_depth: i128,
     water: Option<String>,
     depth: Option<f64>,
     rgb_medium: Option<String>,
     spectral_bin: Option<f64>,
     camera_to_display: bool,
-    threads: Option<i64>,
+    threads: Option<i128>,
     dry_run: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let sc = scene_of(scene, "scene", water.is_some())?;
@@ -881,7 +886,7 @@ fn truth_sums<'py>(
 fn truth_finish<'py>(
     py: Python<'py>,
     xyz: PyReadonlyArrayDyn<'py, f64>,
-    spp: i64,
+    spp: i128,
     bins: Option<PyReadonlyArrayDyn<'py, f64>>,
     display: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyAny>> {

@@ -50,3 +50,22 @@ def test_a_missing_file_is_file_not_found_wherever_it_is_named(tmp_path):
         with pytest.raises(FileNotFoundError, match="nope"):
             call()
             pytest.fail(f"{what}: no error")
+
+
+def test_huge_integers_are_refused_by_name_and_any_u64_seed_is_taken():
+    """Python's integers are unbounded: one beyond the machine's was an OverflowError naming no
+    argument, and seeds from 2⁶³ on (valid for `spectra truth --seed`) could not be given."""
+    s = spectra.load("cornell")
+    r = spectra.Renderer(s, size=(8, 6))
+    for name, call in {
+        "spp": lambda: spectra.truth(s, spp=2**70, size=(8, 6)),
+        "seed": lambda: spectra.truth(s, spp=1, size=(8, 6), seed=2**64),
+        "sample_offset": lambda: spectra.truth(s, spp=1, size=(8, 6), sample_offset=2**80),
+        "size": lambda: spectra.truth(s, spp=1, size=(2**65, 6)),
+        "wavelengths": lambda: r.render(wavelengths=2**64),
+        "samples": lambda: r.render(samples=-(2**70)),
+    }.items():
+        with pytest.raises(ValueError, match=name):
+            call()
+    big = spectra.truth(s, spp=1, size=(8, 6), seed=2**64 - 1)
+    assert big.shape == (6, 8, 3) and not (big == spectra.truth(s, spp=1, size=(8, 6), seed=1)).all()

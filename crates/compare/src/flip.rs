@@ -273,7 +273,8 @@ pub fn hdr_flip(
         if !(start.is_finite() && stop.is_finite()) {
             return Err(CompareError::InvalidOption(
                 "HDR-FLIP: the reference image is black, so FLIP cannot choose its exposure range; \
-                 give the start and stop exposures"
+                 give the exposure range (`spectra diff --flip-start-exposure S --flip-stop-exposure E`) \
+                 or use LDR-FLIP"
                     .into(),
             ));
         }
