@@ -808,7 +808,7 @@ mod tests {
         let msg = e(&cornell, Some("no-such-medium.json"), false, 16);
         assert!(msg.contains("--rgb-medium no-such-medium.json"), "{msg}");
         let msg = e(&cornell, Some(m), false, 33);
-        assert!(msg.contains("march steps") && msg.contains("33"), "{msg}");
+        assert!(msg.contains("--scatter-steps 33") && msg.contains("0–32"), "{msg}");
     }
 
     #[test]
