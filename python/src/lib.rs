@@ -353,7 +353,10 @@ impl Renderer {
     /// Jerlov type, e.g. "IB") with the camera `depth` in metres, or `rgb_medium` (the
     /// `--rgb-medium` JSON or a JSON file); by default the scene's own.
     #[new]
-    #[pyo3(signature = (scene, size = (640, 480), *, water = None, depth = None, rgb_medium = None))]
+    // The text signatures spell the tuple defaults, which pyo3 would show as `...` (so that
+    // `inspect.signature` bound defaults that cannot be passed back).
+    #[pyo3(signature = (scene, size = (640, 480), *, water = None, depth = None, rgb_medium = None),
+           text_signature = "(scene, size=(640, 480), *, water=None, depth=None, rgb_medium=None)")]
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
@@ -716,7 +719,10 @@ fn finish(
 #[pyfunction(name = "truth")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
-                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false))]
+                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false),
+       text_signature = "(scene, spp=64, size=(256, 256), direct_only=False, seed=0, *, sample_offset=0, \
+                         crop=None, range=None, observer=None, white=None, max_depth=1024, water=None, \
+                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False)")]
 #[allow(clippy::too_many_arguments)]
 fn truth_image<'py>(
     py: Python<'py>,
@@ -786,7 +792,11 @@ fn truth_image<'py>(
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
                     depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false, threads = None,
-                    dry_run = false))]
+                    dry_run = false),
+       text_signature = "(scene, spp=64, size=(256, 256), direct_only=False, seed=0, *, sample_offset=0, \
+                         crop=None, range=None, observer=None, white=None, max_depth=1024, water=None, \
+                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False, \
+                         threads=None, dry_run=False)")]
 #[allow(clippy::too_many_arguments)]
 fn truth_sums<'py>(
     py: Python<'py>,

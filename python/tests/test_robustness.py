@@ -69,3 +69,17 @@ def test_huge_integers_are_refused_by_name_and_any_u64_seed_is_taken():
             call()
     big = spectra.truth(s, spp=1, size=(8, 6), seed=2**64 - 1)
     assert big.shape == (6, 8, 3) and not (big == spectra.truth(s, spp=1, size=(8, 6), seed=1)).all()
+
+
+def test_signatures_spell_their_tuple_defaults():
+    """inspect.signature showed `size=Ellipsis` (pyo3's rendering of a tuple default), so a
+    signature's defaults, bound and passed back, were a TypeError."""
+    import inspect
+
+    t = inspect.signature(spectra.truth)
+    assert t.parameters["size"].default == (256, 256)
+    assert inspect.signature(spectra.Renderer).parameters["size"].default == (640, 480)
+    bound = t.bind(spectra.load("cornell"), spp=1)
+    bound.apply_defaults()
+    bound.arguments["size"] = (8, 6)
+    assert spectra.truth(*bound.args, **bound.kwargs).shape == (6, 8, 3)

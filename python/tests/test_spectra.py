@@ -685,7 +685,7 @@ def test_type_stub_matches_the_extension(tmp_path):
         return [p for p in out if p[0] != "self"]
 
     def runtime(obj):
-        # pyo3 cannot spell a tuple default in a text signature: it shows `...`.
+        # A tuple default pyo3 would show as `...`; lib.rs spells those in text signatures.
         return [
             (p.name, p.kind, p.default)
             for p in inspect.signature(obj).parameters.values()
