@@ -504,7 +504,8 @@ pub const MIN_YFOV: f32 = 1e-5;
 /// vertex, camera and light once their nodes' transforms are applied): the renderers work in
 /// single precision, and far out the path tracer's hierarchy and intersections fail (a panic
 /// at 10²⁵, wrong images at 10¹²). The path tracer renders the Khronos Duck (±1 unit) scaled
-/// to span ±10¹⁰ units bit for bit as at its own size: the bound leaves a factor 10.
+/// to span ±10¹⁰ units as at its own size (ΔE2000 ≤ 0.005 in every pixel; docs/scene-format.md
+/// gives the commands): the bound leaves a factor 10.
 pub const MAX_COORDINATE: f32 = 1e9;
 /// Largest |normalTexture.scale| accepted.
 pub const MAX_NORMAL_SCALE: f32 = 1000.0;
