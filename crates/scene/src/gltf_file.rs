@@ -85,10 +85,21 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
     // The `gltf` crate subtracts the 12-byte header from the declared length unchecked (an
     // overflow panic in debug builds, found by crates/fuzz).
-    if bytes.starts_with(b"glTF")
-        && bytes.get(8..12).is_none_or(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) < 12)
-    {
-        return Err(ctx.invalid("GLB header", "the declared length is shorter than the 12-byte header"));
+    if bytes.starts_with(b"glTF") {
+        let declared = bytes.get(8..12).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if declared.is_none_or(|n| n < 12) {
+            return Err(ctx.invalid("GLB header", "the declared length is shorter than the 12-byte header"));
+        }
+        // The crate reads only the declared length: bytes past it (a file cut and re-joined, or
+        // two files concatenated) would be ignored without a word.
+        if let Some(n) = declared
+            && n as usize != bytes.len()
+        {
+            return Err(ctx.invalid(
+                "GLB header",
+                &format!("the declared length is {n} bytes but the file has {}", bytes.len()),
+            ));
+        }
     }
     let json = if bytes.starts_with(b"glTF") {
         gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.json.into_owned()

@@ -395,6 +395,34 @@ fn a_glb_shorter_than_its_header_is_refused() {
     assert_has(&e, &["tiny.glb", "GLB header"]);
 }
 
+/// A GLB is one declared length long: bytes past it (two files joined, a copy cut and resumed)
+/// were ignored without a word, since the `gltf` crate reads only what the header declares.
+#[test]
+fn a_glb_whose_length_differs_from_its_header_is_refused() {
+    let mut json = br#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[]}]}"#.to_vec();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let glb = |declared: usize, tail: &[u8]| {
+        let mut g = b"glTF\x02\0\0\0".to_vec();
+        g.extend_from_slice(&(declared as u32).to_le_bytes());
+        g.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        g.extend_from_slice(b"JSON");
+        g.extend_from_slice(&json);
+        g.extend_from_slice(tail);
+        g
+    };
+    let whole = 20 + json.len();
+    scene::load_slice("ok.glb", &glb(whole, b""), None).unwrap();
+    let e = scene::load_slice("joined.glb", &glb(whole, b"glTF"), None).unwrap_err().to_string();
+    assert_has(
+        &e,
+        &["joined.glb", "GLB header", &format!("declared length is {whole} bytes"), &(whole + 4).to_string()],
+    );
+    let e = scene::load_slice("long.glb", &glb(whole + 8, b""), None).unwrap_err().to_string();
+    assert_has(&e, &["long.glb", "GLB header"]);
+}
+
 /// Found by crates/fuzz: a 685-byte EXR whose header made the `exr` crate's ZIP decoder ask for
 /// 35 GB (an abort, not a panic) through `image`, whose limits apply only after decoding.
 #[test]
