@@ -97,7 +97,7 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
         {
             return Err(ctx.invalid(
                 "GLB header",
-                &format!("the declared length is {n} bytes but the file has {}", bytes.len()),
+                format!("the declared length is {n} bytes but the file has {}", bytes.len()),
             ));
         }
     }
