@@ -400,7 +400,7 @@ fn a_glb_shorter_than_its_header_is_refused() {
 #[test]
 fn a_glb_whose_length_differs_from_its_header_is_refused() {
     let mut json = br#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[]}]}"#.to_vec();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let glb = |declared: usize, tail: &[u8]| {
