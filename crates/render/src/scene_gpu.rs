@@ -578,7 +578,9 @@ impl GpuScene {
         }
         let chunks = chunks.finish();
         if chunks.is_empty() {
-            return Err(bad("the scene has no geometry".into()));
+            // Nothing to rasterise: the frame is the sky (as the path tracer draws it), and the
+            // bounds that size shadow maps and the occlusion radius are a point.
+            (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
         }
         // One light kept for an environment's sun (`Renderer::set_environment`).
         let reserved = s.lights.len() + usize::from(s.environment.is_some());

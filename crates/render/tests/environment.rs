@@ -108,6 +108,26 @@ fn default_sky_lights_a_white_sphere_as_the_closed_form_says() {
     }
 }
 
+/// The path tracer draws a scene without geometry (the sky alone); the real-time renderer
+/// refused it ("the scene has no geometry") and now draws the same sky.
+#[test]
+fn a_scene_without_geometry_is_its_sky() {
+    let g = scene::environment::DEFAULT_GROUND;
+    let mut scene = sphere_scene(Environment::default_sky());
+    scene.meshes.clear();
+    for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8), (Mode::Spectral, 1)] {
+        let img = render(&scene, &RenderSettings { shadows: true, ..settings(mode, n) });
+        let at = |x: u32, y: u32| img[(y * SIZE + x) as usize];
+        for (x, y, want) in [(1, 1, 1.0), (SIZE / 2, 2, 1.0), (1, SIZE - 2, g), (SIZE / 2, SIZE - 3, g)] {
+            assert!(
+                (at(x, y)[1] - want).abs() < 0.01,
+                "{mode:?} N={n}: ({x}, {y}) {:?}, want {want}",
+                at(x, y)
+            );
+        }
+    }
+}
+
 #[test]
 fn rotation_turns_the_environment_about_y() {
     // Red towards −Z (the image's centre half), blue behind: the background straight ahead is red;
