@@ -373,8 +373,8 @@ def eval(
         argv += ["--truth-cache", cache]
         paths.append(len(argv) - 1)
         # The workers' working directory need not be this process's, so their copy names every
-        # file absolutely. This process keeps the paths as given: an observer file's name is
-        # part of a cached truth's key and of results.json, as it is for the command.
+        # file absolutely. This process keeps the paths as given: an observer file's path as
+        # given is what results.json names, as it is for the command.
         remote = list(argv)
         for i in paths:
             remote[i] = _absolute(argv[i])

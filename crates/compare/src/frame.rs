@@ -55,17 +55,22 @@ impl ExrFrame {
         }
         attributes.layer_position = Vec2(self.origin.0 as i32, self.origin.1 as i32);
         for (k, v) in &self.attributes {
-            let (Some(k), Some(v)) = (Text::new_or_none(k), Text::new_or_none(v)) else {
-                return Err(CompareError::InvalidImage(format!(
-                    "{}: attribute {k} cannot be stored in an EXR header (non-Latin-1 text)",
-                    path.display()
-                )));
-            };
-            attributes.other.insert(k, AttributeValue::Text(v));
+            // UTF-8, as OpenEXR's own tools read text (its Python bindings refuse to open a file
+            // whose text is Latin-1 beyond ASCII); a file name in any script can be recorded.
+            attributes.other.insert(
+                Text::from_slice_unchecked(k.as_bytes()),
+                AttributeValue::Text(Text::from_slice_unchecked(v.as_bytes())),
+            );
         }
         let display = IntegerBounds::new(Vec2(0, 0), Vec2(self.display.0 as usize, self.display.1 as usize));
         Ok(exr::meta::header::ImageAttributes::new(display))
     }
+}
+
+/// An attribute's text: UTF-8 as written now, else Latin-1 (a byte a character) as earlier
+/// versions wrote it, so that their renders still read as they did.
+fn text(t: &Text) -> String {
+    String::from_utf8(t.bytes().to_vec()).unwrap_or_else(|_| t.to_string())
 }
 
 /// The frame of the EXR at `path`, from its headers (the first layer's data window): cheap,
@@ -98,9 +103,7 @@ pub fn decode_exr_frame(path: &Path, bytes: &[u8]) -> Result<ExrFrame> {
         .iter()
         .chain(header.shared_attributes.other.iter())
         .filter_map(|(k, v)| match v {
-            AttributeValue::Text(t) if k.to_string().starts_with(PREFIX) => {
-                Some((k.to_string(), t.to_string()))
-            }
+            AttributeValue::Text(t) if k.to_string().starts_with(PREFIX) => Some((k.to_string(), text(t))),
             _ => None,
         })
         .collect();

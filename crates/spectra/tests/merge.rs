@@ -196,3 +196,56 @@ fn mixtures_are_refused() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Found by a sweep: a file name outside Latin-1 (`sky–dusk.hdr`, `камера/cam.csv`) let the
+/// render run to its end and then refused to write it (the record could not be stored); the
+/// record's `×` was a Latin-1 byte that OpenEXR's Python bindings refuse to open; and one
+/// observer file under two paths refused to merge. Now the record is UTF-8 and names an
+/// observer file by its name.
+#[test]
+fn the_record_holds_any_script_and_names_an_observer_file_without_its_folder() {
+    let d = tmp("script");
+    let hdr = d.join("sky–dusk.hdr");
+    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/environments/rooitou_park.hdr"), &hdr)
+        .unwrap();
+    let (a, b) = (d.join("камера"), d.join("other"));
+    for dir in [&a, &b] {
+        std::fs::create_dir_all(dir).unwrap();
+        std::fs::write(dir.join("cam.csv"), "380,1,0,0\n580,0,1,0\n780,0,0,1\n").unwrap();
+    }
+    let chunk = |k: &str, obs: &Path, out: &Path| {
+        ok(&[
+            "truth",
+            "cornell",
+            "--size",
+            "12x8",
+            "--spp",
+            "4",
+            "--chunk",
+            k,
+            "--env",
+            s(&hdr),
+            "--observer",
+            s(obs),
+            "--out",
+            s(out),
+        ])
+    };
+    let (c0, c1, m) = (d.join("c0.exr"), d.join("c1.exr"), d.join("m.exr"));
+    chunk("0/2", &a.join("cam.csv"), &c0);
+    chunk("1/2", &b.join("cam.csv"), &c1);
+    let frame = compare::read_exr_frame(&c0).unwrap();
+    let env = frame.get("spectra.setting.environment").unwrap();
+    assert!(env.starts_with("sky–dusk.hdr × "), "{env}");
+    let obs = frame.get("spectra.setting.observer").unwrap();
+    assert!(obs.starts_with("cam.csv "), "{obs}");
+    // UTF-8 on disk: the en dash's three bytes, not a Latin-1 stand-in.
+    let bytes = std::fs::read(&c0).unwrap();
+    assert!(bytes.windows(3).any(|w| w == "–".as_bytes()));
+    ok(&["merge", s(&c0), s(&c1), "--out", s(&m)]);
+    // Other functions under the same name are another observer.
+    std::fs::write(b.join("cam.csv"), "380,1,0,0\n580,0,1,0\n780,0,0,0.5\n").unwrap();
+    chunk("1/2", &b.join("cam.csv"), &c1);
+    refused(&["merge", s(&c0), s(&c1), "--out", s(&m)], &["c1.exr", "observer"]);
+    let _ = std::fs::remove_dir_all(&d);
+}

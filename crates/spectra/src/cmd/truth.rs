@@ -237,6 +237,18 @@ pub fn fields_hash(fields: &[(String, String)]) -> String {
 /// them. `inputs`: the files the scene was read from (`SceneArgs::input_files`); `spectral`:
 /// the sums include the --spectral-out bands. Shared by `spectra truth`'s records and the
 /// truth cache (`super::truth_cache`), which `spectra eval` uses too.
+/// An observer as the record names it: a file by its name alone (its contents are hashed
+/// beside it), so that chunks rendered where the file lies elsewhere merge.
+fn observer_name(name: &str) -> String {
+    if color::observer_file::is_file_name(name) {
+        let p = std::path::Path::new(name.trim());
+        if let Some(n) = p.file_name() {
+            return n.to_string_lossy().into_owned();
+        }
+    }
+    name.to_string()
+}
+
 pub fn sum_fields(
     scene: &scene::Scene,
     st: &Settings,
@@ -250,7 +262,10 @@ pub fn sum_fields(
         ("size".into(), format!("{}x{}", st.width, st.height)),
         ("seed".into(), st.seed.to_string()),
         ("range".into(), format!("{}-{} nm", st.range.min, st.range.max)),
-        ("observer".into(), format!("{} {}", st.observer.name, hash(&format!("{:?}", st.observer.bar)))),
+        (
+            "observer".into(),
+            format!("{} {}", observer_name(&st.observer.name), hash(&format!("{:?}", st.observer.bar))),
+        ),
         ("white".into(), hash(&format!("{:?}", st.white))),
         ("direct_only".into(), st.direct_only.to_string()),
         ("max_depth".into(), st.max_depth.to_string()),
