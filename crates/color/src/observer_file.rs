@@ -166,6 +166,10 @@ pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
 }
 
 /// The checks on the whole file and the observer, shared by both formats.
+/// Bounds of an observer file's largest value (see `finish`).
+pub const MIN_LARGEST: f64 = 1e-30;
+pub const MAX_LARGEST: f64 = 1e30;
+
 fn finish(
     lambda: Vec<f64>,
     columns: [Vec<f64>; 3],
@@ -186,6 +190,16 @@ fn finish(
         if col.iter().all(|&v| v == 0.0) {
             return Err(whole(format!("{} is zero at every wavelength", column_name(c))));
         }
+    }
+    // The renderers normalise an observer by its response to the white, so its scale is free;
+    // but a scale far from 1 leaves the range where that response and the per-wavelength
+    // weights are finite and normal (values of 10⁻³¹⁰ made the path tracer's image NaN).
+    let largest = columns.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(MIN_LARGEST..=MAX_LARGEST).contains(&largest) {
+        return Err(whole(format!(
+            "its largest value is {largest:e}; scale the file so that it lies within {MIN_LARGEST:e}…{MAX_LARGEST:e} \
+             (only the functions' shape matters)"
+        )));
     }
     let bar = columns.map(|values| Spectrum::piecewise(lambda.clone(), values));
     let [a, b, c] = bar;
@@ -213,6 +227,26 @@ mod tests {
         let big = dir.path().join("big.csv");
         std::fs::File::create(&big).unwrap().set_len(MAX_FILE_BYTES + 1).unwrap();
         assert!(read(&big).unwrap_err().to_string().contains("larger than"));
+    }
+
+    /// Found by a sweep: CIE 1931 × 10⁻³¹⁰ made the path tracer's image NaN (its white
+    /// overflowed the normalisation); a file whose values are that far from 1 is refused,
+    /// naming the file.
+    #[test]
+    fn values_far_from_one_are_refused() {
+        for (scale, ok) in [(1e-310, false), (1e-31, false), (1e-29, true), (1e29, true), (1e31, false)] {
+            let text: String = (0..5)
+                .map(|i| format!("{},{:e},{:e},{:e}\n", 400 + 50 * i, scale, 0.5 * scale, scale))
+                .collect();
+            match parse(&text, "tiny.csv") {
+                Ok(_) => assert!(ok, "{scale:e} accepted"),
+                Err(e) => {
+                    assert!(!ok, "{scale:e}: {e}");
+                    let e = e.to_string();
+                    assert!(e.contains("tiny.csv") && e.contains("largest value"), "{e}");
+                }
+            }
+        }
     }
 
     /// A CSV holding a built-in camera's samples is that camera.

@@ -62,23 +62,50 @@ pub struct XyzSensor {
     cmf: [DenseSpectrum; 3],
 }
 
-/// ∫ observer(λ)·s(λ) dλ over `range`, each channel, on a 0.1 nm midpoint grid: fine enough
-/// that its quadrature error is far below the tracer's noise.
-pub fn observer_integral(observer: &Observer, s: &Spectrum, range: WavelengthRange) -> [f64; 3] {
-    let n = (range.width() * 10.0).round().max(1.0) as usize;
-    let d = range.width() / n as f64;
-    (0..n).fold([0.0; 3], |mut acc, i| {
-        let l = range.min + (i as f64 + 0.5) * d;
-        let (o, w) = (observer.eval(l), s.eval(l));
-        (0..3).for_each(|c| acc[c] += o[c] * w * d);
-        acc
-    })
+/// The observer as the tracer samples it: its three functions on the 1 nm grid of
+/// [`DenseSpectrum`], in f64. Linear between integer nanometres it is the observer itself for
+/// data on an integer grid; for data elsewhere (500.5 nm) or ending inside the range (a step to
+/// zero, which the grid ramps over 1 nm) it differs slightly, and the normalisation must see
+/// what the paths see — integrated against the exact data instead, a white furnace under a
+/// 500–510 nm box observer came out 1.09, under CIE 1931 cut at 420 nm 1.055.
+struct SampledObserver {
+    start: f64,
+    values: Vec<[f64; 3]>,
 }
 
-/// The normalisation of [`XyzSensor`]: the white's second channel (Y for a CIE observer).
-fn white_k(observer: &Observer, white: &Spectrum, range: WavelengthRange) -> f64 {
-    let k = observer_integral(observer, white, range)[1];
-    if k > 0.0 { k } else { 1.0 }
+impl SampledObserver {
+    fn new(observer: &Observer, range: WavelengthRange) -> Self {
+        let start = range.min.floor();
+        let n = (range.max.ceil() - start) as usize + 2;
+        SampledObserver { start, values: (0..n).map(|i| observer.eval(start + i as f64)).collect() }
+    }
+
+    fn eval(&self, lambda: f64) -> [f64; 3] {
+        let x = (lambda - self.start).max(0.0);
+        let i = (x as usize).min(self.values.len() - 2);
+        let t = x - i as f64;
+        let (a, b) = (self.values[i], self.values[i + 1]);
+        [0, 1, 2].map(|c| a[c] * (1.0 - t) + b[c] * t)
+    }
+
+    /// ∫ observer(λ)·s(λ) dλ over `range`, each channel, on a 0.1 nm midpoint grid: fine
+    /// enough that its quadrature error is far below the tracer's noise.
+    fn integral(&self, s: &Spectrum, range: WavelengthRange) -> [f64; 3] {
+        let n = (range.width() * 10.0).round().max(1.0) as usize;
+        let d = range.width() / n as f64;
+        (0..n).fold([0.0; 3], |mut acc, i| {
+            let l = range.min + (i as f64 + 0.5) * d;
+            let (o, w) = (self.eval(l), s.eval(l));
+            (0..3).for_each(|c| acc[c] += o[c] * w * d);
+            acc
+        })
+    }
+
+    /// The normalisation of [`XyzSensor`]: the white's second channel (Y for a CIE observer).
+    fn white_k(&self, white: &Spectrum, range: WavelengthRange) -> f64 {
+        let k = self.integral(white, range)[1];
+        if k > 0.0 { k } else { 1.0 }
+    }
 }
 
 /// The matrix from the tracer's tristimulus values to linear sRGB ([`color::film`], the
@@ -93,16 +120,20 @@ pub fn display_matrix(
 ) -> color::Result<glam::DMat3> {
     let rgb_white = color::RgbColorSpace::srgb()
         .emission_white(white, |s| crate::lights::y_integral(&|l| s.eval(l), range));
-    let k = white_k(observer, white, range);
-    let response = observer_integral(observer, &rgb_white, range).map(|v| v / k);
+    let sampled = SampledObserver::new(observer, range);
+    let k = sampled.white_k(white, range);
+    let response = sampled.integral(&rgb_white, range).map(|v| v / k);
     color::film::to_linear_srgb(observer, response, &rgb_white, view)
 }
 
 impl XyzSensor {
     pub fn new(observer: &Observer, white: &Spectrum, range: WavelengthRange) -> Self {
-        let k = white_k(observer, white, range);
-        let scale = range.width() / k;
-        let cmf = [0, 1, 2].map(|c| DenseSpectrum::from_fn(range, |l| observer.eval(l)[c] * scale));
+        let sampled = SampledObserver::new(observer, range);
+        let scale = range.width() / sampled.white_k(white, range);
+        let cmf = [0, 1, 2].map(|c| DenseSpectrum {
+            start: sampled.start as f32,
+            values: sampled.values.iter().map(|v| (v[c] * scale) as f32).collect(),
+        });
         XyzSensor { range, cmf }
     }
 
@@ -173,6 +204,39 @@ mod tests {
         let want = SpectralIntegrator::emission(&obs, &d65, &dense).integrate(|l| f11.eval(l));
         for c in 0..3 {
             assert!((acc[c] - want[c]).abs() < 2e-3 * want[c].abs().max(0.1), "{acc:?} vs {want:?}");
+        }
+    }
+
+    /// Found by a sweep: an observer file whose data end inside the range (a step to zero) or
+    /// lie between integer nanometres saw a white furnace at 1.09 (a 500–510 nm box), 1.055
+    /// (CIE 1931 cut at 420 nm), 0.992 (500.5–509.5): the paths sample the observer on the
+    /// 1 nm grid, the normalisation integrated the exact data. The white is 1 whatever the file.
+    #[test]
+    fn the_white_is_one_under_any_observer_file() {
+        let mut cut = String::from("nm,x,y,z\n");
+        for l in (420..=780).step_by(5) {
+            let v = Observer::cie1931().eval(l as f64);
+            cut.push_str(&format!("{l},{},{},{}\n", v[0], v[1], v[2]));
+        }
+        let files = [
+            ("box", "500,1,1,1\n505,1,1,1\n510,1,1,1\n".to_string()),
+            ("half", "500.5,1,1,1\n505,1,1,1\n509.5,1,1,1\n".to_string()),
+            ("cut", cut),
+        ];
+        let r = WavelengthRange::VISIBLE;
+        for (name, text) in files {
+            let obs = color::observer_file::parse(&text, name).unwrap();
+            for white in [Spectrum::Constant(1.0), illuminant::by_name("D65").unwrap()] {
+                let sensor = XyzSensor::new(&obs, &white, r);
+                let n = 200_000;
+                let mut y = 0.0f64;
+                for i in 0..n {
+                    let wl = sensor.sample((i as f32 + 0.5) / n as f32);
+                    let l = Vec4::from_array(wl.0.to_array().map(|l| white.eval(l as f64) as f32));
+                    y += sensor.to_xyz(&wl, l)[1] / n as f64;
+                }
+                assert!((y - 1.0).abs() < 2e-3, "{name}: white Y {y}");
+            }
         }
     }
 }
