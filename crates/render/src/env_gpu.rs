@@ -42,7 +42,8 @@ pub const F16_SAFE: f32 = 16384.0;
 /// spectral coefficient or an irradiance is larger still (π·L, the basis' normalisation), where
 /// f16 would hold ∞ (and ∞·0 = NaN in the shader). A power of two divides exactly, so a map
 /// that fits (scale 1) is stored bit for bit as before, and the f16's relative precision is the
-/// same at any scale; what it loses is texels below 2⁻²⁴·scale, i.e. ~10⁻⁹ of the brightest.
+/// same at any scale; what it loses is texels below 2⁻¹⁴·scale, ~10⁻⁹ of the brightest, whose
+/// precision degrades (kept in f32 instead where that matters: [`loses_darks`]).
 pub fn texture_scale(maps: &EnvMaps) -> f32 {
     let max = maps
         .radiance
@@ -72,12 +73,28 @@ pub struct GpuEnvironment {
     pub sampler: wgpu::Sampler,
 }
 
+/// Whether a map that needed [`texture_scale`] (a very bright sun) would lose texels that are
+/// not negligible to half-float: any texel whose largest component, divided by the scale,
+/// falls below f16's smallest normal number (2⁻¹⁴), where its relative precision degrades and,
+/// under 2⁻²⁵, it becomes zero. Measured: a 0.5 sky beside one 10¹² texel was drawn black.
+pub fn loses_darks(maps: &EnvMaps, scale: f32) -> bool {
+    let floor = scale * 2f32.powi(-14);
+    scale > 1.0
+        && maps.radiance.iter().chain(std::iter::once(&maps.irradiance)).flat_map(|m| m.texels.iter()).any(
+            |t| {
+                let v = t.abs().max_element();
+                v > 0.0 && v < floor
+            },
+        )
+}
+
 fn upload_map(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     label: &str,
     levels: &[Map],
     scale: f32,
+    format: wgpu::TextureFormat,
 ) -> wgpu::TextureView {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
@@ -85,13 +102,20 @@ fn upload_map(
         mip_level_count: levels.len() as u32,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba16Float,
+        format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
+    let wide = format == wgpu::TextureFormat::Rgba32Float;
     for (mip, level) in levels.iter().enumerate() {
-        let data: Vec<[f16; 4]> =
-            level.texels.iter().map(|t| (*t / scale).to_array().map(f16::from_f32)).collect();
+        let data: Vec<u8> = if wide {
+            bytemuck::cast_slice(&level.texels.iter().map(|t| (*t / scale).to_array()).collect::<Vec<_>>())
+                .to_vec()
+        } else {
+            let half: Vec<[f16; 4]> =
+                level.texels.iter().map(|t| (*t / scale).to_array().map(f16::from_f32)).collect();
+            bytemuck::cast_slice(&half).to_vec()
+        };
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
@@ -99,10 +123,10 @@ fn upload_map(
                 origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
-            bytemuck::cast_slice(&data),
+            &data,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(8 * level.width),
+                bytes_per_row: Some(if wide { 16 } else { 8 } * level.width),
                 rows_per_image: Some(level.height),
             },
             wgpu::Extent3d { width: level.width, height: level.height, depth_or_array_layers: 1 },
@@ -113,14 +137,23 @@ fn upload_map(
 
 fn upload_maps(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, maps: &EnvMaps) -> EnvTextures {
     let scale = texture_scale(maps);
+    // A map whose range half-float cannot hold (a sun 10⁹ times its sky) is stored in f32 where
+    // the device filters it; every other map stays f16, as before, at half the bandwidth.
+    let (scale, format) =
+        if loses_darks(maps, scale) && device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+            (1.0, wgpu::TextureFormat::Rgba32Float)
+        } else {
+            (scale, wgpu::TextureFormat::Rgba16Float)
+        };
     EnvTextures {
-        radiance: upload_map(device, queue, &format!("{label} radiance"), &maps.radiance, scale),
+        radiance: upload_map(device, queue, &format!("{label} radiance"), &maps.radiance, scale, format),
         irradiance: upload_map(
             device,
             queue,
             &format!("{label} irradiance"),
             std::slice::from_ref(&maps.irradiance),
             scale,
+            format,
         ),
         max_lod: (maps.radiance.len() - 1) as f32,
         scale,

@@ -128,6 +128,28 @@ fn a_scene_without_geometry_is_its_sky() {
     }
 }
 
+/// Found by a sweep: one texel of 10¹² in a 0.5 sky (inside the accepted 10¹⁵) made the
+/// half-float maps' scale so large that the sky underflowed to zero: the background and the
+/// sphere's far side were drawn black (at 10¹¹, 20 % dark). Such a map is kept in f32 where the
+/// adapter filters it (lavapipe does).
+#[test]
+fn a_sky_beside_a_very_bright_texel_keeps_its_value() {
+    let (w, h) = (64u32, 32u32);
+    for peak in [1e9f32, 1e12, 1e15] {
+        let texels =
+            (0..w * h).map(|i| if i == w * 8 + 5 { Vec3::splat(peak) } else { Vec3::splat(0.5) }).collect();
+        let mut env = Environment::from_rgb("peak", w, h, texels).unwrap();
+        env.sun_light = false;
+        let scene = sphere_scene(env);
+        for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8)] {
+            let img = render(&scene, &settings(mode, n));
+            let px = img[(SIZE * (SIZE - 2) + 1) as usize];
+            assert!((px[1] - 0.5).abs() < 0.01, "{mode:?}, peak {peak:e}: background {px:?}");
+            assert!(img.iter().all(|p| p.iter().all(|v| v.is_finite())), "{mode:?}, peak {peak:e}");
+        }
+    }
+}
+
 #[test]
 fn rotation_turns_the_environment_about_y() {
     // Red towards −Z (the image's centre half), blue behind: the background straight ahead is red;
