@@ -6,8 +6,8 @@
 //! polygons of uniform radiance, one-sided (emitting towards the side its vertex normals point
 //! to, as in the path tracer): a mesh of exactly two coplanar triangles forming a convex quad
 //! becomes one quad, any other mesh one polygon per triangle ([`emitters`]). The radiance is the
-//! material's `emissive` (× `KHR_materials_emissive_strength`, already applied) times the mean of
-//! its emissive texture over the polygon's own texture footprint (stratified samples of the
+//! material's `emissive` (× `KHR_materials_emissive_strength`, already applied) times the mean
+//! over the polygon of its emissive texture × its alpha coverage (stratified samples of the
 //! triangle, [`texture_mean`]); a polygon that emits nothing is left out.
 //!
 //! A renderer with a light budget takes [`area_lights`]: the polygons as they are when they fit,
@@ -16,9 +16,9 @@
 //! centre and normal, its spread's aspect, and its mean radiance, so that the emitted power
 //! (π·L·A per polygon) is kept exactly.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
-use crate::{Emission, Scene, Texture, TextureRef, Wrap, srgb};
+use crate::{AlphaMode, Emission, Scene, Texture, TextureRef, Wrap, srgb};
 
 /// One emitting polygon (3 or 4 vertices, counter-clockwise seen from the emitting side).
 #[derive(Clone, Debug)]
@@ -54,34 +54,61 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
             continue;
         }
         let texture = mat.emissive_texture.and_then(|r| scene.textures.get(r.index).map(|t| (r, t)));
+        // Coverage (what the path tracer's rays stop at, `truth::World::coverage`): the base
+        // colour's alpha × its texture's × COLOR_0's, tested against the cutoff (MASK) or taken
+        // as opacity (BLEND). An emitter cut away or see-through emits that much less; before,
+        // one of alpha 0 lit the scene in real time and not in the path tracer.
+        let base_texture = match mat.alpha_mode {
+            AlphaMode::Opaque => None,
+            _ => mat.base_color_texture.and_then(|r| scene.textures.get(r.index).map(|t| (r, t))),
+        };
+        let varying_alpha = mat.alpha_mode != AlphaMode::Opaque
+            && (base_texture.is_some() || mesh.colors.iter().any(|c| c.w != 1.0));
+        let coverage_of = |a: f32| match mat.alpha_mode {
+            AlphaMode::Opaque => 1.0,
+            AlphaMode::Mask { cutoff } => f32::from(u8::from(a >= cutoff)),
+            AlphaMode::Blend => a.clamp(0.0, 1.0),
+        };
+        let constant_coverage = coverage_of(mat.base_color.w);
         let uvs = |r: &TextureRef| if r.tex_coord == 1 { &mesh.uvs1 } else { &mesh.uvs };
-        // The polygon's radiance: the factor × its texture's mean over the polygon.
+        let uv_of = |r: &TextureRef, i: u32| {
+            let uv = uvs(r).get(i as usize).copied().unwrap_or(Vec2::ZERO);
+            r.transform.map_or(uv, |tf| tf.apply(uv))
+        };
+        // The polygon's radiance: the factor × the mean over the polygon of its texture ×
+        // coverage (sampled together: a cut-out decal's bright parts may be where it is cut).
         let radiance = |idx: &[u32]| -> Vec3 {
-            match texture {
-                None => mat.emissive,
-                Some((r, t)) => {
-                    let uv = |i: u32| {
-                        r.transform.map_or_else(
-                            || uvs(&r).get(i as usize).copied().unwrap_or(Vec2::ZERO),
-                            |tf| tf.apply(uvs(&r).get(i as usize).copied().unwrap_or(Vec2::ZERO)),
-                        )
-                    };
-                    let p = |i: u32| mesh.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-                    // A quad's two triangles, each weighted by its area.
-                    let halves: Vec<[u32; 3]> = match idx {
-                        [a, b, c] => vec![[*a, *b, *c]],
-                        [a, b, c, d] => vec![[*a, *b, *c], [*a, *c, *d]],
-                        _ => vec![],
-                    };
-                    let (mut sum, mut area) = (Vec3::ZERO, 0.0f32);
-                    for [a, b, c] in halves {
-                        let w = (p(b) - p(a)).cross(p(c) - p(a)).length().max(1e-30);
-                        sum += w * texture_mean(t, [uv(a), uv(b), uv(c)]);
-                        area += w;
-                    }
-                    mat.emissive * (sum / area.max(1e-30))
-                }
+            if texture.is_none() && !varying_alpha {
+                return mat.emissive * constant_coverage;
             }
+            let p = |i: u32| mesh.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            // A quad's two triangles, each weighted by its area.
+            let halves: Vec<[u32; 3]> = match idx {
+                [a, b, c] => vec![[*a, *b, *c]],
+                [a, b, c, d] => vec![[*a, *b, *c], [*a, *c, *d]],
+                _ => vec![],
+            };
+            let (mut sum, mut area) = (Vec3::ZERO, 0.0f32);
+            for t in halves {
+                let w = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length().max(1e-30);
+                let emit = texture.map(|(r, tex)| (tex, t.map(|i| uv_of(&r, i))));
+                let base = base_texture.map(|(r, tex)| (tex, t.map(|i| uv_of(&r, i))));
+                let colour_alpha = |b: [f32; 3]| {
+                    let c = |i: u32| mesh.colors.get(i as usize).map_or(1.0, |c| c.w);
+                    b[0] * c(t[0]) + b[1] * c(t[1]) + b[2] * c(t[2])
+                };
+                let mean = triangle_mean(emit, base, |texel_e, texel_b, b| {
+                    let e = texel_e.map_or(Vec3::ONE, |t| t.truncate());
+                    if mat.alpha_mode == AlphaMode::Opaque {
+                        return e;
+                    }
+                    let a = mat.base_color.w * texel_b.map_or(1.0, |t| t.w) * colour_alpha(b);
+                    e * coverage_of(a)
+                });
+                sum += w * mean;
+                area += w;
+            }
+            mat.emissive * (sum / area.max(1e-30))
         };
         let emission = |rgb: Vec3| Emission { rgb, intensity: 1.0, spectrum: mat.emission_spectrum.clone() };
         let tri = |t: &[u32]| -> Option<[Vec3; 3]> {
@@ -89,9 +116,12 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
             Some([p(t[0])?, p(t[1])?, p(t[2])?])
         };
         // Which side emits: the side the vertex normals point to (flat meshes: the winding).
-        let facing = |t: &[u32], ng: Vec3| -> f32 {
+        // A single-sided material is seen only from its winding's front, so one whose normals
+        // point the other way emits where nothing sees it, and where the path tracer's rays
+        // pass through it: nothing (it lit the scene in real time only).
+        let facing = |t: &[u32], ng: Vec3| -> Option<f32> {
             let n: Vec3 = t.iter().filter_map(|&i| mesh.normals.get(i as usize)).sum();
-            if n.dot(ng) < 0.0 { -1.0 } else { 1.0 }
+            if n.dot(ng) < 0.0 { mat.double_sided.then_some(-1.0) } else { Some(1.0) }
         };
         let tris: Vec<&[u32]> = mesh.indices.chunks_exact(3).collect();
         if let [a, b] = tris[..]
@@ -105,7 +135,7 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
                 continue;
             }
             if let Some(n) = ng.try_normalize() {
-                let s = facing(a, n);
+                let Some(s) = facing(a, n) else { continue };
                 let mut vertices = quad.to_vec();
                 if s < 0.0 {
                     vertices.reverse();
@@ -122,7 +152,7 @@ pub fn emitters(scene: &Scene) -> Vec<Emitter> {
             }
             let c = (v[1] - v[0]).cross(v[2] - v[0]);
             let Some(n) = c.try_normalize() else { continue };
-            let s = facing(t, n);
+            let Some(s) = facing(t, n) else { continue };
             let mut vertices = v.to_vec();
             if s < 0.0 {
                 vertices.reverse();
@@ -166,32 +196,60 @@ fn as_quad(a: &[u32], b: &[u32], ta: &[Vec3; 3], tb: &[Vec3; 3]) -> Option<([Vec
 /// covers, 16 to 4096), wrapped as the texture's sampler says. The path tracer reads the texture
 /// at every hit; this is what a polygon of uniform radiance can carry of it.
 pub fn texture_mean(t: &Texture, uv: [Vec2; 3]) -> Vec3 {
-    let (w, h) = (t.width as usize, t.height as usize);
-    if w == 0 || h == 0 || t.rgba8.len() < 4 * w * h {
-        return Vec3::ONE;
+    triangle_mean(Some((t, uv)), None, |e, _, _| e.map_or(Vec3::ONE, |t| t.truncate()))
+}
+
+/// The mean of `f` over a triangle, at stratified points (as [`texture_mean`]: as many as the
+/// larger texture footprint asks, 16 to 4096): `f` takes the nearest texel (linear RGB, alpha)
+/// of each texture given (`None` without one) and the point's barycentrics.
+fn triangle_mean(
+    a: Option<(&Texture, [Vec2; 3])>,
+    b: Option<(&Texture, [Vec2; 3])>,
+    f: impl Fn(Option<Vec4>, Option<Vec4>, [f32; 3]) -> Vec3,
+) -> Vec3 {
+    fn usable(x: Option<(&Texture, [Vec2; 3])>) -> Option<(&Texture, [Vec2; 3])> {
+        x.filter(|(t, _)| {
+            t.width > 0 && t.height > 0 && t.rgba8.len() >= 4 * t.width as usize * t.height as usize
+        })
     }
-    let size = Vec2::new(w as f32, h as f32);
-    let texels = 0.5 * ((uv[1] - uv[0]) * size).perp_dot((uv[2] - uv[0]) * size).abs();
-    // k × k cells of the unit square, folded onto the triangle: k² samples.
-    let k = (texels.sqrt().ceil() as usize).clamp(4, 64);
-    let wrap = |i: i64, n: usize, mode: Wrap| mode.index(i, n as i64) as usize;
-    let mut sum = Vec3::ZERO;
-    for i in 0..k {
-        for j in 0..k {
-            let (mut a, mut b) = ((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
-            if a + b > 1.0 {
-                (a, b) = (1.0 - a, 1.0 - b);
-            }
-            let at = uv[0] + a * (uv[1] - uv[0]) + b * (uv[2] - uv[0]);
-            let x = wrap((at.x * size.x).clamp(-1e9, 1e9).floor() as i64, w, t.sampler.wrap_s);
-            let y = wrap((at.y * size.y).clamp(-1e9, 1e9).floor() as i64, h, t.sampler.wrap_t);
+    let (a, b) = (usable(a), usable(b));
+    let footprint = |x: Option<(&Texture, [Vec2; 3])>| {
+        x.map_or(0.0, |(t, uv)| {
+            let size = Vec2::new(t.width as f32, t.height as f32);
+            0.5 * ((uv[1] - uv[0]) * size).perp_dot((uv[2] - uv[0]) * size).abs()
+        })
+    };
+    let k = (footprint(a).max(footprint(b)).sqrt().ceil() as usize).clamp(4, 64);
+    let texel = |x: Option<(&Texture, [Vec2; 3])>, s: f32, r: f32| {
+        x.map(|(t, uv)| {
+            let (w, h) = (t.width as usize, t.height as usize);
+            let at = uv[0] + s * (uv[1] - uv[0]) + r * (uv[2] - uv[0]);
+            let wrap = |i: i64, n: usize, mode: Wrap| mode.index(i, n as i64) as usize;
+            let x = wrap((at.x * w as f32).clamp(-1e9, 1e9).floor() as i64, w, t.sampler.wrap_s);
+            let y = wrap((at.y * h as f32).clamp(-1e9, 1e9).floor() as i64, h, t.sampler.wrap_t);
             let o = 4 * (y * w + x);
             let px = [t.rgba8[o], t.rgba8[o + 1], t.rgba8[o + 2]];
-            sum += if t.srgb {
+            let rgb = if t.srgb {
                 srgb::srgb8_to_linear(px)
             } else {
                 Vec3::new(px[0] as f32, px[1] as f32, px[2] as f32) / 255.0
             };
+            rgb.extend(t.rgba8[o + 3] as f32 / 255.0)
+        })
+    };
+    // The centroids of the k² congruent triangles the triangle divides into (k(k+1)/2 upright,
+    // k(k−1)/2 inverted): equal areas, so an unweighted mean. (Folding a k × k grid of the unit
+    // square onto it put k samples on the hypotenuse: a bias of order 1/k, 12 % of a half-cut
+    // quad at k = 4.)
+    let mut sum = Vec3::ZERO;
+    let mut at = |s: f32, r: f32| sum += f(texel(a, s, r), texel(b, s, r), [1.0 - s - r, s, r]);
+    let kf = k as f32;
+    for i in 0..k {
+        for j in 0..k - i {
+            at((i as f32 + 1.0 / 3.0) / kf, (j as f32 + 1.0 / 3.0) / kf);
+            if i + j + 1 < k {
+                at((i as f32 + 2.0 / 3.0) / kf, (j as f32 + 2.0 / 3.0) / kf);
+            }
         }
     }
     sum / (k * k) as f32
@@ -431,8 +489,67 @@ mod tests {
         assert!((e[0].normal - Vec3::NEG_Y).length() < 1e-6, "{}", e[0].normal);
         let n = (e[0].vertices[1] - e[0].vertices[0]).cross(e[0].vertices[2] - e[0].vertices[0]);
         assert!(n.dot(Vec3::NEG_Y) > 0.0, "winding follows the emitting side");
-        let up = emitters(&scene_with(quad_mesh(true), Vec3::splat(2.0)));
+        // Normals against the winding: a double-sided quad emits towards its normals; a
+        // single-sided one is seen only from its winding's front, where it does not emit (the
+        // path tracer's rays pass through its back): no light.
+        let mut scene = scene_with(quad_mesh(true), Vec3::splat(2.0));
+        scene.materials[0].double_sided = true;
+        let up = emitters(&scene);
         assert!((up[0].normal - Vec3::Y).length() < 1e-6);
+        scene.materials[0].double_sided = false;
+        assert!(emitters(&scene).is_empty());
+        let mut m = quad_mesh(true);
+        m.indices = vec![0, 1, 2];
+        scene.meshes[0] = m;
+        assert!(emitters(&scene).is_empty(), "one triangle");
+    }
+
+    /// An emitter cut away by alpha (MASK below the cutoff, BLEND at 0) lit the scene in real
+    /// time but not in the path tracer, whose rays pass where it is not there: its radiance is
+    /// now its mean coverage × emission, sampled together over the polygon.
+    #[test]
+    fn an_emitter_emits_as_much_as_its_alpha_covers() {
+        let rgb = |alpha: f32, mode: AlphaMode| {
+            let mut scene = scene_with(quad_mesh(false), Vec3::splat(2.0));
+            scene.materials[0].base_color.w = alpha;
+            scene.materials[0].alpha_mode = mode;
+            emitters(&scene).first().map_or(Vec3::ZERO, |e| e.emission.rgb)
+        };
+        assert_eq!(rgb(0.0, AlphaMode::Opaque), Vec3::splat(2.0), "opaque ignores alpha");
+        assert_eq!(rgb(0.0, AlphaMode::Blend), Vec3::ZERO);
+        assert_eq!(rgb(0.25, AlphaMode::Blend), Vec3::splat(0.5));
+        assert_eq!(rgb(0.4, AlphaMode::Mask { cutoff: 0.5 }), Vec3::ZERO);
+        assert_eq!(rgb(0.6, AlphaMode::Mask { cutoff: 0.5 }), Vec3::splat(2.0));
+        // A mask texture cutting the left half, and an emissive texture bright only there: the
+        // two sampled together leave nothing; sampled apart they would leave a quarter.
+        let tex = |name: &str, left: [u8; 4], right: [u8; 4]| Texture {
+            name: name.into(),
+            width: 2,
+            height: 1,
+            rgba8: [left, right].concat(),
+            srgb: false,
+            sampler: Default::default(),
+        };
+        let mut m = quad_mesh(false);
+        m.uvs = vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
+        let mut scene = scene_with(m, Vec3::ONE);
+        scene.textures.push(tex("cut", [255, 255, 255, 0], [255, 255, 255, 255]));
+        scene.textures.push(tex("glow", [255, 255, 255, 255], [0, 0, 0, 255]));
+        scene.materials[0].base_color_texture = Some(TextureRef::new(0));
+        scene.materials[0].emissive_texture = Some(TextureRef::new(1));
+        scene.materials[0].alpha_mode = AlphaMode::Mask { cutoff: 0.5 };
+        assert!(emitters(&scene).is_empty());
+        // The glow on the kept half: half the quad's mean.
+        scene.textures[1] = tex("glow", [0, 0, 0, 255], [255, 255, 255, 255]);
+        let e = emitters(&scene)[0].emission.rgb;
+        assert!((e - Vec3::splat(0.5)).abs().max_element() < 0.02, "{e}");
+        // COLOR_0's alpha counts too.
+        scene.materials[0].base_color_texture = None;
+        scene.materials[0].emissive_texture = None;
+        scene.materials[0].alpha_mode = AlphaMode::Blend;
+        scene.meshes[0].colors = vec![Vec4::new(1.0, 1.0, 1.0, 0.5); 4];
+        let e = emitters(&scene)[0].emission.rgb;
+        assert!((e - Vec3::splat(0.5)).abs().max_element() < 1e-6, "{e}");
     }
 
     /// A glowing sphere of 2 400 triangles in 8 lights: every bit of its area and power kept,
