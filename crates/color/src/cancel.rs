@@ -24,3 +24,28 @@ pub fn is_cancelled() -> bool {
 pub fn cancel() {
     CANCELLED.store(true, Ordering::SeqCst);
 }
+
+static HOLDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Work that must not be cut short once begun — writing the samples a checkpoint keeps — holds
+/// off the binary's forced exit (the one that ends a command that has not stopped in time)
+/// while the guard lives. Cancellation itself is unaffected.
+#[must_use = "the hold lasts as long as the guard"]
+pub struct Hold(());
+
+/// Starts a [`Hold`].
+pub fn hold() -> Hold {
+    HOLDS.fetch_add(1, Ordering::SeqCst);
+    Hold(())
+}
+
+impl Drop for Hold {
+    fn drop(&mut self) {
+        HOLDS.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// Whether some [`Hold`] is alive.
+pub fn held() -> bool {
+    HOLDS.load(Ordering::SeqCst) > 0
+}

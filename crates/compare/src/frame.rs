@@ -82,6 +82,19 @@ pub fn read_exr_frame(path: impl AsRef<Path>) -> Result<ExrFrame> {
     decode_exr_frame(path, &bytes)
 }
 
+/// [`read_exr_frame`] and the size of the data window (the pixels the file holds), from the
+/// headers alone.
+pub fn read_exr_frame_and_size(path: impl AsRef<Path>) -> Result<(ExrFrame, (u32, u32))> {
+    let path = path.as_ref();
+    let bytes = color::input::read_regular(path, crate::io::MAX_INPUT_BYTES)
+        .map_err(|e| CompareError::io(path, e))?;
+    let frame = decode_exr_frame(path, &bytes)?;
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false)
+        .map_err(|e| CompareError::Decode { path: path.into(), format: "OpenEXR", reason: e.to_string() })?;
+    let size = meta.headers.first().map_or((0, 0), |h| (h.layer_size.0 as u32, h.layer_size.1 as u32));
+    Ok((frame, size))
+}
+
 /// [`read_exr_frame`] of the bytes of an EXR (`path` names it in messages).
 pub fn decode_exr_frame(path: &Path, bytes: &[u8]) -> Result<ExrFrame> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };

@@ -21,7 +21,7 @@ pub mod spectral;
 
 pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
-pub use frame::{ExrFrame, read_exr_frame};
+pub use frame::{ExrFrame, read_exr_frame, read_exr_frame_and_size};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
 pub use io::{

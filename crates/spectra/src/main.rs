@@ -71,7 +71,12 @@ fn install_interrupt_handler() {
         color::cancel::cancel();
         std::thread::spawn(|| {
             std::thread::sleep(FORCED_EXIT_AFTER);
-            eprintln!("interrupted (Ctrl-C): stopped (forced: the GPU driver was busy); no output written");
+            // Writing a checkpoint of the samples done so far is worth the wait (a large one
+            // takes seconds); nothing else is.
+            while color::cancel::held() {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            eprintln!("interrupted: stopped (forced: the command did not stop in time); no output written");
             exit_now();
         });
     });
@@ -158,8 +163,8 @@ fn main() {
         // short), the user pressed Ctrl-C: say so once.
         Err(e) if color::cancel::is_cancelled() => {
             match e.downcast_ref::<cmd::KeptOnInterrupt>() {
-                Some(kept) => eprintln!("interrupted (Ctrl-C): stopped; {kept}"),
-                None => eprintln!("interrupted (Ctrl-C): stopped; {unwritten}"),
+                Some(kept) => eprintln!("interrupted: stopped; {kept}"),
+                None => eprintln!("interrupted: stopped; {unwritten}"),
             }
             EXIT_INTERRUPTED
         }

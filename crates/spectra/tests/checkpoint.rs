@@ -127,8 +127,16 @@ fn checkpoints_that_do_not_fit_are_refused() {
 }
 
 /// Ctrl-C after a checkpoint interval keeps the samples so far; `--resume` finishes the render.
+/// So does SIGTERM, what a cluster's scheduler sends on pre-emption (it ended the process as
+/// `kill -9` would, losing the samples since the last checkpoint).
 #[test]
 fn ctrl_c_keeps_the_samples() {
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        keeps_the_samples_on(signal);
+    }
+}
+
+fn keeps_the_samples_on(signal: libc::c_int) {
     let dir = tempfile::tempdir().unwrap();
     let full = dir.path().join("full.exr");
     let out = dir.path().join("r.exr");
@@ -142,17 +150,50 @@ fn ctrl_c_keeps_the_samples() {
     }
     std::thread::sleep(Duration::from_millis(100));
     // SAFETY: kill(2) on our own child's pid.
-    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
     let r = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&r.stderr);
     if r.status.success() {
-        eprintln!("the render finished before the SIGINT; nothing to check");
+        eprintln!("the render finished before signal {signal}; nothing to check");
         return;
     }
-    assert_eq!(r.status.code(), Some(130), "{err}");
+    assert_eq!(r.status.code(), Some(130), "signal {signal}: {err}");
     assert!(err.contains("samples kept in") && err.contains("--resume"), "{err}");
     assert!(ckpt.exists() && !out.exists());
     let r = run(&args(o, &["--checkpoint-every", "0.3", "--resume"]));
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert_eq!(pixels(&out), pixels(&full));
+}
+
+/// Found by a sweep: a checkpoint that could not be written (here its path taken by a
+/// directory; a full disk or a quota alike) ended the render and lost every sample. It is a
+/// safety net: the render warns and finishes.
+#[test]
+fn a_checkpoint_that_cannot_be_written_does_not_stop_the_render() {
+    use std::io::BufRead;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.exr");
+    let o = out.to_str().unwrap();
+    let cache = dir.path().join("cache");
+    let mut child = bin()
+        .args(args(o, &["--checkpoint-every", "0.2", "--truth-cache", cache.to_str().unwrap()]))
+        .spawn()
+        .unwrap();
+    // The cache's note comes after the checks of a leftover checkpoint, before the first pass.
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut text = String::new();
+    while !text.contains("rendering") {
+        let mut line = String::new();
+        if err.read_line(&mut line).unwrap() == 0 {
+            panic!("spectra ended before rendering: {text}");
+        }
+        text.push_str(&line);
+    }
+    std::fs::create_dir(dir.path().join("r.exr.checkpoint")).unwrap();
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{text}{rest}");
+    assert!(rest.contains("warning: writing the checkpoint") && rest.contains("rendering on"), "{rest}");
+    assert!(out.exists());
 }

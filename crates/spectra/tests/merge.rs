@@ -185,6 +185,15 @@ fn mixtures_are_refused() {
     let img = compare::Image::new(12, 8, vec![[0.5; 3]; 96]).unwrap();
     compare::write_image(p("plain.exr"), &img, Default::default()).unwrap();
     m(&[s(&p("a.exr")), s(&p("plain.exr"))], &["plain.exr", "not a spectra truth render"]);
+    // Found by a sweep: a chunk holding a NaN (a truth render never writes one: it drops
+    // non-finite samples) merged silently into a NaN pixel.
+    let mut img = compare::read_image(p("b.exr")).unwrap();
+    img.data[13] = [f32::NAN, 0.0, 0.0];
+    compare::write_exr_framed(p("nan.exr"), &img, &compare::read_exr_frame(p("b.exr")).unwrap()).unwrap();
+    m(&[s(&p("a.exr")), s(&p("nan.exr"))], &["nan.exr", "pixel (1, 1) is not finite"]);
+    // Tiles that leave a gap: the message names them.
+    r("cornell", &["--crop", "8,0,4,8", "--chunk", "1/2"], &p("right.exr"));
+    m(&[s(&p("left.exr")), s(&p("right.exr"))], &["left.exr", "right.exr", "do not cover a rectangle"]);
     // The output may not be an input; a crop outside the frame is refused before rendering.
     let a = p("a.exr");
     refused(&["merge", s(&a), s(&p("b.exr")), "--out", s(&a)], &["--out", "input"]);

@@ -54,14 +54,13 @@ fn show(ranges: &[(u64, u64)]) -> String {
     ranges.iter().map(|(a, b)| format!("{a}..{b}")).collect::<Vec<_>>().join(",")
 }
 
-/// One input: its record, window and pixels (colour, and bands for spectral files).
+/// One input: its record, window and sample ranges, from its headers (its pixels are read
+/// one input at a time, when they are added: [`Pixels::of`]).
 struct Piece {
     path: PathBuf,
     frame: ExrFrame,
     samples: Vec<(u64, u64)>,
     size: (u32, u32),
-    rgb: Image,
-    bands: Option<SpectralImage>,
 }
 
 impl Piece {
@@ -71,10 +70,13 @@ impl Piece {
     fn rect(&self) -> (u32, u32, u32, u32) {
         (self.frame.origin.0, self.frame.origin.1, self.size.0, self.size.1)
     }
+    fn spectral(&self) -> bool {
+        self.frame.get("spectra.content") == Some("spectral")
+    }
 }
 
 fn read_piece(path: &Path) -> Result<Piece> {
-    let frame = compare::read_exr_frame(path)?;
+    let (frame, size) = compare::read_exr_frame_and_size(path)?;
     let version = frame.get("spectra.version").with_context(|| {
         format!(
             "{}: not a spectra truth render (no spectra.* record): only `spectra truth` EXR outputs merge",
@@ -89,10 +91,55 @@ fn read_piece(path: &Path) -> Result<Piece> {
         );
     }
     let samples = parse_samples(path, frame.get("spectra.samples").unwrap_or(""))?;
-    let spectral = frame.get("spectra.content") == Some("spectral");
-    let rgb = if spectral { compare::io::read_spectral_exr_rgb(path)? } else { compare::read_image(path)? };
-    let bands = if spectral { Some(compare::read_spectral_exr(path)?) } else { None };
-    Ok(Piece { path: path.to_path_buf(), size: (rgb.width, rgb.height), frame, samples, rgb, bands })
+    let fits = |o: u32, n: u32, d: u32| u64::from(o) + u64::from(n) <= u64::from(d);
+    if !fits(frame.origin.0, size.0, frame.display.0) || !fits(frame.origin.1, size.1, frame.display.1) {
+        bail!(
+            "{}: its data window ({}×{} at {},{}) does not lie in its {}×{} frame",
+            path.display(),
+            size.0,
+            size.1,
+            frame.origin.0,
+            frame.origin.1,
+            frame.display.0,
+            frame.display.1
+        );
+    }
+    Ok(Piece { path: path.to_path_buf(), frame, samples, size })
+}
+
+/// An input's pixels: colour, and bands for a spectral file.
+struct Pixels {
+    rgb: Image,
+    bands: Option<SpectralImage>,
+}
+
+impl Pixels {
+    /// The pixels of `p`, checked against its headers and finite (a truth render drops
+    /// non-finite samples, so a NaN is a damaged file, and would spread through the merge).
+    fn of(p: &Piece) -> Result<Pixels> {
+        let path = &p.path;
+        let (rgb, bands) = if p.spectral() {
+            (compare::io::read_spectral_exr_rgb(path)?, Some(compare::read_spectral_exr(path)?))
+        } else {
+            (compare::read_image(path)?, None)
+        };
+        if (rgb.width, rgb.height) != p.size {
+            bail!("{}: changed while being merged", path.display());
+        }
+        let bad = |i: usize| {
+            let w = p.size.0 as usize;
+            anyhow::anyhow!("{}: pixel ({}, {}) is not finite: a damaged file", path.display(), i % w, i / w)
+        };
+        if let Some(i) = rgb.data.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+            return Err(bad(i));
+        }
+        if let Some(b) = &bands
+            && let Some(i) = b.data.iter().position(|v| !v.is_finite())
+        {
+            return Err(bad(i / b.bands().max(1)));
+        }
+        Ok(Pixels { rgb, bands })
+    }
 }
 
 /// Why `b` is not the same render as `a`: the first setting that differs.
@@ -208,8 +255,11 @@ pub fn run(a: Args) -> Result<()> {
     let y1 = tiles.iter().map(|t| t[0].rect().1 + t[0].rect().3).max().unwrap_or(0);
     let area: u64 = tiles.iter().map(|t| u64::from(t[0].size.0) * u64::from(t[0].size.1)).sum();
     if area != u64::from(x1 - x0) * u64::from(y1 - y0) {
+        let names: Vec<String> = tiles.iter().take(3).map(|t| t[0].path.display().to_string()).collect();
         bail!(
-            "the tiles do not cover a rectangle: they span {}×{} at {x0},{y0} with {} of its {} pixels missing",
+            "the tiles ({}{}) do not cover a rectangle: they span {}×{} at {x0},{y0} with {} of its {} pixels missing",
+            names.join(", "),
+            if tiles.len() > 3 { format!(" and {} more", tiles.len() - 3) } else { String::new() },
             x1 - x0,
             y1 - y0,
             u64::from(x1 - x0) * u64::from(y1 - y0) - area,
@@ -217,22 +267,42 @@ pub fn run(a: Args) -> Result<()> {
         );
     }
     let (w, h) = (x1 - x0, y1 - y0);
-    let nb = first.bands.as_ref().map_or(0, SpectralImage::bands);
+    // One input decoded at a time: the merge holds the sums and one input, whatever their number
+    // (holding all of them, 64 chunks of a 1080p spectral render would have needed ~40 GB).
     let mut rgb = vec![[0.0f64; 3]; (w * h) as usize];
-    let mut bands = vec![0.0f64; (w * h) as usize * nb];
+    let mut bands: Vec<f64> = Vec::new();
+    let mut like: Option<(SpectralImage, &Path)> = None;
     for t in &tiles {
         let total: u64 = t.iter().map(|p| p.spp()).sum();
         for p in t {
+            if color::cancel::is_cancelled() {
+                bail!("interrupted");
+            }
+            let px_of = Pixels::of(p)?;
+            let nb = match (&px_of.bands, &like) {
+                (Some(b), None) => {
+                    bands = vec![0.0f64; (w * h) as usize * b.bands()];
+                    like = Some((SpectralImage { data: Vec::new(), ..b.clone() }, p.path.as_path()));
+                    b.bands()
+                }
+                (Some(b), Some((l, from))) => {
+                    if b.edges != l.edges {
+                        bail!("{}: its bands are not {}'s", p.path.display(), from.display());
+                    }
+                    b.bands()
+                }
+                (None, _) => 0,
+            };
             let k = p.spp() as f64 / total as f64;
             let (px, py, pw, ph) = p.rect();
             for y in 0..ph {
                 for x in 0..pw {
                     let src = (y * pw + x) as usize;
                     let dst = ((py - y0 + y) * w + (px - x0 + x)) as usize;
-                    for (acc, v) in rgb[dst].iter_mut().zip(p.rgb.data[src]) {
+                    for (acc, v) in rgb[dst].iter_mut().zip(px_of.rgb.data[src]) {
                         *acc += k * f64::from(v);
                     }
-                    if let Some(b) = &p.bands {
+                    if let Some(b) = &px_of.bands {
                         for i in 0..nb {
                             bands[dst * nb + i] += k * f64::from(b.data[src * nb + i]);
                         }
@@ -241,6 +311,10 @@ pub fn run(a: Args) -> Result<()> {
             }
         }
     }
+    if color::cancel::is_cancelled() {
+        bail!("interrupted");
+    }
+    let nb = like.as_ref().map_or(0, |(b, _)| b.bands());
     let image = Image::new(w, h, rgb.iter().map(|p| p.map(|v| v as f32)).collect())?;
     let samples = &tile_samples[0];
     let mut frame = ExrFrame {
@@ -253,14 +327,10 @@ pub fn run(a: Args) -> Result<()> {
             *v = show(samples);
         }
     }
-    match &first.bands {
-        Some(b) => {
-            let spec = SpectralImage {
-                width: w,
-                height: h,
-                data: bands.iter().map(|&v| v as f32).collect(),
-                ..b.clone()
-            };
+    match like {
+        Some((b, _)) => {
+            let spec =
+                SpectralImage { width: w, height: h, data: bands.iter().map(|&v| v as f32).collect(), ..b };
             compare::write_spectral_exr_framed(&a.out, &spec, Some(&image), Some(&frame))
         }
         None => compare::write_exr_framed(&a.out, &image, &frame),

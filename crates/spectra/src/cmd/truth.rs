@@ -513,6 +513,7 @@ pub fn run(a: Args) -> Result<()> {
             Err(TruthError::Cancelled) => {
                 pb.finish_and_clear();
                 if interval > 0.0 && t1.elapsed().as_secs_f64() >= interval && acc.done > resumed {
+                    let _hold = color::cancel::hold();
                     super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc)?;
                     return Err(super::KeptOnInterrupt(format!(
                         "{} of {} samples kept in {}: the same command with --resume continues",
@@ -528,7 +529,12 @@ pub fn run(a: Args) -> Result<()> {
         }
         per_sample = Some(t.elapsed().as_secs_f64() / f64::from(n));
         if interval > 0.0 && acc.done < st.spp && last_write.elapsed().as_secs_f64() >= interval {
-            super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc)?;
+            // A checkpoint is a safety net: one that cannot be written (a full disk, a quota)
+            // must not cost the samples it was to keep. Tried again an interval later.
+            let _hold = color::cancel::hold();
+            if let Err(e) = super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc) {
+                pb.suspend(|| eprintln!("warning: {e:#}; rendering on, trying again in {interval} s"));
+            }
             last_write = Instant::now();
         }
     }
@@ -583,8 +589,10 @@ pub fn run(a: Args) -> Result<()> {
     }
     .with_context(|| format!("writing {}", out.display()))?;
     // The outputs are complete: the samples are safe in them.
-    if std::fs::symlink_metadata(&ckpt).is_ok() {
-        std::fs::remove_file(&ckpt).with_context(|| format!("removing the checkpoint {}", ckpt.display()))?;
+    if std::fs::symlink_metadata(&ckpt).is_ok()
+        && let Err(e) = std::fs::remove_file(&ckpt)
+    {
+        eprintln!("warning: removing the checkpoint {}: {e} (the outputs are complete)", ckpt.display());
     }
     // This process's paths (a resumed render did the checkpoint's before).
     let paths = img.width as f64 * img.height as f64 * f64::from(st.spp - resumed);
