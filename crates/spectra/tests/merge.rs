@@ -258,3 +258,30 @@ fn the_record_holds_any_script_and_names_an_observer_file_without_its_folder() {
     refused(&["merge", s(&c0), s(&c1), "--out", s(&m)], &["c1.exr", "observer"]);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Found by a sweep: a texture changed between two chunks was refused as "the scene's input
+/// file 2", leaving the user to count. The refusal names the file.
+#[test]
+fn a_changed_input_is_named() {
+    let d = tmp("named");
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../scene/tests/data/");
+    for f in ["textured.gltf", "quad.bin", "base.png", "normal.png", "reflectance.csv", "spectrum.csv"] {
+        std::fs::copy(format!("{data}{f}"), d.join(f)).unwrap();
+    }
+    let scene = d.join("textured.gltf");
+    let chunk = |k: &str, out: &Path| {
+        ok(&["truth", s(&scene), "--size", "8x6", "--spp", "2", "--chunk", k, "--out", s(out)]);
+    };
+    let (c0, c1) = (d.join("c0.exr"), d.join("c1.exr"));
+    chunk("0/2", &c0);
+    let mut png = std::fs::read(d.join("base.png")).unwrap();
+    // A byte in the IEND chunk's CRC would fail decoding; append a harmless trailing byte.
+    png.push(0);
+    std::fs::write(d.join("base.png"), png).unwrap();
+    chunk("1/2", &c1);
+    refused(
+        &["merge", s(&c0), s(&c1), "--out", s(&d.join("m.exr"))],
+        &["c1.exr", "base.png", "content hash"],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -310,7 +310,11 @@ pub fn sum_fields(
     for (i, (what, p)) in inputs.iter().enumerate() {
         let bytes = color::input::read_regular(p, scene::environment::MAX_INPUT_BYTES)
             .with_context(|| format!("{what} {}", p.display()))?;
-        fields.push((format!("input{i}"), format!("{:016x}", fnv1a64(&bytes))));
+        // Its name (without the folder) beside the hash, so that a refusal can say which file
+        // changed.
+        let name =
+            p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
+        fields.push((format!("input{i}"), format!("{name} {:016x}", fnv1a64(&bytes))));
     }
     Ok(fields)
 }
@@ -336,11 +340,16 @@ pub fn record_difference(
         return Some(("spectral bands (--spectral-out)".into(), said(get(there, k)), said(get(here, k))));
     }
     if let Some(i) = name.strip_prefix("input") {
-        return Some((
-            format!("the contents of the scene's input file {i} (content hash)"),
-            get(there, k),
-            get(here, k),
-        ));
+        // "DuckCM.png 0123…": the file's name, then its content hash.
+        let (there, here) = (get(there, k), get(here, k));
+        let split = |v: &str| {
+            v.rsplit_once(' ').map_or((String::new(), v.to_string()), |(n, h)| (n.into(), h.into()))
+        };
+        let ((n0, h0), (n1, h1)) = (split(&there), split(&here));
+        let file = if n1.is_empty() { n0 } else { n1 };
+        let what =
+            if file.is_empty() { format!("input file {i} (") } else { format!("{file} (input file {i}; ") };
+        return Some((format!("the contents of {what}content hash)"), h0, h1));
     }
     Some((name.to_string(), get(there, k), get(here, k)))
 }
