@@ -50,18 +50,22 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
         |row: usize, what: String| ColorError::Table(format!("observer file {source}: row {row}: {what}"));
     let mut lambda = Vec::new();
     let mut columns: [Vec<f64>; 3] = Default::default();
+    let mut first = true;
     for (i, line) in text.lines().enumerate() {
         let row = i + 1;
         let line = line.trim().trim_start_matches('\u{feff}');
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
+        // Fields may be quoted, as spreadsheets export them ("360","0.0001",…).
         let fields: Vec<&str> = line
             .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+            .map(|f| f.trim_matches('"'))
             .filter(|f| !f.is_empty())
             .collect();
-        // A header: the first line whose first field is not a number, before any data.
-        if lambda.is_empty() && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) {
+        // A header: the first line, if its first field is not a number. (Every such line was
+        // taken for one, so that a file of text ended as "0 data rows" naming no row.)
+        if std::mem::take(&mut first) && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) {
             continue;
         }
         if fields.len() != 4 {
@@ -247,6 +251,17 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Found by a sweep: a spreadsheet's quoted CSV was read as header lines only ("0 data
+    /// rows", no row named). Quotes are taken off; only the first line may be a header.
+    #[test]
+    fn quoted_fields_are_numbers_and_only_the_first_line_is_a_header() {
+        let quoted = "\"nm\",\"r\",\"g\",\"b\"\n\"400\",\"1\",\"0\",\"0\"\n\"500\",\"0\",\"1\",\"0\"\n\"600\",\"0\",\"0\",\"1\"\n";
+        let o = parse(quoted, "q.csv").unwrap();
+        assert_eq!(o.eval(500.0), [0.0, 1.0, 0.0]);
+        let e = parse("nm,r,g,b\nunits,x,y,z\n400,1,0,0\n", "two.csv").unwrap_err().to_string();
+        assert!(e.contains("two.csv") && e.contains("row 2") && e.contains("column 1"), "{e}");
     }
 
     /// A CSV holding a built-in camera's samples is that camera.
