@@ -706,6 +706,13 @@ fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, Envi
     let meta = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes))
         .map_err(|e| err(format!("not a readable Hdr image: {e}")))?
         .metadata();
+    // The decoder's own limit would say only "Memory limit exceeded".
+    if meta.width > MAX_INPUT_WIDTH || meta.height > MAX_INPUT_HEIGHT {
+        return Err(err(format!(
+            "{}×{} is larger than the {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} accepted",
+            meta.width, meta.height
+        )));
+    }
     let positive = |v: f32| v.is_finite() && v > 0.0;
     let mut scale = DVec3::ONE;
     if let Some(e) = meta.exposure {
@@ -936,6 +943,18 @@ mod tests {
             under_water: false,
         };
         assert!(orphan.apply(&mut lit.clone()).unwrap_err().to_string().contains("--env-intensity"));
+    }
+
+    #[test]
+    fn an_hdr_larger_than_accepted_says_its_size() {
+        for (w, h) in [(32768u32, 16384u32), (16384, 8193), (i32::MAX as u32, 2)] {
+            let bytes = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();
+            let e = Environment::from_bytes(Path::new("big.hdr"), &bytes).unwrap_err().to_string();
+            assert!(
+                e.contains("big.hdr") && e.contains(&format!("{w}×{h}")) && e.contains("16384×8192"),
+                "{e}"
+            );
+        }
     }
 
     #[test]
