@@ -179,6 +179,7 @@ impl Environment {
 
     fn decode(path: &Path, format: image::ImageFormat, bytes: &[u8]) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
+        let mut header = None;
         if format == image::ImageFormat::OpenExr {
             // The `image` crate applies its limits only after the `exr` crate has decoded the
             // blocks, which allocate what the header claims (a 685-byte file asked for 35 GB;
@@ -201,8 +202,11 @@ impl Environment {
                     )));
                 }
             }
+            header = exr_chromaticities(path, &meta)?;
         }
-        let header = if format == image::ImageFormat::Hdr { radiance_header(path, bytes)? } else { None };
+        if format == image::ImageFormat::Hdr {
+            header = radiance_header(path, bytes)?;
+        }
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         reader.set_format(format);
         let mut limits = image::Limits::default();
@@ -687,6 +691,56 @@ impl EnvironmentChoice {
 /// `COLORCORR` (the same, per channel), and `PRIMARIES` other than Rec. 709's (converted, with
 /// Bradford adaptation from the file's white to D65). These used to be ignored: a file written
 /// with `EXPOSURE=4` rendered four times too bright.
+/// The matrix from linear RGB of the colour space with chromaticities `n` (x y of red, green,
+/// blue, white) to linear sRGB, with Bradford adaptation to D65: the identity for Rec. 709's
+/// (within 10⁻³); `None` if `n` is not eight chromaticities of a colour space.
+fn to_srgb_from_chromaticities(n: &[f64]) -> Option<glam::DMat3> {
+    let ok = n.len() == 8
+        && n.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))
+        && n.chunks(2).all(|c| c[1] > 0.0 && c[0] + c[1] <= 1.0);
+    let space = ok.then(|| {
+        color::RgbColorSpace::new(
+            "PRIMARIES",
+            [[n[0], n[1]], [n[2], n[3]], [n[4], n[5]]],
+            [n[6], n[7]],
+            "",
+            color::colorspace::TransferFunction::Linear,
+        )
+    })?;
+    if !(space.to_xyz.is_finite() && space.to_xyz.determinant().abs() > 1e-6) {
+        return None;
+    }
+    let srgb = color::RgbColorSpace::srgb();
+    let same = space
+        .primaries
+        .iter()
+        .flatten()
+        .chain(&space.white)
+        .zip(srgb.primaries.iter().flatten().chain(&srgb.white))
+        .all(|(a, b)| (a - b).abs() < 1e-3);
+    Some(if same { glam::DMat3::IDENTITY } else { space.conversion_to(&srgb) })
+}
+
+/// An OpenEXR's `chromaticities` attribute (its RGB's primaries and white), as the matrix to
+/// linear sRGB (`None`: absent or Rec. 709's, the assumed default).
+fn exr_chromaticities(
+    path: &Path,
+    meta: &exr::meta::MetaData,
+) -> Result<Option<glam::Mat3>, EnvironmentError> {
+    let Some(c) = meta.headers.first().and_then(|h| h.shared_attributes.chromaticities) else {
+        return Ok(None);
+    };
+    let n: Vec<f64> =
+        [c.red, c.green, c.blue, c.white].iter().flat_map(|v| [f64::from(v.0), f64::from(v.1)]).collect();
+    let m = to_srgb_from_chromaticities(&n).ok_or_else(|| EnvironmentError {
+        file: path.to_path_buf(),
+        message: format!(
+            "attribute chromaticities: {n:?} are not the x y of red, green, blue and white of a colour space"
+        ),
+    })?;
+    Ok((m != glam::DMat3::IDENTITY).then(|| m.as_mat3()))
+}
+
 fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, EnvironmentError> {
     use glam::{DMat3, DVec3};
     let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
@@ -732,36 +786,13 @@ fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, Envi
     let mut m = DMat3::from_diagonal(scale);
     if let Some((_, v)) = meta.custom_attributes.iter().rev().find(|(k, _)| k == "PRIMARIES") {
         let n: Vec<f64> = v.split_whitespace().filter_map(|x| x.parse().ok()).collect();
-        let ok = n.len() == 8
-            && n.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))
-            && n.chunks(2).all(|c| c[1] > 0.0 && c[0] + c[1] <= 1.0);
-        let space = ok.then(|| {
-            color::RgbColorSpace::new(
-                "PRIMARIES",
-                [[n[0], n[1]], [n[2], n[3]], [n[4], n[5]]],
-                [n[6], n[7]],
-                "",
-                color::colorspace::TransferFunction::Linear,
-            )
-        });
-        let Some(space) = space.filter(|s| s.to_xyz.is_finite() && s.to_xyz.determinant().abs() > 1e-6)
-        else {
+        let Some(c) = to_srgb_from_chromaticities(&n) else {
             return Err(err(format!(
                 "header PRIMARIES: '{}' is not eight chromaticities (x y of red, green, blue, white) of a colour space",
                 v.trim()
             )));
         };
-        let srgb = color::RgbColorSpace::srgb();
-        let same = space
-            .primaries
-            .iter()
-            .flatten()
-            .chain(&space.white)
-            .zip(srgb.primaries.iter().flatten().chain(&srgb.white))
-            .all(|(a, b)| (a - b).abs() < 1e-3);
-        if !same {
-            m = space.conversion_to(&srgb) * m;
-        }
+        m = c * m;
     }
     Ok((m != DMat3::IDENTITY).then(|| m.as_mat3()))
 }
@@ -1017,6 +1048,49 @@ mod tests {
             let m = load(&with(line)).unwrap_err().to_string();
             assert!(m.contains("sky.hdr") && m.contains(field), "{line}: {m}");
         }
+    }
+
+    /// Found by a sweep: an EXR's `chromaticities` (ACES AP0, Rec. 2020…) were ignored while a
+    /// Radiance file's PRIMARIES were converted. Converted the same way now: checked against the
+    /// matrix built independently from the chromaticities (then Bradford to D65).
+    #[test]
+    fn exr_chromaticities_are_honoured() {
+        use exr::prelude::*;
+        let write = |chroma: Option<exr::meta::attribute::Chromaticities>| {
+            let channels = SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 1.0f32, 0.25f32));
+            let mut image = Image::from_channels((8, 4), channels);
+            image.attributes.chromaticities = chroma;
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            image.write().to_buffered(&mut bytes).unwrap();
+            bytes.into_inner()
+        };
+        let load = |b: &[u8]| Environment::from_bytes(Path::new("sky.exr"), b);
+        let base = load(&write(None)).unwrap().texels[5];
+        let c = |r: (f32, f32), g: (f32, f32), b: (f32, f32), w: (f32, f32)| {
+            exr::meta::attribute::Chromaticities {
+                red: Vec2(r.0, r.1),
+                green: Vec2(g.0, g.1),
+                blue: Vec2(b.0, b.1),
+                white: Vec2(w.0, w.1),
+            }
+        };
+        let rec709 = c((0.64, 0.33), (0.3, 0.6), (0.15, 0.06), (0.3127, 0.329));
+        assert!((load(&write(Some(rec709))).unwrap().texels[5] - base).abs().max_element() < 1e-6);
+        let p3 = c((0.68, 0.32), (0.265, 0.69), (0.15, 0.06), (0.3127, 0.329));
+        let got = load(&write(Some(p3))).unwrap().texels[5];
+        let space = color::RgbColorSpace::new(
+            "p3",
+            [[0.68, 0.32], [0.265, 0.69], [0.15, 0.06]],
+            [0.3127, 0.329],
+            "",
+            color::colorspace::TransferFunction::Linear,
+        );
+        let want = space.conversion_to(&color::RgbColorSpace::srgb()) * base.as_dvec3();
+        assert!((got.as_dvec3() - want.max(glam::DVec3::ZERO)).abs().max_element() < 1e-4, "{got} vs {want}");
+        assert!((got - base).abs().max_element() > 0.01);
+        let flat = c((0.3, 0.3), (0.3, 0.3), (0.3, 0.3), (0.3, 0.3));
+        let e = load(&write(Some(flat))).unwrap_err().to_string();
+        assert!(e.contains("sky.exr") && e.contains("chromaticities"), "{e}");
     }
 
     /// The largest map the documentation promises is not refused by the decoder's memory limit
