@@ -63,8 +63,30 @@ impl Mesh {
         } else {
             self
         };
+        // Files carry un-normalised or zero normals surprisingly often. A zero (or non-finite)
+        // one takes the area-weighted normal of the triangles that use the vertex, so that it
+        // faces as its surface does (a fixed +Z made a zero-normal lamp emit sideways in the
+        // path tracer and down in real time); +Z only where those have no area either.
+        if mesh.normals.iter().any(|n| n.try_normalize().is_none()) {
+            let mut faces = vec![Vec3::ZERO; mesh.normals.len()];
+            for t in mesh.indices.chunks_exact(3) {
+                let p = |i: u32| mesh.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+                let f = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+                if f.is_finite() {
+                    for &i in t {
+                        if let Some(v) = faces.get_mut(i as usize) {
+                            *v += f;
+                        }
+                    }
+                }
+            }
+            for (nrm, f) in mesh.normals.iter_mut().zip(&faces) {
+                if nrm.try_normalize().is_none() {
+                    *nrm = f.try_normalize().unwrap_or(Vec3::Z);
+                }
+            }
+        }
         for nrm in &mut mesh.normals {
-            // Files carry un-normalised or zero normals surprisingly often.
             *nrm = nrm.try_normalize().unwrap_or(Vec3::Z);
         }
         match normal_map_set {
@@ -131,5 +153,40 @@ impl Scene {
             })
             .collect();
         Cow::Owned(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Found by a sweep: a lamp whose file gave zero normals faced +Z (a fixed stand-in), so the
+    /// path tracer emitted it sideways and the real-time renderer (its winding) down. A zero
+    /// normal now takes its triangles' normal; a scaled one is made unit; a degenerate
+    /// triangle's vertex still gets a unit normal.
+    #[test]
+    fn zero_normals_face_as_their_triangles_do() {
+        let quad = Mesh {
+            positions: vec![
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(1.0, 1.0, 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
+            normals: vec![Vec3::ZERO, Vec3::ZERO, Vec3::new(0.0, -3.0, 0.0), Vec3::splat(f32::NAN)],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            ..Default::default()
+        };
+        let m = quad.complete(None).unwrap();
+        for n in &m.normals {
+            assert!((*n - Vec3::NEG_Y).length() < 1e-6, "{n}");
+        }
+        let point = Mesh {
+            positions: vec![Vec3::ZERO; 3],
+            normals: vec![Vec3::ZERO; 3],
+            indices: vec![0, 1, 2],
+            ..Default::default()
+        };
+        assert!(point.complete(None).unwrap().normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-6));
     }
 }
