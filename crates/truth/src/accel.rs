@@ -108,7 +108,11 @@ impl Geometry {
                 });
             }
             let mat = &scene.materials[m.material];
-            let flags = if mat.double_sided { 0 } else { SINGLE_SIDED }
+            // KHR_materials_volume: "the doubleSided property has no effect on volume
+            // boundaries" — a ray inside must find the way out through the back faces (culled,
+            // a single-sided glass cube passed 0.42 of its backdrop instead of 0.92).
+            let volume = mat.transmission.as_ref().is_some_and(|t| t.volume.is_some());
+            let flags = if mat.double_sided || volume { 0 } else { SINGLE_SIDED }
                 | if mat.alpha_mode == scene::AlphaMode::Opaque { 0 } else { NOT_OPAQUE };
             for (k, c) in m.indices.chunks_exact(3).enumerate() {
                 let p = |i: u32| m.positions.get(i as usize).copied();

@@ -532,6 +532,15 @@ pub fn run(a: Args) -> Result<()> {
                     ))
                     .into());
                 }
+                if a.resume && resumed > 0 {
+                    // Nothing new kept, but the checkpoint this run resumed from is intact.
+                    return Err(super::KeptOnInterrupt(format!(
+                        "{resumed} of {} samples still kept in {}: the same command with --resume continues",
+                        st.spp,
+                        ckpt.display()
+                    ))
+                    .into());
+                }
                 bail!("interrupted; nothing written");
             }
             r => r?,
