@@ -68,9 +68,15 @@ impl Volume {
         // A channel of colour 0 (all light absorbed at any distance) is the strongest
         // attenuation the media accept instead: e⁻¹⁴ of the light after the distance.
         let color = self.attenuation_color.map(|c| f64::from(c).max(1e-6));
+        // A distance so short that a coefficient passes the media's bound is that bound: as
+        // opaque as a medium gets (the medium was refused, and the glass drawn clear, from
+        // 10⁻⁶ units down, while 2·10⁻⁶ was black).
+        let strongest = color.iter().map(|c| -c.ln()).fold(0.0, f64::max);
+        let distance = f64::from(self.attenuation_distance)
+            .max(strongest / crate::medium::MAX_COEFFICIENT * (1.0 + 1e-9));
         crate::medium::RgbMedium::from_attenuation(
             color,
-            f64::from(self.attenuation_distance),
+            distance,
             [0.0; 3],
             0.0,
             1.0,
@@ -129,6 +135,31 @@ pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by a sweep: an attenuation distance of 10⁻⁶ units made a coefficient past the
+    /// media's bound, the medium was dropped and the glass drawn clear (2·10⁻⁶: black). Now the
+    /// shortest distances absorb as the bound does.
+    #[test]
+    fn a_very_short_attenuation_distance_absorbs_as_much_as_a_medium_can() {
+        let volume = |d: f32| Volume {
+            thickness: 1.0,
+            thickness_texture: None,
+            attenuation_color: [0.5, 0.25, 1.0],
+            attenuation_distance: d,
+        };
+        let m = volume(1.0).medium().unwrap();
+        assert!((m.absorption[0] - 2f64.ln()).abs() < 1e-9 && m.absorption[2] == 0.0, "{:?}", m.absorption);
+        for d in [2e-6f32, 1e-6, 1e-12, f32::MIN_POSITIVE] {
+            let m = volume(d).medium().unwrap_or_else(|| panic!("distance {d}: no medium"));
+            let top = m.absorption.iter().copied().fold(0.0, f64::max);
+            assert!(
+                top > 0.3 * crate::medium::MAX_COEFFICIENT && top <= crate::medium::MAX_COEFFICIENT,
+                "{d}: {top}"
+            );
+            // The colour's proportions kept: ln 4 / ln 2.
+            assert!((m.absorption[1] / m.absorption[0] - 2.0).abs() < 1e-6, "{:?}", m.absorption);
+        }
+    }
 
     /// The extension's closed form: n(λ) = max(n_d + (n_d − 1)/V_d · (523655/λ² − 1.5168), 1).
     #[test]
