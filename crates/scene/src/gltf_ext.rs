@@ -108,7 +108,33 @@ pub(crate) fn check_required(ctx: &Ctx, raw: &Value) -> Result<(), SceneError> {
 /// is lost.
 pub(crate) fn warnings(raw: &Value) -> Vec<String> {
     let required: Vec<&str> = strings(raw.get("extensionsRequired")).collect();
-    strings(raw.get("extensionsUsed"))
+    // Those the file lists, then those it uses without listing them (a file that forgets
+    // `extensionsUsed` lost its clearcoat or sheen without a word).
+    let mut used: Vec<&str> = strings(raw.get("extensionsUsed")).collect();
+    fn found<'a>(v: &'a Value, out: &mut Vec<&'a str>) {
+        match v {
+            Value::Object(o) => {
+                for (k, x) in o {
+                    match (k.as_str(), x) {
+                        ("extras", _) => {}
+                        ("extensions", Value::Object(e)) => {
+                            for (name, inner) in e {
+                                if !out.contains(&name.as_str()) {
+                                    out.push(name);
+                                }
+                                found(inner, out);
+                            }
+                        }
+                        _ => found(x, out),
+                    }
+                }
+            }
+            Value::Array(a) => a.iter().for_each(|x| found(x, out)),
+            _ => {}
+        }
+    }
+    found(raw, &mut used);
+    used.into_iter()
         .filter(|e| !SUPPORTED.contains(e) && !required.contains(e))
         .filter_map(|e| {
             let (lost, _) = unsupported(e);

@@ -600,6 +600,15 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     let mut d = base.clone();
     d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_sheen"]);
     assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_sheen"]);
+    // Found by a sweep: an extension used but missing from extensionsUsed was ignored without
+    // a warning. Extras are not extensions.
+    let mut d = base.clone();
+    d["materials"] = json!([{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}}]);
+    d["asset"]["extras"] = json!({"extensions": {"KHR_materials_clearcoat": {}}});
+    d["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let s = load(&d).unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].starts_with("KHR_materials_sheen is not supported"), "{:?}", s.warnings);
 }
 
 #[test]
