@@ -32,6 +32,23 @@ pub struct Dielectric {
     /// Index of the far side over the `wo` side (thin-walled: the material's index).
     pub eta: f32,
     pub thin: bool,
+    /// A thin film on the interface (`KHR_materials_iridescence`), which replaces its Fresnel
+    /// term by the film's reflectance per lane, as on the opaque BRDF; 1 − that is transmitted
+    /// (a clear film absorbs nothing). Without one, the arithmetic is the plain interface's.
+    pub film: Option<InterfaceFilm>,
+}
+
+/// The film on a see-through interface at the lanes' wavelengths.
+#[derive(Clone, Copy, Debug)]
+pub struct InterfaceFilm {
+    pub film: crate::bsdf::FilmLanes,
+    /// The material's index: the film's substrate.
+    pub ior: f32,
+    /// The path is inside the volume, meeting the film from the substrate's side: the film's
+    /// reflectance is the same from either side of a clear stack (reciprocity and energy
+    /// conservation), at the outside angle Snell's law gives; beyond the critical angle every
+    /// lane reflects.
+    pub inside: bool,
 }
 
 /// A sampled direction: BSDF value (per lane), pdf (solid angle) and whether it crossed.
@@ -67,6 +84,26 @@ pub fn refract(wo: Vec3, m: Vec3, eta: f32) -> Option<Vec3> {
 }
 
 impl Dielectric {
+    /// The interface's reflectance at a microfacet seen at cosine `c`: per lane, and the one
+    /// value the sampler chooses reflection with (their mean). Only called with a film.
+    fn film_fresnel(&self, c: f32, fl: &InterfaceFilm) -> (Vec4, f32) {
+        let f = fresnel(c, self.eta);
+        let c = f64::from(c);
+        let outside = if fl.inside {
+            let sin2 = (1.0 - c * c).max(0.0) * f64::from(fl.ior) * f64::from(fl.ior);
+            (sin2 < 1.0).then(|| (1.0 - sin2).sqrt())
+        } else {
+            Some(c)
+        };
+        let lanes = Vec4::from_array(std::array::from_fn(|i| {
+            outside.map_or(1.0, |co| {
+                fl.film.film.over_dielectric(f64::from(fl.film.lambda[i]), co, f64::from(fl.ior)) as f32
+            })
+        }));
+        let per_lane = Vec4::splat(f) + (lanes - Vec4::splat(f)) * fl.film.weight;
+        (per_lane, per_lane.element_sum() * 0.25)
+    }
+
     /// Equal indices on both sides (not a thin sheet, whose transmission is the mirrored
     /// reflection lobe): wi = −wo, with no reflection.
     pub fn index_matched(&self) -> bool {
@@ -139,6 +176,21 @@ impl Dielectric {
     /// f(wo, wi) per lane.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec4 {
         let Some((m, transmitted)) = self.half(wo, wi) else { return Vec4::ZERO };
+        if let Some(fl) = &self.film {
+            let (f, _) = self.film_fresnel(wo.dot(m), fl);
+            let (d, g) = (self.d(m), self.g2(wo, wi));
+            if !transmitted {
+                return f * (d * g / (4.0 * wo.z * wi.z));
+            }
+            if self.thin {
+                let r = Vec3::new(wi.x, wi.y, -wi.z);
+                return self.tint * (Vec4::ONE - f) * (d * self.g2(wo, r) / (4.0 * wo.z * r.z));
+            }
+            let (om, im) = (wo.dot(m), wi.dot(m));
+            let denom = im + om / self.eta;
+            let k = d * g * (im * om / (wi.z * wo.z * denom * denom)).abs();
+            return self.tint * (Vec4::ONE - f) * (k / (self.eta * self.eta));
+        }
         let f = fresnel(wo.dot(m), self.eta);
         let (d, g) = (self.d(m), self.g2(wo, wi));
         if !transmitted {
@@ -157,7 +209,10 @@ impl Dielectric {
     /// The pdf [`Self::sample`] draws `wi` with.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let Some((m, transmitted)) = self.half(wo, wi) else { return 0.0 };
-        let f = fresnel(wo.dot(m), self.eta);
+        let f = match &self.film {
+            Some(fl) => self.film_fresnel(wo.dot(m), fl).1,
+            None => fresnel(wo.dot(m), self.eta),
+        };
         let pm = self.pdf_m(wo, m);
         if !transmitted {
             return pm * f / (4.0 * wo.dot(m));
@@ -185,7 +240,10 @@ impl Dielectric {
             });
         }
         let m = crate::bsdf::visible_normal(self.alpha, wo, u);
-        let f = fresnel(wo.dot(m), self.eta);
+        let f = match &self.film {
+            Some(fl) => self.film_fresnel(wo.dot(m), fl).1,
+            None => fresnel(wo.dot(m), self.eta),
+        };
         let r = 2.0 * wo.dot(m) * m - wo;
         let wi = if u_lobe < f {
             r
@@ -221,7 +279,7 @@ mod tests {
     }
 
     fn glass(alpha: f32, eta: f32, thin: bool) -> Dielectric {
-        Dielectric { tint: Vec4::ONE, alpha, eta, thin }
+        Dielectric { tint: Vec4::ONE, alpha, eta, thin, film: None }
     }
 
     /// ∫ f·|cos| over the sphere by quadrature, ∫ pdf, the sampler's estimate of the first,
@@ -371,7 +429,7 @@ mod tests {
         let tint = Vec4::new(0.5, 0.7, 0.9, 1.0);
         let mut s = Sampler::new(11, 12);
         for alpha in [1e-3, 0.3, 1.0] {
-            let b = Dielectric { tint, alpha, eta: 1.0, thin: false };
+            let b = Dielectric { tint, alpha, eta: 1.0, thin: false, film: None };
             for theta in [0.0f32, 0.5, 1.0, 1.5] {
                 let wo = dir(theta, 0.7);
                 for _ in 0..1000 {
@@ -381,5 +439,58 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Found by a sweep: a film on a see-through material was dropped by the path tracer (its
+    /// pixels the same with and without), while the real-time renderer drew it. The interface's
+    /// Fresnel term is the film's reflectance per lane — from outside, and from inside at the
+    /// outside angle Snell gives (a clear stack reflects alike from both sides), all of it
+    /// past the critical angle — and what it does not reflect it transmits.
+    #[test]
+    fn a_film_on_glass_reflects_its_reflectance_and_transmits_the_rest() {
+        let lambda = Vec4::new(420.0, 500.0, 580.0, 660.0);
+        let film = scene::film::Film { thickness_nm: 350.0, ior: 1.33 };
+        let lanes = crate::bsdf::FilmLanes { weight: 1.0, film, lambda };
+        let ior = 1.5f32;
+        let make = |inside: bool| Dielectric {
+            tint: Vec4::ONE,
+            alpha: 0.3,
+            eta: if inside { 1.0 / ior } else { ior },
+            thin: false,
+            film: Some(InterfaceFilm { film: lanes, ior, inside }),
+        };
+        let want = |c: f64| {
+            Vec4::from_array(std::array::from_fn(|i| {
+                film.over_dielectric(f64::from(lambda[i]), c, 1.5) as f32
+            }))
+        };
+        let out = make(false);
+        let (f, p) = out.film_fresnel(0.8, out.film.as_ref().unwrap());
+        assert!((f - want(0.8)).abs().max_element() < 1e-6, "{f} vs {}", want(0.8));
+        assert!((p - f.element_sum() / 4.0).abs() < 1e-7);
+        assert!(f.max_element() - f.min_element() > 0.02, "the film colours the reflection: {f}");
+        let inside = make(true);
+        // cos 0.9 inside ↔ sin_out = 1.5·√(1 − 0.81).
+        let s_out = 1.5 * (1.0f64 - 0.81).sqrt();
+        let (f, _) = inside.film_fresnel(0.9, inside.film.as_ref().unwrap());
+        assert!((f - want((1.0 - s_out * s_out).sqrt())).abs().max_element() < 1e-6, "{f}");
+        let (f, p) = inside.film_fresnel(0.5, inside.film.as_ref().unwrap());
+        assert_eq!((f, p), (Vec4::ONE, 1.0), "past the critical angle");
+        // Reflection and transmission of a smooth-ish interface share the light per lane:
+        // sampled many times, the reflected weight is R and the transmitted 1 − R (normal
+        // incidence, lanes weighed by f·cos/pdf).
+        let g = Dielectric { alpha: crate::bsdf::MIN_ALPHA, ..out };
+        let wo = Vec3::Z;
+        let mut rng = crate::rng::Sampler::new(3, 0);
+        let (mut refl, mut trans, n) = (Vec4::ZERO, Vec4::ZERO, 200_000);
+        for _ in 0..n {
+            let Some(x) = g.sample(wo, rng.uniform(), rng.next2()) else { continue };
+            let w = x.f * (x.wi.z.abs() / x.pdf);
+            if x.transmitted { trans += w * ior * ior } else { refl += w }
+        }
+        let (refl, trans) = (refl / n as f32, trans / n as f32);
+        let r = want(1.0);
+        assert!((refl - r).abs().max_element() < 0.01, "{refl} vs {r}");
+        assert!((trans - (Vec4::ONE - r)).abs().max_element() < 0.01, "{trans} vs {}", Vec4::ONE - r);
     }
 }

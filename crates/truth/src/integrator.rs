@@ -371,23 +371,27 @@ impl Integrator<'_, '_> {
                 Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film)
             };
             let frame = Frame::from_normal(ns);
-            let glass = match (mat.transmission.as_ref(), self.lambert) {
-                (Some(t), false) => material::transmission(mat, &w.scene.textures, &s.tc).map(|weight| {
-                    if t.disperses() {
-                        // Each wavelength refracts its own way: the hero carries the path on
-                        // alone (its pdf over the four lanes' mean, so 4× its own estimate), an
-                        // unbiased single-wavelength estimate from here on.
-                        f = Vec4::new(f.x, 0.0, 0.0, 0.0);
-                        p = Vec4::new(p.x, 0.0, 0.0, 0.0);
-                    }
-                    let ior = t.ior_at(mat.ior, f64::from(l.x)) as f32;
-                    let thin = t.volume.is_none();
-                    let eta = if thin || front { ior } else { 1.0 / ior };
-                    let alpha = (roughness * roughness).clamp(crate::bsdf::MIN_ALPHA, 1.0);
-                    (Dielectric { tint: base, alpha, eta, thin }, weight * (1.0 - metallic))
-                }),
-                _ => None,
-            };
+            let glass =
+                match (mat.transmission.as_ref(), self.lambert) {
+                    (Some(t), false) => material::transmission(mat, &w.scene.textures, &s.tc).map(|weight| {
+                        if t.disperses() {
+                            // Each wavelength refracts its own way: the hero carries the path on
+                            // alone (its pdf over the four lanes' mean, so 4× its own estimate), an
+                            // unbiased single-wavelength estimate from here on.
+                            f = Vec4::new(f.x, 0.0, 0.0, 0.0);
+                            p = Vec4::new(p.x, 0.0, 0.0, 0.0);
+                        }
+                        let ior = t.ior_at(mat.ior, f64::from(l.x)) as f32;
+                        let thin = t.volume.is_none();
+                        let eta = if thin || front { ior } else { 1.0 / ior };
+                        let alpha = (roughness * roughness).clamp(crate::bsdf::MIN_ALPHA, 1.0);
+                        let film = film.filter(|f| f.weight > 0.0).map(|film| {
+                            crate::dielectric::InterfaceFilm { film, ior, inside: !thin && !front }
+                        });
+                        (Dielectric { tint: base, alpha, eta, thin, film }, weight * (1.0 - metallic))
+                    }),
+                    _ => None,
+                };
             let vtx = Vertex::Surface { brdf, frame, ng, glass };
 
             radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);

@@ -73,12 +73,27 @@ fn a_glass_sphere_in_a_furnace_keeps_energy() {
     let range = WavelengthRange::VISIBLE;
     let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.4);
     let env = Vec4::from_array(wl.0.to_array().map(|l| d65().eval(f64::from(l)) as f32));
-    for (ior, roughness, dispersion) in [(1.5, 0.0, 0.0), (1.5, 0.2, 0.0), (1.5, 0.0, 2.0), (1.0, 0.3, 0.0)] {
-        let scene = scene_with(
-            vec![sphere(Vec3::ZERO, 1.0, 96, 0)],
-            vec![glass(ior, roughness, Some(clear(2.0)), dispersion)],
-            vec![],
-        );
+    // The last case with a thin film (KHR_materials_iridescence), which a clear film keeps
+    // energy through: what it does not reflect it transmits, inside and out.
+    for (ior, roughness, dispersion, filmed) in [
+        (1.5, 0.0, 0.0, false),
+        (1.5, 0.2, 0.0, false),
+        (1.5, 0.0, 2.0, false),
+        (1.0, 0.3, 0.0, false),
+        (1.5, 0.1, 0.0, true),
+    ] {
+        let mut material = glass(ior, roughness, Some(clear(2.0)), dispersion);
+        if filmed {
+            material.iridescence = Some(scene::Iridescence {
+                factor: 1.0,
+                texture: None,
+                ior: 1.33,
+                thickness_min: 100.0,
+                thickness_max: 400.0,
+                thickness_texture: None,
+            });
+        }
+        let scene = scene_with(vec![sphere(Vec3::ZERO, 1.0, 96, 0)], vec![material], vec![]);
         let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap().with_environment(&d65());
         let integ = Integrator { world: &world, direct_only: false, max_depth: 1000, lambert: false };
         // Rays at the sphere over its whole disc, from the centre to the grazing edge.
@@ -91,7 +106,7 @@ fn a_glass_sphere_in_a_furnace_keeps_energy() {
             let rel = (m[j] / env[j] - 1.0).abs();
             assert!(
                 rel <= 0.01 && (m[j] - env[j]).abs() <= 5.0 * se[j] + 0.005 * env[j],
-                "η {ior}, roughness {roughness}, dispersion {dispersion}, lane {j}: {} ± {} vs {} ({:.2} %)",
+                "η {ior}, roughness {roughness}, dispersion {dispersion}, film {filmed}, lane {j}: {} ± {} vs {} ({:.2} %)",
                 m[j],
                 se[j],
                 env[j],
@@ -199,7 +214,8 @@ fn a_prism_refracts_each_wavelength_by_snells_law() {
         let through = |d: Vec3, normal: Vec3, eta: f32, rng: &mut Sampler| -> Vec3 {
             // Sampled at the smallest roughness; the median over many samples.
             let f = Frame::from_normal(normal);
-            let b = Dielectric { tint: Vec4::ONE, alpha: crate::bsdf::MIN_ALPHA, eta, thin: false };
+            let b =
+                Dielectric { tint: Vec4::ONE, alpha: crate::bsdf::MIN_ALPHA, eta, thin: false, film: None };
             let mut xs = Vec::new();
             for _ in 0..2001 {
                 if let Some(s) = b.sample(f.to_local(-d), rng.uniform(), rng.next2())
