@@ -17,6 +17,8 @@ use glam::{Vec3, Vec4};
 
 /// Where a path scatters: a surface (BRDF in a shading frame; a see-through material mixes in
 /// the rough dielectric with weight T·(1 − metallic)) or a point in the medium.
+// One lives on the stack per bounce; boxing the large variant would allocate per bounce.
+#[allow(clippy::large_enum_variant)]
 enum Vertex {
     Surface { brdf: Brdf, frame: Frame, ng: Vec3, glass: Option<(Dielectric, f32)> },
     Medium { phase: Phase },
