@@ -125,6 +125,7 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             flags,
             frame_index,
             lod_bias,
+            node_spacing,
             _pad,
         }),
     );

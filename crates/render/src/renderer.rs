@@ -797,7 +797,12 @@ impl Renderer {
                 | if self.capture.is_some() { 4 } else { 0 },
             frame_index,
             lod_bias: settings.texture_lod_bias,
-            _pad: [0; 3],
+            node_spacing: if settings.mode == Mode::Spectral {
+                (settings.range.width() / settings.wavelengths.max(1) as f64) as f32
+            } else {
+                0.0
+            },
+            _pad: [0; 2],
         };
         self.gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         // Screen-space occlusion of the environment searches half the scene's bounding radius.

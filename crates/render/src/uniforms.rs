@@ -23,5 +23,9 @@ pub struct FrameUniforms {
     pub frame_index: u32,
     /// Added to the level of detail of every material texture read (`RenderSettings::texture_lod_bias`).
     pub lod_bias: f32,
-    pub _pad: [u32; 3],
+    /// The width of each node's band in nm (range / N) in spectral mode, where a thin film's
+    /// nodes carry its mean over the band (`film_band_reflectance4`); 0 elsewhere (the naive
+    /// mode point-samples, as the paper's baseline does).
+    pub node_spacing: f32,
+    pub _pad: [u32; 2],
 }

@@ -77,7 +77,21 @@ fn terms(d: Vec3) -> (f64, f64, f64) {
     (nl, nl * dist * vis, vh)
 }
 
-/// Radiance over E at wavelength λ of a filmed surface of reflectance ρ(λ).
+/// The film's reflectance `r(λ)` as a node carries it: its mean over the node's band of width
+/// `spacing` (the phase linearised about the node, as `film_band_reflectance4` takes it), or
+/// the value at the node (`spacing` 0: the naive mode).
+fn band(lambda: f64, spacing: f64, r: impl Fn(f64) -> f64) -> f64 {
+    if spacing == 0.0 {
+        return r(lambda);
+    }
+    let n = 400;
+    (0..n).map(|i| r(lambda / (1.0 + ((i as f64 + 0.5) / n as f64 - 0.5) * spacing / lambda))).sum::<f64>()
+        / n as f64
+}
+
+/// Radiance over E at wavelength λ of a filmed surface of reflectance ρ(λ); the film over a
+/// node's band of width `spacing` ([`band`]).
+#[allow(clippy::too_many_arguments)]
 fn filmed_value(
     rho: f64,
     lambda: f64,
@@ -85,13 +99,15 @@ fn filmed_value(
     film: &Iridescence,
     ior: f32,
     (kd, ks, vh): (f64, f64, f64),
+    spacing: f64,
 ) -> f64 {
     let f = scene::film::Film { thickness_nm: f64::from(film.thickness_max), ior: f64::from(film.ior) };
     let w = f64::from(film.factor);
     let fres = (1.0 - vh).powi(5);
     let f0 = f64::from(scene::dielectric_f0(ior));
-    let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w) + w * f.over_dielectric(lambda, vh, f64::from(ior));
-    let fm = (rho + (1.0 - rho) * fres) * (1.0 - w) + w * f.over_f0(lambda, vh, rho);
+    let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w)
+        + w * band(lambda, spacing, |l| f.over_dielectric(l, vh, f64::from(ior)));
+    let fm = (rho + (1.0 - rho) * fres) * (1.0 - w) + w * band(lambda, spacing, |l| f.over_f0(l, vh, rho));
     let spec = (1.0 - metallic) * fd + metallic * fm;
     kd * (1.0 - metallic) / std::f64::consts::PI * (1.0 - fd) * rho + ks * spec
 }
@@ -111,6 +127,9 @@ fn filmed_patches_match_the_cpu_per_node_in_spectral_and_naive_modes() {
             let spectral = render_hdr(&mut r, &settings(Mode::Spectral, n, rule));
             let naive = render_hdr(&mut r, &settings(Mode::Naive, n, rule));
             let cpu = CpuSpectral::new(n, rule, &f11, 1.5);
+            // The spectral mode's nodes carry the film's mean over their band; the naive
+            // mode's its value at the node.
+            let spacing = color::WavelengthRange::VISIBLE.width() / n as f64;
             let (mut worst, mut worst_naive, mut compared) = (0.0f64, 0.0f64, 0);
             for y in 0..H {
                 for x in 0..W {
@@ -122,12 +141,12 @@ fn filmed_patches_match_the_cpu_per_node_in_spectral_and_naive_modes() {
                     let m = f64::from(metallic);
                     let poly = table.fetch(chart.colours[patch].map(f64::from));
                     let want = cpu.shade_values(|l| {
-                        filmed_value(poly.to_f32_poly_eval(l), l, m, &film, ior_of(patch), t)
+                        filmed_value(poly.to_f32_poly_eval(l), l, m, &film, ior_of(patch), t, spacing)
                     });
                     let boxed =
                         color::upsample::boxes::BoxSpectrum { rgb: chart.colours[patch].map(f64::from) };
                     let want_naive =
-                        cpu.shade_values(|l| filmed_value(boxed.eval(l), l, m, &film, ior_of(patch), t));
+                        cpu.shade_values(|l| filmed_value(boxed.eval(l), l, m, &film, ior_of(patch), t, 0.0));
                     // The HDR target is f16 (2⁻¹⁰ relative, rounded toward zero on lavapipe):
                     // 1e-3 absolute below 1, relative above (a bare metal's highlight is ~2).
                     for c in 0..3 {

@@ -439,10 +439,10 @@ fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
     var r: FilmFresnel;
     r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
-        film_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior)), f.weight);
+        film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing), f.weight);
     if (metallic > 0.0) {
         r.metal = mix(rho + (1.0 - rho) * fres,
-            film_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho)), f.weight);
+            film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho), frame.node_spacing), f.weight);
     }
     return r;
 }
@@ -467,10 +467,10 @@ struct FilmEnvNode {
 fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> FilmEnvNode {
     let a = l.ab.x;
     let b = l.ab.y;
-    var fd = mix(vec4<f32>(f.f0 * a + b), film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(f.base_ior)) * (a + b), f.weight);
+    var fd = mix(vec4<f32>(f.f0 * a + b), film_band_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing) * (a + b), f.weight);
     var fm = vec4<f32>(0.0);
     if (metallic > 0.0) {
-        fm = mix(rho * a + b, film_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, film_ior_from_f0(rho)) * (a + b), f.weight);
+        fm = mix(rho * a + b, film_band_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, film_ior_from_f0(rho), frame.node_spacing) * (a + b), f.weight);
     }
     return FilmEnvNode((1.0 - metallic) / PI * (1.0 - fd) * rho, (1.0 - metallic) * fd + metallic * fm);
 }

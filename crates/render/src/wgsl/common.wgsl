@@ -29,7 +29,8 @@ struct FrameUniforms {
     frame_index: u32,
     // Added to the material textures' level of detail (RenderSettings::texture_lod_bias).
     lod_bias: f32,
-    _pad0: u32,
+    // Width of each node's band, nm (spectral mode), for the thin film's band mean; 0 elsewhere.
+    node_spacing: f32,
     _pad1: u32,
     _pad2: u32,
 };
