@@ -87,11 +87,22 @@ fn wgsl_band_film_is_the_films_mean_over_the_band() {
                             let film = scene::film::Film { thickness_nm: d, ior: nf };
                             // The film's phase δ = K/λ runs over δ₀(1 ± spacing/2λ) across the
                             // band (linearised about the node); R depends on λ only through δ.
+                            // Only past a quarter of a fringe period in the band, fully from
+                            // half of one (`film_band_reflectance4`).
+                            let delta = if d == 0.0 {
+                                0.0
+                            } else {
+                                let c2 = (1.0 - (1.0 - c * c) / (nf * nf)).max(0.0).sqrt();
+                                4.0 * std::f64::consts::PI * d * nf * c2 / lambda
+                            };
+                            let r = delta * 0.5 * spacing / lambda / std::f64::consts::PI;
+                            let x = ((r - 0.25) / 0.25).clamp(0.0, 1.0);
+                            let window = spacing * x * x * (3.0 - 2.0 * x);
                             let n = 4000;
                             let mean = (0..n)
                                 .map(|i| {
                                     let t = (i as f64 + 0.5) / n as f64 - 0.5;
-                                    let l = lambda / (1.0 + t * spacing / lambda);
+                                    let l = lambda / (1.0 + t * window / lambda);
                                     film.over_dielectric(l, c, nb)
                                 })
                                 .sum::<f64>()

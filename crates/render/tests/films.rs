@@ -80,12 +80,19 @@ fn terms(d: Vec3) -> (f64, f64, f64) {
 /// The film's reflectance `r(λ)` as a node carries it: its mean over the node's band of width
 /// `spacing` (the phase linearised about the node, as `film_band_reflectance4` takes it), or
 /// the value at the node (`spacing` 0: the naive mode).
-fn band(lambda: f64, spacing: f64, r: impl Fn(f64) -> f64) -> f64 {
-    if spacing == 0.0 {
+fn band(lambda: f64, spacing: f64, film: &Iridescence, vh: f64, r: impl Fn(f64) -> f64) -> f64 {
+    // The fringes the band holds (`film_band_reflectance4`): none averaged under a quarter of a
+    // period, all from half of one.
+    let (d, nf) = (f64::from(film.thickness_max), f64::from(film.ior));
+    let c2 = (1.0 - (1.0 - vh * vh) / (nf * nf)).max(0.0).sqrt();
+    let delta = 4.0 * std::f64::consts::PI * d * nf * c2 / lambda;
+    let x = ((delta * 0.5 * spacing / lambda / std::f64::consts::PI - 0.25) / 0.25).clamp(0.0, 1.0);
+    let window = spacing * x * x * (3.0 - 2.0 * x);
+    if window == 0.0 {
         return r(lambda);
     }
     let n = 400;
-    (0..n).map(|i| r(lambda / (1.0 + ((i as f64 + 0.5) / n as f64 - 0.5) * spacing / lambda))).sum::<f64>()
+    (0..n).map(|i| r(lambda / (1.0 + ((i as f64 + 0.5) / n as f64 - 0.5) * window / lambda))).sum::<f64>()
         / n as f64
 }
 
@@ -106,8 +113,9 @@ fn filmed_value(
     let fres = (1.0 - vh).powi(5);
     let f0 = f64::from(scene::dielectric_f0(ior));
     let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w)
-        + w * band(lambda, spacing, |l| f.over_dielectric(l, vh, f64::from(ior)));
-    let fm = (rho + (1.0 - rho) * fres) * (1.0 - w) + w * band(lambda, spacing, |l| f.over_f0(l, vh, rho));
+        + w * band(lambda, spacing, film, vh, |l| f.over_dielectric(l, vh, f64::from(ior)));
+    let fm = (rho + (1.0 - rho) * fres) * (1.0 - w)
+        + w * band(lambda, spacing, film, vh, |l| f.over_f0(l, vh, rho));
     let spec = (1.0 - metallic) * fd + metallic * fm;
     kd * (1.0 - metallic) / std::f64::consts::PI * (1.0 - fd) * rho + ks * spec
 }

@@ -43,7 +43,13 @@ fn film_band_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, f
     let b_s = (n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3);
     let b_p = (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3);
     let delta = (4.0 * PI * thickness_nm * n2 * c2) / lambda_nm;
-    let w = delta * (0.5 * spacing_nm) / lambda_nm;
+    // Only fringes the nodes cannot resolve are averaged: a box over the whole band also
+    // flattens resolved fringes by up to a tenth (a 300 nm film at N = 8–16 drawn 0.01–0.02 ΔE
+    // further from the truth). The band holds r = w/π fringe periods: under a quarter of one
+    // (four or more nodes a period) the film is taken at the node, from half of one (past
+    // Nyquist) over the whole band, smoothly between.
+    let w_band = delta * (0.5 * spacing_nm) / lambda_nm;
+    let w = w_band * smoothstep(vec4<f32>(0.25), vec4<f32>(0.5), w_band / PI);
     let exact = 0.5 * (film_airy(a_s, b_s, cos(delta)) + film_airy(a_p, b_p, cos(delta)));
     // The band's ends, as half-angles.
     let x0 = 0.5 * (delta - w);
