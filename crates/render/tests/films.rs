@@ -77,23 +77,37 @@ fn terms(d: Vec3) -> (f64, f64, f64) {
     (nl, nl * dist * vis, vh)
 }
 
-/// The film's reflectance `r(λ)` as a node carries it: its mean over the node's band of width
-/// `spacing` (the phase linearised about the node, as `film_band_reflectance4` takes it), or
-/// the value at the node (`spacing` 0: the naive mode).
-fn band(lambda: f64, spacing: f64, film: &Iridescence, vh: f64, r: impl Fn(f64) -> f64) -> f64 {
-    // The fringes the band holds (`film_band_reflectance4`): none averaged under a quarter of a
-    // period, all from half of one.
-    let (d, nf) = (f64::from(film.thickness_max), f64::from(film.ior));
-    let c2 = (1.0 - (1.0 - vh * vh) / (nf * nf)).max(0.0).sqrt();
-    let delta = 4.0 * std::f64::consts::PI * d * nf * c2 / lambda;
-    let x = ((delta * 0.5 * spacing / lambda / std::f64::consts::PI - 0.25) / 0.25).clamp(0.0, 1.0);
-    let window = spacing * x * x * (3.0 - 2.0 * x);
-    if window == 0.0 {
-        return r(lambda);
+/// The film's reflectance over a base of index `nb` as a spectral node of band `spacing`
+/// carries it (`film_band_reflectance4`, in f64: Airy's form with u·sinc w for u = ab, the
+/// window w growing from none at a quarter fringe period in the band to the whole band at half),
+/// or at the node (`spacing` 0: the naive mode). Its distance from the band's exact mean is
+/// `film_tests.rs`'s to check; this test checks the node loop around it.
+fn band(film: &scene::film::Film, lambda: f64, c: f64, nb: f64, spacing: f64) -> f64 {
+    if spacing == 0.0 {
+        return film.over_dielectric(lambda, c, nb);
     }
-    let n = 400;
-    (0..n).map(|i| r(lambda / (1.0 + ((i as f64 + 0.5) / n as f64 - 0.5) * window / lambda))).sum::<f64>()
-        / n as f64
+    let (c1, nf) = (c.clamp(1e-6, 1.0), film.ior);
+    let s2 = 1.0 - c1 * c1;
+    let (c2, c3) = ((1.0 - s2 / (nf * nf)).max(0.0).sqrt(), (1.0 - s2 / (nb * nb)).max(0.0).sqrt());
+    let pol = [
+        ((c1 - nf * c2) / (c1 + nf * c2), (nf * c2 - nb * c3) / (nf * c2 + nb * c3)),
+        ((nf * c1 - c2) / (nf * c1 + c2), (nb * c2 - nf * c3) / (nb * c2 + nf * c3)),
+    ];
+    let delta = 4.0 * std::f64::consts::PI * film.thickness_nm * nf * c2 / lambda;
+    let w_band = delta * 0.5 * spacing / lambda;
+    let x = ((w_band / std::f64::consts::PI - 0.25) / 0.25).clamp(0.0, 1.0);
+    let w = w_band * x * x * (3.0 - 2.0 * x);
+    let sinc = if w < 1e-4 { 1.0 } else { w.sin() / w };
+    let r: f64 = pol
+        .iter()
+        .map(|&(a, b)| {
+            let v = a * b * sinc;
+            1.0 - (1.0 - a * a) * (1.0 - b * b) * (1.0 - v * v)
+                / (1.0 - a * a * b * b)
+                / (1.0 + v * v + 2.0 * v * delta.cos())
+        })
+        .sum();
+    (0.5 * r).clamp(0.0, 1.0)
 }
 
 /// Radiance over E at wavelength λ of a filmed surface of reflectance ρ(λ); the film over a
@@ -112,10 +126,9 @@ fn filmed_value(
     let w = f64::from(film.factor);
     let fres = (1.0 - vh).powi(5);
     let f0 = f64::from(scene::dielectric_f0(ior));
-    let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w)
-        + w * band(lambda, spacing, film, vh, |l| f.over_dielectric(l, vh, f64::from(ior)));
+    let fd = (f0 + (1.0 - f0) * fres) * (1.0 - w) + w * band(&f, lambda, vh, f64::from(ior), spacing);
     let fm = (rho + (1.0 - rho) * fres) * (1.0 - w)
-        + w * band(lambda, spacing, film, vh, |l| f.over_f0(l, vh, rho));
+        + w * band(&f, lambda, vh, scene::film::ior_from_f0(rho), spacing);
     let spec = (1.0 - metallic) * fd + metallic * fm;
     kd * (1.0 - metallic) / std::f64::consts::PI * (1.0 - fd) * rho + ks * spec
 }
