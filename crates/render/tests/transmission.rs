@@ -442,3 +442,31 @@ fn a_see_through_film_colours_the_reflection() {
         assert!(shift > 0.01, "{mode:?}: the thickness texture is not used ({full:?} → {thin:?})");
     }
 }
+
+/// What a clear film on a see-through pane does not reflect it transmits (as the path tracer's
+/// interface now does): in a white furnace (a white sky, a white backdrop) the filmed pane
+/// vanishes. The transmitted share was 1 − Schlick's F while the reflection took the film's,
+/// so the pane showed the film's colour over white.
+#[test]
+fn a_filmed_pane_in_a_white_furnace_vanishes() {
+    let mut m = glass(1.0, 1.5, 1.0, None, 0.0);
+    m.iridescence = Some(scene::Iridescence {
+        factor: 1.0,
+        texture: None,
+        ior: 1.8,
+        thickness_min: 100.0,
+        thickness_max: 380.0,
+        thickness_texture: None,
+    });
+    let mut s = scene(Some(m), false);
+    s.materials[0].base_color = Vec4::ONE;
+    s.environment = Some(scene::Environment::uniform(Vec3::ONE));
+    let mut r = renderer();
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        r.set_scene(&s).unwrap();
+        r.resize(W, H).unwrap();
+        r.render(&s.camera, &RenderSettings { env_occlusion: false, ..settings(mode) }).unwrap();
+        let img: Vec<[f64; 3]> = r.read_hdr().unwrap().iter().map(rgb_of).collect();
+        close(at(&img, CENTRE), [1.0; 3], 0.02, &format!("{mode:?}: the filmed pane in the furnace"));
+    }
+}

@@ -504,16 +504,16 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         ctx.normal = s.normal;
         var keep = 1.0;
         var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
+        let film = load_film(px);
+        let filmed = HAS_FILM && film.weight > 0.0;
         if (HAS_TRANSMISSION) {
             tr = load_transmissive(px, s);
             keep = 1.0 - tr.weight;
-            through = transmitted_rgb(in.pos.xy, ctx, s, tr);
+            through = transmitted_rgb(in.pos.xy, ctx, s, tr, film);
         }
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
-        let film = load_film(px);
-        let filmed = HAS_FILM && film.weight > 0.0;
         for (var li = 0u; li < n_lit; li++) {
             var e = lights[li].rgb.rgb;
             if (CUSTOM_LIGHT_T) {
@@ -860,7 +860,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         }
     }
     if (HAS_TRANSMISSION) {
-        xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base);
+        xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base, film);
     }
     return hdr_out(frame.xyz_to_rgb * xyz);
 }

@@ -355,10 +355,16 @@ fn transmitted_share(s: GSurface, tr: Transmissive, v: vec3<f32>) -> f32 {
 // RGB mode: the light through the surface, tinted by the base colour and the absorption per
 // channel; under dispersion the Khronos viewer's three indices (n_d ∓ half the spread
 // (n_d − 1)/V_d) refract red, green and blue apart, each traced on its own.
-fn transmitted_rgb(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive) -> vec3<f32> {
+// Under a thin film the share is 1 − the film's Fresnel term (what it does not reflect it
+// transmits, as the path tracer's interface does), per channel.
+fn transmitted_rgb(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, film: FilmSurface) -> vec3<f32> {
     let k = transmitted_share(s, tr, -ctx.view_dir);
     if (k <= 0.0) {
         return vec3<f32>(0.0);
+    }
+    var k3 = vec3<f32>(k);
+    if (HAS_FILM && film.weight > 0.0) {
+        k3 = tr.weight * (1.0 - film_fresnel_rgb(film, s.base, 0.0, max(dot(s.normal, -ctx.view_dir), 0.0))[0]);
     }
     let p = ctx.world_pos;
     var env_t = vec3<f32>(1.0);
@@ -376,7 +382,7 @@ fn transmitted_rgb(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
         let th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness, env_t);
         light = th.rgb * th.share * exp(-tr.absorption * th.length);
     }
-    return k * s.base * light;
+    return k3 * s.base * light;
 }
 
 // The background colour's coefficients for the illuminant upsampling every RGB emission gets
@@ -407,11 +413,13 @@ fn background_nodes(bg: vec3<f32>, c: vec4<f32>, g: u32) -> vec4<f32> {
 // index at its mean wavelength: N/4 directions, each a trace, a background read and a
 // coefficient fetch (a trace per node cost the glass scene's spectral frame 1.1–1.25× at
 // N = 16 and changed its error by 0.003 ΔE at N = 8); without, one of each for the pixel.
-fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>) -> vec3<f32> {
+fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>, film: FilmSurface) -> vec3<f32> {
     let k = transmitted_share(s, tr, -ctx.view_dir);
     if (k <= 0.0) {
         return vec3<f32>(0.0);
     }
+    let filmed = HAS_FILM && film.weight > 0.0;
+    let nv = max(dot(s.normal, -ctx.view_dir), 0.0);
     let p = ctx.world_pos;
     let ng = frame.n_groups;
     let disperses = tr.dispersion > 0.0 && tr.thickness > 0.0;
@@ -431,7 +439,13 @@ fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
         }
         let rho = node_reflectance(c_base, s.base, g);
         let att = exp(-tr.absorption * th.length);
-        let light = k * th.share * rho * background_nodes(th.rgb, c_bg, g);
+        var kn = vec4<f32>(k);
+        if (filmed) {
+            // Under a thin film: 1 − its Fresnel term per node (`film_fresnel`'s dielectric).
+            let l = wavelengths[g].lambda;
+            kn = tr.weight * (1.0 - film_fresnel(film, rho, 0.0, l, nv).dielectric);
+        }
+        let light = kn * th.share * rho * background_nodes(th.rgb, c_bg, g);
         if (NAIVE) {
             xyz += (light * box4(att, g)) * white_weights(g);
         } else {
