@@ -470,3 +470,29 @@ fn a_filmed_pane_in_a_white_furnace_vanishes() {
         close(at(&img, CENTRE), [1.0; 3], 0.02, &format!("{mode:?}: the filmed pane in the furnace"));
     }
 }
+
+/// Found by a sweep: a closed volume whose thickness far exceeds the mesh (10⁶, accepted by
+/// glTF) was drawn black — the search for its back face took steps so wide that the first left
+/// the volume far behind. The mesh's own back face bounds the search now: the ball looks as it
+/// does at its true thickness.
+#[test]
+fn a_volume_thicker_than_its_mesh_is_still_drawn() {
+    let ball = |thickness: f32| {
+        let mut s = scene(None, false);
+        let vol = Volume {
+            thickness,
+            thickness_texture: None,
+            attenuation_color: [1.0; 3],
+            attenuation_distance: f32::INFINITY,
+        };
+        s.materials.push(glass(1.0, 1.5, 1.0, Some(vol), 0.0));
+        s.meshes.push(Mesh::uv_sphere(Vec3::ZERO, 0.3, 24, 48, 2));
+        s
+    };
+    let mut r = renderer();
+    for mode in [Mode::Rgb, Mode::Spectral] {
+        let true_size = at(&render(&mut r, &ball(0.6), mode), (W / 2, H / 2));
+        let huge = at(&render(&mut r, &ball(1e6), mode), (W / 2, H / 2));
+        close(huge, true_size, 0.05, &format!("{mode:?}: thickness 10⁶ vs 0.6"));
+    }
+}

@@ -145,7 +145,11 @@ fn volume_exit(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>, view_dir: vec3<f32>, 
         return slab;
     }
     let dc = frame.view_proj * vec4<f32>(r1, 0.0);
-    let reach = 2.0 * max(gap / max(linear_depth(dc), 1e-3), thickness);
+    // A thickness far beyond what the mesh can hold (10⁶, which glTF allows) spread the steps
+    // so wide that the first one left the volume far behind its back face (drawn black): the
+    // thickness widens the reach by at most 64 gaps (8 changed the glass scene at silhouettes).
+    let along_gap = gap / max(linear_depth(dc), 1e-3);
+    let reach = 2.0 * max(along_gap, min(thickness, 64.0 * along_gap));
     var lo = 0.0;
     var hi = -1.0;
     for (var i = 1u; i <= INSIDE_STEPS; i++) {
