@@ -6,6 +6,21 @@
 // per polarisation. Four wavelengths at once (a node group); the first interface and the
 // film's cosine do not depend on λ. Tested against the Rust (src/film_tests.rs).
 fn film_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_ior: f32, base_ior: vec4<f32>) -> vec4<f32> {
+    let f = film_amplitudes(lambda_nm, cos_i, thickness_nm, film_ior, base_ior);
+    let cd = cos(f.delta);
+    return clamp(0.5 * (film_airy(f.a_s, f.b_s, cd) + film_airy(f.a_p, f.b_p, cd)), vec4<f32>(0.0), vec4<f32>(1.0));
+}
+
+// The two interfaces' real amplitudes per polarisation (s, p) and the film's round-trip phase.
+struct FilmAmplitudes {
+    a_s: f32,
+    a_p: f32,
+    b_s: vec4<f32>,
+    b_p: vec4<f32>,
+    delta: vec4<f32>,
+};
+
+fn film_amplitudes(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_ior: f32, base_ior: vec4<f32>) -> FilmAmplitudes {
     // Not quite grazing: at cos 0 under a film of index 1 both amplitudes would be 0/0.
     let c1 = clamp(cos_i, 1e-6, 1.0);
     let s2 = 1.0 - c1 * c1;
@@ -13,12 +28,13 @@ fn film_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_i
     let n3 = base_ior;
     let c2 = sqrt(max(1.0 - s2 / (n2 * n2), 0.0));
     let c3 = sqrt(max(vec4<f32>(1.0) - s2 / (n3 * n3), vec4<f32>(0.0)));
-    let a_s = (c1 - n2 * c2) / (c1 + n2 * c2);
-    let a_p = (n2 * c1 - c2) / (n2 * c1 + c2);
-    let b_s = (n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3);
-    let b_p = (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3);
-    let cd = cos((4.0 * PI * thickness_nm * n2 * c2) / lambda_nm);
-    return clamp(0.5 * (film_airy(a_s, b_s, cd) + film_airy(a_p, b_p, cd)), vec4<f32>(0.0), vec4<f32>(1.0));
+    return FilmAmplitudes(
+        (c1 - n2 * c2) / (c1 + n2 * c2),
+        (n2 * c1 - c2) / (n2 * c1 + c2),
+        (n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3),
+        (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3),
+        (4.0 * PI * thickness_nm * n2 * c2) / lambda_nm,
+    );
 }
 
 // The film's reflectance averaged over each node's band of `spacing_nm`, where the nodes cannot
@@ -39,22 +55,13 @@ fn film_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_i
 // while the band holds under a quarter of a fringe period (r = w/π), to the whole band from half
 // a period (Nyquist).
 fn film_band_reflectance4(lambda_nm: vec4<f32>, cos_i: f32, thickness_nm: f32, film_ior: f32, base_ior: vec4<f32>, spacing_nm: f32) -> vec4<f32> {
-    let c1 = clamp(cos_i, 1e-6, 1.0);
-    let s2 = 1.0 - c1 * c1;
-    let n2 = film_ior;
-    let n3 = base_ior;
-    let c2 = sqrt(max(1.0 - s2 / (n2 * n2), 0.0));
-    let c3 = sqrt(max(vec4<f32>(1.0) - s2 / (n3 * n3), vec4<f32>(0.0)));
-    let a_s = (c1 - n2 * c2) / (c1 + n2 * c2);
-    let a_p = (n2 * c1 - c2) / (n2 * c1 + c2);
-    let b_s = (n2 * c2 - n3 * c3) / (n2 * c2 + n3 * c3);
-    let b_p = (n3 * c2 - n2 * c3) / (n3 * c2 + n2 * c3);
-    let delta = (4.0 * PI * thickness_nm * n2 * c2) / lambda_nm;
+    let f = film_amplitudes(lambda_nm, cos_i, thickness_nm, film_ior, base_ior);
+    let delta = f.delta;
     let w_band = delta * (0.5 * spacing_nm) / lambda_nm;
     let w = w_band * smoothstep(vec4<f32>(0.25), vec4<f32>(0.5), w_band / PI);
     let sinc = select(sin(w) / w, vec4<f32>(1.0), w < vec4<f32>(1e-4));
     let cd = cos(delta);
-    let r = 0.5 * (film_damped_airy(a_s, b_s, cd, sinc) + film_damped_airy(a_p, b_p, cd, sinc));
+    let r = 0.5 * (film_damped_airy(f.a_s, f.b_s, cd, sinc) + film_damped_airy(f.a_p, f.b_p, cd, sinc));
     return clamp(r, vec4<f32>(0.0), vec4<f32>(1.0));
 }
 
