@@ -565,6 +565,47 @@ fn blend_is_stochastic_coverage_that_averages_to_alpha() {
     assert!((transmitted - 0.5).abs() < 0.06, "transmitted {transmitted}");
 }
 
+#[test]
+fn blend_coverage_is_not_darkened_by_the_environment_occlusion() {
+    // A frontal red BLEND quad of alpha 0.5 one unit above a green floor in a uniform white
+    // environment, no lights: nothing hides the quad's upper hemisphere, so each kept pixel
+    // shades as the opaque quad does. Its screen neighbours are often the floor behind it (the
+    // coverage is dithered); a facet rebuilt from them lay along the view ray, and the floor
+    // then rose above it as a false horizon (the kept pixels lost 11 % of the light).
+    let blend: Rect = (-1.0, 1.0, -1.0, 1.0);
+    let floor: Rect = (-2.0, 3.5, -1.5, 1.5);
+    let frame = |alpha_mode: AlphaMode| {
+        let materials = vec![
+            Material { alpha_mode, double_sided: true, ..material("quad", Vec4::new(1.0, 0.0, 0.0, 0.5)) },
+            material("floor", Vec4::new(0.0, 1.0, 0.0, 1.0)),
+        ];
+        let mut s =
+            scene(vec![quad(blend, 1.0, true, 0), quad(floor, 0.0, true, 1)], materials, vec![], vec![]);
+        s.environment = Some(Environment::uniform(Vec3::ONE));
+        render(&s, &top_camera(Vec2::new(0.75, 0.0), 1.2), 64, 24, false)
+    };
+    let opaque = frame(AlphaMode::Opaque);
+    let dithered = frame(AlphaMode::Blend);
+    let (w, h) = (64, 24);
+    let cam = top_camera(Vec2::new(0.75, 0.0), 1.2);
+    let mut kept = 0;
+    let mut worst: f64 = 0.0;
+    for py in 0..h {
+        for px in 0..w {
+            let i = (py * w + px) as usize;
+            if !inside(hit(&cam, w, h, px, py, 1.0), blend, 0.1) || dithered[i][0] < 0.05 {
+                continue;
+            }
+            kept += 1;
+            worst = worst.max((dithered[i][0] / opaque[i][0] - 1.0).abs());
+        }
+    }
+    println!("{kept} kept quad pixels; worst relative difference from the opaque quad {worst:.4}");
+    assert!(kept > 100, "only {kept} kept pixels");
+    assert!(opaque.iter().any(|p| p[0] > 0.5), "the opaque quad is lit");
+    assert!(worst < 0.01, "a kept BLEND pixel differs from the opaque quad by {worst}");
+}
+
 /// A pixel mask of where `img` is not black.
 fn coverage_mask(img: &[[f64; 3]]) -> Vec<bool> {
     img.iter().map(|p| p[0] + p[1] + p[2] > 0.05).collect()

@@ -30,6 +30,14 @@ fn nearer_offset(a: vec4<f32>, b: vec4<f32>, p: vec3<f32>) -> vec3<f32> {
     return select(da, db, dot(db, db) < dot(da, da));
 }
 
+// Facets that disagree with the surface's own normal by more than this (cos 60°) were built
+// across a depth edge on both sides of an axis, so `depth_normal` keeps the surface's normal:
+// a one-pixel-wide object, or a BLEND material's dithered coverage, whose kept pixels have the
+// backdrop for neighbours (the facet then lay along the view ray, and the backdrop 1 unit behind
+// a frontal quad rose above it: −11 % of the environment's light). Interpolated and mapped normals
+// stay well within 60° of their facets, so their pixels keep the facet as before.
+const OCCLUSION_FACET_MIN_COS: f32 = 0.5;
+
 // Unit normal of the surface's facet at pixel `pix` from the depth buffer, on the side of `n`.
 fn depth_normal(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let dx = nearer_offset(position_at(pix - vec2<f32>(1.0, 0.0)), position_at(pix + vec2<f32>(1.0, 0.0)), p);
@@ -37,7 +45,8 @@ fn depth_normal(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let c = cross(dx, dy);
     if (dot(c, c) < 1e-20) { return n; }
     let g = normalize(c);
-    return select(-g, g, dot(g, n) >= 0.0);
+    let facing = select(-g, g, dot(g, n) >= 0.0);
+    return select(n, facing, dot(facing, n) >= OCCLUSION_FACET_MIN_COS);
 }
 
 fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
