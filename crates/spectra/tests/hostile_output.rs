@@ -260,3 +260,38 @@ fn the_demo_refuses_a_file_for_its_folder_and_leaves_nothing_for_a_bad_scene() {
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!std::path::Path::new(&runs).exists(), "eval left an empty folder behind");
 }
+
+/// `eval --out` at a folder holding files of the names an evaluation writes: files it did not
+/// write are refused by name and kept; an earlier evaluation's are replaced, but only once the
+/// run's inputs are read (a bad --table leaves them as they were).
+#[test]
+fn eval_keeps_files_it_did_not_write_and_an_earlier_runs_until_its_inputs_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = dir.path().join("site");
+    std::fs::create_dir(&site).unwrap();
+    let mine = site.join("index.html");
+    std::fs::write(&mine, "<html>my site</html>").unwrap();
+    let out = site.display().to_string();
+    refused(
+        &["eval", "--quick", "--out", &out],
+        &["index.html", "not an earlier `spectra eval`'s output", "--out"],
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "<html>my site</html>");
+
+    let runs = dir.path().join("runs");
+    std::fs::create_dir(&runs).unwrap();
+    let earlier = [
+        ("results.json", r#"{"quick": true, "budget": {}, "cases": [], "frame_times": []}"#),
+        ("index.html", "<!DOCTYPE html><html><head><title>spectra evaluation</title></head></html>"),
+        ("results.csv", "case,transport,width,height,truth_spp,mode,wavelengths\n"),
+    ];
+    for (name, text) in earlier {
+        std::fs::write(runs.join(name), text).unwrap();
+    }
+    let missing = dir.path().join("missing.coeff").display().to_string();
+    let out = runs.display().to_string();
+    refused(&["eval", "--quick", "--table", &missing, "--out", &out], &["missing.coeff"]);
+    for (name, text) in earlier {
+        assert_eq!(std::fs::read_to_string(runs.join(name)).unwrap(), text, "{name}");
+    }
+}

@@ -463,11 +463,12 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
         let k0 = uw_rate(ja, jb, i);
         let k = select(k0, max(k0, vec4<f32>(0.0)), beyond);
         let z_from = select(0.0, uw_depth_node(i + 1u) - uw_depth_node(i), beyond);
-        let j0 = select(ja, jb, beyond) * exp(-k * (uw_pz[p] - z_from));
+        // J at the piece's start and the view's attenuation up to it, in one exponential.
+        let j0 = select(ja, jb, beyond) * exp(-k * (uw_pz[p] - z_from) - c * uw_pt[p]);
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
         let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
-        sum += j0 * uw_integral_to(rate, uw_pl[p], infinite) * exp(-c * uw_pt[p]);
+        sum += j0 * uw_integral_to(rate, uw_pl[p], infinite);
     }
     return sum;
 }
@@ -489,7 +490,9 @@ var<private> uw_irr_i: u32;
 // The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
 // normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
 // light_field::LightFieldTable::irradiance_at). Only the first call of a pixel reads z and n.
-fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec4<f32> {
+// `view`: an optical depth the result is attenuated by (e^{−view}), taken into the
+// interpolation's exponential.
+fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool, view: vec4<f32>) -> vec4<f32> {
     if (!uw_irr_ready) {
         uw_irr_ready = true;
         let hn = vec3<f32>(n.x, 0.0, n.z);
@@ -509,18 +512,19 @@ fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool) -> vec
         a += w[c] * uw_tab(table, UW_L_IRR + i * UW_NNE * UW_NNA + cells[c], group, rgb);
         b += w[c] * uw_tab(table, UW_L_IRR + (i + 1u) * UW_NNE * UW_NNA + cells[c], group, rgb);
     }
-    return uw_log_interp(a, b, i, z);
+    return uw_log_interp(a, b, i, z, view);
 }
 
 // Between depth nodes i and i + 1 with values a and b, ln-linear at depth z; below the table
 // never growing, from the last node on (light_field::log_interp). One exponential, where the
 // two sides of a branch were two for a CPU driver.
-fn uw_log_interp(a: vec4<f32>, b: vec4<f32>, i: u32, z: f32) -> vec4<f32> {
+// `view`: an optical depth to attenuate the result by, in the same exponential.
+fn uw_log_interp(a: vec4<f32>, b: vec4<f32>, i: u32, z: f32, view: vec4<f32>) -> vec4<f32> {
     let k = uw_rate(a, b, i);
     let beyond = z > UW_ZMAX;
     let kk = select(k, max(k, vec4<f32>(0.0)), beyond);
     let z_from = select(uw_depth_node(i), UW_ZMAX, beyond);
-    return select(a, b, beyond) * exp(-kk * (z - z_from));
+    return select(a, b, beyond) * exp(-kk * (z - z_from) - view);
 }
 
 // The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
@@ -531,7 +535,7 @@ fn uw_surface_irradiance(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool, ctx:
     let zs = max(z0 - uw_d * ctx.view_dir.y, 0.0);
     let hit = ctx.origin + ctx.view_dir * ctx.distance;
     let cv = c - UW_FWD * b;
-    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb) * exp(-cv * uw_d);
+    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb, cv * uw_d);
     return s3_scale(uw_suns(group, rgb), e);
 }
 
@@ -552,11 +556,12 @@ fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
 }
 
 // E_d(z)/E_d source at depth z, ln-linear between nodes (light_field::log_interp).
-fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool) -> vec4<f32> {
+// `view`: as `uw_log_interp`'s.
+fn uw_table_attenuation(table: u32, z: f32, group: u32, rgb: bool, view: vec4<f32>) -> vec4<f32> {
     let i = uw_segment(z);
     let a = uw_ed_node(table, i, group, rgb);
     let b = uw_ed_node(table, i + 1u, group, rgb);
-    return uw_log_interp(a, b, i, z);
+    return uw_log_interp(a, b, i, z, view);
 }
 
 // The lights that get single scattering, at most UW_SS_LIGHTS of those that can (suns, not
@@ -803,16 +808,19 @@ fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, gr
     }
     if (!ctx.background) {
         let zs = max(z0 - uw_d * wy, 0.0);
-        var att = exp(-kd * zs);
+        // The light's attenuation down to the surface and the view's back to the camera, in one
+        // exponential.
+        let view = cv * uw_d;
+        var att = exp(-kd * zs - view);
         if (UW_IRRADIANCE) {
             // The lights' direct light: the sun's unscattered beam (other lights get the same
             // factor, as they got Kd's before). The diffuse light comes from `custom_irradiance`.
-            att = exp(-c * (zs / max(uw_sun_mu, 1e-3)));
+            att = exp(-c * (zs / max(uw_sun_mu, 1e-3)) - view);
         } else if (UW_TABLE_KD) {
             let hit = ctx.origin + ctx.view_dir * ctx.distance;
-            att = uw_table_attenuation(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb);
+            att = uw_table_attenuation(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb, view);
         }
-        l += s3_scale(radiance, att * exp(-cv * uw_d));
+        l += s3_scale(radiance, att);
     }
     return l;
 }

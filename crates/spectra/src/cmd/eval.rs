@@ -61,10 +61,16 @@ pub fn config(a: &Args) -> Result<Config> {
     let ids = if a.scenes.is_empty() {
         suite::default_ids(&budget)
     } else {
+        let mut ids: Vec<String> = Vec::new();
         for id in &a.scenes {
             suite::case(id)?;
+            if ids.contains(id) {
+                eprintln!("warning: --scenes names {id} more than once; it is evaluated once");
+            } else {
+                ids.push(id.clone());
+            }
         }
-        a.scenes.clone()
+        ids
     };
     let notes = suite::notes(&ids);
     if let Some(o) = &a.observer {

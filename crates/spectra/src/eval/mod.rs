@@ -247,15 +247,42 @@ pub fn run(cfg: Config) -> Result<Results> {
     r
 }
 
+/// The files of an earlier evaluation in `out` (its results.json, index.html and results.csv),
+/// which a new run replaces; an error for a file of one of those names that an evaluation did
+/// not write.
+fn earlier_results(out: &Path) -> Result<Vec<PathBuf>> {
+    let ours = |name: &str, text: &str| match name {
+        "results.json" => serde_json::from_str::<serde_json::Value>(text)
+            .is_ok_and(|v| ["cases", "budget", "frame_times"].iter().all(|k| v.get(k).is_some())),
+        "index.html" => text.contains("<title>spectra evaluation</title>"),
+        _ => text.starts_with("case,transport,width,height,truth_spp,mode,"),
+    };
+    let mut found = Vec::new();
+    for name in ["results.json", "index.html", "results.csv"] {
+        let p = out.join(name);
+        if std::fs::symlink_metadata(&p).is_err() {
+            continue;
+        }
+        let text = std::fs::read(&p).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
+        if !p.is_file() || !ours(name, &text) {
+            anyhow::bail!(
+                "{}: exists and is not an earlier `spectra eval`'s output, which a run would replace; \
+                 choose another --out, or move the file",
+                p.display()
+            );
+        }
+        found.push(p);
+    }
+    Ok(found)
+}
+
 fn run_into(cfg: Config) -> Result<Results> {
     let t_start = Instant::now();
     std::fs::create_dir_all(&cfg.out).with_context(|| format!("creating {}", cfg.out.display()))?;
-    for stale in ["results.json", "index.html", "results.csv"] {
-        let p = cfg.out.join(stale);
-        if p.exists() {
-            std::fs::remove_file(&p).with_context(|| format!("removing stale {}", p.display()))?;
-        }
-    }
+    // An earlier run's results are replaced, but only once this run's inputs are all read, and
+    // never a file of that name that an evaluation did not write (an --out pointed at a
+    // project's folder).
+    let stale = earlier_results(&cfg.out)?;
     let table = crate::cmd::setup::load_table(cfg.table.as_deref())?;
     let cancel = color::upsample::interrupt_flag();
     let check = || -> Result<()> {
@@ -273,6 +300,9 @@ fn run_into(cfg: Config) -> Result<Results> {
         measure::TruthJob { width, height, spp, seed, range }
     };
     let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| cfg.case(id)).collect::<Result<_>>()?;
+    for p in stale {
+        std::fs::remove_file(&p).with_context(|| format!("removing an earlier run's {}", p.display()))?;
+    }
 
     let mut results = Vec::new();
     for c in &cases {
@@ -295,6 +325,13 @@ fn run_into(cfg: Config) -> Result<Results> {
         // Volumetric truth is too noisy for a luminance-edge mask (it would mask everything).
         let water = measure::water(&c.scene)?;
         let mask = if water.is_some() { vec![false; t0.data.len()] } else { measure::edge_mask(&t0) };
+        if mask.iter().all(|&m| m) {
+            anyhow::bail!(
+                "{}: at {width}×{height} every pixel lies on an edge of the truth, leaving none to measure; \
+                 use a larger --size",
+                c.id
+            );
+        }
         let noise = Errors::of(&measure::diff(&t0, &t1)?, &mask)?;
         let truth_png = format!("{}_truth.png", c.id);
         save_png(&cfg.out.join(&truth_png), &t0)?;

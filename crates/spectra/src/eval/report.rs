@@ -480,7 +480,8 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
     }
     h.push_str(
         "<h2>Mean errors</h2><p>ours and naive at each case's N with the renderer's default quadrature (column \
-         “N, quadrature”); every N in both quadratures is in the sweep under each case.</p>\
+         “N, quadrature”); every N in both quadratures is in the sweep under each case. Green: the lowest \
+         mean ΔE00, below every other mode's by more than the truth noise.</p>\
          <table><tr><th>case</th><th>N, quadrature</th>",
     );
     for (_, n) in MODES {
@@ -496,9 +497,11 @@ ray tracing differ geometrically, but also texture edges); both whole-image and 
     }
     h.push_str("</tr>");
     for c in &r.cases {
-        let best = (0..3).min_by(|&a, &b| {
-            c.modes[a].errors.delta_e2000.mean.total_cmp(&c.modes[b].errors.delta_e2000.mean)
-        });
+        // A lead smaller than the truth's own noise is no lead (as in the sweep's tables).
+        let noise = c.noise_floor.delta_e2000.mean;
+        let mean = |i: usize| c.modes[i].errors.delta_e2000.mean;
+        let best =
+            (0..c.modes.len()).find(|&i| (0..c.modes.len()).all(|j| j == i || mean(i) + noise < mean(j)));
         let _ = write!(h, "<tr><td>{}</td><td>{}</td>", esc(&c.id), esc(&headline_config(c)));
         for (i, m) in c.modes.iter().enumerate() {
             let cls = if Some(i) == best { " class=\"best\"" } else { "" };
