@@ -65,6 +65,11 @@ pub struct SpectralImage {
     pub data: Vec<f32>,
     /// Name of the white the values are normalised against ([`WHITE_ATTRIBUTE`]), if known.
     pub white: Option<String>,
+    /// The bands' own wavelengths where they are not the centres of their edges: a file
+    /// without [`BAND_EDGES_ATTRIBUTE`] whose channels are unevenly spaced (each band is then
+    /// integrated at its channel's wavelength, weighted by the band's width, and written back
+    /// without the attribute). `None`: the centres of the edges.
+    pub centres: Option<Vec<f64>>,
 }
 
 impl SpectralImage {
@@ -74,7 +79,21 @@ impl SpectralImage {
 
     /// The wavelengths and widths of the bands.
     pub fn wavelengths(&self) -> Result<SampledWavelengths> {
-        SampledWavelengths::from_edges(&self.edges).map_err(|e| CompareError::InvalidImage(e.to_string()))
+        let mut wl = SampledWavelengths::from_edges(&self.edges)
+            .map_err(|e| CompareError::InvalidImage(e.to_string()))?;
+        if let Some(c) = &self.centres {
+            let inside = c.len() == wl.lambda.len()
+                && c.iter().zip(self.edges.windows(2)).all(|(&l, e)| l >= e[0] && l <= e[1]);
+            if !inside {
+                return Err(CompareError::InvalidImage(format!(
+                    "{} band wavelengths for {} bands, or one outside its band",
+                    c.len(),
+                    wl.lambda.len()
+                )));
+            }
+            wl.lambda = c.clone();
+        }
+        Ok(wl)
     }
 
     fn validate(&self) -> Result<()> {
@@ -265,9 +284,16 @@ pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Spect
             )));
         }
     }
-    let edges = match text(BAND_EDGES_ATTRIBUTE) {
-        Some(s) => edges_from_attribute(&s, &bands, &decode)?,
-        None => edges_from_centres(&bands, &decode)?,
+    let (edges, centres) = match text(BAND_EDGES_ATTRIBUTE) {
+        Some(s) => (edges_from_attribute(&s, &bands, &decode)?, None),
+        None => {
+            let edges = edges_from_centres(&bands, &decode)?;
+            // Unevenly spaced channels are not their bands' centres: keep their wavelengths.
+            let own: Vec<f64> = bands.iter().map(|b| b.0).collect();
+            let centred =
+                own.iter().zip(edges.windows(2)).all(|(&l, e)| (l - 0.5 * (e[0] + e[1])).abs() <= 1e-3);
+            (edges, (!centred).then_some(own))
+        }
     };
     let (w, h) = (layer.size.width(), layer.size.height());
     let (width, height) = (
@@ -281,7 +307,7 @@ pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Spect
             data[i * n + b] = c.sample_data.value_by_flat_index(i).to_f32();
         }
     }
-    let img = SpectralImage { width, height, kind, edges, data, white: text(WHITE_ATTRIBUTE) };
+    let img = SpectralImage { width, height, kind, edges, data, white: text(WHITE_ATTRIBUTE), centres };
     img.validate().map_err(|e| decode(e.to_string()))?;
     Ok(img)
 }
@@ -394,8 +420,11 @@ pub fn write_spectral_exr_framed(
     if image.kind == SpectralKind::Emissive {
         set("emissiveUnits", "W.m^-2.sr^-1");
     }
-    let edges: Vec<String> = image.edges.iter().map(|e| format!("{e}")).collect();
-    set(BAND_EDGES_ATTRIBUTE, &edges.join(" "));
+    // Bands off their edges' centres are read back from their channels' wavelengths alone.
+    if image.centres.is_none() {
+        let edges: Vec<String> = image.edges.iter().map(|e| format!("{e}")).collect();
+        set(BAND_EDGES_ATTRIBUTE, &edges.join(" "));
+    }
     if let Some(white) = &image.white {
         set(WHITE_ATTRIBUTE, white);
     }
@@ -428,7 +457,7 @@ mod tests {
         let data = (0..w * h)
             .flat_map(|p| (0..n).map(move |b| 0.1 + 0.8 * (((p as usize * 7 + b * 3) % 11) as f32 / 10.0)))
             .collect();
-        SpectralImage { width: w, height: h, kind, edges, data, white: Some("D65".into()) }
+        SpectralImage { width: w, height: h, kind, edges, data, white: Some("D65".into()), centres: None }
     }
 
     #[test]
@@ -554,5 +583,17 @@ mod tests {
         write_raw(&p, &["S0.500nm", "S0.510nm", "S0.530nm"], &[]);
         let ok = read_spectral_exr(&p).unwrap();
         assert_eq!(ok.edges, vec![495.0, 505.0, 520.0, 540.0]);
+        // Each band is integrated at its channel's wavelength, not at its edges' centre (510,
+        // not 512.5), weighted by its width; written back without edges, it reads the same.
+        let wl = ok.wavelengths().unwrap();
+        assert_eq!(wl.lambda, vec![500.0, 510.0, 530.0]);
+        assert_eq!(wl.weight, vec![10.0, 15.0, 20.0]);
+        let again = dir.path().join("again.exr");
+        write_spectral_exr(&again, &ok, None).unwrap();
+        let back = read_spectral_exr(&again).unwrap();
+        assert_eq!((back.edges.clone(), back.centres.clone()), (ok.edges.clone(), ok.centres.clone()));
+        // Evenly spaced channels are their bands' centres.
+        write_raw(&p, &["S0.500nm", "S0.510nm", "S0.520nm"], &[]);
+        assert_eq!(read_spectral_exr(&p).unwrap().centres, None);
     }
 }

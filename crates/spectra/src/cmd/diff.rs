@@ -374,6 +374,7 @@ mod tests {
             edges,
             data,
             white: Some("D65".into()),
+            centres: None,
         };
         compare::write_spectral_exr(p("s.exr"), &spec, None).unwrap();
         let grey = Image::filled(4, 3, [0.5; 3]).unwrap();

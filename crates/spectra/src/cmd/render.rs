@@ -168,6 +168,7 @@ fn render_frame(
             edges: cap.edges,
             data: cap.data.into_iter().map(|v| v * k).collect(),
             white: Some(settings.white.clone()),
+            centres: None,
         };
         interrupted()?;
         compare::write_spectral_exr(sp, &spec, Some(&rgb))

@@ -593,6 +593,7 @@ pub fn run(a: Args) -> Result<()> {
             edges,
             data: bands,
             white: Some(white),
+            centres: None,
         };
         let spectral_frame =
             compare::ExrFrame { attributes: record(&a, &scene, &st, &table, true)?, ..frame.clone() };
