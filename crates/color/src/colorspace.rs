@@ -233,6 +233,42 @@ impl RgbColorSpace {
     }
 }
 
+/// The matrix from linear RGB of the colour space with chromaticities `n` (x y of red, green,
+/// blue, white: an OpenEXR `chromaticities` attribute, a Radiance `PRIMARIES` line) to linear
+/// sRGB, with Bradford adaptation to D65: the identity for Rec. 709's (within 10⁻³); `None` if
+/// `n` is not eight chromaticities of a colour space. Primaries may lie outside the spectrum
+/// locus (ACES AP0's blue has y = −0.077), the white must be a colour. Every reader of such files
+/// converts through it.
+pub fn to_srgb_from_chromaticities(n: &[f64]) -> Option<DMat3> {
+    let ok = n.len() == 8
+        && n.iter().all(|x| x.is_finite() && (-2.0..=2.0).contains(x))
+        && n[..6].chunks(2).all(|c| c[1].abs() > 1e-6)
+        && n[6] > 0.0
+        && n[7] > 0.0
+        && n[6] + n[7] < 1.0;
+    let space = ok.then(|| {
+        RgbColorSpace::new(
+            "PRIMARIES",
+            [[n[0], n[1]], [n[2], n[3]], [n[4], n[5]]],
+            [n[6], n[7]],
+            "",
+            TransferFunction::Linear,
+        )
+    })?;
+    if !(space.to_xyz.is_finite() && space.to_xyz.determinant().abs() > 1e-6) {
+        return None;
+    }
+    let srgb = RgbColorSpace::srgb();
+    let same = space
+        .primaries
+        .iter()
+        .flatten()
+        .chain(&space.white)
+        .zip(srgb.primaries.iter().flatten().chain(&srgb.white))
+        .all(|(a, b)| (a - b).abs() < 1e-3);
+    Some(if same { DMat3::IDENTITY } else { space.conversion_to(&srgb) })
+}
+
 /// D65 chromaticity as used by sRGB, P3 and Rec.2020 (four decimals, as the standards write it).
 pub const D65_XY: [f64; 2] = [0.3127, 0.3290];
 /// The ACES white (S-2008-001).

@@ -1,6 +1,8 @@
 //! Reading and writing [`Image`]s: OpenEXR (linear, f16/f32) and PNG (sRGB-encoded, 8/16-bit).
 //!
-//! The format follows the extension (case-insensitive). EXR holds linear values as they are;
+//! The format follows the extension (case-insensitive). EXR holds linear values, read from the
+//! first part with R, G and B and converted to linear sRGB by the file's `chromaticities`
+//! attribute where it names other primaries (`color::colorspace::to_srgb_from_chromaticities`);
 //! PNG holds IEC 61966-2-1 sRGB-encoded values, so reading decodes them to linear and writing
 //! clamps linear values to [0, 1] and encodes them. Writes are atomic ([`crate::atomic`]).
 
@@ -138,25 +140,49 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
 fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<Image> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
     check_exr_headers(path, bytes, max_channels)?;
-    let layer = read_flat_exr(bytes).map_err(|e| decode(e.to_string()))?.layer_data;
-    let channels = &layer.channel_data.list;
-    let find = |name: &str| channels.iter().find(|c| c.name.eq(name));
-    let (r, g, b) = match (find("R"), find("G"), find("B")) {
-        (Some(r), Some(g), Some(b)) => (r, g, b),
-        found => {
-            let missing: Vec<&str> =
-                [("R", found.0.is_none()), ("G", found.1.is_none()), ("B", found.2.is_none())]
-                    .into_iter()
-                    .filter_map(|(n, m)| m.then_some(n))
-                    .collect();
-            let present: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
-            return Err(CompareError::MissingChannels {
-                path: path.into(),
-                missing: missing.join(", "),
-                present: if present.is_empty() { "none".into() } else { present.join(", ") },
-            });
-        }
+    // Every part, for the first that holds R, G and B (a render's beauty pass need not be the
+    // file's first part).
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| decode(e.to_string()))?;
+    let to_srgb = exr_to_srgb(&image.attributes).map_err(decode)?;
+    let layers = &image.layer_data;
+    let has = |l: &Layer<AnyChannels<FlatSamples>>, n: &str| l.channel_data.list.iter().any(|c| c.name.eq(n));
+    let Some(layer) = layers.iter().find(|l| ["R", "G", "B"].iter().all(|n| has(l, n))) else {
+        let first = layers.first();
+        let missing: Vec<&str> =
+            ["R", "G", "B"].into_iter().filter(|n| !first.is_some_and(|l| has(l, n))).collect();
+        let names = |l: &Layer<AnyChannels<FlatSamples>>| {
+            let v: Vec<String> = l.channel_data.list.iter().map(|c| c.name.to_string()).collect();
+            if v.is_empty() { "none".to_string() } else { v.join(", ") }
+        };
+        let present = match layers.len() {
+            0 => "none".to_string(),
+            1 => names(&layers[0]),
+            _ => layers
+                .iter()
+                .enumerate()
+                .map(|(i, l)| match &l.attributes.layer_name {
+                    Some(n) => format!("part {i} ({n}): {}", names(l)),
+                    None => format!("part {i}: {}", names(l)),
+                })
+                .collect::<Vec<_>>()
+                .join("; "),
+        };
+        return Err(CompareError::MissingChannels {
+            path: path.into(),
+            missing: missing.join(", "),
+            present,
+        });
     };
+    let channels = &layer.channel_data.list;
+    let find = |name: &str| channels.iter().find(|c| c.name.eq(name)).expect("checked above");
+    let (r, g, b) = (find("R"), find("G"), find("B"));
     for c in [r, g, b] {
         if c.sampling != Vec2(1, 1) {
             return Err(decode(format!("channel {} is subsampled, which is not supported", c.name)));
@@ -167,8 +193,35 @@ fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<Ima
         u32::try_from(w).map_err(|_| decode(format!("width {w} too large")))?,
         u32::try_from(h).map_err(|_| decode(format!("height {h} too large")))?,
     );
-    let data = (0..w * h).map(|i| [r, g, b].map(|c| c.sample_data.value_by_flat_index(i).to_f32())).collect();
+    let data = (0..w * h)
+        .map(|i| {
+            let p = [r, g, b].map(|c| c.sample_data.value_by_flat_index(i).to_f32());
+            match to_srgb {
+                Some(m) => (m * glam::Vec3::from(p)).to_array(),
+                None => p,
+            }
+        })
+        .collect();
     Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+}
+
+/// The matrix from an EXR's RGB to linear sRGB by its `chromaticities` attribute (`None`: absent,
+/// or Rec. 709's, which files without it are taken to hold), as the environment maps' reader
+/// converts them (`color::colorspace::to_srgb_from_chromaticities`).
+fn exr_to_srgb(
+    attributes: &exr::meta::header::ImageAttributes,
+) -> std::result::Result<Option<glam::Mat3>, String> {
+    let Some(c) = attributes.chromaticities else {
+        return Ok(None);
+    };
+    let n: Vec<f64> =
+        [c.red, c.green, c.blue, c.white].iter().flat_map(|v| [f64::from(v.0), f64::from(v.1)]).collect();
+    let m = color::colorspace::to_srgb_from_chromaticities(&n).ok_or_else(|| {
+        format!(
+            "attribute chromaticities: {n:?} are not the x y of red, green, blue and white of a colour space"
+        )
+    })?;
+    Ok((m != glam::DMat3::IDENTITY).then(|| m.as_mat3()))
 }
 
 /// Checks an EXR's headers against the size caps before any sample is decoded: the reader
@@ -413,6 +466,79 @@ mod tests {
             chunks.extend_from_slice(&crc(&body).to_be_bytes());
         }
         [&out[..33], &chunks, &out[33..]].concat()
+    }
+
+    /// An EXR of one part per `(name, channels)`, every sample of channel c `values[c]`, with
+    /// `chromaticities` (x y of red, green, blue, white) if given.
+    fn exr_parts(parts: &[(&str, &[(&str, f32)])], chromaticities: Option<[f32; 8]>) -> Vec<u8> {
+        use exr::prelude::*;
+        let layers: Vec<Layer<AnyChannels<FlatSamples>>> = parts
+            .iter()
+            .map(|(name, channels)| {
+                let list: Vec<AnyChannel<FlatSamples>> = channels
+                    .iter()
+                    .map(|(n, v)| AnyChannel::new(*n, FlatSamples::F32(vec![*v; 4])))
+                    .collect();
+                Layer::new(
+                    (2, 2),
+                    LayerAttributes::named(*name),
+                    Encoding::UNCOMPRESSED,
+                    AnyChannels::sort(list.into()),
+                )
+            })
+            .collect();
+        let mut image = exr::prelude::Image::from_layers(
+            ImageAttributes::new(IntegerBounds::from_dimensions((2, 2))),
+            layers,
+        );
+        if let Some(c) = chromaticities {
+            image.attributes.chromaticities = Some(exr::meta::attribute::Chromaticities {
+                red: Vec2(c[0], c[1]),
+                green: Vec2(c[2], c[3]),
+                blue: Vec2(c[4], c[5]),
+                white: Vec2(c[6], c[7]),
+            });
+        }
+        let mut out = Cursor::new(Vec::new());
+        image.write().to_buffered(&mut out).unwrap();
+        out.into_inner()
+    }
+
+    /// An EXR's `chromaticities` converts its RGB to linear sRGB (Bradford to D65), as the
+    /// environment maps' reader does: ACES AP0 (0.8, 0.2, 0.1) is colour-science 0.4.7's
+    /// `RGB_to_RGB(…, 'ACES2065-1', 'sRGB', chromatic_adaptation_transform='Bradford')` with both
+    /// spaces' matrices derived from their primaries (`use_derived_matrix_*`, the colour crate's
+    /// convention; with the standards' rounded matrices 1.75156538, 0.04391963, 0.07398405);
+    /// Rec. 709's are the identity; a white that is no colour is refused by name.
+    #[test]
+    fn exr_chromaticities_convert_to_srgb() {
+        let rgb: &[(&str, f32)] = &[("R", 0.8), ("G", 0.2), ("B", 0.1)];
+        let ap0 = [0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077, 0.32168, 0.33767];
+        let img = decode_image("ap0.exr", &exr_parts(&[("rgb", rgb)], Some(ap0))).unwrap();
+        let want: [f64; 3] = [1.75176723, 0.04373597, 0.07393782];
+        for (got, want) in img.data[0].iter().zip(want) {
+            assert!((f64::from(*got) - want).abs() < 2e-6, "{:?} vs {want:?}", img.data[0]);
+        }
+        let rec709 = [0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290];
+        let img = decode_image("709.exr", &exr_parts(&[("rgb", rgb)], Some(rec709))).unwrap();
+        assert_eq!(img.data[0], [0.8, 0.2, 0.1]);
+        let bad = [0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.0, 0.0];
+        let e = decode_image("bad.exr", &exr_parts(&[("rgb", rgb)], Some(bad))).unwrap_err().to_string();
+        assert!(e.contains("bad.exr") && e.contains("chromaticities"), "{e}");
+    }
+
+    /// R, G, B are read from the first part that has them; without any, the error lists every
+    /// part's channels.
+    #[test]
+    fn exr_rgb_comes_from_the_first_part_that_has_it() {
+        let y: &[(&str, f32)] = &[("Y", 0.3)];
+        let rgb: &[(&str, f32)] = &[("R", 0.8), ("G", 0.2), ("B", 0.1)];
+        let img = decode_image("m.exr", &exr_parts(&[("lum", y), ("beauty", rgb)], None)).unwrap();
+        assert_eq!(img.data[0], [0.8, 0.2, 0.1]);
+        let e = decode_image("m.exr", &exr_parts(&[("lum", y), ("alpha", &[("A", 1.0)])], None))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("part 0 (lum): Y") && e.contains("part 1 (alpha): A"), "{e}");
     }
 
     /// PNG colour chunks decide how samples become linear (gAMA 1.0 used to be read as sRGB).

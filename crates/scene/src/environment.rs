@@ -685,42 +685,6 @@ impl EnvironmentChoice {
     }
 }
 
-/// What a Radiance header says about its pixels, as the matrix that takes them to linear sRGB
-/// radiance, or `None` where they already are: `EXPOSURE` (every factor the file's writers
-/// applied; the pixels are divided by their product, per the Radiance file format) and
-/// `COLORCORR` (the same, per channel), and `PRIMARIES` other than Rec. 709's (converted, with
-/// Bradford adaptation from the file's white to D65). These used to be ignored: a file written
-/// with `EXPOSURE=4` rendered four times too bright.
-/// The matrix from linear RGB of the colour space with chromaticities `n` (x y of red, green,
-/// blue, white) to linear sRGB, with Bradford adaptation to D65: the identity for Rec. 709's
-/// (within 10⁻³); `None` if `n` is not eight chromaticities of a colour space.
-fn to_srgb_from_chromaticities(n: &[f64]) -> Option<glam::DMat3> {
-    let ok = n.len() == 8
-        && n.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))
-        && n.chunks(2).all(|c| c[1] > 0.0 && c[0] + c[1] <= 1.0);
-    let space = ok.then(|| {
-        color::RgbColorSpace::new(
-            "PRIMARIES",
-            [[n[0], n[1]], [n[2], n[3]], [n[4], n[5]]],
-            [n[6], n[7]],
-            "",
-            color::colorspace::TransferFunction::Linear,
-        )
-    })?;
-    if !(space.to_xyz.is_finite() && space.to_xyz.determinant().abs() > 1e-6) {
-        return None;
-    }
-    let srgb = color::RgbColorSpace::srgb();
-    let same = space
-        .primaries
-        .iter()
-        .flatten()
-        .chain(&space.white)
-        .zip(srgb.primaries.iter().flatten().chain(&srgb.white))
-        .all(|(a, b)| (a - b).abs() < 1e-3);
-    Some(if same { glam::DMat3::IDENTITY } else { space.conversion_to(&srgb) })
-}
-
 /// An OpenEXR's `chromaticities` attribute (its RGB's primaries and white), as the matrix to
 /// linear sRGB (`None`: absent or Rec. 709's, the assumed default).
 fn exr_chromaticities(
@@ -732,7 +696,7 @@ fn exr_chromaticities(
     };
     let n: Vec<f64> =
         [c.red, c.green, c.blue, c.white].iter().flat_map(|v| [f64::from(v.0), f64::from(v.1)]).collect();
-    let m = to_srgb_from_chromaticities(&n).ok_or_else(|| EnvironmentError {
+    let m = color::colorspace::to_srgb_from_chromaticities(&n).ok_or_else(|| EnvironmentError {
         file: path.to_path_buf(),
         message: format!(
             "attribute chromaticities: {n:?} are not the x y of red, green, blue and white of a colour space"
@@ -741,6 +705,12 @@ fn exr_chromaticities(
     Ok((m != glam::DMat3::IDENTITY).then(|| m.as_mat3()))
 }
 
+/// What a Radiance header says about its pixels, as the matrix that takes them to linear sRGB
+/// radiance, or `None` where they already are: `EXPOSURE` (every factor the file's writers
+/// applied; the pixels are divided by their product, per the Radiance file format) and
+/// `COLORCORR` (the same, per channel), and `PRIMARIES` other than Rec. 709's (converted, with
+/// Bradford adaptation from the file's white to D65). These used to be ignored: a file written
+/// with `EXPOSURE=4` rendered four times too bright.
 fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, EnvironmentError> {
     use glam::{DMat3, DVec3};
     let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
@@ -786,7 +756,7 @@ fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, Envi
     let mut m = DMat3::from_diagonal(scale);
     if let Some((_, v)) = meta.custom_attributes.iter().rev().find(|(k, _)| k == "PRIMARIES") {
         let n: Vec<f64> = v.split_whitespace().filter_map(|x| x.parse().ok()).collect();
-        let Some(c) = to_srgb_from_chromaticities(&n) else {
+        let Some(c) = color::colorspace::to_srgb_from_chromaticities(&n) else {
             return Err(err(format!(
                 "header PRIMARIES: '{}' is not eight chromaticities (x y of red, green, blue, white) of a colour space",
                 v.trim()
