@@ -263,14 +263,19 @@ fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {
     let ct = img.color();
     let bits_per_channel = ct.bits_per_pixel() / u16::from(ct.channel_count());
     let (width, height) = (img.width(), img.height());
-    let to_linear = png_transfer(bytes).map_err(decode)?;
+    let (to_linear, to_srgb) = png_transfer(bytes).map_err(decode)?;
+    check_palette(bytes).map_err(decode)?;
     // Lookup tables: decoding is the same few thousand values over and over.
-    let data = if bits_per_channel > 8 {
+    let data: Vec<[f32; 3]> = if bits_per_channel > 8 {
         let lut: Vec<f32> = (0..=u16::MAX).map(|v| to_linear.decode(f64::from(v) / 65535.0) as f32).collect();
         img.to_rgb16().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
     } else {
         let lut: Vec<f32> = (0..=u8::MAX).map(|v| to_linear.decode(f64::from(v) / 255.0) as f32).collect();
         img.to_rgb8().pixels().map(|p| p.0.map(|v| lut[v as usize])).collect()
+    };
+    let data = match to_srgb {
+        Some(m) => data.into_iter().map(|p: [f32; 3]| (m * glam::Vec3::from(p)).to_array()).collect(),
+        None => data,
     };
     Image::new(width, height, data).map_err(|e| decode(e.to_string()))
 }
@@ -294,16 +299,23 @@ impl PngTransfer {
     }
 }
 
-/// The transfer of the PNG in `bytes` (see [`PngTransfer`]); ICC profiles are not interpreted
-/// (read as sRGB, the profile nearly every PNG that carries one has); cICP is accepted for
-/// Rec. 709 primaries with the sRGB or a linear transfer, refused otherwise (HDR PNGs: PQ, HLG).
-fn png_transfer(bytes: &[u8]) -> std::result::Result<PngTransfer, String> {
+/// The transfer of the PNG in `bytes` (see [`PngTransfer`]) and, from a cHRM chunk naming other
+/// primaries or white than sRGB's, the matrix from its linear RGB to linear sRGB (Bradford, as
+/// EXR `chromaticities`); ICC profiles are not interpreted (read as sRGB, the profile nearly
+/// every PNG that carries one has); cICP is accepted for Rec. 709 primaries with the sRGB or a
+/// linear transfer at full range, refused otherwise (HDR PNGs: PQ, HLG; narrow-range video).
+fn png_transfer(bytes: &[u8]) -> std::result::Result<(PngTransfer, Option<glam::Mat3>), String> {
     let reader = png::Decoder::new(Cursor::new(bytes)).read_info().map_err(|e| e.to_string())?;
     let info = reader.info();
     if let Some(c) = &info.coding_independent_code_points {
+        if !c.is_video_full_range_image {
+            return Err("cICP chunk: narrow-range (video) samples are not supported; only full range is: \
+                        write an EXR of linear sRGB instead"
+                .into());
+        }
         return match (c.color_primaries, c.transfer_function) {
-            (1, 13) => Ok(PngTransfer::Srgb),
-            (1, 8) => Ok(PngTransfer::Power(1.0)),
+            (1, 13) => Ok((PngTransfer::Srgb, None)),
+            (1, 8) => Ok((PngTransfer::Power(1.0), None)),
             (p, t) => Err(format!(
                 "cICP chunk: colour primaries {p}, transfer {t} (ITU-T H.273) are not supported; only Rec. 709 \
                  primaries (1) with the sRGB (13) or linear (8) transfer are: write an EXR of linear sRGB instead"
@@ -311,13 +323,60 @@ fn png_transfer(bytes: &[u8]) -> std::result::Result<PngTransfer, String> {
         };
     }
     if info.icc_profile.is_some() || info.srgb.is_some() {
-        return Ok(PngTransfer::Srgb);
+        return Ok((PngTransfer::Srgb, None));
     }
-    match info.gama_chunk.map(|g| f64::from(g.into_value())) {
-        None => Ok(PngTransfer::Srgb),
-        Some(g) if (0.01..=100.0).contains(&g) => Ok(PngTransfer::Power(g)),
-        Some(g) => Err(format!("gAMA chunk: image gamma {g} is outside 0.01–100")),
+    // cHRM counts only where no cICP, iCCP or sRGB chunk says otherwise (the same precedence).
+    let to_srgb = match &info.chrm_chunk {
+        None => None,
+        Some(c) => {
+            let n: Vec<f64> = [c.red, c.green, c.blue, c.white]
+                .iter()
+                .flat_map(|(x, y)| [f64::from(x.into_value()), f64::from(y.into_value())])
+                .collect();
+            let m = color::colorspace::to_srgb_from_chromaticities(&n).ok_or_else(|| {
+                format!("cHRM chunk: {n:?} are not the x y of red, green, blue and white of a colour space")
+            })?;
+            (m != glam::DMat3::IDENTITY).then(|| m.as_mat3())
+        }
+    };
+    let transfer = match info.gama_chunk.map(|g| f64::from(g.into_value())) {
+        None => PngTransfer::Srgb,
+        Some(g) if (0.01..=100.0).contains(&g) => PngTransfer::Power(g),
+        Some(g) => return Err(format!("gAMA chunk: image gamma {g} is outside 0.01–100")),
+    };
+    Ok((transfer, to_srgb))
+}
+
+/// A palette image's indices must name palette entries (the PNG specification calls any other
+/// an error; decoders show such pixels black, a colour the file never held).
+fn check_palette(bytes: &[u8]) -> std::result::Result<(), String> {
+    let mut decoder = png::Decoder::new(Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::IDENTITY);
+    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let info = reader.info();
+    if info.color_type != png::ColorType::Indexed {
+        return Ok(());
     }
+    let entries = info.palette.as_ref().map_or(0, |p| p.len() / 3);
+    let bits = info.bit_depth as usize;
+    let (w, h) = (info.width as usize, info.height as usize);
+    let mut buf = vec![0; reader.output_buffer_size().ok_or("image too large")?];
+    let frame = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
+    let per_byte = 8 / bits;
+    for y in 0..h {
+        let row = &buf[y * frame.line_size..];
+        for x in 0..w {
+            let byte = row[x / per_byte];
+            let shift = 8 - bits * (x % per_byte + 1);
+            let index = (usize::from(byte) >> shift) & ((1 << bits) - 1);
+            if index >= entries {
+                return Err(format!(
+                    "pixel ({x}, {y}): palette index {index}, but the palette has {entries} entries"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes an image as EXR or PNG (by extension), atomically: on error no file is created
@@ -539,6 +598,64 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("part 0 (lum): Y") && e.contains("part 1 (alpha): A"), "{e}");
+    }
+
+    /// A cHRM chunk (with no sRGB, iCCP or cICP chunk) converts to linear sRGB: Rec. 2020
+    /// primaries, D65, gAMA 1.0, codes (128, 51, 26) are colour-science 0.4.7's
+    /// `RGB_to_RGB(codes / 255, 'ITU-R BT.2020', 'sRGB', chromatic_adaptation_transform='Bradford')`
+    /// with derived matrices: (0.70854531, 0.16320921, 0.0848398). A palette index past the
+    /// palette and narrow-range cICP are errors (they were read as black and as full range).
+    #[test]
+    fn png_chrm_palette_and_cicp_range() {
+        let rgb_png = |extra: &[(&[u8; 4], &[u8])]| {
+            let mut out = Vec::new();
+            {
+                let mut e = png::Encoder::new(&mut out, 1, 1);
+                e.set_color(png::ColorType::Rgb);
+                e.set_source_gamma(png::ScaledFloat::new(1.0));
+                e.write_header().unwrap().write_image_data(&[128, 51, 26]).unwrap();
+            }
+            let mut chunks = Vec::new();
+            for (kind, data) in extra {
+                let body = [&kind[..], data].concat();
+                chunks.extend_from_slice(&(data.len() as u32).to_be_bytes());
+                chunks.extend_from_slice(&body);
+                chunks.extend_from_slice(&crc32(&body).to_be_bytes());
+            }
+            [&out[..33], &chunks, &out[33..]].concat()
+        };
+        let chrm: Vec<u8> = [0.3127, 0.3290, 0.708, 0.292, 0.170, 0.797, 0.131, 0.046]
+            .iter()
+            .flat_map(|v: &f64| ((v * 100000.0).round() as u32).to_be_bytes())
+            .collect();
+        let img = decode_image("c.png", &rgb_png(&[(b"cHRM", &chrm)])).unwrap();
+        let want: [f64; 3] = [0.70854531, 0.16320921, 0.0848398];
+        for (got, want) in img.data[0].iter().zip(want) {
+            assert!((f64::from(*got) - want).abs() < 2e-6, "{:?} vs {want:?}", img.data[0]);
+        }
+        // sRGB's own primaries change nothing.
+        let srgb: Vec<u8> = [0.3127, 0.3290, 0.64, 0.33, 0.30, 0.60, 0.15, 0.06]
+            .iter()
+            .flat_map(|v: &f64| ((v * 100000.0).round() as u32).to_be_bytes())
+            .collect();
+        let img = decode_image("c.png", &rgb_png(&[(b"cHRM", &srgb)])).unwrap();
+        assert_eq!(img.data[0], [128.0 / 255.0, 51.0 / 255.0, 26.0 / 255.0]);
+        // cICP: Rec. 709, sRGB transfer, narrow range.
+        let e = decode_image("n.png", &rgb_png(&[(b"cICP", &[1, 13, 0, 0])])).unwrap_err().to_string();
+        assert!(e.contains("n.png") && e.contains("narrow-range"), "{e}");
+
+        let mut out = Vec::new();
+        {
+            let mut e = png::Encoder::new(&mut out, 3, 1);
+            e.set_color(png::ColorType::Indexed);
+            e.set_palette(vec![0u8, 0, 0, 255, 255, 255]);
+            e.write_header().unwrap().write_image_data(&[0, 1, 200]).unwrap();
+        }
+        let e = decode_image("p.png", &out).unwrap_err().to_string();
+        assert!(
+            e.contains("p.png") && e.contains("pixel (2, 0): palette index 200") && e.contains("2 entries"),
+            "{e}"
+        );
     }
 
     /// PNG colour chunks decide how samples become linear (gAMA 1.0 used to be read as sRGB).
