@@ -91,6 +91,12 @@ const INK: [u8; 3] = [0, 0, 0];
 /// Small maps are enlarged until their longer side reaches this many pixels.
 const MIN_MAP_SIDE: u32 = 256;
 
+/// The range of a heat map's scale: beyond it the labels stop being numbers a reader can use (a
+/// scale of 1e300 wrote a 301-digit label on a 3864-pixel-wide image, one of 1e-300 labelled
+/// every tick 0). A ΔE00 between black and white is 100.
+pub const MIN_SCALE: f64 = 1e-4;
+pub const MAX_SCALE: f64 = 1e4;
+
 impl Heatmap {
     /// Heat map of the ΔE2000 map of a comparison.
     pub fn of_delta_e(maps: &DiffMaps, opts: &HeatmapOptions) -> Result<Heatmap> {
@@ -114,13 +120,13 @@ impl Heatmap {
         }
         let data_max = values.iter().copied().fold(0.0, f64::max);
         let max = match opts.max {
-            Some(m) if m.is_finite() && m > 0.0 => m,
+            Some(m) if (MIN_SCALE..=MAX_SCALE).contains(&m) => m,
             Some(m) => {
                 return Err(CompareError::InvalidOption(format!(
-                    "heat map maximum must be positive, got {m}"
+                    "heat map maximum must be from {MIN_SCALE:e} to {MAX_SCALE:e}, got {m:e}"
                 )));
             }
-            None => nice_ceil(data_max),
+            None => nice_ceil(data_max).clamp(MIN_SCALE, MAX_SCALE),
         };
         let clipped = data_max > max;
 

@@ -34,6 +34,11 @@ fn absurd_counts_and_sizes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = two_images(dir.path());
     refused(&["diff", &a, &b, "--white-y", "1e-310"], &["--white-y", "1e-310", "white luminance"]);
+    let heat = dir.path().join("h.png").display().to_string();
+    for m in ["1e300", "1e-300", "0e0"] {
+        refused(&["diff", &a, &b, "--heatmap", &heat, "--max-de", m], &["--max-de", "from 1e-4 to 1e4", m]);
+    }
+    assert!(!dir.path().join("h.png").exists());
     refused(&["upsample", "--roundtrip", "18446744073709551615"], &["--roundtrip", "at most"]);
     let out = dir.path().join("t.coeff").display().to_string();
     refused(

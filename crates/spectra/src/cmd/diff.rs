@@ -186,9 +186,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bail!("{}: the heat map is written as PNG; give it a .png name", h.display());
     }
     if let Some(m) = args.max_de
-        && !(m.is_finite() && m > 0.0)
+        && !(compare::heatmap::MIN_SCALE..=compare::heatmap::MAX_SCALE).contains(&m)
     {
-        bail!("--max-de must be a positive number, got {m}");
+        bail!(
+            "--max-de must be a ΔE00 from {:e} to {:e}, got {m:e}",
+            compare::heatmap::MIN_SCALE,
+            compare::heatmap::MAX_SCALE
+        );
     }
 
     // Before the (possibly long) comparison: every output writable, none an input or another.
