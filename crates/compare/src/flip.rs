@@ -6,8 +6,9 @@
 //! `evaluate` does, so the maps and means are the reference's.
 //!
 //! - LDR-FLIP compares display-encoded sRGB images in [0, 1]: our linear images are clamped and
-//!   encoded to 8-bit sRGB exactly as a PNG output is ([`crate::io::to_display`]), so FLIP of two
-//!   images read from PNG sees the files' own codes, and FLIP decodes them with its own function.
+//!   encoded to 8-bit (or, for 16-bit files, 16-bit; [`ldr_flip_at_depths`]) sRGB exactly as a
+//!   PNG output is ([`crate::io::to_display`]), so FLIP of two images read from PNG sees the
+//!   files' own codes, and FLIP decodes them with its own function.
 //! - HDR-FLIP takes linear images, exposes them over a range of exposures, tone maps each (ACES
 //!   by default), and keeps each pixel's worst LDR-FLIP. Without user exposures the range comes
 //!   from the reference image as in the reference tool: from its brightest pixel to its median
@@ -227,19 +228,33 @@ fn evaluate(
     Ok(FlipMap { width: w as u32, height: h as u32, values, mean, exposures })
 }
 
-/// LDR-FLIP of `test` against `reference` (same size, finite pixels) at `pixels_per_degree`.
+/// LDR-FLIP of `test` against `reference` (same size, finite pixels) at `pixels_per_degree`,
+/// each as an 8-bit PNG of it holds it.
 pub fn ldr_flip(reference: &Image, test: &Image, pixels_per_degree: f32) -> Result<FlipMap> {
+    ldr_flip_at_depths(reference, test, pixels_per_degree, (8, 8))
+}
+
+/// [`ldr_flip`] with each image's codes at its own bit depth (`bits`: the reference's and the
+/// test's, 8 or 16, as read from PNGs of those depths; [`crate::io::png_bit_depth`]), so that
+/// FLIP sees a 16-bit file's own codes, as the reference tool does.
+pub fn ldr_flip_at_depths(
+    reference: &Image,
+    test: &Image,
+    pixels_per_degree: f32,
+    bits: (u8, u8),
+) -> Result<FlipMap> {
     let size = check_pair(reference, test, pixels_per_degree)?;
-    // 8-bit codes as a PNG holds them, given to FLIP as code / 255 like the reference's loader.
-    let codes = |img: &Image| -> Vec<f32> {
+    // Codes as a PNG holds them, given to FLIP as code / (2^bits − 1) like the reference's loader.
+    let codes = |img: &Image, bits: u8| -> Vec<f32> {
+        let top = if bits > 8 { 65535.0 } else { 255.0 };
         img.data
             .iter()
-            .flat_map(|p| p.map(|v| ((crate::io::to_display(v) * 255.0).round() as u8) as f32 / 255.0))
+            .flat_map(|p| p.map(|v| ((crate::io::to_display(v) * top).round() as f32) / top as f32))
             .collect()
     };
     evaluate(
-        &codes(reference),
-        &codes(test),
+        &codes(reference, bits.0),
+        &codes(test, bits.1),
         size,
         false,
         true,

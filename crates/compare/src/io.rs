@@ -99,6 +99,18 @@ pub fn read_image(path: impl AsRef<Path>) -> Result<Image> {
     decode_image(path, &bytes)
 }
 
+/// The bits per sample of the PNG at `path` (8 for 1–8-bit files, 16), `None` for any other
+/// file or one that cannot be read.
+pub fn png_bit_depth(path: impl AsRef<Path>) -> Option<u8> {
+    let path = path.as_ref();
+    if format_of(path).ok()? != Format::Png {
+        return None;
+    }
+    let file = std::fs::File::open(path).ok()?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file)).read_info().ok()?;
+    Some(if reader.info().bit_depth == png::BitDepth::Sixteen { 16 } else { 8 })
+}
+
 /// Decodes the bytes of an EXR or PNG file as [`read_image`] does, the format chosen by the
 /// extension of `path` (which only names the image in messages).
 pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {

@@ -80,3 +80,37 @@ fn hdr_flip_matches_the_reference_implementation() {
     assert_eq!(f64::from(e.stop), exp["stop_exposure"].as_f64().unwrap());
     check_map("HDR-FLIP", &map, &exp);
 }
+
+/// 16-bit codes reach FLIP as they are: two 32×24 images of integer-formula 16-bit sRGB codes
+/// (a = ((2053x + 977y), (311x + 4099y), (37x² + 13y)) mod 65536, b = a + ((7x + 13y + 5c) mod
+/// 6001) − 3000 clamped), given to flip-evaluator 1.7's `evaluate(a / 65535, b / 65535, 'LDR')`:
+/// mean 0.25465670228004456 (at 8 bits, rounded, 0.2546183168888092 — the difference the depth
+/// makes, which the bound below tells apart). The reference tool's own PNG loader reads 16-bit
+/// files at 8 bits (truncated), so its command line differs from both on such files.
+#[test]
+fn ldr_flip_of_16_bit_codes_matches_the_reference_implementation() {
+    use compare::flip::ldr_flip_at_depths;
+    let (w, h) = (32u32, 24u32);
+    let code = |x: i64, y: i64, c: i64| -> i64 {
+        match c {
+            0 => (x * 2053 + y * 977) % 65536,
+            1 => (x * 311 + y * 4099) % 65536,
+            _ => (x * x * 37 + y * 13) % 65536,
+        }
+    };
+    let image = |shift: bool| {
+        let v: Vec<f32> = (0..h as i64)
+            .flat_map(|y| (0..w as i64).flat_map(move |x| (0..3).map(move |c| (x, y, c))))
+            .map(|(x, y, c)| {
+                let a = code(x, y, c);
+                let v = if shift { (a + (x * 7 + y * 13 + c * 5) % 6001 - 3000).clamp(0, 65535) } else { a };
+                srgb_decode(v as f64 / 65535.0) as f32
+            })
+            .collect();
+        Image::from_interleaved(w, h, &v, 3).unwrap()
+    };
+    let map = ldr_flip_at_depths(&image(false), &image(true), DEFAULT_PIXELS_PER_DEGREE, (16, 16)).unwrap();
+    let want = 0.25465670228004456;
+    eprintln!("16-bit LDR-FLIP mean {:.8} (reference {want:.8})", map.mean());
+    assert!((map.mean() - want).abs() <= 1e-6, "{} vs {want}", map.mean());
+}

@@ -232,7 +232,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let map = if hdr_flip {
             compare::flip::hdr_flip(&reference, &test, args.flip_ppd, &hdr_opts).context("HDR-FLIP")?
         } else {
-            compare::flip::ldr_flip(&reference, &test, args.flip_ppd).context("LDR-FLIP")?
+            // A 16-bit PNG's own codes (block means are display codes of no file: 8 bits).
+            let depth = |p: &std::path::Path| {
+                if args.block == 1 { compare::io::png_bit_depth(p).unwrap_or(8) } else { 8 }
+            };
+            let bits = (depth(&args.reference), depth(&args.test));
+            compare::flip::ldr_flip_at_depths(&reference, &test, args.flip_ppd, bits).context("LDR-FLIP")?
         };
         if let Some(p) = &args.flip_map {
             map.save_png(p).context("writing the FLIP map")?;
