@@ -566,9 +566,11 @@ pub fn run(a: Args) -> Result<()> {
     }
     let img = acc.finish(&st);
     let secs = t1.elapsed().as_secs_f64();
-    if cancel.load(Ordering::Relaxed) {
-        bail!("interrupted; nothing written");
-    }
+    // Every sample is rendered: an interrupt now (while the cache was stored, say) would throw
+    // the whole render away to save the second its writing takes, so it is written, held
+    // against the forced exit.
+    let _hold = color::cancel::hold();
+    let late = cancel.load(Ordering::Relaxed);
     let data = if a.xyz {
         img.xyz.clone()
     } else {
@@ -646,6 +648,9 @@ pub fn run(a: Args) -> Result<()> {
     );
     if a.resume && resumed > 0 {
         eprintln!("  resumed from {} with {resumed} of {} samples done", ckpt.display(), st.spp);
+    }
+    if late {
+        eprintln!("  interrupted after the last sample: the finished render is written");
     }
     if let (Some(sp), Some(edges)) = (&a.spectral_out, &st.spectral_bands) {
         eprintln!(
