@@ -191,6 +191,13 @@ fn mixtures_are_refused() {
     img.data[13] = [f32::NAN, 0.0, 0.0];
     compare::write_exr_framed(p("nan.exr"), &img, &compare::read_exr_frame(p("b.exr")).unwrap()).unwrap();
     m(&[s(&p("a.exr")), s(&p("nan.exr"))], &["nan.exr", "pixel (1, 1) is not finite"]);
+    // Found by a sweep: one character of a header edited (b.exr's samples 2..4 made 2..3)
+    // merged with the wrong weight; the record's check refuses it.
+    let mut bytes = std::fs::read(p("b.exr")).unwrap();
+    let at = bytes.windows(4).position(|w| w == b"2..4").expect("b.exr's sample range");
+    bytes[at + 3] = b'3';
+    std::fs::write(p("edited.exr"), &bytes).unwrap();
+    m(&[s(&p("a.exr")), s(&p("edited.exr"))], &["edited.exr", "spectra.check", "edited or damaged"]);
     // Tiles that leave a gap: the message names them.
     r("cornell", &["--crop", "8,0,4,8", "--chunk", "1/2"], &p("right.exr"));
     m(&[s(&p("left.exr")), s(&p("right.exr"))], &["left.exr", "right.exr", "do not cover a rectangle"]);

@@ -91,6 +91,13 @@ fn read_piece(path: &Path) -> Result<Piece> {
         );
     }
     let samples = parse_samples(path, frame.get("spectra.samples").unwrap_or(""))?;
+    if frame.get("spectra.check") != Some(super::truth::record_check(&frame, size).as_str()) {
+        bail!(
+            "{}: its record (spectra.samples, the windows or spectra.content) does not match its \
+             spectra.check: the header was edited or damaged; render the piece again",
+            path.display()
+        );
+    }
     let fits = |o: u32, n: u32, d: u32| u64::from(o) + u64::from(n) <= u64::from(d);
     if !fits(frame.origin.0, size.0, frame.display.0) || !fits(frame.origin.1, size.1, frame.display.1) {
         bail!(
@@ -327,6 +334,7 @@ pub fn run(a: Args) -> Result<()> {
             *v = show(samples);
         }
     }
+    let frame = super::truth::sealed(frame, (w, h));
     match like {
         Some((b, _)) => {
             let spec =

@@ -354,8 +354,37 @@ pub fn record_difference(
     Some((name.to_string(), get(there, k), get(here, k)))
 }
 
-/// Version of the `spectra.*` attributes' meaning.
-pub const RECORD_VERSION: &str = "1";
+/// Version of the `spectra.*` attributes' meaning (2: `spectra.check`).
+pub const RECORD_VERSION: &str = "2";
+
+/// The check of what a record's identity does not cover — its sample ranges, its content and
+/// its windows — so that a header edited or damaged there (a range that reads `4..7` for `4..8`
+/// merged with the wrong weight) is refused, not merged. Not a defence against forgery, like
+/// every signature here (`color::signature`).
+pub fn record_check(frame: &compare::ExrFrame, size: (u32, u32)) -> String {
+    let get = |k: &str| frame.get(k).unwrap_or("");
+    let text = format!(
+        "{}\n{}\n{}\n{} {} {} {}\n{} {}\n",
+        get("spectra.identity"),
+        get("spectra.samples"),
+        get("spectra.content"),
+        frame.origin.0,
+        frame.origin.1,
+        size.0,
+        size.1,
+        frame.display.0,
+        frame.display.1
+    );
+    format!("{:016x}", color::signature::fnv1a64(text.as_bytes()))
+}
+
+/// `frame` with its `spectra.check` for data of `size` (replacing any).
+pub fn sealed(mut frame: compare::ExrFrame, size: (u32, u32)) -> compare::ExrFrame {
+    frame.attributes.retain(|(k, _)| k != "spectra.check");
+    let check = record_check(&frame, size);
+    frame.attributes.push(("spectra.check".into(), check));
+    frame
+}
 
 pub fn run(a: Args) -> Result<()> {
     if a.spectral_out.is_some() && a.out.is_none() {
@@ -578,11 +607,14 @@ pub fn run(a: Args) -> Result<()> {
     };
     let image = compare::image::Image::new(img.width, img.height, data)?;
     let win = st.window();
-    let frame = compare::ExrFrame {
-        display: (st.width, st.height),
-        origin: (win.x, win.y),
-        attributes: record(&a, &scene, &st, &table, false)?,
-    };
+    let frame = sealed(
+        compare::ExrFrame {
+            display: (st.width, st.height),
+            origin: (win.x, win.y),
+            attributes: record(&a, &scene, &st, &table, false)?,
+        },
+        (img.width, img.height),
+    );
     // The spectral file first: an interrupted run leaves neither complete, never a colour image
     // without the spectral one it was asked to go with.
     if let (Some(sp), Some(bands)) = (&a.spectral_out, img.spectral.clone()) {
@@ -597,8 +629,10 @@ pub fn run(a: Args) -> Result<()> {
             white: Some(white),
             centres: None,
         };
-        let spectral_frame =
-            compare::ExrFrame { attributes: record(&a, &scene, &st, &table, true)?, ..frame.clone() };
+        let spectral_frame = sealed(
+            compare::ExrFrame { attributes: record(&a, &scene, &st, &table, true)?, ..frame.clone() },
+            (img.width, img.height),
+        );
         compare::write_spectral_exr_framed(sp, &spec, Some(&image), Some(&spectral_frame))
             .with_context(|| format!("writing {}", sp.display()))?;
     }
