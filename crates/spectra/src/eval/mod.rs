@@ -345,6 +345,9 @@ fn run_into(cfg: Config) -> Result<Results> {
                 measure::realtime(&mut r, &c.scene, &measure::settings_for(&c.scene, *mode, n, range)?)?;
             let png = format!("{}_{}.png", c.id, name);
             save_png(&cfg.out.join(&png), &img)?;
+            // The measured image itself (the PNG is 8-bit sRGB): `spectra diff ID_truth.exr
+            // ID_MODE.exr` gives the report's numbers.
+            write_exr(&cfg.out.join(format!("{}_{}.exr", c.id, name)), &img)?;
             let ppd = compare::flip::DEFAULT_PIXELS_PER_DEGREE;
             let flip = compare::flip::ldr_flip(&t0, &img, ppd)?;
             let flip_hdr = compare::flip::hdr_flip(&t0, &img, ppd, &Default::default())?.mean();
