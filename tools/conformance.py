@@ -248,6 +248,10 @@ def model_delta_e(csv_path, mask, width, block):
     return {"model_delta_e2000_mean": total / n if n else None, "model_units": n}
 
 
+# Below this share of the image the background mask is taken to have missed the model.
+MIN_MODEL_COVERAGE = 0.02
+
+
 def default_background_mask(w, h, ch, k):
     """True where a pixel shows the model, False where it shows the default environment's
     background: its sky (k, k, k), its ground (k/4, k/4, k/4), or the blurred horizon between
@@ -636,6 +640,12 @@ def run_model(a, runner, name, path, outdir):
         mask = default_background_mask(*base, k)
         res["model_coverage"] = sum(mask) / len(mask)
         log(f"    model covers {res['model_coverage']:.1%} of the image")
+        if res["model_coverage"] < MIN_MODEL_COVERAGE:
+            # A flat-lit grey model can look like the sky's horizon band to the mask (neutral
+            # and constant along rows): a model it cannot find is judged over the whole image,
+            # not called black (Cameras, MultipleScenes and SimpleSparseAccessor were).
+            log("    the background mask found too little of the model: judged over the whole image")
+            mask = None
     for key, (w, h, ch) in images.items():
         r = res["renders"][key]
         m = mask if mask is not None and len(mask) == w * h else None
