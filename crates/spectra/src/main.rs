@@ -37,7 +37,7 @@ enum Command {
     Truth(cmd::truth::Args),
     /// Combine sample chunks and crop tiles of one `truth` render into one image.
     Merge(cmd::merge::Args),
-    /// List the built-in observers and cameras (--observer NAME) with their sources.
+    /// List the built-in observers and cameras (the names --observer takes) with their sources.
     Observers(cmd::observers::Args),
     /// Open an interactive window: live mode/N/range/observer/exposure, orbit and fly camera.
     #[cfg(feature = "viewer")]

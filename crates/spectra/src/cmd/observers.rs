@@ -35,9 +35,11 @@ pub fn run(a: Args) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!("{:<24} {:<11} {:>11}  source", "name", "kind", "data (nm)");
+    // The name column as wide as the longest name (arashi_vision_insta360_x5 overflowed 24).
+    let w = rows.iter().map(|r| r.0.chars().count()).max().unwrap_or(0).max(4);
+    println!("{:<w$} {:<11} {:>11}  source", "name", "kind", "data (nm)");
     for (n, k, f, t, s) in &rows {
-        println!("{n:<24} {k:<11} {:>11}  {s}", format!("{f:.0}–{t:.0}"));
+        println!("{n:<w$} {k:<11} {:>11}  {s}", format!("{f:.0}–{t:.0}"));
     }
     println!(
         "\nor a file: --observer my_camera.csv (wavelength and three columns) or a rawtoaces camera .json \
