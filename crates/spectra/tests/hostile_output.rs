@@ -288,7 +288,11 @@ fn eval_keeps_files_it_did_not_write_and_an_earlier_runs_until_its_inputs_are_re
     let earlier = [
         ("results.json", r#"{"quick": true, "budget": {}, "cases": [], "frame_times": []}"#),
         ("index.html", "<!DOCTYPE html><html><head><title>spectra evaluation</title></head></html>"),
-        ("results.csv", "case,transport,width,height,truth_spp,mode,wavelengths\n"),
+        (
+            "results.csv",
+            "case,transport,width,height,truth_spp,mode,wavelengths,quadrature,de_mean,de_median,de_p95,de_max,\
+             mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
+        ),
     ];
     for (name, text) in earlier {
         std::fs::write(runs.join(name), text).unwrap();

@@ -254,8 +254,8 @@ fn earlier_results(out: &Path) -> Result<Vec<PathBuf>> {
     let ours = |name: &str, text: &str| match name {
         "results.json" => serde_json::from_str::<serde_json::Value>(text)
             .is_ok_and(|v| ["cases", "budget", "frame_times"].iter().all(|k| v.get(k).is_some())),
-        "index.html" => text.contains("<title>spectra evaluation</title>"),
-        _ => text.starts_with("case,transport,width,height,truth_spp,mode,"),
+        "index.html" => text.contains(report::HTML_TITLE),
+        _ => text.starts_with(report::CSV_HEADER),
     };
     let mut found = Vec::new();
     for name in ["results.json", "index.html", "results.csv"] {

@@ -203,11 +203,15 @@ fn tradeoff_chart(r: &Results, c: &super::CaseResult) -> Result<String> {
     )
 }
 
+/// The first line of results.csv (also how an earlier evaluation's file is told from others).
+pub const CSV_HEADER: &str = "case,transport,width,height,truth_spp,mode,wavelengths,quadrature,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n";
+
+/// index.html's title element (also how an earlier evaluation's page is told from others).
+pub const HTML_TITLE: &str = "<title>spectra evaluation</title>";
+
 /// Every number as CSV sections separated by a blank line.
 pub fn csv(r: &Results) -> String {
-    let mut s = String::from(
-        "case,transport,width,height,truth_spp,mode,wavelengths,quadrature,de_mean,de_median,de_p95,de_max,mae_mean,de_mean_masked,mae_mean_masked,masked_fraction\n",
-    );
+    let mut s = String::from(CSV_HEADER);
     for c in &r.cases {
         let rows =
             c.modes.iter().map(|m| (m.mode.as_str(), m.wavelengths, m.quadrature.as_deref(), &m.errors));
@@ -446,7 +450,7 @@ fn html(r: &Results) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
-        r#"<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>spectra evaluation</title>
+        r#"<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">{HTML_TITLE}
 <style>body{{font-family:sans-serif;margin:20px;max-width:1360px}}table{{border-collapse:collapse;margin:8px 0}}
 td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}th{{background:#eee}}td:first-child{{text-align:left}}
 .row{{display:flex;gap:8px;flex-wrap:wrap}}figure{{margin:0}}figcaption{{font-size:13px;text-align:center}}
