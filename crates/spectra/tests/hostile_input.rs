@@ -131,3 +131,35 @@ fn demo_values_that_look_like_options_stay_values() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A well-formed table of zeros upsamples every colour to a flat grey: `render` and `truth`
+/// refuse it; `upsample`, which measures tables, uses it but says first what is wrong with it.
+#[test]
+fn a_table_that_reproduces_no_colour_is_refused_or_flagged() {
+    use color::upsample::CoeffTable;
+    use color::upsample::table::uniform_chroma;
+    let d = tmp("zero-table");
+    let path = d.join("zeros.coeff");
+    let res = 4;
+    let zeros = CoeffTable {
+        res,
+        scale: (0..res).map(|k| (k as f32 / (res - 1) as f32).powi(2)).collect(),
+        chroma: uniform_chroma(res),
+        data: vec![0.0; CoeffTable::data_len(res)],
+    };
+    zeros.write(&path).unwrap();
+    let p = path.to_str().unwrap();
+    let o = d.join("t.exr");
+    refused(
+        &["truth", "cornell", "--spp", "1", "--size", "8x8", "--table", p, "--out", o.to_str().unwrap()],
+        &["zeros.coeff", "ΔE2000"],
+    );
+    assert!(!o.exists());
+    let out = spectra(&["upsample", "0.8", "0.2", "0.1", "--table", p]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let warning: Vec<&str> = err.lines().filter(|l| l.starts_with("warning")).collect();
+    assert_eq!(warning.len(), 1, "{err}");
+    assert!(warning[0].contains("zeros.coeff") && warning[0].contains("mean ΔE2000"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

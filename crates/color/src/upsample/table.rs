@@ -132,6 +132,21 @@ impl CoeffTable {
                 ),
             ));
         }
+        // The brightness axis covers the cube up to its brightest node, 1, in every table of
+        // the format (rgb2spec's and ours). One that stops short is damaged, or was read with a
+        // smaller resolution than it was written with.
+        let last = self.scale[self.res - 1];
+        if (last - 1.0).abs() > 1e-6 {
+            return Err(table_err(
+                origin,
+                format!(
+                    "scale must end at 1, but scale[{}] = {last} (is the header's resolution, {}, the \
+                     one the table was written with?)",
+                    self.res - 1,
+                    self.res
+                ),
+            ));
+        }
         if self.chroma.len() != self.res {
             return Err(table_err(
                 origin,
@@ -699,5 +714,12 @@ mod tests {
         let mut b = good;
         b[16..20].copy_from_slice(&f32::INFINITY.to_le_bytes());
         assert!(err(&b).contains("scale[2]"));
+        // A header that understates the resolution: the first nodes of the brightness axis
+        // increase but stop short of 1, and what follows is read as the rest of the table
+        // (the longer file's tail passes for a trailer). It loaded before.
+        let mut b = synthetic(6).to_bytes();
+        b[4..8].copy_from_slice(&3u32.to_le_bytes());
+        let s = err(&b);
+        assert!(s.contains("scale must end at 1") && s.contains("resolution, 3,"), "{s}");
     }
 }

@@ -275,7 +275,8 @@ pub struct SpectrumArgs {
     /// Wavelength range in nm, MIN:MAX (default: the scene's, else 380:730).
     #[arg(long, value_name = "MIN:MAX")]
     pub range: Option<String>,
-    /// Observer: cie1931 or cie1964 (default: the scene's, else cie1931).
+    /// Observer: a name `spectra observers` lists (cie1931, cie1964, a camera) or a sensitivity
+    /// file, CSV or rawtoaces JSON (docs/cameras.md; default: the scene's, else cie1931).
     #[arg(long)]
     pub observer: Option<String>,
     /// Scene white, the reference of the XYZ normalisation and of RGB emission: an illuminant

@@ -62,6 +62,11 @@ fn upsampler(a: &Args, space: &RgbColorSpace) -> Result<Box<dyn Upsampler>> {
     match (&a.table, m) {
         (Some(p), Method::Jakob) => {
             let t = CoeffTable::read(p)?;
+            // This command measures tables, so a bad one is measured, not refused (render and
+            // truth refuse it) — but said so first, before any spectrum it prints.
+            if let Err(e) = color::upsample::cache::check_usable(&t, space) {
+                eprintln!("warning: --table {}: {e}", p.display());
+            }
             Ok(Box::new(method::Jakob(Arc::new(t))))
         }
         (Some(_), _) => bail!("--table only applies to --method jakob"),
