@@ -206,6 +206,15 @@ fn outputs_never_overwrite_inputs_each_other_or_devices() {
     );
     refused(&["truth", &g, "--size", "8x8", "--spp", "1", "--out", &texture], &["file the scene references"]);
     refused(&["bench", &g, "--size", "8x8", "--frames", "1", "--csv", &g], &["--csv", "scene file"]);
+    // The suite's asset too, with what it references (its buffer was overwritten by the CSV).
+    let buffer = p("quad.bin");
+    let buffer_before = std::fs::read(&buffer).unwrap();
+    let suite =
+        ["bench", "--suite", "--suite-asset", &g, "--suite-sizes", "8x8", "--frames", "1", "--warmup", "0"];
+    refused(&[&suite[..], &["--csv", &buffer]].concat(), &["--csv", "--suite-asset references", "quad.bin"]);
+    refused(&[&suite[..], &["--markdown", &texture]].concat(), &["--markdown", "base.png"]);
+    refused(&[&suite[..], &["--csv", &g]].concat(), &["--csv", "--suite-asset"]);
+    assert_eq!(std::fs::read(&buffer).unwrap(), buffer_before);
     assert_eq!(std::fs::read(&texture).unwrap(), texture_before);
     let env = p("sky.exr");
     compare::io::write_image(

@@ -251,7 +251,21 @@ pub fn run(args: Args) -> Result<()> {
         crate::cmd::check_output("--markdown", path)?;
     }
     let mut inputs = args.table.input_files();
-    inputs.extend(args.suite_asset.iter().map(|a| ("--suite-asset".to_string(), a.clone())));
+    if let Some(asset) = &args.suite_asset {
+        // The asset and every file it references (buffers, textures, its environment), so
+        // that no table is written over one of them; loaded again, with its warnings, when
+        // its turn comes.
+        let path = asset.to_string_lossy();
+        let scene = args.files.load(&path).with_context(|| format!("--suite-asset {path}"))?;
+        inputs.extend(scene.inputs.iter().enumerate().map(|(i, p)| {
+            let what = if i == 0 {
+                "--suite-asset".to_string()
+            } else {
+                format!("file --suite-asset references ({})", p.display())
+            };
+            (what, p.clone())
+        }));
+    }
     crate::cmd::check_outputs(
         &[("--csv", args.csv.as_deref()), ("--markdown", args.markdown.as_deref())],
         &inputs,
