@@ -561,3 +561,25 @@ fn a_thin_pane_lit_from_behind_glows_as_in_truth() {
         let _ = std::fs::remove_dir_all(&d);
     }
 }
+
+/// A scene lit below the half-float HDR target's range renders banded or black in real time;
+/// `render` says so (it used to write the black image silently), and not for a lit scene.
+#[test]
+fn a_scene_too_dim_for_the_hdr_target_is_warned_about() {
+    let d = dir("dim");
+    let mut s = scene::builtin("cornell").unwrap();
+    for l in &mut s.lights {
+        l.emission.intensity *= 1e-9;
+    }
+    for m in &mut s.materials {
+        m.emissive *= 1e-9;
+    }
+    let dim = p(&d, "dim.gltf");
+    scene::write_gltf(&s, Path::new(&dim)).unwrap();
+    for (scene, dim_expected) in [(dim.as_str(), true), ("cornell", false)] {
+        let out = spectra(&["render", scene, "--size", "16x12", "--env", "none", "--out", &p(&d, "o.exr")]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.contains("half-float"), dim_expected, "{scene}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

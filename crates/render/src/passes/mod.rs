@@ -37,6 +37,31 @@ pub const HDR_MAX: f32 = 65504.0;
 pub fn hdr_clipped(pixels: &[[f32; 4]]) -> usize {
     pixels.iter().filter(|p| p[..3].iter().any(|c| c.abs() >= HDR_MAX)).count()
 }
+/// The smallest normal value of [`HDR_FORMAT`], 2⁻¹⁴: below it a half float keeps fewer
+/// significant bits the smaller the value, and below 2⁻²⁴ (6·10⁻⁸) none.
+pub const HDR_MIN_NORMAL: f32 = 6.103_515_6e-5;
+
+/// The brightest channel of a read-back HDR image when even it lies below [`HDR_MIN_NORMAL`]
+/// (the whole image quantised to a few levels, or 0), for the caller to warn about: exposure
+/// applied after the read-back cannot bring back what the target did not store. `None` for an
+/// image with a brighter pixel, or none.
+pub fn hdr_too_dim(pixels: &[[f32; 4]]) -> Option<f32> {
+    let max =
+        pixels.iter().flat_map(|p| &p[..3]).filter(|c| c.is_finite()).fold(0.0f32, |m, c| m.max(c.abs()));
+    (!pixels.is_empty() && max < HDR_MIN_NORMAL).then_some(max)
+}
+
+#[test]
+fn dim_images_are_told_from_lit_ones() {
+    assert_eq!(hdr_too_dim(&[]), None);
+    assert_eq!(hdr_too_dim(&[[0.0; 4]; 3]), Some(0.0));
+    assert_eq!(hdr_too_dim(&[[1e-7, 0.0, 3e-5, 1.0], [0.0; 4]]), Some(3e-5));
+    assert_eq!(hdr_too_dim(&[[1e-7, 0.0, 3e-5, 1.0], [0.0, 0.5, 0.0, 1.0]]), None);
+    assert_eq!(hdr_too_dim(&[[HDR_MIN_NORMAL, 0.0, 0.0, 1.0]]), None);
+    // The constant is the format's: 2⁻¹⁴ is a normal half float, the next value down is not.
+    assert_eq!(HDR_MIN_NORMAL, 2f32.powi(-14));
+}
+
 /// G-buffer colour targets: base colour + metallic, normal + roughness + the material's slot
 /// (packed: `gbuffer_pack_normal` in wgsl/common.wgsl), emission. The slot (the material's
 /// index + 1, 0 where no surface is) is 16 bits, so a scene has at most

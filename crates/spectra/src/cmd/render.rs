@@ -146,8 +146,22 @@ fn render_frame(
     // Linear outputs hold the HDR values themselves, so their clipping is worth a warning (a PNG
     // is tone mapped: a clipped pixel is white either way).
     let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
-    let hdr = if linear_out { read_linear(r, samples)? } else { Vec::new() };
-    let clipped = render::passes::hdr_clipped(&hdr);
+    let hdr = read_linear(r, samples)?;
+    if let Some(max) = render::passes::hdr_too_dim(&hdr) {
+        let what = if max > 0.0 {
+            format!("the brightest pixel is {max:.2e}")
+        } else {
+            "every pixel is 0".to_string()
+        };
+        eprintln!(
+            "warning: {what}, below the smallest normal value of the real-time renderer's half-float \
+             target ({:.1e}; nothing below 6e-8 is kept): the image is banded or black, and --exposure, \
+             applied afterwards, cannot bring it back; raise the scene's light instead (its intensities, \
+             --env-intensity) — spectra truth has no such floor",
+            render::passes::HDR_MIN_NORMAL
+        );
+    }
+    let clipped = if linear_out { render::passes::hdr_clipped(&hdr) } else { 0 };
     if clipped > 0 {
         eprintln!(
             "warning: {clipped} pixels reached the HDR target's largest value ({}) and are clipped there; \
