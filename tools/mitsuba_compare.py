@@ -69,6 +69,8 @@ def mitsuba_scene(export_dir, spp, seed_offset=0):
             # before issue 28 have none: Mitsuba's default, 0.01, is the glTF importer's).
             # Mitsuba refuses 0 (glTF allows it for orthographic cameras, not exported).
             "near_clip": max(cam.get("near_clip", 0.01), 1e-6),
+            # And the far plane (exports before session 35 have none: Mitsuba's default).
+            "far_clip": cam.get("far_clip", 1e4),
             "to_world": mi.ScalarTransform4f().look_at(origin=cam["origin"], target=cam["target"], up=cam["up"]),
             "film": {
                 "type": "hdrfilm",

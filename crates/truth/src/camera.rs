@@ -3,8 +3,8 @@
 //! orthographic projection (glTF `orthographic`: parallel rays along −Z).
 //!
 //! Rays start at the eye (orthographic: on the camera's plane), so a medium around the camera
-//! attenuates and scatters over the whole view ray; the near plane clips *surfaces* only
-//! ([`CameraRay::t_near`]), as the rasteriser's clipping does.
+//! attenuates and scatters over the whole view ray; the near and far planes clip *surfaces*
+//! only ([`CameraRay::t_near`], [`CameraRay::t_far`]), as the rasteriser's clipping does.
 
 use glam::{Vec2, Vec3};
 use scene::Camera;
@@ -22,17 +22,22 @@ pub struct RayCamera {
     /// scale, as the rasteriser's view matrix applies it): surfaces in front of it are not seen,
     /// so geometry the rasteriser clips (a cockpit around the camera) is not seen here either.
     near: f32,
+    /// Distance along `forward` of the far clipping plane (glTF `zfar`, likewise): surfaces
+    /// beyond it are not seen, the background is, as in the rasteriser.
+    far: f32,
     width: f32,
     height: f32,
 }
 
 /// A camera ray: from the eye (or the orthographic camera's plane) along the unit direction
-/// `d`; surfaces closer than `t_near` along it are clipped by the near plane, media are not.
+/// `d`; surfaces closer than `t_near` or farther than `t_far` along it are clipped by the near
+/// and far planes, media are not.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRay {
     pub o: Vec3,
     pub d: Vec3,
     pub t_near: f32,
+    pub t_far: f32,
 }
 
 impl RayCamera {
@@ -48,9 +53,12 @@ impl RayCamera {
             Some((_, ymag)) => (ymag.abs(), true),
             None => ((cam.yfov * 0.5).tan(), false),
         };
-        let near = cam.clip_near().max(0.0) * t.transform_vector3(-Vec3::Z).length();
+        let scale = t.transform_vector3(-Vec3::Z).length();
+        let near = cam.clip_near().max(0.0) * scale;
+        let far = cam.zfar * scale;
         RayCamera {
             near: if near.is_finite() { near } else { 0.0 },
+            far: if far > near { far } else { f32::INFINITY },
             origin: t.transform_point3(Vec3::ZERO),
             right: t.transform_vector3(Vec3::X).normalize() * half_h * aspect,
             up: t.transform_vector3(Vec3::Y).normalize() * half_h,
@@ -66,11 +74,17 @@ impl RayCamera {
         let x = 2.0 * p.x / self.width - 1.0;
         let y = 1.0 - 2.0 * p.y / self.height;
         if self.ortho {
-            CameraRay { o: self.origin + self.right * x + self.up * y, d: self.forward, t_near: self.near }
+            CameraRay {
+                o: self.origin + self.right * x + self.up * y,
+                d: self.forward,
+                t_near: self.near,
+                t_far: self.far,
+            }
         } else {
             let d = (self.forward + self.right * x + self.up * y).normalize();
-            // The near plane is a plane: farther along the oblique rays.
-            CameraRay { o: self.origin, d, t_near: self.near / d.dot(self.forward) }
+            // The clipping planes are planes: farther along the oblique rays.
+            let k = d.dot(self.forward);
+            CameraRay { o: self.origin, d, t_near: self.near / k, t_far: self.far / k }
         }
     }
 }
@@ -110,7 +124,7 @@ mod tests {
         cam.znear = 0.0;
         let c = RayCamera::new(&cam, 200, 100);
         for p in [Vec2::ZERO, Vec2::new(200.0, 100.0), Vec2::new(37.0, 81.0), Vec2::new(100.0, 50.0)] {
-            let CameraRay { o, d, t_near } = c.ray(p);
+            let CameraRay { o, d, t_near, .. } = c.ray(p);
             assert!((d - (-Vec3::Z)).length() < 1e-6, "{d}");
             assert!((o.z - 5.0).abs() < 1e-5);
             assert_eq!(t_near, 0.0);

@@ -215,6 +215,7 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
             "fov_y_deg": cam.yfov.to_degrees(),
             // Surfaces nearer than this along the view axis are clipped, as `RayCamera` does.
             "near_clip": cam.clip_near().max(0.0) * cam.transform.transform_vector3(-Vec3::Z).length(),
+            "far_clip": cam.zfar * cam.transform.transform_vector3(-Vec3::Z).length(),
         },
         "materials": materials, "meshes": meshes, "lights": lights,
         "medium": world.medium.is_some(),

@@ -177,21 +177,24 @@ impl Integrator<'_, '_> {
 
     /// Radiance arriving at `o` from direction `-d` at the four wavelengths `wl`.
     pub fn radiance(&self, o: Vec3, d: Vec3, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
-        self.clipped_radiance(o, d, 0.0, wl, rng)
+        self.clipped_radiance(o, d, 0.0, f32::INFINITY, wl, rng)
     }
 
-    /// Radiance along a camera ray: the near plane clips the surfaces in front of it (as the
-    /// rasteriser's clipping does), not the medium, which attenuates and scatters from the eye.
+    /// Radiance along a camera ray: the near and far planes clip the surfaces in front of and
+    /// beyond them (as the rasteriser's clipping does), not the medium, which attenuates and
+    /// scatters from the eye.
     pub fn camera_radiance(&self, ray: CameraRay, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
-        self.clipped_radiance(ray.o, ray.d, ray.t_near, wl, rng)
+        self.clipped_radiance(ray.o, ray.d, ray.t_near, ray.t_far, wl, rng)
     }
 
-    /// [`Self::radiance`] with surfaces closer than `t_near` along the first segment ignored.
+    /// [`Self::radiance`] with surfaces closer than `t_near` or farther than `t_far` along the
+    /// first segment ignored.
     fn clipped_radiance(
         &self,
         mut o: Vec3,
         mut d: Vec3,
         mut t_near: f32,
+        mut t_far: f32,
         wl: &Wavelengths,
         rng: &mut Sampler,
     ) -> Vec4 {
@@ -216,12 +219,13 @@ impl Integrator<'_, '_> {
         loop {
             let hit = if t_near > 0.0 {
                 // Traced from the near plane, with distances still counted from the eye.
-                w.intersect(o + d * t_near, d, f32::INFINITY, w.ray_key(rng))
+                w.intersect(o + d * t_near, d, t_far - t_near, w.ray_key(rng))
                     .map(|h| Hit { t: h.t + t_near, ..h })
             } else {
-                w.intersect(o, d, f32::INFINITY, w.ray_key(rng))
+                w.intersect(o, d, t_far, w.ray_key(rng))
             };
             t_near = 0.0;
+            t_far = f32::INFINITY;
             let mut t_hit = hit.map_or(f32::INFINITY, |h| h.t);
             // Inside an absorbing volume: Beer's law per lane up to the next surface (the same
             // for every lane's pdf, so only `f` changes).
@@ -334,10 +338,18 @@ impl Integrator<'_, '_> {
                 };
                 radiance += f / mean(p) * le * mis;
             }
-            if (self.direct_only && bounces >= 1) || depth + 1 > self.max_depth {
+            let mat = &w.scene.materials[s.material];
+            // Past a direct-only path's one bounce, light still reaches it through see-through
+            // surfaces: refractions are not bounces on the light's side either (as on the
+            // camera's). The path goes on through transmissions only — a reflection would be a
+            // second bounce — until it meets an emitter or the sky. Only where the scene has
+            // light a path can meet: punctual lights cannot be hit.
+            let passing = self.direct_only && bounces >= 1;
+            if (passing && (self.lambert || mat.transmission.is_none() || !w.has_light_to_meet()))
+                || depth + 1 > self.max_depth
+            {
                 break;
             }
-            let mat = &w.scene.materials[s.material];
             if mat.unlit {
                 // Unlit surfaces reflect nothing: the path ends in their colour.
                 break;
@@ -396,7 +408,9 @@ impl Integrator<'_, '_> {
                 };
             let vtx = Vertex::Surface { brdf, frame, ng, glass };
 
-            radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);
+            if !passing {
+                radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);
+            }
 
             let lo = frame.to_local(wo);
             let (wi, crossed) = if let Some((d, wt)) = glass {
@@ -412,7 +426,7 @@ impl Integrator<'_, '_> {
                     let Some(x) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
                     (frame.to_world(x.wi), false)
                 };
-                if (ng.dot(wi) <= 0.0) != crossed {
+                if (ng.dot(wi) <= 0.0) != crossed || (passing && !crossed) {
                     break;
                 }
                 if let Some(weight) = delta {
@@ -428,10 +442,15 @@ impl Integrator<'_, '_> {
                         break;
                     }
                     f *= fv / pdf;
-                    prev_pdf = pdf;
+                    // Passing through, this vertex sampled no light, so what the path meets
+                    // next has full weight.
+                    prev_pdf = if passing { 0.0 } else { pdf };
                 }
                 (wi, crossed)
             } else {
+                if passing {
+                    break;
+                }
                 let Some(bs) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
                 let wi = frame.to_world(bs.wi);
                 if ng.dot(wi) <= 0.0 {

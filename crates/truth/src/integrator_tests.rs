@@ -573,3 +573,75 @@ fn env_volume_furnace_returns_the_emission() {
     });
     assert_within(m, se, spectrum_at(&d65(), &wl), "volume furnace under the environment map");
 }
+
+/// Fresnel reflectance of unpolarised light at a smooth interface from air into index `n`,
+/// written out here (Born & Wolf) rather than taken from the tracer.
+fn fresnel_from_air(cos_i: f64, n: f64) -> f64 {
+    let sin_t = (1.0 - cos_i * cos_i).sqrt() / n;
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+    let rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Direct light that arrives through glass: a mirror floor under a smooth glass sheet (thin
+/// walled) or slab (a volume 0.2 thick), in a uniform white sky, seen from between the two.
+/// The mirror reflects the view up through the glass: one bounce, so direct light. Refractions
+/// are not bounces, so the direct-only path follows the refraction out to the sky: Le·(1 − F)
+/// through the sheet (its transmission is 1 − F, straight on), Le·(1 − F)² through the slab
+/// (in and out at the same angle outside, internal reflections being bounces). The shadow ray
+/// of light sampling stops at glass, so this was black when the path ended at its bounce.
+#[test]
+fn direct_light_through_glass_after_the_bounce() {
+    use scene::transmission::{Transmission, Volume};
+    let glass = |volume: Option<Volume>| Material {
+        roughness: 0.0,
+        metallic: 0.0,
+        ior: 1.5,
+        double_sided: true,
+        transmission: Some(Transmission { factor: 1.0, texture: None, volume, dispersion: 0.0 }),
+        ..Default::default()
+    };
+    let mirror = Material { metallic: 1.0, roughness: 0.0, ..Default::default() };
+    let slab = Volume {
+        thickness: 0.2,
+        thickness_texture: None,
+        attenuation_color: [1.0; 3],
+        attenuation_distance: f32::INFINITY,
+    };
+    let cases = [
+        ("sheet", vec![quad(Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 50.0, 1)], glass(None), 1),
+        (
+            "slab",
+            vec![
+                quad(Vec3::new(0.0, 1.2, 0.0), Vec3::Y, 50.0, 1),
+                quad(Vec3::new(0.0, 1.0, 0.0), -Vec3::Y, 50.0, 1),
+            ],
+            glass(Some(slab)),
+            2,
+        ),
+    ];
+    for (name, mut meshes, material, interfaces) in cases {
+        meshes.push(quad(Vec3::ZERO, Vec3::Y, 50.0, 0));
+        let scene = with_env(
+            scene_with(meshes, vec![mirror.clone(), material], vec![]),
+            scene::Environment::uniform(Vec3::ONE),
+        );
+        let range = WavelengthRange::VISIBLE;
+        let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap();
+        let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.35);
+        let le = spectrum_at(&d65(), &wl);
+        for theta in [0.2f32, 0.9] {
+            let d = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+            let o = Vec3::new(0.0, 0.5, 0.0) - d * 0.5;
+            let t = 1.0 - fresnel_from_air(f64::from(theta.cos()), 1.5);
+            let want = t.powi(interfaces) as f32;
+            let integ = Integrator { world: &world, direct_only: true, max_depth: 100, lambert: false };
+            let (m, se) = estimate(40_000, |rng| radiance_any_hero(&integ, o, d, &wl, rng));
+            println!("{name}, θ = {theta}: {:.5} ± {:.5} (want {want:.5})", mean(m / le), mean(se / le));
+            // The mirror's GGX lobe at the smallest roughness is ~10⁻³ wide and reflects a
+            // little under 1: 0.5 % of slack.
+            assert!((mean(m / le) - want).abs() < 0.005 + 5.0 * mean(se / le), "{name}, θ = {theta}");
+        }
+    }
+}

@@ -140,3 +140,31 @@ fn surfaces_in_front_of_the_near_plane_are_clipped() {
     assert!(clipped < 1e-3 * no_quad, "the clipped quad's shadow on the floor: {clipped} vs {no_quad}");
     assert!(seen > 0.1 * no_quad, "the quad's lit top behind the near plane: {seen} vs {no_quad}");
 }
+
+/// The far plane clips surfaces as the rasteriser's does (the tracer ignored `zfar`, so a file
+/// whose far plane cut its scene short drew it whole): a black floor 2 below a camera looking
+/// down, in a white sky, is the sky once zfar is nearer than the floor.
+#[test]
+fn the_far_plane_clips_surfaces_as_the_rasteriser_does() {
+    let black = Material { base_color: Vec4::new(0.0, 0.0, 0.0, 1.0), ..Default::default() };
+    let mut scene = scene_with(vec![quad(Vec3::ZERO, Vec3::Y, 50.0, 0)], vec![black], vec![]);
+    scene.camera = Camera::look_at(Vec3::new(0.0, D, 0.0), Vec3::ZERO, Vec3::Z, 0.5);
+    let wl = Wavelengths(Vec4::new(450.0, 520.0, 580.0, 650.0));
+    let sky = Vec4::from_array(wl.0.to_array().map(|l| d65().eval(f64::from(l)) as f32));
+    for (zfar, want) in [(1.5, sky), (D * 1.5, Vec4::ZERO)] {
+        scene.camera.zfar = zfar;
+        let world = World::new(&scene, &GreyOnly, &d65(), WavelengthRange::VISIBLE, None)
+            .unwrap()
+            .with_environment(&d65());
+        let integ = Integrator { world: &world, direct_only: true, max_depth: 4, lambert: true };
+        let cam = RayCamera::new(&scene.camera, 8, 8);
+        for p in [Vec2::new(4.0, 4.0), Vec2::new(0.5, 7.5)] {
+            let ray = cam.ray(p);
+            let got = integ.camera_radiance(ray, &wl, &mut Sampler::new(1, 0));
+            assert!(
+                (got - want).abs().max_element() <= 1e-4 * sky.max_element(),
+                "zfar {zfar}: {got} vs {want}"
+            );
+        }
+    }
+}

@@ -167,6 +167,16 @@ impl<'s> World<'s> {
         })
     }
 
+    /// Whether a path can meet light by itself: emitting or unlit surfaces, an environment, the
+    /// sky through a water surface. Punctual lights are found by light sampling only.
+    pub fn has_light_to_meet(&self) -> bool {
+        self.environment.is_some()
+            || self.env_map.is_some()
+            || self.surface.as_ref().is_some_and(|s| s.sky.is_some())
+            || !self.emitters.is_empty()
+            || self.scene.materials.iter().any(|m| m.unlit)
+    }
+
     /// Surrounds the scene with a uniform background radiance `s(λ)` in tracer units (a
     /// spectrum equal to the scene white has Y = 1). Reached by BRDF/phase sampling only.
     /// This is the classic white-furnace illumination, and a flat sky.
