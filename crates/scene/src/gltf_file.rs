@@ -250,7 +250,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         if let (Some(cam), None) = (node.camera(), &camera) {
             let (c, warning) = camera_of(ctx, &cam, world)?;
             warnings.extend(warning);
-            camera = Some(c);
+            camera = Some((c, cam.index()));
         }
         if let Some(light) = node.light() {
             let (l, stand_in) = light_of(ctx, &light, &node, world)?;
@@ -281,7 +281,13 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         // glTF's default material: white, fully rough, dielectric, single-sided.
         materials.push(Material { name: "default".into(), double_sided: false, ..Material::default() });
     }
-    let camera = camera.unwrap_or_else(|| Camera::framing(crate::framing::bounds(&meshes)));
+    let camera = match camera {
+        Some((mut c, index)) => {
+            warnings.extend(fit_clip_planes(&mut c, &meshes, &format!("cameras[{index}]")));
+            c
+        }
+        None => Camera::framing(crate::framing::bounds(&meshes)),
+    };
     let mut scene = Scene {
         warnings,
         source: ctx.path.display().to_string(),
@@ -459,10 +465,13 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
                     ),
                 ));
             }
-            if !(znear >= 0.0 && zfar.is_finite() && zfar > znear) {
+            if !((0.0..crate::MAX_CLIP_DISTANCE).contains(&znear) && zfar.is_finite() && zfar > znear) {
                 return Err(ctx.invalid(
                     format!("{at}.orthographic"),
-                    format!("needs 0 ≤ znear < zfar, finite, got znear {znear}, zfar {zfar}"),
+                    format!(
+                        "needs 0 ≤ znear < zfar, finite, znear below {:e}, got znear {znear}, zfar {zfar}",
+                        crate::MAX_CLIP_DISTANCE
+                    ),
                 ));
             }
             let warning = (xmag < 0.0 || ymag < 0.0).then(|| {
@@ -487,6 +496,15 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
             format!("needs {:e} ≤ yfov < π and znear > 0, got yfov {yfov}, znear {znear}", crate::MIN_YFOV),
         ));
     }
+    if znear >= crate::MAX_CLIP_DISTANCE {
+        return Err(ctx.invalid(
+            at,
+            format!(
+                "znear {znear:e} clips everything: nothing in a scene lies that far (coordinates within ±{:e})",
+                crate::MAX_COORDINATE
+            ),
+        ));
+    }
     let zfar = p.zfar().unwrap_or(1.0e4);
     if zfar.partial_cmp(&znear) != Some(std::cmp::Ordering::Greater) {
         return Err(ctx.invalid(at, format!("zfar {zfar} must exceed znear {znear}")));
@@ -495,15 +513,53 @@ fn camera_of(ctx: &Ctx, cam: &gltf::Camera, world: Mat4) -> Result<(Camera, Opti
     if aspect.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
         return Err(ctx.invalid(at, "aspectRatio must be positive"));
     }
-    let camera = Camera { ortho: None, transform, yfov, znear, zfar, aspect };
-    let warning = (camera.clip_near() > znear).then(|| {
-        format!(
-            "{at}: znear {znear} is below zfar {zfar} × {:e}, more than a depth buffer resolves; both renderers clip at {}",
-            crate::MIN_NEAR_FAR_RATIO,
-            camera.clip_near()
-        )
+    Ok((Camera { ortho: None, transform, yfov, znear, zfar, aspect }, None))
+}
+
+/// The far plane both renderers clip at, where the file's cannot be drawn as it is: beyond
+/// [`crate::MAX_CLIP_DISTANCE`] (nothing can lie so far: it is drawn there), and for a
+/// perspective camera whose znear is below zfar × [`crate::MIN_NEAR_FAR_RATIO`], more than a
+/// depth buffer resolves, at the scene's farthest point (or znear / that ratio, if farther), so
+/// that the near plane need not move. Nothing that lies before the file's far plane is lost
+/// then, and no warning is due; where the scene reaches farther than a depth buffer allows, the
+/// near plane moves out instead, with a warning (`at` names the camera).
+fn fit_clip_planes(camera: &mut Camera, meshes: &[crate::Mesh], at: &str) -> Option<String> {
+    camera.zfar = camera.zfar.min(crate::MAX_CLIP_DISTANCE);
+    if camera.ortho.is_some() || camera.clip_near() <= camera.znear {
+        return None;
+    }
+    let eye = camera.position();
+    let reach = crate::framing::bounds(meshes).map_or(0.0, |(lo, hi)| {
+        (0..8)
+            .map(|i| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]))
+            .map(|c| c.distance(eye))
+            .fold(0.0f32, f32::max)
     });
-    Ok((camera, warning))
+    // A margin for the rounding of depth near the far plane.
+    let fitted = (reach * 1.01).max(camera.znear / crate::MIN_NEAR_FAR_RATIO);
+    let zfar = camera.zfar;
+    camera.zfar = zfar.min(fitted);
+    (camera.clip_near() > camera.znear).then(|| {
+        format!(
+            "{at}: znear {} is below {:e} × the distance to the scene's farthest point ({}), more than a \
+             depth buffer resolves; both renderers clip at {}",
+            short(camera.znear),
+            crate::MIN_NEAR_FAR_RATIO,
+            short(camera.zfar),
+            short(camera.clip_near())
+        )
+    })
+}
+
+/// A distance for a message: four decimals where that reads well, else four digits and an
+/// exponent.
+fn short(x: f32) -> String {
+    if x == 0.0 || (1e-3..1e5).contains(&x.abs()) {
+        let s = format!("{x:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{x:.3e}")
+    }
 }
 
 fn light_of(

@@ -507,6 +507,11 @@ pub const MIN_YFOV: f32 = 1e-5;
 /// to span ±10¹⁰ units as at its own size (ΔE2000 ≤ 0.005 in every pixel; docs/scene-format.md
 /// gives the commands): the bound leaves a factor 10.
 pub const MAX_COORDINATE: f32 = 1e9;
+/// The farthest clipping distance the renderers draw, in scene units: farther than any two
+/// points of a scene can lie apart (2√3 × [`MAX_COORDINATE`]), and far enough below f32's
+/// range that a point on the far plane can be squared (its distance to the eye). A file's
+/// larger zfar is drawn here (nothing is lost); a larger znear is refused.
+pub const MAX_CLIP_DISTANCE: f32 = 1e10;
 /// Largest |normalTexture.scale| accepted.
 pub const MAX_NORMAL_SCALE: f32 = 1000.0;
 

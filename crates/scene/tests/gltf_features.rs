@@ -667,27 +667,46 @@ fn orthographic_cameras_are_read() {
 }
 
 /// A near plane far smaller than the far plane is more than a depth buffer resolves (issue 29:
-/// znear 1e-6 rendered wrong in real time, 1e-8 black): both renderers clip at zfar × 1e-6,
-/// with a warning naming the camera; at the ratio the built-ins use nothing changes.
+/// znear 1e-6 rendered wrong in real time, 1e-8 black). The far plane is drawn at the scene's
+/// farthest point then (nothing lies beyond it), and only where that is still too far for the
+/// near plane do both renderers clip at zfar × 1e-6, with a warning naming the camera; at the
+/// ratio the built-ins use nothing changes. A far plane beyond anything a scene can hold (1e20
+/// made every real-time pixel one grey: its squared distance left f32) is drawn at 1e10; a near
+/// plane there is refused.
 #[test]
 fn tiny_near_planes_are_raised_for_both_renderers_with_a_warning() {
     let mut b = Bin::default();
     let pos = b.triangle();
-    let cam = |znear: f64, yfov: f64| json!([{"type": "perspective", "perspective": {"yfov": yfov, "znear": znear, "zfar": 1000}}]);
+    let cam = |znear: f64, zfar: f64, yfov: f64| json!([{"type": "perspective", "perspective": {"yfov": yfov, "znear": znear, "zfar": zfar}}]);
     let mut doc = b.finish(json!({
         "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
-        "cameras": cam(1e-8, 0.8),
+        "cameras": cam(1e-8, 1000.0, 0.8),
     }));
+    // The farthest corner of the triangle's bounds, (1, 1, 0), from the camera at z = 3.
+    let reach = 11f32.sqrt();
     let s = load(&doc).unwrap();
     assert_eq!(s.camera.znear, 1e-8);
-    assert!((s.camera.clip_near() - 1e-3).abs() < 1e-9, "{}", s.camera.clip_near());
+    assert!((s.camera.zfar - 1.01 * reach).abs() < 1e-5, "{} vs {reach}", s.camera.zfar);
+    assert!((s.camera.clip_near() - 1.01e-6 * reach).abs() < 1e-9, "{}", s.camera.clip_near());
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings[0].contains("cameras[0]") && s.warnings[0].contains("znear"), "{:?}", s.warnings);
-    doc["cameras"] = cam(0.01, 0.8);
+    // Fitting the far plane is enough: no near plane moves, no warning.
+    for (znear, zfar) in [(1e-4, 1e9), (0.01, 1e20), (0.01, 1e38)] {
+        doc["cameras"] = cam(znear, zfar, 0.8);
+        let s = load(&doc).unwrap();
+        assert!(s.warnings.is_empty(), "{znear} {zfar}: {:?}", s.warnings);
+        assert_eq!(s.camera.clip_near(), znear as f32);
+        let want = (znear / 1e-6).max(1.01 * f64::from(reach));
+        assert!((f64::from(s.camera.zfar) / want - 1.0).abs() < 1e-6, "{znear} {zfar}: {}", s.camera.zfar);
+    }
+    // Unchanged at a ratio a depth buffer resolves.
+    doc["cameras"] = cam(0.01, 1000.0, 0.8);
     let s = load(&doc).unwrap();
-    assert!(s.warnings.is_empty() && s.camera.clip_near() == 0.01);
-    doc["cameras"] = cam(0.01, 1e-30);
+    assert!(s.warnings.is_empty() && s.camera.clip_near() == 0.01 && s.camera.zfar == 1000.0);
+    doc["cameras"] = cam(1e30, 1e38, 0.8);
+    assert_has(&error(&doc), &["cameras[0]", "znear 1e30", "clips everything"]);
+    doc["cameras"] = cam(0.01, 1000.0, 1e-30);
     assert_has(&error(&doc), &["cameras[0]", "yfov"]);
 }
 
