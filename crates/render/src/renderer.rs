@@ -510,7 +510,7 @@ impl Renderer {
         let max = self.gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(RenderError::Settings(format!(
-                "image size {width}×{height} must be between 1 and {max}"
+                "image size {width}×{height} must be between 1 and {max} a side (the device's largest texture)"
             )));
         }
         if self.targets.as_ref().is_some_and(|(t, _)| t.width == width && t.height == height) {

@@ -674,12 +674,23 @@ impl EnvironmentChoice {
             env.sun_light = !self.no_sun;
         }
         if !LightSources::of(scene).any() {
-            note = Some(format!(
-                "warning: nothing lights {}: it has no lights, no environment and no emissive surface bright \
-                 enough to light it, so the image will be (nearly) black (drop --env none, or give --env \
-                 FILE.hdr)",
-                scene.source
-            ));
+            // An environment scaled to nothing is there, and says so; otherwise there is none.
+            let scaled_out =
+                scene.environment.as_ref().filter(|e| e.intensity == 0.0).map(|e| e.source.clone());
+            note = Some(match scaled_out {
+                Some(source) => format!(
+                    "warning: nothing lights {}: it has no lights and no emissive surface bright enough to \
+                     light it, and its environment ({source}) is scaled to 0 by --env-intensity, so the \
+                     image will be (nearly) black",
+                    scene.source
+                ),
+                None => format!(
+                    "warning: nothing lights {}: it has no lights, no environment and no emissive surface \
+                     bright enough to light it, so the image will be (nearly) black (drop --env none, or give \
+                     --env FILE.hdr)",
+                    scene.source
+                ),
+            });
         }
         Ok(note)
     }

@@ -73,6 +73,21 @@ fn truth_stops_inside_a_pixel_at_a_huge_sample_count() {
     let cmd =
         spectra(&["truth", "cornell", "--spp", "100000000", "--size", "4x4", "--out", out.to_str().unwrap()]);
     interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
+    // With a truth cache that did not exist: no empty folder is left behind either.
+    let cache = dir.path().join("gt");
+    let cmd = spectra(&[
+        "truth",
+        "cornell",
+        "--spp",
+        "100000000",
+        "--size",
+        "4x4",
+        "--out",
+        out.to_str().unwrap(),
+        "--truth-cache",
+        cache.to_str().unwrap(),
+    ]);
+    interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
 }
 
 #[test]

@@ -583,3 +583,35 @@ fn a_scene_too_dim_for_the_hdr_target_is_warned_about() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// An environment scaled to nothing is named as the reason for the black image (the warning
+/// said the scene had no environment and suggested dropping `--env none`), and the HDR floor's
+/// warning does not follow it.
+#[test]
+fn an_environment_scaled_to_zero_is_the_reason_given() {
+    let d = dir("env-zero");
+    let mut s = scene::builtin("cornell").unwrap();
+    s.lights.clear();
+    for m in &mut s.materials {
+        m.emissive = glam::Vec3::ZERO;
+        m.emission_spectrum = None;
+    }
+    let unlit = p(&d, "unlit.gltf");
+    scene::write_gltf(&s, Path::new(&unlit)).unwrap();
+    let out = spectra(&[
+        "render",
+        &unlit,
+        "--size",
+        "16x12",
+        "--env",
+        "default",
+        "--env-intensity",
+        "-0",
+        "--out",
+        &p(&d, "o.exr"),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("scaled to 0 by --env-intensity") && !err.contains("drop --env none"), "{err}");
+    assert!(!err.contains("half-float") && !err.contains("× -0"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

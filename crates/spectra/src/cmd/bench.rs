@@ -153,10 +153,23 @@ impl Args {
     }
 }
 
+/// The items of a comma list given with `flag`, trimmed; an empty one (`1,,2`, `1,`) is refused
+/// rather than skipped, as a typo may hide there. None for a blank list.
+fn list_items<'a>(flag: &str, s: &'a str) -> Result<Vec<&'a str>> {
+    if s.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    let items: Vec<&str> = s.split(',').map(str::trim).collect();
+    if items.iter().any(|i| i.is_empty()) {
+        bail!("{flag} '{s}': an empty item in the list");
+    }
+    Ok(items)
+}
+
 /// Parses `midpoint,prefiltered` into rules.
 pub fn parse_rules(s: &str) -> Result<Vec<Quadrature>> {
     let mut out = Vec::new();
-    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+    for part in list_items("--quadrature", s)? {
         let q = Quadrature::parse(part).map_err(|e| anyhow!("--quadrature '{s}': {e}"))?;
         if !out.contains(&q) {
             out.push(q);
@@ -178,7 +191,7 @@ pub fn parse_counts(s: &str) -> Result<Vec<usize>> {
 pub fn parse_counts_for(flag: &str, s: &str) -> Result<Vec<usize>> {
     let max = render::settings::MAX_WAVELENGTHS;
     let mut out = Vec::new();
-    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+    for part in list_items(flag, s)? {
         let n: usize = part.parse().map_err(|_| anyhow!("{flag} '{s}': '{part}' is not a whole number"))?;
         if n == 0 || n > max {
             bail!("{flag} '{s}': {n} is outside 1..={max}");
@@ -507,7 +520,7 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(c) = custom {
         r.set_custom_shader(c)?;
     }
-    r.resize(width, height)?;
+    r.resize(width, height).map_err(|e| anyhow::anyhow!("--size {width}x{height}: {e}"))?;
     let load_before = load_average();
     let (has_ts, timing) = timing_of(&r);
     eprintln!(
@@ -600,7 +613,12 @@ mod tests {
         assert_eq!(parse_counts(" 4, 4,8 ").unwrap(), vec![4, 8]);
         assert!(parse_counts("0").unwrap_err().to_string().contains("outside"));
         assert!(parse_counts("4,x").unwrap_err().to_string().contains("'x'"));
-        assert!(parse_counts(",").unwrap_err().to_string().contains("at least one"));
+        assert!(parse_counts(" ").unwrap_err().to_string().contains("at least one"));
+        // An empty item is a typo's place, not skipped (1,,2 ran 1 and 2).
+        for s in [",", "1,,2", "1,2,"] {
+            assert!(parse_counts(s).unwrap_err().to_string().contains("empty item"), "{s}");
+        }
+        assert!(parse_rules("midpoint,,prefiltered").unwrap_err().to_string().contains("--quadrature"));
         assert!(Cli::try_parse_from(["bench", "cornell", "--frames", "-3"]).is_err());
     }
 

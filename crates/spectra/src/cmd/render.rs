@@ -133,7 +133,7 @@ fn render_frame(
     if let Some(c) = custom {
         r.set_custom_shader(c)?;
     }
-    r.resize(width, height)?;
+    r.resize(width, height).map_err(|e| anyhow!("--size {width}x{height}: {e}"))?;
     if args.spectral_out.is_some() {
         r.set_spectral_capture(true);
     }
@@ -147,7 +147,9 @@ fn render_frame(
     // is tone mapped: a clipped pixel is white either way).
     let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
     let hdr = read_linear(r, samples)?;
-    if let Some(max) = render::passes::hdr_too_dim(&hdr) {
+    // (A scene that nothing lights has had its own warning.)
+    let lit = scene::environment::LightSources::of(scene).any();
+    if let Some(max) = render::passes::hdr_too_dim(&hdr).filter(|_| lit) {
         let what = if max > 0.0 {
             format!("the brightest pixel is {max:.2e}")
         } else {
@@ -264,9 +266,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     });
     let under = match (&scene.environment, r.environment_residual()) {
         (Some(e), Some(res)) => {
-            format!("{under}, environment {} × {} (basis residual {res:.1e})", e.source, e.intensity)
+            format!("{under}, environment {} × {} (basis residual {res:.1e})", e.source, e.intensity + 0.0)
         }
-        (Some(e), None) => format!("{under}, environment {} × {}", e.source, e.intensity),
+        (Some(e), None) => format!("{under}, environment {} × {}", e.source, e.intensity + 0.0),
         (None, _) => under,
     };
     let under = match r.environment_sun() {
@@ -305,16 +307,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     let under = if args.samples > 1 { format!("{under}, {} samples per pixel", args.samples) } else { under };
+    // N and the range mean nothing to the RGB mode.
+    let spectrum = match settings.mode {
+        Mode::Rgb => String::new(),
+        _ => format!(" N={} {:.0}–{:.0} nm", settings.wavelengths, settings.range.min, settings.range.max),
+    };
     eprintln!(
-        "{}: {} {}×{}, {} N={} {:.0}–{:.0} nm{under}, on {}",
+        "{}: {} {}×{}, {}{spectrum}{under}, on {}",
         args.out.display(),
         scene.source,
         width,
         height,
         settings.mode.name(),
-        settings.wavelengths,
-        settings.range.min,
-        settings.range.max,
         r.gpu().describe()
     );
     Ok(())

@@ -473,9 +473,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     let (w, h) = s
         .split_once(['x', 'X', '*'])
         .ok_or_else(|| anyhow!("--size '{s}' must look like WIDTHxHEIGHT, e.g. 640x480"))?;
-    let num = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    let num = |v: &str| v.trim().parse::<u64>().ok().filter(|&n| n > 0);
     match (num(w), num(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
+        (Some(w), Some(h)) => match (u32::try_from(w), u32::try_from(h)) {
+            (Ok(w), Ok(h)) => Ok((w, h)),
+            _ => bail!("--size '{s}': {} is too large a side (a device draws at most 16384 or so)", w.max(h)),
+        },
         _ => bail!("--size '{s}': width and height must be positive integers"),
     }
 }
@@ -737,6 +740,8 @@ mod tests {
         assert!(parse_size("64").unwrap_err().to_string().contains("WIDTHxHEIGHT"));
         assert!(parse_size("0x10").unwrap_err().to_string().contains("positive"));
         assert!(parse_size("64,32").is_err());
+        // Too large for any device is said so, not called "not a positive integer".
+        assert!(parse_size("99999999999x1").unwrap_err().to_string().contains("99999999999 is too large"));
     }
 
     /// The flags win over the scene's `spectra` settings, which win over the defaults; an

@@ -653,7 +653,7 @@ pub fn run(a: Args) -> Result<()> {
     let paths = img.width as f64 * img.height as f64 * f64::from(st.spp - resumed);
     let y = img.mean()[1];
     let env = match &scene.environment {
-        Some(e) => format!(", environment {} × {}", e.source, e.intensity),
+        Some(e) => format!(", environment {} × {}", e.source, e.intensity + 0.0),
         None => String::new(),
     };
     eprintln!(

@@ -19,6 +19,18 @@ use truth::{Accumulator, Settings};
 /// A directory of stored truths.
 pub struct TruthCache {
     dir: PathBuf,
+    /// This run made the folder: it goes again if nothing was stored in it (an interrupted
+    /// first run left an empty folder behind).
+    made: bool,
+}
+
+impl Drop for TruthCache {
+    fn drop(&mut self) {
+        if self.made {
+            // Only an empty folder can be removed, so nothing stored is lost.
+            let _ = std::fs::remove_dir(&self.dir);
+        }
+    }
 }
 
 /// Where a render's sums start from.
@@ -38,9 +50,10 @@ impl TruthCache {
         if std::fs::metadata(dir).is_ok_and(|m| !m.is_dir()) {
             bail!("--truth-cache {}: not a directory", dir.display());
         }
+        let made = std::fs::symlink_metadata(dir).is_err();
         std::fs::create_dir_all(dir)
             .with_context(|| format!("--truth-cache {}: cannot create it", dir.display()))?;
-        Ok(TruthCache { dir: dir.to_path_buf() })
+        Ok(TruthCache { dir: dir.to_path_buf(), made })
     }
 
     /// The entries' record: the sums' fields, the first sample and the pixel window.
