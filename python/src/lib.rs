@@ -484,6 +484,7 @@ impl Renderer {
             spectra::cmd::render::draw(&mut inner.renderer, &inner.scene.camera, &settings, samples, &never)
                 .map_err(runtime)?;
             let hdr = spectra::cmd::render::read_linear(&inner.renderer, samples).map_err(runtime)?;
+            spectra::cmd::render::warn_if_too_dim(&inner.scene, &hdr);
             // As `spectra render --out x.exr` writes them.
             let k = settings.exposure_ev.exp2();
             let data = hdr.iter().flat_map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();

@@ -110,6 +110,28 @@ pub fn read_linear(r: &Renderer, samples: u32) -> Result<Vec<[f32; 4]>, render::
     if samples <= 1 { r.read_hdr() } else { r.read_accumulated() }
 }
 
+/// Warns on stderr when even the brightest pixel of `hdr` (a read-back frame of `scene`) lies
+/// below the half-float target's normal range (`render::passes::hdr_too_dim`): `render` and the
+/// Python `Renderer.render` share it.
+pub fn warn_if_too_dim(scene: &scene::Scene, hdr: &[[f32; 4]]) {
+    // (A scene that nothing lights has had its own warning.)
+    let lit = scene::environment::LightSources::of(scene).any();
+    if let Some(max) = render::passes::hdr_too_dim(hdr).filter(|_| lit) {
+        let what = if max > 0.0 {
+            format!("the brightest pixel is {max:.2e}")
+        } else {
+            "every pixel is 0".to_string()
+        };
+        eprintln!(
+            "warning: {what}, below the smallest normal value of the real-time renderer's half-float \
+             target ({:.1e}; nothing below 6e-8 is kept): the image is banded or black, and the exposure (--exposure), \
+             applied afterwards, cannot bring it back; raise the scene's light instead (its intensities, \
+             --env-intensity) — spectra truth has no such floor",
+            render::passes::HDR_MIN_NORMAL
+        );
+    }
+}
+
 /// Renders the frame and writes `args.out`.
 fn render_frame(
     r: &mut Renderer,
@@ -147,22 +169,7 @@ fn render_frame(
     // is tone mapped: a clipped pixel is white either way).
     let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
     let hdr = read_linear(r, samples)?;
-    // (A scene that nothing lights has had its own warning.)
-    let lit = scene::environment::LightSources::of(scene).any();
-    if let Some(max) = render::passes::hdr_too_dim(&hdr).filter(|_| lit) {
-        let what = if max > 0.0 {
-            format!("the brightest pixel is {max:.2e}")
-        } else {
-            "every pixel is 0".to_string()
-        };
-        eprintln!(
-            "warning: {what}, below the smallest normal value of the real-time renderer's half-float \
-             target ({:.1e}; nothing below 6e-8 is kept): the image is banded or black, and --exposure, \
-             applied afterwards, cannot bring it back; raise the scene's light instead (its intensities, \
-             --env-intensity) — spectra truth has no such floor",
-            render::passes::HDR_MIN_NORMAL
-        );
-    }
+    warn_if_too_dim(scene, &hdr);
     let clipped = if linear_out { render::passes::hdr_clipped(&hdr) } else { 0 };
     if clipped > 0 {
         eprintln!(
