@@ -38,6 +38,7 @@ cp -r .dev/cache /tmp/cache
 export XDG_RUNTIME_DIR=/tmp/xdg
 mkdir -p /tmp/xdg
 ASSET=$PWD/.dev/DamagedHelmet/DamagedHelmet.gltf
+[ -f "$ASSET" ] || ASSET=$PWD/.dev/DamagedHelmet/DamagedHelmet.glb
 (nvidia-smi; nvidia-smi -q | grep -iE "driver version|product name|clocks" ; nproc; uname -a) > $R/machine.txt 2>&1
 
 log probe

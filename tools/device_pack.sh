@@ -1,18 +1,19 @@
 #!/bin/bash
 # Fills .dev/ and .gl/ for tools/device_bench.sh (a lent GPU machine; see its header):
-#   tools/device_pack.sh OLD_SPECTRA_BINARY DAMAGED_HELMET_GLTF_DIR [TEST ...]
+#   tools/device_pack.sh OLD_SPECTRA_BINARY DAMAGED_HELMET_DIR [TEST ...]
+# (DAMAGED_HELMET_DIR holds DamagedHelmet.gltf with its files, or DamagedHelmet.glb)
 # builds this checkout's release binary and render tests, strips and packs them (xz) with the
 # old binary to compare against, the asset, the cached coefficient table and the run script,
 # and downloads the Vulkan loader debs. Prints what will travel; keep it under 64 MiB.
 # Then: run `bash .dev/run.sh SECONDS` there, carrying .gl and .dev.
 set -euo pipefail
 old=${1:?old spectra binary}
-asset=${2:?directory holding DamagedHelmet.gltf}
+asset=${2:?directory holding DamagedHelmet.gltf or DamagedHelmet.glb}
 shift 2
 tests=("$@")
 [ ${#tests[@]} -gt 0 ] || tests=(shading_stage environment underwater pipeline material_spectra films transmission shadows gltf_features accumulation)
 cd "$(git rev-parse --show-toplevel)"
-[ -f "$asset/DamagedHelmet.gltf" ] || { echo "no DamagedHelmet.gltf in $asset" >&2; exit 1; }
+[ -f "$asset/DamagedHelmet.gltf" ] || [ -f "$asset/DamagedHelmet.glb" ] || { echo "no DamagedHelmet.gltf or .glb in $asset" >&2; exit 1; }
 table=${SPECTRA_CACHE_DIR:-$HOME/.cache/spectra}/srgb-64-v8.coeff
 [ -f "$table" ] || { echo "no $table: run \`spectra lut\` once" >&2; exit 1; }
 grep -qx '/.dev/' .git/info/exclude 2>/dev/null || printf '/.gl/\n/.dev/\n' >> .git/info/exclude
