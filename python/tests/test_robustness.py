@@ -83,3 +83,36 @@ def test_signatures_spell_their_tuple_defaults():
     bound.apply_defaults()
     bound.arguments["size"] = (8, 6)
     assert spectra.truth(*bound.args, **bound.kwargs).shape == (6, 8, 3)
+
+
+def _one_triangle_gltf(path):
+    """A glTF with one triangle and no lights (so that `load` lights it with the default sky)."""
+    import base64
+    import json
+    import struct
+
+    data = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteLength": len(data)}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+    }
+    path.write_text(json.dumps(doc))
+
+
+def test_a_frame_below_the_half_float_range_is_warned_about(tmp_path, capfd):
+    """The real-time renderer's HDR target is half float: a scene lit at 1e-9 of the default
+    sky comes back black, which `render` and `Renderer.render` say on stderr (it was silent)."""
+    g = tmp_path / "tri.gltf"
+    _one_triangle_gltf(g)
+    capfd.readouterr()
+    for intensity, warned in ((1e-9, True), (1.0, False)):
+        s = spectra.load(str(g), env="default", env_intensity=intensity)
+        img = spectra.Renderer(s, size=(16, 12)).render(mode="rgb")
+        err = capfd.readouterr().err
+        assert ("half-float" in err) == warned, (intensity, err)
+        assert (img.max() < 6.2e-5) == warned
