@@ -224,3 +224,23 @@ fn bad_use_is_refused_with_the_flag_named() {
     assert!(e.contains("--spectral-out") && e.contains("MiB") && e.contains("smaller image"), "{e}");
     assert!(!dir.path().join("s.exr").exists() && !dir.path().join("o.exr").exists());
 }
+
+/// The capture has no see-through layer, so with `--spectral-out` see-through materials are
+/// drawn opaque, in `--out` too (so that the two files agree): said on stderr (it was silent,
+/// and the image differed from the one rendered without the flag; found by a sweep).
+#[test]
+fn see_through_materials_drawn_opaque_for_the_capture_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, warned) in [("glass", true), ("cornell", false)] {
+        let o = Command::new(env!("CARGO_BIN_EXE_spectra"))
+            .args(["render", scene, "--size", "16x12", "--wavelengths", "4", "--out"])
+            .arg(dir.path().join("o.exr"))
+            .arg("--spectral-out")
+            .arg(dir.path().join("s.exr"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert_eq!(err.contains("drawn opaque with --spectral-out"), warned, "{scene}: {err}");
+    }
+}
