@@ -154,12 +154,12 @@ impl Args {
 }
 
 /// The items of a comma list given with `flag`, trimmed; an empty one (`1,,2`, `1,`) is refused
-/// rather than skipped, as a typo may hide there. None for a blank list.
+/// rather than skipped, as a typo may hide there. None for a list of nothing (blank or commas).
 fn list_items<'a>(flag: &str, s: &'a str) -> Result<Vec<&'a str>> {
-    if s.trim().is_empty() {
+    let items: Vec<&str> = s.split(',').map(str::trim).collect();
+    if items.iter().all(|i| i.is_empty()) {
         return Ok(Vec::new());
     }
-    let items: Vec<&str> = s.split(',').map(str::trim).collect();
     if items.iter().any(|i| i.is_empty()) {
         bail!("{flag} '{s}': an empty item in the list");
     }
@@ -613,9 +613,11 @@ mod tests {
         assert_eq!(parse_counts(" 4, 4,8 ").unwrap(), vec![4, 8]);
         assert!(parse_counts("0").unwrap_err().to_string().contains("outside"));
         assert!(parse_counts("4,x").unwrap_err().to_string().contains("'x'"));
-        assert!(parse_counts(" ").unwrap_err().to_string().contains("at least one"));
+        for s in [" ", ",", " , "] {
+            assert!(parse_counts(s).unwrap_err().to_string().contains("at least one"), "{s}");
+        }
         // An empty item is a typo's place, not skipped (1,,2 ran 1 and 2).
-        for s in [",", "1,,2", "1,2,"] {
+        for s in ["1,,2", "1,2,", ",4"] {
             assert!(parse_counts(s).unwrap_err().to_string().contains("empty item"), "{s}");
         }
         assert!(parse_rules("midpoint,,prefiltered").unwrap_err().to_string().contains("--quadrature"));
