@@ -254,10 +254,13 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(asset) = &args.suite_asset {
         // The asset and every file it references (buffers, textures, its environment), so
         // that no table is written over one of them; loaded again, with its warnings, when
-        // its turn comes.
-        let path = asset.to_string_lossy();
-        let scene = args.files.load(&path).with_context(|| format!("--suite-asset {path}"))?;
-        inputs.extend(scene.inputs.iter().enumerate().map(|(i, p)| {
+        // its turn comes. One that does not load is skipped then, as the suite skips any
+        // scene that fails, and only its own path is guarded.
+        let files = match args.files.load(&asset.to_string_lossy()) {
+            Ok(scene) => scene.inputs,
+            Err(_) => vec![asset.clone()],
+        };
+        inputs.extend(files.iter().enumerate().map(|(i, p)| {
             let what = if i == 0 {
                 "--suite-asset".to_string()
             } else {
