@@ -17,7 +17,9 @@ colour-science's integration (method "Integration", ASTM E308-style sum on the d
   emissive:   X = Σ x̄·L·Δλ / Σ ȳ·W·Δλ  (W = D65: a radiance equal to D65 has Y = 1), from two
               colour.sd_to_XYZ calls, L's and W's, both against a flat illuminant;
   reflective: colour.sd_to_XYZ(R, observer, D65) / 100.
-for the CIE 1931 2° and CIE 1964 10° observers.
+for the CIE 1931 2° and CIE 1964 10° observers; and each observer's XYZ of the white on the
+same grid (D65 normalised as above: the value a renderer's white has, which spectra's display
+balances onto sRGB's white, colour.RGB_COLOURSPACES["sRGB"].whitepoint), under "white".
 
 Run: python3 tools/check_fichet_exr.py (what `cargo xtask test` does) writes to a temporary
 folder and fails if the files in the repository differ from what it would write (values to
@@ -84,11 +86,14 @@ def integrate(data, emissive):
                 else:
                     rows.append((colour.sd_to_XYZ(sd, cmfs, d65, method="Integration") / 100.0).tolist())
         result[key] = rows
+        white = colour.sd_to_XYZ(d65, cmfs, flat, method="Integration")
+        result.setdefault("white", {})[key] = (white / white[1]).tolist()
     return result
 
 
 def generate(folder):
-    expected = {"width": W, "height": H, "white": "D65"}
+    xy = colour.RGB_COLOURSPACES["sRGB"].whitepoint
+    expected = {"width": W, "height": H, "white": "D65", "srgb_white": colour.xy_to_XYZ(xy).tolist()}
     for kind, prefix in (("emissive", "S0"), ("reflective", "T")):
         data = spectra(kind)
         write(os.path.join(folder, f"fichet_{kind}.exr"), prefix, data, kind == "emissive")
@@ -120,8 +125,11 @@ def main():
         eb = json.load(open(os.path.join(DATA, "fichet_expected.json")))
         for kind in ("emissive", "reflective"):
             for obs in OBSERVERS:
-                if not np.allclose(ea[kind][obs], eb[kind][obs], rtol=0, atol=1e-12):
-                    bad.append(f"fichet_expected.json {kind} {obs}")
+                for got, want in ((ea[kind][obs], eb[kind][obs]), (ea[kind]["white"][obs], eb[kind]["white"][obs])):
+                    if not np.allclose(got, want, rtol=0, atol=1e-12):
+                        bad.append(f"fichet_expected.json {kind} {obs}")
+        if not np.allclose(ea["srgb_white"], eb["srgb_white"], rtol=0, atol=1e-12):
+            bad.append("fichet_expected.json srgb_white")
         if bad:
             print("fichet_independent: the checked-in data differ from a fresh run:", ", ".join(bad))
             return 1

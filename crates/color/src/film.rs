@@ -3,8 +3,13 @@
 //! sensor's) and `compare` (with a spectral image's), so that the three agree for every
 //! observer.
 //!
-//! - A CIE observer gives CIE XYZ, shown through the sRGB matrix without chromatic adaptation
-//!   (the scene white is taken to be sRGB's D65).
+//! - A CIE observer gives CIE XYZ, each of X, Y and Z scaled so that the renderer's own value
+//!   of the white lands on sRGB's white, then shown through the sRGB matrix without chromatic
+//!   adaptation (the scene white is taken to be sRGB's D65). Over 380–730 nm with many nodes the
+//!   scale is within 2e-3 of 1 (the white outside the range, the illuminant against sRGB's
+//!   rounded chromaticity); at few nodes or a narrowed range the integral of the white is tinted
+//!   by the quadrature or the truncation, and without the scale every pixel would carry that
+//!   tint, differently in each renderer (their integrals differ), where the scene has none.
 //! - Any other observer (a camera, cones, an animal) is white balanced: each channel divided by
 //!   its response to the white (von Kries), so the white is (1, 1, 1). The balanced triple is
 //!   then shown as linear display RGB ([`CameraView::Balanced`], what the sensor separates), or
@@ -57,7 +62,13 @@ pub fn to_linear_srgb(
 ) -> Result<DMat3> {
     let srgb = crate::RgbColorSpace::srgb();
     if observer.kind() == ObserverKind::CieXyz {
-        return Ok(srgb.from_xyz);
+        // A channel the range leaves (almost) blind to the white (z̄ above 650 nm) is left as it
+        // is: nothing in the frame reaches it either, and a tiny divisor would only amplify noise.
+        let target = srgb.white_xyz();
+        let correction = DVec3::from_array(std::array::from_fn(|c| {
+            if white_response[c] > 1e-12 { target[c] / white_response[c] } else { 1.0 }
+        }));
+        return Ok(srgb.from_xyz * DMat3::from_diagonal(correction));
     }
     if white_response.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
         return Err(ColorError::BadSpectrum(format!(
@@ -84,10 +95,28 @@ mod tests {
         illuminant::by_name("D65").unwrap()
     }
 
+    /// A CIE observer's XYZ goes through sRGB's matrix (from the primaries' chromaticities,
+    /// not from us) after the diagonal that puts the renderer's white on sRGB's white, in both
+    /// views: the white's own response shows as (1, 1, 1), a white already at sRGB's white
+    /// XYZ is shown by the bare matrix, and a tinted white's tint is taken out of every colour.
     #[test]
-    fn cie_observers_are_xyz_through_srgb_whatever_the_view() {
-        let m = to_linear_srgb(&Observer::cie1931(), [0.9, 1.0, 1.1], &d65(), CameraView::Display).unwrap();
-        assert_eq!(m, crate::RgbColorSpace::srgb().from_xyz);
+    fn cie_observers_are_xyz_through_srgb_balanced_to_the_white_whatever_the_view() {
+        let srgb = crate::RgbColorSpace::srgb();
+        let exact = srgb.white_xyz();
+        for view in [CameraView::Balanced, CameraView::Display] {
+            let m = to_linear_srgb(&Observer::cie1931(), exact, &d65(), view).unwrap();
+            assert!((m - srgb.from_xyz).to_cols_array().iter().all(|d| d.abs() < 1e-15), "{m}");
+            let tinted = [0.9, 1.0, 1.1];
+            let m = to_linear_srgb(&Observer::cie1964(), tinted, &d65(), view).unwrap();
+            let white = m * DVec3::from(tinted);
+            assert!((white - DVec3::ONE).abs().max_element() < 1e-12, "{white}");
+            let grey = m * (DVec3::from(tinted) * 0.18);
+            assert!((grey - DVec3::splat(0.18)).abs().max_element() < 1e-12, "{grey}");
+        }
+        // A channel blind to the white is left unscaled rather than divided by nothing.
+        let m =
+            to_linear_srgb(&Observer::cie1931(), [exact[0], 1.0, 0.0], &d65(), CameraView::Balanced).unwrap();
+        assert!(m.is_finite() && (m.z_axis - srgb.from_xyz.z_axis).abs().max_element() < 1e-15, "{m}");
     }
 
     /// Both views keep the white white: balanced exactly, the fitted matrix to the fit's

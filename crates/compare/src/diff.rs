@@ -13,6 +13,7 @@
 
 use color::RgbColorSpace;
 use color::metrics::Stats;
+use color::numfmt::short;
 use rayon::prelude::*;
 
 use crate::error::{CompareError, Result};
@@ -91,7 +92,10 @@ impl DiffMaps {
         // ΔE NaN.
         if !(MIN_WHITE_LUMINANCE..=MAX_WHITE_LUMINANCE).contains(&y) {
             return Err(CompareError::InvalidOption(format!(
-                "white luminance must be between {MIN_WHITE_LUMINANCE:e} and {MAX_WHITE_LUMINANCE:e}, got {y:e}"
+                "white luminance must be between {} and {}, got {}",
+                short(MIN_WHITE_LUMINANCE),
+                short(MAX_WHITE_LUMINANCE),
+                short(y)
             )));
         }
         let space = RgbColorSpace::srgb();

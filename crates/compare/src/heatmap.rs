@@ -6,6 +6,7 @@
 //! an embedded bitmap font, under a title ("ΔE00" by default). Values above the maximum take
 //! the top colour and the top label gets a "+" suffix when any pixel is clipped.
 
+use color::numfmt::short;
 use std::path::Path;
 
 use crate::atomic::write_atomic;
@@ -123,7 +124,10 @@ impl Heatmap {
             Some(m) if (MIN_SCALE..=MAX_SCALE).contains(&m) => m,
             Some(m) => {
                 return Err(CompareError::InvalidOption(format!(
-                    "heat map maximum must be from {MIN_SCALE:e} to {MAX_SCALE:e}, got {m:e}"
+                    "heat map maximum must be from {} to {}, got {}",
+                    short(MIN_SCALE),
+                    short(MAX_SCALE),
+                    short(m)
                 )));
             }
             None => nice_ceil(data_max).clamp(MIN_SCALE, MAX_SCALE),

@@ -497,8 +497,9 @@ mod tests {
         assert!(!is_spectral_exr(&std::fs::read(&rgb_only).unwrap()));
     }
 
-    /// A spectrally flat emitter equal to the white integrates to the white: sRGB (1, 1, 1) for
-    /// CIE observers, and for a camera (white balanced by the convention in `color`).
+    /// A spectrally flat emitter, normalised by itself, integrates to its colour against the
+    /// RGB white (D65) on the file's bands, for CIE observers and a camera alike (the
+    /// convention in `color::film`).
     #[test]
     fn white_integrates_to_white() {
         let mut img = sample(SpectralKind::Emissive);
@@ -510,21 +511,25 @@ mod tests {
         }
         for obs in [Observer::cie1931(), Observer::cie1964(), Observer::nikon_d5100()] {
             let rgb = img.to_linear_srgb(&obs, &e).unwrap();
+            // Balanced by the white an RGB (1, 1, 1) light emits (D65's shape at the white's
+            // luminance, as in both renderers), integrated on the file's bands: a flat emitter
+            // is not white to either. A camera's balanced channels are shown as they are; a CIE
+            // observer's XYZ is scaled so that the white lands on sRGB's white, then through
+            // sRGB's matrix.
+            let d65 = color::illuminant::by_name("D65").unwrap();
+            let on_bands = |o: &Observer, s: &Spectrum| {
+                SpectralIntegrator::emission(o, &e, &wl).integrate(|l| s.eval(l))
+            };
+            let (r, w) = (on_bands(&obs, &e), on_bands(&obs, &d65));
+            let cie = Observer::cie1931();
+            let y = on_bands(&cie, &e)[1] / on_bands(&cie, &d65)[1];
+            let balanced = [0, 1, 2].map(|c| r[c] / (w[c] * y));
             let want = if obs.name == "nikon_d5100" {
-                // A camera is balanced by the white an RGB (1, 1, 1) light emits (D65's shape at
-                // the white's luminance, as in both renderers): a flat emitter is not white to
-                // it, as it is not to CIE 1931 through sRGB.
-                let d65 = color::illuminant::by_name("D65").unwrap();
-                let on_bands = |o: &Observer, s: &Spectrum| {
-                    SpectralIntegrator::emission(o, &e, &wl).integrate(|l| s.eval(l))
-                };
-                let (r, w) = (on_bands(&obs, &e), on_bands(&obs, &d65));
-                let cie = Observer::cie1931();
-                let y = on_bands(&cie, &e)[1] / on_bands(&cie, &d65)[1];
-                [0, 1, 2].map(|c| r[c] / (w[c] * y))
+                balanced
             } else {
-                let xyz = SpectralIntegrator::emission(&obs, &e, &wl).integrate(|_| 1.0);
-                color::RgbColorSpace::srgb().xyz_to_rgb(xyz)
+                let srgb = color::RgbColorSpace::srgb();
+                let white = srgb.white_xyz();
+                srgb.xyz_to_rgb([0, 1, 2].map(|c| balanced[c] * white[c]))
             };
             for k in 0..3 {
                 assert!(

@@ -89,7 +89,8 @@ pub struct SpectralSetup {
     /// by the part of the white outside the range (both). With jitter the correction uses the
     /// dense white instead, so it is the same for every frame (and only the average of frames
     /// is white). That is for a CIE observer; any other is balanced by this quadrature's
-    /// response to the white and shown as [`color::film`] says (`RenderSettings::camera_view`).
+    /// response to the white and shown as `RenderSettings::camera_view` asks. Both are
+    /// [`color::film::to_linear_srgb`]'s, which the path tracer calls with its own integral.
     pub xyz_to_rgb: DMat3,
     pub space: RgbColorSpace,
     quad: NodeQuadrature,
@@ -181,17 +182,10 @@ impl SpectralSetup {
             .collect();
         let integrator = SpectralIntegrator { lambda: wavelengths.lambda.clone(), weights };
         let white_samples = white.sample(&wavelengths.lambda);
-        let target_white = space.white_xyz();
-        let correction = DVec3::from_array(std::array::from_fn(|c| {
-            if sampled_white[c] > 1e-12 { target_white[c] / sampled_white[c] } else { 1.0 }
-        }));
-        // Any other observer: balanced by this quadrature's own response to the white, which
-        // makes the white (1, 1, 1) at every N as the correction does for XYZ.
-        let xyz_to_rgb = if observer.kind() == color::observer::ObserverKind::CieXyz {
-            space.from_xyz * DMat3::from_diagonal(correction)
-        } else {
-            color::film::to_linear_srgb(&observer, sampled_white, &white, settings.camera_view)?
-        };
+        // This quadrature's own value of the white is what the display balances to (a diagonal
+        // in XYZ for a CIE observer, von Kries for any other), so the white is (1, 1, 1) at every
+        // N and range, as in the path tracer, which balances to its own integral alike.
+        let xyz_to_rgb = color::film::to_linear_srgb(&observer, sampled_white, &white, settings.camera_view)?;
         let dense_wl = SampledWavelengths::midpoint(WavelengthRange::FULL, 470)?;
         // A measured light's colour in the RGB mode: its chromaticity, a CIE 1931 quantity.
         let dense = SpectralIntegrator::emission(&cie, &white, &dense_wl);

@@ -35,8 +35,13 @@ fn absurd_counts_and_sizes_are_refused() {
     let (a, b) = two_images(dir.path());
     refused(&["diff", &a, &b, "--white-y", "1e-310"], &["--white-y", "1e-310", "white luminance"]);
     let heat = dir.path().join("h.png").display().to_string();
-    for m in ["1e300", "1e-300", "0e0"] {
-        refused(&["diff", &a, &b, "--heatmap", &heat, "--max-de", m], &["--max-de", "from 1e-4 to 1e4", m]);
+    // Values written as one would type them ("-1", not "-1e0").
+    refused(&["diff", &a, &b, "--white-y", "-1"], &["--white-y -1:", "between 1e-20 and 1e20"]);
+    for (m, shown) in [("1e300", "1e300"), ("1e-300", "1e-300"), ("0e0", "got 0"), ("-1", "got -1")] {
+        refused(
+            &["diff", &a, &b, "--heatmap", &heat, "--max-de", m],
+            &["--max-de", "from 1e-4 to 1e4", shown],
+        );
     }
     assert!(!dir.path().join("h.png").exists());
     refused(&["upsample", "--roundtrip", "18446744073709551615"], &["--roundtrip", "at most"]);

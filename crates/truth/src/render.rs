@@ -251,14 +251,15 @@ pub struct XyzImage {
 }
 
 impl XyzImage {
-    /// Linear RGB in `space` (no chromatic adaptation: the scene white is taken to be the
-    /// colour space's white, D65 for sRGB). For a CIE observer only: see [`Self::to_display`].
+    /// Linear RGB in `space` through its bare matrix (no chromatic adaptation, and not the
+    /// display convention: for ratios of two images, as tests take). For a CIE observer only;
+    /// images are shown by [`Self::to_display`].
     pub fn to_rgb(&self, space: &color::RgbColorSpace) -> Vec<[f32; 3]> {
         self.xyz.iter().map(|p| space.xyz_to_rgb(p.map(|c| c as f64)).map(|c| c as f32)).collect()
     }
 
     /// Linear sRGB by the display convention every renderer shares ([`color::film`]): CIE XYZ
-    /// through the sRGB matrix, any other observer white balanced (and with
+    /// balanced onto sRGB's white, then the sRGB matrix; any other observer white balanced (and with
     /// [`color::film::CameraView::Display`] through its fitted matrix to XYZ).
     pub fn to_display(&self, settings: &Settings, view: color::film::CameraView) -> Result<Vec<[f32; 3]>> {
         let m = settings.display_matrix(view)?;

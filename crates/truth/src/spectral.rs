@@ -109,9 +109,10 @@ impl SampledObserver {
 }
 
 /// The matrix from the tracer's tristimulus values to linear sRGB ([`color::film`], the
-/// convention the real-time renderer and `compare` share): a non-CIE observer is balanced by
-/// its response to the RGB white — the colour space's illuminant at the scene white's
-/// luminance, which an RGB (1, 1, 1) light emits — in the sensor's units.
+/// convention the real-time renderer and `compare` share): balanced by the observer's response
+/// to the RGB white — the colour space's illuminant at the scene white's luminance, which an
+/// RGB (1, 1, 1) light emits — integrated over the render range in the sensor's units (for a
+/// CIE observer a diagonal in XYZ onto sRGB's white, for any other von Kries).
 pub fn display_matrix(
     observer: &Observer,
     white: &Spectrum,

@@ -3,6 +3,7 @@
 //! A measurement, not a test: it exits 0 whatever the difference, and non-zero only when it
 //! cannot measure (unreadable file, size mismatch, non-finite pixel, bad option).
 
+use color::numfmt::short;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
@@ -178,7 +179,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let colormap = ColorMap::by_name(&args.colormap)?;
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
     if !(lo..=hi).contains(&args.white_y) {
-        anyhow::bail!("--white-y {:e}: the white luminance must be between {lo:e} and {hi:e}", args.white_y);
+        anyhow::bail!(
+            "--white-y {}: the white luminance must be between {} and {}",
+            short(args.white_y),
+            short(lo),
+            short(hi)
+        );
     }
     if let Some(h) = &args.heatmap
         && !h.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
@@ -189,9 +195,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         && !(compare::heatmap::MIN_SCALE..=compare::heatmap::MAX_SCALE).contains(&m)
     {
         bail!(
-            "--max-de must be a ΔE00 from {:e} to {:e}, got {m:e}",
-            compare::heatmap::MIN_SCALE,
-            compare::heatmap::MAX_SCALE
+            "--max-de must be a ΔE00 from {} to {}, got {}",
+            short(compare::heatmap::MIN_SCALE),
+            short(compare::heatmap::MAX_SCALE),
+            short(m)
         );
     }
 
@@ -375,31 +382,37 @@ mod tests {
         // A D65-coloured emitter at half the white: sRGB (0.5, 0.5, 0.5) for CIE 1931.
         let d65 = color::illuminant::by_name("D65").unwrap();
         let wl = color::SampledWavelengths::from_edges(&edges).unwrap();
-        let data = (0..12).flat_map(|_| wl.lambda.iter().map(|&l| (0.5 * d65.eval(l)) as f32)).collect();
-        let spec = compare::SpectralImage {
+        let image = |f: &dyn Fn(f64) -> f64| compare::SpectralImage {
             width: 4,
             height: 3,
             kind: compare::SpectralKind::Emissive,
-            edges,
-            data,
+            edges: edges.clone(),
+            data: (0..12).flat_map(|_| wl.lambda.iter().map(|&l| f(l) as f32)).collect(),
             white: Some("D65".into()),
             centres: None,
         };
+        let spec = image(&|l| 0.5 * d65.eval(l));
         compare::write_spectral_exr(p("s.exr"), &spec, None).unwrap();
+        // An orange emitter, which the 2° and 10° observers see differently.
+        let orange = image(&|l| 50.0 * (-((l - 600.0) / 30.0).powi(2)).exp());
+        compare::write_spectral_exr(p("o.exr"), &orange, None).unwrap();
         let grey = Image::filled(4, 3, [0.5; 3]).unwrap();
         compare::write_image(p("g.exr"), &grey, Default::default()).unwrap();
         assert_eq!(spec.bands(), n);
-        let pixel = |obs: &str| {
-            let a = args(&[&p("g.exr"), &p("s.exr"), "--observer", obs]);
-            let (img, note) = load(std::path::Path::new(&p("s.exr")), "test", &a).unwrap();
+        let pixel = |file: &str, obs: &str| {
+            let a = args(&[&p("g.exr"), &p(file), "--observer", obs]);
+            let (img, note) = load(std::path::Path::new(&p(file)), "test", &a).unwrap();
             assert!(note.unwrap().contains(obs), "the note names the observer");
             img.data[5]
         };
-        // CIE 1931: D65 is sRGB's white (to the 5 nm bands' quadrature); a camera is white
-        // balanced on D65 exactly; the 10° observer sees D65 away from sRGB's 2° white.
-        let (c31, nikon, c64) = (pixel("cie1931"), pixel("nikon_d5100"), pixel("cie1964"));
-        assert!(c31.iter().all(|v| (v - 0.5).abs() < 2e-3), "{c31:?}");
-        assert!(nikon.iter().all(|v| (v - 0.5).abs() < 1e-6), "{nikon:?}");
+        // D65 is the white an RGB (1, 1, 1) light emits, which every observer's display is
+        // balanced to (`color::film`): grey for the 2° and 10° observers and a camera alike.
+        for obs in ["cie1931", "cie1964", "nikon_d5100"] {
+            let grey = pixel("s.exr", obs);
+            assert!(grey.iter().all(|v| (v - 0.5).abs() < 1e-6), "{obs}: {grey:?}");
+        }
+        // Any other colour depends on the observer.
+        let (c31, c64) = (pixel("o.exr", "cie1931"), pixel("o.exr", "cie1964"));
         assert!(c64.iter().zip(c31).any(|(a, b)| (a - b).abs() > 5e-3), "{c64:?} vs {c31:?}");
         run_with(&[&p("g.exr"), &p("s.exr"), "--metric", "flip", "--flip-map", &p("f.png")]).unwrap();
         assert!(dir.path().join("f.png").exists());

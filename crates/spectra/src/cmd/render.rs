@@ -25,10 +25,9 @@ pub struct RenderArgs {
     /// Also write the radiance at the N wavelength nodes as a spectral EXR (the OpenEXR layout
     /// of Fichet et al. 2021, as `truth --spectral-out` writes it: channels S0.<λ>nm for the N
     /// equal bins around the nodes, with the linear R, G, B beside them). With --quadrature
-    /// midpoint the bins integrate back to the frame's XYZ before its white correction (small at
-    /// N ≥ 16 over the default range, large at few nodes or a narrowed one); with the default prefiltered rule
-    /// they hold the radiance averaged around each node (docs/spectral-exr.md). Spectral or
-    /// naive mode.
+    /// midpoint the bins integrate back (`spectra diff`) to the frame's own pixels, to f16
+    /// rounding, at any N and range; with the default prefiltered rule they hold the radiance
+    /// averaged around each node (docs/spectral-exr.md). Spectral or naive mode.
     #[arg(long, value_name = "FILE.exr")]
     pub spectral_out: Option<PathBuf>,
     /// Antialiasing: the mean of this many frames, each sampling the scene at another place in

@@ -279,9 +279,11 @@ pub struct SpectrumArgs {
     /// file, CSV or rawtoaces JSON (docs/cameras.md; default: the scene's, else cie1931).
     #[arg(long)]
     pub observer: Option<String>,
-    /// Scene white, the reference of the XYZ normalisation and of RGB emission: an illuminant
-    /// name (D65, D50, A, F11, …, or a temperature such as 5000K; default: the scene's
-    /// spectra.white, else D65).
+    /// Scene white: an illuminant name (D65, D50, A, F11, …, or a temperature such as 5000K;
+    /// default: the scene's spectra.white, else D65). It is the unit of radiance (a radiance
+    /// equal to it has Y = 1), not a tint: RGB colours emit sRGB's D65 at its luminance and
+    /// measured lights keep their stated luminance, so the image is the same whatever it is.
+    /// It is what a --spectral-out file's bands are normalised by (recorded as spectra.white).
     #[arg(long)]
     pub white: Option<String>,
     /// Show a camera (any non-CIE observer) through its least-squares matrix to CIE XYZ over

@@ -80,7 +80,7 @@ fn truth(s: &Scene) -> Image {
     let t = table();
     let world = truth::World::new(s, t.as_ref(), &st.white, st.range, None).unwrap();
     let img = truth::render_world(&world, &st, &AtomicBool::new(false), &|_| {}).unwrap();
-    Image::new(SIZE, SIZE, img.to_rgb(&color::RgbColorSpace::srgb())).unwrap()
+    Image::new(SIZE, SIZE, img.to_display(&st, color::film::CameraView::Balanced).unwrap()).unwrap()
 }
 
 fn realtime(s: &Scene) -> Image {
