@@ -398,7 +398,8 @@ impl Renderer {
 
     /// One frame as a float32 array of shape (height, width, 3), C-contiguous: the linear RGB
     /// HDR image (`spectra render --out x.exr`'s pixels, the f16 HDR target read back, alpha
-    /// dropped), multiplied by 2^exposure.
+    /// dropped), multiplied by 2^exposure before the f16 (so a scene outside its range, e.g. lit
+    /// at 1e-9, is brought into it).
     ///
     /// mode: "spectral" (Jakob–Hanika), "naive" (box upsampling) or "rgb".
     /// wavelengths: N nodes, 1–256 (default: the scene's, else 16).
@@ -408,7 +409,7 @@ impl Renderer {
     /// cie1931).
     /// white: the scene white, an illuminant name ("D65", "F11", "5000K", …; default: the
     /// scene's, else D65).
-    /// exposure: stops.
+    /// exposure: stops (the radiance × 2^exposure is what the f16 target holds).
     /// spectral: also return the radiance at each of the N nodes, as `--spectral-out` writes
     /// it: the tuple (image, radiance of shape (H, W, N) float32, wavelengths of shape (N,)
     /// float64, nm). With the midpoint rule a node's value is L(λₖ); with the prefiltered rule
@@ -490,9 +491,10 @@ impl Renderer {
                 .map_err(runtime)?;
             let hdr = spectra::cmd::render::read_linear(&inner.renderer, samples).map_err(runtime)?;
             spectra::cmd::render::warn_if_too_dim(&inner.scene, &hdr);
-            // As `spectra render --out x.exr` writes them.
+            // As `spectra render --out x.exr` writes them: the exposure is in the HDR values
+            // already (applied before the half float); the capture's f32 radiance takes it here.
             let k = settings.exposure_ev.exp2();
-            let data = hdr.iter().flat_map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+            let data = hdr.iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
             let capture = if spectral {
                 let cap = inner.renderer.read_spectral_capture().map_err(runtime)?;
                 Some((cap.data.into_iter().map(|v| v * k).collect(), cap.lambda))

@@ -92,6 +92,69 @@ pub fn read_regular_string(path: &Path, max_bytes: u64) -> io::Result<String> {
         .map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "not valid UTF-8 text"))
 }
 
+/// A JSON document a user wrote (an observer, a medium), as serde_json's value, refusing what
+/// serde_json would take silently: an object that names one key twice (the value map keeps the
+/// last, so a pasted duplicate row replaced the first without a word). A leading byte-order mark
+/// (Windows Notepad writes one) is skipped. The error is serde_json's, with its line and column.
+pub fn json_value(text: &str) -> Result<serde_json::Value, serde_json::Error> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut de = serde_json::Deserializer::from_str(text);
+    serde::de::DeserializeSeed::deserialize(NoDuplicateKeys, &mut de)?;
+    de.end()?;
+    serde_json::from_str(text)
+}
+
+/// Walks a JSON document and fails on the first object with a repeated key.
+struct NoDuplicateKeys;
+
+impl<'de> serde::de::DeserializeSeed<'de> for NoDuplicateKeys {
+    type Value = ();
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for NoDuplicateKeys {
+    type Value = ();
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        while seq.next_element_seed(NoDuplicateKeys)?.is_some() {}
+        Ok(())
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if !seen.insert(key.clone()) {
+                return Err(serde::de::Error::custom(format!(
+                    "the key \"{key}\" is given twice in one object"
+                )));
+            }
+            map.next_value_seed(NoDuplicateKeys)?;
+        }
+        Ok(())
+    }
+}
+
 fn too_big(len: u64, max: u64) -> io::Error {
     io::Error::new(
         io::ErrorKind::InvalidData,
@@ -102,6 +165,25 @@ fn too_big(len: u64, max: u64) -> io::Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn json_refuses_repeated_keys_at_any_depth_and_skips_a_bom() {
+        let v = json_value(
+            "\u{feff}{\"a\": {\"400\": [1, 2], \"410\": [3, 4]}, \"b\": [{\"x\": 1}, {\"x\": 2}]}",
+        )
+        .unwrap();
+        assert_eq!(v["a"]["410"][1], 4);
+        for (doc, key) in [
+            ("{\"a\": 1, \"a\": 2}", "\"a\""),
+            ("{\"d\": {\"m\": {\"400\": [9], \"400\": [1]}}}", "\"400\""),
+            ("[{\"x\": 1, \"y\": 2, \"x\": 3}]", "\"x\""),
+        ] {
+            let e = json_value(doc).unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains("twice") && e.contains("line 1"), "{doc}: {e}");
+        }
+        assert!(json_value("{\"a\": 1} x").is_err(), "trailing characters");
+        assert!(json_value("{\"a\": ").is_err());
+    }
     use std::time::{Duration, Instant};
 
     #[test]

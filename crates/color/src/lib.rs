@@ -12,7 +12,6 @@ pub mod illuminant;
 pub mod input;
 pub mod lab;
 pub mod metrics;
-pub mod numfmt;
 pub mod observer;
 pub mod observer_file;
 pub mod outfile;

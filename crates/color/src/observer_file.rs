@@ -106,8 +106,7 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
 /// `spectral_data.data.main`); `source` names it in errors and becomes its name.
 pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
     let err = |what: String| ColorError::Table(format!("observer file {source}: {what}"));
-    let doc: serde_json::Value = serde_json::from_str(text.trim_start_matches('\u{feff}'))
-        .map_err(|e| err(format!("not valid JSON: {e}")))?;
+    let doc = crate::input::json_value(text).map_err(|e| err(format!("not valid JSON: {e}")))?;
     let field = |path: &[&str]| -> Result<&serde_json::Value> {
         let mut v = &doc;
         for (i, key) in path.iter().enumerate() {
@@ -363,6 +362,11 @@ mod tests {
             (
                 json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "400.0": [1, 2, 3], "600": [1, 2, 3]"#),
                 "400 nm is given twice",
+            ),
+            (
+                // The same key twice: serde_json's map kept the last, silently.
+                json(r#"["R", "G", "B"]"#, r#""400": [9, 9, 9], "400": [1, 2, 3], "600": [1, 2, 3]"#),
+                "the key \"400\" is given twice",
             ),
             (json(r#"["R", "G", "B"]"#, r#""400": [1, 2, 3], "500": [1, 2, 3]"#), "2 data rows"),
             (

@@ -12,8 +12,8 @@
 //! per-pixel values is the usual image MAE over pixels and channels.
 
 use color::RgbColorSpace;
+use color::error::show as short;
 use color::metrics::Stats;
-use color::numfmt::short;
 use rayon::prelude::*;
 
 use crate::error::{CompareError, Result};

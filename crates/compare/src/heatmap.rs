@@ -6,7 +6,7 @@
 //! an embedded bitmap font, under a title ("ΔE00" by default). Values above the maximum take
 //! the top colour and the top label gets a "+" suffix when any pixel is clipped.
 
-use color::numfmt::short;
+use color::error::show as short;
 use std::path::Path;
 
 use crate::atomic::write_atomic;

@@ -190,6 +190,10 @@ fn parse_channel(name: &str) -> Option<std::result::Result<(SpectralKind, f64), 
         && !number.starts_with(',');
     let lambda = if ok { number.replace(',', ".").parse::<f64>().ok() } else { None };
     match lambda {
+        // Up to a millimetre: a 25-digit "wavelength" made bands reaching −5e22 nm.
+        Some(l) if l > 1e6 => {
+            Some(Err(format!("{number} nm is longer than a millimetre: not a wavelength in nm")))
+        }
         Some(l) if l.is_finite() && l > 0.0 => Some(Ok((kind, l))),
         _ => Some(Err(format!("'{number}' is not a wavelength (digits with a comma decimal separator)"))),
     }
@@ -295,6 +299,19 @@ pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Spect
             (edges, (!centred).then_some(own))
         }
     };
+    // Bands that no observer sees would integrate to a black image, silently: 4000–7000 "nm"
+    // (Ångström) or an infrared-only file.
+    let (lo, hi) = (edges[0], edges[edges.len() - 1]);
+    if hi <= color::spectrum::LAMBDA_MIN || lo >= color::spectrum::LAMBDA_MAX {
+        return Err(decode(format!(
+            "its bands span {}–{} nm, outside the {}–{} nm the observers cover: nothing in it can be seen \
+             (are the wavelengths in nm?)",
+            color::error::show(lo),
+            color::error::show(hi),
+            color::spectrum::LAMBDA_MIN,
+            color::spectrum::LAMBDA_MAX
+        )));
+    }
     let (w, h) = (layer.size.width(), layer.size.height());
     let (width, height) = (
         u32::try_from(w).map_err(|_| decode(format!("width {w} too large")))?,
@@ -565,6 +582,11 @@ mod tests {
         assert!(e.contains("bad.exr") && e.contains("no spectral channel") && e.contains("B, G, R"), "{e}");
         let e = err(&["S0.500nm", "S0.510,abcnm"], &[]);
         assert!(e.contains("channel S0.510,abcnm") && e.contains("not a wavelength"), "{e}");
+        // Bands no observer sees (Ångström taken for nm): an error, not a black image.
+        let e = err(&["S0.4000nm", "S0.5500nm", "S0.7000nm"], &[]);
+        assert!(e.contains("bad.exr") && e.contains("3250–7750 nm") && e.contains("360–830"), "{e}");
+        let e = err(&["S0.500nm", "S0.99999999999999999999999nm"], &[]);
+        assert!(e.contains("S0.99999999999999999999999nm") && e.contains("millimetre"), "{e}");
         let e = err(&["S0.500nm", "S0.500,000nm", "S0.510nm"], &[]);
         assert!(e.contains("S0.500,000nm") && e.contains("S0.500nm") && e.contains("same wavelength"), "{e}");
         let e = err(&["S0.500nm", "T.510nm"], &[]);

@@ -169,7 +169,10 @@ pub struct RenderSettings {
     /// How a camera's (any non-CIE observer's) balanced channels are shown
     /// ([`color::film`]; `--camera-to-display`). CIE observers ignore it.
     pub camera_view: color::film::CameraView,
-    /// Exposure in stops: the HDR colour is multiplied by 2^EV before tone mapping.
+    /// Exposure in stops: the radiance is multiplied by 2^EV as it is written to the half-float
+    /// HDR target (before tone mapping), so the exposure also brings a scene whose radiance lies
+    /// below f16's range (6.1e-5) or above it (65504) into it. What is read back
+    /// (`Renderer::read_hdr`) is exposed.
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
     /// Render a shadow map for each light, stand-ins and emissive polygons included (every

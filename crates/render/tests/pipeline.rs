@@ -167,9 +167,13 @@ fn occluder_casts_a_shadow_from_the_main_light() {
     assert!(darkened > 10 && unchanged_far > 100, "{darkened} shadowed, {unchanged_far} lit pixels checked");
 }
 
+/// The exposure is applied as the radiance is written to the half-float target (2^EV times the
+/// unexposed frame, to the f16 rounding of each), then post tone maps and encodes what the
+/// target holds.
 #[test]
 fn post_applies_exposure_tonemap_and_srgb() {
     let (mut r, _) = chart_renderer(2.0);
+    let unexposed = hdr(&mut r, &RenderSettings { mode: Mode::Rgb, ..Default::default() });
     for (tonemap, ev) in [(Tonemap::None, 0.0f32), (Tonemap::Reinhard, 1.0), (Tonemap::Aces, -0.5)] {
         let s = RenderSettings { mode: Mode::Rgb, tonemap, exposure_ev: ev, ..Default::default() };
         let cam = r.scene_camera().unwrap();
@@ -177,9 +181,16 @@ fn post_applies_exposure_tonemap_and_srgb() {
         let hdr = r.read_hdr().unwrap();
         let ldr = r.read_ldr().unwrap();
         let k = ev.exp2() as f64;
+        for (p, u) in hdr.iter().zip(&unexposed) {
+            for c in 0..3 {
+                // One f16 rounding on each side (lavapipe truncates): two units in the last place.
+                let (got, want) = (p[c] as f64, u[c] * k);
+                assert!((got - want).abs() <= want.abs() * 2.0 / 1024.0 + 1e-7, "EV {ev}: {got} vs {want}");
+            }
+        }
         for (p, q) in hdr.iter().zip(ldr.chunks_exact(4)) {
             let want = rgb_of(p).map(|c| {
-                let c = (c * k).max(0.0);
+                let c = c.max(0.0);
                 let t = match tonemap {
                     Tonemap::None => c,
                     Tonemap::Reinhard => c / (1.0 + c),
@@ -295,4 +306,53 @@ fn material_slots_past_eight_bits_and_the_limit() {
     }
     let err = renderer().set_scene(&too_many).unwrap_err().to_string();
     assert!(err.contains("65535 materials") && err.contains("at most 65534"), "{err}");
+}
+
+/// A scene in units far below the half-float target's range (a 1e-9 lux light: every pixel
+/// under f16's 6e-8, stored as 0) is brought into it by the exposure, which the shaders apply
+/// before the target: at +30 EV it is the frame of a 2^30 times brighter light, in every mode.
+#[test]
+fn exposure_reaches_below_the_half_float_floor() {
+    let dim = 1e-9f32;
+    let (mut r, _) = chart_renderer(dim);
+    let (mut bright, _) = chart_renderer(dim * 2f32.powi(30));
+    for mode in [Mode::Rgb, Mode::Naive, Mode::Spectral] {
+        let s = RenderSettings { mode, ..Default::default() };
+        let unexposed = hdr(&mut r, &s);
+        assert!(
+            unexposed.iter().flatten().all(|c| *c == 0.0),
+            "{mode:?}: the dim frame is below f16's range"
+        );
+        let exposed = hdr(&mut r, &RenderSettings { exposure_ev: 30.0, ..s.clone() });
+        let want = hdr(&mut bright, &s);
+        let peak = want.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+        assert!(peak > 0.1, "{mode:?}: the bright frame is lit ({peak})");
+        let mut worst = 0.0f64;
+        for (a, b) in exposed.iter().zip(&want) {
+            for c in 0..3 {
+                worst = worst.max((a[c] - b[c]).abs() / (b[c].abs() * 2.0 / 1024.0 + 1e-6));
+            }
+        }
+        assert!(
+            worst <= 1.0,
+            "{mode:?}: {worst:.2} of the f16 bound between +30 EV and a 2^30 brighter light"
+        );
+    }
+}
+
+/// The pass-3 hook sees radiance, not the exposed values the target holds: a hook that adds a
+/// constant adds it before the exposure.
+#[test]
+fn the_pixel_hook_sees_radiance_whatever_the_exposure() {
+    let (mut r, chart) = chart_renderer(1.0);
+    let grey = centre_pixel_of_patch(&chart, 21);
+    let s = RenderSettings { mode: Mode::Rgb, shadows: false, ..Default::default() };
+    let plain = hdr(&mut r, &s)[grey];
+    let src = "fn custom_pixel(hdr: vec4<f32>, ctx: SurfaceContext) -> vec4<f32> { return vec4<f32>(hdr.rgb + 0.1, hdr.a); }";
+    r.set_custom_shader(CustomShader::new(src)).unwrap();
+    let exposed = hdr(&mut r, &RenderSettings { exposure_ev: 2.0, ..s.clone() })[grey];
+    for c in 0..3 {
+        let want = 4.0 * (plain[c] + 0.1);
+        assert!((exposed[c] - want).abs() <= want * 2.0 / 1024.0, "{exposed:?} vs 4 × ({plain:?} + 0.1)");
+    }
 }

@@ -674,15 +674,20 @@ impl EnvironmentChoice {
             env.sun_light = !self.no_sun;
         }
         if !LightSources::of(scene).any() {
-            // An environment scaled to nothing is there, and says so; otherwise there is none.
-            let scaled_out =
-                scene.environment.as_ref().filter(|e| e.intensity == 0.0).map(|e| e.source.clone());
-            note = Some(match scaled_out {
-                Some(source) => format!(
+            // An environment scaled to nothing, or black in every texel, is there, and says so;
+            // otherwise there is none.
+            note = Some(match scene.environment.as_ref() {
+                Some(e) if e.intensity == 0.0 => format!(
                     "warning: nothing lights {}: it has no lights and no emissive surface bright enough to \
-                     light it, and its environment ({source}) is scaled to 0 by --env-intensity, so the \
+                     light it, and its environment ({}) is scaled to 0 by --env-intensity, so the \
                      image will be (nearly) black",
-                    scene.source
+                    scene.source, e.source
+                ),
+                Some(e) => format!(
+                    "warning: nothing lights {}: it has no lights and no emissive surface bright enough to \
+                     light it, and its environment ({}) is black in every texel, so the image will be \
+                     (nearly) black",
+                    scene.source, e.source
                 ),
                 None => format!(
                     "warning: nothing lights {}: it has no lights, no environment and no emissive surface \

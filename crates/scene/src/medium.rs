@@ -20,6 +20,7 @@
 //! `"unbounded"`.
 
 use color::Spectrum;
+use color::error::show;
 use color::upsample::CoeffTable;
 use color::upsample::medium::Attenuation;
 use serde_json::{Map, Value};
@@ -72,7 +73,8 @@ fn check_coefficients(field: &str, v: [f64; 3]) -> Result<(), FieldError> {
             return Err(err(
                 field,
                 format!(
-                    "the {c} coefficient is {x}; coefficients must be finite, ≥ 0 and ≤ {MAX_COEFFICIENT:e} per metre"
+                    "the {c} coefficient is {}; coefficients must be finite, ≥ 0 and ≤ {MAX_COEFFICIENT:e} per metre",
+                    show(x)
                 ),
             ));
         }
@@ -102,19 +104,22 @@ impl RgbMedium {
         if !(g > -1.0 && g < 1.0 && (g as f32).abs() < 1.0) {
             return Err(err(
                 "g",
-                format!("the Henyey–Greenstein g = {g} must lie strictly between −1 and 1"),
+                format!("the Henyey–Greenstein g = {} must lie strictly between −1 and 1", show(g)),
             ));
         }
         if !(scale.is_finite() && scale > 0.0) {
             return Err(err(
                 "scale",
-                format!("metres per scene unit must be a finite number > 0, got {scale}"),
+                format!("metres per scene unit must be a finite number > 0, got {}", show(scale)),
             ));
         }
         if absorption.iter().chain(&scattering).any(|&x| x * scale > MAX_COEFFICIENT) {
             return Err(err(
                 "scale",
-                format!("{scale} m per unit makes a coefficient above {MAX_COEFFICIENT:e} per scene unit"),
+                format!(
+                    "{} m per unit makes a coefficient above {MAX_COEFFICIENT:e} per scene unit",
+                    show(scale)
+                ),
             ));
         }
         Ok(RgbMedium { absorption, scattering, g, scale, upsampling })
@@ -136,19 +141,22 @@ impl RgbMedium {
             if !(x > 0.0 && x <= 1.0) {
                 return Err(err(
                     "attenuation_color",
-                    format!("the {c} component is {x}; a transmittance colour must lie in (0, 1]"),
+                    format!("the {c} component is {}; a transmittance colour must lie in (0, 1]", show(x)),
                 ));
             }
         }
         if !(distance.is_finite() && distance > 0.0) {
             return Err(err(
                 "attenuation_distance",
-                format!("must be a finite distance > 0 m, got {distance}"),
+                format!("must be a finite distance > 0 m, got {}", show(distance)),
             ));
         }
         for (c, x) in CHANNELS.iter().zip(albedo) {
             if !(0.0..=1.0).contains(&x) {
-                return Err(err("albedo", format!("the {c} component is {x}; an albedo must lie in [0, 1]")));
+                return Err(err(
+                    "albedo",
+                    format!("the {c} component is {}; an albedo must lie in [0, 1]", show(x)),
+                ));
             }
         }
         if color == [1.0; 3] {
@@ -254,8 +262,7 @@ impl RgbMedium {
 
     /// Parses JSON text (a `--rgb-medium` argument or file).
     pub fn from_json_str(text: &str) -> Result<Self, FieldError> {
-        let v: Value =
-            serde_json::from_str(text).map_err(|e| err("medium", format!("not valid JSON: {e}")))?;
+        let v = color::input::json_value(text).map_err(|e| err("medium", format!("not valid JSON: {e}")))?;
         Self::from_json(&v)
     }
 
@@ -314,6 +321,25 @@ mod tests {
 
     fn e(json: &str) -> FieldError {
         RgbMedium::from_json_str(json).unwrap_err()
+    }
+
+    /// What Windows Notepad writes (a byte-order mark first) is read; a key given twice is
+    /// refused (the last one won, silently); numbers in messages stay short.
+    #[test]
+    fn a_bom_is_read_a_repeated_key_refused_and_numbers_short() {
+        assert!(RgbMedium::from_json_str("\u{feff}{\"absorption\": [0.1, 0.2, 0.3]}").is_ok());
+        let dup = e(r#"{"absorption": [0.1, 0.2, 0.3], "absorption": [1, 1, 1]}"#);
+        assert!(dup.to_string().contains("\"absorption\" is given twice"), "{dup}");
+        for (json, shown) in [
+            (r#"{"absorption": [1, 1, 1], "scale": 1e300}"#, "1e300 m per unit"),
+            (
+                r#"{"attenuation_color": [0.5, 0.5, 0.5], "attenuation_distance": 1e-300}"#,
+                "is 6.931471805599452e299",
+            ),
+        ] {
+            let m = e(json).to_string();
+            assert!(m.contains(shown) && m.len() < 200, "{m}");
+        }
     }
 
     #[test]

@@ -107,7 +107,7 @@ fn absurd_settings_are_refused_before_rendering() {
     refused(&with(&base, &["--white", "1K"]), &["500–1000000 K"]);
     let m = d.join("m.json");
     std::fs::write(&m, r#"{"sigma_a": 1e39, "sigma_s": 0}"#).unwrap();
-    refused(&with(&base, &["--medium", m.to_str().unwrap()]), &["sigma_a", "1e39", "0–1e6"]);
+    refused(&with(&base, &["--medium", m.to_str().unwrap()]), &["sigma_a", "1e39", "0–1e7"]);
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }

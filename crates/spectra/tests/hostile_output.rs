@@ -40,7 +40,7 @@ fn absurd_counts_and_sizes_are_refused() {
     for (m, shown) in [("1e300", "1e300"), ("1e-300", "1e-300"), ("0e0", "got 0"), ("-1", "got -1")] {
         refused(
             &["diff", &a, &b, "--heatmap", &heat, "--max-de", m],
-            &["--max-de", "from 1e-4 to 1e4", shown],
+            &["--max-de", "from 0.0001 to 10000", shown],
         );
     }
     assert!(!dir.path().join("h.png").exists());

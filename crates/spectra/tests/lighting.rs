@@ -580,7 +580,24 @@ fn a_scene_too_dim_for_the_hdr_target_is_warned_about() {
         let out = spectra(&["render", scene, "--size", "16x12", "--env", "none", "--out", &p(&d, "o.exr")]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(err.contains("half-float"), dim_expected, "{scene}: {err}");
+        assert!(!dim_expected || err.contains("--exposure"), "the remedy is named: {err}");
     }
+    // The remedy works: the exposure is applied before the half float, so +30 EV renders the
+    // dim scene as cornell times 1e-9 · 2^30, without the warning.
+    let mean = |args: &[&str], name: &str| {
+        let o = p(&d, name);
+        let out = spectra(&[args, &["--size", "16x12", "--env", "none", "--out", &o]].concat());
+        assert!(out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        let img = compare::io::read_image(Path::new(&o)).unwrap();
+        let sum: f64 = img.data.iter().flat_map(|px| px.map(f64::from)).sum();
+        (sum / img.data.len() as f64, err)
+    };
+    let (exposed, err) = mean(&["render", &dim, "--exposure", "30"], "e.exr");
+    let (bright, _) = mean(&["render", "cornell"], "c.exr");
+    assert!(!err.contains("half-float"), "{err}");
+    let want = bright * 1e-9 * 2f64.powi(30);
+    assert!((exposed - want).abs() < 2e-3 * want, "mean {exposed} at +30 EV, want {want}");
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -613,5 +630,14 @@ fn an_environment_scaled_to_zero_is_the_reason_given() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("scaled to 0 by --env-intensity") && !err.contains("drop --env none"), "{err}");
     assert!(!err.contains("half-float") && !err.contains("× -0"), "{err}");
+    // A map black in every texel is named as the reason too (the warning said there was no
+    // environment and suggested giving one).
+    let black = p(&d, "black.hdr");
+    let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+    bytes.extend([0u8; 4 * 8]);
+    std::fs::write(&black, bytes).unwrap();
+    let out = spectra(&["render", &unlit, "--size", "16x12", "--env", &black, "--out", &p(&d, "b.exr")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("black.hdr) is black in every texel") && !err.contains("drop --env none"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -76,6 +76,32 @@ fn truth_renders_only_what_the_cache_lacks() {
     assert!(e.contains("8 of 16 samples from"), "{e}");
     assert_eq!(pixels(Path::new(&again)), pixels(Path::new(&f16)));
     assert!(std::fs::read(&p).unwrap().len() == bytes.len(), "the entry is stored again");
+    // An entry whose name lies about its samples: the warning names the file it removes.
+    let renamed = p.with_file_name(sixteen.replace("-16.", "-12."));
+    std::fs::rename(&p, &renamed).unwrap();
+    let e = truth("12", "3", &out("twelve.exr"), true);
+    let name = renamed.file_name().unwrap().to_str().unwrap();
+    assert!(e.contains(name) && e.contains("its name says 12") && e.contains("removed it"), "{e}");
+    assert!(e.contains("8 of 12 samples from"), "rendered on from the next entry down: {e}");
+
+    // The cache where the checkpoint goes (`--out`'s name + .checkpoint): refused before any
+    // work (it was accepted, and the folder then blocked every later render to that --out).
+    let x = out("x.exr");
+    let o = run(&[
+        "truth",
+        "cornell",
+        "--size",
+        "8x8",
+        "--spp",
+        "1",
+        "--truth-cache",
+        &format!("{x}.checkpoint"),
+        "--out",
+        &x,
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("checkpoint") && err.contains("--truth-cache"), "{err}");
+    assert!(!Path::new(&format!("{x}.checkpoint")).exists());
 
     // Not a directory.
     let file = out("file");

@@ -12,9 +12,12 @@ use glam::{Vec3, Vec4};
 use std::f32::consts::PI;
 
 /// Largest absorption or scattering coefficient accepted (per scene unit): a mean free path of
-/// 10⁻⁶ units. Larger finite values (1e38, 1e39) overflow the tracer's f32 transmittance into
-/// black or NaN pixels.
-pub const MAX_SIGMA: f64 = 1.0e6;
+/// 10⁻⁷ units. Larger finite values (1e38, 1e39) overflow the tracer's f32 transmittance into
+/// black or NaN pixels. Ten times the RGB media's bound (`scene::medium::MAX_COEFFICIENT`):
+/// their upsampled spectra overshoot their RGB coefficients, by up to 5.5× (test
+/// `every_rgb_medium_the_parser_accepts_the_tracer_accepts`), and every RGB medium the parser
+/// accepts must be one the tracer accepts, as the real-time renderer does.
+pub const MAX_SIGMA: f64 = 1.0e7;
 
 /// Where a medium is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -267,5 +270,49 @@ mod tests {
         assert_eq!(m.overlap(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, 100.0), Some((4.0, 6.0)));
         assert_eq!(m.overlap(Vec3::ZERO, Vec3::X, 0.5), Some((0.0, 0.5)));
         assert_eq!(m.overlap(Vec3::new(-5.0, 3.0, 0.0), Vec3::X, 100.0), None);
+    }
+
+    /// Every RGB medium the scene's parser accepts (coefficients up to its bound) is one the
+    /// tracer accepts, whatever its upsampling: the spectra overshoot their RGB coefficients
+    /// (a red-only 9e5 "unbounded" peaks at 1.02e6), which the tracer used to refuse while the
+    /// real-time renderer drew them.
+    #[test]
+    fn every_rgb_medium_the_parser_accepts_the_tracer_accepts() {
+        use color::upsample::medium::Attenuation;
+        use scene::medium::{MAX_COEFFICIENT, RgbMedium};
+        let table = color::upsample::table("srgb").unwrap();
+        let top = MAX_COEFFICIENT;
+        let mut worst = 0.0f64;
+        let mut rgbs = vec![];
+        for c in 1..8u32 {
+            let v = [0, 1, 2].map(|i| if c >> i & 1 == 1 { top } else { 0.0 });
+            rgbs.push(v);
+            rgbs.push(v.map(|x| x * 0.9));
+            rgbs.push(v.map(|x| if x > 0.0 { x } else { top * 0.01 }));
+        }
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..200 {
+            rgbs.push([next(), next(), next()].map(|u| top * u * u));
+        }
+        for method in [Attenuation::DEFAULT, Attenuation::TRANSMITTANCE, Attenuation::Unbounded] {
+            for v in &rgbs {
+                for (a, s) in [(*v, [0.0; 3]), ([0.0; 3], *v)] {
+                    let m = RgbMedium::new(a, s, 0.0, 1.0, method).unwrap();
+                    let medium = Medium::from_rgb(&m, &table).unwrap();
+                    for l in 360..=830 {
+                        let peak = medium.sigma_a.eval(l as f64).max(medium.sigma_s.eval(l as f64));
+                        worst = worst.max(peak / v.iter().copied().fold(0.0, f64::max));
+                    }
+                    medium
+                        .validate(WavelengthRange::FULL)
+                        .unwrap_or_else(|e| panic!("{method:?} {v:?}: {e}"));
+                }
+            }
+        }
+        eprintln!("largest upsampled coefficient / largest RGB coefficient: {worst:.4}");
     }
 }

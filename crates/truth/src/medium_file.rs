@@ -79,7 +79,7 @@ impl Medium {
     /// Parses the JSON form; `origin` (a file name) prefixes every error. Values are checked
     /// by [`Medium::validate`] at render time, against the render's wavelength range.
     pub fn from_json(text: &str, origin: &str) -> Result<Medium> {
-        let v: Value = serde_json::from_str(text).map_err(|e| bad(origin, format!("not valid JSON: {e}")))?;
+        let v = color::input::json_value(text).map_err(|e| bad(origin, format!("not valid JSON: {e}")))?;
         let obj = v.as_object().ok_or_else(|| bad(origin, "expected a JSON object".into()))?;
         if let Some(k) = obj.keys().find(|k| !["sigma_a", "sigma_s", "phase", "box"].contains(&k.as_str())) {
             return Err(bad(origin, format!("unknown key \"{k}\" (known: sigma_a, sigma_s, phase, box)")));

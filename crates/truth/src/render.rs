@@ -183,7 +183,11 @@ impl Settings {
             )));
         }
         if c.width as u64 * c.height as u64 > MAX_PIXELS {
-            return Err(TruthError::TooLarge(c.width, c.height));
+            return Err(TruthError::BadCrop(format!(
+                "{},{},{},{} is {}×{} pixels: at most {MAX_PIXELS} (8192×8192) are rendered at once; split it into \
+                 smaller crops and merge them",
+                c.x, c.y, c.width, c.height, c.width, c.height
+            )));
         }
         if self.sample_offset.checked_add(u64::from(self.spp)).is_none_or(|end| end > MAX_SAMPLE_INDEX) {
             return Err(TruthError::BadSamples(format!(
@@ -830,8 +834,17 @@ mod tests {
             let e = Settings { crop: Some(bad), ..base.clone() }.validate().unwrap_err().to_string();
             assert!(e.contains("crop") && e.contains("9×6"), "{e}");
         }
-        let e = Settings { sample_offset: MAX_SAMPLE_INDEX, ..base }.validate().unwrap_err().to_string();
+        let e =
+            Settings { sample_offset: MAX_SAMPLE_INDEX, ..base.clone() }.validate().unwrap_err().to_string();
         assert!(e.contains("sample"), "{e}");
+        // A crop of a large frame over the pixel budget is the crop's fault, named as such (the
+        // message read as if the frame's size were wrong).
+        let big = Crop { x: 0, y: 0, width: 8192, height: 8193 };
+        let e = Settings { width: MAX_SIDE, height: MAX_SIDE, crop: Some(big), ..base }
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("crop") && e.contains("8192×8193") && !e.contains("image size"), "{e}");
     }
 
     /// Direct lighting never exceeds full transport, and both see the lamp.

@@ -19,6 +19,8 @@ fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
     if (!ctx.background) {
         ctx.normal = gbuffer_normal(textureLoad(gbuf_normal, px, 0));
     }
-    let c = custom_pixel(textureLoad(hdr_in, px, 0), ctx);
-    return vec4<f32>(hdr_out(c.rgb).rgb, c.a);
+    // The hook sees radiance: the target holds it times the exposure (`hdr_out`).
+    let held = textureLoad(hdr_in, px, 0);
+    let c = custom_pixel(vec4<f32>(held.rgb / frame.exposure, held.a), ctx);
+    return vec4<f32>(hdr_out(c.rgb, frame.exposure).rgb, c.a);
 }

@@ -42,9 +42,9 @@ pub fn hdr_clipped(pixels: &[[f32; 4]]) -> usize {
 pub const HDR_MIN_NORMAL: f32 = 6.103_515_6e-5;
 
 /// The brightest channel of a read-back HDR image when even it lies below [`HDR_MIN_NORMAL`]
-/// (the whole image quantised to a few levels, or 0), for the caller to warn about: exposure
-/// applied after the read-back cannot bring back what the target did not store. `None` for an
-/// image with a brighter pixel, or none.
+/// (the whole image quantised to a few levels, or 0), for the caller to warn about: a higher
+/// exposure (applied before the target) would have kept it. `None` for an image with a brighter
+/// pixel, or none.
 pub fn hdr_too_dim(pixels: &[[f32; 4]]) -> Option<f32> {
     let max =
         pixels.iter().flat_map(|p| &p[..3]).filter(|c| c.is_finite()).fold(0.0f32, |m, c| m.max(c.abs()));

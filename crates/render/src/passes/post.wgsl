@@ -1,4 +1,5 @@
-// Pass 4: exposure, tone mapping; the sRGB encoding is done by the rgba8unorm-srgb target.
+// Pass 4: tone mapping (the exposure is in the HDR values already: `hdr_out`); the sRGB
+// encoding is done by the rgba8unorm-srgb target.
 // Prepended: wgsl/common.wgsl.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -22,6 +23,6 @@ fn tonemap(c: vec3<f32>, op: u32) -> vec3<f32> {
 
 @fragment
 fn fs_main(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let c = textureLoad(hdr, vec2<i32>(in.pos.xy), 0).rgb * frame.exposure;
+    let c = textureLoad(hdr, vec2<i32>(in.pos.xy), 0).rgb;
     return vec4<f32>(clamp(tonemap(max(c, vec3<f32>(0.0)), frame.tonemap), vec3<f32>(0.0), vec3<f32>(1.0)), 1.0);
 }

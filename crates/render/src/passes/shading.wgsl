@@ -583,7 +583,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             out += s.base * (lobe * ambient_visibility(in.pos.xy, ctx.world_pos, s)) * custom_irradiance_rgb(ctx);
         }
     }
-    return hdr_out(out);
+    return hdr_out(out, frame.exposure);
 }
 
 // The spectral entry point's pipeline constants (`Variant` in src/passes/shading.rs), so that a
@@ -707,7 +707,7 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
 // Spectral and naive modes.
 fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     if (CUSTOM_SPECTRAL || CAPTURE) {
-        return hdr_out(shade_nodes(in));
+        return hdr_out(shade_nodes(in), frame.exposure);
     }
     let px = vec2<i32>(in.pos.xy);
     if (HAS_TRANSMISSION && gbuffer_slot(textureLoad(gbuf_normal, px, 0)) == 0u) {
@@ -717,7 +717,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     let has_env = shading_env();
     if (ctx.background) {
         if (has_env && env.flags.y != 0u) {
-            return hdr_out(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)));
+            return hdr_out(frame.xyz_to_rgb * env_xyz(env_background(ctx.view_dir)), frame.exposure);
         }
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
@@ -862,7 +862,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     if (HAS_TRANSMISSION) {
         xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base, film);
     }
-    return hdr_out(frame.xyz_to_rgb * xyz);
+    return hdr_out(frame.xyz_to_rgb * xyz, frame.exposure);
 }
 
 // The general spectral loop, groups outermost, for what needs each node's whole radiance: a

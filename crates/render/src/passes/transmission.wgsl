@@ -309,12 +309,13 @@ fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>
 const BLUR_TAPS: u32 = 13u;
 
 // The background around pixel `at`, blurred over a disc whose radius grows with α = roughness²
-// (a tenth of the image height at α = 1): a rough surface refracts a cone, not a ray.
+// (a tenth of the image height at α = 1): a rough surface refracts a cone, not a ray. As
+// radiance: the target holds it times the exposure (`hdr_out`).
 fn background_at(at: vec2<f32>, roughness: f32) -> vec3<f32> {
     let inv = frame.viewport.zw;
     let radius = 0.1 * roughness * roughness * frame.viewport.y;
     if (radius < 0.5) {
-        return textureSampleLevel(background, env_sampler, clamp(at * inv, vec2<f32>(0.0), vec2<f32>(1.0)), 0.0).rgb;
+        return textureSampleLevel(background, env_sampler, clamp(at * inv, vec2<f32>(0.0), vec2<f32>(1.0)), 0.0).rgb / frame.exposure;
     }
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < BLUR_TAPS; i++) {
@@ -326,7 +327,7 @@ fn background_at(at: vec2<f32>, roughness: f32) -> vec3<f32> {
         }
         sum += textureSampleLevel(background, env_sampler, clamp((at + o) * inv, vec2<f32>(0.0), vec2<f32>(1.0)), 0.0).rgb;
     }
-    return sum / f32(BLUR_TAPS);
+    return sum / (f32(BLUR_TAPS) * frame.exposure);
 }
 
 // What light `li` brings through a thin-walled see-through surface from behind it, per unit of

@@ -93,9 +93,14 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
 // later arithmetic; clamped, it saturates at f16's largest finite value, which the host counts
 // and reports (`render::passes::hdr_clipped`). Not a NaN filter: what clamp does with a NaN is
 // the driver's, and a NaN is a bug to find, not to hide.
+// The exposure (2^EV, `FrameUniforms::exposure`) is applied here, before the half float, not
+// after it: f16 keeps nothing below 6e-8 (and is coarse below 6.1e-5) nor above 65504, so a scene
+// in other units than the target's can still be brought into its range by the exposure.
+// Whatever reads the target back as radiance (the see-through layer's background, the custom
+// pass) divides the exposure out again.
 const HDR_MAX: f32 = 65504.0;
-fn hdr_out(c: vec3<f32>) -> vec4<f32> {
-    return vec4<f32>(clamp(c, vec3<f32>(-HDR_MAX), vec3<f32>(HDR_MAX)), 1.0);
+fn hdr_out(c: vec3<f32>, exposure: f32) -> vec4<f32> {
+    return vec4<f32>(clamp(c * exposure, vec3<f32>(-HDR_MAX), vec3<f32>(HDR_MAX)), 1.0);
 }
 
 // The G-buffer's second target (passes::GBUFFER_FORMATS[1], Rgba16Uint): the unit normal in

@@ -3,7 +3,7 @@
 //! A measurement, not a test: it exits 0 whatever the difference, and non-zero only when it
 //! cannot measure (unreadable file, size mismatch, non-finite pixel, bad option).
 
-use color::numfmt::short;
+use color::error::show as short;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};

@@ -139,9 +139,8 @@ pub fn warn_if_too_dim(scene: &scene::Scene, hdr: &[[f32; 4]]) {
         };
         eprintln!(
             "warning: {what}, below the smallest normal value of the real-time renderer's half-float \
-             target ({:.1e}; nothing below 6e-8 is kept): the image is banded or black, and the exposure (--exposure), \
-             applied afterwards, cannot bring it back; raise the scene's light instead (its intensities, \
-             --env-intensity) — spectra truth has no such floor",
+             target ({:.1e}; nothing below 6e-8 is kept): the image is banded or black; raise --exposure \
+             (applied before the target) or the scene's light (its intensities, --env-intensity)",
             render::passes::HDR_MIN_NORMAL
         );
     }
@@ -182,6 +181,8 @@ fn render_frame(
         || if color::cancel::is_cancelled() { Err(render::RenderError::Cancelled) } else { Ok(()) };
     let samples = args.samples;
     draw(r, &scene.camera, settings, samples, &interrupted)?;
+    // The exposure is in the HDR values already (the shaders apply it before the half float);
+    // the spectral capture, an f32 buffer of radiance, takes it here.
     let k = settings.exposure_ev.exp2();
     // Linear outputs hold the HDR values themselves, so their clipping is worth a warning (a PNG
     // is tone mapped: a clipped pixel is white either way).
@@ -192,7 +193,7 @@ fn render_frame(
     if clipped > 0 {
         eprintln!(
             "warning: {clipped} pixels reached the HDR target's largest value ({}) and are clipped there; \
-             lower the light (--env-intensity, the scene's intensities) and raise --exposure",
+             lower --exposure (applied before the target) or the light (--env-intensity, the scene's intensities)",
             render::passes::HDR_MAX
         );
     }
@@ -200,7 +201,7 @@ fn render_frame(
     // without the spectral one it was asked to go with.
     if let Some(sp) = &args.spectral_out {
         let cap = r.read_spectral_capture()?;
-        let rgb = hdr.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+        let rgb = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let rgb = compare::image::Image::new(width, height, rgb)?;
         let spec = compare::SpectralImage {
             width,
@@ -227,7 +228,7 @@ fn render_frame(
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
         OutFormat::Exr => {
-            let data = hdr.iter().map(|p| [p[0] * k, p[1] * k, p[2] * k]).collect();
+            let data = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
             let img = compare::image::Image::new(width, height, data)?;
             interrupted()?;
             compare::io::write_image(&args.out, &img, Default::default())

@@ -81,7 +81,9 @@ pub struct LookArgs {
     /// (the paper's point-sampled sum).
     #[arg(long, default_value = "prefiltered", value_parser = parse_quadrature)]
     pub quadrature: color::Quadrature,
-    /// Exposure in stops (the image is multiplied by 2^EV).
+    /// Exposure in stops: the radiance is multiplied by 2^EV as the frame is written to its
+    /// half-float target (range 6.1e-5…65504), so it also brings a scene lit far below or above
+    /// that range into it.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Tone mapping (PNG output and the window): none, reinhard or aces; any case.

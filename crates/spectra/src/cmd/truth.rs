@@ -59,7 +59,10 @@ pub struct Args {
     /// Lambertian BRDF instead of glTF's (only for comparisons with Mitsuba's `diffuse`).
     #[arg(long)]
     pub lambert: bool,
-    /// Write CIE XYZ into the EXR's three channels instead of linear sRGB.
+    /// Write CIE XYZ into the EXR's three channels instead of linear sRGB: the tracer's own
+    /// integral (Y = 1 for the white), before the display's balance onto sRGB's white
+    /// (`--out` without this flag is XYZ scaled so that the white over --range lands on sRGB's
+    /// white, then the sRGB matrix: docs/cameras.md).
     #[arg(long)]
     pub xyz: bool,
     #[command(flatten)]
@@ -432,11 +435,31 @@ pub fn run(a: Args) -> Result<()> {
     }
     if let Some(out) = &a.out {
         let ckpt = super::checkpoint::path_for(out);
-        if !a.resume && std::fs::symlink_metadata(&ckpt).is_ok() {
-            bail!(
+        // The cache is a folder made on first use: the same path as an output or the checkpoint
+        // would end a long render in "is a directory" (or leave a folder where the next run
+        // looks for an interrupted render's checkpoint).
+        if let Some(cache) = &a.truth_cache {
+            let same = |p: &std::path::Path| std::path::absolute(p).ok() == std::path::absolute(cache).ok();
+            for (flag, p) in [
+                ("--out", Some(out.as_path())),
+                ("--spectral-out", a.spectral_out.as_deref()),
+                ("the checkpoint", Some(ckpt.as_path())),
+            ] {
+                if let Some(p) = p.filter(|p| same(p)) {
+                    bail!("{flag} {} is the --truth-cache folder; give each a path of its own", p.display());
+                }
+            }
+        }
+        match std::fs::symlink_metadata(&ckpt) {
+            Ok(m) if m.is_dir() => bail!(
+                "{}: a folder is where this render keeps its checkpoint (--out's name + .checkpoint); move it, or choose another --out",
+                ckpt.display()
+            ),
+            Ok(_) if !a.resume => bail!(
                 "{}: the checkpoint of an interrupted render is there: add --resume to continue it, or remove it to start over",
                 ckpt.display()
-            );
+            ),
+            _ => {}
         }
     }
     let scene = a.scene.load(a.water.water.as_deref())?;
@@ -454,16 +477,6 @@ pub fn run(a: Args) -> Result<()> {
         ],
         &inputs,
     )?;
-    // The cache is a folder made on first use: the same path as an output would end a long
-    // render in "is a directory".
-    if let (Some(cache), Some(out)) = (&a.truth_cache, &a.out) {
-        let same = |p: &std::path::Path| std::path::absolute(p).ok() == std::path::absolute(cache).ok();
-        for (flag, p) in [("--out", Some(out.as_path())), ("--spectral-out", a.spectral_out.as_deref())] {
-            if let Some(p) = p.filter(|p| same(p)) {
-                bail!("{flag} {} is the --truth-cache folder; give each a path of its own", p.display());
-            }
-        }
-    }
     let table = a.table.load()?;
     let st = settings(&a, &scene, &table)?;
     let t0 = Instant::now();

@@ -101,10 +101,12 @@ impl TruthCache {
             let bad = |why: String| anyhow::anyhow!("the truth-cache entry {}: {why}", path.display());
             let check = |there: &[(String, String)], n: u32, done: u32| -> Result<()> {
                 if let Some((k, there, here)) = super::truth::record_difference(there, &record) {
-                    bail!("it is of a different render ({k} is {there} there and {here} here)");
+                    return Err(bad(format!(
+                        "it is of a different render ({k} is {there} there and {here} here)"
+                    )));
                 }
                 if n != spp || done != spp {
-                    bail!("it holds {done} of {n} samples, its name says {spp}");
+                    return Err(bad(format!("it holds {done} of {n} samples, its name says {spp}")));
                 }
                 Ok(())
             };
