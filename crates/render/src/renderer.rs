@@ -532,8 +532,8 @@ impl Renderer {
         self.targets.as_ref().map(|(t, _)| &t.ldr_view)
     }
 
-    /// The linear HDR image of the last frame (`Rgba16Float`, after the custom pass, before
-    /// exposure).
+    /// The linear HDR image of the last frame (`Rgba16Float`, after the custom pass, exposed:
+    /// the shaders apply the exposure as they write it).
     pub fn hdr_view(&self) -> Option<&wgpu::TextureView> {
         self.targets.as_ref().map(|(t, _)| &t.hdr_view)
     }
@@ -1016,7 +1016,8 @@ impl Renderer {
         readback::read_texture(&self.gpu.device, &self.gpu.queue, &t.ldr, 4)
     }
 
-    /// The linear HDR image (after the custom pass, before exposure) as RGBA f32 pixels.
+    /// The linear HDR image (after the custom pass; times 2^EV, which the shaders apply as they
+    /// write it, before the half float) as RGBA f32 pixels.
     pub fn read_hdr(&self) -> Result<Vec<[f32; 4]>> {
         let (t, _) =
             self.targets.as_ref().ok_or_else(|| RenderError::Settings("nothing rendered yet".into()))?;

@@ -1,4 +1,5 @@
-//! Pass 4: exposure (×2^EV), tone mapping (none / Reinhard / ACES fitted) and sRGB encoding
+//! Pass 4: tone mapping (none / Reinhard / ACES fitted; the exposure, ×2^EV, is in the HDR
+//! values already, applied as they were written) and sRGB encoding
 //! (by the `Rgba8UnormSrgb` target's store). EXR output skips this pass's result and reads the
 //! linear HDR target instead.
 
