@@ -86,40 +86,21 @@ fn truth_renders_only_what_the_cache_lacks() {
 
     // The cache where the checkpoint goes (`--out`'s name + .checkpoint): refused before any
     // work (it was accepted, and the folder then blocked every later render to that --out).
+    // One sample of an 8×8 Cornell into `o` with `cache` as the truth cache: failed?, stderr.
+    let attempt = |cache: &str, o: &str| {
+        let r = run(&["truth", "cornell", "--size", "8x8", "--spp", "1", "--truth-cache", cache, "--out", o]);
+        (!r.status.success(), String::from_utf8_lossy(&r.stderr).to_string())
+    };
     let x = out("x.exr");
-    let o = run(&[
-        "truth",
-        "cornell",
-        "--size",
-        "8x8",
-        "--spp",
-        "1",
-        "--truth-cache",
-        &format!("{x}.checkpoint"),
-        "--out",
-        &x,
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("checkpoint") && err.contains("--truth-cache"), "{err}");
+    let (failed, err) = attempt(&format!("{x}.checkpoint"), &x);
+    assert!(failed && err.contains("checkpoint") && err.contains("--truth-cache"), "{err}");
     assert!(!Path::new(&format!("{x}.checkpoint")).exists());
 
     // Not a directory.
     let file = out("file");
     std::fs::write(&file, "x").unwrap();
-    let o = run(&[
-        "truth",
-        "cornell",
-        "--size",
-        "8x8",
-        "--spp",
-        "1",
-        "--truth-cache",
-        &file,
-        "--out",
-        &out("x.exr"),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("--truth-cache") && err.contains("not a directory"), "{err}");
+    let (failed, err) = attempt(&file, &out("x.exr"));
+    assert!(failed && err.contains("--truth-cache") && err.contains("not a directory"), "{err}");
 }
 
 #[test]
