@@ -479,11 +479,6 @@ impl Renderer {
                     )));
                 }
                 inner.renderer.check_spectral_capture(w, h, settings.wavelengths).map_err(value)?;
-                if let Some(w) =
-                    spectra::cmd::render::capture_drops_layer(&inner.scene, "spectral=True", "the image")
-                {
-                    eprintln!("{w}");
-                }
             }
             inner.renderer.set_spectral_capture(spectral);
             let never = || Ok(());

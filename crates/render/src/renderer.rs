@@ -674,6 +674,16 @@ impl Renderer {
         }
         let untimed = RenderSettings { timestamps: false, ..settings.clone() };
         let accumulating = std::mem::replace(&mut self.accumulating, false);
+        // The capture's frame integrates with weights of its own (a radiance per node, the same
+        // in X, Y and Z), so its RGB image is no colour: a see-through layer, which reads the
+        // opaque layer's image as its background (transmission.wgsl), reads the one a frame
+        // with the display's weights drew just before.
+        if self.scene.as_ref().is_some_and(|s| s.has_transmission) {
+            if let Err(e) = self.render_frame(camera, &untimed, true) {
+                self.accumulating = accumulating;
+                return Err(e);
+            }
+        }
         self.capture_frame = true;
         let radiance = self.render_frame(camera, &untimed, true).and_then(|()| self.read_capture_buffer());
         self.capture_frame = false;
@@ -837,11 +847,9 @@ impl Renderer {
             occlusion_map: occlusion,
         };
         // See-through materials get a layer of their own, shaded over the opaque one
-        // (`passes::gbuffer::Layer`), except where the shading runs its general node loop (a
-        // spectral hook, the capture): there they are drawn opaque (`Layer::All`).
-        let layered = scene.has_transmission
-            && self.capture.is_none()
-            && !(settings.mode != Mode::Rgb && self.custom.spectral());
+        // (`passes::gbuffer::Layer`), in every mode: the general node loop (a spectral hook,
+        // the capture) shades it too, and the capture takes its pixels from it.
+        let layered = scene.has_transmission;
         if layered {
             // Prepared first: `select` leaves the pipeline it makes last current.
             // The layer searches its occlusion on its own depth.
@@ -925,11 +933,15 @@ impl Renderer {
                 self.shading.record(&mut encoder, &shared, draw);
                 let shaded_texture =
                     if self.custom_pass.skipped() { &targets.hdr } else { &targets.hdr_shaded };
-                encoder.copy_texture_to_texture(
-                    shaded_texture.as_image_copy(),
-                    layer.background.as_image_copy(),
-                    wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                );
+                // The capture's frame keeps the background the frame before it left (`render`):
+                // its own opaque layer is drawn with the capture's weights, no colour.
+                if !self.capture_frame {
+                    encoder.copy_texture_to_texture(
+                        shaded_texture.as_image_copy(),
+                        layer.background.as_image_copy(),
+                        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                    );
+                }
                 encoder.copy_texture_to_texture(
                     targets.depth.as_image_copy(),
                     layer.depth.as_image_copy(),
@@ -952,12 +964,13 @@ impl Renderer {
                     &self.frame_bind_group,
                     scene,
                 );
+                let capture = self.capture.as_ref().map_or(&self.capture_dummy, |c| &c.buffer);
                 let layer_inputs = self.shading.bind_layer_inputs(
                     &self.gpu.device,
                     layer,
                     &targets.depth_view,
                     &self.shadow,
-                    &self.capture_dummy,
+                    capture,
                 );
                 let draw =
                     Draw { target: shaded, inputs: &layer_inputs, timestamps: timer.map(|t| t.ends(2)) };

@@ -706,12 +706,12 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
 
 // Spectral and naive modes.
 fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
-    if (CUSTOM_SPECTRAL || CAPTURE) {
-        return hdr_out(shade_nodes(in), frame.exposure);
-    }
     let px = vec2<i32>(in.pos.xy);
     if (HAS_TRANSMISSION && gbuffer_slot(textureLoad(gbuf_normal, px, 0)) == 0u) {
         return textureLoad(background, px, 0);
+    }
+    if (CUSTOM_SPECTRAL || CAPTURE) {
+        return hdr_out(shade_nodes(in), frame.exposure);
     }
     var ctx = surface_context(in.pos.xy, textureLoad(gbuf_depth, px, 0), frame);
     let has_env = shading_env();
@@ -891,10 +891,19 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var metallic = 0.0;
     // Loaded once: the coefficients below are fetched from it too.
     var s: GSurface;
+    // The see-through layer (transmission.wgsl): its diffuse layer is what its transmission
+    // leaves (`keep`), a thin wall lets lights behind it through (in `fa` beside the rest, or
+    // alone for a filmed pixel), and the light through it is added per group after the hook,
+    // which the background it reads has had already.
+    var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
     if (!background) {
         s = load_surface(px);
         film = load_film(px);
         metallic = s.metallic;
+        if (HAS_TRANSMISSION) {
+            tr = load_transmissive(px, s);
+        }
+        let keep = 1.0 - tr.weight;
         var vis = 1.0;
         if ((has_env || CUSTOM_IRRADIANCE) && !s.unlit) {
             vis = ambient_visibility(in.pos.xy, p, s);
@@ -904,8 +913,15 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 lobes = env_lobes(s.normal, -ctx.view_dir, s.roughness);
                 lobes.irr *= vis;
                 lobes.spec *= vis;
+                if (HAS_TRANSMISSION) {
+                    lobes.irr *= keep;
+                }
             } else {
-                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
+                if (HAS_TRANSMISSION) {
+                    et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+                } else {
+                    et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
+                }
                 et.a *= vis;
                 et.b *= vis;
             }
@@ -921,11 +937,22 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
+            var through = 0.0;
+            if (HAS_TRANSMISSION) {
+                t.kd *= keep;
+                through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k;
+            }
             if (HAS_FILM && film.weight > 0.0) {
                 ft[li] = t;
+                if (HAS_TRANSMISSION) {
+                    fa[li] = through;
+                }
             } else {
                 let f = factors_of(t, s.metallic, s.f0);
                 fa[li] = f.x;
+                if (HAS_TRANSMISSION) {
+                    fa[li] += through;
+                }
                 fb[li] = f.y;
             }
         }
@@ -953,6 +980,10 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let ng = frame.n_groups;
+    var tp = TransmittedPixel(0.0, Through(vec3<f32>(0.0), 0.0, 0.0, false), vec4<f32>(0.0));
+    if (HAS_TRANSMISSION) {
+        tp = transmitted_pixel(in.pos.xy, ctx, s, tr);
+    }
     var xyz = vec3<f32>(0.0);
     // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
     // light's XYZ once; the capture still takes them per node.
@@ -980,6 +1011,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             }
             if (filmed) {
                 acc_f += s3_scale(w, film_light_node(ft[li], film, rho, metallic, lambda));
+                if (HAS_TRANSMISSION) {
+                    acc_f += s3_scale(w, fa[li] * rho);
+                }
             } else {
                 acc_a += w * fa[li];
                 acc_b += w * fb[li];
@@ -1033,6 +1067,16 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             let irr = s3_scale(custom_irradiance(lambda, g, ctx), rho * lobe);
             xyz += s3_xyz(irr);
             part += irr;
+        }
+        if (HAS_TRANSMISSION && tp.k > 0.0) {
+            let tn = transmitted_nodes(in.pos.xy, ctx, s, tr, c_base, film, tp, g);
+            var through = transmitted_weighted(tn, g);
+            if (CUSTOM_ENV_T && tn.sky) {
+                // What the hooks let through of the environment (`seen_through` took none).
+                through = s3_scale(through, custom_env_transmittance(lambda, g, ctx));
+            }
+            xyz += s3_xyz(through);
+            part += through;
         }
         if (CAPTURE) {
             capture_group(px, g, part);

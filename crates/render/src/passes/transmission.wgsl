@@ -266,18 +266,20 @@ fn landing_pixel(e: Exit) -> vec2<f32> {
 // the roughness), else the environment's radiance in its direction (black without one) times
 // `env_t`, what a medium's hooks let through of it (the background has had them already: in a
 // medium filling the scene the environment was drawn at full strength through the glass).
-fn seen_through(e: Exit, roughness: f32, env_t: vec3<f32>) -> vec3<f32> {
+// w is 1 where the ray took the environment (the spectral loop lets a hook's per-node
+// transmittance through there instead of `env_t`).
+fn seen_through(e: Exit, roughness: f32, env_t: vec3<f32>) -> vec4<f32> {
     let at = landing_pixel(e);
     if (at.x >= 0.0) {
-        return background_at(at, roughness);
+        return vec4<f32>(background_at(at, roughness), 0.0);
     }
     if (!shading_env() || env.flags.y == 0u) {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
     if (frame.mode == MODE_RGB) {
-        return env_background(e.dir).rgb * env_t;
+        return vec4<f32>(env_background(e.dir).rgb * env_t, 1.0);
     }
-    return frame.xyz_to_rgb * env_xyz(env_background(e.dir)) * env_t;
+    return vec4<f32>(frame.xyz_to_rgb * env_xyz(env_background(e.dir)) * env_t, 1.0);
 }
 
 // The light arriving at the front surface through the volume, at index `ior`, before the base
@@ -287,6 +289,8 @@ struct Through {
     rgb: vec3<f32>,
     share: f32,
     length: f32,
+    // Whether the ray left the screen for the environment (`seen_through`'s w).
+    sky: bool,
 };
 
 fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>, ior: f32, thickness: f32, env_t: vec3<f32>) -> Through {
@@ -300,9 +304,10 @@ fn through_volume(pix: vec2<f32>, p: vec3<f32>, s: GSurface, view_dir: vec3<f32>
                 at = clip_to_pixel(clip);
             }
         }
-        return Through(background_at(at, s.roughness), 1.0, thickness);
+        return Through(background_at(at, s.roughness), 1.0, thickness, false);
     }
-    return Through(seen_through(e, s.roughness, env_t), e.share, e.length);
+    let seen = seen_through(e, s.roughness, env_t);
+    return Through(seen.rgb, e.share, e.length, seen.w > 0.0);
 }
 
 // Taps of the roughness blur: the centre and two rings of six.
@@ -409,7 +414,7 @@ fn background_nodes(bg: vec3<f32>, c: vec4<f32>, g: u32) -> vec4<f32> {
     return c.w * sigmoid4(c.xyz, wavelengths[g].lambda);
 }
 
-// Spectral and naive modes: XYZ of the transmitted light, node by node — the base colour's
+// Spectral and naive modes: the transmitted light, node by node — the base colour's
 // reflectance (coefficients `c_base`), the absorption exp(−σ_a(λ)·d) (a box spectrum per channel,
 // exactly the box of the per-channel exp(−σ·d)) and the spectrum of what the ray meets. The
 // spectral mode integrates the absorption's steps exactly (`box_white_weights`: the smooth
@@ -417,45 +422,81 @@ fn background_nodes(bg: vec3<f32>, c: vec4<f32>, g: u32) -> vec4<f32> {
 // as it does its reflectances. Under dispersion each group of four nodes is traced with the
 // index at its mean wavelength: N/4 directions, each a trace, a background read and a
 // coefficient fetch (a trace per node cost the glass scene's spectral frame 1.1–1.25× at
-// N = 16 and changed its error by 0.003 ΔE at N = 8); without, one of each for the pixel.
-fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>, film: FilmSurface) -> vec3<f32> {
-    let k = transmitted_share(s, tr, -ctx.view_dir);
-    if (k <= 0.0) {
-        return vec3<f32>(0.0);
+// N = 16 and changed its error by 0.003 ΔE at N = 8); without, one of each for the pixel
+// (`transmitted_pixel`), which `transmitted_nodes` reuses for every group.
+struct TransmittedPixel {
+    // T·(1 − F(n·v)): nothing is transmitted where it is 0.
+    k: f32,
+    // Without dispersion: what the ray meets, and its coefficients (`background_coeffs`).
+    th: Through,
+    c_bg: vec4<f32>,
+};
+
+fn disperses(tr: Transmissive) -> bool {
+    return tr.dispersion > 0.0 && tr.thickness > 0.0;
+}
+
+fn transmitted_pixel(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive) -> TransmittedPixel {
+    var tp = TransmittedPixel(transmitted_share(s, tr, -ctx.view_dir), Through(vec3<f32>(0.0), 0.0, 0.0, false), vec4<f32>(0.0));
+    if (tp.k > 0.0 && !disperses(tr)) {
+        tp.th = through_volume(pix, ctx.world_pos, s, ctx.view_dir, tr.ior, tr.thickness, vec3<f32>(1.0));
+        tp.c_bg = background_coeffs(tp.th.rgb);
     }
-    let filmed = HAS_FILM && film.weight > 0.0;
-    let nv = max(dot(s.normal, -ctx.view_dir), 0.0);
-    let p = ctx.world_pos;
-    let ng = frame.n_groups;
-    let disperses = tr.dispersion > 0.0 && tr.thickness > 0.0;
-    var th = Through(vec3<f32>(0.0), 0.0, 0.0);
-    var c_bg = vec4<f32>(0.0);
-    if (!disperses) {
-        th = through_volume(pix, p, s, ctx.view_dir, tr.ior, tr.thickness, vec3<f32>(1.0));
+    return tp;
+}
+
+// Group g's transmitted light: `light` at the nodes, times the absorption box `att` (per
+// channel) in the weights (`transmitted_xyz`, `transmitted_weighted`); `sky` where the ray met
+// the environment.
+struct TransmittedNodes {
+    light: vec4<f32>,
+    att: vec3<f32>,
+    sky: bool,
+};
+
+fn transmitted_nodes(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>, film: FilmSurface, tp: TransmittedPixel, g: u32) -> TransmittedNodes {
+    var th = tp.th;
+    var c_bg = tp.c_bg;
+    if (disperses(tr)) {
+        let l = wavelengths[g].lambda;
+        let ior = abbe_ior(tr.ior, tr.dispersion, 0.25 * (l.x + l.y + l.z + l.w));
+        th = through_volume(pix, ctx.world_pos, s, ctx.view_dir, ior, tr.thickness, vec3<f32>(1.0));
         c_bg = background_coeffs(th.rgb);
     }
+    let rho = node_reflectance(c_base, s.base, g);
+    let att = exp(-tr.absorption * th.length);
+    var kn = vec4<f32>(tp.k);
+    if (HAS_FILM && film.weight > 0.0) {
+        // Under a thin film: 1 − its Fresnel term per node (`film_fresnel`'s dielectric).
+        let nv = max(dot(s.normal, -ctx.view_dir), 0.0);
+        kn = tr.weight * (1.0 - film_fresnel(film, rho, 0.0, wavelengths[g].lambda, nv).dielectric);
+    }
+    let light = kn * th.share * rho * background_nodes(th.rgb, c_bg, g);
+    return TransmittedNodes(light, att, th.sky);
+}
+
+// XYZ of the transmitted light (the direct spectral loop).
+fn transmitted_xyz(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive, c_base: vec3<f32>, film: FilmSurface) -> vec3<f32> {
+    let tp = transmitted_pixel(pix, ctx, s, tr);
+    if (tp.k <= 0.0) {
+        return vec3<f32>(0.0);
+    }
     var xyz = vec3<f32>(0.0);
-    for (var g = 0u; g < ng; g++) {
-        if (disperses) {
-            let l = wavelengths[g].lambda;
-            let ior = abbe_ior(tr.ior, tr.dispersion, 0.25 * (l.x + l.y + l.z + l.w));
-            th = through_volume(pix, p, s, ctx.view_dir, ior, tr.thickness, vec3<f32>(1.0));
-            c_bg = background_coeffs(th.rgb);
-        }
-        let rho = node_reflectance(c_base, s.base, g);
-        let att = exp(-tr.absorption * th.length);
-        var kn = vec4<f32>(k);
-        if (filmed) {
-            // Under a thin film: 1 − its Fresnel term per node (`film_fresnel`'s dielectric).
-            let l = wavelengths[g].lambda;
-            kn = tr.weight * (1.0 - film_fresnel(film, rho, 0.0, l, nv).dielectric);
-        }
-        let light = kn * th.share * rho * background_nodes(th.rgb, c_bg, g);
+    for (var g = 0u; g < frame.n_groups; g++) {
+        let t = transmitted_nodes(pix, ctx, s, tr, c_base, film, tp, g);
         if (NAIVE) {
-            xyz += (light * box4(att, g)) * white_weights(g);
+            xyz += (t.light * box4(t.att, g)) * white_weights(g);
         } else {
-            xyz += light * box_white_weights(att, g);
+            xyz += t.light * box_white_weights(t.att, g);
         }
     }
     return xyz;
+}
+
+// The same in weighted form (the general node loop, which hooks transform and the capture stores).
+fn transmitted_weighted(t: TransmittedNodes, g: u32) -> mat3x4<f32> {
+    if (NAIVE) {
+        return s3_scale(white_weights(g), t.light * box4(t.att, g));
+    }
+    return s3_scale(box_white_weights(t.att, g), t.light);
 }

@@ -110,21 +110,6 @@ pub fn read_linear(r: &Renderer, samples: u32) -> Result<Vec<[f32; 4]>, render::
     if samples <= 1 { r.read_hdr() } else { r.read_accumulated() }
 }
 
-/// The warning due when `scene`'s see-through materials are drawn opaque because the spectral
-/// capture is on (`render::Renderer::set_spectral_capture`: its node loop has no see-through
-/// layer, and the image goes through the same loop, so that the two agree); `what` names the
-/// capture, `image` the image, as the caller's user knows them.
-pub fn capture_drops_layer(scene: &scene::Scene, what: &str, image: &str) -> Option<String> {
-    scene.materials.iter().any(|m| m.transmission.is_some()).then(|| {
-        format!(
-            "warning: {}: its see-through materials are drawn opaque with {what} (the spectral capture \
-             has no see-through layer), and so is {image}, so that the two agree; render without {what} \
-             for the see-through image",
-            scene.source
-        )
-    })
-}
-
 /// Warns on stderr when even the brightest pixel of `hdr` (a read-back frame of `scene`) lies
 /// below the half-float target's normal range (`render::passes::hdr_too_dim`): `render` and the
 /// Python `Renderer.render` share it.
@@ -172,9 +157,6 @@ fn render_frame(
     r.resize(width, height).map_err(|e| anyhow!("--size {width}x{height}: {e}"))?;
     if args.spectral_out.is_some() {
         r.set_spectral_capture(true);
-        if let Some(w) = capture_drops_layer(scene, "--spectral-out", "--out") {
-            eprintln!("{w}");
-        }
     }
     // Encoding a large image takes seconds; Ctrl-C meanwhile must not be followed by a write.
     let interrupted =
