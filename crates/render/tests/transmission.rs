@@ -270,6 +270,59 @@ fn dispersion_refracts_the_colours_apart() {
     }
 }
 
+/// Dispersion at every node count: the spectral mode refracts each node on its own up to
+/// N = 8 (one direction per group of four left N ≤ 4 with a single index for the whole
+/// spectrum — no fringe at all where the RGB mode's three channels split — and N = 8 with two
+/// blocks of colour), pairs up to 16, groups beyond. The fringe across the tilted dispersive
+/// pane: present from N = 2 on (at N = 4 it was 0.03 of the dense one), and from N = 5 on
+/// within a third of the dense (N = 64) one (at N = 5 it was a quarter of it).
+#[test]
+fn dispersion_fringes_at_every_node_count() {
+    let mut r = renderer();
+    let vol = Volume {
+        thickness: 0.6,
+        thickness_texture: None,
+        attenuation_color: [1.0; 3],
+        attenuation_distance: f32::INFINITY,
+    };
+    let mut s = scene(Some(glass(1.0, 1.5, 1.0, Some(vol), 8.0)), true);
+    let m = s.meshes.last_mut().unwrap();
+    let rot = glam::Quat::from_rotation_y(0.7);
+    for p in &mut m.positions {
+        *p = rot * *p;
+    }
+    for n in &mut m.normals {
+        *n = rot * *n;
+    }
+    r.set_scene(&s).unwrap();
+    r.resize(W, H).unwrap();
+    // The colour across the pane's middle row: each pixel's chroma (largest minus smallest
+    // channel over their sum), summed.
+    let fringe = |r: &mut Renderer, n: usize| {
+        r.render(&s.camera, &RenderSettings { wavelengths: n, ..settings(Mode::Spectral) }).unwrap();
+        let img: Vec<[f64; 3]> = r.read_hdr().unwrap().iter().map(rgb_of).collect();
+        let row: Vec<[f64; 3]> = (W / 2 - 8..W / 2 + 8).map(|x| at(&img, (x, H / 2))).collect();
+        // Against the background's hue as this N draws it (beside the pane): what refraction
+        // without dispersion leaves, at any N.
+        let bg = at(&img, BESIDE);
+        row.iter()
+            .map(|p| {
+                let k = p[0] / bg[0];
+                (0..3).map(|c| (p[c] - k * bg[c]).abs()).fold(0.0, f64::max)
+            })
+            .sum::<f64>()
+    };
+    let dense = fringe(&mut r, 64);
+    for n in [2usize, 3, 4, 5, 8, 12, 16, 32] {
+        let f = fringe(&mut r, n);
+        println!("N = {n}: fringe {f:.3} (N = 64: {dense:.3})");
+        assert!(f > 0.25 * dense, "N = {n}: fringe {f:.3} against {dense:.3} at N = 64");
+        if n >= 5 {
+            assert!((f - dense).abs() < dense / 3.0, "N = {n}: fringe {f:.3} against {dense:.3} at N = 64");
+        }
+    }
+}
+
 /// Snell's law in vector form (unit `d`, `n` facing against `d`), `None` past the critical angle.
 fn snell(d: glam::DVec3, n: glam::DVec3, eta: f64) -> Option<glam::DVec3> {
     let c = -n.dot(d);

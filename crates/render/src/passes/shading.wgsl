@@ -1071,9 +1071,10 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         if (HAS_TRANSMISSION && tp.k > 0.0) {
             let tn = transmitted_nodes(in.pos.xy, ctx, s, tr, c_base, film, tp, g);
             var through = transmitted_weighted(tn, g);
-            if (CUSTOM_ENV_T && tn.sky) {
+            if (CUSTOM_ENV_T && (tn.sky || any(tn.sky_lanes))) {
                 // What the hooks let through of the environment (`seen_through` took none).
-                through = s3_scale(through, custom_env_transmittance(lambda, g, ctx));
+                let sky = select(vec4<bool>(tn.sky), tn.sky_lanes, tn.lanes);
+                through = s3_scale(through, select(vec4<f32>(1.0), custom_env_transmittance(lambda, g, ctx), sky));
             }
             xyz += s3_xyz(through);
             part += through;
