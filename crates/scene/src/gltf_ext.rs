@@ -68,7 +68,7 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_materials_clearcoat" => ("the clear-coat layer is ignored", "this renderer has no clear coat"),
         "KHR_materials_sheen" => ("sheen (cloth, velvet) is ignored", "this renderer has no sheen"),
         "KHR_materials_specular" => (
-            "specular strength and colour are ignored (dielectrics use F0 = 0.04)",
+            "specular strength and colour are ignored (a dielectric's F0 comes from its index of refraction: 0.04 at the default 1.5)",
             "this renderer has no specular extension",
         ),
         "KHR_materials_anisotropy" => {

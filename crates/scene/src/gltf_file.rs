@@ -701,6 +701,17 @@ impl Loader<'_> {
                 AlphaMode::Mask { cutoff }
             }
         };
+        // The extension's strength is a non-negative multiplier: a negative one was refused as
+        // "factors must be finite (and emissive non-negative)" naming no field, and accepted
+        // silently beside an emissive factor of zero (found by a sweep).
+        if let Some(k) = m.emissive_strength()
+            && !(k.is_finite() && k >= 0.0)
+        {
+            return Err(self.ctx.invalid(
+                format!("{at}.extensions.KHR_materials_emissive_strength.emissiveStrength"),
+                format!("{k} is not a finite number ≥ 0"),
+            ));
+        }
         let mut out = Material {
             name: m.name().map_or_else(|| format!("material {idx}"), str::to_string),
             base_color: Vec4::from(pbr.base_color_factor()),
@@ -778,10 +789,15 @@ impl Loader<'_> {
                 }
             };
         }
+        let volume = info("/extensions/KHR_materials_volume");
+        let dispersion = info("/extensions/KHR_materials_dispersion");
         if let Some(tr) = info("/extensions/KHR_materials_transmission") {
-            let volume = info("/extensions/KHR_materials_volume");
-            let dispersion = info("/extensions/KHR_materials_dispersion");
             out.transmission = self.transmission(&at, tr, volume, dispersion)?;
+        } else if volume.is_some() || dispersion.is_some() {
+            // Without transmission they change nothing here, but they are read and validated
+            // as documented (a negative dispersion or thickness was accepted silently; found
+            // by a sweep).
+            self.transmission(&at, &Value::Object(Default::default()), volume, dispersion)?;
         }
         let values = [
             out.base_color.to_array().as_slice(),
@@ -866,9 +882,14 @@ impl Loader<'_> {
                     .extras(f, "a spectral emission cannot be combined with an emissiveTexture"));
             }
             if out.emissive == Vec3::ZERO {
-                return Err(self
-                    .ctx
-                    .extras(f, "the material's emissiveFactor is zero, so the spectrum would emit nothing"));
+                // An unlit material's factor was dropped above: say so, not that the file's
+                // factor is zero (found by a sweep).
+                let why = if out.unlit {
+                    "the material is unlit (KHR_materials_unlit), which shows its base colour and no emission, so the spectrum would emit nothing"
+                } else {
+                    "the material's emissiveFactor is zero, so the spectrum would emit nothing"
+                };
+                return Err(self.ctx.extras(f, why));
             }
             let e = Emission::new(out.emissive, 1.0, Some(&shape)).map_err(|msg| self.ctx.extras(&f, msg))?;
             out.emission_spectrum = e.spectrum;

@@ -981,4 +981,17 @@ fn transmission_volume_and_dispersion_are_read_checked_and_exported() {
     bad("KHR_materials_dispersion", "dispersion", json!(-0.5), &["Abbe number must be > 0"]);
     bad("KHR_materials_dispersion", "dispersion", json!(1e9), &["[0, 20]"]);
     bad("KHR_materials_transmission", "transmissionTexture", json!({"index": 7}), &["no texture"]);
+    // Without transmission too (accepted silently; found by a sweep): read and validated.
+    for (ext, key, v, part) in [
+        ("KHR_materials_dispersion", "dispersion", json!(-1), "Abbe number must be > 0"),
+        ("KHR_materials_volume", "thicknessFactor", json!(-1), "thickness"),
+    ] {
+        let mut d = doc.clone();
+        d["materials"][0]["extensions"] = json!({ ext: { key: v } });
+        let e = load(&d).unwrap_err();
+        assert!(e.contains(&format!("materials[0].extensions.{ext}.{key}")), "{e}");
+        assert_has(&e, &[part]);
+        d["materials"][0]["extensions"][ext][key] = json!(0.5);
+        assert!(load(&d).unwrap().materials[0].transmission.is_none());
+    }
 }

@@ -330,6 +330,23 @@ fn finite_but_absurd_values_are_refused_with_their_path() {
             }),
             &["materials[0].emissiveFactor", "at most"],
         ),
+        // Negative: named as the extension's field (it named none; with a factor of zero it
+        // was accepted; found by a sweep).
+        (
+            Box::new(|d| {
+                d["materials"][0]["extensions"] =
+                    json!({"KHR_materials_emissive_strength": {"emissiveStrength": -2}})
+            }),
+            &["materials[0].extensions.KHR_materials_emissive_strength.emissiveStrength", "≥ 0"],
+        ),
+        (
+            Box::new(|d| {
+                d["materials"][0]["emissiveFactor"] = json!([0, 0, 0]);
+                d["materials"][0]["extensions"] =
+                    json!({"KHR_materials_emissive_strength": {"emissiveStrength": -2}})
+            }),
+            &["emissiveStrength", "≥ 0"],
+        ),
         (
             Box::new(|d| {
                 d["materials"][0]["pbrMetallicRoughness"] = json!({"baseColorFactor": [-0.5, 0.5, 0.5, 1]})

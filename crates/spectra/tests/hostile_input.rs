@@ -108,7 +108,34 @@ fn absurd_settings_are_refused_before_rendering() {
     let m = d.join("m.json");
     std::fs::write(&m, r#"{"sigma_a": 1e39, "sigma_s": 0}"#).unwrap();
     refused(&with(&base, &["--medium", m.to_str().unwrap()]), &["sigma_a", "1e39", "0–1e7"]);
+    // Inline, as --rgb-medium takes it (the help said JSON; only a file worked), and a box of
+    // no extent (accepted silently: it holds nothing; both found by a sweep).
+    refused(&with(&base, &["--medium", r#"{"sigma_a": -1, "sigma_s": 0}"#]), &["--medium", "sigma_a"]);
+    let flat = r#"{"sigma_a": 0.1, "sigma_s": 0.1, "box": {"min": [0, 0, 0], "max": [1, 0, 1]}}"#;
+    refused(&with(&base, &["--medium", flat]), &["--medium", "box", "empty"]);
     assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `truth --medium` takes the medium inline or from a file: the same render either way.
+#[test]
+fn a_medium_inline_renders_as_from_a_file() {
+    let d = tmp("inline-medium");
+    let json = r#"{"sigma_a": 0.3, "sigma_s": 0.5, "phase": {"hg": 0.4}}"#;
+    let file = d.join("m.json");
+    std::fs::write(&file, json).unwrap();
+    let mut images = vec![];
+    for (i, arg) in [json, file.to_str().unwrap()].into_iter().enumerate() {
+        let out = d.join(format!("t{i}.exr"));
+        let o = Command::new(env!("CARGO_BIN_EXE_spectra"))
+            .args(["truth", "cornell", "--spp", "2", "--size", "12x9", "--medium", arg, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        images.push(compare::io::read_image(&out).unwrap().data);
+    }
+    assert_eq!(images[0], images[1], "inline and file media render differently");
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -62,6 +62,20 @@ fn absurd_counts_and_sizes_are_refused() {
         &["render", "fog", "--size", "8x8", "--scatter-steps", "1000", "--out", &exr],
         &["--scatter-steps 1000", "0–32"],
     );
+    // The media's bounds hold on any scene, each naming its flag (on a dry scene they were
+    // accepted silently, under water the message named no flag; found by a sweep).
+    for (scene, flag, value, shown) in [
+        ("cornell", "--scatter-steps", "33", "0–32"),
+        ("underwater", "--scatter-steps", "33", "0–32"),
+        ("cornell", "--phase-g", "1", "between −1 and 1"),
+        ("cornell", "--forward-cone", "46", "0–45"),
+        ("cornell", "--light-field-photons", "0", "photons"),
+    ] {
+        refused(
+            &["render", scene, "--size", "8x8", flag, value, "--out", &exr],
+            &[&format!("{flag} {value}"), shown],
+        );
+    }
     let missing = dir.path().join("no/such/dir/t.exr").display().to_string();
     refused(&["truth", "cornell", "--spp", "100000", "--out", &missing], &["--out", "does not exist"]);
     // Issue 29: numbers that aborted, ran for minutes or overflowed into garbage.

@@ -81,10 +81,11 @@ impl Medium {
             if !min.is_finite() || !max.is_finite() {
                 return bad(format!("box: min {min} and max {max} must be finite"));
             }
-            if let Some(axis) = (0..3).find(|&i| min[i] > max[i]) {
+            // A box of no extent along an axis holds no volume: nothing would be scattered.
+            if let Some(axis) = (0..3).find(|&i| min[i] >= max[i]) {
                 let name = ["x", "y", "z"][axis];
                 return bad(format!(
-                    "box: max.{name} = {} is below min.{name} = {}: the box is empty",
+                    "box: max.{name} = {} is not above min.{name} = {}: the box is empty",
                     max[axis], min[axis]
                 ));
             }
@@ -246,6 +247,12 @@ mod tests {
         assert!(g.validate(r).is_err());
         let b = Medium { region: Region::Box { min: Vec3::ONE, max: Vec3::ZERO }, ..ok.clone() };
         assert!(b.validate(r).is_err());
+        // Flat or a point: no volume (accepted silently before; found by a sweep).
+        for max in [Vec3::new(1.0, 1.0, 2.0), Vec3::ONE] {
+            let flat = Medium { region: Region::Box { min: Vec3::ONE, max }, ..ok.clone() };
+            let e = flat.validate(r).unwrap_err().to_string();
+            assert!(e.contains("box") && e.contains("empty"), "{e}");
+        }
         let no_box = Medium { surface_ior: Some(1.34), ..ok.clone() };
         assert!(no_box.validate(r).unwrap_err().to_string().contains("box"));
         let slab = Region::Box { min: Vec3::ZERO, max: Vec3::ONE };

@@ -56,6 +56,10 @@ pub const RGB_WAVELENGTHS: [f64; 3] = [611.0, 549.0, 464.0];
 pub const SS_LIGHTS: usize = 4;
 /// Most march steps; `UW_MAX_STEPS` in the WGSL, checked by `layout_tests`.
 pub const MAX_STEPS: u32 = 32;
+/// Largest half-angle of the light-field model's forward cone (degrees).
+pub const MAX_FORWARD_CONE_DEG: f32 = 45.0;
+/// Most photons per node and source for the light-field table's solver.
+pub const MAX_PHOTONS: usize = 10_000_000;
 
 /// Choices of the real-time model beyond the water itself.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,10 +176,12 @@ impl Options {
         if self.light_field && (self.split_beams || self.scalar_irradiance) {
             return Err(OptionsError::NeedsIsotropic);
         }
-        if !(self.forward_cone_deg.is_finite() && (0.0..=45.0).contains(&self.forward_cone_deg)) {
+        if !(self.forward_cone_deg.is_finite()
+            && (0.0..=MAX_FORWARD_CONE_DEG).contains(&self.forward_cone_deg))
+        {
             return Err(OptionsError::ForwardCone(self.forward_cone_deg));
         }
-        if self.light_field && !(1..=10_000_000).contains(&self.photons) {
+        if self.light_field && !(1..=MAX_PHOTONS).contains(&self.photons) {
             return Err(OptionsError::Photons(self.photons));
         }
         Ok(())

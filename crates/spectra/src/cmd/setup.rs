@@ -228,8 +228,48 @@ impl LookArgs {
                 photons: self.light_field_photons,
             }
         };
-        o.validate().map_err(|e| anyhow!("underwater model options: {e}"))?;
+        o.validate().map_err(|e| self.flag_error(e))?;
         Ok(o)
+    }
+
+    /// An underwater option's error, naming the flag that gave the value.
+    fn flag_error(&self, e: ::render::passes::underwater::OptionsError) -> anyhow::Error {
+        use ::render::passes::underwater::OptionsError as E;
+        let flag = match e {
+            E::Steps(_) | E::LightFieldNoMarch => format!("--scatter-steps {}", self.scatter_steps),
+            E::PhaseG(_) => format!("--phase-g {}", self.phase_g),
+            E::ForwardCone(_) => format!("--forward-cone {}", self.forward_cone),
+            E::Photons(_) => format!("--light-field-photons {}", self.light_field_photons),
+            E::NeedsIsotropic => "--split-beams / --scalar-irradiance".to_string(),
+        };
+        anyhow!("{flag}: {e}")
+    }
+
+    /// The bounds of the media's numeric options, checked whatever the scene holds (a value
+    /// out of range on a dry scene was accepted silently; found by a sweep): each error names
+    /// its flag. Combinations of the underwater model's flags are checked under water only.
+    fn check_media_ranges(&self) -> Result<()> {
+        use ::render::passes::underwater::{MAX_FORWARD_CONE_DEG, MAX_PHOTONS, MAX_STEPS};
+        let most = MAX_STEPS;
+        if self.scatter_steps > most {
+            bail!("--scatter-steps {}: media are marched in 0–{most} steps", self.scatter_steps);
+        }
+        if !(self.phase_g.is_finite() && self.phase_g.abs() < 1.0) {
+            bail!("--phase-g {}: the Henyey–Greenstein g must lie strictly between −1 and 1", self.phase_g);
+        }
+        if !(self.forward_cone.is_finite() && (0.0..=MAX_FORWARD_CONE_DEG).contains(&self.forward_cone)) {
+            bail!(
+                "--forward-cone {}: the cone's half-angle must be 0–{MAX_FORWARD_CONE_DEG}°",
+                self.forward_cone
+            );
+        }
+        if !(1..=MAX_PHOTONS).contains(&self.light_field_photons) {
+            bail!(
+                "--light-field-photons {}: 1–{MAX_PHOTONS} photons per node and source",
+                self.light_field_photons
+            );
+        }
+        Ok(())
     }
 
     /// The RGB medium's real-time options (`--scatter-steps`, `--single-scattering`).
@@ -241,6 +281,7 @@ impl LookArgs {
     /// its model options, or the RGB medium (`--rgb-medium` or the scene's) as its hooks;
     /// both at once is an error.
     pub fn media(&self, scene: &scene::Scene, table: &CoeffTable) -> Result<RealtimeMedia> {
+        self.check_media_ranges()?;
         let water = self.water.medium(scene)?;
         // The model's options matter only under water (as before, bad ones are refused there).
         let water_options = if water.is_some() { self.underwater()? } else { underwater::Options::default() };

@@ -49,9 +49,12 @@ pub struct Args {
     /// Longest path, in scattering events (Russian roulette ends most paths long before).
     #[arg(long, default_value_t = 1024)]
     pub max_depth: u32,
-    /// A homogeneous participating medium, as JSON (see `truth::medium_file`).
+    /// A homogeneous participating medium: a JSON file or inline JSON ('{…}'), keys sigma_a,
+    /// sigma_s (per scene unit: a number or {"wavelengths": […], "values": […]}), phase
+    /// ("isotropic" or {"hg": g}), box ({"min": [x, y, z], "max": […]}; without it the medium
+    /// fills the scene): docs/ground-truth.md.
     #[arg(long, conflicts_with = "rgb_medium")]
-    pub medium: Option<PathBuf>,
+    pub medium: Option<String>,
     #[command(flatten)]
     pub rgb_medium: RgbMediumArgs,
     #[command(flatten)]
@@ -128,9 +131,14 @@ pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTa
     s.range = sp.range;
     s.observer = Observer::by_name(&sp.observer)?;
     s.white = color::illuminant::by_name(&sp.white)?;
-    if let Some(p) = &a.medium {
-        let m = Medium::read(p)?;
-        m.validate(s.range).with_context(|| format!("medium {}", p.display()))?;
+    if let Some(arg) = &a.medium {
+        // Inline JSON as for --rgb-medium; anything else names a file.
+        let (m, origin) = if arg.trim_start().starts_with('{') {
+            (Medium::from_json(arg, "--medium")?, "--medium".to_string())
+        } else {
+            (Medium::read(std::path::Path::new(arg))?, format!("medium {arg}"))
+        };
+        m.validate(s.range).with_context(|| origin)?;
         s.medium = Some(m);
     }
     // An explicit --medium / --rgb-medium replaces the scene's own RGB medium.
@@ -466,7 +474,12 @@ pub fn run(a: Args) -> Result<()> {
     let mut inputs = a.scene.input_files(&scene);
     inputs.extend(a.table.input_files());
     inputs.extend(a.rgb_medium.input_files());
-    inputs.extend(a.medium.iter().map(|m| ("--medium file".to_string(), m.clone())));
+    inputs.extend(
+        a.medium
+            .iter()
+            .filter(|m| !m.trim_start().starts_with('{'))
+            .map(|m| ("--medium file".to_string(), PathBuf::from(m))),
+    );
     inputs.extend(super::setup::observer_input(a.spectrum.observer.as_deref()));
     let ckpt = a.out.as_deref().map(super::checkpoint::path_for);
     super::check_outputs(
