@@ -839,6 +839,7 @@ impl Renderer {
             ior: scene.has_ior,
             transmission: false,
             thin_walls: scene.has_thin_walls,
+            dispersion: scene.has_dispersion,
             // The naive mode's basis is the three bands (the fourth's weights are zero).
             env_bases: match settings.mode {
                 Mode::Spectral => self.environment.spectral_bases() as u32,

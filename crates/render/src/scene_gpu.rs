@@ -444,6 +444,9 @@ pub struct GpuScene {
     /// Whether some see-through material is thin-walled (no volume): only then does the
     /// transmissive layer's shading carry the light from behind (`thin_transmission`).
     pub has_thin_walls: bool,
+    /// Whether some see-through material disperses (a volume with `KHR_materials_dispersion`):
+    /// only then does the layer's shading carry the per-channel and per-node refraction.
+    pub has_dispersion: bool,
     /// Per material, `MaterialSpectrum::refraction` and `::absorption` ([`refraction_record`]).
     pub material_refraction: Vec<[[f32; 4]; 2]>,
 }
@@ -704,6 +707,7 @@ impl GpuScene {
                 .iter()
                 .any(|m| transmission(m).is_some() && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
             has_thin_walls: s.materials.iter().any(|m| transmission(m).is_some_and(|t| t.volume.is_none())),
+            has_dispersion: s.materials.iter().any(|m| transmission(m).is_some_and(|t| t.disperses())),
             material_refraction: s.materials.iter().map(refraction_record).collect(),
             material_films: s
                 .materials

@@ -147,6 +147,9 @@ pub struct Variant {
     /// Some see-through material is thin-walled (`HAS_THIN_WALLS`): the lights behind it shine
     /// through (`thin_transmission`).
     pub thin_walls: bool,
+    /// Some see-through material disperses (`HAS_DISPERSION`): only then are the refraction's
+    /// per-channel (RGB) or per-node (spectral) traces compiled in.
+    pub dispersion: bool,
     /// The environment's basis spectra that its coefficients use (`ENV_BASES`, 1..=4;
     /// `environment::SpectralBasis::used` in the spectral mode): the per-node environment
     /// weights of the others are not read.
@@ -170,14 +173,15 @@ impl Variant {
         ior: true,
         transmission: false,
         thin_walls: true,
+        dispersion: true,
         env_bases: crate::environment::K as u32,
         occlusion_map: false,
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, emission, film, ior, transmission, thin walls) and the occlusion's; its
+    /// environment, emission, film, ior, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 13] {
+    fn constants(&self) -> [(&'static str, f64); 14] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -191,6 +195,7 @@ impl Variant {
             ("HAS_IOR", b(self.ior)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
+            ("HAS_DISPERSION", b(self.dispersion)),
             ("ENV_BASES", f64::from(self.env_bases)),
             ("OCCLUSION_MAP", b(self.occlusion_map)),
         ]
@@ -207,6 +212,7 @@ impl Variant {
             ior: self.ior,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
+            dispersion: self.dispersion,
             occlusion_map: self.occlusion_map,
             ..Variant::ALL
         }

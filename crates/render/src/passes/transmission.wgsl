@@ -36,6 +36,9 @@ fn layer_values(px: vec2<i32>) -> vec4<f32> {
 override HAS_TRANSMISSION: bool = false;
 // Some see-through material is thin-walled (`thin_transmission`).
 override HAS_THIN_WALLS: bool = true;
+// Some see-through material disperses: without, neither mode compiles its extra traces (a CPU
+// driver runs a branch's both sides).
+override HAS_DISPERSION: bool = true;
 
 // The transmissive layer's shading is drawn over the see-through meshes themselves, not over the
 // whole screen (the frame's other pixels already hold the background, copied there): a CPU
@@ -382,7 +385,7 @@ fn transmitted_rgb(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmi
         env_t = custom_env_transmittance_rgb(ctx);
     }
     var light: vec3<f32>;
-    if (tr.dispersion > 0.0 && tr.thickness > 0.0) {
+    if (disperses(tr)) {
         let half_spread = (tr.ior - 1.0) * 0.025 * tr.dispersion;
         for (var c = 0; c < 3; c++) {
             let th = through_volume(pix, p, s, ctx.view_dir, tr.ior + f32(c - 1) * half_spread, tr.thickness, env_t);
@@ -433,7 +436,7 @@ struct TransmittedPixel {
 };
 
 fn disperses(tr: Transmissive) -> bool {
-    return tr.dispersion > 0.0 && tr.thickness > 0.0;
+    return HAS_DISPERSION && tr.dispersion > 0.0 && tr.thickness > 0.0;
 }
 
 fn transmitted_pixel(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Transmissive) -> TransmittedPixel {
