@@ -781,10 +781,15 @@ impl Loader<'_> {
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
+                // The extension's compatibility mode: an infinite index, Fresnel term 1.
+                Some(x) if x == 0.0 => crate::MAX_IOR,
                 _ => {
                     return Err(self.ctx.invalid(
                         format!("{at}.extensions.KHR_materials_ior.ior"),
-                        format!("{v} is not an index of refraction in [1, {}]", crate::MAX_IOR),
+                        format!(
+                            "{v} is not an index of refraction in [1, {}] (or 0, an infinite one)",
+                            crate::MAX_IOR
+                        ),
                     ));
                 }
             };

@@ -196,8 +196,11 @@ pub struct Material {
     pub transmission: Option<transmission::Transmission>,
 }
 
-/// Largest index of refraction a material may give (diamond is 2.42).
-pub const MAX_IOR: f32 = 10.0;
+/// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
+/// bound, and tools write large ones to make a surface all specular): f0 is 0.9996 there, and
+/// the refraction's arithmetic stays far inside f32. `KHR_materials_ior`'s special value 0 (the
+/// specular-glossiness compatibility mode, an infinite index) is read as this.
+pub const MAX_IOR: f32 = 1.0e4;
 
 /// A dielectric's normal-incidence reflectance from air, ((η − 1)/(η + 1))²: exactly glTF's
 /// constant 0.04 at its default η = 1.5 (so that files without `KHR_materials_ior` keep the

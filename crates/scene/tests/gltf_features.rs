@@ -880,7 +880,10 @@ fn iridescence_survives_export() {
 }
 
 /// `KHR_materials_ior`: the index sets the dielectric's F0 (glTF's 0.04 exactly at the
-/// default 1.5), survives export, and a value outside [1, 10] is an error naming the field.
+/// default 1.5), survives export, and a value outside [1, 10000] is an error naming the field;
+/// 0, the extension's specular-glossiness compatibility mode (an infinite index, Fresnel term
+/// 1), is read as the largest index (f0 0.9996), and large ones are accepted (both were refused
+/// above 10; found by a sweep).
 #[test]
 fn index_of_refraction_is_read_checked_and_exported() {
     let mut b = Bin::default();
@@ -902,15 +905,24 @@ fn index_of_refraction_is_read_checked_and_exported() {
         scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
             .unwrap();
     assert_eq!((back.materials[0].ior, back.materials[1].ior), (2.0, 1.5));
-    for v in [json!(0.9), json!(11), json!("1.4"), json!(-1)] {
+    for v in [json!(0.9), json!(1e5), json!("1.4"), json!(-1), json!(1e-9)] {
         let mut d = doc.clone();
         d["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = v.clone();
         let e = load(&d).unwrap_err().to_string();
         assert!(
-            e.contains("materials[0].extensions.KHR_materials_ior.ior") && e.contains("[1, 10]"),
+            e.contains("materials[0].extensions.KHR_materials_ior.ior") && e.contains("[1, 10000]"),
             "{v}: {e}"
         );
     }
+    for (v, ior) in [(json!(0), scene::MAX_IOR), (json!(20), 20.0), (json!(1000), 1000.0)] {
+        let mut d = doc.clone();
+        d["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = v.clone();
+        let m = &load(&d).unwrap().materials[0];
+        assert_eq!(m.ior, ior, "{v}");
+    }
+    let mut d = doc.clone();
+    d["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = json!(0);
+    assert!(load(&d).unwrap().materials[0].dielectric_f0() > 0.999);
 }
 
 /// `KHR_materials_transmission` with `_volume` and `_dispersion`: read with their defaults
