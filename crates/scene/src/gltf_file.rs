@@ -782,7 +782,7 @@ impl Loader<'_> {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
                 // The extension's compatibility mode: an infinite index, Fresnel term 1.
-                Some(x) if x == 0.0 => crate::MAX_IOR,
+                Some(0.0) => crate::MAX_IOR,
                 _ => {
                     return Err(self.ctx.invalid(
                         format!("{at}.extensions.KHR_materials_ior.ior"),
