@@ -979,6 +979,14 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         // The capture buffer is cleared before the frame: nothing to write.
         return vec3<f32>(0.0);
     }
+    // A background pixel under a spectral hook: the sky is the radiance the hook receives, as
+    // `custom_rgb` receives it in the RGB mode (it received none: a hook that only attenuates
+    // drew a black sky in the spectral modes). The media's hooks replace a background's radiance.
+    let sky = background && has_env && env.flags.y != 0u;
+    var sky_c = vec4<f32>(0.0);
+    if (sky) {
+        sky_c = env_background(ctx.view_dir);
+    }
     let ng = frame.n_groups;
     var tp = TransmittedPixel(0.0, Through(vec3<f32>(0.0), 0.0, 0.0, false), vec4<f32>(0.0));
     if (HAS_TRANSMISSION) {
@@ -1049,6 +1057,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         }
         if (HAS_EMISSION) {
             part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g));
+        }
+        if (sky) {
+            part += env_w(sky_c, g, ng);
         }
         if (CUSTOM_SPECTRAL) {
             part = custom_spectral(lambda, part, g, ctx);
