@@ -4,7 +4,9 @@
 
 // Pass 2, spectral and naive modes, once per group of four node wavelengths (`lambda`, nm),
 // before integration. `radiance[c]` is the light leaving the surface towards the camera at
-// the four nodes, in weighted form for channel c (X, Y, Z): XYZ = Σ over groups and lanes of
+// the four nodes (on a background pixel the environment's, as `custom_rgb` receives it; at a
+// see-through surface its own reflection: the light through it, which has had the hook along
+// its own view ray, is added after), in weighted form for channel c (X, Y, Z): XYZ = Σ over groups and lanes of
 // `radiance[c]`. A factor that depends on wavelength (a transmittance, say) multiplies every
 // column (`s3_scale`); light added along the ray is a light's node weights (`light_w`) or the
 // white's (`white_weights`) times its factor. Return the radiance to integrate. Defining this
