@@ -276,6 +276,11 @@ fn bad_extras() {
         &mutate(|d| d["materials"][1]["emissiveFactor"] = json!([0, 0, 0])),
         &["materials[1].extras.emission", "zero"],
     );
+    // Unlit drops the factor: said so, not that the file's factor is zero (found by a sweep).
+    expect(
+        &mutate(|d| d["materials"][1]["extensions"] = json!({"KHR_materials_unlit": {}})),
+        &["materials[1].extras.emission", "unlit"],
+    );
     expect(
         &mutate(|d| d["materials"][1]["extras"] = json!(["not", "an", "object"])),
         &["materials[1].extras", "object"],
