@@ -1179,22 +1179,22 @@ impl Renderer {
         let mut env_basis: Vec<Vec<[f64; 3]>> = Vec::new();
         if self.environment.source.is_some() && settings.mode != Mode::Rgb {
             let white = &setup.white;
-            let basis: Vec<Vec<[f64; 3]>> = match (settings.mode, &self.environment.spectral) {
-                (Mode::Spectral, Some((b, _))) => (0..crate::environment::K)
-                    .map(|j| setup.weights_of(|l| b.eval(j, l) * white.eval(l)))
-                    .collect(),
-                _ => (0..crate::environment::K)
-                    .map(|j| {
-                        let (blue_max, green_max) = crate::spectral_data::naive_band_edges();
-                        setup.weights_of(|l| {
-                            let band = crate::spectral_data::naive_band(l, blue_max, green_max);
-                            if band == j { white.eval(l) } else { 0.0 }
-                        })
-                    })
-                    .collect(),
+            let (blue_max, green_max) = crate::spectral_data::naive_band_edges();
+            // Basis spectrum j times the white: the spectral basis, or the naive mode's bands.
+            let spectrum = |j: usize, l: f64| match (settings.mode, &self.environment.spectral) {
+                (Mode::Spectral, Some((b, _))) => b.eval(j, l) * white.eval(l),
+                _ => {
+                    let band = crate::spectral_data::naive_band(l, blue_max, green_max);
+                    if band == j { white.eval(l) } else { 0.0 }
+                }
             };
+            let basis: Vec<Vec<[f64; 3]>> =
+                (0..crate::environment::K).map(|j| setup.weights_of(|l| spectrum(j, l))).collect();
             for (j, w) in basis.iter().enumerate() {
-                let t = SpectralSetup::light_total(w);
+                // The totals are the environment's colour (the sky seen through glass is read as
+                // one, `seen_through`): by the display's rule in a capture's frame too, whose own
+                // weights (a radiance per node) make no colour; elsewhere the same weights.
+                let t = SpectralSetup::light_total(&setup.display_weights_of(|l| spectrum(j, l)));
                 env_totals[j] = [t[0] as f32, t[1] as f32, t[2] as f32, 0.0];
                 env_weights.extend(setup.gpu_weights(w));
             }

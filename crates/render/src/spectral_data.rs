@@ -266,6 +266,13 @@ impl SpectralSetup {
         w.into_iter().map(|w| w.map(|c| c / k)).collect()
     }
 
+    /// [`Self::weights_of`] by the display's rule even in a capture's setup: what the frame's
+    /// colours (not the capture's nodes) are integrated with.
+    pub fn display_weights_of(&self, emission: impl Fn(f64) -> f64) -> Vec<[f64; 3]> {
+        let k = self.k;
+        self.quad.weights(emission).into_iter().map(|w| w.map(|c| c / k)).collect()
+    }
+
     /// The white illuminant's normalised node weights (for emissive surfaces).
     pub fn white_weights(&self) -> Vec<[f64; 3]> {
         self.weights_of(|l| self.white.eval(l))

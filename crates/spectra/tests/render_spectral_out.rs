@@ -97,6 +97,10 @@ fn midpoint_node_radiances_reintegrate_to_the_frame() {
         // glass: the see-through layer (refraction, dispersion, absorption), captured from its
         // own pass.
         ("glass", &[][..]),
+        // ... and the sky through it: a ray through the glass that leaves the screen reads the
+        // environment's colour, which the capture's frame took from its own weights (3–10× too
+        // bright; found by a sweep).
+        ("glass", &["--env", "default", "--wavelengths", "8"][..]),
         // Few nodes and narrowed ranges, where the white's integral is tinted by the quadrature
         // or the truncation (both sides balance it away alike; before they shared one
         // convention, 15–37 ΔE2000 apart here).

@@ -283,6 +283,16 @@ impl LookArgs {
     pub fn media(&self, scene: &scene::Scene, table: &CoeffTable) -> Result<RealtimeMedia> {
         self.check_media_ranges()?;
         let water = self.water.medium(scene)?;
+        // As the path tracer refuses it (truth::World): the water's light field has its own sky,
+        // and an environment drawn through the water's hooks lit the floor and shone through
+        // glass at full strength 5 m down (found by a sweep).
+        if let (Some(_), Some(env)) = (&water, scene.environment.as_ref().filter(|e| !e.is_black())) {
+            bail!(
+                "an environment map ({}) cannot light a scene under a water surface: the surface shows the water \
+                 settings' sky (drop the environment, e.g. --env none)",
+                env.source
+            );
+        }
         // The model's options matter only under water (as before, bad ones are refused there).
         let water_options = if water.is_some() { self.underwater()? } else { underwater::Options::default() };
         let rgb =
@@ -470,7 +480,7 @@ impl RgbMediumArgs {
     /// `--rgb-medium`'s file (not an inline JSON object), named for [`super::check_outputs`].
     pub fn input_files(&self) -> Vec<(String, PathBuf)> {
         self.arg()
-            .filter(|a| !a.trim_start().starts_with('{'))
+            .filter(|a| !inline_json(a))
             .map(|a| ("--rgb-medium file".to_string(), PathBuf::from(a)))
             .into_iter()
             .collect()
@@ -655,8 +665,13 @@ pub fn print_warnings(scene: &scene::Scene) {
 
 /// `--rgb-medium`: inline JSON (starting with `{`) or a file holding it (`render`, `view`,
 /// `bench`, `truth`).
+/// Whether a medium argument is JSON written inline: it starts with '{' and names no file.
+pub fn inline_json(arg: &str) -> bool {
+    arg.trim_start().starts_with('{') && !std::path::Path::new(arg).is_file()
+}
+
 pub fn rgb_medium_arg(arg: &str) -> Result<scene::medium::RgbMedium> {
-    let (text, origin) = if arg.trim_start().starts_with('{') {
+    let (text, origin) = if inline_json(arg) {
         (arg.to_string(), "--rgb-medium".to_string())
     } else {
         let p = std::path::Path::new(arg);

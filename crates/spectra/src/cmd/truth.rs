@@ -132,8 +132,9 @@ pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTa
     s.observer = Observer::by_name(&sp.observer)?;
     s.white = color::illuminant::by_name(&sp.white)?;
     if let Some(arg) = &a.medium {
-        // Inline JSON as for --rgb-medium; anything else names a file.
-        let (m, origin) = if arg.trim_start().starts_with('{') {
+        // Inline JSON as for --rgb-medium; anything else names a file (and so does a '{…}' that
+        // is a file's name).
+        let (m, origin) = if super::setup::inline_json(arg) {
             (Medium::from_json(arg, "--medium")?, "--medium".to_string())
         } else {
             (Medium::read(std::path::Path::new(arg))?, format!("medium {arg}"))
@@ -477,7 +478,7 @@ pub fn run(a: Args) -> Result<()> {
     inputs.extend(
         a.medium
             .iter()
-            .filter(|m| !m.trim_start().starts_with('{'))
+            .filter(|m| !super::setup::inline_json(m))
             .map(|m| ("--medium file".to_string(), PathBuf::from(m))),
     );
     inputs.extend(super::setup::observer_input(a.spectrum.observer.as_deref()));
