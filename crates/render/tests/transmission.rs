@@ -217,6 +217,27 @@ fn a_coloured_volume_integrates_its_box_absorption_exactly() {
     }
 }
 
+/// A clear thick pane of index 1.5 and `dispersion`, tilted about y so that the refracted ray
+/// leans sideways, over the stripe.
+fn tilted_pane(dispersion: f32) -> Scene {
+    let vol = Volume {
+        thickness: 0.6,
+        thickness_texture: None,
+        attenuation_color: [1.0; 3],
+        attenuation_distance: f32::INFINITY,
+    };
+    let mut s = scene(Some(glass(1.0, 1.5, 1.0, Some(vol), dispersion)), true);
+    let m = s.meshes.last_mut().unwrap();
+    let rot = glam::Quat::from_rotation_y(0.7);
+    for p in &mut m.positions {
+        *p = rot * *p;
+    }
+    for n in &mut m.normals {
+        *n = rot * *n;
+    }
+    s
+}
+
 /// Dispersion: a tilted thick pane over a black stripe shifts the stripe by refraction. With a
 /// dispersion of 0 every channel (RGB) or the whole spectrum (spectral) is shifted alike, so the
 /// image near the stripe keeps the background's hue (each pixel a multiple of C); with a strong
@@ -224,25 +245,7 @@ fn a_coloured_volume_integrates_its_box_absorption_exactly() {
 #[test]
 fn dispersion_refracts_the_colours_apart() {
     let mut r = renderer();
-    let vol = Volume {
-        thickness: 0.6,
-        thickness_texture: None,
-        attenuation_color: [1.0; 3],
-        attenuation_distance: f32::INFINITY,
-    };
-    let tilted = |dispersion: f32| {
-        let mut s = scene(Some(glass(1.0, 1.5, 1.0, Some(vol.clone()), dispersion)), true);
-        // Tilt the pane about y so the refracted ray leans sideways.
-        let m = s.meshes.last_mut().unwrap();
-        let rot = glam::Quat::from_rotation_y(0.7);
-        for p in &mut m.positions {
-            *p = rot * *p;
-        }
-        for n in &mut m.normals {
-            *n = rot * *n;
-        }
-        s
-    };
+    let tilted = tilted_pane;
     for mode in [Mode::Rgb, Mode::Spectral] {
         let fringe = |img: &[[f64; 3]]| {
             // Largest departure from the background's hue across the pane's middle row.
@@ -279,21 +282,7 @@ fn dispersion_refracts_the_colours_apart() {
 #[test]
 fn dispersion_fringes_at_every_node_count() {
     let mut r = renderer();
-    let vol = Volume {
-        thickness: 0.6,
-        thickness_texture: None,
-        attenuation_color: [1.0; 3],
-        attenuation_distance: f32::INFINITY,
-    };
-    let mut s = scene(Some(glass(1.0, 1.5, 1.0, Some(vol), 8.0)), true);
-    let m = s.meshes.last_mut().unwrap();
-    let rot = glam::Quat::from_rotation_y(0.7);
-    for p in &mut m.positions {
-        *p = rot * *p;
-    }
-    for n in &mut m.normals {
-        *n = rot * *n;
-    }
+    let s = tilted_pane(8.0);
     r.set_scene(&s).unwrap();
     r.resize(W, H).unwrap();
     // The colour across the pane's middle row: each pixel's chroma (largest minus smallest
