@@ -485,12 +485,8 @@ fn a_see_through_film_colours_the_reflection() {
     }
 }
 
-/// What a clear film on a see-through pane does not reflect it transmits (as the path tracer's
-/// interface now does): in a white furnace (a white sky, a white backdrop) the filmed pane
-/// vanishes. The transmitted share was 1 − Schlick's F while the reflection took the film's,
-/// so the pane showed the film's colour over white.
-#[test]
-fn a_filmed_pane_in_a_white_furnace_vanishes() {
+/// A clear pane of index 1.5 under a film of index 1.8, 100–380 nm thick.
+fn filmed_pane() -> Material {
     let mut m = glass(1.0, 1.5, 1.0, None, 0.0);
     m.iridescence = Some(scene::Iridescence {
         factor: 1.0,
@@ -500,7 +496,16 @@ fn a_filmed_pane_in_a_white_furnace_vanishes() {
         thickness_max: 380.0,
         thickness_texture: None,
     });
-    let mut s = scene(Some(m), false);
+    m
+}
+
+/// What a clear film on a see-through pane does not reflect it transmits (as the path tracer's
+/// interface now does): in a white furnace (a white sky, a white backdrop) the filmed pane
+/// vanishes. The transmitted share was 1 − Schlick's F while the reflection took the film's,
+/// so the pane showed the film's colour over white.
+#[test]
+fn a_filmed_pane_in_a_white_furnace_vanishes() {
+    let mut s = scene(Some(filmed_pane()), false);
     s.materials[0].base_color = Vec4::ONE;
     s.environment = Some(scene::Environment::uniform(Vec3::ONE));
     let mut r = renderer();
@@ -576,15 +581,7 @@ fn general_loop_scenes() -> Vec<(&'static str, Scene)> {
         attenuation_color: c,
         attenuation_distance: 0.2,
     };
-    let mut filmed = glass(1.0, 1.5, 1.0, None, 0.0);
-    filmed.iridescence = Some(scene::Iridescence {
-        factor: 1.0,
-        texture: None,
-        ior: 1.8,
-        thickness_min: 100.0,
-        thickness_max: 380.0,
-        thickness_texture: None,
-    });
+    let filmed = filmed_pane();
     let mut thin = scene(Some(glass(0.8, 1.5, 0.7, None, 0.0)), false);
     thin.materials[2].roughness = 0.4;
     thin.lights.push(scene::Light::point("behind", Vec3::new(0.1, 0.0, -0.5), 2.0));
