@@ -20,6 +20,9 @@ pub struct MaterialSpectrum {
     pub emission: [f32; 4],
     /// A constant emission's XYZ at the frame's nodes (Σ over the nodes of
     /// scale·sigmoid(λ)·white weights, what the shader's node loop would add up); w unused.
+    /// With [`MEASURED_EMISSION`]: the measured spectrum's XYZ per unit luminance of the
+    /// pixel's emissive colour and w the index of its node weights in `light_weights` (the
+    /// spectral modes), or its linear RGB per unit luminance (the RGB mode).
     pub emission_xyz: [f32; 4],
     /// The material's thin film (`KHR_materials_iridescence`): x its index (1 without a film),
     /// y and z its thickness minimum and maximum in nm, which every mode reads (the G-buffer
@@ -105,6 +108,10 @@ impl MaterialSpectrum {
         v
     }
 }
+
+/// `MaterialSpectrum::emission` of a material that glows with a measured spectrum
+/// (`emission_xyz` says how): w = −2, which the shader tells from a varying emission's −1.
+pub const MEASURED_EMISSION: [f32; 4] = [0.0, 0.0, 0.0, -2.0];
 
 /// Entries of [`reflected_xyz`] per material for `n_lights` lights: a column per light, three
 /// to an entry, then one for the environment.

@@ -831,6 +831,7 @@ impl Renderer {
             polygons: !scene.emitters.is_empty(),
             environment: env_uniforms.flags[0] != 0,
             emission: scene.has_emission,
+            emission_spectra: scene.emission_spectra.iter().any(Option::is_some),
             naive: settings.mode == Mode::Naive,
             capture: self.capture.is_some(),
             fetch_base: scene.varying_colours.0,
@@ -1139,6 +1140,33 @@ impl Renderer {
         // Each light's weights per node (spectral modes), for the materials' reflected XYZ.
         let mut light_node_weights: Vec<Vec<[f64; 3]>> = Vec::new();
         // Punctual lights, then the emissive polygons: each a GPU light and its emission.
+        // Materials that glow with a measured spectrum: its node weights per unit luminance (the
+        // spectral modes), or its colour per unit luminance (the RGB mode, as a light's). First,
+        // so that a spectrum the range cannot show is named by its material, not by the
+        // emissive polygons lit with it.
+        let measured: Vec<Option<MeasuredEmission>> = scene
+            .emission_spectra
+            .iter()
+            .map(|m| {
+                let Some((name, spectrum)) = m else { return Ok(None) };
+                let unit = scene::Emission {
+                    rgb: glam::Vec3::ONE,
+                    intensity: 1.0,
+                    spectrum: Some(spectrum.clone()),
+                };
+                if settings.mode == Mode::Rgb {
+                    return Ok(Some(MeasuredEmission::Rgb(setup.light_rgb(&unit))));
+                }
+                match setup.light_weights(&unit, settings.mode, &self.table) {
+                    Ok(w) => Ok(Some(MeasuredEmission::Weights(w))),
+                    Err(RenderError::Settings(why)) => {
+                        Err(RenderError::Settings(format!("material '{name}': {why}")))
+                    }
+                    Err(other) => Err(other),
+                }
+            })
+            .collect::<Result<_>>()?;
+        let n_punctual = scene.lights.len();
         let sources =
             scene.lights.iter().map(|l| (GpuLight::new(l, setup.light_rgb(&l.emission)), &l.emission)).chain(
                 scene
@@ -1146,9 +1174,18 @@ impl Renderer {
                     .iter()
                     .map(|e| (GpuLight::polygon(e, setup.light_rgb(&e.emission)), &e.emission)),
             );
-        for (mut gpu, emission) in sources {
+        for (i, (mut gpu, emission)) in sources.enumerate() {
             if settings.mode != Mode::Rgb {
-                let w = setup.light_weights(emission, settings.mode, &self.table)?;
+                let w = setup.light_weights(emission, settings.mode, &self.table).map_err(|e| match e {
+                    RenderError::Settings(why) if i < n_punctual => {
+                        RenderError::Settings(format!("light '{}': {why}", scene.lights[i].name))
+                    }
+                    RenderError::Settings(why) => RenderError::Settings(format!(
+                        "the emissive surface of mesh {}: {why}",
+                        scene.emitters[i - n_punctual].mesh
+                    )),
+                    other => other,
+                })?;
                 let total = SpectralSetup::light_total(&w);
                 gpu.xyz = [total[0] as f32, total[1] as f32, total[2] as f32, 0.0];
                 light_weights.extend(setup.gpu_weights(&w));
@@ -1202,7 +1239,7 @@ impl Renderer {
         }
         let env_weight_buf = GpuEnvironment::storage(device, &env_weights);
         let env_tex = self.environment.textures(settings.mode == Mode::Spectral);
-        let records = MaterialSpectrum::of_scene(
+        let mut records = MaterialSpectrum::of_scene(
             &scene.constant_colours,
             &scene.material_films,
             &scene.material_refraction,
@@ -1218,6 +1255,22 @@ impl Renderer {
                 &env_basis,
                 &groups,
             ));
+        }
+        // The measured emissions' node weights after the rest, found by the record
+        // (`MaterialSpectrum::emission`).
+        for (record, m) in records.iter_mut().zip(&measured) {
+            let value = match m {
+                None => continue,
+                Some(MeasuredEmission::Rgb(rgb)) => [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0],
+                Some(MeasuredEmission::Weights(w)) => {
+                    let t = SpectralSetup::light_total(w);
+                    let offset = light_weights.len();
+                    light_weights.extend(setup.gpu_weights(w));
+                    [t[0] as f32, t[1] as f32, t[2] as f32, offset as f32]
+                }
+            };
+            record.emission = crate::material_spectra::MEASURED_EMISSION;
+            record.emission_xyz = value;
         }
         if light_weights.is_empty() {
             light_weights.push([[0f32; 4]; 3]);
@@ -1274,6 +1327,13 @@ impl Renderer {
             Some(SpectralState { key, setup, bind_group, custom_bind_group, n_lights, env_totals });
         Ok(())
     }
+}
+
+/// A material's measured emission spectrum prepared for a frame: its node weights per unit
+/// luminance (the spectral modes) or its linear RGB per unit luminance (the RGB mode).
+enum MeasuredEmission {
+    Weights(Vec<[f64; 3]>),
+    Rgb([f64; 3]),
 }
 
 #[cfg(test)]

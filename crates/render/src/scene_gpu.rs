@@ -339,6 +339,11 @@ impl<'a> Chunks<'a> {
 
     /// Adds one mesh (`template` gives the material flags); returns its draws.
     fn add(&mut self, vertices: Vec<Vertex>, indices: &[u32], template: Draw) -> Vec<Draw> {
+        // A mesh of no triangles (a scene built in code; the glTF loader skips them) draws
+        // nothing, and would name a chunk that `finish` never makes.
+        if indices.is_empty() {
+            return Vec::new();
+        }
         let fits = |c: &Self| {
             c.vertices.len() + vertices.len() <= c.max_vertices
                 && c.indices.len() + indices.len() <= c.max_indices
@@ -422,6 +427,11 @@ pub struct GpuScene {
     pub has_emission: bool,
     /// Per material, the G-buffer colours that do not vary over its surface.
     pub constant_colours: Vec<ConstantColour>,
+    /// Per material that emits with a measured spectrum (`extras.emission`; not unlit), its
+    /// name and spectrum: its surface glows with that spectrum at the luminance of its
+    /// emissive colour in every mode (`MaterialSpectrum::emission`, `HAS_EMISSION_SPECTRA`), as
+    /// the path tracer draws it.
+    pub emission_spectra: Vec<Option<(String, color::Spectrum)>>,
     /// Whether some material's base colour (`.0`) or emission (`.1`) varies over its surface,
     /// so that the spectral shading pass needs its per-pixel fetch for it.
     pub varying_colours: (bool, bool),
@@ -678,6 +688,14 @@ impl GpuScene {
                 )
             })
             .collect();
+        let emission_spectra: Vec<_> = s
+            .materials
+            .iter()
+            .map(|m| {
+                let glows = !m.unlit && m.emissive.max_element() > 0.0;
+                m.emission_spectrum.clone().filter(|_| glows).map(|sp| (m.name.clone(), sp))
+            })
+            .collect();
         Ok(GpuScene {
             source: s.source.clone(),
             chunks,
@@ -693,9 +711,14 @@ impl GpuScene {
             has_emission: s.materials.iter().any(|m| m.unlit || m.emissive.max_element() > 0.0),
             varying_colours: (
                 constant_colours.iter().any(|c| c.base.is_none()),
-                constant_colours.iter().any(|c| c.emission.is_none()),
+                // A measured spectrum is not upsampled: no fetch for it.
+                constant_colours
+                    .iter()
+                    .zip(&emission_spectra)
+                    .any(|(c, measured)| c.emission.is_none() && measured.is_none()),
             ),
             constant_colours,
+            emission_spectra,
             has_film: s
                 .materials
                 .iter()

@@ -340,15 +340,8 @@ impl SpectralSetup {
                 Some(norm) => norm.integrate(|l| s.eval(l))[1],
             };
             let want = self.luminance(rgb);
-            if y.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) && want > 0.0 {
-                let r = self.quad.nodes.range;
-                return Err(RenderError::Settings(format!(
-                    "a light's emission spectrum has no luminance inside the render range {}–{} nm \
-                     (it is zero or outside it there); widen --range or fix the spectrum",
-                    r.min, r.max
-                )));
-            }
-            let k = if y > 0.0 { want / y } else { 0.0 };
+            let r = self.quad.nodes.range;
+            let k = scene::emission::range_scale(y, want, (r.min, r.max)).map_err(RenderError::Settings)?;
             return Ok(Box::new(move |l| s.eval(l) * k));
         }
         let white = &self.white;

@@ -824,3 +824,77 @@ fn unlit_surfaces_show_their_base_colour_whatever_the_light() {
         assert!((g - 0.6).abs() > 0.05, "{mode:?}: the lit quad shows {g}, as if unlit");
     }
 }
+
+#[test]
+fn a_measured_emission_spectrum_colours_its_surface_in_every_mode() {
+    // Left: a constant grey emission with an illuminant-A spectrum (`extras.emission`); right:
+    // the same spectrum under an emissive texture (the 2×2 texels' luminance scales it, as the
+    // path tracer's `emitted` does). Both glow orange at their emissive luminance in every mode
+    // and through the capture's loop; they showed the RGB colour (grey, red, …) before.
+    let rects: [Rect; 2] = [(-2.0, -0.2, -1.0, 1.0), (0.2, 2.0, -1.0, 1.0)];
+    let meshes: Vec<Mesh> = rects.iter().enumerate().map(|(i, r)| quad(*r, 0.0, true, i)).collect();
+    let a = color::illuminant::by_name("A").unwrap();
+    let mut materials = vec![material("constant", Vec4::ONE), material("textured", Vec4::ONE)];
+    materials[0].emissive = Vec3::splat(0.6);
+    materials[1].emissive = Vec3::splat(0.9);
+    materials[1].emissive_texture = Some(scene::TextureRef::new(0));
+    for m in &mut materials {
+        m.emission_spectrum = Some(a.clone());
+        m.base_color = Vec4::new(0.0, 0.0, 0.0, 1.0);
+    }
+    let s = scene(meshes, materials, vec![texture_2x2(nearest(Wrap::ClampToEdge))], vec![]);
+    // Illuminant A's colour per unit luminance, from its dense XYZ (independent of either renderer).
+    let xyz = scene::emission::spectrum_xyz(&a);
+    let unit = scene::srgb::xyz_to_linear([xyz[0] / xyz[1], 1.0, xyz[2] / xyz[1]]);
+    let (w, h) = (48, 24);
+    let cam = top_camera(Vec2::ZERO, 1.1);
+    let expected: Vec<Option<[f64; 3]>> = (0..h)
+        .flat_map(|py| (0..w).map(move |px| (px, py)))
+        .map(|(px, py)| {
+            let p = hit(&cam, w, h, px, py, 0.0);
+            let lum = if inside(p, rects[0], 0.08) {
+                Some(0.6)
+            } else if inside(p, rects[1], 0.08) {
+                texel_at(uv_of(rects[1], p), Wrap::ClampToEdge, 0.1)
+                    .map(|t| 0.9 * scene::srgb::luminance(glam::DVec3::from_array(t).as_vec3()))
+            } else {
+                None
+            };
+            lum.map(|l| (unit * l).to_array())
+        })
+        .collect();
+    assert!(unit.x > 1.5 * unit.z, "illuminant A is orange: {unit}");
+    for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8), (Mode::Spectral, 16), (Mode::Naive, 16)] {
+        let mut r = renderer();
+        r.set_scene(&s).unwrap();
+        r.resize(w, h).unwrap();
+        let settings = RenderSettings { mode, wavelengths: n, shadows: false, ..Default::default() };
+        r.render(&cam, &settings).unwrap();
+        let actual: Vec<[f64; 3]> = r.read_hdr().unwrap().iter().map(rgb_of).collect();
+        assert_close(&format!("measured-emission-{mode:?}-{n}"), w, h, &actual, &expected, 0.01);
+        if mode != Mode::Rgb {
+            // The capture's loop (and every spectral hook's) draws it as the plain loop does.
+            r.set_spectral_capture(true);
+            r.render(&cam, &settings).unwrap();
+            let captured: Vec<[f64; 3]> = r.read_hdr().unwrap().iter().map(rgb_of).collect();
+            r.set_spectral_capture(false);
+            let plain: Vec<Option<[f64; 3]>> = actual.iter().map(|v| Some(*v)).collect();
+            assert_close(&format!("measured-emission-captured-{mode:?}-{n}"), w, h, &captured, &plain, 0.002);
+        }
+    }
+}
+
+/// A mesh of no triangles (a scene built in code; the glTF loader skips them) draws nothing:
+/// alone it made the upload name a vertex buffer that was never made (a panic).
+#[test]
+fn a_mesh_without_triangles_draws_nothing() {
+    let mut empty = quad((-1.0, 1.0, -1.0, 1.0), 0.0, true, 0);
+    empty.indices.clear();
+    let lit = scene(vec![empty.clone()], vec![material("m", Vec4::ONE)], vec![], vec![sun(Vec3::NEG_Z, PI)]);
+    let cam = top_camera(Vec2::ZERO, 1.1);
+    assert!(render(&lit, &cam, 16, 12, false).iter().all(|p| *p == [0.0; 3]));
+    // Beside a real quad, the quad is drawn.
+    let both = Scene { meshes: vec![empty, quad((-1.0, 1.0, -1.0, 1.0), 0.0, true, 0)], ..lit };
+    let img = render(&both, &cam, 16, 12, false);
+    assert!((img[6 * 16 + 8][1] - 1.0).abs() < 0.01, "{:?}", img[6 * 16 + 8]);
+}

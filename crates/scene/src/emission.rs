@@ -59,6 +59,25 @@ pub enum EmissionError {
     NoColour,
 }
 
+/// The factor both renderers scale a measured spectrum by for the render range `range` (nm):
+/// `want / y`, with `y` its luminance inside the range by the renderer's own integral and
+/// `want` the luminance it must have there (that of `rgb × intensity`, in the renderer's
+/// units). A spectrum with no luminance inside the range cannot have it: an error (the
+/// caller names the light or material), where either renderer would draw it dark.
+pub fn range_scale(y: f64, want: f64, range: (f64, f64)) -> Result<f64, String> {
+    if y.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        if want > 0.0 {
+            return Err(format!(
+                "its emission spectrum has no luminance inside the render range {}–{} nm (it is \
+                 zero or outside it there); widen --range or fix the spectrum",
+                range.0, range.1
+            ));
+        }
+        return Ok(0.0);
+    }
+    Ok(want / y)
+}
+
 /// Scales `shape` so that its luminance equals that of `rgb × intensity`.
 ///
 /// Errors when the shape has no luminance to scale or a negative value somewhere, since

@@ -213,6 +213,20 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
                 };
                 let need = needs.get(mi).cloned().unwrap_or_default();
                 let local = primitive::build(ctx, &pat, &prim, &buffers, mi, &need)?;
+                if local.indices.is_empty() {
+                    // Fewer indices than one triangle: nothing to draw (the renderers had a mesh
+                    // of no triangles to upload).
+                    if skipped_modes.insert((mesh.index(), prim.index())) {
+                        warnings.push(format!(
+                            "{pat}: mode {:?} with {} index(es) makes no triangle; skipped",
+                            prim.mode(),
+                            prim.indices()
+                                .map_or(prim.attributes().next().map_or(0, |(_, a)| a.count()), |a| a
+                                    .count())
+                        ));
+                    }
+                    continue;
+                }
                 let added = (local.indices.len() / 3).saturating_mul(worlds.len());
                 triangles = triangles.saturating_add(added);
                 if triangles > MAX_TRIANGLES {
@@ -276,6 +290,14 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
             ));
         }
         lights[li].stands_in_for = Some(mesh);
+    }
+    if meshes.is_empty() {
+        // Both renderers would draw only the environment (or black) without saying why.
+        warnings.push(
+            "the scene has no triangles to draw (no mesh in its scene, or only points, lines and \
+             primitives of fewer than three indices): only its environment, if any, is drawn"
+                .into(),
+        );
     }
     if uses_default {
         // glTF's default material: white, fully rough, dielectric, single-sided.

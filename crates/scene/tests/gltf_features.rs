@@ -636,7 +636,46 @@ fn points_and_lines_are_skipped_with_a_warning() {
     let mut d = doc.clone();
     d["meshes"][0]["primitives"] = json!([{"attributes": {"POSITION": pos}, "mode": 1}]);
     let s = load(&d).unwrap();
-    assert!(s.meshes.is_empty() && s.warnings.len() == 1);
+    assert!(s.meshes.is_empty() && s.warnings.len() == 2, "{:?}", s.warnings);
+    assert!(s.warnings[1].starts_with("the scene has no triangles to draw"), "{:?}", s.warnings);
+}
+
+/// A triangle primitive of fewer indices than a triangle (TRIANGLES with 1–2, a strip or fan
+/// with 2) is skipped with a warning: the real-time renderer panicked uploading its empty mesh,
+/// and the path tracer drew the scene black without a word.
+#[test]
+fn primitives_of_no_triangle_are_skipped_with_a_warning() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let two = b.acc(&[0.0, 1.0], U8, "SCALAR", false);
+    let doc = b.finish(json!({
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": pos}, "indices": two, "mode": 4},
+            {"attributes": {"POSITION": pos}, "indices": two, "mode": 5},
+            {"attributes": {"POSITION": pos}, "indices": two, "mode": 6},
+        ]}],
+    }));
+    let s = load(&doc).unwrap();
+    assert!(s.meshes.is_empty(), "{} meshes", s.meshes.len());
+    assert_eq!(s.warnings.len(), 4, "{:?}", s.warnings);
+    for (i, mode) in ["Triangles", "TriangleStrip", "TriangleFan"].iter().enumerate() {
+        assert!(
+            s.warnings[i].starts_with(&format!(
+                "meshes[0].primitives[{i}]: mode {mode} with 2 index(es) makes no triangle"
+            )),
+            "{:?}",
+            s.warnings
+        );
+    }
+    // Beside a real triangle, only the short primitive goes.
+    let mut d = doc.clone();
+    d["meshes"][0]["primitives"] = json!([
+        {"attributes": {"POSITION": pos}, "indices": two, "mode": 4},
+        {"attributes": {"POSITION": pos}, "mode": 4},
+    ]);
+    let s = load(&d).unwrap();
+    assert_eq!((s.meshes.len(), s.warnings.len()), (1, 1), "{:?}", s.warnings);
 }
 
 #[test]

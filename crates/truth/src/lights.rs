@@ -50,26 +50,28 @@ impl EmissionUnits {
     /// The emitted spectrum of a light. With a measured spectrum: its shape, scaled so its
     /// CIE 1931 luminance is that of rgb × intensity (the convention of [`scene::Emission`]);
     /// otherwise the illuminant upsampling of rgb × intensity.
-    pub fn light(&self, e: &Emission, up: &dyn RgbToSpectrum) -> DenseSpectrum {
+    /// A measured spectrum with no luminance inside the range is an error (`scene::emission::range_scale`,
+    /// the real-time renderer's rule): the caller names the light or material.
+    pub fn light(&self, e: &Emission, up: &dyn RgbToSpectrum) -> Result<DenseSpectrum, String> {
         let rgb = e.rgb * e.intensity;
-        match &e.spectrum {
+        Ok(match &e.spectrum {
             Some(s) => {
                 let y = y_integral(&|l| s.eval(l), self.range);
                 let target = luminance(rgb) as f64 * self.k_white;
-                let k = if y > 0.0 { target / y } else { 0.0 };
+                let k = scene::emission::range_scale(y, target, (self.range.min, self.range.max))?;
                 DenseSpectrum::new(s, self.range).scaled(k as f32)
             }
             None => {
                 // One table fetch; the shape is then a closed form in λ.
                 let Some((scale, c)) = upsample::emission_coeffs(up, rgb.to_array()) else {
-                    return DenseSpectrum::from_fn(self.range, |_| 0.0);
+                    return Ok(DenseSpectrum::from_fn(self.range, |_| 0.0));
                 };
                 DenseSpectrum::from_fn(self.range, |l| {
                     let s = upsample::eval4(c, Vec4::splat(l as f32)).x * scale;
                     (s * self.rgb_illuminant.eval(l as f32)) as f64
                 })
             }
-        }
+        })
     }
 
     /// Emission of an RGB radiance (emissive materials) at four wavelengths.
@@ -196,7 +198,7 @@ mod tests {
         let d65 = color::illuminant::by_name("D65").unwrap();
         let u = EmissionUnits::new(&d65, WavelengthRange::VISIBLE);
         let e = Emission { rgb: Vec3::ONE, intensity: 2.0, spectrum: None };
-        let s = u.light(&e, &GreyOnly);
+        let s = u.light(&e, &GreyOnly).unwrap();
         let y = y_integral(&|l| s.eval(l as f32) as f64, WavelengthRange::VISIBLE) / u.k_white;
         assert!((y - 2.0).abs() < 1e-3, "{y}");
         assert!((s.eval(560.0) as f64 - 2.0 * d65.eval(560.0)).abs() < 1e-2);
@@ -208,10 +210,24 @@ mod tests {
         let u = EmissionUnits::new(&d65, WavelengthRange::VISIBLE);
         let f11 = color::illuminant::by_name("F11").unwrap();
         let e = Emission { rgb: Vec3::new(1.0, 0.5, 0.2), intensity: 3.0, spectrum: Some(f11) };
-        let s = u.light(&e, &GreyOnly);
+        let s = u.light(&e, &GreyOnly).unwrap();
         let y = y_integral(&|l| s.eval(l as f32) as f64, WavelengthRange::VISIBLE) / u.k_white;
         let want = 3.0 * (0.2126 + 0.7152 * 0.5 + 0.0722 * 0.2);
         assert!((y - want).abs() < 2e-3 * want, "{y} vs {want}");
+    }
+
+    /// A spectrum with no luminance inside the range is refused, as the real-time renderer
+    /// refuses it (`scene::emission::range_scale`): it drew an all-black image.
+    #[test]
+    fn a_spectrum_outside_the_range_is_an_error_unless_the_light_is_dark() {
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let u = EmissionUnits::new(&d65, WavelengthRange::VISIBLE);
+        let ir = Spectrum::piecewise(vec![790.0, 800.0, 810.0], vec![0.0, 1.0, 0.0]).unwrap();
+        let e = Emission { rgb: Vec3::ONE, intensity: 2.0, spectrum: Some(ir) };
+        let err = u.light(&e, &GreyOnly).unwrap_err();
+        assert!(err.contains("380–730") && err.contains("--range"), "{err}");
+        let dark = Emission { intensity: 0.0, ..e };
+        assert_eq!(u.light(&dark, &GreyOnly).unwrap().eval(550.0), 0.0);
     }
 
     #[test]

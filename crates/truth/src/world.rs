@@ -108,20 +108,37 @@ impl<'s> World<'s> {
             .lights
             .iter()
             .filter(|l| l.stands_in_for.is_none())
-            .map(|l| DeltaLight::new(l, units.light(&l.emission, upsampler)))
-            .collect();
+            .map(|l| {
+                let s = units
+                    .light(&l.emission, upsampler)
+                    .map_err(|why| bad(format!("light '{}': {why}", l.name)))?;
+                Ok(DeltaLight::new(l, s))
+            })
+            .collect::<Result<_>>()?;
         let emission_spectra = scene
             .materials
             .iter()
             .map(|m| {
-                m.emission_spectrum.as_ref().map(|s| {
-                    units.light(
-                        &scene::Emission { rgb: m.emissive, intensity: 1.0, spectrum: Some(s.clone()) },
-                        upsampler,
-                    )
-                })
+                // Only a surface that glows needs its spectrum (the real-time renderer's rule).
+                let glows = !m.unlit && m.emissive.max_element() > 0.0;
+                m.emission_spectrum
+                    .as_ref()
+                    .filter(|_| glows)
+                    .map(|s| {
+                        units
+                            .light(
+                                &scene::Emission {
+                                    rgb: m.emissive,
+                                    intensity: 1.0,
+                                    spectrum: Some(s.clone()),
+                                },
+                                upsampler,
+                            )
+                            .map_err(|why| bad(format!("material '{}': {why}", m.name)))
+                    })
+                    .transpose()
             })
-            .collect();
+            .collect::<Result<_>>()?;
         let areas: Vec<f32> =
             geometry.verts.iter().map(|v| 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()).collect();
         let emitters = EmitterDistribution::new(
@@ -341,7 +358,7 @@ fn water_surface(
         .iter()
         .filter(|l| scene::sky::is_stand_in(l))
         .map(|l| units.light(&l.emission, upsampler))
-        .collect();
+        .collect::<std::result::Result<_, _>>()?;
     if let Some(w) = &scene.water
         && w.sky > 0.0
         && skies.is_empty()

@@ -127,6 +127,8 @@ pub struct Variant {
     pub environment: bool,
     /// A material that emits or is unlit (`HAS_EMISSION`; every mode).
     pub emission: bool,
+    /// A material that glows with a measured spectrum (`HAS_EMISSION_SPECTRA`; every mode).
+    pub emission_spectra: bool,
     /// Box upsampling instead of the sigmoid (`NAIVE`: the naive mode).
     pub naive: bool,
     /// The frame writes the spectral capture (`CAPTURE`).
@@ -165,6 +167,7 @@ impl Variant {
         polygons: true,
         environment: true,
         emission: true,
+        emission_spectra: true,
         naive: false,
         capture: false,
         fetch_base: true,
@@ -181,12 +184,13 @@ impl Variant {
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
     /// environment, emission, film, ior, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 14] {
+    fn constants(&self) -> [(&'static str, f64); 15] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
             ("HAS_ENV", b(self.environment)),
             ("HAS_EMISSION", b(self.emission)),
+            ("HAS_EMISSION_SPECTRA", b(self.emission_spectra)),
             ("NAIVE", b(self.naive)),
             ("CAPTURE", b(self.capture)),
             ("FETCH_BASE", b(self.fetch_base)),
@@ -208,6 +212,7 @@ impl Variant {
             polygons: self.polygons,
             environment: self.environment,
             emission: self.emission,
+            emission_spectra: self.emission_spectra,
             film: self.film,
             ior: self.ior,
             transmission: self.transmission,

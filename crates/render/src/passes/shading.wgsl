@@ -546,7 +546,8 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         if (HAS_EMISSION) {
             // Without emission in the scene, and without ambient light (whose occlusion shares
             // the texel), the emission target is not read.
-            rgb += s.emission;
+            let me = measured_emission(px, s.emission);
+            rgb += select(s.emission, me.value, me.on);
         }
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
@@ -598,6 +599,35 @@ override HAS_EMISSION: bool = true;
 // surface (a texture, vertex colours): only then is the per-pixel coefficient fetch compiled in.
 override FETCH_BASE: bool = true;
 override FETCH_EMISSION: bool = true;
+// Whether some material glows with a measured spectrum (`measured_emission`).
+override HAS_EMISSION_SPECTRA: bool = false;
+
+// sRGB's luminance row (`scene::srgb::luminance`): a measured emission's scale.
+const SRGB_Y: vec3<f32> = vec3<f32>(0.2126729, 0.7151522, 0.0721750);
+
+// The emission of a pixel whose material glows with a measured spectrum
+// (`MaterialSpectrum::emission` w = −2; the path tracer's `emitted`): the spectrum at the
+// luminance `k` of the pixel's emissive colour — the XYZ (RGB in the RGB mode) `value`, and in
+// the spectral modes the node weights per unit luminance at light_weights[index + group].
+// `on` is false elsewhere, where the emission is upsampled from its RGB as usual.
+struct MeasuredEmission {
+    on: bool,
+    k: f32,
+    index: u32,
+    value: vec3<f32>,
+};
+
+fn measured_emission(px: vec2<i32>, emission: vec3<f32>) -> MeasuredEmission {
+    if (!HAS_EMISSION_SPECTRA) {
+        return MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
+    }
+    let m = material_at(px);
+    if (m.emission.w > -1.5) {
+        return MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
+    }
+    let k = dot(emission, SRGB_Y);
+    return MeasuredEmission(true, k, u32(m.emission_xyz.w), m.emission_xyz.xyz * k);
+}
 
 // The reflectance at group g's four nodes: the sigmoid of the base colour's coefficients `c`,
 // or in the naive mode the box of the band each node falls in.
@@ -726,7 +756,12 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     // memory traffic on every pixel); a varying reflectance is kept for the first four groups
     // (below) and re-evaluated per light past them (7 operations per node).
     let p = ctx.world_pos;
-    let s = load_surface(px);
+    var s = load_surface(px);
+    // A measured emission is added as its XYZ; its RGB is not upsampled.
+    let me = measured_emission(px, s.emission);
+    if (me.on) {
+        s.emission = vec3<f32>(0.0);
+    }
     ctx.normal = s.normal;
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
@@ -834,6 +869,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     let em_scale = select(em.w, 0.0, sc.emission_known);
     let em_nodes = HAS_EMISSION && (NAIVE || FETCH_EMISSION);
     xyz += sc.emission_xyz;
+    if (HAS_EMISSION_SPECTRA) {
+        xyz += me.value;
+    }
     let env_known = known && has_env && !s.unlit && !film_env;
     if (env_known) {
         xyz += reflected_env(sc, et.a);
@@ -865,6 +903,54 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     return hdr_out(frame.xyz_to_rgb * xyz, frame.exposure);
 }
 
+// One light at a pixel for the general loop: its terms, what multiplies ρ (`a`, with a thin
+// wall's light from behind) and what does not (`b`); a filmed pixel uses the terms (and `a`
+// for the light from behind) instead.
+struct NodeLight {
+    t: LightTerms,
+    a: f32,
+    b: f32,
+};
+
+fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool) -> NodeLight {
+    var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness);
+    let k = custom_light_surface(li, ctx);
+    t.kd *= k;
+    t.ks *= k;
+    var through = 0.0;
+    if (HAS_TRANSMISSION) {
+        t.kd *= (1.0 - tr.weight);
+        through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k;
+    }
+    if (filmed) {
+        return NodeLight(t, through, 0.0);
+    }
+    let f = factors_of(t, s.metallic, s.f0);
+    var a = f.x;
+    if (HAS_TRANSMISSION) {
+        a += through;
+    }
+    return NodeLight(t, a, f.y);
+}
+
+// Light `li`'s part of group g in weighted form, into the general loop's accumulators.
+fn add_node_light(acc_a: ptr<function, mat3x4<f32>>, acc_b: ptr<function, mat3x4<f32>>, acc_f: ptr<function, mat3x4<f32>>,
+    nl: NodeLight, li: u32, g: u32, lambda: vec4<f32>, rho: vec4<f32>, film: FilmSurface, metallic: f32, ctx: SurfaceContext) {
+    var w = light_w(li, g, frame.n_groups);
+    if (CUSTOM_LIGHT_T) {
+        w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
+    }
+    if (HAS_FILM && film.weight > 0.0) {
+        *acc_f += s3_scale(w, film_light_node(nl.t, film, rho, metallic, lambda));
+        if (HAS_TRANSMISSION) {
+            *acc_f += s3_scale(w, nl.a * rho);
+        }
+    } else {
+        *acc_a += w * nl.a;
+        *acc_b += w * nl.b;
+    }
+}
+
 // The general spectral loop, groups outermost, for what needs each node's whole radiance: a
 // spectral hook (which transforms it) and the capture (which stores it). Returns linear RGB.
 fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
@@ -877,16 +963,22 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var emission = vec3<f32>(0.0);
     var n_lights = 0u;
     var lobe = 0.0;
-    // The spectral loop reads each light's factors once per wavelength group.
-    var fa: array<f32, MAX_LIGHTS>;
-    var fb: array<f32, MAX_LIGHTS>;
+    // The first four lights' factors (and a filmed pixel's terms), kept in registers for the
+    // group loop; lights past them are evaluated again per group (`node_light`). A private
+    // array per light, as this loop had, cost every pixel its zero-initialisation and memory
+    // traffic (on a GPU, local memory) although most scenes have a light or two.
+    var fa4 = vec4<f32>(0.0);
+    var fb4 = vec4<f32>(0.0);
+    var kd4 = vec4<f32>(0.0);
+    var ks4 = vec4<f32>(0.0);
+    var vh4 = vec4<f32>(1.0);
+    var n_kept = 0u;
     // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
     var et: EnvTerms;
     let has_env = shading_env();
     // A filmed pixel keeps each light's terms instead (its Fresnel term depends on λ), and the
     // environment's lobes.
     var film = FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
-    var ft: array<LightTerms, MAX_LIGHTS>;
     var lobes: EnvLobes;
     var metallic = 0.0;
     // Loaded once: the coefficients below are fetched from it too.
@@ -896,8 +988,14 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     // alone for a filmed pixel), and the light through it is added per group after the hook,
     // which the background it reads has had already.
     var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
+    var me = MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
     if (!background) {
         s = load_surface(px);
+        // A measured emission goes through its own node weights; its RGB is not upsampled.
+        me = measured_emission(px, s.emission);
+        if (me.on) {
+            s.emission = vec3<f32>(0.0);
+        }
         film = load_film(px);
         metallic = s.metallic;
         if (HAS_TRANSMISSION) {
@@ -932,29 +1030,15 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         // The hook's irradiance is ambient light too: occluded like the environment.
         lobe = diffuse_lobe(s) * vis;
-        for (var li = 0u; li < n_lights; li++) {
-            var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness);
-            let k = custom_light_surface(li, ctx);
-            t.kd *= k;
-            t.ks *= k;
-            var through = 0.0;
-            if (HAS_TRANSMISSION) {
-                t.kd *= keep;
-                through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k;
-            }
-            if (HAS_FILM && film.weight > 0.0) {
-                ft[li] = t;
-                if (HAS_TRANSMISSION) {
-                    fa[li] = through;
-                }
-            } else {
-                let f = factors_of(t, s.metallic, s.f0);
-                fa[li] = f.x;
-                if (HAS_TRANSMISSION) {
-                    fa[li] += through;
-                }
-                fb[li] = f.y;
-            }
+        n_kept = min(n_lights, 4u);
+        for (var li = 0u; li < n_kept; li++) {
+            let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0);
+            let lane = vec4<u32>(li) == vec4<u32>(0u, 1u, 2u, 3u);
+            fa4 = select(fa4, vec4<f32>(nl.a), lane);
+            fb4 = select(fb4, vec4<f32>(nl.b), lane);
+            kd4 = select(kd4, vec4<f32>(nl.t.kd), lane);
+            ks4 = select(ks4, vec4<f32>(nl.t.ks), lane);
+            vh4 = select(vh4, vec4<f32>(nl.t.vh), lane);
         }
     }
     let filmed = HAS_FILM && film.weight > 0.0;
@@ -996,8 +1080,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
     // light's XYZ once; the capture still takes them per node.
     if (!CUSTOM_SPECTRAL && !filmed) {
-        for (var li = 0u; li < n_lights; li++) {
-            xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
+        for (var li = 0u; li < n_kept; li++) {
+            xyz = fma(vec3<f32>(fb4[li]), lights[li].xyz.xyz, xyz);
+        }
+        for (var li = 4u; li < n_lights; li++) {
+            xyz = fma(vec3<f32>(node_light(li, p, s, ctx, tr, false).b), lights[li].xyz.xyz, xyz);
         }
         if (has_env) {
             xyz += env_xyz(et.b);
@@ -1012,20 +1099,13 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         var acc_b = zero;
         // A filmed pixel's reflection, all of it (it is not a multiple of ρ).
         var acc_f = zero;
-        for (var li = 0u; li < n_lights; li++) {
-            var w = light_w(li, g, ng);
-            if (CUSTOM_LIGHT_T) {
-                w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
-            }
-            if (filmed) {
-                acc_f += s3_scale(w, film_light_node(ft[li], film, rho, metallic, lambda));
-                if (HAS_TRANSMISSION) {
-                    acc_f += s3_scale(w, fa[li] * rho);
-                }
-            } else {
-                acc_a += w * fa[li];
-                acc_b += w * fb[li];
-            }
+        for (var li = 0u; li < n_kept; li++) {
+            let nl = NodeLight(LightTerms(kd4[li], ks4[li], vh4[li]), fa4[li], fb4[li]);
+            add_node_light(&acc_a, &acc_b, &acc_f, nl, li, g, lambda, rho, film, metallic, ctx);
+        }
+        for (var li = 4u; li < n_lights; li++) {
+            let nl = node_light(li, p, s, ctx, tr, filmed);
+            add_node_light(&acc_a, &acc_b, &acc_f, nl, li, g, lambda, rho, film, metallic, ctx);
         }
         if (has_env && !background) {
             if (filmed) {
@@ -1058,6 +1138,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         if (HAS_EMISSION) {
             part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g));
         }
+        var measured = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+        if (HAS_EMISSION_SPECTRA && me.on) {
+            measured = light_weights[me.index + g] * me.k;
+            part += measured;
+        }
         if (sky) {
             part += env_w(sky_c, g, ng);
         }
@@ -1072,6 +1157,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             }
             if (HAS_EMISSION) {
                 xyz += node_emission(em.xyz, em.w, emission, g) * white_weights(g);
+            }
+            if (HAS_EMISSION_SPECTRA) {
+                xyz += s3_xyz(measured);
             }
         }
         if (CUSTOM_IRRADIANCE && lobe > 0.0) {
