@@ -505,14 +505,21 @@ impl Renderer {
         &self.custom
     }
 
-    /// Sets the output size (pixels). Cheap when unchanged.
-    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+    /// Whether this device can render `width`×`height` (its largest texture): for callers that
+    /// check every size before any work ([`Self::resize`] checks it too).
+    pub fn check_size(&self, width: u32, height: u32) -> Result<()> {
         let max = self.gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(RenderError::Settings(format!(
                 "image size {width}×{height} must be between 1 and {max} a side (the device's largest texture)"
             )));
         }
+        Ok(())
+    }
+
+    /// Sets the output size (pixels). Cheap when unchanged.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.check_size(width, height)?;
         if self.targets.as_ref().is_some_and(|(t, _)| t.width == width && t.height == height) {
             return Ok(());
         }

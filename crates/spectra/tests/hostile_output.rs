@@ -287,6 +287,12 @@ fn the_demo_refuses_a_file_for_its_folder_and_leaves_nothing_for_a_bad_scene() {
     let folder = p_(dir.path(), "demo");
     refused(&["demo", "--scene", &p_(dir.path(), "missing.gltf"), "--out", &folder], &["missing.gltf"]);
     assert!(!std::path::Path::new(&folder).exists(), "an empty folder was left behind");
+    // demo refuses a size the real-time renderer cannot make before its ground truth.
+    let demo = p_(dir.path(), "demo");
+    let out = spectra(&["demo", "--size", "16385x2", "--spp", "1", "--out", &demo]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--size 16385x2"));
+    assert!(!std::path::Path::new(&demo).exists(), "demo made its folder (and rendered the truth)");
     // eval likewise, for a size it refuses only once it runs.
     let runs = p_(dir.path(), "eval");
     let out = spectra(&["eval", "--quick", "--size", "100000x100000", "--out", &runs]);
@@ -328,7 +334,14 @@ fn eval_keeps_files_it_did_not_write_and_an_earlier_runs_until_its_inputs_are_re
     let missing = dir.path().join("missing.coeff").display().to_string();
     let out = runs.display().to_string();
     refused(&["eval", "--quick", "--table", &missing, "--out", &out], &["missing.coeff"]);
+    // A size a renderer refuses and a case whose water settings are bad are refused before the
+    // earlier results go (they were removed, and the cases before the bad one rendered).
+    let quick = ["eval", "--quick", "--spp", "2", "--sweep", "4", "--out", &out];
+    refused(&[&quick[..], &["--scenes", "metamerism", "--size", "40000x2"]].concat(), &["--size 40000x2"]);
+    refused(&[&quick[..], &["--scenes", "metamerism", "--size", "16385x2"]].concat(), &["--size 16385x2"]);
+    refused(&[&quick[..], &["--scenes", "metamerism,underwater-xx"]].concat(), &["'XX'", "Jerlov"]);
     for (name, text) in earlier {
         assert_eq!(std::fs::read_to_string(runs.join(name)).unwrap(), text, "{name}");
     }
+    assert!(!runs.join("metamerism_truth.exr").exists(), "a case rendered before the refusal");
 }

@@ -87,6 +87,18 @@ pub const MAX_SIDE: u32 = 32_768;
 /// The most pixels `truth` renders: 8192² (the XYZ image alone is 12 bytes a pixel, 0.8 GB).
 pub const MAX_PIXELS: u64 = 1 << 26;
 
+/// Whether `truth` renders a whole `width`×`height` frame ([`MAX_SIDE`], [`MAX_PIXELS`]), for
+/// callers that check their sizes before any work.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(TruthError::BadSize(width, height));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width as u64 * height as u64 > MAX_PIXELS {
+        return Err(TruthError::TooLarge(width, height));
+    }
+    Ok(())
+}
+
 /// Most memory the binned spectral image may take (f32 samples).
 pub const MAX_SPECTRAL_BYTES: u64 = 1 << 31;
 

@@ -60,8 +60,13 @@ pub fn run(a: Args) -> Result<()> {
             a.out.display()
         );
     }
-    // A scene that cannot be loaded is refused before the folder is made.
+    // A scene that cannot be loaded, or a size either renderer refuses, is refused before the
+    // folder is made and the ground truth rendered.
     a.files.load(&a.scene)?;
+    let (w, h) = super::setup::parse_size(&a.size)?;
+    let size_error = |e: String| anyhow::anyhow!("--size {}: {e}", a.size);
+    truth::render::check_size(w, h).map_err(|e| size_error(e.to_string()))?;
+    render::Renderer::new()?.check_size(w, h).map_err(|e| size_error(e.to_string()))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let file = |name: &str| a.out.join(name);
     let spp = a.spp.to_string();

@@ -291,7 +291,8 @@ fn run_into(cfg: Config) -> Result<Results> {
         }
         Ok(())
     };
-    let adapter = Renderer::with_table(table.clone())?.gpu().describe();
+    let probe = Renderer::with_table(table.clone())?;
+    let adapter = probe.gpu().describe();
     let cache = cfg.truth_cache.as_deref().map(crate::cmd::truth_cache::TruthCache::open).transpose()?;
     let cache = cache.as_ref();
     let b = &cfg.budget;
@@ -300,6 +301,19 @@ fn run_into(cfg: Config) -> Result<Results> {
         measure::TruthJob { width, height, spp, seed, range }
     };
     let cases: Vec<suite::Case> = cfg.ids.iter().map(|id| cfg.case(id)).collect::<Result<_>>()?;
+    // Every case's inputs are checked before an earlier run's results go or any work starts: a
+    // size either renderer refuses, a range, water settings (`underwater-XX`) failed only when
+    // their case came, after the earlier results were removed and the cases before it rendered.
+    for c in &cases {
+        let (width, height, spp) = b.for_case(c);
+        let at = |e: String| anyhow::anyhow!("{}: --size {width}x{height}: {e}", c.id);
+        probe.check_size(width, height).map_err(|e| at(e.to_string()))?;
+        truth::render::check_size(width, height).map_err(|e| at(e.to_string()))?;
+        anyhow::ensure!(spp > 0, "{}: --spp must be at least 1", c.id);
+        scene_range(&c.scene).with_context(|| c.id.clone())?;
+        measure::water(&c.scene)?;
+    }
+    drop(probe);
     for p in stale {
         std::fs::remove_file(&p).with_context(|| format!("removing an earlier run's {}", p.display()))?;
     }
