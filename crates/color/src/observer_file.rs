@@ -22,14 +22,11 @@ use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN, Spectrum};
 /// files ~10 kB).
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
 
-/// Whether an `--observer` value names a file rather than a built-in observer.
+/// Whether an `--observer` value names a file rather than a built-in observer: a path, or a
+/// name with an extension (no built-in name has a dot; `obs.png` holding a CSV was looked up
+/// as an unknown built-in).
 pub fn is_file_name(name: &str) -> bool {
-    let lower = name.to_ascii_lowercase();
-    lower.ends_with(".csv")
-        || lower.ends_with(".txt")
-        || lower.ends_with(".json")
-        || name.contains('/')
-        || name.contains('\\')
+    name.contains('.') || name.contains('/') || name.contains('\\')
 }
 
 /// The observer in the file at `path` (JSON when it ends in `.json` or starts with `{`, else
@@ -204,14 +201,55 @@ fn finish(
              (only the functions' shape matters)"
         )));
     }
+    // Each channel is normalised by its own response to the white, which a channel far weaker
+    // than the others takes out of f32's range in the renderers' sums (channels of 10²⁰ and
+    // 10⁻²⁰ made the path tracer's image NaN and the real-time one ±65504). No real observer or
+    // camera has channels 10¹² apart.
+    for (c, col) in columns.iter().enumerate() {
+        let peak = col.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if peak < largest * MIN_CHANNEL_SHARE {
+            return Err(whole(format!(
+                "{} peaks at {peak:e}, below {MIN_CHANNEL_SHARE:e} of the largest value {largest:e}: a channel \
+                 that weak cannot be normalised (scale the columns to comparable peaks)",
+                column_name(c)
+            )));
+        }
+    }
     let bar = columns.map(|values| Spectrum::piecewise(lambda.clone(), values));
     let [a, b, c] = bar;
     Ok(Observer { name: source.to_string(), bar: [a?, b?, c?] })
 }
 
+/// The weakest channel's peak an observer file may have, as a share of its largest value.
+pub const MIN_CHANNEL_SHARE: f64 = 1e-12;
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Found by a sweep: `--observer obs.png` (a CSV under another extension) was looked up as
+    /// an unknown built-in name; any name with an extension or a path is a file.
+    #[test]
+    fn names_with_an_extension_or_a_path_are_files() {
+        for f in ["obs.png", "obs.csv", "my.data.txt", "./obs", "dir/obs", "c:\\obs"] {
+            assert!(is_file_name(f), "{f}");
+        }
+        for n in ["cie1931", "canon_eos_r5", "nikon", "2015"] {
+            assert!(!is_file_name(n), "{n}");
+        }
+        assert!(Observer::by_name("missing.png").unwrap_err().to_string().contains("missing.png"));
+    }
+
+    /// Found by a sweep: channels peaking at 10²⁰ and 10⁻²⁰ passed every check and made the
+    /// path tracer's image NaN and the real-time one ±65504; a channel 10¹² below the largest
+    /// is refused by name, in CSV and JSON alike.
+    #[test]
+    fn a_channel_far_weaker_than_the_others_is_refused() {
+        let rows = |g: f64| -> String { (0..5).map(|i| format!("{},1,{g:e},0.5\n", 400 + 50 * i)).collect() };
+        assert!(parse(&rows(1e-11), "ok.csv").is_ok());
+        let e = parse(&rows(1e-13), "weak.csv").unwrap_err().to_string();
+        assert!(e.contains("weak.csv") && e.contains("column 3") && e.contains("peaks at"), "{e}");
+    }
 
     /// A FIFO or a device is refused at once (it blocked, or /dev/zero was read until memory
     /// ran out), and so is a file past the size cap.
