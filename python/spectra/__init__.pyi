@@ -1,7 +1,7 @@
 """Type stub of the `spectra` package (the extension module spectra._spectra). See docs/python.md."""
 
 import os
-from typing import Any, Literal, Optional, Tuple, TypedDict, Union, overload
+from typing import Any, Literal, Optional, Sequence, Tuple, TypedDict, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -23,6 +23,14 @@ _Bands = npt.NDArray[np.float32]
 """Per-pixel spectral values: float32, shape (height, width, N)."""
 _Wavelengths = npt.NDArray[np.float64]
 """Wavelengths in nm (node wavelengths, band edges): float64, 1-D."""
+_Path = Union[str, os.PathLike[str]]
+"""A file's name: a str or an os.PathLike (pathlib.Path)."""
+_Size = Union[Tuple[int, int], Sequence[int]]
+"""(width, height): a tuple, a list or a 1-D array of two ints."""
+_Range = Union[Tuple[float, float], Sequence[float]]
+"""(min_nm, max_nm): a tuple, a list or a 1-D array of two floats."""
+_Crop = Union[Tuple[int, int, int, int], Sequence[int]]
+"""(x, y, width, height): a tuple, a list or a 1-D array of four ints."""
 
 class Stats(TypedDict):
     mean: float
@@ -54,9 +62,9 @@ class Scene:
         """The number of lights (stand-ins included)."""
 
 def load(
-    path_or_builtin: Union[str, os.PathLike[str]],
+    path_or_builtin: _Path,
     allow_outside_scene_dir: bool = False,
-    env: Optional[str] = None,
+    env: Optional[_Path] = None,
     env_intensity: Optional[float] = None,
     env_rotation: Optional[float] = None,
     env_sun: bool = True,
@@ -80,11 +88,11 @@ class Renderer:
     def __init__(
         self,
         scene: Scene,
-        size: Tuple[int, int] = (640, 480),
+        size: _Size = (640, 480),
         *,
         water: Optional[str] = None,
         depth: Optional[float] = None,
-        rgb_medium: Optional[str] = None,
+        rgb_medium: Optional[_Path] = None,
     ) -> None:
         """`water`: a Jerlov type ("IB", …) with the camera `depth` in metres; `rgb_medium`: the
         `--rgb-medium` JSON or a JSON file; by default the scene's own medium."""
@@ -95,8 +103,8 @@ class Renderer:
         *,
         wavelengths: Optional[int] = None,
         quadrature: str = "prefiltered",
-        range: Optional[Tuple[float, float]] = None,
-        observer: Optional[str] = None,
+        range: Optional[_Range] = None,
+        observer: Optional[_Path] = None,
         white: Optional[str] = None,
         exposure: float = 0.0,
         spectral: Literal[False] = False,
@@ -116,8 +124,9 @@ class Renderer:
         samples: antialiasing, the mean of 1–256 frames each looking at another place in every
         pixel (`--samples`): the image box-filtered over each pixel, as the path tracer's are
         (not with spectral=True).
-        Unknown keywords raise TypeError, bad values ValueError with the CLI's message; the GIL
-        is released while rendering."""
+        Unknown keywords and badly typed arguments raise TypeError (its message starts with the
+        argument's name), bad values ValueError with the CLI's message; the GIL is released while
+        rendering, and `size`, `device` and `repr()` never wait for a render on another thread."""
     @overload
     def render(
         self,
@@ -125,8 +134,8 @@ class Renderer:
         *,
         wavelengths: Optional[int] = None,
         quadrature: str = "prefiltered",
-        range: Optional[Tuple[float, float]] = None,
-        observer: Optional[str] = None,
+        range: Optional[_Range] = None,
+        observer: Optional[_Path] = None,
         white: Optional[str] = None,
         exposure: float = 0.0,
         spectral: Literal[True],
@@ -140,8 +149,8 @@ class Renderer:
         *,
         wavelengths: Optional[int] = None,
         quadrature: str = "prefiltered",
-        range: Optional[Tuple[float, float]] = None,
-        observer: Optional[str] = None,
+        range: Optional[_Range] = None,
+        observer: Optional[_Path] = None,
         white: Optional[str] = None,
         exposure: float = 0.0,
         spectral: bool = False,
@@ -161,19 +170,19 @@ class Renderer:
 def truth(
     scene: Scene,
     spp: int = 64,
-    size: Tuple[int, int] = (256, 256),
+    size: _Size = (256, 256),
     direct_only: bool = False,
     seed: int = 0,
     *,
     sample_offset: int = 0,
-    crop: Optional[Tuple[int, int, int, int]] = None,
-    range: Optional[Tuple[float, float]] = None,
-    observer: Optional[str] = None,
+    crop: Optional[_Crop] = None,
+    range: Optional[_Range] = None,
+    observer: Optional[_Path] = None,
     white: Optional[str] = None,
     max_depth: int = 1024,
     water: Optional[str] = None,
     depth: Optional[float] = None,
-    rgb_medium: Optional[str] = None,
+    rgb_medium: Optional[_Path] = None,
     spectral_bin: None = None,
     camera_to_display: bool = False,
 ) -> RGBImage:
@@ -183,25 +192,28 @@ def truth(
     same seed gives the same image. water / depth / rgb_medium / observer / camera_to_display as
     for `Renderer.render`.
     spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
-    (`--spectral-out`). Ctrl-C raises KeyboardInterrupt; the GIL is released."""
+    (`--spectral-out`). size / range / crop may be tuples, lists or 1-D arrays; observer and
+    rgb_medium files str or os.PathLike; counts ints (bools and floats are refused). Ctrl-C
+    raises KeyboardInterrupt within a fraction of a second (in a forked child too); the GIL is
+    released."""
 
 @overload
 def truth(
     scene: Scene,
     spp: int = 64,
-    size: Tuple[int, int] = (256, 256),
+    size: _Size = (256, 256),
     direct_only: bool = False,
     seed: int = 0,
     *,
     sample_offset: int = 0,
-    crop: Optional[Tuple[int, int, int, int]] = None,
-    range: Optional[Tuple[float, float]] = None,
-    observer: Optional[str] = None,
+    crop: Optional[_Crop] = None,
+    range: Optional[_Range] = None,
+    observer: Optional[_Path] = None,
     white: Optional[str] = None,
     max_depth: int = 1024,
     water: Optional[str] = None,
     depth: Optional[float] = None,
-    rgb_medium: Optional[str] = None,
+    rgb_medium: Optional[_Path] = None,
     spectral_bin: float,
     camera_to_display: bool = False,
 ) -> Tuple[RGBImage, _Bands, _Wavelengths]: ...
@@ -209,19 +221,19 @@ def truth(
 def truth(
     scene: Scene,
     spp: int = 64,
-    size: Tuple[int, int] = (256, 256),
+    size: _Size = (256, 256),
     direct_only: bool = False,
     seed: int = 0,
     *,
     sample_offset: int = 0,
-    crop: Optional[Tuple[int, int, int, int]] = None,
-    range: Optional[Tuple[float, float]] = None,
-    observer: Optional[str] = None,
+    crop: Optional[_Crop] = None,
+    range: Optional[_Range] = None,
+    observer: Optional[_Path] = None,
     white: Optional[str] = None,
     max_depth: int = 1024,
     water: Optional[str] = None,
     depth: Optional[float] = None,
-    rgb_medium: Optional[str] = None,
+    rgb_medium: Optional[_Path] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
 ) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
@@ -234,13 +246,21 @@ def diff(
     flip: Optional[str] = None,
     flip_ppd: Optional[float] = None,
     maps: bool = False,
+    flip_start_exposure: Optional[float] = None,
+    flip_stop_exposure: Optional[float] = None,
+    flip_exposures: Optional[int] = None,
+    flip_tone_mapper: Optional[str] = None,
 ) -> dict[str, Any]:
     """`spectra diff --json`'s statistics of image `b` against the reference `a` (float32 or
     float64 arrays of shape (H, W, 3), linear sRGB): ΔE2000, MAE linear and sRGB-encoded
-    (a `DiffSummary`); flip="ldr"/"hdr" adds NVIDIA FLIP (`flip`, `flip_kind`, `flip_ppd`);
+    (a `DiffSummary`); flip="ldr"/"hdr" adds NVIDIA FLIP (`flip`, `flip_kind`, `flip_ppd`,
+    and `flip_exposures`: HDR-FLIP's `start`, `stop`, `count`, `tone_mapper`, None for LDR-FLIP);
+    flip_ppd and the HDR-FLIP options (`flip_start_exposure`, `flip_stop_exposure` (both needed
+    for a black `a`), `flip_exposures` (their number), `flip_tone_mapper` "aces"/"reinhard"/
+    "hable") need `flip`, as `spectra diff --flip-…` need `--metric flip`.
     maps=True adds the per-pixel (H, W) arrays `delta_e2000_map`, `mae_linear_map`,
     `mae_srgb_map` (and `flip_map`). ValueError naming the argument for a wrong dtype or
-    shape, or a non-finite pixel."""
+    shape, a non-finite pixel, or a float64 value beyond float32's range."""
 
 @overload
 def upsample(rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: None = None) -> npt.NDArray[np.float64]:
@@ -256,21 +276,22 @@ def upsample(
     rgb: npt.ArrayLike, space: str = "srgb", *, wavelengths: Optional[npt.ArrayLike] = None
 ) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]: ...
 
-def observer(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
+def observer(name: _Path, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """An observer's colour-matching functions or a camera's sensitivities at `wavelengths`
     (nm): float64 (L, 3)."""
 
 def illuminant(name: str, wavelengths: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """An illuminant's relative spectral power at `wavelengths` (nm): float64 (L,)."""
 
-def chart(observer: str, illuminant: str = "D65", *, balanced: bool = False) -> npt.NDArray[np.float64]:
+def chart(observer: _Path, illuminant: str = "D65", *, balanced: bool = False) -> npt.NDArray[np.float64]:
     """The 24 ColorChecker Classic patches seen by `observer` under `illuminant`: float64
     (24, 3), ∫ sensitivity·R·E dλ at 1 nm over 360–830 nm; balanced=True divides by the
     perfect white's response."""
 
-def read_image(path: Union[str, os.PathLike[str]]) -> RGBImage:
+def read_image(path: _Path) -> RGBImage:
     """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""
 
-def write_image(path: Union[str, os.PathLike[str]], image: _FloatImage) -> None:
+def write_image(path: _Path, image: _FloatImage) -> None:
     """Writes an (H, W, 3) linear RGB array as `.exr` (float32) or `.png` (sRGB, 8-bit),
-    atomically."""
+    atomically. FileNotFoundError when the directory does not exist; ValueError for a float64
+    value beyond float32's range."""

@@ -22,7 +22,11 @@ path (absolute), so the file must be reachable there (a shared filesystem, or `w
 so are an `observer=` or `rgb_medium=` file (and `eval`'s `table`), named absolutely for the
 workers whatever their working directory.
 `eval` runs `spectra eval` with its ground truths rendered the same way (stored in its truth
-cache, the real-time renders and the report on this machine). See docs/python.md.
+cache, the real-time renders and the report on this machine).
+
+Ctrl-C in `truth` or `eval` cancels the tasks it submitted (a running task stops within a
+fraction of a second, as `spectra.truth` does on Ctrl-C); a `Job` from `submit` is cancelled
+with `Job.cancel()`, and `ray.cancel` on a task stops it too. See docs/python.md.
 """
 
 from __future__ import annotations
@@ -31,15 +35,29 @@ import operator
 import os
 import sys
 import time
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 
-from . import Scene, _spectra
+from . import Scene
+from . import _spectra  # type: ignore[attr-defined]  # the extension, typed by __init__.pyi's names
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
+    _Image = npt.NDArray[np.float32]
+    _Bands = npt.NDArray[np.float32]
+    _Edges = npt.NDArray[np.float64]
+    _Result = Union[_Image, Tuple[_Image, _Bands, _Edges]]
+    _Path = Union[str, "os.PathLike[str]"]
 
 __all__ = ["Job", "eval", "split", "submit", "truth"]
 
+#: A piece of a render: (chunk index, sample_offset, spp, crop (x, y, w, h)).
+Piece = Tuple[int, int, int, Tuple[int, int, int, int]]
 
-def _ray():
+
+def _ray() -> Any:
     try:
         import ray
     except ImportError as e:  # pragma: no cover - depends on the environment
@@ -53,7 +71,7 @@ def _ray():
 CHUNKS = 8
 
 
-def _whole(name, value, least=1):
+def _whole(name: str, value: Any, least: int = 1) -> int:
     """`value` as an int ≥ `least`, or the ValueError naming `name`. Any integral type is one
     (numpy's integers too, as the extension's own arguments take them); bool and float are not."""
     try:
@@ -67,24 +85,28 @@ def _whole(name, value, least=1):
     return n
 
 
-def _observer_file(name):
+def _observer_file(name: str) -> bool:
     """Whether an `observer=` value names a file rather than a built-in observer: the rule of
     the Rust side (`color::observer_file::is_file_name`)."""
     lower = name.lower()
     return lower.endswith((".csv", ".txt", ".json")) or "/" in name or "\\" in name
 
 
-def _absolute(path):
+def _absolute(path: str) -> str:
     """`path` made absolute against this process's working directory, as `load` names a
     scene file (no `..` or symlink resolved: `std::path::absolute`'s result)."""
     return path if os.path.isabs(path) else os.path.join(os.getcwd(), path)
 
 
-def _for_workers(options):
+def _for_workers(options: Dict[str, Any]) -> Dict[str, Any]:
     """`options` with the files they name (`observer=`, `rgb_medium=`) as absolute paths: a
     Ray worker's working directory need not be this process's (another node, or this process
-    changed its own after Ray started). Names and inline JSON are left as they are."""
+    changed its own after Ray started). Names and inline JSON are left as they are; an
+    `os.PathLike` (`pathlib.Path`) becomes its str."""
     options = dict(options)
+    for key in ("observer", "rgb_medium"):
+        if isinstance(options.get(key), os.PathLike):
+            options[key] = os.fspath(options[key])
     observer, medium = options.get("observer"), options.get("rgb_medium")
     if isinstance(observer, str) and _observer_file(observer):
         options["observer"] = _absolute(observer)
@@ -93,7 +115,14 @@ def _for_workers(options):
     return options
 
 
-def split(spp, size, chunks=None, tiles=(1, 1), sample_offset=0, crop=None):
+def split(
+    spp: int,
+    size: Sequence[int],
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+) -> List[Piece]:
     """The pieces a render is split into: a list of (chunk index, sample_offset, spp, crop),
     chunks of as equal a number of samples as can be (the first ones one more), each over
     every tile of a `tiles=(nx, ny)` grid of the window (the frame, or `crop`). `chunks`
@@ -118,7 +147,8 @@ def split(spp, size, chunks=None, tiles=(1, 1), sample_offset=0, crop=None):
     xs = [x0 + ww * i // nx for i in range(nx + 1)]
     ys = [y0 + wh * j // ny for j in range(ny + 1)]
     base, extra = divmod(spp, chunks)
-    pieces, offset = [], sample_offset
+    pieces: List[Piece] = []
+    offset = sample_offset
     for c in range(chunks):
         n = base + (1 if c < extra else 0)
         for j in range(ny):
@@ -129,7 +159,15 @@ def split(spp, size, chunks=None, tiles=(1, 1), sample_offset=0, crop=None):
     return pieces
 
 
-def _piece(scene, options, chunk, sample_offset, spp, crop, threads):
+def _piece(
+    scene: Scene,
+    options: Dict[str, Any],
+    chunk: int,
+    sample_offset: int,
+    spp: int,
+    crop: Tuple[int, int, int, int],
+    threads: int,
+) -> Dict[str, Any]:
     """One Ray task: the sums of samples sample_offset … +spp−1 over `crop`."""
     # The tests' way to kill a worker mid-render: the first attempt of chunk 0 exits the
     # process, as a crashed or preempted node would; Ray runs the task again.
@@ -137,35 +175,57 @@ def _piece(scene, options, chunk, sample_offset, spp, crop, threads):
     if marker and chunk == 0 and not os.path.exists(marker):
         open(marker, "w").close()
         os._exit(1)
-    return _spectra._truth_sums(
+    sums: Dict[str, Any] = _spectra._truth_sums(
         scene, spp=spp, sample_offset=sample_offset, crop=crop, threads=threads, **options
     )
+    return sums
 
 
 class Job:
     """A truth render running as Ray tasks (from `submit`): `result()` waits for its tasks and
-    merges them; `done()` says whether they have all finished."""
+    merges them; `done()` says whether they have all finished; `cancel()` stops them."""
 
-    def __init__(self, ray, plan, pieces, refs, spp, progress, label):
+    def __init__(
+        self,
+        ray: Any,
+        plan: Dict[str, Any],
+        pieces: List[Piece],
+        refs: List[Any],
+        spp: int,
+        progress: bool,
+        label: str,
+    ) -> None:
         self._ray, self._plan, self._pieces, self._refs = ray, plan, pieces, refs
         self._spp, self._progress, self._label = spp, progress, label
         self._t0 = time.perf_counter()
-        self._result = None
+        self._result: Optional[_Result] = None
 
-    def done(self):
+    def done(self) -> bool:
+        """Whether every task has finished (without waiting); a cancelled or failed task counts
+        as finished."""
         ready, _ = self._ray.wait(self._refs, num_returns=len(self._refs), timeout=0)
         return len(ready) == len(self._refs)
 
-    def result(self):
-        """`spectra.truth`'s result: the (h, w, 3) image, or (image, bands, edges)."""
+    def cancel(self, force: bool = False) -> None:
+        """Cancels the tasks not yet finished (`ray.cancel`): one not started never runs, a
+        running one stops within a fraction of a second (its render is interrupted as Ctrl-C
+        interrupts `spectra.truth`; `force=True` kills its worker process instead). `result()`
+        then raises Ray's `TaskCancelledError`. Finished tasks are left as they are."""
+        for ref in self._refs:
+            self._ray.cancel(ref, force=force)
+
+    def result(self) -> _Result:
+        """`spectra.truth`'s result: the (h, w, 3) image, or (image, bands, edges) with
+        `spectral_bin`. Waits for the tasks; interrupted (Ctrl-C), it leaves them running (call
+        `cancel()` to stop them)."""
         if self._result is None:
             self._result = self._merge()
         return self._result
 
-    def _merge(self):
+    def _merge(self) -> _Result:
         ray = self._ray
         index = {ref: k for k, ref in enumerate(self._refs)}
-        results = [None] * len(self._refs)
+        results: List[Any] = [None] * len(self._refs)
         pending = list(self._refs)
         while pending:
             done, pending = ray.wait(pending, num_returns=1)
@@ -197,41 +257,58 @@ class Job:
         if dropped:
             print(f"warning: truth: {dropped} non-finite samples dropped", file=sys.stderr)
         if bins is None:
-            return _spectra._truth_finish(xyz, self._spp, display=plan["display"])
+            image: _Image = _spectra._truth_finish(xyz, self._spp, display=plan["display"])
+            return image
         img, bands = _spectra._truth_finish(xyz, self._spp, bins, display=plan["display"])
         return img, bands, plan["edges"]
 
 
+def _check_cpus(ray: Any, threads_per_task: int) -> None:
+    """A task asking for more CPUs than any node of the cluster has is never scheduled: Ray
+    waits for such a node for ever (its autoscaler prints "No available node types can fulfill
+    resource request" every half minute). Refused before any task, naming the most there is."""
+    most = max(
+        (float(n.get("Resources", {}).get("CPU", 0)) for n in ray.nodes() if n.get("Alive")),
+        default=0.0,
+    )
+    if threads_per_task > most:
+        raise ValueError(
+            f"threads_per_task {threads_per_task}: no node of the Ray cluster has more than {most:g} CPUs, "
+            "so a task asking for that many would wait for ever (give at most that many, or add a "
+            "larger node before submitting)"
+        )
+
+
 def submit(
-    scene,
-    spp=64,
-    size=(256, 256),
-    direct_only=False,
-    seed=0,
+    scene: Scene,
+    spp: int = 64,
+    size: Sequence[int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
     *,
-    sample_offset=0,
-    crop=None,
-    range=None,
-    observer=None,
-    white=None,
-    max_depth=1024,
-    water=None,
-    depth=None,
-    rgb_medium=None,
-    spectral_bin=None,
-    camera_to_display=False,
-    chunks=None,
-    tiles=(1, 1),
-    threads_per_task=1,
-    max_retries=3,
-    address=None,
-    runtime_env=None,
-    progress=True,
-    label="",
-):
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+    range: Optional[Sequence[float]] = None,
+    observer: Optional[_Path] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[_Path] = None,
+    spectral_bin: Optional[float] = None,
+    camera_to_display: bool = False,
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+    label: str = "",
+) -> Job:
     """`truth` without waiting: the render's tasks are submitted and a `Job` is returned, so
     that many renders (an evaluation's truths, a table's rows) share the cluster at once.
-    `label`: shown in the progress lines."""
+    `label`: shown in the progress lines. `Job.cancel()` stops the tasks."""
     ray = _ray()
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a spectra.Scene (from spectra.load), not {type(scene).__name__}")
@@ -256,6 +333,7 @@ def submit(
     pieces = split(spp, size, chunks, tiles, sample_offset, plan["window"])
     if not ray.is_initialized():
         ray.init(address=address, runtime_env=runtime_env)
+    _check_cpus(ray, threads_per_task)
     task = ray.remote(_piece).options(num_cpus=threads_per_task, max_retries=max_retries)
     scene_ref = ray.put(scene)
     options = _for_workers(options)
@@ -263,22 +341,113 @@ def submit(
     return Job(ray, plan, pieces, refs, plan["spp"], progress, f" {label}" if label else "")
 
 
+@overload
 def truth(
-    scene,
-    spp=64,
-    size=(256, 256),
-    direct_only=False,
-    seed=0,
+    scene: Scene,
+    spp: int = 64,
+    size: Sequence[int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
     *,
-    chunks=None,
-    tiles=(1, 1),
-    threads_per_task=1,
-    max_retries=3,
-    address=None,
-    runtime_env=None,
-    progress=True,
-    **options,
-):
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+    range: Optional[Sequence[float]] = None,
+    observer: Optional[_Path] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[_Path] = None,
+    spectral_bin: None = None,
+    camera_to_display: bool = False,
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+) -> _Image: ...
+@overload
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Sequence[int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+    range: Optional[Sequence[float]] = None,
+    observer: Optional[_Path] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[_Path] = None,
+    spectral_bin: float,
+    camera_to_display: bool = False,
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+) -> Tuple[_Image, _Bands, _Edges]: ...
+@overload
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Sequence[int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+    range: Optional[Sequence[float]] = None,
+    observer: Optional[_Path] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[_Path] = None,
+    spectral_bin: Optional[float] = None,
+    camera_to_display: bool = False,
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+) -> _Result: ...
+def truth(
+    scene: Scene,
+    spp: int = 64,
+    size: Sequence[int] = (256, 256),
+    direct_only: bool = False,
+    seed: int = 0,
+    *,
+    sample_offset: int = 0,
+    crop: Optional[Sequence[int]] = None,
+    range: Optional[Sequence[float]] = None,
+    observer: Optional[_Path] = None,
+    white: Optional[str] = None,
+    max_depth: int = 1024,
+    water: Optional[str] = None,
+    depth: Optional[float] = None,
+    rgb_medium: Optional[_Path] = None,
+    spectral_bin: Optional[float] = None,
+    camera_to_display: bool = False,
+    chunks: Optional[int] = None,
+    tiles: Sequence[int] = (1, 1),
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+) -> _Result:
     """`spectra.truth` split into `chunks` sample chunks × a `tiles=(nx, ny)` grid of tiles,
     each a Ray task, and merged: the same arguments (`sample_offset`, `crop`, `range`,
     `observer`, `white`, `max_depth`, `water`, `depth`, `rgb_medium`, `spectral_bin`,
@@ -288,17 +457,30 @@ def truth(
 
     chunks: default 8, or `spp` when that is fewer (more than `spp` given explicitly is an
     error). threads_per_task: CPUs each task asks Ray for and uses (the tracer's threads); Ray
-    runs as many tasks at once as the cluster has CPUs for. max_retries: how often Ray runs a
+    runs as many tasks at once as the cluster has CPUs for, and more than any node has is a
+    ValueError. max_retries: how often Ray runs a
     task again whose worker died (-1: without limit). address / runtime_env: passed to
     `ray.init` when Ray is not running yet in this process (address None: a local instance, or
     the cluster of $RAY_ADDRESS). progress: a line on stderr per finished task. Counts may be
-    any integral type (numpy's integers too)."""
-    return submit(
+    any integral type (numpy's integers too), not bools or floats. Ctrl-C (KeyboardInterrupt),
+    or any other error while waiting, cancels the tasks not yet finished."""
+    job = submit(
         scene,
         spp,
         size,
         direct_only,
         seed,
+        sample_offset=sample_offset,
+        crop=crop,
+        range=range,
+        observer=observer,
+        white=white,
+        max_depth=max_depth,
+        water=water,
+        depth=depth,
+        rgb_medium=rgb_medium,
+        spectral_bin=spectral_bin,
+        camera_to_display=camera_to_display,
         chunks=chunks,
         tiles=tiles,
         threads_per_task=threads_per_task,
@@ -306,28 +488,34 @@ def truth(
         address=address,
         runtime_env=runtime_env,
         progress=progress,
-        **options,
-    ).result()
+    )
+    try:
+        return job.result()
+    except BaseException:
+        # Ctrl-C in a notebook or a script: the tasks would otherwise go on rendering, holding
+        # the cluster's CPUs, with nobody to take their result.
+        job.cancel()
+        raise
 
 
 def eval(
-    out,
+    out: _Path,
     *,
-    quick=False,
-    scenes=None,
-    spp=None,
-    size=None,
-    sweep=None,
-    table=None,
-    observer=None,
-    truth_cache=None,
-    chunks=8,
-    threads_per_task=1,
-    max_retries=3,
-    address=None,
-    runtime_env=None,
-    progress=True,
-):
+    quick: bool = False,
+    scenes: Optional[Union[str, Sequence[str]]] = None,
+    spp: Optional[int] = None,
+    size: Optional[Union[str, Sequence[int]]] = None,
+    sweep: Optional[Union[str, Sequence[int]]] = None,
+    table: Optional[_Path] = None,
+    observer: Optional[_Path] = None,
+    truth_cache: Optional[_Path] = None,
+    chunks: int = 8,
+    threads_per_task: int = 1,
+    max_retries: int = 3,
+    address: Optional[str] = None,
+    runtime_env: Optional[Dict[str, Any]] = None,
+    progress: bool = True,
+) -> Dict[str, Any]:
     """`spectra eval` with its ground truths rendered as Ray tasks: every truth the evaluation
     needs (two seeds per case, the jittered-accumulation truth) is split into `chunks` sample
     chunks, all submitted at once; each finished truth is stored in the truth cache
@@ -338,7 +526,7 @@ def eval(
     them), `spp`, `size` "WxH", `sweep` "4,8,16", `table`, `observer`); returns `results.json` as
     a dict. `chunks` is at most each truth's samples per pixel. Files given by relative paths
     (`table`, an `observer` file) are found from this process's working directory, not the
-    workers'."""
+    workers'. Ctrl-C (or any other error while waiting) cancels the tasks not yet finished."""
     import json
     import tempfile
 
@@ -346,7 +534,7 @@ def eval(
     chunks = _whole("chunks", chunks)
     threads_per_task = _whole("threads_per_task", threads_per_task)
     max_retries = _whole("max_retries", max_retries, -1)
-    argv = ["eval", "--out", str(out)]
+    argv = ["eval", "--out", os.fspath(out)]
     # Where argv names a file or directory (the workers get them absolute).
     paths = [2]
     if quick:
@@ -362,14 +550,14 @@ def eval(
     if sweep is not None:
         argv += ["--sweep", sweep if isinstance(sweep, str) else ",".join(map(str, sweep))]
     if table is not None:
-        argv += ["--table", str(table)]
+        argv += ["--table", os.fspath(table)]
         paths.append(len(argv) - 1)
     if observer is not None:
-        argv += ["--observer", str(observer)]
+        argv += ["--observer", os.fspath(observer)]
         if _observer_file(argv[-1]):
             paths.append(len(argv) - 1)
     with tempfile.TemporaryDirectory(prefix="spectra-truth-cache-") as tmp:
-        cache = str(truth_cache) if truth_cache is not None else tmp
+        cache = os.fspath(truth_cache) if truth_cache is not None else tmp
         argv += ["--truth-cache", cache]
         paths.append(len(argv) - 1)
         # The workers' working directory need not be this process's, so their copy names every
@@ -382,35 +570,48 @@ def eval(
         plan = _spectra._eval_plan(argv)
         if plan and not ray.is_initialized():
             ray.init(address=address, runtime_env=runtime_env)
+        if plan:
+            _check_cpus(ray, threads_per_task)
         task = ray.remote(_eval_piece).options(num_cpus=threads_per_task, max_retries=max_retries)
         jobs = []
-        for job in plan:
-            pieces = split(job["spp"], (job["width"], job["height"]), min(chunks, job["spp"]))
-            refs = [task.remote(remote, job, off, n, threads_per_task) for _, off, n, _ in pieces]
-            jobs.append((job, refs))
-        t0 = time.perf_counter()
-        total = sum(len(r) for _, r in jobs)
-        finished = 0
-        for job, refs in jobs:
-            xyz, dropped = None, 0
-            # Chunk order, whatever order they finish in.
-            for r in ray.get(refs):
-                xyz = r["xyz"] if xyz is None else xyz + r["xyz"]
-                dropped += r["dropped"]
-            _spectra._eval_truth_store(argv, job, xyz, dropped)
-            finished += len(refs)
-            if progress:
-                print(
-                    f"spectra.distributed.eval: truth {job['case']} seed {job['seed']} stored "
-                    f"({finished}/{total} tasks, {time.perf_counter() - t0:.1f} s)",
-                    file=sys.stderr,
-                    flush=True,
-                )
+        try:
+            for job in plan:
+                pieces = split(job["spp"], (job["width"], job["height"]), min(chunks, job["spp"]))
+                refs = [task.remote(remote, job, off, n, threads_per_task) for _, off, n, _ in pieces]
+                jobs.append((job, refs))
+            t0 = time.perf_counter()
+            total = sum(len(r) for _, r in jobs)
+            finished = 0
+            for job, refs in jobs:
+                xyz, dropped = None, 0
+                # Chunk order, whatever order they finish in.
+                for r in ray.get(refs):
+                    xyz = r["xyz"] if xyz is None else xyz + r["xyz"]
+                    dropped += r["dropped"]
+                _spectra._eval_truth_store(argv, job, xyz, dropped)
+                finished += len(refs)
+                if progress:
+                    print(
+                        f"spectra.distributed.eval: truth {job['case']} seed {job['seed']} stored "
+                        f"({finished}/{total} tasks, {time.perf_counter() - t0:.1f} s)",
+                        file=sys.stderr,
+                        flush=True,
+                    )
+        except BaseException:
+            # Interrupted (Ctrl-C) or failed: the tasks not yet finished are of no use.
+            for _, refs in jobs:
+                for ref in refs:
+                    ray.cancel(ref)
+            raise
         _spectra._eval_run(argv)
-    with open(os.path.join(str(out), "results.json")) as f:
-        return json.load(f)
+    with open(os.path.join(os.fspath(out), "results.json")) as f:
+        result: Dict[str, Any] = json.load(f)
+    return result
 
 
-def _eval_piece(argv, job, sample_offset, spp, threads):
+def _eval_piece(
+    argv: List[str], job: Dict[str, Any], sample_offset: int, spp: int, threads: int
+) -> Dict[str, Any]:
     """One Ray task of `eval`: samples sample_offset … +spp−1 of one evaluation truth."""
-    return _spectra._eval_truth_sums(argv, job, sample_offset, spp, threads)
+    sums: Dict[str, Any] = _spectra._eval_truth_sums(argv, job, sample_offset, spp, threads)
+    return sums

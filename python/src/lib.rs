@@ -9,16 +9,17 @@
 //! file `FileNotFoundError`, failures of the work itself `RuntimeError`.
 
 use anyhow::Context;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
 
 /// The CLI's scene, spectrum, water, medium and table options.
 use spectra::cmd::setup;
+
+mod args;
 
 /// Why a call failed, carried out of a GIL-free section and raised as the matching exception.
 enum Fail {
@@ -85,8 +86,15 @@ fn size_arg(size: (i128, i128)) -> PyResult<(u32, u32)> {
 }
 
 /// `range=(MIN, MAX)` as the CLI's `--range MIN:MAX`.
-fn range_arg(range: Option<(f64, f64)>) -> Option<String> {
-    range.map(|(a, b)| format!("{a}:{b}"))
+/// An invalid range is refused here, naming `range` and its values in short (the CLI's message
+/// spelt 1e-300 with 300 digits); a valid one is spelt so that it parses back exactly.
+fn range_arg(range: Option<(f64, f64)>) -> PyResult<Option<String>> {
+    let Some((a, b)) = range else { return Ok(None) };
+    let (sa, sb) = (args::short(a), args::short(b));
+    if let Err(color::ColorError::BadRange { why, .. }) = color::WavelengthRange::new(a, b) {
+        return Err(PyValueError::new_err(format!("range ({sa}, {sb}): {why}")));
+    }
+    Ok(Some(format!("{sa}:{sb}")))
 }
 
 /// A linear RGB image as a C-contiguous float32 array of shape (height, width, 3).
@@ -234,13 +242,13 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
 fn load(
     py: Python<'_>,
-    path_or_builtin: PathBuf,
-    allow_outside_scene_dir: bool,
-    env: Option<String>,
-    env_intensity: Option<f32>,
-    env_rotation: Option<f32>,
-    env_sun: bool,
-    env_sun_share: Option<f32>,
+    #[pyo3(from_py_with = args::path_or_builtin)] path_or_builtin: PathBuf,
+    #[pyo3(from_py_with = args::allow_outside_scene_dir)] allow_outside_scene_dir: bool,
+    #[pyo3(from_py_with = args::env)] env: Option<String>,
+    #[pyo3(from_py_with = args::env_intensity)] env_intensity: Option<f32>,
+    #[pyo3(from_py_with = args::env_rotation)] env_rotation: Option<f32>,
+    #[pyo3(from_py_with = args::env_sun)] env_sun: bool,
+    #[pyo3(from_py_with = args::env_sun_share)] env_sun_share: Option<f32>,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
@@ -344,6 +352,10 @@ type Frame = (Vec<f32>, Option<(Vec<f32>, Vec<f64>)>, (u32, u32));
 struct Renderer {
     inner: Mutex<Inner>,
     scene: Py<Scene>,
+    /// (width, height) and the GPU's description, fixed at creation: read without the lock,
+    /// which a render on another thread holds for as long as it runs.
+    size: (u32, u32),
+    device: String,
 }
 
 #[pymethods]
@@ -360,10 +372,10 @@ impl Renderer {
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
-        size: (i128, i128),
-        water: Option<String>,
-        depth: Option<f64>,
-        rgb_medium: Option<String>,
+        #[pyo3(from_py_with = args::size)] size: (i128, i128),
+        #[pyo3(from_py_with = args::water)] water: Option<String>,
+        #[pyo3(from_py_with = args::depth)] depth: Option<f64>,
+        #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
     ) -> PyResult<Self> {
         let sc = scene_of(scene, "scene", water.is_some())?;
         let scene_obj: Py<Scene> = scene.extract()?;
@@ -390,9 +402,12 @@ impl Renderer {
             r.resize(w, h).map_err(value)?;
             Ok(r)
         })?;
+        let device = renderer.gpu().describe();
         Ok(Renderer {
             inner: Mutex::new(Inner { renderer, scene: sc, size: (w, h), water, rgb_medium }),
             scene: scene_obj,
+            size: (w, h),
+            device,
         })
     }
 
@@ -418,23 +433,26 @@ impl Renderer {
     /// samples: antialiasing, the mean of this many frames each looking at another place in
     /// every pixel (`spectra render --samples`): the image box-filtered over each pixel, as the
     /// path tracer's are; 1–256, default 1 (the pixel centres). Not with spectral=True.
-    #[pyo3(signature = (mode = "spectral", *, wavelengths = None, quadrature = "prefiltered", range = None,
-                        observer = None, white = None, exposure = 0.0, spectral = false, camera_to_display = false,
-                        samples = 1))]
+    #[pyo3(signature = (mode = "spectral".to_string(), *, wavelengths = None, quadrature = "prefiltered".to_string(),
+                        range = None, observer = None, white = None, exposure = 0.0, spectral = false,
+                        camera_to_display = false, samples = 1),
+           text_signature = "($self, mode='spectral', *, wavelengths=None, quadrature='prefiltered', range=None, \
+                             observer=None, white=None, exposure=0.0, spectral=False, camera_to_display=False, \
+                             samples=1)")]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
-        mode: &str,
-        wavelengths: Option<i128>,
-        quadrature: &str,
-        range: Option<(f64, f64)>,
-        observer: Option<String>,
-        white: Option<String>,
-        exposure: f32,
-        spectral: bool,
-        camera_to_display: bool,
-        samples: i128,
+        #[pyo3(from_py_with = args::mode)] mode: String,
+        #[pyo3(from_py_with = args::wavelengths)] wavelengths: Option<i128>,
+        #[pyo3(from_py_with = args::quadrature)] quadrature: String,
+        #[pyo3(from_py_with = args::range)] range: Option<(f64, f64)>,
+        #[pyo3(from_py_with = args::observer)] observer: Option<String>,
+        #[pyo3(from_py_with = args::white)] white: Option<String>,
+        #[pyo3(from_py_with = args::exposure)] exposure: f32,
+        #[pyo3(from_py_with = args::spectral)] spectral: bool,
+        #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
+        #[pyo3(from_py_with = args::samples)] samples: i128,
     ) -> PyResult<Bound<'py, PyAny>> {
         let max = spectra::cmd::render::MAX_SAMPLES;
         let samples = match u32::try_from(samples) {
@@ -449,7 +467,7 @@ impl Renderer {
             )));
         }
         let mut look = default_look();
-        look.mode = render::Mode::parse(mode).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        look.mode = render::Mode::parse(&mode).map_err(|e| PyValueError::new_err(e.to_string()))?;
         look.wavelengths = match wavelengths {
             // The CLI's message for a count out of range (a negative one never parses there).
             Some(n) if n < 0 => {
@@ -461,9 +479,9 @@ impl Renderer {
             Some(n) => Some(usize::try_from(n).unwrap_or(usize::MAX)),
             None => None,
         };
-        look.quadrature = setup::parse_quadrature(quadrature)
+        look.quadrature = setup::parse_quadrature(&quadrature)
             .map_err(|e| PyValueError::new_err(format!("--quadrature '{quadrature}': {e}")))?;
-        look.spectrum = setup::SpectrumArgs { range: range_arg(range), observer, white, camera_to_display };
+        look.spectrum = setup::SpectrumArgs { range: range_arg(range)?, observer, white, camera_to_display };
         look.exposure = exposure;
         let (data, capture, (w, h)) = py.detach(|| -> Result<Frame, Fail> {
             let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
@@ -519,18 +537,20 @@ impl Renderer {
     /// (width, height).
     #[getter]
     fn size(&self) -> (u32, u32) {
-        self.inner.lock().unwrap_or_else(|p| p.into_inner()).size
+        self.size
     }
 
     /// The GPU adapter and backend, e.g. "llvmpipe (LLVM …) (Vulkan, Cpu)".
     #[getter]
     fn device(&self) -> String {
-        self.inner.lock().unwrap_or_else(|p| p.into_inner()).renderer.gpu().describe()
+        self.device.clone()
     }
 
+    // None of these three takes the renderer's lock: a render on another thread holds it, and
+    // waiting for it here, with the GIL held, froze every Python thread until that render ended.
     fn __repr__(&self) -> String {
-        let g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        format!("<spectra.Renderer {} {}×{}>", g.scene.source, g.size.0, g.size.1)
+        let source = &self.scene.get().inner.source;
+        format!("<spectra.Renderer {source} {}×{}>", self.size.0, self.size.1)
     }
 }
 
@@ -601,7 +621,7 @@ impl TruthArgs {
             sample_offset: sample_offset as u64,
             crop,
             max_depth: whole("max_depth", max_depth, 0)?,
-            spectrum: setup::SpectrumArgs { range: range_arg(range), observer, white, camera_to_display },
+            spectrum: setup::SpectrumArgs { range: range_arg(range)?, observer, white, camera_to_display },
             water: setup::WaterArgs { water, depth },
             rgb_medium: setup::RgbMediumArgs { rgb_medium },
             spectral_bin,
@@ -641,10 +661,13 @@ impl TruthArgs {
         spectra::cmd::truth::settings(&a, scene, table)
     }
 
-    /// Renders the samples: passes of about a quarter second (the first, of one sample,
-    /// measures them), with a look at Python's signals between them, so Ctrl-C raises
-    /// KeyboardInterrupt within about a second. The sums do not depend on the passes.
-    fn run(&self, sc: &scene::Scene) -> Result<(truth::Settings, truth::Accumulator), Fail> {
+    /// Renders the samples, stopping early (`Cancelled`) once `cancel` is set: the tracer looks
+    /// at it every few samples of every pixel (`interruptible` sets it on Ctrl-C).
+    fn run(
+        &self,
+        sc: &scene::Scene,
+        cancel: &AtomicBool,
+    ) -> Result<(truth::Settings, truth::Accumulator), Fail> {
         let table = setup::load_table(None).map_err(runtime)?;
         let st = self.settings(sc, &table).map_err(value)?;
         let mut world =
@@ -653,24 +676,56 @@ impl TruthArgs {
             world = world.with_environment(env);
         }
         let mut acc = truth::Accumulator::new(&st).map_err(value)?;
-        let cancel = AtomicBool::new(false);
-        let mut per_sample: Option<f64> = None;
-        while acc.done < st.spp {
-            let left = st.spp - acc.done;
-            let n = match per_sample {
-                None => 1,
-                Some(t) => ((0.25 / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
-            };
-            let t = Instant::now();
-            truth::render_pass(&world, &st, &cancel, &mut acc, n, &|_| {}).map_err(runtime)?;
-            per_sample = Some(t.elapsed().as_secs_f64() / f64::from(n));
-            Python::attach(|py| py.check_signals()).map_err(Fail::Py)?;
-        }
+        truth::render_pass(&world, &st, cancel, &mut acc, st.spp, &|_| {}).map_err(runtime)?;
         if acc.dropped > 0 {
             eprintln!("warning: truth: {} non-finite samples dropped", acc.dropped);
         }
         Ok((st, acc))
     }
+}
+
+/// How often a waiting call looks at Python's signals.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own while this thread, the caller's (called without the GIL),
+/// looks at Python's signals every `SIGNAL_POLL`. On a pending exception (Ctrl-C's
+/// KeyboardInterrupt, or `ray.cancel` interrupting a Ray task) it sets `work`'s cancel flag,
+/// waits for `work` to stop (the tracer stops within a few samples) and returns the exception.
+///
+/// CPython runs signal handlers on the main thread only, so the check must be made from the
+/// thread that called in, never from the worker or a rayon pool's thread (where
+/// `check_signals` does nothing): a forked child's render, on a pool of its own, and a Ray
+/// task's, on a pool of `threads`, could not be interrupted, and a pass over a large image
+/// (2048² took 9 s) ran to its end before the check between passes.
+fn interruptible<R: Send>(work: impl FnOnce(&AtomicBool) -> Result<R, Fail> + Send) -> Result<R, Fail> {
+    let cancel = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        let cancel = &cancel;
+        let worker = s.spawn(move || {
+            let r = work(cancel);
+            let _ = tx.send(());
+            r
+        });
+        let mut interrupted = None;
+        loop {
+            match rx.recv_timeout(SIGNAL_POLL) {
+                Ok(()) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+                        interrupted = Some(e);
+                        break;
+                    }
+                }
+            }
+        }
+        let r = worker.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        match interrupted {
+            Some(e) => Err(Fail::Py(e)),
+            None => r,
+        }
+    })
 }
 
 /// The image of per-pixel sums over `spp` samples, as `spectra truth` finishes a render
@@ -718,7 +773,8 @@ fn finish(
 /// (`--spectral-out` with `--spectral-bin`): returns (image, bands of shape (h, w, B) float32,
 /// band edges of shape (B + 1,) float64, nm).
 ///
-/// Ctrl-C interrupts it (KeyboardInterrupt) within about a second.
+/// Ctrl-C interrupts it (KeyboardInterrupt) within a fraction of a second, wherever it runs
+/// (a forked child, a Ray task: `interruptible`).
 #[pyfunction(name = "truth")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
@@ -730,21 +786,21 @@ fn finish(
 fn truth_image<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
-    spp: i128,
-    size: (i128, i128),
-    direct_only: bool,
-    seed: i128,
-    sample_offset: i128,
-    crop: Option<(i128, i128, i128, i128)>,
-    range: Option<(f64, f64)>,
-    observer: Option<String>,
-    white: Option<String>,
-    max_depth: i128,
-    water: Option<String>,
-    depth: Option<f64>,
-    rgb_medium: Option<String>,
-    spectral_bin: Option<f64>,
-    camera_to_display: bool,
+    #[pyo3(from_py_with = args::spp)] spp: i128,
+    #[pyo3(from_py_with = args::size)] size: (i128, i128),
+    #[pyo3(from_py_with = args::direct_only)] direct_only: bool,
+    #[pyo3(from_py_with = args::seed)] seed: i128,
+    #[pyo3(from_py_with = args::sample_offset)] sample_offset: i128,
+    #[pyo3(from_py_with = args::crop)] crop: Option<(i128, i128, i128, i128)>,
+    #[pyo3(from_py_with = args::range)] range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = args::observer)] observer: Option<String>,
+    #[pyo3(from_py_with = args::white)] white: Option<String>,
+    #[pyo3(from_py_with = args::max_depth)] max_depth: i128,
+    #[pyo3(from_py_with = args::water)] water: Option<String>,
+    #[pyo3(from_py_with = args::depth)] depth: Option<f64>,
+    #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
+    #[pyo3(from_py_with = args::spectral_bin)] spectral_bin: Option<f64>,
+    #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let sc = scene_of(scene, "scene", water.is_some())?;
     let a = TruthArgs::new(
@@ -766,7 +822,7 @@ fn truth_image<'py>(
     )?;
     let view = color::film::CameraView::from_flag(camera_to_display);
     let (rgb, bands, edges, (w, h)) = py.detach(move || -> Result<_, Fail> {
-        let (st, acc) = fork_safe(|| a.run(&sc))?;
+        let (st, acc) = interruptible(|cancel| fork_safe(|| a.run(&sc, cancel)))?;
         let win = st.window();
         let display = st.display_matrix(view).map_err(value)?;
         let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp, display);
@@ -804,23 +860,23 @@ fn truth_image<'py>(
 fn truth_sums<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
-    spp: i128,
-    size: (i128, i128),
-    direct_only: bool,
-    seed: i128,
-    sample_offset: i128,
-    crop: Option<(i128, i128, i128, i128)>,
-    range: Option<(f64, f64)>,
-    observer: Option<String>,
-    white: Option<String>,
-    max_depth: i128,
-    water: Option<String>,
-    depth: Option<f64>,
-    rgb_medium: Option<String>,
-    spectral_bin: Option<f64>,
-    camera_to_display: bool,
-    threads: Option<i128>,
-    dry_run: bool,
+    #[pyo3(from_py_with = args::spp)] spp: i128,
+    #[pyo3(from_py_with = args::size)] size: (i128, i128),
+    #[pyo3(from_py_with = args::direct_only)] direct_only: bool,
+    #[pyo3(from_py_with = args::seed)] seed: i128,
+    #[pyo3(from_py_with = args::sample_offset)] sample_offset: i128,
+    #[pyo3(from_py_with = args::crop)] crop: Option<(i128, i128, i128, i128)>,
+    #[pyo3(from_py_with = args::range)] range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = args::observer)] observer: Option<String>,
+    #[pyo3(from_py_with = args::white)] white: Option<String>,
+    #[pyo3(from_py_with = args::max_depth)] max_depth: i128,
+    #[pyo3(from_py_with = args::water)] water: Option<String>,
+    #[pyo3(from_py_with = args::depth)] depth: Option<f64>,
+    #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
+    #[pyo3(from_py_with = args::spectral_bin)] spectral_bin: Option<f64>,
+    #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
+    #[pyo3(from_py_with = args::threads)] threads: Option<i128>,
+    #[pyo3(from_py_with = args::dry_run)] dry_run: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
     let sc = scene_of(scene, "scene", water.is_some())?;
     let a = TruthArgs::new(
@@ -856,13 +912,15 @@ fn truth_sums<'py>(
             Ok(st)
         })?
     } else {
-        let (st, acc) = py.detach(move || match threads {
-            None => fork_safe(|| a.run(&sc)),
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n as usize)
-                .build()
-                .map_err(runtime)?
-                .install(|| a.run(&sc)),
+        let (st, acc) = py.detach(move || {
+            interruptible(|cancel| match threads {
+                None => fork_safe(|| a.run(&sc, cancel)),
+                Some(n) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(n as usize)
+                    .build()
+                    .map_err(runtime)?
+                    .install(|| a.run(&sc, cancel)),
+            })
         })?;
         let win = st.window();
         let (w, h) = (win.width as usize, win.height as usize);
@@ -955,18 +1013,43 @@ fn image_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<compare::Image> {
             "{what}: expected a numpy float32 or float64 array of shape (H, W, 3), got {got}"
         ))
     };
+    // A finite float64 beyond float32's range, which narrowing would make inf: written as such
+    // by `write_image`, or reported by `diff` as a non-finite pixel the caller never gave.
+    let mut too_big: Option<(usize, f64)> = None;
     let (shape, data): (Vec<usize>, Vec<f32>) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
         (a.shape().to_vec(), a.as_array().iter().copied().collect())
     } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
-        (a.shape().to_vec(), a.as_array().iter().map(|&v| v as f32).collect())
+        let data = a
+            .as_array()
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let f = v as f32;
+                if too_big.is_none() && v.is_finite() && f.is_infinite() {
+                    too_big = Some((i, v));
+                }
+                f
+            })
+            .collect();
+        (a.shape().to_vec(), data)
     } else if let Ok(a) = obj.extract::<Bound<'_, numpy::PyUntypedArray>>() {
         return Err(bad(format!("dtype {} with shape {:?}", a.dtype(), a.shape())));
     } else {
-        let t = obj.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "another type".into());
-        return Err(bad(format!("a {t}")));
+        return Err(bad(format!("a {}", args::type_name(obj))));
     };
     match shape[..] {
         [h, w, 3] if h > 0 && w > 0 && h <= u32::MAX as usize && w <= u32::MAX as usize => {
+            if let Some((i, v)) = too_big {
+                let p = i / 3;
+                return Err(PyValueError::new_err(format!(
+                    "{what}: pixel (x {}, y {}) channel {} is {}, beyond float32's range (±{:e})",
+                    p % w,
+                    p / w,
+                    i % 3,
+                    args::short(v),
+                    f32::MAX
+                )));
+            }
             compare::Image::new(
                 w as u32,
                 h as u32,
@@ -978,6 +1061,21 @@ fn image_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<compare::Image> {
     }
 }
 
+/// `Ok` when every pixel of `img` is finite, else a `ValueError` naming the argument `what`
+/// (the statistics' own message names "reference" or "test").
+fn finite_image(what: &str, img: &compare::Image) -> PyResult<()> {
+    let w = img.size().0 as usize;
+    match img.data.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+        None => Ok(()),
+        Some(i) => Err(PyValueError::new_err(format!(
+            "{what}: pixel (x {}, y {}) is not finite: {:?}",
+            i % w,
+            i / w,
+            img.data[i]
+        ))),
+    }
+}
+
 /// How far image `b` is from the reference `a` (both linear sRGB arrays of shape (H, W, 3)):
 /// the statistics `spectra diff --json` prints, as a dict: `width`, `height`,
 /// `white_luminance`, and per-pixel `delta_e2000`, `mae_linear`, `mae_srgb`, each a dict of
@@ -985,22 +1083,33 @@ fn image_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<compare::Image> {
 ///
 /// white_y: the luminance of the CIELAB reference white (D65 chromaticity), 1 by default.
 /// flip: also NVIDIA's FLIP (its reference C++ code, as `spectra diff --metric flip`):
-/// "ldr" or "hdr" (HDR-FLIP over the exposures FLIP chooses from `a`); adds `flip` (the same
-/// statistics, `mean` as FLIP computes it), `flip_kind` and `flip_ppd`.
-/// flip_ppd: FLIP's pixels per degree (default FLIP's, 67.0).
+/// "ldr" or "hdr" (HDR-FLIP over a range of exposures, tone mapped); adds `flip` (the same
+/// statistics, `mean` as FLIP computes it), `flip_kind`, `flip_ppd` and `flip_exposures`
+/// (HDR-FLIP's `start`, `stop`, `count` and `tone_mapper`; None for LDR-FLIP).
+/// flip_ppd: FLIP's pixels per degree (default FLIP's, 67.0); only with `flip`.
+/// flip_start_exposure / flip_stop_exposure: HDR-FLIP's exposure range in stops (default, as
+/// FLIP's tool: from `a`'s brightest pixel and median luminance; give both for a black `a`);
+/// flip_exposures: their number (default ⌈stop − start⌉, at least 2); flip_tone_mapper: "aces"
+/// (default), "reinhard" or "hable". Only with flip="hdr" (`--flip-start-exposure` …).
 /// maps: also return the per-pixel maps, float64 arrays of shape (H, W): `delta_e2000_map`,
 /// `mae_linear_map` and `mae_srgb_map` (the mean absolute difference over R, G, B), and
 /// `flip_map` (float32) with `flip`.
 #[pyfunction]
-#[pyo3(signature = (a, b, *, white_y = 1.0, flip = None, flip_ppd = None, maps = false))]
+#[pyo3(signature = (a, b, *, white_y = 1.0, flip = None, flip_ppd = None, maps = false, flip_start_exposure = None,
+                    flip_stop_exposure = None, flip_exposures = None, flip_tone_mapper = None))]
+#[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
 fn diff<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
-    white_y: f64,
-    flip: Option<String>,
-    flip_ppd: Option<f32>,
-    maps: bool,
+    #[pyo3(from_py_with = args::white_y)] white_y: f64,
+    #[pyo3(from_py_with = args::flip)] flip: Option<String>,
+    #[pyo3(from_py_with = args::flip_ppd)] flip_ppd: Option<f32>,
+    #[pyo3(from_py_with = args::maps)] maps: bool,
+    #[pyo3(from_py_with = args::flip_start_exposure)] flip_start_exposure: Option<f32>,
+    #[pyo3(from_py_with = args::flip_stop_exposure)] flip_stop_exposure: Option<f32>,
+    #[pyo3(from_py_with = args::flip_exposures)] flip_exposures: Option<i128>,
+    #[pyo3(from_py_with = args::flip_tone_mapper)] flip_tone_mapper: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let reference = image_arg("a", a)?;
     let test = image_arg("b", b)?;
@@ -1011,6 +1120,8 @@ fn diff<'py>(
             ra.0, ra.1, rb.0, rb.1
         )));
     }
+    finite_image("a", &reference)?;
+    finite_image("b", &test)?;
     let hdr = match flip.as_deref().map(str::to_ascii_lowercase).as_deref() {
         None => None,
         Some("ldr") => Some(false),
@@ -1022,13 +1133,78 @@ fn diff<'py>(
             )));
         }
     };
+    let hdr_given: Vec<&str> = [
+        ("flip_start_exposure", flip_start_exposure.is_some()),
+        ("flip_stop_exposure", flip_stop_exposure.is_some()),
+        ("flip_exposures", flip_exposures.is_some()),
+        ("flip_tone_mapper", flip_tone_mapper.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(k, given)| given.then_some(k))
+    .collect();
+    if hdr.is_none() && (flip_ppd.is_some() || !hdr_given.is_empty()) {
+        let k = if flip_ppd.is_some() { "flip_ppd" } else { hdr_given[0] };
+        return Err(PyValueError::new_err(format!(
+            "{k} is a FLIP option: it needs flip='ldr' or flip='hdr'"
+        )));
+    }
+    if hdr == Some(false) && !hdr_given.is_empty() {
+        return Err(PyValueError::new_err(format!(
+            "{} set HDR-FLIP, and flip='ldr' was chosen",
+            hdr_given.join(", ")
+        )));
+    }
     let ppd = flip_ppd.unwrap_or(compare::flip::DEFAULT_PIXELS_PER_DEGREE);
     let (lo, hi) = compare::flip::PPD_RANGE;
     if !(lo..=hi).contains(&ppd) {
         return Err(PyValueError::new_err(format!(
-            "flip_ppd {ppd}: pixels per degree must be between {lo} and {hi}"
+            "flip_ppd {}: pixels per degree must be between {lo} and {hi}",
+            args::short(f64::from(ppd))
         )));
     }
+    let (lo, hi) = compare::flip::EXPOSURE_RANGE;
+    for (k, v) in [("flip_start_exposure", flip_start_exposure), ("flip_stop_exposure", flip_stop_exposure)] {
+        if let Some(v) = v
+            && !(lo..=hi).contains(&v)
+        {
+            return Err(PyValueError::new_err(format!(
+                "{k} {}: an exposure must lie within {lo}…{hi} stops",
+                args::short(f64::from(v))
+            )));
+        }
+    }
+    if let (Some(a), Some(b)) = (flip_start_exposure, flip_stop_exposure) {
+        if a > b {
+            return Err(PyValueError::new_err(format!(
+                "flip_start_exposure {a} must not exceed flip_stop_exposure {b}"
+            )));
+        }
+        if b - a > compare::flip::MAX_EXPOSURE_SPAN {
+            return Err(PyValueError::new_err(format!(
+                "flip_start_exposure {a}, flip_stop_exposure {b}: the span must be at most {} stops",
+                compare::flip::MAX_EXPOSURE_SPAN
+            )));
+        }
+    }
+    let exposures = match flip_exposures {
+        None => None,
+        Some(n) if (2..=1000).contains(&n) => Some(n as u32),
+        Some(n) => {
+            return Err(PyValueError::new_err(format!(
+                "flip_exposures {n}: HDR-FLIP's number of exposures must be 2 to 1000"
+            )));
+        }
+    };
+    let hdr_opts = compare::flip::HdrOptions {
+        start_exposure: flip_start_exposure,
+        stop_exposure: flip_stop_exposure,
+        exposures,
+        tone_mapper: match &flip_tone_mapper {
+            None => Default::default(),
+            Some(t) => compare::flip::ToneMapper::by_name(t)
+                .map_err(|e| PyValueError::new_err(format!("flip_tone_mapper: {e}")))?,
+        },
+    };
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
     if !(lo..=hi).contains(&white_y) {
         return Err(PyValueError::new_err(format!(
@@ -1047,9 +1223,23 @@ fn diff<'py>(
             let mut flip_map = None;
             if let Some(hdr) = hdr {
                 let map = if hdr {
-                    compare::flip::hdr_flip(&reference, &test, ppd, &Default::default())
-                        .context("HDR-FLIP")
-                        .map_err(value)?
+                    compare::flip::hdr_flip(&reference, &test, ppd, &hdr_opts).map_err(|e| {
+                        // The tracer's messages name the command's flags: these are Python's.
+                        let m = e
+                            .to_string()
+                            .replace(
+                                "(`spectra diff --flip-start-exposure S --flip-stop-exposure E`)",
+                                "(flip_start_exposure=S, flip_stop_exposure=E)",
+                            )
+                            .replace("--flip-start-exposure", "flip_start_exposure=")
+                            .replace("--flip-stop-exposure", "flip_stop_exposure=")
+                            .replace("or use LDR-FLIP", "or use LDR-FLIP (flip='ldr')");
+                        value(anyhow::anyhow!(if m.contains("HDR-FLIP") {
+                            m
+                        } else {
+                            format!("HDR-FLIP: {m}")
+                        }))
+                    })?
                 } else {
                     compare::flip::ldr_flip(&reference, &test, ppd).context("LDR-FLIP").map_err(value)?
                 };
@@ -1061,6 +1251,7 @@ fn diff<'py>(
                 let o = v.as_object_mut().expect("a struct serialises to an object");
                 o.insert("flip".into(), serde_json::to_value(st).map_err(runtime)?);
                 o.insert("flip_kind".into(), if hdr { "hdr" } else { "ldr" }.into());
+                o.insert("flip_exposures".into(), serde_json::to_value(map.exposures).map_err(runtime)?);
                 o.insert("flip_ppd".into(), ppd.into());
                 flip_map = Some(map.values);
             }
@@ -1086,23 +1277,35 @@ fn triples(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<(Vec<usize>, Vec<f64>
     let bad = |got: String| {
         PyValueError::new_err(format!("{what}: expected a float array of shape (..., 3), got {got}"))
     };
+    let np = obj.py().import("numpy")?;
+    // Integer arrays, and nested lists or tuples of numbers of any depth, as float64 (what
+    // `npt.ArrayLike` promises); bool, complex, string and object arrays are refused.
+    let converted;
+    let obj = if let Ok(a) = obj.cast::<numpy::PyUntypedArray>() {
+        match a.dtype().kind() {
+            b'i' | b'u' => {
+                converted = np.call_method1("asarray", (obj, "float64"))?;
+                &converted
+            }
+            _ => obj,
+        }
+    } else if obj.is_instance_of::<pyo3::types::PyList>() || obj.is_instance_of::<pyo3::types::PyTuple>() {
+        let t = args::type_name(obj);
+        converted = np.call_method1("asarray", (obj, "float64")).map_err(|e| {
+            bad(format!("a {t} that is not a rectangular array of numbers ({})", e.value(obj.py())))
+        })?;
+        &converted
+    } else {
+        obj
+    };
     let (shape, data): (Vec<usize>, Vec<f64>) = if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f64>>() {
         (a.shape().to_vec(), a.as_array().iter().copied().collect())
     } else if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
         (a.shape().to_vec(), a.as_array().iter().map(|&v| f64::from(v)).collect())
     } else if let Ok(a) = obj.extract::<Bound<'_, numpy::PyUntypedArray>>() {
         return Err(bad(format!("dtype {} with shape {:?}", a.dtype(), a.shape())));
-    } else if let Ok(v) = obj.extract::<Vec<f64>>() {
-        (vec![v.len()], v)
-    } else if let Ok(v) = obj.extract::<Vec<Vec<f64>>>() {
-        let n = v.len();
-        if v.iter().any(|r| r.len() != 3) {
-            return Err(bad("a list of rows that are not all of length 3".into()));
-        }
-        (vec![n, 3], v.into_iter().flatten().collect())
     } else {
-        let t = obj.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "another type".into());
-        return Err(bad(format!("a {t}")));
+        return Err(bad(format!("a {}", args::type_name(obj))));
     };
     if shape.last() != Some(&3) {
         return Err(bad(format!("shape {shape:?}")));
@@ -1142,11 +1345,12 @@ fn wavelengths_arg(what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 /// s(λ) = ½ + x / (2√(1 + x²)), x = (c0·λ + c1)·λ + c2 — exactly those the renderers use; with
 /// `wavelengths` (1-D, nm) the tuple (coefficients, spectra of shape (..., L)).
 #[pyfunction]
-#[pyo3(signature = (rgb, space = "srgb", *, wavelengths = None))]
+#[pyo3(signature = (rgb, space = "srgb".to_string(), *, wavelengths = None),
+       text_signature = "(rgb, space='srgb', *, wavelengths=None)")]
 fn upsample<'py>(
     py: Python<'py>,
     rgb: &Bound<'py, PyAny>,
-    space: &str,
+    #[pyo3(from_py_with = args::space)] space: String,
     wavelengths: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (lead, data) = triples("rgb", rgb)?;
@@ -1160,7 +1364,7 @@ fn upsample<'py>(
     let lambda = wavelengths.map(|w| wavelengths_arg("wavelengths", w)).transpose()?;
     let n_lambda = lambda.as_ref().map(Vec::len);
     let cs =
-        color::RgbColorSpace::by_name(space).map_err(|e| PyValueError::new_err(format!("space: {e}")))?;
+        color::RgbColorSpace::by_name(&space).map_err(|e| PyValueError::new_err(format!("space: {e}")))?;
     let (coeffs, spectra) = py.detach(move || -> Result<_, Fail> {
         let table = color::upsample::table_for(&cs).map_err(runtime)?;
         let polys: Vec<color::upsample::SigmoidPolynomial> =
@@ -1191,11 +1395,11 @@ fn upsample<'py>(
 #[pyfunction]
 fn observer<'py>(
     py: Python<'py>,
-    name: &str,
+    #[pyo3(from_py_with = args::name)] name: String,
     wavelengths: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let l = wavelengths_arg("wavelengths", wavelengths)?;
-    let o = color::Observer::by_name(name).map_err(value)?;
+    let o = color::Observer::by_name(&name).map_err(value)?;
     let v: Vec<f64> = l.iter().flat_map(|&x| o.eval(x)).collect();
     PyArray1::from_vec(py, v).reshape([l.len(), 3])
 }
@@ -1205,15 +1409,16 @@ fn observer<'py>(
 /// over 360–830 nm (`Observer::response`, what white balance and the camera fit integrate).
 /// balanced=True divides by the perfect white's response (white = (1, 1, 1)).
 #[pyfunction]
-#[pyo3(signature = (observer, illuminant = "D65", *, balanced = false))]
+#[pyo3(signature = (observer, illuminant = "D65".to_string(), *, balanced = false),
+       text_signature = "(observer, illuminant='D65', *, balanced=False)")]
 fn chart<'py>(
     py: Python<'py>,
-    observer: &str,
-    illuminant: &str,
-    balanced: bool,
+    #[pyo3(from_py_with = args::observer_name)] observer: String,
+    #[pyo3(from_py_with = args::illuminant)] illuminant: String,
+    #[pyo3(from_py_with = args::balanced)] balanced: bool,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-    let o = color::Observer::by_name(observer).map_err(value)?;
-    let e = color::illuminant::by_name(illuminant).map_err(value)?;
+    let o = color::Observer::by_name(&observer).map_err(value)?;
+    let e = color::illuminant::by_name(&illuminant).map_err(value)?;
     let white = if balanced { o.white_balance(&e) } else { [1.0; 3] };
     let v: Vec<f64> = color::data::colorchecker::SPECTRA
         .iter()
@@ -1231,18 +1436,21 @@ fn chart<'py>(
 #[pyfunction]
 fn illuminant<'py>(
     py: Python<'py>,
-    name: &str,
+    #[pyo3(from_py_with = args::illuminant_name)] name: String,
     wavelengths: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let l = wavelengths_arg("wavelengths", wavelengths)?;
-    let s = color::illuminant::by_name(name).map_err(value)?;
+    let s = color::illuminant::by_name(&name).map_err(value)?;
     Ok(PyArray1::from_vec(py, s.sample(&l)))
 }
 
 /// Reads an EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it: a float32
 /// array of shape (height, width, 3).
 #[pyfunction]
-fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, numpy::PyArray3<f32>>> {
+fn read_image(
+    py: Python<'_>,
+    #[pyo3(from_py_with = args::path_arg)] path: PathBuf,
+) -> PyResult<Bound<'_, numpy::PyArray3<f32>>> {
     let img = py.detach(|| compare::read_image(&path).map_err(value))?;
     let (w, h) = img.size();
     rgb_array(py, w, h, img.data.into_iter().flatten().collect())
@@ -1252,12 +1460,32 @@ fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, numpy::PyArra
 /// write images: `.exr` (float32, linear) or `.png` (sRGB-encoded, clipped, 8-bit), atomically
 /// (the file is complete or absent). A `ValueError` names a bad array or extension.
 #[pyfunction]
-fn write_image(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
+fn write_image(
+    py: Python<'_>,
+    #[pyo3(from_py_with = args::path_arg)] path: PathBuf,
+    image: &Bound<'_, PyAny>,
+) -> PyResult<()> {
     let img = image_arg("image", image)?;
+    // A missing directory is a missing file (FileNotFoundError), as `open()` raises it.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(PyFileNotFoundError::new_err(format!(
+            "writing {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        )));
+    }
     py.detach(|| {
-        compare::io::write_image(&path, &img, Default::default())
-            .with_context(|| format!("writing {}", path.display()))
-            .map_err(value)
+        compare::io::write_image(&path, &img, Default::default()).map_err(|e| {
+            // The writer's messages name the file; named once.
+            let (m, p) = (e.to_string(), path.display().to_string());
+            value(anyhow::anyhow!(if m.starts_with(&p) {
+                format!("writing {m}")
+            } else {
+                format!("writing {p}: {m}")
+            }))
+        })
     })?;
     Ok(())
 }
@@ -1354,12 +1582,14 @@ fn eval_truth_sums<'py>(
         let cfg = spectra::cmd::eval::config(&args).map_err(value)?;
         let table = setup::load_table(cfg.table.as_deref()).map_err(value)?;
         let c = cfg.case(&p.case).map_err(value)?;
-        let cancel = AtomicBool::new(false);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build().map_err(runtime)?;
-        pool.install(|| {
-            spectra::eval::measure::truth_piece(&c.scene, &table, p.job, sample_offset, spp, &cancel)
+        // `ray.cancel` interrupts the task as Ctrl-C would.
+        interruptible(|cancel| {
+            pool.install(|| {
+                spectra::eval::measure::truth_piece(&c.scene, &table, p.job, sample_offset, spp, cancel)
+            })
+            .map_err(runtime)
         })
-        .map_err(runtime)
     })?;
     let d = pyo3::types::PyDict::new(py);
     let (w, h) = (p.job.width as usize, p.job.height as usize);
@@ -1419,7 +1649,7 @@ fn eval_run(py: Python<'_>, argv: Vec<String>) -> PyResult<()> {
     });
     let result = py.detach(move || {
         loop {
-            match rx.recv_timeout(std::time::Duration::from_millis(200)) {
+            match rx.recv_timeout(SIGNAL_POLL) {
                 Ok(r) => return Ok(r),
                 Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
                     if let Err(e) = Python::attach(|py| py.check_signals()) {

@@ -3,6 +3,9 @@ equals the single-process render; a worker killed mid-task is replaced and the r
 exact. Needs Ray (`cargo xtask test` installs it in its venv)."""
 
 import os
+import signal
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -221,3 +224,77 @@ def test_eval_relative_observer_and_one_scene_name(local_ray, tmp_path, monkeypa
     assert len(list((tmp_path / "cache").glob("*.truth"))) == 3
     with pytest.raises(ValueError, match="no-such-case"):
         dist.eval(tmp_path / "bad", quick=True, scenes="no-such-case")
+
+
+def _cpus_free():
+    return ray.available_resources().get("CPU", 0)
+
+
+def _wait_for(cond, timeout):
+    t = time.time() + timeout
+    while time.time() < t:
+        if cond():
+            return True
+        time.sleep(0.2)
+    return cond()
+
+
+def test_cancel_stops_running_tasks(local_ray):
+    """Nothing stopped a job's tasks: `ray.cancel` raised KeyboardInterrupt in a task whose
+    render never looked (it runs on a pool of `threads`), and `Job` had no `cancel()`."""
+    from ray.exceptions import TaskCancelledError
+
+    scene = spectra.load("cornell")
+    job = dist.submit(scene, spp=40000, size=(32, 24), chunks=2, progress=False)
+    assert _wait_for(lambda: _cpus_free() == 0, 60), "the tasks did not start"
+    assert not job.done()
+    job.cancel()
+    assert _wait_for(lambda: _cpus_free() == 2, 10), "tasks still running 10 s after Job.cancel()"
+    assert job.done()
+    with pytest.raises(TaskCancelledError):
+        job.result()
+    assert dist.Job.done.__doc__ and dist.Job.cancel.__doc__
+
+
+def test_ctrl_c_cancels_the_tasks(local_ray):
+    """Ctrl-C on the driver raised at once, and the tasks went on rendering, holding every CPU."""
+    scene = spectra.load("cornell")
+
+    def interrupt():
+        _wait_for(lambda: _cpus_free() == 0, 60)
+        time.sleep(0.5)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    with pytest.raises(KeyboardInterrupt):
+        dist.truth(scene, spp=40000, size=(32, 24), chunks=2, progress=False)
+    assert _wait_for(lambda: _cpus_free() == 2, 10), "tasks still running 10 s after Ctrl-C"
+
+
+def test_more_threads_per_task_than_any_node_has(local_ray):
+    """A task asking for 3 CPUs of a cluster whose nodes have 2 waited for ever."""
+    scene = spectra.load("cornell")
+    job = None
+    try:
+        with pytest.raises(ValueError, match="threads_per_task 3: no node .* more than 2 CPUs"):
+            job = dist.submit(scene, spp=2, size=(8, 6), threads_per_task=3, progress=False)
+    finally:
+        if job is not None:
+            job.cancel(force=True)
+    assert dist.truth(scene, spp=2, size=(8, 6), threads_per_task=2, progress=False).shape == (6, 8, 3)
+
+
+def test_truth_agrees_with_spectra_truth_on_arguments(local_ray):
+    """Keywords unknown to distributed.truth were reported against `submit()`, and `spp=True`
+    was refused by distributed.truth but taken as 1 by spectra.truth."""
+    scene = spectra.load("cornell")
+    with pytest.raises(TypeError, match=r"^truth\(\) got an unexpected keyword argument 'bogus'"):
+        dist.truth(scene, spp=4, bogus=1)
+    for f in (spectra.truth, dist.truth):
+        with pytest.raises(ValueError, match="spp True"):
+            f(scene, spp=True, size=(8, 6))
+    # Lists and paths, as spectra.truth takes them.
+    kw = dict(spp=2, seed=1, crop=[0, 0, 6, 4], range=[400, 700])
+    one = spectra.truth(scene, size=(8, 6), **kw)
+    assert relative(dist.truth(scene, size=[8, 6], chunks=2, progress=False, **kw), one).max() <= 1e-6
+

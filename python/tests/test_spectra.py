@@ -192,7 +192,7 @@ def test_bad_input_raises_the_right_exception(cornell, renderer):
         spectra.diff(img, img[:10])
     bad = img.copy()
     bad[1, 2, 0] = np.nan
-    with pytest.raises(ValueError, match="test"):
+    with pytest.raises(ValueError, match="^b: pixel .*not finite"):
         spectra.diff(img, bad)
     with pytest.raises(TypeError):
         renderer.render(no_such_option=1)
@@ -206,7 +206,7 @@ def test_bad_input_raises_the_right_exception(cornell, renderer):
         renderer.render(wavelengths=999)
     with pytest.raises(ValueError, match="--quadrature 'simpson'"):
         renderer.render(quadrature="simpson")
-    with pytest.raises(ValueError, match="--range"):
+    with pytest.raises(ValueError, match=r"range \(700, 400\)"):
         renderer.render(range=(700, 400))
     with pytest.raises(ValueError, match="--observer 'martian'"):
         renderer.render(observer="martian")
@@ -394,7 +394,7 @@ def test_diff_equals_the_cli(tmp_path):
     ).stdout
     cli = json.loads(out)
     py = spectra.diff(spectra.read_image(ref), spectra.read_image(test), flip="hdr")
-    for key in ("delta_e2000", "mae_linear", "mae_srgb", "flip"):
+    for key in ("delta_e2000", "mae_linear", "mae_srgb", "flip", "flip_exposures"):
         assert py[key] == cli[key], key
     # The truth EXR holds what spectra.truth returns, bit for bit.
     scene = spectra.load("metamerism")
@@ -454,7 +454,7 @@ def test_upsample_against_colour_science():
     with pytest.raises(ValueError, match="rgb: .*shape"):
         spectra.upsample(np.zeros((4, 2)))
     with pytest.raises(ValueError, match="rgb: .*dtype"):
-        spectra.upsample(np.zeros((4, 3), dtype=np.int64))
+        spectra.upsample(np.zeros((4, 3), dtype=np.complex128))
     with pytest.raises(ValueError, match="wavelengths"):
         spectra.upsample(rgb, wavelengths=[500, np.nan])
     with pytest.raises(ValueError, match="space"):
