@@ -70,8 +70,18 @@ fn interrupt(mut cmd: Command, after: Duration, dir: Option<&Path>, cooperative:
 fn truth_stops_inside_a_pixel_at_a_huge_sample_count() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.exr");
-    let cmd =
-        spectra(&["truth", "cornell", "--spp", "100000000", "--size", "4x4", "--out", out.to_str().unwrap()]);
+    let cmd = spectra(&[
+        "truth",
+        "cornell",
+        "--spp",
+        "100000000",
+        "--size",
+        "4x4",
+        "--out",
+        out.to_str().unwrap(),
+        "--checkpoint-every",
+        "0",
+    ]);
     interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
     // With a truth cache that did not exist: no empty folder is left behind either.
     let cache = dir.path().join("gt");
@@ -86,8 +96,23 @@ fn truth_stops_inside_a_pixel_at_a_huge_sample_count() {
         out.to_str().unwrap(),
         "--truth-cache",
         cache.to_str().unwrap(),
+        "--checkpoint-every",
+        "0",
     ]);
     interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
+}
+
+/// With checkpoints (the default), Ctrl-C keeps the finished passes however soon it comes: a
+/// render interrupted before its first interval threw away every sample.
+#[test]
+fn truth_keeps_its_finished_passes_on_ctrl_c_before_an_interval() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.exr");
+    let cmd =
+        spectra(&["truth", "cornell", "--spp", "100000000", "--size", "4x4", "--out", out.to_str().unwrap()]);
+    let stderr = interrupt(cmd, Duration::from_secs(3), None, true);
+    assert!(stderr.contains("samples kept in") && stderr.contains("--resume"), "{stderr}");
+    assert_eq!(entries(dir.path()), vec!["t.exr.checkpoint".to_string()]);
 }
 
 #[test]

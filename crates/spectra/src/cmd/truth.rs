@@ -558,13 +558,19 @@ pub fn run(a: Args) -> Result<()> {
     let mut per_sample: Option<f64> = None;
     let resumed = acc.done;
     while acc.done < st.spp {
-        // Passes of about half an interval (a first pass of one sample measures them), so a
-        // checkpoint is at most one interval old; without checkpoints, one pass.
+        // Passes of at most half an interval (a first pass of one sample measures them), so a
+        // checkpoint is at most one interval old, and no longer than all the passes before
+        // them: they double from the first, so that Ctrl-C, which keeps the finished passes,
+        // loses at most about half of what was rendered. Without checkpoints, one pass.
         let left = st.spp - acc.done;
         let n = match (interval > 0.0, per_sample) {
             (false, _) => left,
             (true, None) => 1,
-            (true, Some(t)) => ((0.5 * interval / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32,
+            (true, Some(t)) => {
+                let rendered = f64::from(acc.done - resumed) * t;
+                let budget = (0.5 * interval).min(rendered.max(t));
+                ((budget / t.max(1e-9)).floor().clamp(1.0, f64::from(left))) as u32
+            }
         };
         let done = acc.done;
         // The samples this pass renders (the bar moves with its rows): "1/256" for a whole
@@ -577,7 +583,9 @@ pub fn run(a: Args) -> Result<()> {
         match r {
             Err(TruthError::Cancelled) => {
                 pb.finish_and_clear();
-                if interval > 0.0 && t1.elapsed().as_secs_f64() >= interval && acc.done > resumed {
+                // Every finished pass is kept (only an interval's worth was, which threw away up
+                // to a minute of rendering at the default interval).
+                if interval > 0.0 && acc.done > resumed {
                     let _hold = color::cancel::hold();
                     super::checkpoint::write(&ckpt, &ckpt_record, &st, &acc)?;
                     return Err(super::KeptOnInterrupt(format!(
