@@ -23,6 +23,15 @@ pub fn parent_dir(path: &Path) -> &Path {
 pub const NAME_MAX: usize = 255;
 
 fn file_name(path: &Path) -> io::Result<String> {
+    // `out.exr/` names a folder: Path's file name ignores the separator, and the write failed
+    // with "Not a directory" only after the render.
+    let raw = path.as_os_str().to_string_lossy();
+    if raw.ends_with('/') || (cfg!(windows) && raw.ends_with('\\')) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "ends with a path separator, which names a folder; give a file name",
+        ));
+    }
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -328,6 +337,9 @@ mod tests {
             assert!(check_distinct(&[("--out", &fifo)], &[]).unwrap_err().contains("FIFO"));
         }
         assert!(check_distinct(&[("--out", d.path())], &[]).unwrap_err().contains("directory"));
+        // A trailing separator names a folder, refused before the work (the write failed after it).
+        let slash = PathBuf::from(format!("{}/", p("new.exr").display()));
+        assert!(check_writable(&slash).unwrap_err().to_string().contains("path separator"));
         // Two outputs on one path, existing or not.
         let e = check_distinct(&[("--out", &p("n.exr")), ("--spectral-out", &p("n.exr"))], &[]).unwrap_err();
         assert!(e.contains("--out") && e.contains("--spectral-out") && e.contains("same file"), "{e}");
