@@ -169,8 +169,16 @@ pub fn phase_eval(p: Phase, cos_theta: f32) -> f32 {
     match p {
         Phase::Isotropic => 1.0 / (4.0 * PI),
         Phase::HenyeyGreenstein { g } => {
-            let d = 1.0 + g * g - 2.0 * g * cos_theta;
-            (1.0 - g * g) / (4.0 * PI * d * d.max(1e-12).sqrt())
+            // 1 + g² − 2g·cosθ as two terms of one sign, in f64: the plain sum cancels to zero or
+            // below near g = −1 and cosθ = −1 (or +1, +1), where f32 made the value inf or NaN
+            // (g = −0.9999 dropped paths as non-finite).
+            let (g, c) = (f64::from(g), f64::from(cos_theta).clamp(-1.0, 1.0));
+            let d = if g < 0.0 {
+                (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c)
+            } else {
+                (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c)
+            };
+            ((1.0 - g) * (1.0 + g) / (4.0 * std::f64::consts::PI * d * d.sqrt())) as f32
         }
     }
 }
@@ -181,8 +189,10 @@ pub fn phase_sample(p: Phase, dir: Vec3, u: [f32; 2]) -> (Vec3, f32) {
         Phase::Isotropic => 1.0 - 2.0 * u[0],
         Phase::HenyeyGreenstein { g } if g.abs() < 1e-3 => 1.0 - 2.0 * u[0],
         Phase::HenyeyGreenstein { g } => {
-            let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u[0]);
-            ((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
+            // In f64, for the same cancellation as `phase_eval`'s near |g| = 1.
+            let (g, u) = (f64::from(g), f64::from(u[0]));
+            let s = (1.0 - g) * (1.0 + g) / (1.0 + g - 2.0 * g * u);
+            (((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)) as f32
         }
     };
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
@@ -210,6 +220,29 @@ mod tests {
             }
             assert!((norm - 1.0).abs() < 1e-3, "g={g}: ∫p = {norm}");
             assert!((mean - g as f64).abs() < 2e-3, "g={g}: mean cos = {mean}");
+        }
+    }
+
+    /// Found by a sweep: g = −0.9999 (accepted: |g| < 1) made f32's 1 + g² − 2g·cosθ cancel
+    /// to zero or below, and the tracer dropped paths as non-finite. Finite and positive over
+    /// the whole accepted range, and equal to the f64 formula.
+    #[test]
+    fn hg_is_finite_and_positive_next_to_g_one() {
+        for g in [-0.9999999f32, -0.99999, -0.9999, 0.9999, 0.99999, 0.9999999] {
+            let p = Phase::HenyeyGreenstein { g };
+            for i in 0..=2000 {
+                let c = -1.0 + 2.0 * i as f32 / 2000.0;
+                let v = phase_eval(p, c);
+                assert!(v.is_finite() && v > 0.0, "g {g} cos {c}: {v}");
+                let (g64, c64) = (g as f64, c as f64);
+                let want = (1.0 - g64 * g64)
+                    / (4.0 * std::f64::consts::PI * (1.0 + g64 * g64 - 2.0 * g64 * c64).powf(1.5));
+                assert!((v as f64 - want).abs() <= 1e-3 * want, "g {g} cos {c}: {v} vs {want}");
+            }
+            for i in 0..1000 {
+                let (w, pdf) = phase_sample(p, Vec3::Z, [(i as f32 + 0.5) / 1000.0, 0.3]);
+                assert!(w.is_finite() && pdf.is_finite() && pdf > 0.0, "g {g}: {w} {pdf}");
+            }
         }
     }
 
