@@ -97,7 +97,14 @@ fn the_table_states_the_bounds_the_code_enforces() {
     has("--frames", format!("1–{}", crate::cmd::bench::MAX_FRAMES));
     has("--samples", format!("render: 1–{} frames", crate::cmd::render::MAX_SAMPLES));
     has("--warmup", format!("0–{}", crate::cmd::bench::MAX_FRAMES));
-    has("--checkpoint-every", format!("–{:e} s", crate::cmd::truth::MAX_CHECKPOINT_SECONDS));
+    has(
+        "--checkpoint-every",
+        format!(
+            "{}–{:e} s",
+            crate::cmd::truth::MIN_CHECKPOINT_SECONDS,
+            crate::cmd::truth::MAX_CHECKPOINT_SECONDS
+        ),
+    );
     has("--sample-offset", format!("+ spp ≤ 2^{}", truth::render::MAX_SAMPLE_INDEX.trailing_zeros()));
     let (lo, hi) = (compare::diff::MIN_WHITE_LUMINANCE, compare::diff::MAX_WHITE_LUMINANCE);
     has("--white-y", format!("{lo:e}…{hi:e}"));

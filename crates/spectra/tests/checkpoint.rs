@@ -124,6 +124,7 @@ fn checkpoints_that_do_not_fit_are_refused() {
     std::fs::remove_file(&ckpt).unwrap();
     refused(&["--resume"], &["no checkpoint", "r.exr.checkpoint"]);
     refused(&["--checkpoint-every", "-1"], &["--checkpoint-every"]);
+    refused(&["--checkpoint-every", "1e-30"], &["--checkpoint-every", "0.1"]);
 }
 
 /// Ctrl-C after a checkpoint interval keeps the samples so far; `--resume` finishes the render.

@@ -115,6 +115,9 @@ pub struct Args {
 
 /// Longest `--checkpoint-every`, seconds (a year).
 pub const MAX_CHECKPOINT_SECONDS: f64 = 3.2e7;
+/// Shortest `--checkpoint-every` but 0, seconds: below it the render spends its time writing
+/// checkpoints (1e-30 ran 10× slower, a checkpoint after every one-sample pass).
+pub const MIN_CHECKPOINT_SECONDS: f64 = 0.1;
 
 /// The tracer's settings these flags ask for, the scene's own medium and water included: what
 /// `spectra truth` renders, and what the Python package's `truth` renders with the same options.
@@ -436,10 +439,12 @@ pub fn run(a: Args) -> Result<()> {
         }
         super::check_output("--export-mitsuba", dir)?;
     }
-    if !(a.checkpoint_every.is_finite() && (0.0..=MAX_CHECKPOINT_SECONDS).contains(&a.checkpoint_every)) {
+    let every = a.checkpoint_every;
+    if !(every == 0.0
+        || (every.is_finite() && (MIN_CHECKPOINT_SECONDS..=MAX_CHECKPOINT_SECONDS).contains(&every)))
+    {
         bail!(
-            "--checkpoint-every {}: give seconds from 0 (never) to {MAX_CHECKPOINT_SECONDS:e}",
-            a.checkpoint_every
+            "--checkpoint-every {every:.6}: give 0 (never) or seconds from {MIN_CHECKPOINT_SECONDS} to {MAX_CHECKPOINT_SECONDS:e}"
         );
     }
     if let Some(out) = &a.out {
