@@ -290,5 +290,27 @@ fn a_changed_input_is_named() {
         &["merge", s(&c0), s(&c1), "--out", s(&d.join("m.exr"))],
         &["c1.exr", "base.png", "content hash"],
     );
+    // A renamed copy of the scene: its name is what differs, not its contents (the message
+    // said "the contents … differ" and showed one hash twice; found by a sweep).
+    std::fs::copy(&scene, d.join("renamed.gltf")).unwrap();
+    let c2 = d.join("c2.exr");
+    ok(&[
+        "truth",
+        s(&d.join("renamed.gltf")),
+        "--size",
+        "8x6",
+        "--spp",
+        "2",
+        "--chunk",
+        "1/2",
+        "--out",
+        s(&c2),
+    ]);
+    let c3 = d.join("c3.exr");
+    chunk("0/2", &c3);
+    refused(
+        &["merge", s(&c3), s(&c2), "--out", s(&d.join("m.exr"))],
+        &["the name of input file 0", "textured.gltf there", "renamed.gltf here"],
+    );
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -361,6 +361,11 @@ pub fn record_difference(
             v.rsplit_once(' ').map_or((String::new(), v.to_string()), |(n, h)| (n.into(), h.into()))
         };
         let ((n0, h0), (n1, h1)) = (split(&there), split(&here));
+        if h0 == h1 && n0 != n1 {
+            // A renamed copy: the same contents under another name (which the record keeps, to
+            // name a changed file); the hashes would read "x there and x here".
+            return Some((format!("the name of input file {i} (its contents are the same)"), n0, n1));
+        }
         let file = if n1.is_empty() { n0 } else { n1 };
         let what =
             if file.is_empty() { format!("input file {i} (") } else { format!("{file} (input file {i}; ") };
