@@ -155,7 +155,7 @@ impl Args {
 
 /// The items of a comma list given with `flag`, trimmed; an empty one (`1,,2`, `1,`) is refused
 /// rather than skipped, as a typo may hide there. None for a list of nothing (blank or commas).
-fn list_items<'a>(flag: &str, s: &'a str) -> Result<Vec<&'a str>> {
+pub(crate) fn list_items<'a>(flag: &str, s: &'a str) -> Result<Vec<&'a str>> {
     let items: Vec<&str> = s.split(',').map(str::trim).collect();
     if items.iter().all(|i| i.is_empty()) {
         return Ok(Vec::new());

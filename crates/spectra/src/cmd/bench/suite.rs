@@ -72,10 +72,11 @@ pub fn configs(counts: &[usize]) -> Vec<(Mode, Option<Quadrature>, Option<usize>
     out
 }
 
-/// Parses `1280x720,1920x1080` (each as `--size` takes it), duplicates dropped, at least one.
+/// Parses `1280x720,1920x1080` (each as `--size` takes it), duplicates dropped, at least one; an
+/// empty item is refused as the other lists refuse it (`16x12,,16x12` ran one size silently).
 pub fn parse_sizes(s: &str) -> Result<Vec<(u32, u32)>> {
     let mut out = Vec::new();
-    for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+    for part in super::list_items("--suite-sizes", s)? {
         let size = parse_size(part).with_context(|| format!("--suite-sizes '{s}'"))?;
         if !out.contains(&size) {
             out.push(size);
@@ -441,6 +442,7 @@ mod tests {
         assert_eq!(parse_sizes(" 64x48, 64X48 ,32*24").unwrap(), [(64, 48), (32, 24)]);
         assert!(parse_sizes("64x0").unwrap_err().to_string().contains("--suite-sizes"));
         assert!(parse_sizes(",").unwrap_err().to_string().contains("at least one"));
+        assert!(parse_sizes("16x12,,16x12").unwrap_err().to_string().contains("empty item"));
     }
 
     #[test]
