@@ -656,16 +656,20 @@ impl EnvironmentChoice {
                             .into(),
                 });
             };
+            // Named by their flags, as the message above.
+            let flag = |name: &'static str| {
+                move |e: EnvironmentError| EnvironmentError { message: format!("{name}: {}", e.message), ..e }
+            };
             let env = match self.intensity {
-                Some(k) => env.with_intensity(k)?,
+                Some(k) => env.with_intensity(k).map_err(flag("--env-intensity"))?,
                 None => env,
             };
             let env = match self.rotation {
-                Some(r) => env.with_rotation_degrees(r)?,
+                Some(r) => env.with_rotation_degrees(r).map_err(flag("--env-rotation"))?,
                 None => env,
             };
             let env = match self.sun_share {
-                Some(share) => env.with_sun_min_share(share)?,
+                Some(share) => env.with_sun_min_share(share).map_err(flag("--env-sun-share"))?,
                 None => env,
             };
             scene.environment = Some(env);

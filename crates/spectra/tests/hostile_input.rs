@@ -113,6 +113,28 @@ fn absurd_settings_are_refused_before_rendering() {
     refused(&with(&base, &["--medium", r#"{"sigma_a": -1, "sigma_s": 0}"#]), &["--medium", "sigma_a"]);
     let flat = r#"{"sigma_a": 0.1, "sigma_s": 0.1, "box": {"min": [0, 0, 0], "max": [1, 0, 1]}}"#;
     refused(&with(&base, &["--medium", flat]), &["--medium", "box", "empty"]);
+    // Each refusal names the flag that set the bad value (found by a sweep: these did not).
+    let truth = ["truth", "cornell", "--spp", "1", "--out", o];
+    refused(&with(&truth, &["--size", "100000x100000"]), &["--size 100000x100000", "too large"]);
+    refused(&with(&truth, &["--size", "16x12", "--crop", "16,0,1,1"]), &["--crop", "16,0,1,1"]);
+    let late = [
+        "truth",
+        "cornell",
+        "--spp",
+        "64",
+        "--size",
+        "8x8",
+        "--out",
+        o,
+        "--sample-offset",
+        "9007199254740991",
+    ];
+    refused(&late, &["--sample-offset"]);
+    let render = ["render", "cornell", "--size", "8x8", "--out", o];
+    refused(&with(&render, &["--exposure", "1000"]), &["--exposure 1000", "±64"]);
+    refused(&with(&render, &["--env", "default", "--env-intensity", "-1"]), &["--env-intensity", "-1"]);
+    refused(&with(&render, &["--env", "default", "--env-rotation", "1000001"]), &["--env-rotation"]);
+    refused(&with(&render, &["--env", "default", "--env-sun-share", "0"]), &["--env-sun-share"]);
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -200,6 +200,11 @@ impl LookArgs {
             Some(n) if n == s.wavelengths && !(1..=MAX_WAVELENGTHS).contains(&n) => {
                 anyhow!("--wavelengths {n}: {e}")
             }
+            _ if !(-render::settings::MAX_EXPOSURE_EV..=render::settings::MAX_EXPOSURE_EV)
+                .contains(&self.exposure) =>
+            {
+                anyhow!("--exposure {}: {e}", self.exposure)
+            }
             _ => anyhow!("{e}"),
         })?;
         Ok(s)

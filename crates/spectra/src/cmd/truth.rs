@@ -172,7 +172,15 @@ pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTa
     if a.spectral_out.is_some() || a.spectral_bands {
         s.spectral_bands = Some(s.range.bin_edges(a.spectral_bin).context("--spectral-bin")?);
     }
-    s.validate()?;
+    // Named by the flag that set what is wrong.
+    s.validate().map_err(|e| match &e {
+        truth::TruthError::TooLarge(..) | truth::TruthError::BadSize(..) => {
+            anyhow::anyhow!("--size {}: {e}", a.size)
+        }
+        truth::TruthError::BadCrop(_) => anyhow::anyhow!("--crop: {e}"),
+        truth::TruthError::BadSamples(_) => anyhow::anyhow!("--spp / --chunk / --sample-offset: {e}"),
+        _ => anyhow::anyhow!(e),
+    })?;
     Ok(s)
 }
 
