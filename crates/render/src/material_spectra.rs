@@ -110,8 +110,9 @@ impl MaterialSpectrum {
 }
 
 /// `MaterialSpectrum::emission` of a material that glows with a measured spectrum
-/// (`emission_xyz` says how): w = −2, which the shader tells from a varying emission's −1.
-pub const MEASURED_EMISSION: [f32; 4] = [0.0, 0.0, 0.0, -2.0];
+/// (`emission_xyz` says how): w = −2, which the shader tells from a varying emission's −1; x
+/// the luminance of a constant emission (−1 where it varies: the G-buffer's is used).
+pub const MEASURED_EMISSION: [f32; 4] = [-1.0, 0.0, 0.0, -2.0];
 
 /// Entries of [`reflected_xyz`] per material for `n_lights` lights: a column per light, three
 /// to an entry, then one for the environment.

@@ -1265,7 +1265,7 @@ impl Renderer {
         }
         // The measured emissions' node weights after the rest, found by the record
         // (`MaterialSpectrum::emission`).
-        for (record, m) in records.iter_mut().zip(&measured) {
+        for ((record, m), colour) in records.iter_mut().zip(&measured).zip(&scene.constant_colours) {
             let value = match m {
                 None => continue,
                 Some(MeasuredEmission::Rgb(rgb)) => [rgb[0] as f32, rgb[1] as f32, rgb[2] as f32, 0.0],
@@ -1276,7 +1276,11 @@ impl Renderer {
                     [t[0] as f32, t[1] as f32, t[2] as f32, offset as f32]
                 }
             };
-            record.emission = crate::material_spectra::MEASURED_EMISSION;
+            // A constant emission's luminance from the material itself: the G-buffer's f16 loses
+            // a dim one (4e-8 became 0, where `--exposure` was to bring it up).
+            let k =
+                colour.emission.map_or(-1.0, |e| scene::srgb::luminance(glam::Vec3::from_array(e)) as f32);
+            record.emission = [k, 0.0, 0.0, crate::material_spectra::MEASURED_EMISSION[3]];
             record.emission_xyz = value;
         }
         if light_weights.is_empty() {

@@ -625,7 +625,8 @@ fn measured_emission(px: vec2<i32>, emission: vec3<f32>) -> MeasuredEmission {
     if (m.emission.w > -1.5) {
         return MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
     }
-    let k = dot(emission, SRGB_Y);
+    // A constant emission's own luminance (x ≥ 0), exact where the G-buffer's f16 is not.
+    let k = select(dot(emission, SRGB_Y), m.emission.x, m.emission.x >= 0.0);
     return MeasuredEmission(true, k, u32(m.emission_xyz.w), m.emission_xyz.xyz * k);
 }
 
