@@ -746,6 +746,16 @@ impl Loader<'_> {
         };
         let raw = self.raw.pointer(&format!("/materials/{idx}"));
         let info = |path: &str| raw.and_then(|r| r.pointer(path));
+        // An extension's value is an object: one given as anything else (an array, a number)
+        // was ignored without a word (KHR_materials_transmission: [..] drew the glass opaque).
+        if let Some(exts) = info("/extensions") {
+            let Some(map) = exts.as_object() else {
+                return Err(self.ctx.invalid(format!("{at}.extensions"), "must be an object"));
+            };
+            if let Some((name, _)) = map.iter().find(|(_, v)| !v.is_object()) {
+                return Err(self.ctx.invalid(format!("{at}.extensions.{name}"), "must be an object"));
+            }
+        }
         out.unlit = info("/extensions/KHR_materials_unlit").is_some();
         if let Some(t) = pbr.base_color_texture() {
             out.base_color_texture = Some(self.texture(

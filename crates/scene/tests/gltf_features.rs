@@ -19,7 +19,7 @@ fn data_uri(mime: &str, bytes: &[u8]) -> String {
 }
 
 /// The binary part of a test document: buffer views and accessors in one buffer.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct Bin {
     bytes: Vec<u8>,
     views: Vec<Value>,
@@ -638,6 +638,22 @@ fn points_and_lines_are_skipped_with_a_warning() {
     let s = load(&d).unwrap();
     assert!(s.meshes.is_empty() && s.warnings.len() == 2, "{:?}", s.warnings);
     assert!(s.warnings[1].starts_with("the scene has no triangles to draw"), "{:?}", s.warnings);
+}
+
+/// Found by a sweep: `KHR_materials_transmission` given as an array was ignored (the glass
+/// drawn opaque, exit 0). A material extension that is not an object is refused by its field.
+#[test]
+fn a_material_extension_that_is_not_an_object_is_refused() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    for (ext, value) in [("KHR_materials_transmission", json!([1.0])), ("KHR_materials_ior", json!(1.5))] {
+        let doc = b.clone().finish(json!({
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0}]}],
+            "materials": [{"extensions": {ext: value}}],
+        }));
+        assert_has(&error(&doc), &[&format!("materials[0].extensions.{ext}"), "must be an object"]);
+    }
 }
 
 /// A triangle primitive of fewer indices than a triangle (TRIANGLES with 1–2, a strip or fan

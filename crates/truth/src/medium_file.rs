@@ -21,11 +21,21 @@ fn bad(origin: &str, why: String) -> TruthError {
     TruthError::BadMedium(format!("{origin}: {why}"))
 }
 
+/// An unknown key of the object `v` at `at` (the top level's are checked in `from_json`): a
+/// typo inside `phase`, `box` or a sampled coefficient was accepted without a word.
+fn only_keys(origin: &str, at: &str, v: &Value, known: &[&str]) -> Result<()> {
+    if let Some(k) = v.as_object().and_then(|o| o.keys().find(|k| !known.contains(&k.as_str()))) {
+        return Err(bad(origin, format!("unknown key \"{at}.{k}\" (known: {})", known.join(", "))));
+    }
+    Ok(())
+}
+
 fn spectrum(origin: &str, key: &str, v: Option<&Value>) -> Result<Spectrum> {
     let v = v.ok_or_else(|| bad(origin, format!("missing \"{key}\"")))?;
     if let Some(x) = v.as_f64() {
         return Ok(Spectrum::Constant(x));
     }
+    only_keys(origin, key, v, &["wavelengths", "values"])?;
     let nums = |k: &str| -> Result<Vec<f64>> {
         v.get(k)
             .and_then(Value::as_array)
@@ -87,31 +97,36 @@ impl Medium {
         let phase = match obj.get("phase") {
             None => Phase::Isotropic,
             Some(Value::String(s)) if s == "isotropic" => Phase::Isotropic,
-            Some(p) => match p.get("hg").and_then(Value::as_f64) {
-                // Checked here, as written: as f32 0.99999999999 is 1, refused below as "g = 1".
-                Some(g) if !(g > -1.0 && g < 1.0 && (g as f32).abs() < 1.0) => {
-                    return Err(bad(
-                        origin,
-                        format!(
-                            "\"phase.hg\" = {g}: the Henyey–Greenstein g must lie strictly between −1 and 1 (as a 32-bit float)"
-                        ),
-                    ));
+            Some(p) => {
+                match only_keys(origin, "phase", p, &["hg"]).map(|_| p.get("hg").and_then(Value::as_f64))? {
+                    // Checked here, as written: as f32 0.99999999999 is 1, refused below as "g = 1".
+                    Some(g) if !(g > -1.0 && g < 1.0 && (g as f32).abs() < 1.0) => {
+                        return Err(bad(
+                            origin,
+                            format!(
+                                "\"phase.hg\" = {g}: the Henyey–Greenstein g must lie strictly between −1 and 1 (as a 32-bit float)"
+                            ),
+                        ));
+                    }
+                    Some(g) => Phase::HenyeyGreenstein { g: g as f32 },
+                    None => {
+                        return Err(bad(
+                            origin,
+                            format!("\"phase\" must be \"isotropic\" or {{\"hg\": g}}, got {p}"),
+                        ));
+                    }
                 }
-                Some(g) => Phase::HenyeyGreenstein { g: g as f32 },
-                None => {
-                    return Err(bad(
-                        origin,
-                        format!("\"phase\" must be \"isotropic\" or {{\"hg\": g}}, got {p}"),
-                    ));
-                }
-            },
+            }
         };
         let region = match obj.get("box") {
             None => Region::Everywhere,
-            Some(b) => Region::Box {
-                min: vec3(origin, "min", b.get("min"))?,
-                max: vec3(origin, "max", b.get("max"))?,
-            },
+            Some(b) => {
+                only_keys(origin, "box", b, &["min", "max"])?;
+                Region::Box {
+                    min: vec3(origin, "min", b.get("min"))?,
+                    max: vec3(origin, "max", b.get("max"))?,
+                }
+            }
         };
         Ok(Medium {
             sigma_a: spectrum(origin, "sigma_a", obj.get("sigma_a"))?,
@@ -163,6 +178,23 @@ mod tests {
 
     /// Values the f32 tracer cannot hold are refused as written, naming the field (they used
     /// to read "box [-inf, -1, -1]..[inf, 1, 1]" and "g = 1").
+    /// Found by a sweep: unknown keys inside `phase`, `box` and a sampled coefficient were
+    /// accepted (the docs promise that unknown keys are errors, typos caught).
+    #[test]
+    fn unknown_keys_inside_the_objects_are_errors() {
+        for (text, key) in [
+            (r#"{"sigma_a": 0, "sigma_s": 1, "phase": {"hg": 0.5, "extra": 1}}"#, "phase.extra"),
+            (r#"{"sigma_a": 0, "sigma_s": 1, "box": {"min": [0, 0, 0], "max": [1, 1, 1], "x": 1}}"#, "box.x"),
+            (
+                r#"{"sigma_a": {"wavelengths": [400, 700], "values": [1, 1], "unit": "m"}, "sigma_s": 1}"#,
+                "sigma_a.unit",
+            ),
+        ] {
+            let e = Medium::from_json(text, "m.json").unwrap_err().to_string();
+            assert!(e.contains("m.json") && e.contains(&format!("unknown key \"{key}\"")), "{e}");
+        }
+    }
+
     #[test]
     fn values_beyond_f32_name_their_field() {
         let e = |t: &str| Medium::from_json(t, "w.json").unwrap_err().to_string();

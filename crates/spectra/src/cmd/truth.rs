@@ -740,11 +740,13 @@ pub fn run(a: Args) -> Result<()> {
         eprintln!("  interrupted after the last sample: the finished render is written");
     }
     if let (Some(sp), Some(edges)) = (&a.spectral_out, &st.spectral_bands) {
+        // The bands as written (a --spectral-bin wider than the range is one band of it; the
+        // requested width was shown, 301 digits for 1e300).
+        let width = (edges[edges.len() - 1] - edges[0]) / (edges.len() - 1) as f64;
         eprintln!(
-            "{}: {} bands of {} nm, {:.0}–{:.0} nm (S0.<λ>nm channels, with R, G, B)",
+            "{}: {} bands of {width:.4} nm, {:.0}–{:.0} nm (S0.<λ>nm channels, with R, G, B)",
             sp.display(),
             edges.len() - 1,
-            a.spectral_bin,
             st.range.min,
             st.range.max
         );
