@@ -546,8 +546,14 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         if (HAS_EMISSION) {
             // Without emission in the scene, and without ambient light (whose occlusion shares
             // the texel), the emission target is not read.
-            let me = measured_emission(px, s.emission);
-            rgb += select(s.emission, me.value, me.on);
+            var e = s.emission;
+            // Only a glowing pixel reads its material's record (the RGB mode reads it for
+            // nothing else; a GPU branches past it elsewhere).
+            if (HAS_EMISSION_SPECTRA && max(e.r, max(e.g, e.b)) > 0.0) {
+                let me = measured_emission(px, e);
+                e = select(e, me.value, me.on);
+            }
+            rgb += e;
         }
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
