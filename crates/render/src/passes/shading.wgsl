@@ -970,22 +970,16 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var emission = vec3<f32>(0.0);
     var n_lights = 0u;
     var lobe = 0.0;
-    // The first four lights' factors (and a filmed pixel's terms), kept in registers for the
-    // group loop; lights past them are evaluated again per group (`node_light`). A private
-    // array per light, as this loop had, cost every pixel its zero-initialisation and memory
-    // traffic (on a GPU, local memory) although most scenes have a light or two.
-    var fa4 = vec4<f32>(0.0);
-    var fb4 = vec4<f32>(0.0);
-    var kd4 = vec4<f32>(0.0);
-    var ks4 = vec4<f32>(0.0);
-    var vh4 = vec4<f32>(1.0);
-    var n_kept = 0u;
+    // The spectral loop reads each light's factors once per wavelength group.
+    var fa: array<f32, MAX_LIGHTS>;
+    var fb: array<f32, MAX_LIGHTS>;
     // The environment's coefficients (src/environment.rs): `a` multiplies ρ, `b` does not.
     var et: EnvTerms;
     let has_env = shading_env();
     // A filmed pixel keeps each light's terms instead (its Fresnel term depends on λ), and the
     // environment's lobes.
     var film = FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
+    var ft: array<LightTerms, MAX_LIGHTS>;
     var lobes: EnvLobes;
     var metallic = 0.0;
     // Loaded once: the coefficients below are fetched from it too.
@@ -1037,15 +1031,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         // The hook's irradiance is ambient light too: occluded like the environment.
         lobe = diffuse_lobe(s) * vis;
-        n_kept = min(n_lights, 4u);
-        for (var li = 0u; li < n_kept; li++) {
+        for (var li = 0u; li < n_lights; li++) {
             let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0);
-            let lane = vec4<u32>(li) == vec4<u32>(0u, 1u, 2u, 3u);
-            fa4 = select(fa4, vec4<f32>(nl.a), lane);
-            fb4 = select(fb4, vec4<f32>(nl.b), lane);
-            kd4 = select(kd4, vec4<f32>(nl.t.kd), lane);
-            ks4 = select(ks4, vec4<f32>(nl.t.ks), lane);
-            vh4 = select(vh4, vec4<f32>(nl.t.vh), lane);
+            ft[li] = nl.t;
+            fa[li] = nl.a;
+            fb[li] = nl.b;
         }
     }
     let filmed = HAS_FILM && film.weight > 0.0;
@@ -1087,11 +1077,8 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
     // light's XYZ once; the capture still takes them per node.
     if (!CUSTOM_SPECTRAL && !filmed) {
-        for (var li = 0u; li < n_kept; li++) {
-            xyz = fma(vec3<f32>(fb4[li]), lights[li].xyz.xyz, xyz);
-        }
-        for (var li = 4u; li < n_lights; li++) {
-            xyz = fma(vec3<f32>(node_light(li, p, s, ctx, tr, false).b), lights[li].xyz.xyz, xyz);
+        for (var li = 0u; li < n_lights; li++) {
+            xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
         }
         if (has_env) {
             xyz += env_xyz(et.b);
@@ -1106,12 +1093,8 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         var acc_b = zero;
         // A filmed pixel's reflection, all of it (it is not a multiple of ρ).
         var acc_f = zero;
-        for (var li = 0u; li < n_kept; li++) {
-            let nl = NodeLight(LightTerms(kd4[li], ks4[li], vh4[li]), fa4[li], fb4[li]);
-            add_node_light(&acc_a, &acc_b, &acc_f, nl, li, g, lambda, rho, film, metallic, ctx);
-        }
-        for (var li = 4u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, filmed);
+        for (var li = 0u; li < n_lights; li++) {
+            let nl = NodeLight(ft[li], fa[li], fb[li]);
             add_node_light(&acc_a, &acc_b, &acc_f, nl, li, g, lambda, rho, film, metallic, ctx);
         }
         if (has_env && !background) {
