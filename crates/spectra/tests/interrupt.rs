@@ -66,40 +66,21 @@ fn interrupt(mut cmd: Command, after: Duration, dir: Option<&Path>, cooperative:
     stderr
 }
 
+/// A `truth` of the Cornell box that runs until interrupted (10⁸ samples of 4×4 pixels).
+fn long_truth(out: &str, extra: &[&str]) -> Command {
+    spectra(&[&["truth", "cornell", "--spp", "100000000", "--size", "4x4", "--out", out][..], extra].concat())
+}
+
 #[test]
 fn truth_stops_inside_a_pixel_at_a_huge_sample_count() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.exr");
-    let cmd = spectra(&[
-        "truth",
-        "cornell",
-        "--spp",
-        "100000000",
-        "--size",
-        "4x4",
-        "--out",
-        out.to_str().unwrap(),
-        "--checkpoint-every",
-        "0",
-    ]);
-    interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
+    let o = out.to_str().unwrap();
+    interrupt(long_truth(o, &["--checkpoint-every", "0"]), Duration::from_secs(3), Some(dir.path()), true);
     // With a truth cache that did not exist: no empty folder is left behind either.
     let cache = dir.path().join("gt");
-    let cmd = spectra(&[
-        "truth",
-        "cornell",
-        "--spp",
-        "100000000",
-        "--size",
-        "4x4",
-        "--out",
-        out.to_str().unwrap(),
-        "--truth-cache",
-        cache.to_str().unwrap(),
-        "--checkpoint-every",
-        "0",
-    ]);
-    interrupt(cmd, Duration::from_secs(3), Some(dir.path()), true);
+    let extra = ["--truth-cache", cache.to_str().unwrap(), "--checkpoint-every", "0"];
+    interrupt(long_truth(o, &extra), Duration::from_secs(3), Some(dir.path()), true);
 }
 
 /// With checkpoints (the default), Ctrl-C keeps the finished passes however soon it comes: a
@@ -108,8 +89,7 @@ fn truth_stops_inside_a_pixel_at_a_huge_sample_count() {
 fn truth_keeps_its_finished_passes_on_ctrl_c_before_an_interval() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("t.exr");
-    let cmd =
-        spectra(&["truth", "cornell", "--spp", "100000000", "--size", "4x4", "--out", out.to_str().unwrap()]);
+    let cmd = long_truth(out.to_str().unwrap(), &[]);
     let stderr = interrupt(cmd, Duration::from_secs(3), None, true);
     assert!(stderr.contains("samples kept in") && stderr.contains("--resume"), "{stderr}");
     assert_eq!(entries(dir.path()), vec!["t.exr.checkpoint".to_string()]);
