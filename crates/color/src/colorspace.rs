@@ -239,13 +239,19 @@ impl RgbColorSpace {
 /// `n` is not eight chromaticities of a colour space. Primaries may lie outside the spectrum
 /// locus (ACES AP0's blue has y = −0.077), the white must be a colour. Every reader of such files
 /// converts through it.
+/// The least x, y and 1 − x − y of a white in [`to_srgb_from_chromaticities`]: the
+/// illuminants of every standard lie far inside (D65 0.3127, 0.3290; illuminant A 0.4476, 0.4074).
+pub const MIN_WHITE_XY: f64 = 0.01;
+
 pub fn to_srgb_from_chromaticities(n: &[f64]) -> Option<DMat3> {
     let ok = n.len() == 8
         && n.iter().all(|x| x.is_finite() && (-2.0..=2.0).contains(x))
         && n[..6].chunks(2).all(|c| c[1].abs() > 1e-6)
-        && n[6] > 0.0
-        && n[7] > 0.0
-        && n[6] + n[7] < 1.0;
+        // The white is a colour: inside the chromaticity diagram, where no real white comes
+        // near its edges (a white at y = 1e-30 passed and scaled the image by ~1e29).
+        && n[6] >= MIN_WHITE_XY
+        && n[7] >= MIN_WHITE_XY
+        && n[6] + n[7] <= 1.0 - MIN_WHITE_XY;
     let space = ok.then(|| {
         RgbColorSpace::new(
             "PRIMARIES",
@@ -255,7 +261,10 @@ pub fn to_srgb_from_chromaticities(n: &[f64]) -> Option<DMat3> {
             TransferFunction::Linear,
         )
     })?;
-    if !(space.to_xyz.is_finite() && space.to_xyz.determinant().abs() > 1e-6) {
+    let usable = space.to_xyz.is_finite()
+        && space.to_xyz.determinant().abs() > 1e-6
+        && space.conversion_to(&RgbColorSpace::srgb()).is_finite();
+    if !usable {
         return None;
     }
     let srgb = RgbColorSpace::srgb();
@@ -388,5 +397,23 @@ mod tests {
     fn unknown_space_lists_known() {
         let e = RgbColorSpace::by_name("adobe").unwrap_err().to_string();
         assert!(e.contains("adobe") && e.contains("rec2020"));
+    }
+
+    /// A file's chromaticities: the white must be a colour (a Radiance PRIMARIES line with a
+    /// white at y = 1e-30 was accepted and scaled the map by ~1e29); imaginary primaries stay.
+    #[test]
+    fn chromaticities_need_a_white_inside_the_diagram() {
+        let rec709 = [0.64, 0.33, 0.3, 0.6, 0.15, 0.06, 0.3127, 0.329];
+        assert_eq!(to_srgb_from_chromaticities(&rec709), Some(DMat3::IDENTITY));
+        let ap0 = [0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077, 0.32168, 0.33767];
+        assert!(to_srgb_from_chromaticities(&ap0).is_some());
+        for white in [[0.3127, 1e-30], [1e-30, 0.329], [0.6, 0.3999], [0.3127, 0.0]] {
+            let mut n = rec709;
+            n[6..].copy_from_slice(&white);
+            assert_eq!(to_srgb_from_chromaticities(&n), None, "{white:?}");
+        }
+        let mut a = rec709;
+        a[6..].copy_from_slice(&[0.4476, 0.4074]);
+        assert!(to_srgb_from_chromaticities(&a).is_some_and(|m| m.is_finite()));
     }
 }

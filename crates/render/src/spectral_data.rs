@@ -341,7 +341,8 @@ impl SpectralSetup {
             };
             let want = self.luminance(rgb);
             let r = self.quad.nodes.range;
-            let k = scene::emission::range_scale(y, want, (r.min, r.max)).map_err(RenderError::Settings)?;
+            let k =
+                scene::emission::range_scale(y, want, want, (r.min, r.max)).map_err(RenderError::Settings)?;
             return Ok(Box::new(move |l| s.eval(l) * k));
         }
         let white = &self.white;

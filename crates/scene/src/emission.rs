@@ -63,10 +63,14 @@ pub enum EmissionError {
 /// `want / y`, with `y` its luminance inside the range by the renderer's own integral and
 /// `want` the luminance it must have there (that of `rgb × intensity`, in the renderer's
 /// units). A spectrum with no luminance inside the range cannot have it: an error (the
-/// caller names the light or material), where either renderer would draw it dark.
-pub fn range_scale(y: f64, want: f64, range: (f64, f64)) -> Result<f64, String> {
+/// caller names the light or material), where either renderer would draw it dark. Whether the
+/// light shines at all is `rgb_luminance` (that of `rgb × intensity`, independent of the
+/// range): `want` is not, as a renderer whose unit carries the white's luminance in the range
+/// (the path tracer's) has `want` = 0 where the white is zero too, and drew such a lamp black
+/// where the other renderer refused it.
+pub fn range_scale(y: f64, want: f64, rgb_luminance: f64, range: (f64, f64)) -> Result<f64, String> {
     if y.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        if want > 0.0 {
+        if rgb_luminance > 0.0 || want > 0.0 {
             return Err(format!(
                 "its emission spectrum has no luminance inside the render range {}–{} nm (it is \
                  zero or outside it there); widen --range or fix the spectrum",

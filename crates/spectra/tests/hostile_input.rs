@@ -135,6 +135,22 @@ fn absurd_settings_are_refused_before_rendering() {
     refused(&with(&render, &["--env", "default", "--env-intensity", "-1"]), &["--env-intensity", "-1"]);
     refused(&with(&render, &["--env", "default", "--env-rotation", "1000001"]), &["--env-rotation"]);
     refused(&with(&render, &["--env", "default", "--env-sun-share", "0"]), &["--env-sun-share"]);
+    // Found by a sweep: an all-zero medium was drawn as none (--rgb-medium refused it); a
+    // lamp whose measured spectrum is zero in the range (D65 ends at 780 nm) drew black in the
+    // path tracer where real time refused it; a scene's own wavelength count past the real-time
+    // limit was refused without its file or field.
+    refused(&with(&base, &["--medium", r#"{"sigma_a": 0, "sigma_s": 0}"#]), &["--medium", "zero", "nothing"]);
+    refused(&with(&base, &["--range", "790:830"]), &["lamp (D65)", "790–830", "--range"]);
+    let wl = d.join("wl.gltf");
+    scene::write_gltf(&scene::builtin("cornell").unwrap(), &wl).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&wl).unwrap()).unwrap();
+    doc["scenes"][0]["extras"]["spectra"]["wavelengths"] = 100000.into();
+    std::fs::write(&wl, doc.to_string()).unwrap();
+    let wl = wl.to_str().unwrap();
+    refused(
+        &["render", wl, "--size", "8x8", "--out", o],
+        &["wl.gltf", "extras.spectra.wavelengths = 100000", "256"],
+    );
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -58,7 +58,12 @@ impl EmissionUnits {
             Some(s) => {
                 let y = y_integral(&|l| s.eval(l), self.range);
                 let target = luminance(rgb) as f64 * self.k_white;
-                let k = scene::emission::range_scale(y, target, (self.range.min, self.range.max))?;
+                let k = scene::emission::range_scale(
+                    y,
+                    target,
+                    luminance(rgb) as f64,
+                    (self.range.min, self.range.max),
+                )?;
                 DenseSpectrum::new(s, self.range).scaled(k as f32)
             }
             None => {
@@ -228,6 +233,22 @@ mod tests {
         assert!(err.contains("380–730") && err.contains("--range"), "{err}");
         let dark = Emission { intensity: 0.0, ..e };
         assert_eq!(u.light(&dark, &GreyOnly).unwrap().eval(550.0), 0.0);
+    }
+
+    /// Where the white itself is zero (D65 is tabulated to 780 nm), the light's target
+    /// luminance in the path tracer's units is zero too: a D65 lamp rendered over 790–830 nm
+    /// was drawn black without a word where the real-time renderer refused it.
+    #[test]
+    fn a_lamp_whose_white_is_zero_in_the_range_is_refused_as_in_real_time() {
+        let d65 = color::illuminant::by_name("D65").unwrap();
+        let range = WavelengthRange::new(790.0, 830.0).unwrap();
+        let u = EmissionUnits::new(&d65, range);
+        assert_eq!(u.k_white, 0.0);
+        let lamp = Emission { rgb: Vec3::ONE, intensity: 40.0, spectrum: Some(d65.clone()) };
+        let err = u.light(&lamp, &GreyOnly).unwrap_err();
+        assert!(err.contains("790–830") && err.contains("--range"), "{err}");
+        let dark = Emission { intensity: 0.0, ..lamp };
+        assert_eq!(u.light(&dark, &GreyOnly).unwrap().eval(800.0), 0.0);
     }
 
     #[test]

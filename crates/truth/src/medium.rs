@@ -59,6 +59,7 @@ impl Medium {
     /// Also refuses coefficients above [`MAX_SIGMA`].
     pub fn validate(&self, range: WavelengthRange) -> Result<()> {
         let bad = |s: String| Err(TruthError::BadMedium(s));
+        let mut any = false;
         for (name, s) in [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)] {
             let n = range.width().ceil() as usize;
             for i in 0..=n {
@@ -70,7 +71,18 @@ impl Medium {
                         color::error::show(v)
                     ));
                 }
+                any |= v > 0.0;
             }
+        }
+        // As `--rgb-medium` refuses one (color::upsample::medium): a medium that neither
+        // absorbs nor scatters anywhere in the range is almost surely a mistake (a unit, a
+        // sampled coefficient outside the range), and it would render as no medium. A water
+        // surface on its box still refracts: clear water is a medium then.
+        if !any && self.surface_ior.is_none() {
+            return bad(format!(
+                "sigma_a and sigma_s are zero over {}–{} nm: the medium would do nothing",
+                range.min, range.max
+            ));
         }
         if let Phase::HenyeyGreenstein { g } = self.phase
             && !(g > -1.0 && g < 1.0)
@@ -286,6 +298,19 @@ mod tests {
             let e = flat.validate(r).unwrap_err().to_string();
             assert!(e.contains("box") && e.contains("empty"), "{e}");
         }
+        // Zero everywhere in the range (--rgb-medium refused it; --medium drew no medium).
+        let none =
+            Medium { sigma_a: Spectrum::Constant(0.0), sigma_s: Spectrum::Constant(0.0), ..ok.clone() };
+        let e = none.validate(r).unwrap_err().to_string();
+        assert!(e.contains("zero over 380–730 nm"), "{e}");
+        let outside = Spectrum::piecewise(vec![800.0, 820.0], vec![1.0, 1.0]).unwrap();
+        assert!(
+            Medium { sigma_s: outside.clone(), sigma_a: Spectrum::Constant(0.0), ..ok.clone() }
+                .validate(r)
+                .is_err()
+        );
+        let inside = Medium { sigma_s: outside, ..ok.clone() };
+        assert!(inside.validate(r).is_ok());
         let no_box = Medium { surface_ior: Some(1.34), ..ok.clone() };
         assert!(no_box.validate(r).unwrap_err().to_string().contains("box"));
         let slab = Region::Box { min: Vec3::ZERO, max: Vec3::ONE };

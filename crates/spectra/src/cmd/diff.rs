@@ -322,10 +322,9 @@ fn print_table(
         "per-pixel metric", "mean", "median", "p95", "p99", "max"
     );
     let row = |name: &str, st: &color::metrics::Stats, prec: usize| {
-        println!(
-            "{name:<22}{:>12.prec$}{:>12.prec$}{:>12.prec$}{:>12.prec$}{:>12.prec$}",
-            st.mean, st.median, st.p95, st.p99, st.max
-        );
+        let cells: String =
+            [st.mean, st.median, st.p95, st.p99, st.max].map(|v| table_cell(v, prec)).concat();
+        println!("{name:<22}{cells}");
     };
     row("ΔE2000", &s.delta_e2000, 4);
     row("MAE linear RGB", &s.mae_linear, 6);
@@ -353,9 +352,27 @@ fn print_table(
     }
 }
 
+/// One column of the statistics table: 12 characters, at least one a space, so that columns
+/// never run together; values of a million or more in scientific notation (the MAE of a 3e38
+/// pixel filled 40 digits and joined the next column).
+fn table_cell(v: f64, prec: usize) -> String {
+    let s = if v.is_finite() && v.abs() >= 1e6 { format!("{v:.4e}") } else { format!("{v:.prec$}") };
+    format!(" {s:>11}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn table_cells_keep_their_columns() {
+        assert_eq!(table_cell(0.25, 6), "    0.250000");
+        assert_eq!(table_cell(133.33333, 4), "    133.3333");
+        assert_eq!(table_cell(3e38, 6), "   3.0000e38");
+        assert_eq!(table_cell(-2.5e6, 6), "   -2.5000e6");
+        assert_eq!(table_cell(f64::NAN, 6), "         NaN");
+        assert!(table_cell(123456.789, 6).starts_with(' '));
+    }
 
     fn args(extra: &[&str]) -> Args {
         use clap::Parser;

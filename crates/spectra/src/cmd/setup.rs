@@ -200,6 +200,15 @@ impl LookArgs {
             Some(n) if n == s.wavelengths && !(1..=MAX_WAVELENGTHS).contains(&n) => {
                 anyhow!("--wavelengths {n}: {e}")
             }
+            // The scene's own count (checked by the loader as a count only: the path tracer
+            // takes no N): named by its file and field, as the loader names the others.
+            None if !(1..=MAX_WAVELENGTHS).contains(&s.wavelengths) => {
+                anyhow!(
+                    "{}: extras.spectra.wavelengths = {}: {e}; or give --wavelengths",
+                    scene.source,
+                    s.wavelengths
+                )
+            }
             _ if !(-render::settings::MAX_EXPOSURE_EV..=render::settings::MAX_EXPOSURE_EV)
                 .contains(&self.exposure) =>
             {
@@ -618,6 +627,17 @@ pub fn water_medium(
             (underwater::light_field_range(medium.depth), "20 m below it, rounded up to 20 m".to_string())
         }
     };
+    if let Some(f) = medium.floor.as_ref().filter(|f| f.below_camera >= max_z) {
+        // No depth helps: the floor alone lies beyond the table (a water.scale of 1e30 gave
+        // "a camera at most -1.2e30 m deep").
+        bail!(
+            "scene {}: its sea floor lies {} m below the camera at water.scale {:e} m per scene unit, beyond the \
+             underwater light-field table's {max_z} m; lower water.scale or raise the floor",
+            scene.source,
+            metres(f.below_camera),
+            medium.scale as f32
+        );
+    }
     if z_max > max_z {
         let what = match depth {
             Some(d) => format!("--depth {d}"),
@@ -647,6 +667,19 @@ pub fn water_medium(
     // path tracer.
     if let Some((_, hi)) = scene.bounds() {
         let above = (hi.y - scene.camera.position().y) as f64 * medium.scale;
+        // No allowed depth reaches that high: say what to change instead of a depth the bound
+        // above refuses (water.scale 1e30 suggested a 31-digit --depth).
+        let deepest = medium.floor.as_ref().map_or(max_z - 20.0, |f| max_z - f.below_camera);
+        if above > deepest {
+            bail!(
+                "scene {}: its geometry reaches {} m above the camera at water.scale {:e} m per scene unit, above \
+                 any water surface allowed (a camera at most {deepest:.1} m deep); lower water.scale or keep the \
+                 geometry below the surface",
+                scene.source,
+                metres(above),
+                medium.scale as f32
+            );
+        }
         if above > medium.depth + 1e-6 {
             bail!(
                 "scene {}: its geometry reaches {above:.2} m above the camera, above the water surface {:.2} m \
@@ -658,6 +691,12 @@ pub fn water_medium(
         }
     }
     Ok(Some(medium))
+}
+
+/// A length for a message: two decimals, or three significant digits where that would run to
+/// many digits.
+fn metres(x: f64) -> String {
+    if x.abs() < 1e6 { format!("{x:.2}") } else { format!("{x:.3e}") }
 }
 
 /// Prints what the loader skipped or approximated, one `warning: <scene>: <text>` line each on
@@ -888,6 +927,18 @@ mod tests {
         let e = format!("{:#}", water_medium(&cornell, Some("II"), Some(0.0)).unwrap_err());
         assert!(e.contains("above the water surface") && e.contains("--depth"), "{e}");
         assert!(water_medium(&cornell, Some("II"), Some(50.0)).unwrap().is_some());
+        // No allowed depth covers it: the scale is named, no impossible --depth suggested.
+        let mut huge = scene::builtin("underwater").unwrap();
+        huge.water.as_mut().unwrap().scale = 1e30;
+        let e = format!("{:#}", water_medium(&huge, None, None).unwrap_err());
+        assert!(e.contains("sea floor lies 1.200e30 m") && e.contains("water.scale 1e30"), "{e}");
+        // Without a floor under the camera: the geometry above the surface.
+        let mut high = scene::builtin("colorchecker").unwrap();
+        high.water = scene::builtin("underwater").unwrap().water;
+        high.lights.clear();
+        high.water.as_mut().unwrap().scale = 1e30;
+        let e = format!("{:#}", water_medium(&high, None, None).unwrap_err());
+        assert!(e.contains("m above the camera at water.scale 1e30") && !e.contains("--depth"), "{e}");
     }
 
     #[test]
