@@ -211,6 +211,14 @@ fn opt_string(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
     opt(o, what, string)
 }
 
+fn opt_path(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<std::path::PathBuf>> {
+    opt(o, what, path)
+}
+
+fn opt_boolean(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<bool>> {
+    opt(o, what, boolean)
+}
+
 fn opt_name_or_path(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
     opt(o, what, name_or_path)
 }
@@ -261,4 +269,23 @@ arg_fns! {
     maps("maps") -> bool = boolean;
     space("space") -> String = string;
     balanced("balanced") -> bool = boolean;
+    medium("medium") -> Option<String> = opt_name_or_path;
+    lambert("lambert") -> bool = boolean;
+    xyz("xyz") -> bool = boolean;
+    table("table") -> Option<std::path::PathBuf> = opt_path;
+    scatter_steps("scatter_steps") -> i128 = int;
+    single_scattering("single_scattering") -> bool = boolean;
+    phase_g("phase_g") -> f32 = float32;
+    paper_model("paper_model") -> bool = boolean;
+    isotropic("isotropic") -> bool = boolean;
+    tabulated_kd("tabulated_kd") -> bool = boolean;
+    surface_irradiance("surface_irradiance") -> bool = boolean;
+    forward_cone("forward_cone") -> f32 = float32;
+    light_field_photons("light_field_photons") -> i128 = int;
+    scalar_irradiance("scalar_irradiance") -> bool = boolean;
+    split_beams("split_beams") -> bool = boolean;
+    water_surface("water_surface") -> Option<bool> = opt_boolean;
+    sea_floor("sea_floor") -> bool = boolean;
+    env_occlusion("env_occlusion") -> bool = boolean;
+    shadows("shadows") -> bool = boolean;
 }
