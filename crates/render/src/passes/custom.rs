@@ -4,6 +4,9 @@
 //! the identity from `custom_hooks.wgsl`):
 //!
 //! ```wgsl
+//! // Pass 2, every mode, once per pixel before the other pass-2 hooks (ctx.normal set on a
+//! // surface): wavelength-independent work the per-group and per-light hooks share:
+//! fn custom_prepare(ctx: SurfaceContext)
 //! // Pass 2, spectral & naive modes, once per group of four node wavelengths, before
 //! // integration; radiance[c] is channel c's (X, Y, Z) weighted node radiance:
 //! fn custom_spectral(lambda: vec4<f32>, radiance: mat3x4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32>
@@ -74,7 +77,8 @@ pub const DEFAULT_HOOKS: &str = include_str!("custom_hooks.wgsl");
 pub const MEDIUM_COMMON: &str = include_str!("medium_common.wgsl");
 
 /// The hook names, in the order `custom_hooks.wgsl` defines them.
-const HOOKS: [&str; 10] = [
+const HOOKS: [&str; 11] = [
+    "custom_prepare",
     "custom_spectral",
     "custom_rgb",
     "custom_pixel",

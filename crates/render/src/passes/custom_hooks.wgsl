@@ -2,6 +2,14 @@
 // may declare helpers too); the renderer adds this file's definition of each one it leaves out
 // (`CustomShader::assembled`).
 
+// Pass 2, every mode, once per pixel before any other pass-2 hook (on a surface `ctx.normal`
+// is set): per-pixel work that does not depend on wavelength, kept in private variables for the
+// hooks called per group and light. Preparing here rather than behind a "done yet" flag in each
+// hook keeps one copy of that work in the shader: a CPU driver runs a skipped branch's code all
+// the same, so a flagged copy in a per-group hook cost it the whole preparation again per group.
+fn custom_prepare(ctx: SurfaceContext) {
+}
+
 // Pass 2, spectral and naive modes, once per group of four node wavelengths (`lambda`, nm),
 // before integration. `radiance[c]` is the light leaving the surface towards the camera at
 // the four nodes (on a background pixel the environment's, as `custom_rgb` receives it; at a

@@ -28,11 +28,11 @@ const RM_SS_LIGHTS: u32 = 4u;
 const RM_MAX_STEPS: u32 = 32u;
 const RM_ZERO: mat3x4<f32> = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
 
-// Per-pixel, wavelength-independent march, filled once by `rm_prepare` and reused by every
+// Per-pixel, wavelength-independent march, filled once by `rm_prepare` (from `custom_prepare`,
+// before the hooks that read it) and reused by every
 // wavelength group: for light slot j and step k, weight W = phase × visibility × incidence ×
 // step length and optical path s (scene units, light → point → camera), so that the light's
 // single scattering is σ_s·Σ_k W·e^{−σ_t·s}.
-var<private> rm_ready: bool = false;
 var<private> rm_n: u32 = 0u;
 var<private> rm_steps: u32 = 0u;
 var<private> rm_light: array<u32, RM_SS_LIGHTS>;
@@ -111,9 +111,11 @@ fn rm_mean_intensity(li: u32) -> f32 {
     return 1.0;
 }
 
+fn custom_prepare(ctx: SurfaceContext) {
+    rm_prepare(ctx);
+}
+
 fn rm_prepare(ctx: SurfaceContext) {
-    if (rm_ready) { return; }
-    rm_ready = true;
     if (!ctx.background) {
         rm_d = ctx.distance;
     }
@@ -332,7 +334,6 @@ fn rm_ms_coefficients(group: u32, rgb: bool) -> mat2x4<f32> {
 }
 
 fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3x4<f32> {
-    rm_prepare(ctx);
     if (!rm_multiple() || ctx.background) {
         return RM_ZERO;
     }
@@ -341,7 +342,6 @@ fn custom_irradiance(lambda: vec4<f32>, group: u32, ctx: SurfaceContext) -> mat3
 }
 
 fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
-    rm_prepare(ctx);
     if (!rm_multiple() || ctx.background) {
         return vec3<f32>(0.0);
     }
@@ -350,7 +350,6 @@ fn custom_irradiance_rgb(ctx: SurfaceContext) -> vec3<f32> {
 }
 
 fn rm_shade(radiance: mat3x4<f32>, lambda: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
-    rm_prepare(ctx);
     var ms = RM_ZERO;
     if (rm_multiple()) {
         let km = rm_ms_coefficients(group, rgb);

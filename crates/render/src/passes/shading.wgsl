@@ -502,6 +502,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
     if (!ctx.background) {
         s = load_surface(px);
         ctx.normal = s.normal;
+    }
+    custom_prepare(ctx);
+    if (!ctx.background) {
         var keep = 1.0;
         var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
         let film = load_film(px);
@@ -770,6 +773,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         s.emission = vec3<f32>(0.0);
     }
     ctx.normal = s.normal;
+    custom_prepare(ctx);
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
     var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u);
@@ -1028,9 +1032,12 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         base = s.base;
         emission = s.emission;
         ctx.normal = s.normal;
-        n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         // The hook's irradiance is ambient light too: occluded like the environment.
         lobe = diffuse_lobe(s) * vis;
+    }
+    custom_prepare(ctx);
+    if (!background) {
+        n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
             let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0);
             ft[li] = nl.t;

@@ -108,12 +108,11 @@ fn uw_params() -> UwParams {
 // point and spot lights are marched over at most that length.
 const UW_CAP: f32 = 6.0;
 
-// Per-pixel, wavelength-independent march, filled once by `uw_prepare` and reused by every
-// wavelength group: for light slot j and step k, weight W = phase × visibility × geometry and
+// Per-pixel, wavelength-independent march, filled once by `uw_prepare` (from `custom_prepare`,
+// before the hooks that read it) and reused by every wavelength group: for light slot j and step k, weight W = phase × visibility × geometry and
 // optical path s (metres) so that the light's single scattering is b·E·Σ_k W·e^{−c·s}. For a
 // directional slot only s at the first step is stored: the later ones follow from q and the
 // segment length in `uw_dir` (see `uw_single_scatter`).
-var<private> uw_ready: bool = false;
 var<private> uw_n: u32 = 0u;
 var<private> uw_steps: u32 = 0u;
 var<private> uw_light: array<u32, UW_SS_LIGHTS>;
@@ -481,28 +480,28 @@ fn uw_table_in_scatter(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> mat3x4<f
 }
 
 // The pixel's cells, weights and depth segment in the irradiance table: the same for every
-// group, so found once (`uw_irradiance` is called per group with the pixel's own z and n).
-var<private> uw_irr_ready: bool = false;
+// group, so found once per pixel by `uw_prepare_irradiance` (`uw_irradiance` is called per group).
 var<private> uw_irr_cells: vec4<u32>;
 var<private> uw_irr_w: vec4<f32>;
 var<private> uw_irr_i: u32;
 
-// The diffuse irradiance per unit sun E⊥ on a surface at depth z facing n, bilinear in the
-// normal's polar angle and azimuth to the sun, ln-linear in depth (CPU reference:
-// light_field::LightFieldTable::irradiance_at). Only the first call of a pixel reads z and n.
+// The irradiance table's cells for a surface at depth z facing n.
+fn uw_prepare_irradiance(z: f32, n: vec3<f32>) {
+    let hn = vec3<f32>(n.x, 0.0, n.z);
+    let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
+    let fk = uw_sun_azimuth(hn) / 3.14159265358979 * f32(UW_NNA - 1u);
+    let cell = uw_cells(fe, fk, UW_NNE, UW_NNA);
+    uw_irr_cells = cell.index;
+    uw_irr_w = cell.w;
+    uw_irr_i = uw_segment(z);
+}
+
+// The diffuse irradiance per unit sun E⊥ on the pixel's surface at depth z (the cells of
+// `uw_prepare_irradiance`), bilinear in the normal's polar angle and azimuth to the sun,
+// ln-linear in depth (CPU reference: light_field::LightFieldTable::irradiance_at).
 // `view`: an optical depth the result is attenuated by (e^{−view}), taken into the
 // interpolation's exponential.
-fn uw_irradiance(table: u32, z: f32, n: vec3<f32>, group: u32, rgb: bool, view: vec4<f32>) -> vec4<f32> {
-    if (!uw_irr_ready) {
-        uw_irr_ready = true;
-        let hn = vec3<f32>(n.x, 0.0, n.z);
-        let fe = uw_angle(length(hn), n.y) / 3.14159265358979 * f32(UW_NNE - 1u);
-        let fk = uw_sun_azimuth(hn) / 3.14159265358979 * f32(UW_NNA - 1u);
-        let cell = uw_cells(fe, fk, UW_NNE, UW_NNA);
-        uw_irr_cells = cell.index;
-        uw_irr_w = cell.w;
-        uw_irr_i = uw_segment(z);
-    }
+fn uw_irradiance(table: u32, z: f32, group: u32, rgb: bool, view: vec4<f32>) -> vec4<f32> {
     let cells = uw_irr_cells;
     let w = uw_irr_w;
     let i = uw_irr_i;
@@ -530,12 +529,11 @@ fn uw_log_interp(a: vec4<f32>, b: vec4<f32>, i: u32, z: f32, view: vec4<f32>) ->
 // The diffuse irradiance of every sun's column on the pixel's surface, as it reaches the
 // camera (× e^{−c·d}), in weighted form.
 fn uw_surface_irradiance(b: vec4<f32>, c: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
-    uw_prepare(ctx);
     let z0 = uw_params().depth;
     let zs = max(z0 - uw_d * ctx.view_dir.y, 0.0);
     let hit = ctx.origin + ctx.view_dir * ctx.distance;
     let cv = c - UW_FWD * b;
-    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, ctx.normal, group, rgb, cv * uw_d);
+    let e = uw_irradiance(select(1u, 0u, uw_over_floor(hit)), zs, group, rgb, cv * uw_d);
     return s3_scale(uw_suns(group, rgb), e);
 }
 
@@ -602,9 +600,14 @@ fn uw_marched_lights(cam: vec3<f32>) -> vec4<u32> {
     return index;
 }
 
+fn custom_prepare(ctx: SurfaceContext) {
+    uw_prepare(ctx);
+    if (UW_IRRADIANCE && !ctx.background) {
+        uw_prepare_irradiance(max(uw_params().depth - uw_d * ctx.view_dir.y, 0.0), ctx.normal);
+    }
+}
+
 fn uw_prepare(ctx: SurfaceContext) {
-    if (uw_ready) { return; }
-    uw_ready = true;
     let z0 = uw_params().depth;
     let scale = uw_params().scale;
     let g = uw_params().g;
@@ -784,7 +787,6 @@ fn uw_surface_from_below(b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, 
 }
 
 fn uw_shade(radiance: mat3x4<f32>, b: vec4<f32>, c: vec4<f32>, kd: vec4<f32>, group: u32, rgb: bool, ctx: SurfaceContext) -> mat3x4<f32> {
-    uw_prepare(ctx);
     let wy = ctx.view_dir.y;
     let z0 = uw_params().depth;
     // Along the view: c minus the forward cone's scattering (light-field model; = c otherwise).
