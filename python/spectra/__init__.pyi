@@ -93,9 +93,31 @@ class Renderer:
         water: Optional[str] = None,
         depth: Optional[float] = None,
         rgb_medium: Optional[_Path] = None,
+        table: Optional[_Path] = None,
+        scatter_steps: int = 16,
+        single_scattering: bool = False,
+        phase_g: float = 0.924,
+        paper_model: bool = False,
+        isotropic: bool = False,
+        tabulated_kd: bool = False,
+        surface_irradiance: bool = True,
+        forward_cone: float = 15.0,
+        light_field_photons: int = 8000,
+        scalar_irradiance: bool = False,
+        split_beams: bool = False,
+        water_surface: Optional[bool] = None,
+        sea_floor: bool = True,
     ) -> None:
         """`water`: a Jerlov type ("IB", …) with the camera `depth` in metres; `rgb_medium`: the
-        `--rgb-medium` JSON or a JSON file; by default the scene's own medium."""
+        `--rgb-medium` JSON or a JSON file; by default the scene's own medium. `table`: a
+        Jakob–Hanika .coeff table (`--table`; default the cached sRGB fit).
+        The media options are `spectra render`'s flags with its defaults: `scatter_steps`
+        (0–32), `single_scattering`, `phase_g`, `paper_model`, `isotropic`, `tabulated_kd`,
+        `surface_irradiance=False` (`--no-surface-irradiance`), `forward_cone` (0–45°),
+        `light_field_photons`, `scalar_irradiance`, `split_beams`, `water_surface` (None: the
+        model's default; True `--water-surface`, False `--no-water-surface`), `sea_floor=False`
+        (`--no-sea-floor`). Flags the command refuses together are refused together (ValueError
+        naming the arguments)."""
     @overload
     def render(
         self,
@@ -110,6 +132,9 @@ class Renderer:
         spectral: Literal[False] = False,
         camera_to_display: bool = False,
         samples: int = 1,
+        lambert: bool = False,
+        env_occlusion: bool = True,
+        shadows: bool = True,
     ) -> RGBImage:
         """One frame: the linear RGB HDR image (`spectra render --out x.exr`'s pixels) × 2^exposure.
 
@@ -124,6 +149,8 @@ class Renderer:
         samples: antialiasing, the mean of 1–256 frames each looking at another place in every
         pixel (`--samples`): the image box-filtered over each pixel, as the path tracer's are
         (not with spectral=True).
+        lambert=True: Lambert only, base colour / π (`--lambert`); env_occlusion=False:
+        `--no-env-occlusion`; shadows=False: `--no-shadows`.
         Unknown keywords and badly typed arguments raise TypeError (its message starts with the
         argument's name), bad values ValueError with the CLI's message; the GIL is released while
         rendering, and `size`, `device` and `repr()` never wait for a render on another thread."""
@@ -141,6 +168,9 @@ class Renderer:
         spectral: Literal[True],
         camera_to_display: bool = False,
         samples: int = 1,
+        lambert: bool = False,
+        env_occlusion: bool = True,
+        shadows: bool = True,
     ) -> Tuple[RGBImage, _Bands, _Wavelengths]: ...
     @overload
     def render(
@@ -156,6 +186,9 @@ class Renderer:
         spectral: bool = False,
         camera_to_display: bool = False,
         samples: int = 1,
+        lambert: bool = False,
+        env_occlusion: bool = True,
+        shadows: bool = True,
     ) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
     @property
     def scene(self) -> Scene: ...
@@ -185,6 +218,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: None = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
 ) -> RGBImage:
     """The CPU spectral path tracer's linear sRGB image (what `spectra truth` renders with the same
     options); with `crop=(x, y, w, h)` the crop's pixels, with the full render's samples.
@@ -192,7 +229,10 @@ def truth(
     same seed gives the same image. water / depth / rgb_medium / observer / camera_to_display as
     for `Renderer.render`.
     spectral_bin=NM: the tuple (image, bands float32 (h, w, B), band edges float64 (B + 1,))
-    (`--spectral-out`). size / range / crop may be tuples, lists or 1-D arrays; observer and
+    (`--spectral-out`). medium: a spectral participating medium, inline JSON or a JSON file
+    (`--medium`, docs/ground-truth.md; not with rgb_medium). lambert=True: a Lambertian BRDF
+    (`--lambert`). xyz=True: the image in CIE XYZ (the observer's tristimulus) instead of linear
+    sRGB (`--xyz`). table: a Jakob–Hanika .coeff table (`--table`). size / range / crop may be tuples, lists or 1-D arrays; observer and
     rgb_medium files str or os.PathLike; counts ints (bools and floats are refused). Ctrl-C
     raises KeyboardInterrupt within a fraction of a second (in a forked child too); the GIL is
     released."""
@@ -216,6 +256,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: float,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
 ) -> Tuple[RGBImage, _Bands, _Wavelengths]: ...
 @overload
 def truth(
@@ -236,6 +280,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
 ) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
 
 def diff(

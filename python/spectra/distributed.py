@@ -19,8 +19,8 @@ Otherwise ship the wheel with the job: `pip wheel ./python -w dist` and
 `ray.init(runtime_env={"py_modules": ["dist/spectra-….whl"]})` (or pass `runtime_env=` here
 when this call starts Ray). A scene given as a file is loaded again on each worker from the same
 path (absolute), so the file must be reachable there (a shared filesystem, or `working_dir`);
-so are an `observer=` or `rgb_medium=` file (and `eval`'s `table`), named absolutely for the
-workers whatever their working directory.
+so are an `observer=`, `rgb_medium=`, `medium=` or `table=` file (and `eval`'s `table`), named
+absolutely for the workers whatever their working directory.
 `eval` runs `spectra eval` with its ground truths rendered the same way (stored in its truth
 cache, the real-time renders and the report on this machine).
 
@@ -99,19 +99,24 @@ def _absolute(path: str) -> str:
 
 
 def _for_workers(options: Dict[str, Any]) -> Dict[str, Any]:
-    """`options` with the files they name (`observer=`, `rgb_medium=`) as absolute paths: a
-    Ray worker's working directory need not be this process's (another node, or this process
-    changed its own after Ray started). Names and inline JSON are left as they are; an
-    `os.PathLike` (`pathlib.Path`) becomes its str."""
+    """`options` with the files they name (`observer=`, `rgb_medium=`, `medium=`, `table=`) as
+    absolute paths: a Ray worker's working directory need not be this process's (another node,
+    or this process changed its own after Ray started). Names and inline JSON are left as they
+    are; an `os.PathLike` (`pathlib.Path`) becomes its str."""
     options = dict(options)
-    for key in ("observer", "rgb_medium"):
+    for key in ("observer", "rgb_medium", "medium", "table"):
         if isinstance(options.get(key), os.PathLike):
             options[key] = os.fspath(options[key])
-    observer, medium = options.get("observer"), options.get("rgb_medium")
+    observer = options.get("observer")
     if isinstance(observer, str) and _observer_file(observer):
         options["observer"] = _absolute(observer)
-    if isinstance(medium, str) and not medium.lstrip().startswith("{"):
-        options["rgb_medium"] = _absolute(medium)
+    for key in ("rgb_medium", "medium"):
+        medium = options.get(key)
+        if isinstance(medium, str) and not medium.lstrip().startswith("{"):
+            options[key] = _absolute(medium)
+    table = options.get("table")
+    if isinstance(table, str):
+        options["table"] = _absolute(table)
     return options
 
 
@@ -297,6 +302,10 @@ def submit(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
     chunks: Optional[int] = None,
     tiles: Sequence[int] = (1, 1),
     threads_per_task: int = 1,
@@ -327,6 +336,10 @@ def submit(
         rgb_medium=rgb_medium,
         spectral_bin=spectral_bin,
         camera_to_display=camera_to_display,
+        medium=medium,
+        lambert=lambert,
+        xyz=xyz,
+        table=table,
     )
     # Every argument checked here, before any task: the errors `spectra.truth` raises.
     plan = _spectra._truth_sums(scene, spp=spp, sample_offset=sample_offset, crop=crop, dry_run=True, **options)
@@ -360,6 +373,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: None = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
     chunks: Optional[int] = None,
     tiles: Sequence[int] = (1, 1),
     threads_per_task: int = 1,
@@ -387,6 +404,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: float,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
     chunks: Optional[int] = None,
     tiles: Sequence[int] = (1, 1),
     threads_per_task: int = 1,
@@ -414,6 +435,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
     chunks: Optional[int] = None,
     tiles: Sequence[int] = (1, 1),
     threads_per_task: int = 1,
@@ -440,6 +465,10 @@ def truth(
     rgb_medium: Optional[_Path] = None,
     spectral_bin: Optional[float] = None,
     camera_to_display: bool = False,
+    medium: Optional[_Path] = None,
+    lambert: bool = False,
+    xyz: bool = False,
+    table: Optional[_Path] = None,
     chunks: Optional[int] = None,
     tiles: Sequence[int] = (1, 1),
     threads_per_task: int = 1,
@@ -451,8 +480,9 @@ def truth(
     """`spectra.truth` split into `chunks` sample chunks × a `tiles=(nx, ny)` grid of tiles,
     each a Ray task, and merged: the same arguments (`sample_offset`, `crop`, `range`,
     `observer`, `white`, `max_depth`, `water`, `depth`, `rgb_medium`, `spectral_bin`,
-    `camera_to_display` as keywords) and the same result (an (h, w, 3) float32 linear sRGB array; with
-    `spectral_bin`, (image, bands, edges)). An `observer` or `rgb_medium` file given by a
+    `camera_to_display`, `medium`, `lambert`, `xyz`, `table` as keywords) and the same result
+    (an (h, w, 3) float32 linear sRGB array, CIE XYZ with `xyz=True`; with `spectral_bin`,
+    (image, bands, edges)). An `observer`, `rgb_medium`, `medium` or `table` file given by a
     relative path is found from this process's working directory, not the workers'.
 
     chunks: default 8, or `spp` when that is fewer (more than `spp` given explicitly is an
@@ -481,6 +511,10 @@ def truth(
         rgb_medium=rgb_medium,
         spectral_bin=spectral_bin,
         camera_to_display=camera_to_display,
+        medium=medium,
+        lambert=lambert,
+        xyz=xyz,
+        table=table,
         chunks=chunks,
         tiles=tiles,
         threads_per_task=threads_per_task,

@@ -323,23 +323,161 @@ fn load(
 
 /// The CLI's `LookArgs` with every default (`spectra render SCENE` without options).
 fn default_look() -> setup::LookArgs {
+    parse_look(vec!["render".into()]).expect("the render options have defaults")
+}
+
+/// `spectra render`'s picture options parsed from a command line (`["render", "--flag", …]`)
+/// by the CLI's own parser, so that its checks (the underwater model's flags that exclude one
+/// another) are the command's; a `ValueError` with clap's message, its flags spelt as the
+/// Python arguments, otherwise.
+fn parse_look(argv: Vec<String>) -> PyResult<setup::LookArgs> {
     use clap::Parser;
     #[derive(Parser)]
     struct Cli {
         #[command(flatten)]
         look: setup::LookArgs,
     }
-    Cli::try_parse_from(["render"]).expect("the render options have defaults").look
+    Cli::try_parse_from(argv).map(|c| c.look).map_err(|e| {
+        let text = e.render().to_string();
+        PyValueError::new_err(python_flags(text.trim_start_matches("error: ").lines().next().unwrap_or("")))
+    })
+}
+
+/// `Renderer`'s arguments for `spectra render`'s picture flags, as the CLI's messages name the
+/// flags: (flag, Python argument). Longer flags first, so that `--no-water-surface` is not
+/// taken for `--water-surface`.
+const PYTHON_FLAGS: &[(&str, &str)] = &[
+    ("--no-surface-irradiance", "surface_irradiance=False"),
+    ("--no-water-surface", "water_surface=False"),
+    ("--no-env-occlusion", "env_occlusion=False"),
+    ("--no-sea-floor", "sea_floor=False"),
+    ("--light-field-photons", "light_field_photons"),
+    ("--single-scattering", "single_scattering=True"),
+    ("--scalar-irradiance", "scalar_irradiance=True"),
+    ("--scatter-steps", "scatter_steps"),
+    ("--water-surface", "water_surface=True"),
+    ("--forward-cone", "forward_cone"),
+    ("--tabulated-kd", "tabulated_kd=True"),
+    ("--paper-model", "paper_model=True"),
+    ("--split-beams", "split_beams=True"),
+    ("--isotropic", "isotropic=True"),
+    ("--phase-g", "phase_g"),
+];
+
+/// A message of the CLI's about `Renderer`'s picture flags with each flag spelt as the Python
+/// argument that gives it (`--scatter-steps 33: …` → `scatter_steps 33: …`), clap's value names
+/// (` <STEPS>`) dropped. Other flags (`--water`, `--rgb-medium`) are left as they are.
+fn python_flags(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    'scan: while !rest.is_empty() {
+        if rest.starts_with("--") {
+            for (flag, arg) in PYTHON_FLAGS {
+                let ends =
+                    |r: &str| r.chars().next().is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '-'));
+                if let Some(after) = rest.strip_prefix(flag)
+                    && ends(after)
+                {
+                    out.push_str(arg);
+                    rest = after;
+                    // clap's value name after the flag: ` <STEPS>`.
+                    if let Some(v) = rest.strip_prefix(" <")
+                        && let Some(end) = v.find('>')
+                        && v[..end].chars().all(|c| c.is_ascii_uppercase() || c == '_')
+                    {
+                        rest = &v[end + 1..];
+                    }
+                    continue 'scan;
+                }
+            }
+        }
+        let c = rest.chars().next().expect("not empty");
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    out
+}
+
+/// `Renderer`'s medium and table options: `spectra render`'s flags of the same meaning
+/// (`surface_irradiance=False` is `--no-surface-irradiance`, `water_surface` True / False
+/// `--water-surface` / `--no-water-surface`, `sea_floor=False` `--no-sea-floor`).
+struct MediaOptions {
+    table: Option<PathBuf>,
+    scatter_steps: i128,
+    single_scattering: bool,
+    phase_g: f32,
+    paper_model: bool,
+    isotropic: bool,
+    tabulated_kd: bool,
+    surface_irradiance: bool,
+    forward_cone: f32,
+    light_field_photons: i128,
+    scalar_irradiance: bool,
+    split_beams: bool,
+    water_surface: Option<bool>,
+    sea_floor: bool,
+}
+
+impl MediaOptions {
+    /// The CLI's picture options with these given as its flags (a value equal to the CLI's
+    /// default is not given, so that it conflicts with nothing, as an absent flag), parsed by
+    /// the CLI's parser: the flags that exclude one another are refused as `spectra render`
+    /// refuses them. Ranges are checked by `LookArgs::media`, as for the command.
+    fn look(&self, water: setup::WaterArgs, rgb_medium: setup::RgbMediumArgs) -> PyResult<setup::LookArgs> {
+        let d = default_look();
+        let steps = whole("scatter_steps", self.scatter_steps, 0)?;
+        let photons = whole("light_field_photons", self.light_field_photons, 0)?;
+        let mut argv: Vec<String> = vec!["render".into()];
+        if steps != d.scatter_steps {
+            argv.push(format!("--scatter-steps={steps}"));
+        }
+        if self.phase_g.to_bits() != d.phase_g.to_bits() {
+            argv.push(format!("--phase-g={}", self.phase_g));
+        }
+        if self.forward_cone.to_bits() != d.forward_cone.to_bits() {
+            argv.push(format!("--forward-cone={}", self.forward_cone));
+        }
+        if photons as usize != d.light_field_photons {
+            argv.push(format!("--light-field-photons={photons}"));
+        }
+        for (on, flag) in [
+            (self.single_scattering, "--single-scattering"),
+            (self.paper_model, "--paper-model"),
+            (self.isotropic, "--isotropic"),
+            (self.tabulated_kd, "--tabulated-kd"),
+            (!self.surface_irradiance, "--no-surface-irradiance"),
+            (self.scalar_irradiance, "--scalar-irradiance"),
+            (self.split_beams, "--split-beams"),
+            (self.water_surface == Some(true), "--water-surface"),
+            (self.water_surface == Some(false), "--no-water-surface"),
+            (!self.sea_floor, "--no-sea-floor"),
+        ] {
+            if on {
+                argv.push(flag.into());
+            }
+        }
+        let mut look = parse_look(argv)?;
+        look.table = setup::TableArgs { table: self.table.clone() };
+        look.water = water;
+        look.rgb_medium = rgb_medium;
+        Ok(look)
+    }
+}
+
+/// The coefficient table: `table=` (a bad or missing file is the caller's: `ValueError` /
+/// `FileNotFoundError`, the message naming it as `--table` does), else the cached sRGB fit
+/// (which failing is a `RuntimeError`).
+fn load_table(table: Option<&std::path::Path>) -> Result<Arc<color::upsample::CoeffTable>, Fail> {
+    setup::load_table(table).map_err(|e| if table.is_some() { value(e) } else { runtime(e) })
 }
 
 struct Inner {
     renderer: render::Renderer,
     scene: Arc<scene::Scene>,
     size: (u32, u32),
-    /// The water and RGB medium options the renderer was made with (`render` resolves its
-    /// settings with them, as `spectra render` does).
-    water: setup::WaterArgs,
-    rgb_medium: setup::RgbMediumArgs,
+    /// The picture options the renderer was made with: water, RGB medium, table and the media
+    /// options (`render` resolves its settings with them, as `spectra render` does).
+    look: setup::LookArgs,
 }
 
 /// A (H, W, 3) float32 image, and with a spectral capture its (H, W, N) node radiances and the
@@ -348,6 +486,17 @@ type Frame = (Vec<f32>, Option<(Vec<f32>, Vec<f64>)>, (u32, u32));
 
 /// The real-time renderer (wgpu) for one scene at one size. It keeps its GPU device, pipelines
 /// and scene buffers between `render()` calls, so only the first call pays for them.
+///
+/// Renderer(scene, size=(640, 480), *, water=None, depth=None, rgb_medium=None, table=None,
+/// scatter_steps=16, single_scattering=False, phase_g=0.924, paper_model=False,
+/// isotropic=False, tabulated_kd=False, surface_irradiance=True, forward_cone=15.0,
+/// light_field_photons=8000, scalar_irradiance=False, split_beams=False, water_surface=None,
+/// sea_floor=True): the medium as `spectra render` sets it up (`water` a Jerlov type with the
+/// camera `depth` in metres, or `rgb_medium`, inline JSON or a file; by default the scene's
+/// own), `table` its `--table`, and the media options its flags of the same names, with its
+/// defaults (`surface_irradiance=False` is `--no-surface-irradiance`, `water_surface`
+/// True / False `--water-surface` / `--no-water-surface`, None the model's choice,
+/// `sea_floor=False` `--no-sea-floor`); flags it refuses together are refused together.
 #[pyclass(frozen, module = "spectra")]
 struct Renderer {
     inner: Mutex<Inner>,
@@ -364,11 +513,32 @@ impl Renderer {
     /// `size=(width, height)`. The medium is set up as `spectra render` sets it up: `water` (a
     /// Jerlov type, e.g. "IB") with the camera `depth` in metres, or `rgb_medium` (the
     /// `--rgb-medium` JSON or a JSON file); by default the scene's own.
+    ///
+    /// table: a Jakob–Hanika coefficient table (.coeff) to upsample with (`--table`; default the
+    /// cached sRGB fit). The media options are `spectra render`'s flags, with its defaults:
+    /// scatter_steps (`--scatter-steps`, 0–32, default 16), single_scattering
+    /// (`--single-scattering`), phase_g (`--phase-g`, default 0.924), paper_model
+    /// (`--paper-model`), isotropic (`--isotropic`), tabulated_kd (`--tabulated-kd`),
+    /// surface_irradiance (False: `--no-surface-irradiance`), forward_cone (`--forward-cone`,
+    /// degrees 0–45, default 15), light_field_photons (`--light-field-photons`, default 8000),
+    /// scalar_irradiance (`--scalar-irradiance`), split_beams (`--split-beams`), water_surface
+    /// (None: the model's default; True `--water-surface`, False `--no-water-surface`), sea_floor
+    /// (False: `--no-sea-floor`). Options that exclude one another on the command line (e.g.
+    /// paper_model with scatter_steps other than 16) are refused as it refuses them.
     #[new]
     // The text signatures spell the tuple defaults, which pyo3 would show as `...` (so that
     // `inspect.signature` bound defaults that cannot be passed back).
-    #[pyo3(signature = (scene, size = (640, 480), *, water = None, depth = None, rgb_medium = None),
-           text_signature = "(scene, size=(640, 480), *, water=None, depth=None, rgb_medium=None)")]
+    #[pyo3(signature = (scene, size = (640, 480), *, water = None, depth = None, rgb_medium = None, table = None,
+                        scatter_steps = 16, single_scattering = false, phase_g = 0.924, paper_model = false,
+                        isotropic = false, tabulated_kd = false, surface_irradiance = true, forward_cone = 15.0,
+                        light_field_photons = 8000, scalar_irradiance = false, split_beams = false,
+                        water_surface = None, sea_floor = true),
+           text_signature = "(scene, size=(640, 480), *, water=None, depth=None, rgb_medium=None, table=None, \
+                             scatter_steps=16, single_scattering=False, phase_g=0.924, paper_model=False, \
+                             isotropic=False, tabulated_kd=False, surface_irradiance=True, forward_cone=15.0, \
+                             light_field_photons=8000, scalar_irradiance=False, split_beams=False, \
+                             water_surface=None, sea_floor=True)")]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
@@ -376,21 +546,50 @@ impl Renderer {
         #[pyo3(from_py_with = args::water)] water: Option<String>,
         #[pyo3(from_py_with = args::depth)] depth: Option<f64>,
         #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
+        #[pyo3(from_py_with = args::table)] table: Option<PathBuf>,
+        #[pyo3(from_py_with = args::scatter_steps)] scatter_steps: i128,
+        #[pyo3(from_py_with = args::single_scattering)] single_scattering: bool,
+        #[pyo3(from_py_with = args::phase_g)] phase_g: f32,
+        #[pyo3(from_py_with = args::paper_model)] paper_model: bool,
+        #[pyo3(from_py_with = args::isotropic)] isotropic: bool,
+        #[pyo3(from_py_with = args::tabulated_kd)] tabulated_kd: bool,
+        #[pyo3(from_py_with = args::surface_irradiance)] surface_irradiance: bool,
+        #[pyo3(from_py_with = args::forward_cone)] forward_cone: f32,
+        #[pyo3(from_py_with = args::light_field_photons)] light_field_photons: i128,
+        #[pyo3(from_py_with = args::scalar_irradiance)] scalar_irradiance: bool,
+        #[pyo3(from_py_with = args::split_beams)] split_beams: bool,
+        #[pyo3(from_py_with = args::water_surface)] water_surface: Option<bool>,
+        #[pyo3(from_py_with = args::sea_floor)] sea_floor: bool,
     ) -> PyResult<Self> {
         let sc = scene_of(scene, "scene", water.is_some())?;
         let scene_obj: Py<Scene> = scene.extract()?;
         let (w, h) = size_arg(size)?;
-        let water = setup::WaterArgs { water, depth };
-        let rgb_medium = setup::RgbMediumArgs { rgb_medium };
+        let options = MediaOptions {
+            table,
+            scatter_steps,
+            single_scattering,
+            phase_g,
+            paper_model,
+            isotropic,
+            tabulated_kd,
+            surface_irradiance,
+            forward_cone,
+            light_field_photons,
+            scalar_irradiance,
+            split_beams,
+            water_surface,
+            sea_floor,
+        };
+        let look = options.look(setup::WaterArgs { water, depth }, setup::RgbMediumArgs { rgb_medium })?;
         let s = sc.clone();
-        let (wa, ra) = (water.clone(), rgb_medium.clone());
+        let l = look.clone();
         let renderer = py.detach(move || -> Result<render::Renderer, Fail> {
-            let mut look = default_look();
-            look.water = wa;
-            look.rgb_medium = ra;
-            let table = look.table.load().map_err(runtime)?;
-            let media = look.media(&s, &table).map_err(value)?;
-            let custom = media.shader().map_err(value)?;
+            let look = l;
+            let table = load_table(look.table.table.as_deref())?;
+            // The media options' messages name the Python arguments (`scatter_steps 33: …`).
+            let named = |e: anyhow::Error| value(anyhow::anyhow!(python_flags(&format!("{e:#}"))));
+            let media = look.media(&s, &table).map_err(named)?;
+            let custom = media.shader().map_err(named)?;
             let mut r = render::Renderer::with_table(table).map_err(runtime)?;
             r.set_scene(&s).map_err(runtime)?;
             for w in r.scene_warnings() {
@@ -404,7 +603,7 @@ impl Renderer {
         })?;
         let device = renderer.gpu().describe();
         Ok(Renderer {
-            inner: Mutex::new(Inner { renderer, scene: sc, size: (w, h), water, rgb_medium }),
+            inner: Mutex::new(Inner { renderer, scene: sc, size: (w, h), look }),
             scene: scene_obj,
             size: (w, h),
             device,
@@ -433,12 +632,16 @@ impl Renderer {
     /// samples: antialiasing, the mean of this many frames each looking at another place in
     /// every pixel (`spectra render --samples`): the image box-filtered over each pixel, as the
     /// path tracer's are; 1–256, default 1 (the pixel centres). Not with spectral=True.
+    /// lambert: every surface reflects base colour / π, no specular (`--lambert`, like
+    /// `truth(lambert=True)`). env_occlusion: the screen-space occlusion of ambient light (False:
+    /// `--no-env-occlusion`). shadows: shadow maps (False: `--no-shadows`).
     #[pyo3(signature = (mode = "spectral".to_string(), *, wavelengths = None, quadrature = "prefiltered".to_string(),
                         range = None, observer = None, white = None, exposure = 0.0, spectral = false,
-                        camera_to_display = false, samples = 1),
+                        camera_to_display = false, samples = 1, lambert = false, env_occlusion = true,
+                        shadows = true),
            text_signature = "($self, mode='spectral', *, wavelengths=None, quadrature='prefiltered', range=None, \
                              observer=None, white=None, exposure=0.0, spectral=False, camera_to_display=False, \
-                             samples=1)")]
+                             samples=1, lambert=False, env_occlusion=True, shadows=True)")]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -453,6 +656,9 @@ impl Renderer {
         #[pyo3(from_py_with = args::spectral)] spectral: bool,
         #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
         #[pyo3(from_py_with = args::samples)] samples: i128,
+        #[pyo3(from_py_with = args::lambert)] lambert: bool,
+        #[pyo3(from_py_with = args::env_occlusion)] env_occlusion: bool,
+        #[pyo3(from_py_with = args::shadows)] shadows: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let max = spectra::cmd::render::MAX_SAMPLES;
         let samples = match u32::try_from(samples) {
@@ -483,12 +689,15 @@ impl Renderer {
             .map_err(|e| PyValueError::new_err(format!("--quadrature '{quadrature}': {e}")))?;
         look.spectrum = setup::SpectrumArgs { range: range_arg(range)?, observer, white, camera_to_display };
         look.exposure = exposure;
+        look.lambert = lambert;
+        look.no_env_occlusion = !env_occlusion;
         let (data, capture, (w, h)) = py.detach(|| -> Result<Frame, Fail> {
             let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
             let inner = &mut *g;
-            look.water = inner.water.clone();
-            look.rgb_medium = inner.rgb_medium.clone();
-            let settings = look.settings(&inner.scene, true, false).map_err(value)?;
+            look.water = inner.look.water.clone();
+            look.rgb_medium = inner.look.rgb_medium.clone();
+            look.table = inner.look.table.clone();
+            let settings = look.settings(&inner.scene, shadows, false).map_err(value)?;
             let (w, h) = inner.size;
             if spectral {
                 if settings.mode == render::Mode::Rgb {
@@ -567,6 +776,12 @@ struct TruthArgs {
     water: setup::WaterArgs,
     rgb_medium: setup::RgbMediumArgs,
     spectral_bin: Option<f64>,
+    /// `--medium`: a spectral medium, JSON inline or a file.
+    medium: Option<String>,
+    lambert: bool,
+    /// `--xyz`: the image is CIE XYZ (the observer's tristimulus), not linear sRGB.
+    xyz: bool,
+    table: Option<PathBuf>,
 }
 
 impl TruthArgs {
@@ -588,8 +803,18 @@ impl TruthArgs {
         rgb_medium: Option<String>,
         spectral_bin: Option<f64>,
         camera_to_display: bool,
+        medium: Option<String>,
+        lambert: bool,
+        xyz: bool,
+        table: Option<PathBuf>,
     ) -> PyResult<Self> {
         let spp = whole("spp", spp, 1)?;
+        // `--medium` conflicts with `--rgb-medium` on the command line (clap refuses the pair).
+        if medium.is_some() && rgb_medium.is_some() {
+            return Err(PyValueError::new_err(
+                "medium cannot be used with rgb_medium: pick one medium (as --medium cannot be used with --rgb-medium)",
+            ));
+        }
         let size = size_arg(size)?;
         // Python's integers are unbounded: every count is taken as i128 so that one too large
         // for the machine is refused naming its argument (not an OverflowError naming none),
@@ -625,6 +850,10 @@ impl TruthArgs {
             water: setup::WaterArgs { water, depth },
             rgb_medium: setup::RgbMediumArgs { rgb_medium },
             spectral_bin,
+            medium,
+            lambert,
+            xyz,
+            table,
         })
     }
 
@@ -654,6 +883,10 @@ impl TruthArgs {
         a.spectrum = self.spectrum.clone();
         a.water = self.water.clone();
         a.rgb_medium = self.rgb_medium.clone();
+        a.medium = self.medium.clone();
+        a.lambert = self.lambert;
+        a.xyz = self.xyz;
+        a.table = setup::TableArgs { table: self.table.clone() };
         if let Some(bin) = self.spectral_bin {
             a.spectral_bands = true;
             a.spectral_bin = bin;
@@ -668,7 +901,7 @@ impl TruthArgs {
         sc: &scene::Scene,
         cancel: &AtomicBool,
     ) -> Result<(truth::Settings, truth::Accumulator), Fail> {
-        let table = setup::load_table(None).map_err(runtime)?;
+        let table = load_table(self.table.as_deref())?;
         let st = self.settings(sc, &table).map_err(value)?;
         let mut world =
             truth::World::new(sc, table.as_ref(), &st.white, st.range, st.medium.as_ref()).map_err(value)?;
@@ -772,16 +1005,24 @@ fn finish(
 /// spectral_bin: also bin the radiance by wavelength, in bins of this many nm over the range
 /// (`--spectral-out` with `--spectral-bin`): returns (image, bands of shape (h, w, B) float32,
 /// band edges of shape (B + 1,) float64, nm).
+/// medium: a homogeneous spectral participating medium, inline JSON ('{…}') or a JSON file
+/// (`--medium`: keys sigma_a, sigma_s, phase, box; docs/ground-truth.md); not with rgb_medium.
+/// lambert: a Lambertian BRDF instead of glTF's (`--lambert`). xyz: the image in CIE XYZ (the
+/// observer's tristimulus, Y = 1 for the white) instead of linear sRGB (`--xyz`). table: the
+/// Jakob–Hanika coefficient table (.coeff) to upsample with (`--table`; default the cached
+/// sRGB fit).
 ///
 /// Ctrl-C interrupts it (KeyboardInterrupt) within a fraction of a second, wherever it runs
 /// (a forked child, a Ray task: `interruptible`).
 #[pyfunction(name = "truth")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
-                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false),
+                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false, medium = None,
+                    lambert = false, xyz = false, table = None),
        text_signature = "(scene, spp=64, size=(256, 256), direct_only=False, seed=0, *, sample_offset=0, \
                          crop=None, range=None, observer=None, white=None, max_depth=1024, water=None, \
-                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False)")]
+                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False, medium=None, \
+                         lambert=False, xyz=False, table=None)")]
 #[allow(clippy::too_many_arguments)]
 fn truth_image<'py>(
     py: Python<'py>,
@@ -801,6 +1042,10 @@ fn truth_image<'py>(
     #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
     #[pyo3(from_py_with = args::spectral_bin)] spectral_bin: Option<f64>,
     #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
+    #[pyo3(from_py_with = args::medium)] medium: Option<String>,
+    #[pyo3(from_py_with = args::lambert)] lambert: bool,
+    #[pyo3(from_py_with = args::xyz)] xyz: bool,
+    #[pyo3(from_py_with = args::table)] table: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let sc = scene_of(scene, "scene", water.is_some())?;
     let a = TruthArgs::new(
@@ -819,12 +1064,17 @@ fn truth_image<'py>(
         rgb_medium,
         spectral_bin,
         camera_to_display,
+        medium,
+        lambert,
+        xyz,
+        table,
     )?;
     let view = color::film::CameraView::from_flag(camera_to_display);
     let (rgb, bands, edges, (w, h)) = py.detach(move || -> Result<_, Fail> {
         let (st, acc) = interruptible(|cancel| fork_safe(|| a.run(&sc, cancel)))?;
         let win = st.window();
-        let display = st.display_matrix(view).map_err(value)?;
+        // `--xyz` writes the tracer's XYZ as it is (`XyzImage::xyz`): the identity here.
+        let display = if xyz { glam::DMat3::IDENTITY } else { st.display_matrix(view).map_err(value)? };
         let (rgb, bands) = finish(win.width, win.height, &acc.xyz, &acc.bins, st.spp, display);
         Ok((rgb, bands, st.spectral_bands, (win.width, win.height)))
     })?;
@@ -850,12 +1100,12 @@ fn truth_image<'py>(
 #[pyfunction(name = "_truth_sums")]
 #[pyo3(signature = (scene, spp = 64, size = (256, 256), direct_only = false, seed = 0, *, sample_offset = 0,
                     crop = None, range = None, observer = None, white = None, max_depth = 1024, water = None,
-                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false, threads = None,
-                    dry_run = false),
+                    depth = None, rgb_medium = None, spectral_bin = None, camera_to_display = false, medium = None,
+                    lambert = false, xyz = false, table = None, threads = None, dry_run = false),
        text_signature = "(scene, spp=64, size=(256, 256), direct_only=False, seed=0, *, sample_offset=0, \
                          crop=None, range=None, observer=None, white=None, max_depth=1024, water=None, \
-                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False, \
-                         threads=None, dry_run=False)")]
+                         depth=None, rgb_medium=None, spectral_bin=None, camera_to_display=False, medium=None, \
+                         lambert=False, xyz=False, table=None, threads=None, dry_run=False)")]
 #[allow(clippy::too_many_arguments)]
 fn truth_sums<'py>(
     py: Python<'py>,
@@ -875,6 +1125,10 @@ fn truth_sums<'py>(
     #[pyo3(from_py_with = args::rgb_medium)] rgb_medium: Option<String>,
     #[pyo3(from_py_with = args::spectral_bin)] spectral_bin: Option<f64>,
     #[pyo3(from_py_with = args::camera_to_display)] camera_to_display: bool,
+    #[pyo3(from_py_with = args::medium)] medium: Option<String>,
+    #[pyo3(from_py_with = args::lambert)] lambert: bool,
+    #[pyo3(from_py_with = args::xyz)] xyz: bool,
+    #[pyo3(from_py_with = args::table)] table: Option<PathBuf>,
     #[pyo3(from_py_with = args::threads)] threads: Option<i128>,
     #[pyo3(from_py_with = args::dry_run)] dry_run: bool,
 ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
@@ -895,12 +1149,16 @@ fn truth_sums<'py>(
         rgb_medium,
         spectral_bin,
         camera_to_display,
+        medium,
+        lambert,
+        xyz,
+        table,
     )?;
     let threads = threads.map(|t| whole("threads", t, 1)).transpose()?;
     let d = pyo3::types::PyDict::new(py);
     let st = if dry_run {
         py.detach(|| -> Result<_, Fail> {
-            let table = setup::load_table(None).map_err(runtime)?;
+            let table = load_table(a.table.as_deref())?;
             let st = a.settings(&sc, &table).map_err(value)?;
             // What `run` refuses before its first sample (an environment under water, a
             // medium the scene cannot hold), refused here too: `distributed.submit` checks
@@ -942,9 +1200,13 @@ fn truth_sums<'py>(
     }
     d.set_item("window", (win.x, win.y, win.width, win.height))?;
     d.set_item("spp", st.spp)?;
-    // What `_truth_finish` turns the sums into linear sRGB with (`color::film`), row-major.
-    let m =
-        st.display_matrix(color::film::CameraView::from_flag(camera_to_display)).map_err(value)?.transpose();
+    // What `_truth_finish` turns the sums into linear sRGB with (`color::film`), row-major; with
+    // `xyz`, the identity (the sums' XYZ as it is).
+    let m = if xyz {
+        glam::DMat3::IDENTITY
+    } else {
+        st.display_matrix(color::film::CameraView::from_flag(camera_to_display)).map_err(value)?.transpose()
+    };
     d.set_item("display", m.to_cols_array().to_vec())?;
     Ok(d)
 }

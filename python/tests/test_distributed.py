@@ -298,3 +298,31 @@ def test_truth_agrees_with_spectra_truth_on_arguments(local_ray):
     one = spectra.truth(scene, size=(8, 6), **kw)
     assert relative(dist.truth(scene, size=[8, 6], chunks=2, progress=False, **kw), one).max() <= 1e-6
 
+
+
+def test_medium_lambert_xyz_and_table_as_tasks(local_ray, tmp_path, monkeypatch):
+    """The CLI-parity options of `spectra.truth` (`medium`, `lambert`, `xyz`, `table`) travel to
+    the tasks: the merged image is the single-process one (XYZ with `xyz=True`), and relative
+    `medium` / `table` files are the driver's."""
+    import subprocess
+
+    from test_spectra import spectra_bin
+
+    subprocess.run(
+        [spectra_bin(), "lut", "--res", "8", "--no-refine", "--check", "0", "--out", str(tmp_path / "t8.coeff")],
+        check=True,
+        capture_output=True,
+    )
+    (tmp_path / "fog.json").write_text('{"sigma_a": 0.05, "sigma_s": 0.2, "phase": {"hg": 0.3}}')
+    monkeypatch.chdir(tmp_path)
+    scene = spectra.load("cornell")
+    kw = dict(spp=2, size=(12, 8), seed=3, medium="fog.json", lambert=True, xyz=True, table="t8.coeff")
+    one = spectra.truth(scene, **kw)
+    assert not np.array_equal(one, spectra.truth(scene, spp=2, size=(12, 8), seed=3))
+    assert relative(dist.truth(scene, chunks=2, progress=False, **kw), one).max() <= 1e-6
+    files = dist._for_workers(dict(medium="fog.json", table="t8.coeff"))
+    assert files == dict(medium=str(tmp_path / "fog.json"), table=str(tmp_path / "t8.coeff"))
+    inline = '{"sigma_a": 0.1, "sigma_s": 0}'
+    assert dist._for_workers(dict(medium=inline)) == dict(medium=inline)
+    with pytest.raises(ValueError, match="^medium cannot be used with rgb_medium"):
+        dist.truth(scene, spp=2, medium="fog.json", rgb_medium='{"absorption": [1, 1, 1]}')
