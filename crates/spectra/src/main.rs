@@ -122,6 +122,40 @@ fn quiet_runtime_dir(headless: bool) -> Option<tempfile::TempDir> {
     Some(dir)
 }
 
+/// `println!` and `eprintln!` panic when their stream cannot be written (standard output on a
+/// full disk or `/dev/full`; a closed pipe already ends the process, see `main`): the payload
+/// names the stream and the cause. Such a panic is an error like any other, one line and exit
+/// status 1, not a panic report and 101.
+fn print_failure(payload: &(dyn std::any::Any + Send)) -> Option<String> {
+    let text = payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied())?;
+    print_failure_text(text)
+}
+
+fn print_failure_text(text: &str) -> Option<String> {
+    let rest = text.strip_prefix("failed printing to ")?;
+    let (stream, cause) = rest.split_once(": ").unwrap_or((rest, "unknown cause"));
+    let stream = match stream {
+        "stdout" => "standard output",
+        "stderr" => "standard error",
+        other => other,
+    };
+    Some(format!("cannot write to {stream}: {cause}"))
+}
+
+/// Keeps the default panic report for real panics and leaves a stream's write failure to
+/// [`print_failure`].
+fn install_print_failure_hook() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if info.payload_as_str().and_then(print_failure_text).is_none() {
+            default(info);
+        }
+    }));
+}
+
 fn main() {
     let cli = Cli::parse();
     #[cfg(feature = "viewer")]
@@ -143,7 +177,8 @@ fn main() {
         Command::Eval(_) => "results.json and index.html not written",
         _ => "no output written",
     };
-    let result: anyhow::Result<()> = match cli.command {
+    install_print_failure_hook();
+    let run = std::panic::AssertUnwindSafe(|| match cli.command {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Render(a) => cmd::render::run(a),
         Command::Diff(a) => cmd::diff::run(a),
@@ -156,6 +191,13 @@ fn main() {
         Command::View(a) => cmd::view::run(a),
         Command::Bench(a) => cmd::bench::run(a),
         Command::Eval(a) => cmd::eval::run(a),
+    });
+    let result: anyhow::Result<()> = match std::panic::catch_unwind(run) {
+        Ok(r) => r,
+        Err(payload) => match print_failure(payload.as_ref()) {
+            Some(what) => Err(anyhow::anyhow!("{what}")),
+            None => std::panic::resume_unwind(payload),
+        },
     };
     let code = match result {
         Ok(()) => 0,
@@ -170,7 +212,9 @@ fn main() {
         }
         Err(e) => {
             // `{:#}` prints the whole context chain on one line: "reading x.coeff: file is truncated".
-            eprintln!("error: {e:#}");
+            // Not `eprintln!`: standard error may be the stream that failed.
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "error: {e:#}");
             1
         }
     };

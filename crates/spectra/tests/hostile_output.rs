@@ -174,6 +174,30 @@ fn a_closed_stdout_ends_quietly() {
     assert!(out.status.success() || out.status.signal() == Some(libc::SIGPIPE), "{:?}: {err}", out.status);
 }
 
+/// Standard output that cannot be written (a full disk; `/dev/full` here): one error line and
+/// exit status 1, as for any other failure, where `println!` panicked (status 101).
+#[test]
+fn an_unwritable_stdout_is_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = two_images(dir.path());
+    for args in [
+        vec!["diff", a.as_str(), b.as_str()],
+        vec!["diff", a.as_str(), b.as_str(), "--json"],
+        vec!["observers"],
+    ] {
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").expect("/dev/full");
+        let out = Command::new(env!("CARGO_BIN_EXE_spectra")).args(&args).stdout(full).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_eq!(
+            err.trim_end().lines().collect::<Vec<_>>(),
+            ["error: cannot write to standard output: No space left on device (os error 28)"],
+            "{args:?}"
+        );
+    }
+}
+
 /// Outputs that would destroy an input, another output of the same command, or something that
 /// is not a regular file (issue 29) are refused before any work, naming both flags; the inputs
 /// are left as they were.
