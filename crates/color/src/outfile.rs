@@ -68,10 +68,9 @@ pub fn check_writable(path: &Path) -> io::Result<()> {
     let dir = parent_dir(path);
     file_name(path)?;
     if !dir.is_dir() {
-        return Err(io::Error::new(
-            io::ErrorKind::NotFound,
-            format!("directory {} does not exist", dir.display()),
-        ));
+        // Where the parent is a file, saying it does not exist sent users looking for it.
+        let why = if dir.exists() { "is a file, not a directory" } else { "does not exist" };
+        return Err(io::Error::new(io::ErrorKind::NotFound, format!("directory {} {why}", dir.display())));
     }
     if path.is_dir() {
         return Err(io::Error::new(io::ErrorKind::IsADirectory, "is a directory"));
@@ -194,10 +193,9 @@ pub fn write_atomic_with(
     let dir = parent_dir(path);
     let name = file_name(path)?;
     if !dir.is_dir() {
-        return Err(io::Error::new(
-            io::ErrorKind::NotFound,
-            format!("directory {} does not exist", dir.display()),
-        ));
+        // Where the parent is a file, saying it does not exist sent users looking for it.
+        let why = if dir.exists() { "is a file, not a directory" } else { "does not exist" };
+        return Err(io::Error::new(io::ErrorKind::NotFound, format!("directory {} {why}", dir.display())));
     }
     remove_stale_temps(dir, &name);
     let mut builder = tempfile::Builder::new();

@@ -130,6 +130,20 @@ fn absurd_settings_are_refused_before_rendering() {
         "9007199254740991",
     ];
     refused(&late, &["--sample-offset"]);
+    // A legal --out whose checkpoint name is not (found by a sweep: Ctrl-C lost every sample).
+    let long = d.join(format!("{}.exr", "b".repeat(247)));
+    let long = long.to_str().unwrap();
+    refused(
+        &["truth", "cornell", "--spp", "1", "--size", "8x8", "--out", long],
+        &["checkpoint", "262 bytes", "--checkpoint-every 0"],
+    );
+    // A parent that is a file, not "a directory that does not exist".
+    let file = d.join("m.json");
+    let under = file.join("t.exr");
+    refused(
+        &with(&["truth", "cornell", "--spp", "1", "--size", "8x8"], &["--out", under.to_str().unwrap()]),
+        &["is a file, not a directory"],
+    );
     let render = ["render", "cornell", "--size", "8x8", "--out", o];
     refused(&with(&render, &["--exposure", "1000"]), &["--exposure 1000", "±64"]);
     refused(&with(&render, &["--env", "default", "--env-intensity", "-1"]), &["--env-intensity", "-1"]);

@@ -462,6 +462,17 @@ pub fn run(a: Args) -> Result<()> {
     }
     if let Some(out) = &a.out {
         let ckpt = super::checkpoint::path_for(out);
+        // A legal --out whose checkpoint's name is not (245–255 bytes): every checkpoint would
+        // fail, and Ctrl-C lose every sample.
+        let ckpt_len = ckpt.file_name().map_or(0, |n| n.len());
+        if every != 0.0 && ckpt_len > color::outfile::NAME_MAX {
+            bail!(
+                "--out {}: its checkpoint's name (--out's + .checkpoint) would be {ckpt_len} bytes, past the {} \
+                 file systems allow; shorten the name, or give --checkpoint-every 0",
+                out.display(),
+                color::outfile::NAME_MAX
+            );
+        }
         // The cache is a folder made on first use: the same path as an output or the checkpoint
         // would end a long render in "is a directory" (or leave a folder where the next run
         // looks for an interrupted render's checkpoint).
