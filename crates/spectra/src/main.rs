@@ -150,7 +150,7 @@ fn print_failure_text(text: &str) -> Option<String> {
 fn install_print_failure_hook() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if info.payload_as_str().and_then(print_failure_text).is_none() {
+        if print_failure(info.payload()).is_none() {
             default(info);
         }
     }));
