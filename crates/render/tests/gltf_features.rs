@@ -884,6 +884,59 @@ fn a_measured_emission_spectrum_colours_its_surface_in_every_mode() {
     }
 }
 
+/// Emission is one-sided, towards the vertex normals, as in the path tracer: the back of a
+/// double-sided lamp is black in every mode and loop (it glowed at full strength, found by a
+/// sweep), whether its emission is fetched from the G-buffer, the material's constant or a
+/// measured spectrum; its front still glows.
+#[test]
+fn a_double_sided_emitter_is_dark_from_behind_in_every_mode() {
+    let rects: [Rect; 3] = [(-2.0, -0.8, -1.0, 1.0), (-0.6, 0.6, -1.0, 1.0), (0.8, 2.0, -1.0, 1.0)];
+    let mut materials = vec![
+        material("constant", Vec4::ONE),
+        material("textured", Vec4::ONE),
+        material("measured", Vec4::ONE),
+    ];
+    for m in &mut materials {
+        m.double_sided = true;
+        m.emissive = Vec3::splat(0.7);
+        m.base_color = Vec4::new(0.0, 0.0, 0.0, 1.0);
+    }
+    materials[1].emissive_texture = Some(scene::TextureRef::new(0));
+    materials[2].emission_spectrum = Some(color::illuminant::by_name("A").unwrap());
+    let (w, h) = (48, 24);
+    let cam = top_camera(Vec2::ZERO, 1.1);
+    for facing_up in [false, true] {
+        let meshes: Vec<Mesh> = rects.iter().enumerate().map(|(i, r)| quad(*r, 0.0, facing_up, i)).collect();
+        let s = scene(meshes, materials.clone(), vec![texture_2x2(nearest(Wrap::ClampToEdge))], vec![]);
+        for (mode, n) in [(Mode::Rgb, 16), (Mode::Spectral, 8), (Mode::Naive, 16)] {
+            for capture in [false, true] {
+                if capture && mode == Mode::Rgb {
+                    continue;
+                }
+                let mut r = renderer();
+                r.set_scene(&s).unwrap();
+                r.resize(w, h).unwrap();
+                r.set_spectral_capture(capture);
+                let settings = RenderSettings { mode, wavelengths: n, shadows: false, ..Default::default() };
+                r.render(&cam, &settings).unwrap();
+                let px: Vec<[f64; 3]> = r.read_hdr().unwrap().iter().map(rgb_of).collect();
+                // The middle row crosses all three quads.
+                let row = &px[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
+                let lit = row.iter().filter(|p| p.iter().any(|&c| c > 0.05)).count();
+                let brightest = px.iter().flatten().fold(0.0f64, |a, &c| a.max(c));
+                if facing_up {
+                    assert!(
+                        lit > w as usize / 2,
+                        "{mode:?} {n} capture {capture}: the front glows ({lit} of {w})"
+                    );
+                } else {
+                    assert_eq!(brightest, 0.0, "{mode:?} {n} capture {capture}: the back is dark");
+                }
+            }
+        }
+    }
+}
+
 /// A mesh of no triangles (a scene built in code; the glTF loader skips them) draws nothing:
 /// alone it made the upload name a vertex buffer that was never made (a panic).
 #[test]

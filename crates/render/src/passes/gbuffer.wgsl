@@ -54,7 +54,7 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     let base = textureSampleBias(base_color_tex, base_color_smp, material_uv(TEX_BASE, v.uv, v.uv1), frame.lod_bias)
         * material.base_color * v.color;
     let mr = textureSampleBias(metal_rough_tex, metal_rough_smp, material_uv(TEX_METAL_ROUGH, v.uv, v.uv1), frame.lod_bias);
-    let emissive = textureSampleBias(emissive_tex, emissive_smp, material_uv(TEX_EMISSIVE, v.uv, v.uv1), frame.lod_bias).rgb
+    var emissive = textureSampleBias(emissive_tex, emissive_smp, material_uv(TEX_EMISSIVE, v.uv, v.uv1), frame.lod_bias).rgb
         * material.emissive.rgb;
     let tn_sample = textureSampleBias(normal_tex, normal_smp, material_uv(TEX_NORMAL, v.uv, v.uv1), frame.lod_bias).xyz;
     let occlusion = textureSampleBias(occlusion_tex, occlusion_smp, material_uv(TEX_OCCLUSION, v.uv, v.uv1), frame.lod_bias).r;
@@ -71,6 +71,15 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
         var tn = tn_sample * 2.0 - 1.0;
         tn = vec3<f32>(tn.xy * material.emissive.w, tn.z);
         n = normalize(t * tn.x + b * tn.y + n * tn.z);
+    }
+    // Emission is one-sided, towards the vertex normals, as the path tracer's and the polygon
+    // lights' (docs/environment.md): the back of a double-sided lamp glowed here and was black
+    // there. Only emissive materials (uniform per draw) compute the side.
+    if (any(material.emissive.rgb > vec3<f32>(0.0))) {
+        let p = world_from_depth(v.clip.xy, v.clip.z, frame);
+        if (dot(v.normal, view_origin(v.clip.xy, p, frame) - p) <= 0.0) {
+            emissive = vec3<f32>(0.0);
+        }
     }
     var o: GBufferOut;
     o.base = vec4<f32>(base.rgb, clamp(material.params.x * mr.b, 0.0, 1.0));

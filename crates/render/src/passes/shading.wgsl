@@ -626,6 +626,14 @@ struct MeasuredEmission {
     value: vec3<f32>,
 };
 
+// Whether a surface of constant emission `size` (any measure of it: the material's own value)
+// is seen from its emitting side: the G-buffer writes zero emission on its back (one-sided, as
+// the path tracer's), and the constant's value comes from the material, not the G-buffer. An
+// emission too small for f16 (its smallest subnormal) cannot say, and counts as seen.
+fn emitter_seen(gbuffer_emission: vec3<f32>, size: f32) -> bool {
+    return max(gbuffer_emission.r, max(gbuffer_emission.g, gbuffer_emission.b)) > 0.0 || size < 1e-7;
+}
+
 fn measured_emission(px: vec2<i32>, emission: vec3<f32>) -> MeasuredEmission {
     if (!HAS_EMISSION_SPECTRA) {
         return MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
@@ -634,8 +642,9 @@ fn measured_emission(px: vec2<i32>, emission: vec3<f32>) -> MeasuredEmission {
     if (m.emission.w > -1.5) {
         return MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
     }
-    // A constant emission's own luminance (x ≥ 0), exact where the G-buffer's f16 is not.
-    let k = select(dot(emission, SRGB_Y), m.emission.x, m.emission.x >= 0.0);
+    // A constant emission's own luminance (x ≥ 0), exact where the G-buffer's f16 is not; none
+    // where the G-buffer says the surface is seen from behind (`emitter_seen`).
+    let k = select(dot(emission, SRGB_Y), select(0.0, m.emission.x, emitter_seen(emission, m.emission.x)), m.emission.x >= 0.0);
     return MeasuredEmission(true, k, u32(m.emission_xyz.w), m.emission_xyz.xyz * k);
 }
 
@@ -720,7 +729,9 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
     let base_known = !FETCH_BASE || m.base.w != 0.0;
     let reflected = frame.n_lights * frame.n_groups + index * reflected_stride();
     var base = m.base.xyz;
-    var emission = select(vec4<f32>(0.0), m.emission, m.emission.w >= 0.0);
+    // A constant emission (w = its scale ≥ 0) where the surface is seen from its emitting side.
+    let em_seen = emitter_seen(s.emission, m.emission.w);
+    var emission = select(vec4<f32>(0.0), m.emission, m.emission.w >= 0.0 && em_seen);
     // A scene whose colours are all constant has no fetch compiled in.
     if (FETCH_BASE || (HAS_EMISSION && FETCH_EMISSION)) {
         let base_known = m.base.w != 0.0;
@@ -741,7 +752,7 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
         return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected);
     }
     let known = m.emission.w >= 0.0;
-    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known), base_known, reflected);
+    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known && em_seen), base_known, reflected);
 }
 
 // Spectral and naive modes.
