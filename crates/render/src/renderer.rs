@@ -366,6 +366,20 @@ impl Renderer {
                 self.sun = Some(state);
                 Some(e.without_sun(&s))
             }
+            (Some(_), Some(gs)) => {
+                // Said, not silent: the sun stays in the map, lit unshadowed.
+                let why = format!(
+                    "the environment's sun is lit as part of the map, unshadowed: the scene's {} light(s) and {} \
+                     emissive area light(s) fill the real-time renderer's {} light slots",
+                    gs.lights.len(),
+                    gs.emitters.len(),
+                    crate::scene_gpu::MAX_LIGHTS
+                );
+                if !gs.warnings.contains(&why) {
+                    gs.warnings.push(why);
+                }
+                None
+            }
             _ => None,
         };
         self.environment = GpuEnvironment::new(&self.gpu.device, &self.gpu.queue, rest.as_ref().or(env));

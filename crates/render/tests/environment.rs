@@ -375,6 +375,27 @@ fn an_environment_sun_becomes_a_directional_light_and_keeps_the_energy() {
     let (turned, _) = r.environment_sun().unwrap();
     let want = Vec3::new(-towards.z, towards.y, towards.x);
     assert!((turned - want).length() < 1e-4, "{turned} vs {want}");
+    assert!(r.scene_warnings().is_empty(), "{:?}", r.scene_warnings());
+    // A scene whose own lights fill every slot keeps the sun in the map, and says so (it was
+    // silent: the sun's shadow vanished between 31 and 32 lights).
+    let mut full = scene.clone();
+    full.lights = (0..render::scene_gpu::MAX_LIGHTS)
+        .map(|i| scene::Light {
+            name: format!("lamp {i}"),
+            kind: scene::LightKind::Point { position: Vec3::new(0.0, 5.0 + i as f32, 0.0), range: None },
+            emission: scene::Emission { rgb: Vec3::ONE, intensity: 1e-3, spectrum: None },
+            stands_in_for: None,
+        })
+        .collect();
+    let mut r3 = renderer();
+    r3.set_scene(&full).unwrap();
+    r3.set_environment(full.environment.as_ref());
+    assert!(r3.environment_sun().is_none());
+    let w = r3.scene_warnings();
+    assert!(
+        w.len() == 1 && w[0].contains("sun is lit as part of the map") && w[0].contains("32 light"),
+        "{w:?}"
+    );
 }
 
 /// A mirror shows the sun at the sun's own radiance: a smooth metal floor (roughness 0, white,

@@ -290,8 +290,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Some((n, polygons, _)) if n > 0 && n == polygons => format!("{under}, {n} emissive polygon light(s)"),
         Some((n, polygons, frac)) if frac > 0.0 => format!(
             "{under}, {n} emissive area lights for {polygons} emitting polygons (warning: {:.1} % of the emitted \
-             power left out: more emitting materials than lights)",
-            100.0 * frac
+             power left out: {})",
+            100.0 * frac,
+            // The scene's own lights come first: with none left over, the emitters got no slot.
+            if n == 0 {
+                "the scene's lights fill the real-time renderer's light slots"
+            } else {
+                "more emitting materials than light slots left"
+            }
         ),
         Some((n, polygons, _)) if n > 0 => format!(
             "{under}, {n} emissive area lights: {polygons} emitting polygons clustered, all of their power \
