@@ -358,6 +358,15 @@ fn eval_keeps_files_it_did_not_write_and_an_earlier_runs_until_its_inputs_are_re
     let missing = dir.path().join("missing.coeff").display().to_string();
     let out = runs.display().to_string();
     refused(&["eval", "--quick", "--table", &missing, "--out", &out], &["missing.coeff"]);
+    // An input inside the folder the run writes (a table named like a chart was replaced by it).
+    let inside = runs.join("mae.svg");
+    std::fs::write(&inside, "not a chart").unwrap();
+    refused(
+        &["eval", "--quick", "--table", inside.to_str().unwrap(), "--out", &out],
+        &["--table", "lies in --out"],
+    );
+    assert_eq!(std::fs::read_to_string(&inside).unwrap(), "not a chart");
+    std::fs::remove_file(&inside).unwrap();
     // A size a renderer refuses and a case whose water settings are bad are refused before the
     // earlier results go (they were removed, and the cases before the bad one rendered).
     let quick = ["eval", "--quick", "--spp", "2", "--sweep", "4", "--out", &out];
