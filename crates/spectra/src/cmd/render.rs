@@ -179,8 +179,11 @@ fn render_frame(
             render::passes::HDR_MAX
         );
     }
-    // The spectral file first: an interrupted run leaves neither complete, never a colour image
-    // without the spectral one it was asked to go with.
+    // An interrupt is honoured up to here; once the first output is being written both are,
+    // held against the forced exit (a Ctrl-C between them left a new spectral file beside the
+    // old image, and said no output was written).
+    interrupted()?;
+    let _hold = color::cancel::hold();
     if let Some(sp) = &args.spectral_out {
         let cap = r.read_spectral_capture()?;
         let rgb = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
@@ -194,7 +197,6 @@ fn render_frame(
             white: Some(settings.white.clone()),
             centres: None,
         };
-        interrupted()?;
         compare::write_spectral_exr(sp, &spec, Some(&rgb))
             .with_context(|| format!("writing {}", sp.display()))?;
     }
@@ -205,14 +207,12 @@ fn render_frame(
                 image::RgbaImage::from_raw(width, height, rgba).context("readback has the wrong size")?;
             let mut bytes = std::io::Cursor::new(Vec::new());
             img.write_to(&mut bytes, image::ImageFormat::Png).context("encoding PNG")?;
-            interrupted()?;
             compare::atomic::write_atomic(&args.out, bytes.get_ref())
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
         OutFormat::Exr => {
             let data = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
             let img = compare::image::Image::new(width, height, data)?;
-            interrupted()?;
             compare::io::write_image(&args.out, &img, Default::default())
                 .with_context(|| format!("writing {}", args.out.display()))?;
         }
