@@ -166,6 +166,39 @@ fn keeps_the_samples_on(signal: libc::c_int) {
     assert_eq!(pixels(&out), pixels(&full));
 }
 
+/// Two renders to one --out shared its checkpoint (each overwrote the other's, the first to
+/// finish deleted it); the second is refused while the first runs, naming the lock, and the
+/// lock file goes with the first render. Found by a sweep.
+#[test]
+fn a_second_render_to_the_same_out_is_refused_while_the_first_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.exr");
+    let o = out.to_str().unwrap();
+    let lock = dir.path().join(".r.exr.lock");
+    let child = bin().args(args(o, &["--spp", "1000000", "--checkpoint-every", "0.3"])).spawn().unwrap();
+    let t = Instant::now();
+    while !lock.exists() && t.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let second = run(&args(o, &["--spp", "4"]));
+    let err = String::from_utf8_lossy(&second.stderr);
+    // SAFETY: kill(2) on our own child's pid.
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let first = child.wait_with_output().unwrap();
+    assert_eq!(second.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("another `spectra truth` is rendering to it") && err.contains(".r.exr.lock"),
+        "{err}"
+    );
+    assert_eq!(first.status.code(), Some(130), "{}", String::from_utf8_lossy(&first.stderr));
+    assert!(!lock.exists(), "the lock file stays behind");
+    // The first one's samples are kept (for --resume); set aside here.
+    let _ = std::fs::remove_file(dir.path().join("r.exr.checkpoint"));
+    // Without checkpoints nothing is shared: no lock.
+    assert!(run(&args(o, &["--spp", "4", "--checkpoint-every", "0"])).status.success());
+    assert!(!lock.exists());
+}
+
 /// Found by a sweep: a checkpoint that could not be written (here its path taken by a
 /// directory; a full disk or a quota alike) ended the render and lost every sample. It is a
 /// safety net: the render warns and finishes.

@@ -20,6 +20,61 @@ pub fn path_for(out: &Path) -> PathBuf {
     out.with_file_name(name)
 }
 
+/// Exclusive use of one `--out`'s checkpoint by one `truth` process: two renders to the same
+/// output shared its checkpoint, each overwrote the other's, and the first to finish deleted
+/// it — a later kill of the other lost every sample. An advisory `flock(2)` on the hidden file
+/// `.<out's name>.lock` beside it (the kernel lets it go when the process ends, however it
+/// ends); the file is removed when the guard is dropped.
+pub struct OutLock {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl OutLock {
+    /// Takes the lock for `out`, or says that another render holds it.
+    pub fn take(out: &Path) -> anyhow::Result<OutLock> {
+        use std::os::unix::fs::MetadataExt;
+        use std::os::unix::io::AsRawFd;
+        let mut name = std::ffi::OsString::from(".");
+        name.push(out.file_name().unwrap_or_default());
+        name.push(".lock");
+        let path = out.with_file_name(name);
+        // A lock file removed by its holder between our open and our lock is not the path's
+        // file any more: take the new one instead.
+        for _ in 0..100 {
+            let file =
+                std::fs::OpenOptions::new().create(true).truncate(false).write(true).open(&path).map_err(
+                    |e| anyhow::anyhow!("{}: cannot create the render's lock file: {e}", path.display()),
+                )?;
+            // SAFETY: flock(2) on a descriptor this function owns.
+            if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+                anyhow::bail!(
+                    "--out {}: another `spectra truth` is rendering to it (it holds {}); wait for it to end, or \
+                     choose another --out",
+                    out.display(),
+                    path.display()
+                );
+            }
+            let same = match (file.metadata(), std::fs::metadata(&path)) {
+                (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+                _ => false,
+            };
+            if same {
+                return Ok(OutLock { file, path });
+            }
+        }
+        anyhow::bail!("{}: the render's lock file keeps changing", path.display())
+    }
+}
+
+impl Drop for OutLock {
+    fn drop(&mut self) {
+        // Removed while still held, so no other process takes the lock of a file about to go.
+        let _ = std::fs::remove_file(&self.path);
+        let _ = &self.file;
+    }
+}
+
 #[derive(Serialize, Deserialize)]
 struct Header {
     record: Vec<(String, String)>,

@@ -538,6 +538,8 @@ pub fn run(a: Args) -> Result<()> {
     }
     let Some(out) = &a.out else { return Ok(()) };
 
+    // One render per --out while checkpoints are on (they share the checkpoint file).
+    let _lock = (a.checkpoint_every != 0.0).then(|| super::checkpoint::OutLock::take(out)).transpose()?;
     let ckpt = super::checkpoint::path_for(out);
     let ckpt_record = record(&a, &scene, &st, &table, st.spectral_bands.is_some())?;
     let cache = a.truth_cache.as_deref().map(super::truth_cache::TruthCache::open).transpose()?;
