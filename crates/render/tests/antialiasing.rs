@@ -47,6 +47,7 @@ fn scene() -> Scene {
         environment: None,
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     }
 }
 

@@ -46,6 +46,7 @@ fn sphere_scene(env: Environment) -> Scene {
         environment: Some(env),
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     }
 }
 
@@ -222,6 +223,7 @@ fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
         environment: None,
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     };
     let want = radiance as f64 * square_irradiance(0.5, 1.0) / std::f64::consts::PI;
     for (mode, shadows) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {

@@ -42,6 +42,7 @@ fn scene(pane: Option<Material>, stripe: bool) -> Scene {
         environment: None,
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     };
     let bg = Material {
         name: "background".into(),

@@ -29,7 +29,45 @@ impl Scene {
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         bounds(&self.meshes)
     }
+
+    /// Moves a scene that lies far from its file's origin (the centre of its geometry and
+    /// camera more than [`FAR_FROM_ORIGIN`] times their extent away: geo-referenced and CAD
+    /// exports) so that that centre is the origin, and records the move in
+    /// [`Scene::origin`]. Both renderers work in single precision: 10⁴ units out, the real-time
+    /// renderer's depth-reconstructed positions and shadow maps lost the scene (89 % black),
+    /// 10⁶ out every pixel. Positions, point and spot lights and the camera move; directions do
+    /// not. A translation changes no image; a scene near its origin is left exactly as it is.
+    pub fn recentre(&mut self) {
+        let cam = self.camera.transform.w_axis.truncate();
+        let Some((lo, hi)) = self.bounds() else { return };
+        let (lo, hi) = (lo.min(cam), hi.max(cam));
+        let centre = (lo + hi) * 0.5;
+        let extent = (hi - lo).max_element();
+        if !(centre.is_finite() && centre.abs().max_element() > FAR_FROM_ORIGIN * extent.max(1e-30)) {
+            return;
+        }
+        for m in &mut self.meshes {
+            for p in &mut m.positions {
+                *p -= centre;
+            }
+        }
+        for l in &mut self.lights {
+            match &mut l.kind {
+                crate::LightKind::Point { position, .. } | crate::LightKind::Spot { position, .. } => {
+                    *position -= centre
+                }
+                crate::LightKind::Directional { .. } => {}
+            }
+        }
+        self.camera.transform.w_axis -= centre.extend(0.0);
+        self.origin += centre.as_dvec3();
+    }
 }
+
+/// How far (in multiples of its extent) a scene's centre may lie from its file's origin before
+/// [`Scene::recentre`] moves it: beyond that, single precision spends most of its bits on the
+/// offset (a ratio of 4 still leaves over 21 of f32's 24 for the scene itself).
+pub const FAR_FROM_ORIGIN: f32 = 4.0;
 
 impl Camera {
     /// The default camera: looks at the centre of `bounds` from [`DEFAULT_VIEW_DIRECTION`]
@@ -102,5 +140,51 @@ mod tests {
         let d = to_eye(Vec3::new(-5.0, -5.0, -0.15), Vec3::new(5.0, 4.5, 0.1));
         assert!(d.abs_diff_eq(Vec3::Z, 1e-6), "{d}");
         assert!(Camera::framing(None).position() == Vec3::ZERO);
+    }
+
+    /// A scene far from its file's origin is moved to it (both renderers in f32 lost it: the
+    /// real-time one drew it black 10⁶ units out), with everything positional and the move
+    /// recorded; one near its origin is left bit for bit.
+    #[test]
+    fn a_far_scene_is_recentred_and_a_near_one_left_alone() {
+        let near = crate::builtin("cornell").unwrap();
+        let mut same = near.clone();
+        same.recentre();
+        assert_eq!(same.origin, glam::DVec3::ZERO);
+        assert_eq!(same.meshes[0].positions, near.meshes[0].positions);
+        let shift = Vec3::new(1.0e6, -2.0e5, 3.0e6);
+        let mut far = near.clone();
+        for m in &mut far.meshes {
+            for p in &mut m.positions {
+                *p += shift;
+            }
+        }
+        for l in &mut far.lights {
+            if let crate::LightKind::Point { position, .. } | crate::LightKind::Spot { position, .. } =
+                &mut l.kind
+            {
+                *position += shift;
+            }
+        }
+        far.camera.transform.w_axis += shift.extend(0.0);
+        far.recentre();
+        let moved = far.origin.as_vec3();
+        assert!((moved - shift).abs().max_element() < 10.0, "{moved}");
+        // Relative positions as the file had them, within its own f32 precision at 3e6 (0.25).
+        let (a, b) = (
+            near.camera.position() - near.meshes[0].positions[0],
+            far.camera.position() - far.meshes[0].positions[0],
+        );
+        assert!((a - b).abs().max_element() < 0.5, "{a} {b}");
+        assert!(far.bounds().unwrap().1.abs().max_element() < 10.0);
+        for (l0, l1) in near.lights.iter().zip(&far.lights) {
+            if let (
+                crate::LightKind::Point { position: p0, .. },
+                crate::LightKind::Point { position: p1, .. },
+            ) = (&l0.kind, &l1.kind)
+            {
+                assert!((*p1 + moved - shift - *p0).abs().max_element() < 0.5);
+            }
+        }
     }
 }

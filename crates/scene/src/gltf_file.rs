@@ -323,6 +323,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         environment: sx.environment,
         medium: sx.medium,
         inputs: ctx.inputs.take(),
+        origin: glam::DVec3::ZERO,
     };
     if scene.water.is_some() && scene.medium.is_some() {
         return Err(ctx.extras(
@@ -331,6 +332,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         ));
     }
     crate::sky::sync(&mut scene).map_err(|m| ctx.extras("water.sky", m))?;
+    scene.recentre();
     Ok(scene)
 }
 

@@ -88,6 +88,10 @@ pub struct Scene {
     /// images, CSV spectra, environment maps); empty for scenes built in code. A command's
     /// outputs must not overwrite any of them (`color::outfile::check_distinct`).
     pub inputs: Vec<std::path::PathBuf>,
+    /// Where the file's origin went: every position here is the file's minus this
+    /// ([`Scene::recentre`]; zero unless the scene lay far from its origin). Coordinates given
+    /// apart from the scene in its file's frame (`truth --medium`'s box) are moved by it too.
+    pub origin: glam::DVec3,
 }
 
 impl Scene {
@@ -108,6 +112,7 @@ impl Scene {
             environment: None,
             medium: None,
             inputs: Vec::new(),
+            origin: glam::DVec3::ZERO,
         }
     }
 }

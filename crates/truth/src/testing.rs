@@ -24,6 +24,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         environment: None,
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     }
 }
 

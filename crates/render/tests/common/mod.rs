@@ -131,6 +131,7 @@ impl Chart {
             environment: None,
             medium: None,
             inputs: vec![],
+            origin: glam::DVec3::ZERO,
         }
     }
 }

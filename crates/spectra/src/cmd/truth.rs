@@ -143,6 +143,13 @@ pub fn settings(a: &Args, scene: &scene::Scene, table: &color::upsample::CoeffTa
             (Medium::read(std::path::Path::new(arg))?, format!("medium {arg}"))
         };
         m.validate(s.range).with_context(|| origin)?;
+        let mut m = m;
+        // The box is in the scene file's frame; a recentred scene moved away from it.
+        if let truth::medium::Region::Box { min, max } = &mut m.region {
+            let o = scene.origin.as_vec3();
+            *min -= o;
+            *max -= o;
+        }
         s.medium = Some(m);
     }
     // An explicit --medium / --rgb-medium replaces the scene's own RGB medium.

@@ -65,6 +65,7 @@ fn scene(mesh: Mesh, white: &str) -> Scene {
         environment: None,
         medium: None,
         inputs: vec![],
+        origin: glam::DVec3::ZERO,
     }
 }
 
