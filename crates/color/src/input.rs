@@ -68,6 +68,31 @@ pub fn open_regular(path: &Path) -> io::Result<File> {
     Ok(file)
 }
 
+/// What tells a file's contents apart on disk without reading them: its device and inode, its
+/// length and its modification time. A file replaced (an exporter's rename over it) or rewritten
+/// gets another stamp. The scene loader stamps every file as it takes it, so that a record's
+/// content hash, read afterwards, can be checked to be of the bytes that were loaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FileStamp {
+    dev: u64,
+    ino: u64,
+    len: u64,
+    modified: Option<std::time::SystemTime>,
+}
+
+/// The [`FileStamp`] of the file at `path` now, `None` if it cannot be read.
+pub fn stamp(path: &Path) -> Option<FileStamp> {
+    let m = std::fs::metadata(path).ok()?;
+    #[cfg(unix)]
+    let (dev, ino) = {
+        use std::os::unix::fs::MetadataExt;
+        (m.dev(), m.ino())
+    };
+    #[cfg(not(unix))]
+    let (dev, ino) = (0, 0);
+    Some(FileStamp { dev, ino, len: m.len(), modified: m.modified().ok() })
+}
+
 /// The whole content of the regular file at `path`, refused (without reading further) once it
 /// exceeds `max_bytes`. Errors are `io::Error`s whose message says what was wrong, for the
 /// caller to prefix with the file name.

@@ -48,6 +48,7 @@ fn scene() -> Scene {
         medium: None,
         inputs: vec![],
         origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
     }
 }
 

@@ -84,6 +84,7 @@ fn scene(meshes: Vec<Mesh>, materials: Vec<Material>, textures: Vec<Texture>, li
         medium: None,
         inputs: vec![],
         origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
     }
 }
 

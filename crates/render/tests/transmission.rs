@@ -43,6 +43,7 @@ fn scene(pane: Option<Material>, stripe: bool) -> Scene {
         medium: None,
         inputs: vec![],
         origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
     };
     let bg = Material {
         name: "background".into(),

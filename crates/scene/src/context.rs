@@ -15,6 +15,8 @@ pub(crate) struct Ctx {
     /// Every file read so far: the scene file, then each reference as it is resolved
     /// ([`crate::Scene::inputs`]).
     pub inputs: std::cell::RefCell<Vec<PathBuf>>,
+    /// Each input's [`color::input::FileStamp`] when it was taken ([`crate::Scene::input_stamps`]).
+    pub stamps: std::cell::RefCell<Vec<Option<color::input::FileStamp>>>,
 }
 
 impl Ctx {
@@ -22,7 +24,13 @@ impl Ctx {
         let dir = path
             .parent()
             .map(|p| if p.as_os_str().is_empty() { PathBuf::from(".") } else { p.to_path_buf() });
-        Ctx { path: path.to_path_buf(), dir, allow_outside: false, inputs: vec![path.to_path_buf()].into() }
+        Ctx {
+            path: path.to_path_buf(),
+            dir,
+            allow_outside: false,
+            inputs: vec![path.to_path_buf()].into(),
+            stamps: vec![color::input::stamp(path)].into(),
+        }
     }
 
     pub fn builtin(name: &str) -> Self {
@@ -31,6 +39,7 @@ impl Ctx {
             dir: None,
             allow_outside: false,
             inputs: Vec::new().into(),
+            stamps: Vec::new().into(),
         }
     }
 
@@ -62,6 +71,7 @@ impl Ctx {
         if self.allow_outside {
             let p = d.join(rel);
             self.inputs.borrow_mut().push(p.clone());
+            self.stamps.borrow_mut().push(color::input::stamp(&p));
             return Ok(p);
         }
         let refuse = |why: &str| {
@@ -89,6 +99,7 @@ impl Ctx {
             return Err(refuse("resolves (through a symbolic link) outside the folder"));
         }
         self.inputs.borrow_mut().push(joined.clone());
+        self.stamps.borrow_mut().push(color::input::stamp(&joined));
         Ok(joined)
     }
 }

@@ -75,6 +75,7 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
         dir: base_dir.map(Path::to_path_buf),
         allow_outside: false,
         inputs: Vec::new().into(),
+        stamps: Vec::new().into(),
     };
     from_slice(&ctx, bytes)
 }
@@ -323,6 +324,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
         environment: sx.environment,
         medium: sx.medium,
         inputs: ctx.inputs.take(),
+        input_stamps: ctx.stamps.take(),
         origin: glam::DVec3::ZERO,
     };
     if scene.water.is_some() && scene.medium.is_some() {

@@ -92,6 +92,10 @@ pub struct Scene {
     /// ([`Scene::recentre`]; zero unless the scene lay far from its origin). Coordinates given
     /// apart from the scene in its file's frame (`truth --medium`'s box) are moved by it too.
     pub origin: glam::DVec3,
+    /// Each of [`Scene::inputs`]'s [`color::input::FileStamp`] when the loader took it (`None`
+    /// where it could not be stamped): a record hashing the files afterwards checks that they
+    /// are still what was loaded.
+    pub input_stamps: Vec<Option<color::input::FileStamp>>,
 }
 
 impl Scene {
@@ -113,6 +117,7 @@ impl Scene {
             medium: None,
             inputs: Vec::new(),
             origin: glam::DVec3::ZERO,
+            input_stamps: Vec::new(),
         }
     }
 }

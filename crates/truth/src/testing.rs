@@ -25,6 +25,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         medium: None,
         inputs: vec![],
         origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
     }
 }
 

@@ -132,6 +132,7 @@ impl Chart {
             medium: None,
             inputs: vec![],
             origin: glam::DVec3::ZERO,
+            input_stamps: vec![],
         }
     }
 }

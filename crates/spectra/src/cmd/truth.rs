@@ -340,6 +340,21 @@ pub fn sum_fields(
     for (i, (what, p)) in inputs.iter().enumerate() {
         let bytes = color::input::read_regular(p, scene::environment::MAX_INPUT_BYTES)
             .with_context(|| format!("{what} {}", p.display()))?;
+        // The hash must be of what the scene was loaded from: a file replaced since (an
+        // exporter's rename over it) recorded the other version — merge then accepted pieces of
+        // two scenes and the truth cache kept samples under the wrong contents for good.
+        let loaded = scene
+            .inputs
+            .iter()
+            .position(|q| q == p)
+            .and_then(|k| scene.input_stamps.get(k).copied().flatten());
+        if let Some(then) = loaded
+            && color::input::stamp(p) != Some(then)
+        {
+            let shown = p.display().to_string();
+            let name = if what.contains(&shown) { what.clone() } else { format!("{what} {shown}") };
+            bail!("{name} changed while the scene was being loaded: run the command again");
+        }
         // Its name (without the folder) beside the hash, so that a refusal can say which file
         // changed.
         let name =
@@ -790,6 +805,30 @@ mod tests {
 
     fn srgb_table() -> std::sync::Arc<color::upsample::CoeffTable> {
         color::upsample::table("srgb").expect("the sRGB table")
+    }
+
+    /// A scene file replaced after it was loaded (an exporter's rename over it, found by a
+    /// sweep: 12–19 of 30 renders recorded the other version) is not hashed into a record as if
+    /// it had been rendered: the hash is refused, naming the file.
+    #[test]
+    fn a_file_replaced_after_loading_is_not_recorded() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("box.gltf");
+        scene::write_gltf(&scene::builtin("cornell").unwrap(), &file).unwrap();
+        let a = args(&[]);
+        let scene = scene::load(&file).unwrap();
+        let tab = srgb_table();
+        let st = settings(&a, &scene, &tab).unwrap();
+        let inputs = vec![("scene file".to_string(), file.clone())];
+        let before = sum_fields(&scene, &st, &tab, &inputs, false).unwrap();
+        let copy = dir.path().join("new.gltf");
+        std::fs::copy(&file, &copy).unwrap();
+        std::fs::rename(&copy, &file).unwrap();
+        let e = format!("{:#}", sum_fields(&scene, &st, &tab, &inputs, false).unwrap_err());
+        assert!(e.contains("box.gltf") && e.contains("changed while the scene was being loaded"), "{e}");
+        // Loaded again, it hashes as before (the same bytes).
+        let again = scene::load(&file).unwrap();
+        assert_eq!(sum_fields(&again, &st, &tab, &inputs, false).unwrap(), before);
     }
 
     /// `--rgb-medium` inline or from a file reaches the tracer as a medium filling the scene;

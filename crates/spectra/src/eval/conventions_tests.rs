@@ -66,6 +66,7 @@ fn scene(mesh: Mesh, white: &str) -> Scene {
         medium: None,
         inputs: vec![],
         origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
     }
 }
 
