@@ -7,6 +7,11 @@
 //! from a process killed with `kill -9` is recognised and removed by the next write of the
 //! same file ([`remove_stale_temps`]). An existing destination keeps its permission bits; a new
 //! one gets `0666` minus the umask, like any file a shell redirection creates.
+//!
+//! A command with several outputs (an image and its spectral file, a heat map and a CSV) writes
+//! them together or not at all: it [`stage`]s each, complete and on disk under its temporary
+//! name, and only then renames them all into place ([`commit_all`]). One after the other, a full
+//! disk on the second left the first replaced beside the second's old version.
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -190,6 +195,47 @@ pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>,
 ) -> io::Result<()> {
+    stage_with(path, fill)?.commit()
+}
+
+/// A complete output waiting beside its destination under a temporary name: everything that
+/// can run out of space (the bytes, their fsync) is done, and only a rename is left. A command
+/// with several outputs stages them all before it puts any in place ([`commit_all`]), so that a
+/// full disk on its second file cannot leave the first replaced beside the second's old
+/// version. Dropped uncommitted (an error, a panic), it deletes its temporary file and the
+/// destination is untouched.
+#[derive(Debug)]
+pub struct Staged {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl Staged {
+    /// The destination it will be renamed to.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the temporary file over the destination.
+    pub fn commit(self) -> io::Result<()> {
+        // On failure `PersistError` hands the temp file back; dropping it deletes it.
+        self.tmp.persist(&self.path).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+/// [`stage_with`] for bytes already in memory.
+pub fn stage(path: &Path, bytes: &[u8]) -> io::Result<Staged> {
+    stage_with(path, |f| f.write_all(bytes))
+}
+
+/// Writes the content `fill` makes to a temporary file beside `path` and flushes it to disk,
+/// but leaves `path` alone until [`Staged::commit`]: the first half of [`write_atomic_with`],
+/// with the same checks, temporary name, permissions and removal of dead writers' leftovers.
+pub fn stage_with(
+    path: &Path,
+    fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>,
+) -> io::Result<Staged> {
     let dir = parent_dir(path);
     let name = file_name(path)?;
     if !dir.is_dir() {
@@ -217,8 +263,43 @@ pub fn write_atomic_with(
     }
     fill(tmp.as_file_mut())?;
     tmp.as_file().sync_all()?;
-    // On failure `PersistError` hands the temp file back; dropping it deletes it.
-    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(Staged { tmp, path: path.to_path_buf() })
+}
+
+/// A rename in [`commit_all`] that failed: which destination, and why. Its message names the
+/// file, since the caller cannot tell which of its outputs it was.
+#[derive(Debug)]
+pub struct CommitError {
+    pub path: PathBuf,
+    pub error: io::Error,
+}
+
+impl std::fmt::Display for CommitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.error)
+    }
+}
+
+// No `source`: the cause is in the message, and error chains would print it twice.
+impl std::error::Error for CommitError {}
+
+impl From<CommitError> for io::Error {
+    fn from(e: CommitError) -> io::Error {
+        io::Error::new(e.error.kind(), e.to_string())
+    }
+}
+
+/// Puts a command's staged outputs in place, in order, once every one of them is complete on
+/// disk: nothing under an output's name changes unless all of them were written. A rename
+/// needs no space, so a full disk or a quota cannot stop it; what is left is a rename failing
+/// in the middle (an I/O error, the file system remounted read-only, a destination replaced by
+/// a directory meanwhile), which leaves the outputs before it replaced and the rest untouched,
+/// their temporary files deleted.
+pub fn commit_all(staged: Vec<Staged>) -> Result<(), CommitError> {
+    for s in staged {
+        let path = s.path.clone();
+        s.commit().map_err(|error| CommitError { path, error })?;
+    }
     Ok(())
 }
 
@@ -433,6 +514,85 @@ mod tests {
         assert!(e.to_string().contains("does not exist"), "{e}");
         assert!(check_writable(&p).is_ok());
         assert!(entries(dir.path()).is_empty());
+    }
+
+    /// Outputs staged but not committed (the command failed on a later one) leave every
+    /// destination as it was and no temporary file.
+    #[test]
+    fn staged_outputs_dropped_leave_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
+        std::fs::write(&a, b"old a").unwrap();
+        let staged = vec![stage(&a, b"new a").unwrap(), stage(&b, b"new b").unwrap()];
+        assert_eq!(staged[1].path(), b);
+        assert_eq!(entries(dir.path()).len(), 3, "two temporary files beside a.exr");
+        assert_eq!(std::fs::read(&a).unwrap(), b"old a", "nothing in place before the commit");
+        drop(staged);
+        assert_eq!(entries(dir.path()), vec!["a.exr"]);
+        assert_eq!(std::fs::read(&a).unwrap(), b"old a");
+        // The second's content fails half way (a full disk): the first, staged, goes with it.
+        let first = stage(&a, b"new a").unwrap();
+        let e = stage_with(&b, |f| {
+            f.write_all(b"half")?;
+            Err(io::Error::from_raw_os_error(libc::ENOSPC))
+        })
+        .unwrap_err();
+        assert_eq!(e.raw_os_error(), Some(libc::ENOSPC));
+        drop(first);
+        assert_eq!(entries(dir.path()), vec!["a.exr"]);
+        assert_eq!(std::fs::read(&a).unwrap(), b"old a");
+    }
+
+    /// Committed together, every output is replaced and keeps its mode; a new one gets the
+    /// umask's.
+    #[cfg(unix)]
+    #[test]
+    fn commit_all_replaces_every_output() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let p = |n: &str| dir.path().join(n);
+        for (n, mode) in [("a.exr", 0o600), ("b.png", 0o640)] {
+            std::fs::write(p(n), b"old").unwrap();
+            std::fs::set_permissions(p(n), std::fs::Permissions::from_mode(mode)).unwrap();
+        }
+        let staged: Vec<Staged> = [("a.exr", &b"A"[..]), ("b.png", b"B"), ("c.csv", b"C")]
+            .iter()
+            .map(|(n, bytes)| stage(&p(n), bytes).unwrap())
+            .collect();
+        commit_all(staged).unwrap();
+        assert_eq!(entries(dir.path()), vec!["a.exr", "b.png", "c.csv"]);
+        for (n, bytes, m) in
+            [("a.exr", b"A", 0o600), ("b.png", b"B", 0o640), ("c.csv", b"C", 0o666 & !umask())]
+        {
+            assert_eq!(std::fs::read(p(n)).unwrap(), bytes, "{n}");
+            assert_eq!(mode(&p(n)), m, "{n}");
+        }
+    }
+
+    /// The window left: a rename that fails in the middle (here the destination became a
+    /// non-empty directory after it was staged) is named, the outputs before it are in place
+    /// and those after it untouched, and no temporary file stays.
+    #[test]
+    fn a_rename_failing_in_the_middle_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = |n: &str| dir.path().join(n);
+        for n in ["a.exr", "c.csv"] {
+            std::fs::write(p(n), b"old").unwrap();
+        }
+        let staged = vec![
+            stage(&p("a.exr"), b"A").unwrap(),
+            stage(&p("b.png"), b"B").unwrap(),
+            stage(&p("c.csv"), b"C").unwrap(),
+        ];
+        std::fs::create_dir(p("b.png")).unwrap();
+        std::fs::write(p("b.png").join("keep"), b"x").unwrap();
+        let e = commit_all(staged).unwrap_err();
+        assert_eq!(e.path, p("b.png"));
+        assert!(e.to_string().starts_with(&format!("{}: ", p("b.png").display())), "{e}");
+        assert_eq!(io::Error::from(e).to_string().matches("b.png").count(), 1);
+        assert_eq!(entries(dir.path()), vec!["a.exr", "b.png", "c.csv"]);
+        assert_eq!(std::fs::read(p("a.exr")).unwrap(), b"A");
+        assert_eq!(std::fs::read(p("c.csv")).unwrap(), b"old");
     }
 
     /// A symlink planted where the old exporter's predictable temp directory went is not

@@ -151,6 +151,12 @@ impl FlipMap {
 
     /// Writes the magma-coloured map as PNG, atomically.
     pub fn save_png(&self, path: &std::path::Path) -> Result<()> {
+        crate::atomic::write_atomic(path, &self.to_png(path)?)
+    }
+
+    /// The PNG [`FlipMap::save_png`] writes to `path` (named in errors), for staging beside a
+    /// command's other outputs.
+    pub fn to_png(&self, path: &std::path::Path) -> Result<Vec<u8>> {
         let img = image::RgbImage::from_raw(self.width, self.height, self.magma())
             .expect("the lookup gives three bytes a pixel");
         let mut buf = std::io::Cursor::new(Vec::new());
@@ -159,7 +165,7 @@ impl FlipMap {
             format: "PNG",
             reason: e.to_string(),
         })?;
-        crate::atomic::write_atomic(path, &buf.into_inner())
+        Ok(buf.into_inner())
     }
 }
 

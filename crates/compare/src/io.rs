@@ -398,19 +398,35 @@ fn check_palette(bytes: &[u8]) -> std::result::Result<(), String> {
 /// naming the first offending pixel. EXR stores NaN and ∞ as they are.
 pub fn write_image(path: impl AsRef<Path>, image: &Image, opts: WriteOptions) -> Result<()> {
     let path = path.as_ref();
+    write_atomic(path, &encode_image(path, image, opts)?)
+}
+
+/// The bytes [`write_image`] writes to `path` (whose extension picks the format), for a command
+/// that stages several outputs before it puts any in place ([`crate::atomic::stage`]).
+pub fn encode_image(path: impl AsRef<Path>, image: &Image, opts: WriteOptions) -> Result<Vec<u8>> {
+    let path = path.as_ref();
     let format = format_of(path)?;
     // The fields are public, so a hand-built image may be inconsistent.
     image.validate()?;
-    let bytes = match format {
-        Format::Exr => encode_exr(path, image, opts.exr, None)?,
-        Format::Png => encode_png(path, image, opts.png)?,
-    };
-    write_atomic(path, &bytes)
+    match format {
+        Format::Exr => encode_exr(path, image, opts.exr, None),
+        Format::Png => encode_png(path, image, opts.png),
+    }
 }
 
 /// Writes `image` as an EXR (f32) whose pixels sit in `frame` (display and data windows,
 /// `spectra.*` attributes), atomically: a crop or sample chunk of a render.
 pub fn write_exr_framed(path: impl AsRef<Path>, image: &Image, frame: &crate::frame::ExrFrame) -> Result<()> {
+    let path = path.as_ref();
+    write_atomic(path, &encode_exr_framed(path, image, frame)?)
+}
+
+/// The bytes [`write_exr_framed`] writes to `path`, for staging beside other outputs.
+pub fn encode_exr_framed(
+    path: impl AsRef<Path>,
+    image: &Image,
+    frame: &crate::frame::ExrFrame,
+) -> Result<Vec<u8>> {
     let path = path.as_ref();
     if format_of(path)? != Format::Exr {
         return Err(CompareError::InvalidImage(format!(
@@ -419,7 +435,7 @@ pub fn write_exr_framed(path: impl AsRef<Path>, image: &Image, frame: &crate::fr
         )));
     }
     image.validate()?;
-    write_atomic(path, &encode_exr(path, image, ExrPrecision::F32, Some(frame))?)
+    encode_exr(path, image, ExrPrecision::F32, Some(frame))
 }
 
 fn encode_exr(

@@ -25,8 +25,10 @@ pub use frame::{ExrFrame, read_exr_frame, read_exr_frame_and_size};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
 pub use io::{
-    ExrPrecision, PngBitDepth, WriteOptions, decode_image, read_image, write_exr_framed, write_image,
+    ExrPrecision, PngBitDepth, WriteOptions, decode_image, encode_exr_framed, encode_image, read_image,
+    write_exr_framed, write_image,
 };
 pub use spectral::{
-    SpectralImage, SpectralKind, read_spectral_exr, write_spectral_exr, write_spectral_exr_framed,
+    SpectralImage, SpectralKind, encode_spectral_exr_framed, read_spectral_exr, write_spectral_exr,
+    write_spectral_exr_framed,
 };

@@ -403,6 +403,19 @@ pub fn write_spectral_exr_framed(
     frame: Option<&crate::frame::ExrFrame>,
 ) -> Result<()> {
     let path = path.as_ref();
+    write_atomic(path, &encode_spectral_exr_framed(path, image, rgb, frame)?)
+}
+
+/// The bytes [`write_spectral_exr_framed`] writes to `path` (`frame` None for
+/// [`write_spectral_exr`]'s), for a command that stages them beside its colour image and puts
+/// both in place together ([`crate::atomic::stage`]).
+pub fn encode_spectral_exr_framed(
+    path: impl AsRef<Path>,
+    image: &SpectralImage,
+    rgb: Option<&Image>,
+    frame: Option<&crate::frame::ExrFrame>,
+) -> Result<Vec<u8>> {
+    let path = path.as_ref();
     image.validate()?;
     let (w, h) = (image.width as usize, image.height as usize);
     if let Some(rgb) = rgb
@@ -460,7 +473,7 @@ pub fn write_spectral_exr_framed(
         format: "spectral OpenEXR",
         reason: e.to_string(),
     })?;
-    write_atomic(path, &buf.into_inner())
+    Ok(buf.into_inner())
 }
 
 #[cfg(test)]

@@ -580,16 +580,23 @@ pub fn run(args: Args) -> Result<()> {
         println!("{line}");
     }
     if let Some(path) = &args.csv {
-        write_table(path, &csv(&rows))?;
+        write_tables(&[(path, csv(&rows))])?;
     }
     Ok(())
 }
 
-/// Writes a table (CSV, markdown) atomically and says so.
-pub(crate) fn write_table(path: &std::path::Path, text: &str) -> Result<()> {
-    compare::atomic::write_atomic(path, text.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))?;
-    eprintln!("wrote {}", path.display());
+/// Writes tables (CSV, markdown) together or not at all, each atomically, and says so: staged
+/// first, then put in place, so a full disk on the second does not leave the first replaced
+/// beside the second's old version.
+pub(crate) fn write_tables(tables: &[(&std::path::Path, String)]) -> Result<()> {
+    let staged = tables
+        .iter()
+        .map(|(path, text)| super::stage_output(path, text.as_bytes()))
+        .collect::<Result<Vec<_>>>()?;
+    super::commit_outputs(staged)?;
+    for (path, _) in tables {
+        eprintln!("wrote {}", path.display());
+    }
     Ok(())
 }
 

@@ -235,6 +235,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let maps = DiffMaps::compute(&reference, &test, DiffOptions { white_luminance: args.white_y })
         .with_context(|| format!("comparing {} with {}", args.reference.display(), args.test.display()))?;
     let summary = maps.summary();
+    // Every output is staged, complete on disk, and all are put in place only at the end: one
+    // after the other, a failure on the CSV (a full disk) left a new heat map and FLIP map
+    // beside the old CSV.
+    let mut staged = Vec::new();
     let flip_stats = if flip {
         let map = if hdr_flip {
             compare::flip::hdr_flip(&reference, &test, args.flip_ppd, &hdr_opts).context("HDR-FLIP")?
@@ -247,7 +251,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             compare::flip::ldr_flip_at_depths(&reference, &test, args.flip_ppd, bits).context("LDR-FLIP")?
         };
         if let Some(p) = &args.flip_map {
-            map.save_png(p).context("writing the FLIP map")?;
+            let png = map.to_png(p).context("writing the FLIP map")?;
+            staged.push(compare::atomic::stage(p, &png).context("writing the FLIP map")?);
         }
         let v: Vec<f64> = map.values.iter().map(|&x| f64::from(x)).collect();
         // The mean as FLIP's own tool computes and prints it.
@@ -261,14 +266,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(path) => {
             let opts = HeatmapOptions { max: args.max_de, colormap, ..Default::default() };
             let h = Heatmap::of_delta_e(&maps, &opts)?;
-            h.save_png(path).context("writing the heat map")?;
+            let png = h.to_png().context("writing the heat map")?;
+            staged.push(compare::atomic::stage(path, &png).context("writing the heat map")?);
             Some((path, h.max))
         }
         None => None,
     };
     if let Some(path) = &args.per_pixel_out {
-        compare::atomic::write_atomic(path, maps.to_csv().as_bytes()).context("writing per-pixel values")?;
+        staged.push(
+            compare::atomic::stage(path, maps.to_csv().as_bytes()).context("writing per-pixel values")?,
+        );
     }
+    super::commit_outputs(staged)?;
 
     if args.json {
         let mut v = serde_json::to_value(summary)?;

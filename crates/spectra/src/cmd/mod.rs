@@ -36,6 +36,23 @@ pub fn check_output(flag: &str, path: &std::path::Path) -> anyhow::Result<()> {
     color::outfile::check_writable(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
 }
 
+/// Stages the output `bytes` for `path` (`compare::atomic::stage`): complete on disk, not yet in
+/// place. The error reads as a failed write did, "writing PATH: PATH: cause".
+pub fn stage_output(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<compare::atomic::Staged> {
+    use anyhow::Context;
+    compare::atomic::stage(path, bytes).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Puts a command's staged outputs in place together, once all are written
+/// (`color::outfile::commit_all`): a command with several outputs stages every one first, so a
+/// full disk on one leaves the others as they were rather than a new file beside an old one.
+pub fn commit_outputs(staged: Vec<compare::atomic::Staged>) -> anyhow::Result<()> {
+    compare::atomic::commit_all(staged).map_err(|e| {
+        let what = format!("writing {}", e.path.display());
+        anyhow::Error::new(e).context(what)
+    })
+}
+
 /// Refuses, before the work, a command's outputs (flag, path; `None` for one not asked for) that
 /// are not regular files, are the same file as one of `inputs` (what, path) or as each other:
 /// one guard for every command (`color::outfile::check_distinct`).

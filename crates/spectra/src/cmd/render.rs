@@ -179,11 +179,14 @@ fn render_frame(
             render::passes::HDR_MAX
         );
     }
-    // An interrupt is honoured up to here; once the first output is being written both are,
-    // held against the forced exit (a Ctrl-C between them left a new spectral file beside the
-    // old image, and said no output was written).
+    // An interrupt is honoured up to here; once the outputs are being written both are, held
+    // against the forced exit (a Ctrl-C between them left a new spectral file beside the old
+    // image, and said no output was written). Both are staged, complete on disk, before either
+    // is put in place: a full disk on the second left the first replaced beside the second's
+    // old version.
     interrupted()?;
     let _hold = color::cancel::hold();
+    let mut staged = Vec::new();
     if let Some(sp) = &args.spectral_out {
         let cap = r.read_spectral_capture()?;
         let rgb = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
@@ -197,27 +200,28 @@ fn render_frame(
             white: Some(settings.white.clone()),
             centres: None,
         };
-        compare::write_spectral_exr(sp, &spec, Some(&rgb))
+        let bytes = compare::encode_spectral_exr_framed(sp, &spec, Some(&rgb), None)
             .with_context(|| format!("writing {}", sp.display()))?;
+        staged.push(super::stage_output(sp, &bytes)?);
     }
-    match format {
+    let bytes = match format {
         OutFormat::Png => {
             let rgba = r.read_ldr()?;
             let img =
                 image::RgbaImage::from_raw(width, height, rgba).context("readback has the wrong size")?;
             let mut bytes = std::io::Cursor::new(Vec::new());
             img.write_to(&mut bytes, image::ImageFormat::Png).context("encoding PNG")?;
-            compare::atomic::write_atomic(&args.out, bytes.get_ref())
-                .with_context(|| format!("writing {}", args.out.display()))?;
+            bytes.into_inner()
         }
         OutFormat::Exr => {
             let data = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
             let img = compare::image::Image::new(width, height, data)?;
-            compare::io::write_image(&args.out, &img, Default::default())
-                .with_context(|| format!("writing {}", args.out.display()))?;
+            compare::io::encode_image(&args.out, &img, Default::default())
+                .with_context(|| format!("writing {}", args.out.display()))?
         }
-    }
-    Ok(())
+    };
+    staged.push(super::stage_output(&args.out, &bytes)?);
+    super::commit_outputs(staged)
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {

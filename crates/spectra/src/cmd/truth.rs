@@ -703,8 +703,9 @@ pub fn run(a: Args) -> Result<()> {
         },
         (img.width, img.height),
     );
-    // The spectral file first: an interrupted run leaves neither complete, never a colour image
-    // without the spectral one it was asked to go with.
+    // Both outputs are staged, complete on disk, before either is put in place: a failure on
+    // the second (a full disk) left the first replaced beside the second's old version.
+    let mut staged = Vec::new();
     if let (Some(sp), Some(bands)) = (&a.spectral_out, img.spectral.clone()) {
         let edges = st.spectral_bands.clone().expect("bands were asked for");
         let white = a.spectrum.resolve(&scene)?.white;
@@ -721,16 +722,19 @@ pub fn run(a: Args) -> Result<()> {
             compare::ExrFrame { attributes: record(&a, &scene, &st, &table, true)?, ..frame.clone() },
             (img.width, img.height),
         );
-        compare::write_spectral_exr_framed(sp, &spec, Some(&image), Some(&spectral_frame))
+        let bytes = compare::encode_spectral_exr_framed(sp, &spec, Some(&image), Some(&spectral_frame))
             .with_context(|| format!("writing {}", sp.display()))?;
+        staged.push(super::stage_output(sp, &bytes)?);
     }
     let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if is_exr {
-        compare::write_exr_framed(out, &image, &frame)
+    let bytes = if is_exr {
+        compare::encode_exr_framed(out, &image, &frame)
     } else {
-        compare::io::write_image(out, &image, Default::default())
+        compare::io::encode_image(out, &image, Default::default())
     }
     .with_context(|| format!("writing {}", out.display()))?;
+    staged.push(super::stage_output(out, &bytes)?);
+    super::commit_outputs(staged)?;
     // The outputs are complete: the samples are safe in them.
     if std::fs::symlink_metadata(&ckpt).is_ok()
         && let Err(e) = std::fs::remove_file(&ckpt)

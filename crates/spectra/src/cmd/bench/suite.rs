@@ -388,13 +388,14 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(line) = load_report(load_before, load_average(), cores, cpu_device(&r)) {
         println!("{line}");
     }
+    let mut tables = Vec::new();
     if let Some(path) = &args.csv {
-        super::write_table(path, &csv(&rows, &adapter))?;
+        tables.push((path.as_path(), csv(&rows, &adapter)));
     }
     if let Some(path) = &args.markdown {
-        super::write_table(path, &markdown(&rows, &header, &skipped))?;
+        tables.push((path.as_path(), markdown(&rows, &header, &skipped)));
     }
-    Ok(())
+    super::write_tables(&tables)
 }
 
 #[cfg(test)]
