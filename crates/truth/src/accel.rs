@@ -37,6 +37,22 @@ pub struct Geometry {
     pub filter: Vec<u8>,
     any_filtered: bool,
     bvh: Option<CwBvh>,
+    /// The power of two the BVH's space is scaled by (1 for a scene at least a unit across):
+    /// its traversal skips boxes nearer than 10⁻⁴ along the ray (obvhs's `EPSILON`), which hid
+    /// every surface of a scene smaller than that. Scaling by a power of two is exact, so the
+    /// triangles are tested unscaled and the hits are the same bits.
+    scale: f32,
+    /// The largest side of the triangles' bounding box (0 without triangles).
+    pub size: f32,
+}
+
+/// [`Geometry::scale`] for a scene whose bounding box's largest side is `size`: the smallest
+/// power of two that brings it to 1 or more, within f32's exponents; 1 at `size` ≥ 1.
+fn bvh_scale(size: f32) -> f32 {
+    if !(size > 0.0 && size < 1.0) {
+        return 1.0;
+    }
+    (-size.log2().floor()).clamp(0.0, 100.0).exp2()
 }
 
 fn v3a(v: Vec3) -> Vec3A {
@@ -150,12 +166,19 @@ impl Geometry {
                 filter.push(flags);
             }
         }
+        let (lo, hi) = verts
+            .iter()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let size = if verts.is_empty() { 0.0 } else { (hi - lo).max_element() };
+        let scale = bvh_scale(size);
         let bvh = (!verts.is_empty()).then(|| {
-            let boxes: Vec<Aabb> = verts.iter().enumerate().map(|(i, v)| build_box(i, v)).collect();
+            let boxes: Vec<Aabb> =
+                verts.iter().enumerate().map(|(i, v)| build_box(i, &v.map(|p| p * scale))).collect();
             build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut Duration::default())
         });
         let any_filtered = filter.iter().any(|&f| f != 0);
-        Ok(Geometry { refs, verts, filter, any_filtered, bvh })
+        Ok(Geometry { refs, verts, filter, any_filtered, bvh, scale, size })
     }
 
     pub fn len(&self) -> usize {
@@ -188,16 +211,17 @@ impl Geometry {
         mut pass: impl FnMut(u32, f32, f32) -> bool,
     ) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
+        let s = self.scale;
+        let ray = Ray::new(v3a(o * s), traversal_dir(d), 0.0, tmax * s);
         let mut best: Option<Hit> = None;
         let mut hit = obvhs::ray::RayHit::none();
         let any = self.any_filtered;
         bvh.ray_traverse(ray, &mut hit, |r, id| {
             let tri = bvh.primitive_indices[id];
-            match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax) {
+            match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax / s) {
                 Some((t, b1, b2)) if !(any && self.filter[tri as usize] != 0) || pass(tri, b1, b2) => {
                     best = Some(Hit { t, tri, b1, b2 });
-                    t
+                    t * s
                 }
                 _ => f32::INFINITY,
             }
@@ -215,12 +239,13 @@ impl Geometry {
         mut pass: impl FnMut(u32, f32, f32) -> bool,
     ) -> bool {
         let Some(bvh) = self.bvh.as_ref() else { return false };
-        let ray = Ray::new(v3a(o), traversal_dir(d), 0.0, tmax);
+        let s = self.scale;
+        let ray = Ray::new(v3a(o * s), traversal_dir(d), 0.0, tmax * s);
         let any = self.any_filtered;
         !bvh.ray_traverse_miss(ray, |r, id| {
             let tri = bvh.primitive_indices[id];
-            match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax) {
-                Some((t, b1, b2)) if !(any && self.filter[tri as usize] != 0) || pass(tri, b1, b2) => t,
+            match intersect_triangle(&self.verts[tri as usize], o, d, r.tmax / s) {
+                Some((t, b1, b2)) if !(any && self.filter[tri as usize] != 0) || pass(tri, b1, b2) => t * s,
                 _ => f32::INFINITY,
             }
         })
@@ -271,6 +296,39 @@ mod tests {
                 assert!(!g.occluded(o, d, t * 0.999));
             }
         }
+    }
+
+    /// The same soup scaled by 2⁻²⁴ (11 units across become 7·10⁻⁷) is hit by the same rays,
+    /// scaled, at the same triangles and barycentrics, to the bit: obvhs skips boxes nearer than
+    /// 10⁻⁴ along the ray, which hid every surface of a scene smaller than that, so the BVH's
+    /// space is scaled by a power of two (`Geometry::scale`).
+    #[test]
+    fn a_tiny_scene_is_hit_as_its_unit_sized_copy() {
+        let unit = soup(500, 4);
+        let k = (-24f32).exp2();
+        let mut tiny = unit.clone();
+        for p in &mut tiny.meshes[0].positions {
+            *p *= k;
+        }
+        let (g, gt) = (Geometry::new(&unit).unwrap(), Geometry::new(&tiny).unwrap());
+        let mut s = Sampler::new(2, 7);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            // Aimed into the soup, from inside and outside it.
+            let o = Vec3::new(s.uniform(), s.uniform(), s.uniform()) * 14.0 - 2.0;
+            let d = (Vec3::new(s.uniform(), s.uniform(), s.uniform()) * 10.0 - o).normalize();
+            let (a, b) = (g.intersect(o, d, f32::INFINITY), gt.intersect(o * k, d, f32::INFINITY));
+            match (a, b) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert_eq!((a.tri, a.t * k, a.b1, a.b2), (b.tri, b.t, b.b1, b.b2));
+                    assert!(!gt.occluded(o * k, d, b.t * 0.999) && gt.occluded(o * k, d, b.t * 1.001));
+                    hits += 1;
+                }
+                other => panic!("unit-sized and tiny copies differ: {other:?}"),
+            }
+        }
+        assert!(hits > 400, "{hits} hits");
     }
 
     /// A mesh duplicated in place thousands of times (careless exports; a deep chain of nodes

@@ -12,7 +12,7 @@ use crate::medium::{Phase, phase_eval, phase_sample};
 use crate::rng::Sampler;
 use crate::sampling::{Frame, power_heuristic, triangle_barycentrics};
 use crate::spectral::Wavelengths;
-use crate::world::{World, offset};
+use crate::world::{World, offset, offset_distance};
 use glam::{Vec3, Vec4};
 
 /// Where a path scatters: a surface (BRDF in a shading frame; a see-through material mixes in
@@ -109,7 +109,7 @@ impl Integrator<'_, '_> {
     ) -> Vec4 {
         let w = self.world;
         let l = wl.0;
-        let origin = |dir: Vec3| ng.map_or(p, |n| offset(p, n, dir));
+        let origin = |dir: Vec3| ng.map_or(p, |n| offset(p, n, dir, w.offset_floor));
         let mut sum = Vec4::ZERO;
         for light in &w.delta_lights {
             let Some(s) = light.sample(p) else { continue };
@@ -146,7 +146,7 @@ impl Integrator<'_, '_> {
                         // light point would hit the light itself first when it leaves at an
                         // oblique angle (the origin offset brings it nearer the light's plane).
                         let o = origin(wi);
-                        let end = offset(q.p, q.ng, -wi);
+                        let end = offset(q.p, q.ng, -wi, w.offset_floor);
                         let seg = end - o;
                         let tmax = seg.length();
                         let dir = seg / tmax;
@@ -301,7 +301,7 @@ impl Integrator<'_, '_> {
                     break;
                 }
                 let pos = o + d * t;
-                o = Vec3::new(pos.x, surf.height - 1e-4 * (1.0 + pos.abs().max_element()), pos.z);
+                o = Vec3::new(pos.x, surf.height - offset_distance(pos, self.world.offset_floor), pos.z);
                 d = Vec3::new(d.x, -d.y, d.z);
                 prev_pdf = 0.0;
                 depth += 1;
@@ -461,7 +461,7 @@ impl Integrator<'_, '_> {
                 prev_pdf = bs.pdf;
                 (wi, false)
             };
-            o = offset(s.p, ng, wi);
+            o = offset(s.p, ng, wi, self.world.offset_floor);
             d = wi;
             depth += 1;
             if crossed {

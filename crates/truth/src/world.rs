@@ -61,6 +61,9 @@ pub struct World<'s> {
     pub stochastic: bool,
     /// Per material, the absorption inside its volume (`material::volume_absorption`).
     pub absorption: Vec<Option<[f64; 3]>>,
+    /// The absolute part of [`offset`]'s distance: the scene's size, at most 1 (a scene
+    /// smaller than the fixed floor of 10⁻⁴ units had every ray leave it).
+    pub offset_floor: f32,
 }
 
 impl<'s> World<'s> {
@@ -165,6 +168,7 @@ impl<'s> World<'s> {
             _ => None,
         };
         let medium = medium.map(|m| PreparedMedium::new(m, range)).transpose()?;
+        let offset_floor = offset_floor(geometry.size);
         Ok(World {
             scene,
             geometry,
@@ -181,6 +185,7 @@ impl<'s> World<'s> {
             surface,
             stochastic,
             absorption: original.materials.iter().map(crate::material::volume_absorption).collect(),
+            offset_floor,
         })
     }
 
@@ -380,9 +385,23 @@ fn water_surface(
 }
 
 /// Offsets a ray origin off a surface along the geometric normal, on the side of `dir`,
-/// by an amount relative to the coordinates' magnitude (f32 has 24 bits of mantissa).
+/// by an amount relative to the coordinates' magnitude (f32 has 24 bits of mantissa) plus
+/// `floor` ([`World::offset_floor`]) for points near the origin.
 #[inline]
-pub fn offset(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
+pub fn offset(p: Vec3, ng: Vec3, dir: Vec3, floor: f32) -> Vec3 {
+    let eps = offset_distance(p, floor);
     if ng.dot(dir) >= 0.0 { p + ng * eps } else { p - ng * eps }
+}
+
+/// How far [`offset`] moves a point at `p`.
+#[inline]
+pub fn offset_distance(p: Vec3, floor: f32) -> f32 {
+    1e-4 * (floor + p.abs().max_element())
+}
+
+/// [`World::offset_floor`] for a scene whose largest side is `size`: that size, at most 1, so
+/// that a scene of ordinary size keeps the fixed floor (and its images their bits) and a tiny
+/// one is offset in proportion to itself; 1 without triangles.
+fn offset_floor(size: f32) -> f32 {
+    if size.is_finite() && size > 0.0 { size.min(1.0) } else { 1.0 }
 }
