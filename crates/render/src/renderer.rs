@@ -30,14 +30,20 @@ use wgpu::util::DeviceExt;
 /// orthographic with half-height `ymag` and half-width `ymag × aspect` (like the perspective
 /// camera, the target's aspect wins over the one the file was authored for, so nothing is
 /// stretched; `xmag` is then unused).
+///
+/// Depth is reversed: 1 at the near plane, 0 at the far one ([`crate::passes::FAR_DEPTH`]). A
+/// perspective depth falls as 1/distance, and a float holds small values finely where it holds
+/// values near 1 coarsely; the usual order spent that precision at the near plane and left a
+/// far surface's reconstructed position centimetres off (a camera with znear 10⁻⁴ and zfar 100
+/// streaked its shadows), the reversed one keeps every distance to about 10⁻⁷ of itself.
 pub fn projection(camera: &scene::Camera, aspect: f32) -> Mat4 {
     match camera.ortho {
         Some((_, ymag)) => {
             let y = ymag.abs();
             let x = y * aspect;
-            Mat4::orthographic_rh(-x, x, -y, y, camera.clip_near(), camera.zfar)
+            Mat4::orthographic_rh(-x, x, -y, y, camera.zfar, camera.clip_near())
         }
-        None => Mat4::perspective_rh(camera.yfov, aspect, camera.clip_near(), camera.zfar),
+        None => Mat4::perspective_rh(camera.yfov, aspect, camera.zfar, camera.clip_near()),
     }
 }
 
@@ -813,7 +819,8 @@ impl Renderer {
         let m = spectral.setup.xyz_to_rgb;
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            // Inverted in f64: the shaders rebuild positions from depth with it.
+            inv_view_proj: view_proj.as_dmat4().inverse().as_mat4().to_cols_array_2d(),
             camera_pos: camera.position().extend(1.0).to_array(),
             xyz_to_rgb: [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x as f32, c.y as f32, c.z as f32, 0.0]),
             viewport: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],

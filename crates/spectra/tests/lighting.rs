@@ -668,3 +668,77 @@ fn a_scene_far_from_its_origin_renders_as_at_the_origin() {
     assert!(de < 0.5, "block-mean ΔE2000 {de:.3} between the box at the origin and 2·10⁴ units out");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The Cornell box lit by its emissive ceiling alone (radiance does not depend on the scene's
+/// size) scaled by 2⁻²⁰ (a micrometre-sized scene in metres) renders as at its own size in both
+/// renderers: the path tracer offset every ray origin by at least 10⁻⁴ units, which put every
+/// bounce outside so small a scene (`World::offset_floor`).
+#[test]
+fn a_tiny_scene_renders_as_at_its_own_size() {
+    let d = dir("tiny");
+    let mut s = scene::builtin("cornell").unwrap();
+    s.lights.clear();
+    let unit = d.join("unit.gltf");
+    scene::write_gltf(&s, &unit).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&unit).unwrap()).unwrap();
+    let roots = doc["scenes"][0]["nodes"].clone();
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    let k = (-20f32).exp2();
+    nodes.push(serde_json::json!({"scale": [k, k, k], "children": roots}));
+    let root = nodes.len() - 1;
+    doc["scenes"][0]["nodes"] = serde_json::json!([root]);
+    // glTF does not scale a camera's clip planes with its node.
+    let persp = &mut doc["cameras"][0]["perspective"];
+    for plane in ["znear", "zfar"] {
+        persp[plane] = serde_json::json!(persp[plane].as_f64().unwrap() * f64::from(k));
+    }
+    let tiny = d.join("tiny.gltf");
+    std::fs::write(&tiny, doc.to_string()).unwrap();
+    let (u, t) = (unit.to_str().unwrap(), tiny.to_str().unwrap());
+    for (what, args) in [
+        ("truth", vec!["truth", "--spp", "64", "--size", "48x48"]),
+        ("render", vec!["render", "--size", "48x48"]),
+    ] {
+        let (a, b) = (p(&d, &format!("{what}-unit.exr")), p(&d, &format!("{what}-tiny.exr")));
+        for (file, out) in [(u, &a), (t, &b)] {
+            let mut v = args.clone();
+            v.insert(1, file);
+            v.extend(["--out", out.as_str()]);
+            spectra(&v);
+        }
+        let de = block_de(&a, &b);
+        eprintln!("{what}: block-mean ΔE2000 {de:.3} between the box at its size and at 2^-20");
+        assert!(de < 0.5, "{what}: block-mean ΔE2000 {de:.3} between the box at its size and at 2^-20");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The Cornell box through a camera whose near plane is 10⁻⁴ (far plane 100, the smallest ratio
+/// a camera is drawn with) renders as through one with an ordinary near plane: with depth in
+/// the usual order its positions rebuilt from depth were millimetres off at the box (6·10⁻⁸ of
+/// depth there is 5 mm of distance), and its shadows and occlusion streaked; reversed depth
+/// keeps them to 10⁻⁷ of the distance (`render::renderer::projection`).
+#[test]
+fn a_tiny_near_plane_renders_as_an_ordinary_one() {
+    let d = dir("near");
+    let mut s = scene::builtin("cornell").unwrap();
+    let mut files = vec![];
+    for (name, znear) in [("ordinary", 0.1f32), ("tiny", 1e-4)] {
+        s.camera.znear = znear;
+        s.camera.zfar = 100.0;
+        let f = d.join(format!("{name}.gltf"));
+        scene::write_gltf(&s, &f).unwrap();
+        files.push(f.display().to_string());
+    }
+    for env in ["none", "default"] {
+        let (a, b) = (p(&d, &format!("ordinary-{env}.exr")), p(&d, &format!("tiny-{env}.exr")));
+        for (f, out) in [(&files[0], &a), (&files[1], &b)] {
+            let out = spectra(&["render", f, "--env", env, "--size", "64x64", "--out", out]);
+            assert!(!String::from_utf8_lossy(&out.stderr).contains("clip at"), "the near plane was moved");
+        }
+        let de = block_de(&a, &b);
+        eprintln!("--env {env}: block-mean ΔE2000 {de:.4} between znear 0.1 and 1e-4");
+        assert!(de < 0.05, "--env {env}: block-mean ΔE2000 {de:.4} between znear 0.1 and 1e-4");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

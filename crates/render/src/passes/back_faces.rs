@@ -37,7 +37,7 @@ impl BackFacesPass {
                     buffers: &[Some(Vertex::layout())],
                 },
                 primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Front), ..Default::default() },
-                depth_stencil: Some(depth_state(wgpu::CompareFunction::Less, true)),
+                depth_stencil: Some(depth_state(super::NEARER, true)),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
@@ -79,7 +79,7 @@ impl BackFacesPass {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: wgpu::LoadOp::Clear(super::FAR_DEPTH),
                     store: wgpu::StoreOp::Discard,
                 }),
                 stencil_ops: None,

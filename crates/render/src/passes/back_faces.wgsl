@@ -19,6 +19,6 @@ fn vs_back(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
 @fragment
 fn fs_back(in: BackOut) -> @location(0) vec4<f32> {
     let c = frame.view_proj * vec4<f32>(in.world, 1.0);
-    let depth = select(c.w, c.z, (frame.flags & FLAG_ORTHO) != 0u);
+    let depth = select(c.w, 1.0 - c.z, (frame.flags & FLAG_ORTHO) != 0u);
     return vec4<f32>(normalize(in.normal), depth);
 }

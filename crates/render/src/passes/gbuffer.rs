@@ -138,7 +138,7 @@ impl GBufferPass {
                     load: if layer == Layer::Transmissive {
                         wgpu::LoadOp::Load
                     } else {
-                        wgpu::LoadOp::Clear(1.0)
+                        wgpu::LoadOp::Clear(super::FAR_DEPTH)
                     },
                     store: wgpu::StoreOp::Store,
                 }),
@@ -208,7 +208,7 @@ fn build(
                     cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
                     ..Default::default()
                 },
-                depth_stencil: Some(super::depth_state(wgpu::CompareFunction::Less, true)),
+                depth_stencil: Some(super::depth_state(super::NEARER, true)),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module,

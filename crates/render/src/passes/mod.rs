@@ -81,6 +81,13 @@ pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Fl
 /// the other three take 24, and WebGPU counts an Rgba8Unorm target as 8.
 pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The camera's depth where nothing is drawn, what its depth targets are cleared to: depth is
+/// reversed (1 near, 0 far; [`crate::renderer::projection`]), so a nearer surface has the
+/// larger depth and passes [`NEARER`]. The shaders' `is_far_depth` knows the same. (Shadow maps
+/// keep the usual order: their range is a thousandfold, not a millionfold.)
+pub const FAR_DEPTH: f32 = 0.0;
+/// The camera's depth test (reversed depth, see [`FAR_DEPTH`]).
+pub const NEARER: wgpu::CompareFunction = wgpu::CompareFunction::Greater;
 
 /// A [`DEPTH_FORMAT`] depth test with `compare`, writing depth when `write`.
 pub fn depth_state(compare: wgpu::CompareFunction, write: bool) -> wgpu::DepthStencilState {

@@ -20,7 +20,7 @@ const OCCLUSION_DEPTH_STEPS: f32 = 4.0;
 fn position_at(q: vec2<f32>) -> vec4<f32> {
     if (any(q < vec2<f32>(0.0)) || any(q >= frame.viewport.xy)) { return vec4<f32>(0.0); }
     let d = textureLoad(gbuf_depth, vec2<i32>(q), 0);
-    if (d >= 1.0) { return vec4<f32>(0.0); }
+    if (is_far_depth(d)) { return vec4<f32>(0.0); }
     return vec4<f32>(world_from_depth(floor(q) + 0.5, d, frame), 1.0);
 }
 
@@ -70,7 +70,7 @@ fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
     // sphere under a 1e-5 rad field of view lost up to 75 % of its light, in blocks), so the
     // light is left unoccluded there.
     let dp = textureLoad(gbuf_depth, vec2<i32>(pix), 0);
-    let along = world_from_depth(pix, min(dp + OCCLUSION_DEPTH_STEPS * max(dp, 1e-30) * 1.1920929e-7, 1.0), frame) - p;
+    let along = world_from_depth(pix, max(dp - OCCLUSION_DEPTH_STEPS * dp * 1.1920929e-7, 0.0), frame) - p;
     let side = world_from_depth(pix + vec2<f32>(1.0, 0.0), dp, frame) - p;
     if (dot(side, side) <= dot(along, along)) { return 1.0; }
     // Horizons are measured from the facet's plane, reconstructed from the depth of the nearer
@@ -95,7 +95,7 @@ fn env_occlusion(pix: vec2<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
             let q = pix + dir * (1.0 + t * screen_r);
             if (any(q < vec2<f32>(0.0)) || q.x >= frame.viewport.x || q.y >= frame.viewport.y) { break; }
             let depth = textureLoad(gbuf_depth, vec2<i32>(q), 0);
-            if (depth >= 1.0) { continue; }
+            if (is_far_depth(depth)) { continue; }
             // The depth is that of the texel's centre: placing it at q instead would move the
             // point sideways by up to half a pixel, which at a silhouette, where depth changes
             // fast across the screen, tilts v by tenths of a radian (a convex sphere's rim

@@ -11,7 +11,7 @@
 fn occlusion_at(in: FullscreenOut) -> vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     let depth = textureLoad(gbuf_depth, px, 0);
-    if (depth >= 1.0) {
+    if (is_far_depth(depth)) {
         return vec4<f32>(1.0);
     }
     // The position and normal exactly as the shading pass has them (`surface_context`,

@@ -444,7 +444,7 @@ impl ShadingPass {
                 buffers: &[Some(crate::scene_gpu::Vertex::layout())],
             },
             primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(super::depth_state(wgpu::CompareFunction::LessEqual, false)),
+            depth_stencil: Some(super::depth_state(wgpu::CompareFunction::GreaterEqual, false)),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &self.module,

@@ -11,7 +11,7 @@
 fn shade(in: FullscreenOut) -> vec4<f32> {
     let px = vec2<i32>(in.pos.xy);
     let depth = textureLoad(gbuf_depth, px, 0);
-    if (depth >= 1.0 || frame.n_lights == 0u) {
+    if (is_far_depth(depth) || frame.n_lights == 0u) {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let p = world_from_depth(in.pos.xy, depth, frame);

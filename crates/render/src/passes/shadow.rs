@@ -452,11 +452,18 @@ fn casts(view_proj: Mat4, skip: Option<usize>, mesh_bounds: &[(Vec3, Vec3)]) -> 
     })
 }
 
+/// Half the diagonal of the scene's bounds, which sizes every shadow frustum, texel and bias.
+/// Not floored at any fixed size (it was at 10⁻³: a scene 10⁻⁶ across had a bias larger than
+/// itself and its lamp's shadows drew nothing); only a point-like scene gets a nonzero floor.
+fn scene_radius(bounds: (Vec3, Vec3)) -> f32 {
+    ((bounds.1 - bounds.0).length() * 0.5).max(1e-30)
+}
+
 /// View-projection from the light and a normal-offset bias (world units), or `None` when the
 /// light cannot cast a shadow map (degenerate geometry).
 pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Mat4, f32)> {
     let centre = (bounds.0 + bounds.1) * 0.5;
-    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let radius = scene_radius(bounds);
     let up_for = |dir: Vec3| if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let texel = 2.0 * radius / SHADOW_SIZE as f32;
     match light.kind {
@@ -477,7 +484,7 @@ pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Ma
         LightKind::Point { position, .. } => {
             let to_centre = centre - position;
             let dist = to_centre.length();
-            let d = if dist > 1e-4 { to_centre / dist } else { Vec3::NEG_Y };
+            let d = if dist > 1e-4 * radius { to_centre / dist } else { Vec3::NEG_Y };
             let fov = if dist > radius { 2.2 * (radius / dist).asin() } else { 150f32.to_radians() };
             let fov = fov.clamp(0.1, 150f32.to_radians());
             let far = dist + radius * 2.0;
@@ -491,7 +498,7 @@ pub fn light_view_proj(light: &scene::Light, bounds: (Vec3, Vec3)) -> Option<(Ma
 /// emitting normal (what lies outside it is treated as lit); the shading pass softens its
 /// shadows by the polygon's size (`soft_visibility` in shading.wgsl, from `ShadowUniforms::bias`).
 pub fn emitter_view_proj(e: &scene::emitters::Emitter, bounds: (Vec3, Vec3)) -> Option<(Mat4, f32)> {
-    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let radius = scene_radius(bounds);
     let texel = 2.0 * radius / SHADOW_SIZE as f32;
     let d = e.normal.try_normalize()?;
     let up = if d.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
@@ -507,7 +514,7 @@ pub const EMITTER_FOV: f32 = 150.0 * std::f32::consts::PI / 180.0;
 /// Near and far distances of an emissive polygon's shadow frustum.
 fn emitter_depth_range(e: &scene::emitters::Emitter, bounds: (Vec3, Vec3)) -> (f32, f32) {
     let centre = (bounds.0 + bounds.1) * 0.5;
-    let radius = ((bounds.1 - bounds.0).length() * 0.5).max(1e-3);
+    let radius = scene_radius(bounds);
     let d = e.normal.try_normalize().unwrap_or(Vec3::Y);
     let eye = e.centroid() + d * (1e-4 * radius);
     let far = (eye - centre).length() + radius * 2.0;

@@ -86,9 +86,10 @@ fn abbe_ior(n_d: f32, dispersion: f32, lambda: f32) -> f32 {
 }
 
 // A depth that grows linearly along any ray: the clip w of a perspective camera (its view
-// depth), the clip z of an orthographic one. The back-face pass stores the same.
+// depth), 1 − the clip z of an orthographic one (whose depth is reversed, as every camera's).
+// The back-face pass stores the same.
 fn linear_depth(c: vec4<f32>) -> f32 {
-    return select(c.w, c.z, (frame.flags & FLAG_ORTHO) != 0u);
+    return select(c.w, 1.0 - c.z, (frame.flags & FLAG_ORTHO) != 0u);
 }
 
 // Pixel coordinates of clip-space point c (in front of the camera).
@@ -238,8 +239,8 @@ fn landing_pixel(e: Exit) -> vec2<f32> {
         let u = f32(i) / f32(OUTSIDE_STEPS);
         let k = k_end * u * u;
         let depth = textureLoad(opaque_depth, vec2<i32>(mix(s0, s1, k)), 0);
-        let sky = depth >= 1.0;
-        if ((!sky && mix(z0, z1, k) >= depth) || (sky && over_surface)) {
+        let sky = is_far_depth(depth);
+        if ((!sky && mix(z0, z1, k) <= depth) || (sky && over_surface)) {
             hi = k;
             break;
         }
@@ -252,14 +253,14 @@ fn landing_pixel(e: Exit) -> vec2<f32> {
     for (var i = 0u; i < REFINE_STEPS; i++) {
         let k = 0.5 * (lo + hi);
         let depth = textureLoad(opaque_depth, vec2<i32>(mix(s0, s1, k)), 0);
-        if (depth >= 1.0 || mix(z0, z1, k) >= depth) {
+        if (is_far_depth(depth) || mix(z0, z1, k) <= depth) {
             hi = k;
         } else {
             lo = k;
         }
     }
     let depth = textureLoad(opaque_depth, vec2<i32>(mix(s0, s1, hi)), 0);
-    if (depth >= 1.0) {
+    if (is_far_depth(depth)) {
         return vec2<f32>(-1.0);
     }
     return mix(s0, s1, hi);

@@ -46,7 +46,14 @@ const PI: f32 = 3.14159265358979;
 // shading can tell it apart; its colour is stored as emission.
 const UNLIT_MARK: f32 = -1.0;
 
-// World position of a pixel from its depth (wgpu depth 0..1, y down in pixel space).
+// Whether a camera depth is the far plane's, where nothing was drawn. The camera's depth is
+// reversed, 1 near and 0 far (renderer::projection, passes::FAR_DEPTH): a nearer surface has the
+// larger depth.
+fn is_far_depth(depth: f32) -> bool {
+    return depth <= 0.0;
+}
+
+// World position of a pixel from its (reversed) depth, y down in pixel space.
 fn world_from_depth(pixel: vec2<f32>, depth: f32, f: FrameUniforms) -> vec3<f32> {
     let ndc = vec2<f32>(pixel.x * f.viewport.z * 2.0 - 1.0, 1.0 - pixel.y * f.viewport.w * 2.0);
     let h = f.inv_view_proj * vec4<f32>(ndc, depth, 1.0);
@@ -60,7 +67,7 @@ fn view_origin(pixel: vec2<f32>, p: vec3<f32>, f: FrameUniforms) -> vec3<f32> {
     if ((f.flags & FLAG_ORTHO) == 0u) {
         return cam;
     }
-    let forward = normalize(world_from_depth(pixel, 1.0, f) - world_from_depth(pixel, 0.0, f));
+    let forward = normalize(world_from_depth(pixel, 0.0, f) - world_from_depth(pixel, 1.0, f));
     return p - forward * dot(p - cam, forward);
 }
 

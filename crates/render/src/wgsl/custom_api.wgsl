@@ -40,7 +40,7 @@ struct SurfaceContext {
 // The context of the pixel at fragment position `pos` whose G-buffer depth is `depth`, as the
 // shading and custom passes both build it. The normal is left zero for the caller to fill.
 fn surface_context(pos: vec2<f32>, depth: f32, f: FrameUniforms) -> SurfaceContext {
-    let background = depth >= 1.0;
+    let background = is_far_depth(depth);
     let p = world_from_depth(pos, depth, f);
     let origin = view_origin(pos, p, f);
     let to_p = p - origin;

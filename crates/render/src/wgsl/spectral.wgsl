@@ -83,13 +83,13 @@ fn light_incidence(li: u32, p: vec3<f32>) -> vec4<f32> {
         // shading pass integrates polygons exactly; this serves the custom hooks).
         let c = polygon_centroid(li);
         let d = c - p;
-        let dist2 = max(dot(d, d), 1e-8);
+        let dist2 = max(dot(d, d), 1e-30);
         let wi = d * inverseSqrt(dist2);
         let cos_l = max(dot(polygon_normal(li), -wi), 0.0);
         return vec4<f32>(wi, light.cone.w * cos_l / dist2);
     }
     let d = light.pos_kind.xyz - p;
-    let dist2 = max(dot(d, d), 1e-8);
+    let dist2 = max(dot(d, d), 1e-30);
     let wi = d * inverseSqrt(dist2);
     var atten = 1.0 / dist2;
     let range = light.dir_range.w;
