@@ -307,6 +307,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
     let camera = match camera {
         Some((mut c, index)) => {
             warnings.extend(fit_clip_planes(&mut c, &meshes, &format!("cameras[{index}]")));
+            warnings.extend(clipped_whole(&c, &meshes, &format!("cameras[{index}]")));
             c
         }
         None => Camera::framing(crate::framing::bounds(&meshes)),
@@ -575,6 +576,35 @@ fn fit_clip_planes(camera: &mut Camera, meshes: &[crate::Mesh], at: &str) -> Opt
             short(camera.clip_near())
         )
     })
+}
+
+/// A warning where the camera's clip planes leave out the whole scene: every point of its
+/// bounding box nearer than the near plane or farther than the far one (a scene shrunk by a
+/// node's scale keeps its camera's clip planes, which glTF does not scale: the frame was the
+/// background alone, without a word).
+fn clipped_whole(camera: &Camera, meshes: &[crate::Mesh], at: &str) -> Option<String> {
+    let (lo, hi) = crate::framing::bounds(meshes)?;
+    let view = camera.transform.inverse();
+    let depths = (0..8).map(|i| {
+        let c = Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2]);
+        -view.transform_point3(c).z
+    });
+    let (near, far) = depths.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
+    if far < camera.clip_near() {
+        Some(format!(
+            "{at}: every surface lies nearer than the near plane (znear {}; the scene reaches {} along the view): nothing is drawn",
+            short(camera.clip_near()),
+            short(far)
+        ))
+    } else if near > camera.zfar {
+        Some(format!(
+            "{at}: every surface lies beyond the far plane (zfar {}; the scene starts at {} along the view): nothing is drawn",
+            short(camera.zfar),
+            short(near)
+        ))
+    } else {
+        None
+    }
 }
 
 /// A distance for a message: four decimals where that reads well, else four digits and an

@@ -1062,3 +1062,30 @@ fn transmission_volume_and_dispersion_are_read_checked_and_exported() {
         assert!(load(&d).unwrap().materials[0].transmission.is_none());
     }
 }
+
+/// Clip planes that leave out the whole scene (a scene shrunk by a node's scale keeps its
+/// camera's planes, which glTF does not scale) are said, naming the camera; the frame was the
+/// background alone, without a word. A camera that sees part of the scene is not.
+#[test]
+fn clip_planes_that_leave_out_the_whole_scene_are_warned_about() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let cam = |znear: f64, zfar: f64| json!([{"type": "perspective", "perspective": {"yfov": 0.8, "znear": znear, "zfar": zfar}}]);
+    // The triangle lies in z = 0, 3 units before the camera.
+    let mut doc = b.finish(json!({
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+        "cameras": cam(5.0, 100.0),
+    }));
+    let s = load(&doc).unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert_has(&s.warnings[0], &["cameras[0]", "nearer than the near plane", "znear 5", "nothing is drawn"]);
+    doc["cameras"] = cam(0.1, 2.0);
+    let s = load(&doc).unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert_has(&s.warnings[0], &["cameras[0]", "beyond the far plane", "zfar 2", "nothing is drawn"]);
+    for (znear, zfar) in [(0.1, 100.0), (2.9, 100.0), (0.1, 3.1)] {
+        doc["cameras"] = cam(znear, zfar);
+        assert!(load(&doc).unwrap().warnings.is_empty(), "{znear} {zfar}");
+    }
+}
