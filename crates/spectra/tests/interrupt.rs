@@ -173,3 +173,62 @@ fn eval_stops_without_a_summary() {
         assert!(temps.is_empty(), "{temps:?}");
     }
 }
+
+/// `demo --out DIR` holding a previous run's image (`truth.png`): what is left after Ctrl-C at
+/// `stage` (the line of standard error to wait for) and `after` it.
+fn demo_interrupted(spp: &str, size: &str, stage: &str, after: Duration) -> (String, Vec<String>, String) {
+    use std::io::BufRead;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("truth.png"), "previous run").unwrap();
+    let mut cmd = spectra(&["demo", "--out", dir.path().to_str().unwrap(), "--spp", spp, "--size", size]);
+    let mut child = cmd.spawn().expect("spawn spectra");
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut all = String::new();
+        for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line.clone());
+            all += &line;
+            all.push('\n');
+        }
+        all
+    });
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        match rx.recv_timeout(Duration::from_millis(100)) {
+            Ok(line) if line.contains(stage) => break,
+            Ok(_) => {}
+            Err(_) if Instant::now() > deadline => panic!("no '{stage}' within 120 s"),
+            Err(_) => assert!(child.try_wait().unwrap().is_none(), "demo ended before '{stage}'"),
+        }
+    }
+    std::thread::sleep(after);
+    // SAFETY: kill(2) on our own child's pid.
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let status = child.wait().unwrap();
+    let stderr = reader.join().unwrap();
+    assert_eq!(status.code(), Some(130), "{stderr}");
+    let kept = std::fs::read_to_string(dir.path().join("truth.png")).unwrap_or_default();
+    let mut left = entries(dir.path());
+    left.sort();
+    (stderr, left, kept)
+}
+
+/// Ctrl-C during the demo's ground truth, and during its real-time renders once the truth is
+/// done, leaves --out as it was: the images are made in a private folder and put in place
+/// together (the truth was written into --out before the renders, so an interrupt then left
+/// a new truth beside the previous run's renders while saying nothing was written).
+#[test]
+fn demo_leaves_its_folder_as_it_was() {
+    for (spp, size, stage) in [("100000000", "8x8", "1/3"), ("1", "1024x1024", "2/3")] {
+        let (stderr, left, kept) = demo_interrupted(spp, size, stage, Duration::from_millis(1500));
+        assert!(stderr.contains("no output written"), "{stderr}");
+        assert_eq!(kept, "previous run", "truth.png replaced ({stage}); {stderr}");
+        // The forced exit (a driver call that cannot be interrupted) skips the working folder's
+        // removal; its name carries the pid, so the next demo removes it.
+        let forced = stderr.contains("forced");
+        let expected: &[&str] = &["truth.png"];
+        let visible: Vec<&String> = left.iter().filter(|n| !(forced && n.starts_with(".demo."))).collect();
+        assert_eq!(visible, expected, "left after Ctrl-C at {stage}: {left:?}; {stderr}");
+    }
+}

@@ -14,6 +14,7 @@ use scene::{LightKind, Scene, SpectralReflectance};
 use serde_json::{Value, json};
 use std::fs;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 fn io(path: &Path) -> impl Fn(std::io::Error) -> TruthError + '_ {
     move |source| TruthError::Io { path: path.display().to_string(), source }
@@ -59,6 +60,13 @@ fn ply(m: &scene::Mesh) -> Vec<u8> {
     b
 }
 
+/// A scene with large textures or meshes takes seconds to write; Ctrl-C meanwhile ends it here,
+/// where dropping the temporary directory removes it, rather than by the forced exit, which
+/// left the directory behind.
+fn stop_if_cancelled(cancel: &AtomicBool) -> Result<()> {
+    if cancel.load(Ordering::Relaxed) { Err(TruthError::Cancelled) } else { Ok(()) }
+}
+
 fn ppm(t: &scene::Texture) -> Vec<u8> {
     let mut b = format!("P6\n{} {}\n255\n", t.width, t.height).into_bytes();
     for px in t.rgba8.chunks_exact(4) {
@@ -69,8 +77,16 @@ fn ppm(t: &scene::Texture) -> Vec<u8> {
 
 /// Exports `world` for a `width`×`height` render into the directory `dir`, which must not
 /// exist yet (it is written under a temporary name and renamed, so it is never half there).
-/// Returns the list of unsupported features it left out.
-pub fn export(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<String>> {
+/// Returns the list of unsupported features it left out. Stops with [`TruthError::Cancelled`]
+/// between files once `cancel` is set (the binary passes [`color::cancel::token`]), removing
+/// what it wrote.
+pub fn export(
+    world: &World,
+    width: u32,
+    height: u32,
+    dir: &Path,
+    cancel: &AtomicBool,
+) -> Result<Vec<String>> {
     if dir.exists() {
         return Err(TruthError::Io {
             path: dir.display().to_string(),
@@ -80,12 +96,13 @@ pub fn export(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<
     // An unpredictable private directory (mkdtemp) is filled, then renamed into place: a
     // predictable name made with `create_dir_all` would follow a symlink planted there.
     let tmp = color::outfile::temp_dir_next_to(dir).map_err(io(dir))?;
-    let unsupported = write_all(world, width, height, tmp.path())?;
+    let unsupported = write_all(world, width, height, tmp.path(), cancel)?;
+    stop_if_cancelled(cancel)?;
     color::outfile::persist_dir(tmp, dir).map_err(io(dir))?;
     Ok(unsupported)
 }
 
-fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<String>> {
+fn write_all(world: &World, width: u32, height: u32, dir: &Path, cancel: &AtomicBool) -> Result<Vec<String>> {
     let scene: &Scene = &world.scene;
     let mut unsupported = Vec::new();
 
@@ -95,6 +112,7 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
     let up = cam.transform.transform_vector3(Vec3::Y).normalize();
 
     for (i, t) in scene.textures.iter().enumerate() {
+        stop_if_cancelled(cancel)?;
         let p = dir.join(format!("texture_{i}.ppm"));
         fs::write(&p, ppm(t)).map_err(io(&p))?;
     }
@@ -163,6 +181,7 @@ fn write_all(world: &World, width: u32, height: u32, dir: &Path) -> Result<Vec<S
         if !m.colors.is_empty() {
             unsupported.push(format!("mesh {i}: vertex colours (COLOR_0)"));
         }
+        stop_if_cancelled(cancel)?;
         let p = dir.join(format!("mesh_{i}.ply"));
         fs::write(&p, ply(m)).map_err(io(&p))?;
         meshes.push(json!({ "ply": format!("mesh_{i}.ply"), "material": m.material }));
@@ -243,7 +262,11 @@ mod tests {
         let _ = fs::remove_dir_all(&base);
         fs::create_dir_all(&base).unwrap();
         let dir = base.join("out");
-        assert!(export(&w, 16, 8, &dir).unwrap().is_empty());
+        // Cancelled, it stops and leaves nothing, not even its temporary directory.
+        assert!(matches!(export(&w, 16, 8, &dir, &AtomicBool::new(true)), Err(TruthError::Cancelled)));
+        assert_eq!(fs::read_dir(&base).unwrap().count(), 0);
+        let go = AtomicBool::new(false);
+        assert!(export(&w, 16, 8, &dir, &go).unwrap().is_empty());
         let doc: Value = serde_json::from_str(&fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
         assert_eq!(doc["meshes"][0]["ply"], "mesh_0.ply");
         assert!((doc["camera"]["near_clip"].as_f64().unwrap() - 0.01).abs() < 1e-9);
@@ -252,7 +275,7 @@ mod tests {
         assert!((e[560 - 380].as_f64().unwrap() - 200.0).abs() < 1.0, "{}", e[180]);
         let ply = fs::read(dir.join("mesh_0.ply")).unwrap();
         assert!(ply.starts_with(b"ply\nformat binary_little_endian"));
-        assert!(export(&w, 16, 8, &dir).is_err());
+        assert!(export(&w, 16, 8, &dir, &go).is_err());
         fs::remove_dir_all(&base).unwrap();
     }
 }

@@ -68,18 +68,33 @@ pub fn run(a: Args) -> Result<()> {
     truth::render::check_size(w, h).map_err(|e| size_error(e.to_string()))?;
     render::Renderer::new()?.check_size(w, h).map_err(|e| size_error(e.to_string()))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let file = |name: &str| a.out.join(name);
+    // Every image is made in a private folder inside --out and the eleven are put in place
+    // together at the end: an interrupt or a failure part way (Ctrl-C during the real-time
+    // renders, a full disk) left a new truth beside the previous run's renders and heat maps,
+    // as if they belonged together. The folder goes when the demo ends, however it ends; one
+    // left by a killed demo is removed by the next (its name carries the dead pid).
+    let work = color::outfile::temp_dir_next_to(&a.out.join("demo"))
+        .with_context(|| format!("creating a working folder in {}", a.out.display()))?;
+    let file = |name: &str| work.path().join(name);
     let spp = a.spp.to_string();
 
     eprintln!("1/3 ground truth: CPU spectral path tracer, direct lighting, {} spp", a.spp);
     let truth = file("truth.exr");
-    for out in [&truth, &file("truth.png")] {
-        let (size, out) = (format!("--size={}", a.size), format!("--out={}", path_str(out)?));
-        let argv = ["truth", "--direct-only", "--spp", &spp, &size, &out, "--", &a.scene];
+    {
+        let (size, out) = (format!("--size={}", a.size), format!("--out={}", path_str(&truth)?));
+        // No checkpoint: it would be kept in the working folder, which an interrupt removes.
+        let argv =
+            ["truth", "--direct-only", "--spp", &spp, "--checkpoint-every=0", &size, &out, "--", &a.scene];
         let mut args: super::truth::Args = parse(&argv)?;
         args.scene.files = a.files.clone();
         super::truth::run(args)?;
     }
+    // The PNG is the EXR's values encoded as `spectra truth --out truth.png` encodes them (the
+    // EXR holds them in f32): the same image without tracing it a second time.
+    let reference = read_image(&truth)?;
+    let png = compare::io::encode_image(file("truth.png"), &reference, Default::default())?;
+    std::fs::write(file("truth.png"), png)
+        .with_context(|| format!("writing {}", file("truth.png").display()))?;
 
     eprintln!("2/3 real-time renderer: rgb, naive and spectral modes");
     let modes = ["rgb", "naive", "spectral"];
@@ -95,7 +110,6 @@ pub fn run(a: Args) -> Result<()> {
     }
 
     eprintln!("3/3 error against the ground truth");
-    let reference = read_image(&truth)?;
     let mut rows = Vec::new();
     for mode in modes {
         let test = read_image(file(&format!("{mode}.exr")))?;
@@ -105,6 +119,22 @@ pub fn run(a: Args) -> Result<()> {
             .save_png(&heat)?;
         rows.push((mode, maps.summary()));
     }
+    if color::cancel::is_cancelled() {
+        anyhow::bail!("interrupted");
+    }
+    let names = ["truth.exr", "truth.png"]
+        .into_iter()
+        .map(String::from)
+        .chain(modes.iter().flat_map(|m| [format!("{m}.exr"), format!("{m}.png"), format!("{m}-error.png")]));
+    let _hold = color::cancel::hold();
+    let mut staged = Vec::new();
+    for name in names {
+        let bytes =
+            std::fs::read(file(&name)).with_context(|| format!("reading {}", file(&name).display()))?;
+        staged.push(super::stage_output(&a.out.join(&name), &bytes)?);
+    }
+    super::commit_outputs(staged)?;
+    drop(work);
     println!("\n{} against its path-traced ground truth ({} spp, direct lighting):\n", a.scene, a.spp);
     println!("{:<10} {:>12} {:>12} {:>14}", "mode", "mean ΔE2000", "p95 ΔE2000", "MAE (linear)");
     for (mode, s) in &rows {

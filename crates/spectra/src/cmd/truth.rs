@@ -551,7 +551,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     let prep = t0.elapsed();
     if let Some(dir) = &a.export_mitsuba {
-        let skipped = truth::export_mitsuba::export(&world, st.width, st.height, dir)
+        let skipped = truth::export_mitsuba::export(&world, st.width, st.height, dir, color::cancel::token())
             .with_context(|| format!("exporting to {}", dir.display()))?;
         eprintln!("exported {} for Mitsuba to {}", scene.source, dir.display());
         for s in skipped {
