@@ -841,11 +841,12 @@ fn upload_textures(
                 }
                 None => (t.width, t.height, t.rgba8.as_slice()),
             };
-            if t.srgb {
-                Ok(srgb8_as_linear_f16(device, queue, &t.name, width, height, rgba8))
+            let texture = if t.srgb {
+                srgb8_as_linear_f16(device, queue, &t.name, width, height, rgba8, UPLOAD_SLICE_BYTES)
             } else {
-                Ok(linear8_mipmapped(device, queue, &t.name, width, height, rgba8))
-            }
+                linear8_mipmapped(device, queue, &t.name, width, height, rgba8, UPLOAD_SLICE_BYTES)
+            };
+            Ok(texture.create_view(&Default::default()))
         })
         .collect()
 }
@@ -968,17 +969,121 @@ pub fn downsample(width: u32, height: u32, texel: impl Fn(u32, u32) -> [f32; 4] 
 
 /// Every level after the first of a full mip chain, from level 0's `texel(x, y)`.
 pub fn mip_chain(width: u32, height: u32, texel: impl Fn(u32, u32) -> [f32; 4] + Sync) -> Vec<Vec<[f32; 4]>> {
-    let mut levels: Vec<Vec<[f32; 4]>> = Vec::new();
+    let mut levels = Vec::new();
+    for_each_mip(width, height, texel, |_, _, _, level| levels.push(level.to_vec()));
+    levels
+}
+
+/// [`mip_chain`]'s levels handed to `f` one at a time (`f(mip, width, height, texels)`), each
+/// made from the one before and dropped after the next: at most two levels are held, not all.
+pub fn for_each_mip(
+    width: u32,
+    height: u32,
+    texel: impl Fn(u32, u32) -> [f32; 4] + Sync,
+    mut f: impl FnMut(u32, u32, u32, &[[f32; 4]]),
+) {
+    let mut prev: Option<Vec<[f32; 4]>> = None;
     let (mut w, mut h) = (width, height);
-    for _ in 1..mip_count(width, height) {
-        let next = match levels.last() {
+    for mip in 1..mip_count(width, height) {
+        let next = match &prev {
             None => downsample(w, h, &texel),
             Some(prev) => downsample(w, h, |x, y| prev[(y * w + x) as usize]),
         };
-        levels.push(next);
         (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        f(mip, w, h, &next);
+        prev = Some(next);
     }
-    levels
+}
+
+/// Bytes written to a texture between waits for the GPU. `write_texture` keeps a staging copy
+/// of what it is given until a submission carrying it completes, so a whole mip chain written at
+/// once was held three times (the CPU's copy, the staging one, the texture): an 8192² colour
+/// texture took 1.7 GB of memory while it loaded.
+const UPLOAD_SLICE_BYTES: usize = 64 << 20;
+
+/// A texture with a full mip chain, written band of rows by band of rows.
+struct MipUpload<'a> {
+    device: &'a wgpu::Device,
+    queue: &'a wgpu::Queue,
+    texture: wgpu::Texture,
+    texel_bytes: u32,
+    /// [`UPLOAD_SLICE_BYTES`]; tests make it small to cut every level into many bands.
+    slice: usize,
+    pending: usize,
+}
+
+impl<'a> MipUpload<'a> {
+    fn new(
+        device: &'a wgpu::Device,
+        queue: &'a wgpu::Queue,
+        label: &str,
+        width: u32,
+        height: u32,
+        format: wgpu::TextureFormat,
+        slice: usize,
+    ) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: mip_count(width, height),
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            // COPY_SRC for the test that reads every level back.
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let texel_bytes = format.block_copy_size(None).expect("an uncompressed colour format");
+        MipUpload { device, queue, texture, texel_bytes, slice, pending: 0 }
+    }
+
+    /// Writes level `mip` (`width` × `height`) in bands of rows, `band(rows)` giving each
+    /// band's tightly packed bytes.
+    fn level(&mut self, mip: u32, width: u32, height: u32, band: impl Fn(std::ops::Range<u32>) -> Vec<u8>) {
+        let row_bytes = (width * self.texel_bytes) as usize;
+        let rows = (self.slice / row_bytes).clamp(1, height as usize) as u32;
+        for y0 in (0..height).step_by(rows as usize) {
+            let y1 = (y0 + rows).min(height);
+            let data = band(y0..y1);
+            debug_assert_eq!(data.len(), row_bytes * (y1 - y0) as usize);
+            self.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &self.texture,
+                    mip_level: mip,
+                    origin: wgpu::Origin3d { x: 0, y: y0, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &data,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row_bytes as u32),
+                    rows_per_image: Some(y1 - y0),
+                },
+                wgpu::Extent3d { width, height: y1 - y0, depth_or_array_layers: 1 },
+            );
+            self.pending += data.len();
+            if self.pending >= self.slice {
+                self.flush();
+            }
+        }
+    }
+
+    /// Submits the writes so far and waits for them, which frees their staging copies.
+    fn flush(&mut self) {
+        self.queue.submit(std::iter::empty());
+        // A failed wait (a lost device) shows in the frame that follows, with its own error.
+        let _ = self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None });
+        self.pending = 0;
+    }
+
+    fn finish(mut self) -> wgpu::Texture {
+        if self.pending > 0 {
+            self.flush();
+        }
+        self.texture
+    }
 }
 
 /// A linear (non-colour) RGBA8 image as `Rgba8Unorm` with a box-filtered mip chain.
@@ -989,25 +1094,24 @@ fn linear8_mipmapped(
     width: u32,
     height: u32,
     rgba8: &[u8],
-) -> wgpu::TextureView {
+    slice: usize,
+) -> wgpu::Texture {
     let texel = |x: u32, y: u32| {
         let i = 4 * (y * width + x) as usize;
         std::array::from_fn(|c| rgba8[i + c] as f32 / 255.0)
     };
-    let mut data = rgba8.to_vec();
-    for level in mip_chain(width, height, texel) {
-        data.extend(level.iter().flat_map(|t| t.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)));
-    }
-    texture_with_mips(
-        device,
-        queue,
-        label,
-        width,
-        height,
-        mip_count(width, height),
-        wgpu::TextureFormat::Rgba8Unorm,
-        &data,
-    )
+    let mut up = MipUpload::new(device, queue, label, width, height, wgpu::TextureFormat::Rgba8Unorm, slice);
+    let row = 4 * width as usize;
+    up.level(0, width, height, |r| rgba8[r.start as usize * row..r.end as usize * row].to_vec());
+    for_each_mip(width, height, texel, |mip, w, h, level| {
+        up.level(mip, w, h, |r| {
+            level[(r.start * w) as usize..(r.end * w) as usize]
+                .iter()
+                .flat_map(|t| t.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8))
+                .collect()
+        });
+    });
+    up.finish()
 }
 
 /// An sRGB-encoded RGBA8 image decoded exactly on the CPU into linear `Rgba16Float`, with a mip
@@ -1023,7 +1127,8 @@ fn srgb8_as_linear_f16(
     width: u32,
     height: u32,
     rgba8: &[u8],
-) -> wgpu::TextureView {
+    slice: usize,
+) -> wgpu::Texture {
     let lut: Vec<f32> =
         (0..=255u8).map(|v| color::colorspace::srgb_decode(v as f64 / 255.0) as f32).collect();
     let texel = |x: u32, y: u32| {
@@ -1033,30 +1138,32 @@ fn srgb8_as_linear_f16(
     };
     let lut16: Vec<half::f16> =
         (0..=255u8).map(|v| half::f16::from_f64(color::colorspace::srgb_decode(v as f64 / 255.0))).collect();
-    let mut texels: Vec<half::f16> = rgba8
-        .chunks_exact(4)
-        .flat_map(|p| {
-            [
-                lut16[p[0] as usize],
-                lut16[p[1] as usize],
-                lut16[p[2] as usize],
-                half::f16::from_f32(p[3] as f32 / 255.0),
-            ]
-        })
-        .collect();
-    for level in mip_chain(width, height, texel) {
-        texels.extend(level.iter().flat_map(|t| t.map(half::f16::from_f32)));
-    }
-    texture_with_mips(
-        device,
-        queue,
-        label,
-        width,
-        height,
-        mip_count(width, height),
-        wgpu::TextureFormat::Rgba16Float,
-        bytemuck::cast_slice(&texels),
-    )
+    let mut up = MipUpload::new(device, queue, label, width, height, wgpu::TextureFormat::Rgba16Float, slice);
+    let row = 4 * width as usize;
+    up.level(0, width, height, |r| {
+        let texels: Vec<half::f16> = rgba8[r.start as usize * row..r.end as usize * row]
+            .chunks_exact(4)
+            .flat_map(|p| {
+                [
+                    lut16[p[0] as usize],
+                    lut16[p[1] as usize],
+                    lut16[p[2] as usize],
+                    half::f16::from_f32(p[3] as f32 / 255.0),
+                ]
+            })
+            .collect();
+        bytemuck::cast_slice(&texels).to_vec()
+    });
+    for_each_mip(width, height, texel, |mip, w, h, level| {
+        up.level(mip, w, h, |r| {
+            let texels: Vec<half::f16> = level[(r.start * w) as usize..(r.end * w) as usize]
+                .iter()
+                .flat_map(|t| t.map(half::f16::from_f32))
+                .collect();
+            bytemuck::cast_slice(&texels).to_vec()
+        });
+    });
+    up.finish()
 }
 
 /// 1×1 textures standing in for absent material textures (the factors then apply alone).
@@ -1119,6 +1226,93 @@ pub fn refraction_record(m: &scene::Material) -> [[f32; 4]; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every level of a texture, tightly packed, level after level.
+    fn read_levels(gpu: &crate::Gpu, texture: &wgpu::Texture, texel_bytes: u32) -> Vec<Vec<u8>> {
+        (0..texture.mip_level_count())
+            .map(|mip| {
+                let (w, h) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
+                let row = w * texel_bytes;
+                let padded =
+                    row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+                let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: None,
+                    size: (padded * h) as u64,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                });
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                encoder.copy_texture_to_buffer(
+                    wgpu::TexelCopyTextureInfo { mip_level: mip, ..texture.as_image_copy() },
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &buffer,
+                        layout: wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(padded),
+                            rows_per_image: Some(h),
+                        },
+                    },
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                );
+                gpu.queue.submit([encoder.finish()]);
+                crate::readback::map_buffer(&gpu.device, &buffer, |b| {
+                    b.chunks(padded as usize).flat_map(|r| r[..row as usize].to_vec()).collect()
+                })
+                .unwrap()
+            })
+            .collect()
+    }
+
+    /// Textures are written in bands of rows, level by level, to bound the memory a large one
+    /// takes while it loads: cut into bands of one row, or of a few, every level holds exactly
+    /// what the whole chain built in memory and written at once holds (what the upload did
+    /// before), for both formats and odd sizes.
+    #[test]
+    fn banded_texture_upload_is_the_whole_chain() {
+        let gpu = crate::Gpu::headless().unwrap_or_else(|e| panic!("{e}\n{}", crate::Gpu::install_help()));
+        let (w, h) = (67u32, 13u32);
+        let rgba8: Vec<u8> = (0..w * h * 4).map(|i| (i * 97 % 251) as u8).collect();
+        let texel = |x: u32, y: u32| -> [f32; 4] {
+            let i = 4 * (y * w + x) as usize;
+            std::array::from_fn(|c| rgba8[i + c] as f32 / 255.0)
+        };
+        // The whole chain, as the upload built it before.
+        let mut linear = vec![rgba8.clone()];
+        linear.extend(mip_chain(w, h, texel).iter().map(|l| {
+            l.iter().flat_map(|t| t.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)).collect::<Vec<u8>>()
+        }));
+        let decode = |v: u8| color::colorspace::srgb_decode(v as f64 / 255.0);
+        let srgb_texel = |x: u32, y: u32| -> [f32; 4] {
+            let i = 4 * (y * w + x) as usize;
+            std::array::from_fn(
+                |c| if c < 3 { decode(rgba8[i + c]) as f32 } else { rgba8[i + 3] as f32 / 255.0 },
+            )
+        };
+        let level0: Vec<half::f16> = rgba8
+            .chunks_exact(4)
+            .flat_map(|p| {
+                [0, 1, 2, 3].map(|c| {
+                    if c < 3 {
+                        half::f16::from_f64(decode(p[c]))
+                    } else {
+                        half::f16::from_f32(p[3] as f32 / 255.0)
+                    }
+                })
+            })
+            .collect();
+        let mut srgb = vec![bytemuck::cast_slice::<half::f16, u8>(&level0).to_vec()];
+        srgb.extend(mip_chain(w, h, srgb_texel).iter().map(|l| {
+            let t: Vec<half::f16> = l.iter().flat_map(|t| t.map(half::f16::from_f32)).collect();
+            bytemuck::cast_slice::<half::f16, u8>(&t).to_vec()
+        }));
+        assert_eq!(linear.len(), 7);
+        for slice in [1, 3 * 67 * 8, UPLOAD_SLICE_BYTES] {
+            let t = linear8_mipmapped(&gpu.device, &gpu.queue, "test", w, h, &rgba8, slice);
+            assert_eq!(read_levels(&gpu, &t, 4), linear, "linear, slices of {slice} bytes");
+            let t = srgb8_as_linear_f16(&gpu.device, &gpu.queue, "test", w, h, &rgba8, slice);
+            assert_eq!(read_levels(&gpu, &t, 8), srgb, "sRGB, slices of {slice} bytes");
+        }
+    }
 
     #[test]
     fn vertex_is_72_bytes() {
