@@ -1,7 +1,11 @@
 #!/bin/bash
 # Fills .dev/ and .gl/ for tools/device_bench.sh (a lent GPU machine; see its header):
 #   tools/device_pack.sh OLD_SPECTRA_BINARY DAMAGED_HELMET_DIR [TEST ...]
-# (DAMAGED_HELMET_DIR holds DamagedHelmet.gltf with its files, or DamagedHelmet.glb)
+# (DAMAGED_HELMET_DIR holds DamagedHelmet.gltf with its files, or DamagedHelmet.glb. The Khronos
+# sample repositories are larger than this workplace's fetch tool brings (500 MB); the fetchable
+# github:googlestadia/PorQue4K holds the model's earlier export (same textures, 552 200-byte .bin):
+#   git -C /work/.mirror/googlestadia+PorQue4K/repo archive HEAD assets/models/DamagedHelmet/glTF | tar x -C /tmp/dh
+#   -> /tmp/dh/assets/models/DamagedHelmet/glTF)
 # builds this checkout's release binary and render tests, strips and packs them (xz) with the
 # old binary to compare against, the asset, the cached coefficient table and the run script,
 # and downloads the Vulkan loader debs. Prints what will travel; keep it under 64 MiB.
