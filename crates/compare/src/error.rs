@@ -28,6 +28,10 @@ pub enum CompareError {
     /// A pixel is NaN or infinite where a finite value is required.
     #[error("{what}: pixel ({x}, {y}) is not finite: {value:?}")]
     NonFinite { what: String, x: u32, y: u32, value: [f32; 3] },
+    /// Two images hold different parts of their frames (EXR data and display windows) that
+    /// cannot be lined up pixel for pixel.
+    #[error("{0}")]
+    Misplaced(String),
     /// Two images that must match in size do not.
     #[error("image sizes differ: reference is {}×{}, test is {}×{}", reference.0, reference.1, test.0, test.1)]
     SizeMismatch { reference: (u32, u32), test: (u32, u32) },

@@ -11,6 +11,7 @@ use exr::meta::attribute::{AttributeValue, IntegerBounds, Text};
 use exr::prelude::Vec2;
 
 use crate::error::{CompareError, Result};
+use crate::image::Image;
 
 /// The display and data windows and the `spectra.*` text attributes of an EXR.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -126,4 +127,105 @@ pub fn decode_exr_frame(path: &Path, bytes: &[u8]) -> Result<ExrFrame> {
         origin: (dx as u32, dy as u32),
         attributes,
     })
+}
+
+/// Where an image's pixels lie in the frame they belong to: the OpenEXR display window (the
+/// frame) and data window (the pixels the file holds). A PNG, and an EXR whose data window is its
+/// display window, hold the whole frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// The frame's size (the display window's).
+    pub frame: (u32, u32),
+    /// The top-left pixel held, from the frame's top-left (negative for overscan).
+    pub origin: (i64, i64),
+    /// The size of the pixels held (the data window's).
+    pub size: (u32, u32),
+}
+
+impl Placement {
+    /// An image that is its whole frame.
+    pub fn whole(size: (u32, u32)) -> Placement {
+        Placement { frame: size, origin: (0, 0), size }
+    }
+
+    /// Whether the image holds exactly its frame.
+    pub fn is_whole(&self) -> bool {
+        self.origin == (0, 0) && self.size == self.frame
+    }
+
+    /// From an EXR layer's data window position and size and the image's display window.
+    pub(crate) fn of_exr(display: &IntegerBounds, position: Vec2<i32>, size: (usize, usize)) -> Placement {
+        Placement {
+            frame: (display.size.0 as u32, display.size.1 as u32),
+            origin: (
+                i64::from(position.0) - i64::from(display.position.0),
+                i64::from(position.1) - i64::from(display.position.1),
+            ),
+            size: (size.0 as u32, size.1 as u32),
+        }
+    }
+
+    fn describe(&self) -> String {
+        if self.is_whole() {
+            format!("the whole of a {}×{} frame", self.frame.0, self.frame.1)
+        } else {
+            format!(
+                "{}×{} pixels at ({}, {}) of a {}×{} frame (its data window)",
+                self.size.0, self.size.1, self.origin.0, self.origin.1, self.frame.0, self.frame.1
+            )
+        }
+    }
+}
+
+/// The part of a frame two images are compared over, where it is not simply both images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Region {
+    /// The frame's size.
+    pub frame: (u32, u32),
+    /// The region's top-left pixel in the frame.
+    pub origin: (i64, i64),
+    pub size: (u32, u32),
+}
+
+/// Lines up a reference and a test image by where their pixels lie in their frames, so that the
+/// same pixel of the frame is compared with itself: images that hold the same pixels (the same
+/// size at the same place) are returned as they are (`None`); images of one frame that hold
+/// different parts of it (a crop and the full frame, two overlapping crops, an overscan) are cut
+/// to the pixels both hold, and that region is returned. Anything else — different frames with
+/// the pixels at different places, crops that share no pixel — is an error that says where each
+/// image's pixels lie (the size check of the comparison itself is left to it).
+pub fn align(
+    reference: Image,
+    rp: Placement,
+    test: Image,
+    tp: Placement,
+) -> Result<(Image, Image, Option<Region>)> {
+    let same = rp.origin == tp.origin && rp.size == tp.size;
+    if same || (rp.is_whole() && tp.is_whole()) {
+        return Ok((reference, test, None));
+    }
+    let both = || format!("the reference holds {}, the test {}", rp.describe(), tp.describe());
+    if rp.frame != tp.frame {
+        return Err(CompareError::Misplaced(format!(
+            "the images hold different parts of different frames: {}",
+            both()
+        )));
+    }
+    let x0 = rp.origin.0.max(tp.origin.0);
+    let y0 = rp.origin.1.max(tp.origin.1);
+    let x1 = (rp.origin.0 + i64::from(rp.size.0)).min(tp.origin.0 + i64::from(tp.size.0));
+    let y1 = (rp.origin.1 + i64::from(rp.size.1)).min(tp.origin.1 + i64::from(tp.size.1));
+    if x1 <= x0 || y1 <= y0 {
+        return Err(CompareError::Misplaced(format!("the images share no pixel of their frame: {}", both())));
+    }
+    let (w, h) = ((x1 - x0) as u32, (y1 - y0) as u32);
+    let cut = |im: &Image, p: &Placement| {
+        let (dx, dy) = ((x0 - p.origin.0) as u32, (y0 - p.origin.1) as u32);
+        Image::from_fn(w, h, |x, y| im.get(x + dx, y + dy))
+    };
+    Ok((
+        cut(&reference, &rp)?,
+        cut(&test, &tp)?,
+        Some(Region { frame: rp.frame, origin: (x0, y0), size: (w, h) }),
+    ))
 }

@@ -17,6 +17,7 @@ use exr::prelude::{
 
 use crate::atomic::write_atomic;
 use crate::error::{CompareError, Result};
+use crate::frame::Placement;
 use crate::image::Image;
 
 /// Sample type of written EXR files.
@@ -88,7 +89,8 @@ fn check_size(path: &Path, format: &'static str, w: u64, h: u64) -> Result<()> {
 ///
 /// EXR: the first valid layer at its largest resolution; channels `R`, `G`, `B` are required
 /// (any other channel, e.g. `A`, is ignored); f16, f32 and u32 samples are converted to f32.
-/// The data window is taken as the image (its offset is ignored).
+/// The data window is taken as the image; [`decode_image_placed`] also says where it lies in the
+/// display window.
 ///
 /// PNG: 8- or 16-bit, grey, grey+alpha, RGB, RGBA or palette; values are sRGB-decoded.
 /// Alpha is dropped, not composited: renders and references are opaque.
@@ -114,11 +116,21 @@ pub fn png_bit_depth(path: impl AsRef<Path>) -> Option<u8> {
 /// Decodes the bytes of an EXR or PNG file as [`read_image`] does, the format chosen by the
 /// extension of `path` (which only names the image in messages).
 pub fn decode_image(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Image> {
+    decode_image_placed(path, bytes).map(|(image, _)| image)
+}
+
+/// [`decode_image`], and where the pixels lie in the image's frame (an EXR's data and display
+/// windows; a PNG is its whole frame), for comparing images pixel for pixel
+/// ([`crate::frame::align`]).
+pub fn decode_image_placed(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(Image, Placement)> {
     let path = path.as_ref();
     let format = format_of(path)?;
     match format {
-        Format::Exr => read_exr(path, bytes),
-        Format::Png => read_png(path, bytes),
+        Format::Exr => read_exr_channels(path, bytes, 64),
+        Format::Png => read_png(path, bytes).map(|im| {
+            let size = im.size();
+            (im, Placement::whole(size))
+        }),
     }
 }
 
@@ -142,14 +154,10 @@ pub(crate) fn read_flat_exr(bytes: &[u8]) -> std::result::Result<FlatExr, exr::e
 pub fn read_spectral_exr_rgb(path: impl AsRef<Path>) -> Result<Image> {
     let path = path.as_ref();
     let bytes = color::input::read_regular(path, MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
-    read_exr_channels(path, &bytes, crate::spectral::MAX_BANDS as u64 + 8)
+    read_exr_channels(path, &bytes, crate::spectral::MAX_BANDS as u64 + 8).map(|(image, _)| image)
 }
 
-fn read_exr(path: &Path, bytes: &[u8]) -> Result<Image> {
-    read_exr_channels(path, bytes, 64)
-}
-
-fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<Image> {
+fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<(Image, Placement)> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
     check_exr_headers(path, bytes, max_channels)?;
     // Every part, for the first that holds R, G and B (a render's beauty pass need not be the
@@ -214,7 +222,9 @@ fn read_exr_channels(path: &Path, bytes: &[u8], max_channels: u64) -> Result<Ima
             }
         })
         .collect();
-    Image::new(width, height, data).map_err(|e| decode(e.to_string()))
+    let placement =
+        Placement::of_exr(&image.attributes.display_window, layer.attributes.layer_position, (w, h));
+    Ok((Image::new(width, height, data).map_err(|e| decode(e.to_string()))?, placement))
 }
 
 /// The matrix from an EXR's RGB to linear sRGB by its `chromaticities` attribute (`None`: absent,

@@ -21,12 +21,12 @@ pub mod spectral;
 
 pub use diff::{DiffMaps, DiffOptions, DiffSummary};
 pub use error::{CompareError, Result};
-pub use frame::{ExrFrame, read_exr_frame, read_exr_frame_and_size};
+pub use frame::{ExrFrame, Placement, Region, align, read_exr_frame, read_exr_frame_and_size};
 pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
 pub use io::{
-    ExrPrecision, PngBitDepth, WriteOptions, decode_image, encode_exr_framed, encode_image, read_image,
-    write_exr_framed, write_image,
+    ExrPrecision, PngBitDepth, WriteOptions, decode_image, decode_image_placed, encode_exr_framed,
+    encode_image, read_image, write_exr_framed, write_image,
 };
 pub use spectral::{
     SpectralImage, SpectralKind, encode_spectral_exr_framed, read_spectral_exr, write_spectral_exr,

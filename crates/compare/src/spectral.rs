@@ -230,6 +230,15 @@ pub fn read_spectral_exr(path: impl AsRef<Path>) -> Result<SpectralImage> {
 /// polarised or subsampled channels, band edges that are unsorted, of zero or negative width, or
 /// do not hold their channel's wavelength at their centre.
 pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<SpectralImage> {
+    decode_spectral_exr_placed(path, bytes).map(|(image, _)| image)
+}
+
+/// [`decode_spectral_exr`], and where the pixels lie in the image's frame (its data and display
+/// windows), for comparing images pixel for pixel ([`crate::frame::align`]).
+pub fn decode_spectral_exr_placed(
+    path: impl AsRef<Path>,
+    bytes: &[u8],
+) -> Result<(SpectralImage, crate::frame::Placement)> {
     let path = path.as_ref();
     let decode =
         |reason: String| CompareError::Decode { path: path.into(), format: "spectral OpenEXR", reason };
@@ -326,7 +335,12 @@ pub fn decode_spectral_exr(path: impl AsRef<Path>, bytes: &[u8]) -> Result<Spect
     }
     let img = SpectralImage { width, height, kind, edges, data, white: text(WHITE_ATTRIBUTE), centres };
     img.validate().map_err(|e| decode(e.to_string()))?;
-    Ok(img)
+    let placement = crate::frame::Placement::of_exr(
+        &image.attributes.display_window,
+        layer.attributes.layer_position,
+        (w, h),
+    );
+    Ok((img, placement))
 }
 
 fn edges_from_attribute(

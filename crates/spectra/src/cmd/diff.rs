@@ -84,16 +84,21 @@ pub struct Args {
 }
 
 /// Reads an input; a spectral EXR is integrated to linear sRGB with the chosen observer and
-/// white. Returns a note saying how, for spectral inputs.
-fn load(path: &std::path::Path, what: &str, args: &Args) -> anyhow::Result<(Image, Option<String>)> {
+/// white. Returns where its pixels lie in its frame, and a note saying how, for spectral inputs.
+fn load(
+    path: &std::path::Path,
+    what: &str,
+    args: &Args,
+) -> anyhow::Result<(Image, compare::Placement, Option<String>)> {
     let bytes = color::input::read_regular(path, compare::io::MAX_INPUT_BYTES)
         .with_context(|| format!("reading the {what} image {}", path.display()))?;
     let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if !(is_exr && compare::spectral::is_spectral_exr(&bytes)) {
-        let img = compare::decode_image(path, &bytes).with_context(|| format!("reading the {what} image"))?;
-        return Ok((img, None));
+        let (img, placed) = compare::decode_image_placed(path, &bytes)
+            .with_context(|| format!("reading the {what} image"))?;
+        return Ok((img, placed, None));
     }
-    let spec = compare::spectral::decode_spectral_exr(path, &bytes)
+    let (spec, placed) = compare::spectral::decode_spectral_exr_placed(path, &bytes)
         .with_context(|| format!("reading the {what} image"))?;
     let obs_name = args.observer.as_deref().unwrap_or("cie1931");
     let observer = color::Observer::by_name(obs_name).context("--observer")?;
@@ -110,7 +115,7 @@ fn load(path: &std::path::Path, what: &str, args: &Args) -> anyhow::Result<(Imag
         edges[edges.len() - 1],
         observer.name
     );
-    Ok((img, Some(note)))
+    Ok((img, placed, Some(note)))
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -219,11 +224,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             super::check_output(flag, p)?;
         }
     }
-    let (mut reference, ref_note) = load(&args.reference, "reference", &args)?;
-    let (mut test, test_note) = load(&args.test, "test", &args)?;
+    let (reference, ref_placed, ref_note) = load(&args.reference, "reference", &args)?;
+    let (test, test_placed, test_note) = load(&args.test, "test", &args)?;
     if (args.observer.is_some() || args.white.is_some()) && ref_note.is_none() && test_note.is_none() {
         bail!("--observer and --white integrate spectral EXR inputs, and neither input is one");
     }
+    // The same pixel of the frame with itself: an EXR's data window may be a crop of its frame
+    // (two crops of one size at different places were compared pixel for pixel).
+    let (mut reference, mut test, region) = compare::align(reference, ref_placed, test, test_placed)
+        .with_context(|| format!("comparing {} with {}", args.reference.display(), args.test.display()))?;
     if args.block != 1 {
         // Blocks of two different sizes could coincide: compare sizes first.
         if reference.size() != test.size() {
@@ -301,9 +310,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             },
         );
         o.insert("per_pixel_out".into(), args.per_pixel_out.as_ref().map(|p| p.display().to_string()).into());
+        o.insert(
+            "region".into(),
+            match region {
+                Some(r) => serde_json::json!({
+                    "frame": [r.frame.0, r.frame.1],
+                    "x": r.origin.0,
+                    "y": r.origin.1,
+                    "width": r.size.0,
+                    "height": r.size.1,
+                }),
+                None => serde_json::Value::Null,
+            },
+        );
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_table(&args, &summary, heatmap, [&ref_note, &test_note], flip_stats.as_ref());
+        print_table(&args, &summary, heatmap, [&ref_note, &test_note], flip_stats.as_ref(), region);
     }
     Ok(())
 }
@@ -314,6 +336,7 @@ fn print_table(
     heatmap: Option<(&PathBuf, f64)>,
     notes: [&Option<String>; 2],
     flip: Option<&(color::metrics::Stats, Option<compare::flip::Exposures>)>,
+    region: Option<compare::Region>,
 ) {
     let note = |n: &Option<String>| n.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
     println!("reference  {}{}", args.reference.display(), note(notes[0]));
@@ -325,6 +348,13 @@ fn print_table(
         u64::from(s.width) * u64::from(s.height),
         s.white_luminance
     );
+    if let Some(r) = region {
+        println!(
+            "region     {}×{} at ({}, {}) of the {}×{} frame: the pixels both images hold (data windows); \
+             the maps' and per-pixel x, y count from it",
+            r.size.0, r.size.1, r.origin.0, r.origin.1, r.frame.0, r.frame.1
+        );
+    }
     println!();
     println!(
         "{:<22}{:>12}{:>12}{:>12}{:>12}{:>12}",
@@ -427,7 +457,7 @@ mod tests {
         assert_eq!(spec.bands(), n);
         let pixel = |file: &str, obs: &str| {
             let a = args(&[&p("g.exr"), &p(file), "--observer", obs]);
-            let (img, note) = load(std::path::Path::new(&p(file)), "test", &a).unwrap();
+            let (img, _, note) = load(std::path::Path::new(&p(file)), "test", &a).unwrap();
             assert!(note.unwrap().contains(obs), "the note names the observer");
             img.data[5]
         };
