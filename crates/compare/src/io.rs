@@ -251,7 +251,7 @@ fn exr_to_srgb(
 pub(crate) fn check_exr_headers(path: &Path, bytes: &[u8], max_channels: u64) -> Result<()> {
     let decode = |reason: String| CompareError::Decode { path: path.into(), format: "OpenEXR", reason };
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
-        .map_err(|e| decode(e.to_string()))?;
+        .map_err(|e| decode(header_error(bytes, e)))?;
     for h in &meta.headers {
         let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
         check_size(path, "OpenEXR", w, ht)?;
@@ -267,6 +267,32 @@ pub(crate) fn check_exr_headers(path: &Path, bytes: &[u8], max_channels: u64) ->
         return Err(decode(format!("{} layers; at most 64 are read", meta.headers.len())));
     }
     Ok(())
+}
+
+/// Why the exr crate refused an EXR's headers, said plainly where its words mislead: an empty file
+/// ("reference to missing bytes"), a compression method newer than it (OpenEXR 3.4's LJ2K and
+/// ZSTD, 12 and 13: "missing or invalid compression attribute", as if the file were damaged).
+fn header_error(bytes: &[u8], e: exr::error::Error) -> String {
+    if bytes.is_empty() {
+        return "the file is empty".into();
+    }
+    // The attribute's name, type, size (1) and value: the first part's.
+    let key = b"compression\0compression\0\x01\0\0\0";
+    let method = bytes.windows(key.len()).position(|w| w == key).and_then(|at| bytes.get(at + key.len()));
+    if let Some(&m) = method
+        && m > 11
+    {
+        let name = match m {
+            12 => " (LJ2K)",
+            13 => " (ZSTD)",
+            _ => "",
+        };
+        return format!(
+            "compression method {m}{name} is not supported; these are: none, RLE, ZIPS, ZIP, PIZ, PXR24, B44, \
+             B44A, DWAA, DWAB (rewrite it with one, e.g. `oiiotool IN --compression zip -o OUT`)"
+        );
+    }
+    e.to_string()
 }
 
 fn read_png(path: &Path, bytes: &[u8]) -> Result<Image> {
@@ -840,6 +866,30 @@ mod tests {
         std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
         let e = read_image(&cut).unwrap_err().to_string();
         assert!(e.contains("cut.exr"), "{e}");
+    }
+
+    /// An empty file and a compression method the exr crate does not know (OpenEXR 3.4's ZSTD,
+    /// written by its Python package 3.5) are said as such; they read as a damaged file ("reference
+    /// to missing bytes", "missing or invalid compression attribute").
+    #[test]
+    fn empty_files_and_newer_compressions_are_named() {
+        let e = decode_image("e.exr", &[]).unwrap_err().to_string();
+        assert!(e.contains("e.exr") && e.contains("the file is empty"), "{e}");
+        let mut buf = Cursor::new(Vec::new());
+        exr::prelude::Image::from_channels(
+            (2, 2),
+            SpecificChannels::rgb(|_: Vec2<usize>| (0.5f32, 0.5f32, 0.5f32)),
+        )
+        .write()
+        .to_buffered(&mut buf)
+        .unwrap();
+        let mut bytes = buf.into_inner();
+        let key = b"compression\0compression\0\x01\0\0\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len();
+        assert!(decode_image("z.exr", &bytes).is_ok());
+        bytes[at] = 13;
+        let e = decode_image("z.exr", &bytes).unwrap_err().to_string();
+        assert!(e.contains("z.exr") && e.contains("compression method 13 (ZSTD) is not supported"), "{e}");
     }
 
     /// `bytes` of an EXR with its dataWindow replaced by (0, 0)–(w−1, h−1).
