@@ -1707,7 +1707,10 @@ fn illuminant<'py>(
 }
 
 /// Reads an EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it: a float32
-/// array of shape (height, width, 3).
+/// array of shape (height, width, 3) of the pixels it holds. An EXR cropped from a larger frame
+/// (its data window inside its display window, as `truth --crop` writes) gives the crop alone;
+/// `spectra diff` lines two such files up by where they lie in the frame, while `diff` here
+/// compares the arrays as given, pixel for pixel.
 #[pyfunction]
 fn read_image(
     py: Python<'_>,
