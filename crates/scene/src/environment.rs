@@ -180,6 +180,13 @@ impl Environment {
     fn decode(path: &Path, format: image::ImageFormat, bytes: &[u8]) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
         let mut header = None;
+        // A Radiance file in any of its eight orientations, or with another magic line than
+        // `#?RADIANCE`, as the standard one the decoder reads, and how to put its pixels back.
+        let (bytes, layout) = match format {
+            image::ImageFormat::Hdr => radiance_layout(bytes),
+            _ => (std::borrow::Cow::Borrowed(bytes), None),
+        };
+        let bytes = &*bytes;
         if format == image::ImageFormat::OpenExr {
             // The `image` crate applies its limits only after the `exr` crate has decoded the
             // blocks, which allocate what the header claims (a 685-byte file asked for 35 GB;
@@ -205,13 +212,15 @@ impl Environment {
             header = exr_chromaticities(path, &meta)?;
         }
         if format == image::ImageFormat::Hdr {
-            header = radiance_header(path, bytes)?;
+            header = radiance_header(path, bytes, layout.is_some_and(|l| l.x_major))?;
         }
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
         reader.set_format(format);
         let mut limits = image::Limits::default();
-        limits.max_image_width = Some(MAX_INPUT_WIDTH);
-        limits.max_image_height = Some(MAX_INPUT_HEIGHT);
+        // (A picture stored column by column is decoded as its transpose.)
+        let transposed = layout.is_some_and(|l| l.x_major);
+        limits.max_image_width = Some(if transposed { MAX_INPUT_HEIGHT } else { MAX_INPUT_WIDTH });
+        limits.max_image_height = Some(if transposed { MAX_INPUT_WIDTH } else { MAX_INPUT_HEIGHT });
         // The decoded image of the largest accepted size, as RGBA f32 (the EXR decoder's form; a
         // limit of half that refused the 16384×8192 maps promised above).
         limits.max_alloc = Some(MAX_DECODED_BYTES);
@@ -232,6 +241,10 @@ impl Environment {
             // edge, as any sRGB renderer shows them.
             Some(m) => texels.into_iter().map(|t| (m * t).max(Vec3::ZERO)).collect(),
             None => texels,
+        };
+        let (w, h, texels) = match layout {
+            Some(l) => l.to_standard(w, h, &texels),
+            None => (w, h, texels),
         };
         Self::from_rgb(&path.display().to_string(), w, h, texels)
     }
@@ -725,13 +738,96 @@ fn exr_chromaticities(
     Ok((m != glam::DMat3::IDENTITY).then(|| m.as_mat3()))
 }
 
+/// How a Radiance file lays out its scanlines (its resolution line, such as `+Y 512 +X 1024`),
+/// when that is not the standard `-Y H +X W` (top to bottom, each left to right).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct RadianceLayout {
+    /// Scanlines are columns (`±X n ±Y m`), not rows.
+    x_major: bool,
+    /// Columns run right to left (`-X`).
+    x_decreasing: bool,
+    /// Rows run bottom to top (`+Y`; Radiance's Y points up).
+    y_increasing: bool,
+}
+
+impl RadianceLayout {
+    /// The picture, row 0 at the top and each row left to right, from the decoded scanlines
+    /// (`n` of `len` pixels: the decoder's width × height).
+    fn to_standard(self, len: u32, n: u32, px: &[Vec3]) -> (u32, u32, Vec<Vec3>) {
+        let (w, h) = if self.x_major { (n, len) } else { (len, n) };
+        let mut out = vec![Vec3::ZERO; px.len()];
+        for i in 0..n {
+            for j in 0..len {
+                let (x, y) = if self.x_major { (i, j) } else { (j, i) };
+                let x = if self.x_decreasing { w - 1 - x } else { x };
+                let y = if self.y_increasing { h - 1 - y } else { y };
+                out[(y * w + x) as usize] = px[(i * len + j) as usize];
+            }
+        }
+        (w, h, out)
+    }
+}
+
+/// A Radiance file as the `image` decoder reads it (which knows only `#?RADIANCE` and `-Y H +X W`),
+/// with the layout to undo afterwards. Radiance writes pictures in eight orientations (`pflip`,
+/// `protate`, other writers: `+Y H +X W` is upside down, `+X W -Y H` column by column) and other
+/// programs' files begin with another magic line such as `#?RGBE` (stb_image reads both); they
+/// were refused ("does not support the format features Orientation +Y +X", "signature not
+/// found"). Anything unexpected is left for the decoder to report.
+fn radiance_layout(bytes: &[u8]) -> (std::borrow::Cow<'_, [u8]>, Option<RadianceLayout>) {
+    use std::borrow::Cow;
+    let unchanged = (Cow::Borrowed(bytes), None);
+    let line_end = |from: usize| bytes[from..].iter().position(|&b| b == b'\n').map(|i| from + i);
+    let Some(magic_end) = line_end(0) else { return unchanged };
+    if !bytes.starts_with(b"#?") {
+        return unchanged;
+    }
+    // The header's lines up to the empty one, then the resolution line.
+    let mut at = magic_end + 1;
+    loop {
+        let Some(end) = line_end(at) else { return unchanged };
+        let empty = end == at;
+        at = end + 1;
+        if empty {
+            break;
+        }
+    }
+    let Some(res_end) = line_end(at) else { return unchanged };
+    let Ok(res) = std::str::from_utf8(&bytes[at..res_end]) else { return unchanged };
+    let f: Vec<&str> = res.split_whitespace().collect();
+    let [a, n1, b, n2] = f[..] else { return unchanged };
+    let (Ok(n1), Ok(n2)) = (n1.parse::<u32>(), n2.parse::<u32>()) else { return unchanged };
+    let layout = match (a, b) {
+        ("-Y" | "+Y", "-X" | "+X") => {
+            RadianceLayout { x_major: false, x_decreasing: b == "-X", y_increasing: a == "+Y" }
+        }
+        ("-X" | "+X", "-Y" | "+Y") => {
+            RadianceLayout { x_major: true, x_decreasing: a == "-X", y_increasing: b == "+Y" }
+        }
+        _ => return unchanged,
+    };
+    let standard = RadianceLayout { x_major: false, x_decreasing: false, y_increasing: false };
+    if layout == standard && &bytes[..magic_end] == b"#?RADIANCE" {
+        return unchanged;
+    }
+    let mut out = b"#?RADIANCE".to_vec();
+    out.extend_from_slice(&bytes[magic_end..at]);
+    out.extend_from_slice(format!("-Y {n1} +X {n2}").as_bytes());
+    out.extend_from_slice(&bytes[res_end..]);
+    (Cow::Owned(out), (layout != standard).then_some(layout))
+}
+
 /// What a Radiance header says about its pixels, as the matrix that takes them to linear sRGB
 /// radiance, or `None` where they already are: `EXPOSURE` (every factor the file's writers
 /// applied; the pixels are divided by their product, per the Radiance file format) and
 /// `COLORCORR` (the same, per channel), and `PRIMARIES` other than Rec. 709's (converted, with
 /// Bradford adaptation from the file's white to D65). These used to be ignored: a file written
 /// with `EXPOSURE=4` rendered four times too bright.
-fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, EnvironmentError> {
+fn radiance_header(
+    path: &Path,
+    bytes: &[u8],
+    transposed: bool,
+) -> Result<Option<glam::Mat3>, EnvironmentError> {
     use glam::{DMat3, DVec3};
     let err = |message: String| EnvironmentError { file: path.to_path_buf(), message };
     // The header ends at the first empty line; Radiance's own tools write a few hundred bytes.
@@ -751,11 +847,9 @@ fn radiance_header(path: &Path, bytes: &[u8]) -> Result<Option<glam::Mat3>, Envi
         .map_err(|e| err(format!("not a readable Hdr image: {e}")))?
         .metadata();
     // The decoder's own limit would say only "Memory limit exceeded".
-    if meta.width > MAX_INPUT_WIDTH || meta.height > MAX_INPUT_HEIGHT {
-        return Err(err(format!(
-            "{}×{} is larger than the {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} accepted",
-            meta.width, meta.height
-        )));
+    let (w, h) = if transposed { (meta.height, meta.width) } else { (meta.width, meta.height) };
+    if w > MAX_INPUT_WIDTH || h > MAX_INPUT_HEIGHT {
+        return Err(err(format!("{w}×{h} is larger than the {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} accepted")));
     }
     let positive = |v: f32| v.is_finite() && v > 0.0;
     let mut scale = DVec3::ONE;
@@ -995,6 +1089,61 @@ mod tests {
     /// Radiance headers are honoured (they used to be ignored): EXPOSURE divides, cumulatively,
     /// COLORCORR per channel, PRIMARIES other than Rec. 709's are converted; bad values name
     /// the header field.
+    /// Radiance pictures stored in any of the eight orientations, or under another magic line
+    /// (`#?RGBE`), read as the same picture (all but `-Y H +X W` under `#?RADIANCE` were refused).
+    #[test]
+    fn radiance_files_in_every_orientation_read_as_the_same_picture() {
+        let (w, h) = (16u32, 8u32);
+        // Exact RGBE texels: red says the column, green the row (value = byte / 128).
+        let px = |x: u32, y: u32| [16 + x as u8, 16 + y as u8, 100, 129];
+        let want: Vec<Vec3> =
+            (0..h * w).map(|i| Vec3::new((16 + i % w) as f32, (16 + i / w) as f32, 100.0) / 128.0).collect();
+        let file = |magic: &str, res: &str| {
+            let f: Vec<&str> = res.split_whitespace().collect();
+            let (major, minor) = (f[0], f[2]);
+            let (n1, n2) = (f[1].parse::<u32>().unwrap(), f[3].parse::<u32>().unwrap());
+            let mut b = format!("{magic}\nFORMAT=32-bit_rle_rgbe\n\n{res}\n").into_bytes();
+            for i in 0..n1 {
+                for j in 0..n2 {
+                    // Radiance's X points right and Y up: "-Y" is top to bottom.
+                    let at = |axis: &str, k: u32| match axis {
+                        "+X" | "-Y" => k,
+                        "-X" => w - 1 - k,
+                        _ => h - 1 - k,
+                    };
+                    let (x, y) = if major.ends_with('Y') {
+                        (at(minor, j), at(major, i))
+                    } else {
+                        (at(major, i), at(minor, j))
+                    };
+                    b.extend_from_slice(&px(x, y));
+                }
+            }
+            b
+        };
+        for res in [
+            "-Y 8 +X 16",
+            "+Y 8 +X 16",
+            "-Y 8 -X 16",
+            "+Y 8 -X 16",
+            "+X 16 -Y 8",
+            "+X 16 +Y 8",
+            "-X 16 -Y 8",
+            "-X 16 +Y 8",
+        ] {
+            for magic in ["#?RADIANCE", "#?RGBE"] {
+                let e = Environment::from_bytes(Path::new("o.hdr"), &file(magic, res))
+                    .unwrap_or_else(|e| panic!("{magic} {res}: {e}"));
+                assert_eq!((e.width, e.height), (w, h), "{magic} {res}");
+                assert_eq!(e.texels, want, "{magic} {res}");
+            }
+        }
+        // A picture stored column by column is limited by its own size, not its transpose's.
+        let big = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+X 16385 -Y 8192\n";
+        let m = Environment::from_bytes(Path::new("big.hdr"), big.as_bytes()).unwrap_err().to_string();
+        assert!(m.contains("16385×8192") && m.contains("16384×8192"), "{m}");
+    }
+
     #[test]
     fn radiance_headers_are_honoured() {
         let px: Vec<image::Rgb<f32>> = (0..32).map(|_| image::Rgb([0.5, 1.0, 0.25])).collect();
