@@ -208,6 +208,16 @@ impl Environment {
                         h.channels.list.len()
                     )));
                 }
+                // The map is the display window (the decoder fills it around the data window):
+                // one larger than accepted said only "Memory limit exceeded".
+                let d = h.shared_attributes.display_window.size;
+                if d.width() > MAX_INPUT_WIDTH as usize || d.height() > MAX_INPUT_HEIGHT as usize {
+                    return Err(err(format!(
+                        "the display window is {}×{}; at most {MAX_INPUT_WIDTH}×{MAX_INPUT_HEIGHT} is accepted",
+                        d.width(),
+                        d.height()
+                    )));
+                }
             }
             header = exr_chromaticities(path, &meta)?;
         }
@@ -1142,6 +1152,22 @@ mod tests {
         let big = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n+X 16385 -Y 8192\n";
         let m = Environment::from_bytes(Path::new("big.hdr"), big.as_bytes()).unwrap_err().to_string();
         assert!(m.contains("16385×8192") && m.contains("16384×8192"), "{m}");
+    }
+
+    /// An EXR whose display window (the map the decoder makes) is larger than accepted around a
+    /// small data window is refused with its size, not the decoder's "Memory limit exceeded".
+    #[test]
+    fn an_exr_display_window_larger_than_accepted_says_its_size() {
+        use exr::prelude::*;
+        let px = SpecificChannels::rgb(|_: Vec2<usize>| (1.0f32, 1.0f32, 1.0f32));
+        let mut layer = Layer::new((2, 1), LayerAttributes::default(), Encoding::UNCOMPRESSED, px);
+        layer.attributes.layer_position = Vec2(0, 0);
+        let mut image = Image::from_layer(layer);
+        image.attributes.display_window = IntegerBounds::new((0, 0), (40000, 20000));
+        let mut b = std::io::Cursor::new(Vec::new());
+        image.write().to_buffered(&mut b).unwrap();
+        let m = Environment::from_bytes(Path::new("crop.exr"), b.get_ref()).unwrap_err().to_string();
+        assert!(m.contains("crop.exr") && m.contains("display window is 40000×20000"), "{m}");
     }
 
     #[test]
