@@ -151,8 +151,12 @@ impl Observer {
             "cie1931" | "cie1964" | "cie2015_2" | "cie2015_10" => ObserverKind::CieXyz,
             "nikon_d5100" | "sigma_sd_merrill" | "canon_5d_mark_ii" | "aces_ricd" => ObserverKind::CameraRgb,
             n if Self::camera(n).is_some() => ObserverKind::CameraRgb,
-            // A file (`--observer FILE.csv`): most such files are cameras.
-            n if crate::observer_file::is_file_name(n) => ObserverKind::CameraRgb,
+            // A file (`--observer FILE.csv`): a CIE observer's colour-matching functions give
+            // CIE XYZ; any other such file is taken for a camera, as most are.
+            n if crate::observer_file::is_file_name(n) => match crate::observer_file::cie_twin(self) {
+                Some(_) => ObserverKind::CieXyz,
+                None => ObserverKind::CameraRgb,
+            },
             _ => ObserverKind::Receptors,
         }
     }

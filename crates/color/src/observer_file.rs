@@ -1,16 +1,19 @@
 //! Observers from a file (`--observer FILE`, issue 33): a camera's or any other three
 //! sensitivity curves, as
 //! - a CSV of wavelength (nm) and three columns — the layout camera databases and
-//!   `colour-science` export. Header and `#` comment lines are skipped; commas, semicolons, tabs
-//!   or spaces separate the fields;
+//!   `colour-science` export. Header and `#` comment lines are skipped; each line's separator
+//!   is a semicolon (then a comma is a decimal comma), a tab (likewise), a comma or runs of
+//!   spaces; UTF-8, UTF-16 with a BOM or Latin-1 text, any line ends (docs/cameras.md);
 //! - the Academy's rawtoaces camera JSON (AcademySoftwareFoundation/rawtoaces-data,
 //!   `schema/spectral_1.0.0.json`): `spectral_data.index.main` names the channels (R, G and B
 //!   are taken by name), `spectral_data.data.main` maps each wavelength to its values.
 //!
 //! Checked, each refusal naming the file and the row (CSV) or the wavelength's entry (JSON) and
-//! the column: finite numbers, wavelengths increasing strictly (CSV) or distinct (JSON),
-//! sensitivities ≥ 0, at least three samples, some overlap with 360–830 nm, no channel all zero.
-//! Outside the file's range the sensitivities are zero; between samples they are linear.
+//! the column: finite numbers, no empty cell, wavelengths increasing strictly (CSV) or distinct
+//! (JSON), sensitivities ≥ 0 (rounding noise of 10⁻⁹ of the largest aside), at least three
+//! samples, some overlap with 360–830 nm, no channel all zero. Outside the file's range the
+//! sensitivities are zero; between samples they are linear. A file holding a CIE observer's
+//! functions gives CIE XYZ ([`cie_twin`]); any other is shown as a camera.
 
 use std::path::Path;
 
@@ -34,11 +37,77 @@ pub fn is_file_name(name: &str) -> bool {
 pub fn read(path: &Path) -> Result<Observer> {
     let shown = path.display().to_string();
     // A regular file of bounded size: a FIFO or a device (/dev/zero) would hang or exhaust memory.
-    let text = crate::input::read_regular_string(path, MAX_FILE_BYTES)
+    let bytes = crate::input::read_regular(path, MAX_FILE_BYTES)
         .map_err(|e| ColorError::Table(format!("observer file {shown}: cannot read it: {e}")))?;
+    let text = decode(&bytes);
     let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
         || text.trim_start_matches('\u{feff}').trim_start().starts_with('{');
     if json { parse_json(&text, &shown) } else { parse(&text, &shown) }
+}
+
+/// A file's text: UTF-8; UTF-16 with its byte-order mark (a spreadsheet's "Unicode text"); else
+/// Latin-1, byte for byte (a spreadsheet's CSV on Windows is Windows-1252: a header such as
+/// `x̄ 2°` or `Wellenlänge` refused the whole file as "not valid UTF-8"). The numbers are ASCII
+/// in all of them, so only the header's text can differ.
+fn decode(bytes: &[u8]) -> String {
+    let utf16 = |le: bool| {
+        let units = bytes[2..]
+            .chunks_exact(2)
+            .map(|c| if le { u16::from_le_bytes([c[0], c[1]]) } else { u16::from_be_bytes([c[0], c[1]]) });
+        char::decode_utf16(units).map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER)).collect()
+    };
+    match bytes {
+        [0xff, 0xfe, ..] => utf16(true),
+        [0xfe, 0xff, ..] => utf16(false),
+        _ => match std::str::from_utf8(bytes) {
+            Ok(s) => s.to_string(),
+            Err(_) => bytes.iter().map(|&b| b as char).collect(),
+        },
+    }
+}
+
+/// The fields of one CSV line. The separator is the line's: a semicolon if it has one (then a
+/// comma is a decimal comma, as European spreadsheets write `400;0,0143;…`), else a tab (also
+/// with decimal commas), else a comma, else runs of spaces. Quotes are taken off and a
+/// separator inside them is text (`"0,5"`). An empty field is kept as one — `400,,0.3,0.1`
+/// has an empty second column; the separators were runs, so it was read as three columns and
+/// `400,0.1,,0.2,0.3` as four, shifted — but empty fields after the fourth are dropped (a
+/// spreadsheet's trailing separators).
+fn split_fields(line: &str) -> Vec<String> {
+    let sep = [';', '\t', ','].into_iter().find(|&c| line.contains(c));
+    let mut fields: Vec<String> = match sep {
+        None => line.split_whitespace().map(|f| f.trim_matches('"').trim().to_string()).collect(),
+        Some(sep) => {
+            let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+            for c in line.chars() {
+                match c {
+                    '"' => quoted = !quoted,
+                    c if c == sep && !quoted => out.push(std::mem::take(&mut cur)),
+                    c => cur.push(c),
+                }
+            }
+            out.push(cur);
+            out.into_iter().map(|f| f.trim().to_string()).collect()
+        }
+    };
+    while fields.len() > 4 && fields.last().is_some_and(|f| f.is_empty()) {
+        fields.pop();
+    }
+    // A decimal comma: one comma, no point (a comma-separated line cannot have one in a field
+    // unless it was quoted, which is how spreadsheets write a decimal comma there).
+    for f in &mut fields {
+        if f.matches(',').count() == 1 && !f.contains('.') {
+            *f = f.replace(',', ".");
+        }
+    }
+    fields
+}
+
+/// A field as it may be shown in an error: control characters escaped, at most 40 characters
+/// (the file may not be a table at all).
+fn shown_field(f: &str) -> String {
+    let s: String = f.chars().take(40).collect::<String>().escape_debug().to_string();
+    if f.chars().count() > 40 { format!("{s}…") } else { s }
 }
 
 /// The observer in CSV `text`; `source` names it in errors and becomes its name.
@@ -46,36 +115,56 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
     let bad =
         |row: usize, what: String| ColorError::Table(format!("observer file {source}: row {row}: {what}"));
     let mut lambda = Vec::new();
+    let mut rows = Vec::new();
     let mut columns: [Vec<f64>; 3] = Default::default();
     let mut first = true;
+    // Lines end in LF, CRLF or — a classic Mac OS export — CR alone (read as one line).
+    let text: std::borrow::Cow<str> =
+        if text.contains('\n') { text.into() } else { text.replace('\r', "\n").into() };
     for (i, line) in text.lines().enumerate() {
         let row = i + 1;
         let line = line.trim().trim_start_matches('\u{feff}');
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        // Fields may be quoted, as spreadsheets export them ("360","0.0001",…).
-        let fields: Vec<&str> = line
-            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-            .map(|f| f.trim_matches('"'))
-            .filter(|f| !f.is_empty())
-            .collect();
+        let fields = split_fields(line);
         // A header: the first line, if its first field is not a number. (Every such line was
         // taken for one, so that a file of text ended as "0 data rows" naming no row.)
         if std::mem::take(&mut first) && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) {
             continue;
         }
         if fields.len() != 4 {
+            let hint = if fields.len() > 8 {
+                "; one row per wavelength is expected (sensitivities given as rows, as in Jiang et al.'s \
+                 camera database, must be turned into columns: tools/camspec_to_csv.py)"
+            } else {
+                ""
+            };
             return Err(bad(
                 row,
-                format!("{} columns; expected 4 (wavelength in nm and three sensitivities)", fields.len()),
+                format!(
+                    "{} column{}; expected 4 (wavelength in nm and three sensitivities){hint}",
+                    fields.len(),
+                    if fields.len() == 1 { "" } else { "s" }
+                ),
             ));
         }
         let mut nums = [0.0f64; 4];
         for (c, f) in fields.iter().enumerate() {
             nums[c] = match f.parse::<f64>() {
                 Ok(x) if x.is_finite() => x,
-                _ => return Err(bad(row, format!("column {}: '{f}' is not a finite number", c + 1))),
+                _ if f.is_empty() => {
+                    return Err(bad(
+                        row,
+                        format!("column {} is empty (write 0 where a sensitivity is zero)", c + 1),
+                    ));
+                }
+                _ => {
+                    return Err(bad(
+                        row,
+                        format!("column {}: '{}' is not a finite number", c + 1, shown_field(f)),
+                    ));
+                }
             };
         }
         if let Some(&prev) = lambda.last()
@@ -86,17 +175,13 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
                 format!("column 1: wavelength {} nm after {prev} nm; wavelengths must increase", nums[0]),
             ));
         }
-        for (c, &v) in nums.iter().enumerate().skip(1) {
-            if v < 0.0 {
-                return Err(bad(row, format!("column {}: sensitivity {v} is negative", c + 1)));
-            }
-        }
         lambda.push(nums[0]);
+        rows.push(row);
         for (col, &v) in columns.iter_mut().zip(&nums[1..]) {
             col.push(v);
         }
     }
-    finish(lambda, columns, source, |c| format!("column {}", c + 2))
+    finish(lambda, columns, source, |c| format!("column {}", c + 2), |i| format!("row {}", rows[i]))
 }
 
 /// The observer in rawtoaces camera JSON `text` (`spectral_data.index.main` and
@@ -133,7 +218,7 @@ pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
     let data = field(&["spectral_data", "data", "main"])?
         .as_object()
         .ok_or_else(|| err("field spectral_data.data.main is not an object of wavelength → values".into()))?;
-    let mut rows: Vec<(f64, [f64; 3])> = Vec::with_capacity(data.len());
+    let mut rows: Vec<(f64, [f64; 3], &String)> = Vec::with_capacity(data.len());
     for (key, values) in data {
         let at = |what: String| err(format!("spectral_data.data.main entry \"{key}\": {what}"));
         let l = match key.trim().parse::<f64>() {
@@ -147,14 +232,11 @@ pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
         let mut v = [0.0; 3];
         for (c, (&i, name)) in channels.iter().zip(["R", "G", "B"]).enumerate() {
             v[c] = match list[i].as_f64() {
-                Some(x) if x.is_finite() && x >= 0.0 => x,
-                Some(x) if x.is_finite() => {
-                    return Err(at(format!("channel {name}: sensitivity {x} is negative")));
-                }
+                Some(x) if x.is_finite() => x,
                 _ => return Err(at(format!("channel {name}: {} is not a finite number", list[i]))),
             };
         }
-        rows.push((l, v));
+        rows.push((l, v, key));
     }
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));
     if let Some(w) = rows.windows(2).find(|w| w[0].0 == w[1].0) {
@@ -162,7 +244,13 @@ pub fn parse_json(text: &str, source: &str) -> Result<Observer> {
     }
     let lambda = rows.iter().map(|r| r.0).collect();
     let columns = [0, 1, 2].map(|c| rows.iter().map(|r| r.1[c]).collect());
-    finish(lambda, columns, source, |c| format!("channel {}", ["R", "G", "B"][c]))
+    finish(
+        lambda,
+        columns,
+        source,
+        |c| format!("channel {}", ["R", "G", "B"][c]),
+        |i| format!("spectral_data.data.main entry \"{}\"", rows[i].2),
+    )
 }
 
 /// The checks on the whole file and the observer, shared by both formats.
@@ -175,8 +263,26 @@ fn finish(
     columns: [Vec<f64>; 3],
     source: &str,
     column_name: impl Fn(usize) -> String,
+    place: impl Fn(usize) -> String,
 ) -> Result<Observer> {
     let whole = |what: String| ColorError::Table(format!("observer file {source}: {what}"));
+    // Negative sensitivities are refused, but not rounding noise: colour-science's CIE 1931 and
+    // 1964 tables, and so spectra's own built-ins written out, hold z̄ values of −3·10⁻²² and
+    // −1.4·10⁻²⁰ where the CIE's are 0, and such a file was refused.
+    let largest = columns.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..lambda.len() {
+        for (c, col) in columns.iter().enumerate() {
+            if col[i] < -NEGATIVE_NOISE * largest {
+                return Err(whole(format!(
+                    "{}: {}: sensitivity {} is negative (sensitivities with negative lobes, such as the CIE 1931 \
+                     RGB colour-matching functions, are not supported: use a non-negative transform of them, such as XYZ)",
+                    place(i),
+                    column_name(c),
+                    col[i]
+                )));
+            }
+        }
+    }
     if lambda.len() < 3 {
         return Err(whole(format!("{} data rows; at least 3 are needed", lambda.len())));
     }
@@ -194,7 +300,6 @@ fn finish(
     // The renderers normalise an observer by its response to the white, so its scale is free;
     // but a scale far from 1 leaves the range where that response and the per-wavelength
     // weights are finite and normal (values of 10⁻³¹⁰ made the path tracer's image NaN).
-    let largest = columns.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(MIN_LARGEST..=MAX_LARGEST).contains(&largest) {
         return Err(whole(format!(
             "its largest value is {largest:e}; scale the file so that it lies within {MIN_LARGEST:e}…{MAX_LARGEST:e} \
@@ -219,6 +324,51 @@ fn finish(
     let [a, b, c] = bar;
     Ok(Observer { name: source.to_string(), bar: [a?, b?, c?] })
 }
+
+/// How far (a share of each channel's peak) a file's samples may lie from a CIE observer's,
+/// each channel scaled by its own factor, for the file to be that observer (see [`cie_twin`]).
+/// The CIE's 5 nm tables with four decimals lie within 5·10⁻⁵; no camera comes near it.
+pub const CIE_TWIN_TOLERANCE: f64 = 1e-4;
+
+/// The CIE observer whose colour-matching functions an observer from a file holds, if any: at
+/// every sample of the file in 360–830 nm, each channel within [`CIE_TWIN_TOLERANCE`] of its
+/// peak of that observer's x̄, ȳ or z̄ times a positive factor of its own (percent, or ȳ scaled
+/// to another peak, are the same observer: the renderers scale each of X, Y and Z by the
+/// white). Such a file gives CIE XYZ and is shown as the built-in is; any other file is shown as
+/// a camera. (Every file was: the CIE's own CSV of CIE 1931 gave an image ΔE2000 up to 30 from
+/// `--observer cie1931`, XYZ white balanced and shown as RGB.)
+pub fn cie_twin(o: &Observer) -> Option<&'static str> {
+    let Spectrum::Piecewise { lambda, .. } = &o.bar[0] else { return None };
+    let at: Vec<f64> = lambda.iter().copied().filter(|l| (LAMBDA_MIN..=LAMBDA_MAX).contains(l)).collect();
+    if at.len() < 3 {
+        return None;
+    }
+    let twin = |cie: &Observer| {
+        (0..3).all(|c| {
+            let f: Vec<f64> = at.iter().map(|&l| o.bar[c].eval(l)).collect();
+            let b: Vec<f64> = at.iter().map(|&l| cie.bar[c].eval(l)).collect();
+            let bb: f64 = b.iter().map(|v| v * v).sum();
+            let k = f.iter().zip(&b).map(|(f, b)| f * b).sum::<f64>() / bb;
+            let peak = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            bb > 0.0
+                && k > 0.0
+                && peak > 0.0
+                && f.iter().zip(&b).all(|(f, b)| (f - k * b).abs() <= CIE_TWIN_TOLERANCE * peak)
+        })
+    };
+    [
+        ("cie1931", Observer::cie1931()),
+        ("cie1964", Observer::cie1964()),
+        ("cie2015_2", Observer::cie2015_2()),
+        ("cie2015_10", Observer::cie2015_10()),
+    ]
+    .into_iter()
+    .find_map(|(name, cie)| twin(&cie).then_some(name))
+}
+
+/// A negative value no further below zero than this share of a file's largest value is
+/// rounding noise, read as it is (see `finish`).
+pub const NEGATIVE_NOISE: f64 = 1e-9;
 
 /// The weakest channel's peak an observer file may have, as a share of its largest value.
 pub const MIN_CHANNEL_SHARE: f64 = 1e-12;
@@ -299,6 +449,143 @@ mod tests {
         assert_eq!(o.eval(500.0), [0.0, 1.0, 0.0]);
         let e = parse("nm,r,g,b\nunits,x,y,z\n400,1,0,0\n", "two.csv").unwrap_err().to_string();
         assert!(e.contains("two.csv") && e.contains("row 2") && e.contains("column 1"), "{e}");
+    }
+
+    /// Every sample of `o` (its first channel's wavelengths), as `row` formats them.
+    fn table(o: &Observer, row: impl Fn(f64, [f64; 3]) -> String) -> String {
+        let Spectrum::Piecewise { lambda, .. } = &o.bar[0] else { panic!("tabulated") };
+        lambda.iter().map(|&l| row(l, o.eval(l))).collect()
+    }
+
+    /// Found by a sweep of files from elsewhere: CIE 1931 written as a spreadsheet writes it was
+    /// refused or misread — decimal commas after semicolons ("7 columns"), classic Mac line
+    /// ends ("0 data rows"), a Windows-1252 or UTF-16 export ("not valid UTF-8"), and the
+    /// built-in's own values (colour-science's, whose z̄ is −3·10⁻²² at 651 nm) as "negative".
+    /// Each now reads as the built-in, percent included, and is CIE XYZ (it was a camera).
+    #[test]
+    fn cie_1931_from_spreadsheets_and_databases_reads_as_the_built_in() {
+        let cie = Observer::cie1931();
+        let plain = table(&cie, |l, v| format!("{l},{:?},{:?},{:?}\n", v[0], v[1], v[2]));
+        let comma = |x: f64| format!("{x:?}").replace('.', ",");
+        let variants: Vec<(&str, Vec<u8>, f64)> = vec![
+            ("cie.csv", plain.clone().into_bytes(), 1.0),
+            (
+                "bom_crlf.csv",
+                format!("\u{feff}\"nm\",\"x\",\"y\",\"z\"\r\n{}\r\n\r\n", plain.replace('\n', "\r\n"))
+                    .into_bytes(),
+                1.0,
+            ),
+            ("mac.csv", format!("wavelength,x,y,z\r{}", plain.replace('\n', "\r")).into_bytes(), 1.0),
+            (
+                "excel_de.csv",
+                table(&cie, |l, v| {
+                    format!("{l};\"{}\";\"{}\";\"{}\"\r\n", comma(v[0]), comma(v[1]), comma(v[2]))
+                })
+                .into_bytes(),
+                1.0,
+            ),
+            (
+                "tabs_decimal_comma.txt",
+                table(&cie, |l, v| format!("{l}\t{}\t{}\t{}\n", comma(v[0]), comma(v[1]), comma(v[2])))
+                    .into_bytes(),
+                1.0,
+            ),
+            (
+                "percent.csv",
+                table(&cie, |l, v| format!("{l},{:?},{:?},{:?}\n", 100.0 * v[0], 100.0 * v[1], 100.0 * v[2]))
+                    .into_bytes(),
+                100.0,
+            ),
+            ("latin1.csv", [b"Wellenl\xe4nge,x\xaf 2\xb0,y,z\n".as_slice(), plain.as_bytes()].concat(), 1.0),
+            (
+                "utf16.txt",
+                [0xffu8, 0xfe]
+                    .into_iter()
+                    .chain(
+                        format!("nm\tx\ty\tz\r\n{}", plain.replace(',', "\t"))
+                            .encode_utf16()
+                            .flat_map(u16::to_le_bytes),
+                    )
+                    .collect(),
+                1.0,
+            ),
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        for (name, bytes, scale) in variants {
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).unwrap();
+            let o = read(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            for i in 0..=470 {
+                let l = 360.0 + i as f64;
+                let (a, b) = (o.eval(l), cie.eval(l));
+                for c in 0..3 {
+                    assert!(
+                        (a[c] / scale - b[c]).abs() <= 1e-15 * scale.max(1.0),
+                        "{name}: {l} nm: {a:?} vs {b:?}"
+                    );
+                }
+            }
+            assert_eq!(o.kind(), crate::observer::ObserverKind::CieXyz, "{name}");
+            assert_eq!(cie_twin(&o), Some("cie1931"), "{name}");
+        }
+    }
+
+    /// Only the CIE observers' functions are CIE XYZ: CIE 1964 is, each channel scaled its own
+    /// way too; a 5 nm subsample is; every camera, the ACES RICD (XYZ mixed) and the cone
+    /// fundamentals are not.
+    #[test]
+    fn only_cie_functions_in_a_file_are_xyz() {
+        let write = |o: &Observer, k: [f64; 3]| {
+            table(o, |l, v| format!("{l},{:?},{:?},{:?}\n", k[0] * v[0], k[1] * v[1], k[2] * v[2]))
+        };
+        let o = parse(&write(&Observer::cie1964(), [2.0, 0.5, 3.0]), "c.csv").unwrap();
+        assert_eq!((o.kind(), cie_twin(&o)), (crate::observer::ObserverKind::CieXyz, Some("cie1964")));
+        let five: String =
+            write(&Observer::cie1931(), [1.0; 3]).lines().step_by(5).map(|l| format!("{l}\n")).collect();
+        assert_eq!(cie_twin(&parse(&five, "5nm.csv").unwrap()), Some("cie1931"));
+        for name in Observer::names().into_iter().filter(|n| !n.starts_with("cie")) {
+            let o = parse(&write(&Observer::by_name(name).unwrap(), [1.0; 3]), "f.csv").unwrap();
+            assert_eq!(cie_twin(&o), None, "{name}");
+            assert_eq!(o.kind(), crate::observer::ObserverKind::CameraRgb, "{name}");
+        }
+    }
+
+    /// Found by a sweep: runs of separators were one separator, so an empty cell shifted the
+    /// columns after it (`400,0.1,,0.2,0.3` read as 0.1, 0.2, 0.3), a decimal comma was a
+    /// separator (`400;0,5;1` read as 0, 5, 1) and so was a comma inside quotes. Empty cells are
+    /// named; a spreadsheet's trailing separators are not cells.
+    #[test]
+    fn empty_cells_and_decimal_commas_are_not_separators() {
+        let e = parse("400,0.1,,0.2,0.3\n500,1,1,1,1\n600,1,1,1,1\n", "e.csv").unwrap_err().to_string();
+        assert!(e.contains("e.csv: row 1: 5 columns"), "{e}");
+        let e = parse("400,1,1,1\n500,,0.3,0.1\n600,1,1,1\n", "e.csv").unwrap_err().to_string();
+        assert!(e.contains("row 2: column 2 is empty"), "{e}");
+        let e = parse("400,1,1,1\n620,0.5,0.3,\n", "cvrl.csv").unwrap_err().to_string();
+        assert!(e.contains("row 2: column 4 is empty"), "{e}");
+        for text in ["400;0,5;1\n500;0,7;1\n600;1,2;1\n", "400,\"0,5\",1\n500,\"0,7\",1\n600,\"1,2\",1\n"] {
+            let e = parse(text, "d.csv").unwrap_err().to_string();
+            assert!(e.contains("row 1: 3 columns"), "{text:?}: {e}");
+        }
+        let o = parse("400,1,2,3,,\n500;1;2;3;;\n600\t1\t2\t3\t\n", "t.csv").unwrap();
+        assert_eq!(o.eval(500.0), [1.0, 2.0, 3.0]);
+        // A field shown in an error cannot write to the terminal.
+        let e = parse("400,1,1,1\n500,\u{1b}[2J,1,1\n", "x.csv").unwrap_err().to_string();
+        assert!(e.contains("\\u{1b}[2J") && !e.contains('\u{1b}'), "{e}");
+    }
+
+    /// Rounding noise below zero is not a negative sensitivity (the built-ins hold it); a
+    /// negative lobe is refused, saying which functions have them.
+    #[test]
+    fn rounding_noise_is_not_a_negative_lobe() {
+        assert!(parse("400,1,1,1\n500,1,-1e-21,1\n600,1,1,1\n", "n.csv").is_ok());
+        let e = parse("400,1,1,1\n500,1,-0.01,1\n600,1,1,1\n", "rgb.csv").unwrap_err().to_string();
+        assert!(
+            e.contains("rgb.csv: row 2: column 3: sensitivity -0.01 is negative")
+                && e.contains("CIE 1931 RGB"),
+            "{e}"
+        );
+        let j = json(r#"["R", "G", "B"]"#, r#""400": [1, 1, 1], "500": [1, -1e-21, 1], "600": [1, 1, 1]"#);
+        assert!(parse_json(&j, "n.json").is_ok());
     }
 
     /// A CSV holding a built-in camera's samples is that camera.

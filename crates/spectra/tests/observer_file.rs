@@ -15,8 +15,9 @@ fn ok(args: &[&str]) -> std::process::Output {
     out
 }
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("spectra-observer-file-{}", std::process::id()));
+/// A fresh directory of this test process's own, one per test (they run in parallel).
+fn dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("spectra-observer-file-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -35,7 +36,7 @@ fn difference(a: &str, b: &str) -> (f64, f64) {
 
 #[test]
 fn a_csv_of_a_built_in_camera_renders_as_that_camera_and_bad_files_are_refused() {
-    let d = dir();
+    let d = dir("camera");
     let nikon = color::Observer::nikon_d5100();
     let color::Spectrum::Piecewise { lambda, .. } = &nikon.bar[0] else { panic!("tabulated") };
     let mut csv = String::from("wavelength_nm,r,g,b\n");
@@ -109,5 +110,42 @@ fn a_csv_of_a_built_in_camera_renders_as_that_camera_and_bad_files_are_refused()
     );
     assert!(!Path::new(&out_file).exists());
     // Kept where an assertion failed, for the files.
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Found by a sweep of files from elsewhere: CIE 1931 as the CIE publishes it (no header,
+/// 1 nm, 360–830 nm, twelve decimals) was taken for a camera — its X, Y, Z white balanced
+/// and shown as RGB, ΔE2000 up to 30 from `--observer cie1931` in both renderers — and the
+/// same table as a German spreadsheet saves it (BOM, CRLF, semicolons, decimal commas, in
+/// percent) was refused. Both now render the built-in's image.
+#[test]
+fn the_cie_1931_table_from_a_file_renders_as_the_built_in() {
+    let d = dir("cie");
+    let cie = color::Observer::cie1931();
+    let color::Spectrum::Piecewise { lambda, .. } = &cie.bar[0] else { panic!("tabulated") };
+    let (mut official, mut excel) =
+        (String::new(), String::from("\u{feff}\"Wellenlänge\";\"x\";\"y\";\"z\"\r\n"));
+    for &l in lambda {
+        let v = cie.eval(l);
+        official.push_str(&format!("{l},{:.12},{:.12},{:.12}\n", v[0], v[1], v[2]));
+        let pc = |x: f64| format!("{:?}", 100.0 * x).replace('.', ",");
+        excel.push_str(&format!("{l};{};{};{}\r\n", pc(v[0]), pc(v[1]), pc(v[2])));
+    }
+    let files = [(p(&d, "CIE_xyz_1931_2deg.csv"), official), (p(&d, "excel.csv"), excel)];
+    for (f, text) in &files {
+        std::fs::write(f, text).unwrap();
+    }
+    for (cmd, extra) in [("render", &["--wavelengths", "8"][..]), ("truth", &["--spp", "4"][..])] {
+        let common: Vec<&str> =
+            [cmd, "metamerism", "--size", "48x32"].into_iter().chain(extra.iter().copied()).collect();
+        let by_name = p(&d, &format!("{cmd}-cie1931.exr"));
+        ok(&[&common[..], &["--out", &by_name]].concat());
+        for (i, (f, _)) in files.iter().enumerate() {
+            let by_file = p(&d, &format!("{cmd}-file{i}.exr"));
+            ok(&[&common[..], &["--observer", f, "--out", &by_file]].concat());
+            let (de, mae) = difference(&by_name, &by_file);
+            assert!(de < 1e-4 && mae < 1e-7, "{cmd} --observer {f}: ΔE max {de}, MAE {mae} from cie1931");
+        }
+    }
     let _ = std::fs::remove_dir_all(&d);
 }
