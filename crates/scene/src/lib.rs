@@ -120,6 +120,41 @@ impl Scene {
             input_stamps: Vec::new(),
         }
     }
+
+    /// A warning when measured reflectances (a material's `reflectance` or palette entries given
+    /// as samples) end inside the render range `lo`–`hi` nm, where they are taken as zero: a
+    /// spectrophotometer's 400–700 nm file made a white tile black at both ends of 380–730 nm
+    /// without a word. One line for all of them, naming the first; `None` where all cover it.
+    pub fn short_reflectances(&self, lo: f64, hi: f64) -> Option<String> {
+        let mut short = Vec::new();
+        for m in &self.materials {
+            let spectra: Vec<&color::Spectrum> = match &m.spectral {
+                Some(SpectralReflectance::Uniform(s)) => vec![s],
+                Some(SpectralReflectance::Palette(p)) => p.iter().map(|e| &e.spectrum).collect(),
+                None => continue,
+            };
+            for s in spectra {
+                if let color::Spectrum::Piecewise { lambda, .. } = s
+                    && let (Some(&a), Some(&b)) = (lambda.first(), lambda.last())
+                    && (a > lo || b < hi)
+                {
+                    short.push((m.name.clone(), a, b));
+                }
+            }
+        }
+        let (name, a, b) = short.first()?;
+        let fix = "extend the data to the range, or render --range within it";
+        Some(match short.len() {
+            1 => format!(
+                "the measured reflectance of material '{name}' covers {a}–{b} nm, less than the render range \
+                 {lo}–{hi} nm: taken as zero outside its data ({fix})"
+            ),
+            n => format!(
+                "{n} measured reflectances cover less than the render range {lo}–{hi} nm (the first, of material \
+                 '{name}', covers {a}–{b} nm): taken as zero outside their data ({fix})"
+            ),
+        })
+    }
 }
 
 impl Mesh {

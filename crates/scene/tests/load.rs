@@ -176,3 +176,32 @@ fn absurd_normal_scales_are_refused() {
         }
     }
 }
+
+/// Measured reflectances that end inside the render range are zero there: one warning line says
+/// so (a spectrophotometer's 400–700 nm file turned a white tile black at both ends of the default
+/// 380–730 nm without a word).
+#[test]
+fn reflectances_short_of_the_render_range_are_named() {
+    let cc = scene::builtin("colorchecker").unwrap();
+    // N. Ohta's patches cover 380–780 nm.
+    assert_eq!(cc.short_reflectances(380.0, 730.0), None);
+    assert_eq!(cc.short_reflectances(400.0, 700.0), None);
+    let w = cc.short_reflectances(360.0, 830.0).expect("a warning below 380 nm");
+    assert!(
+        w.starts_with("24 measured reflectances") && w.contains("380–780 nm") && w.contains("360–830"),
+        "{w}"
+    );
+
+    let mut s = scene::Scene::empty("test", cc.camera);
+    let tile = |spectrum| scene::Material {
+        name: "tile".into(),
+        spectral: Some(SpectralReflectance::Uniform(spectrum)),
+        ..Default::default()
+    };
+    s.materials.push(tile(color::Spectrum::Constant(0.9)));
+    assert_eq!(s.short_reflectances(380.0, 730.0), None, "a constant covers every range");
+    s.materials.push(tile(color::Spectrum::piecewise(vec![400.0, 700.0], vec![0.9, 0.9]).unwrap()));
+    let w = s.short_reflectances(380.0, 730.0).expect("a warning for 400–700 nm");
+    assert!(w.contains("material 'tile' covers 400–700 nm") && w.contains("380–730 nm"), "{w}");
+    assert_eq!(s.short_reflectances(400.0, 700.0), None);
+}

@@ -442,6 +442,9 @@ impl SpectrumArgs {
         if let Some(w) = range_warning(&obs, &observer, range) {
             eprintln!("{w}");
         }
+        if let Some(w) = scene.short_reflectances(range.min, range.max) {
+            eprintln!("warning: scene {}: {w}", scene.source);
+        }
         let white = self.white.clone().unwrap_or_else(|| scene.spectral.white_name().to_string());
         color::illuminant::by_name(&white).with_context(|| from("--white", &self.white))?;
         let camera_view = color::film::CameraView::from_flag(self.camera_to_display);
