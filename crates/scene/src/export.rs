@@ -219,6 +219,23 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_iridescence"] = e;
         }
+        if let Some(c) = &m.clearcoat {
+            let mut e = json!({
+                "clearcoatFactor": c.factor,
+                "clearcoatRoughnessFactor": c.roughness,
+            });
+            if let Some(t) = &c.texture {
+                e["clearcoatTexture"] = tex(t);
+            }
+            if let Some(t) = &c.roughness_texture {
+                e["clearcoatRoughnessTexture"] = tex(t);
+            }
+            if let Some(t) = &c.normal_texture {
+                e["clearcoatNormalTexture"] = tex(t);
+                e["clearcoatNormalTexture"]["scale"] = json!(c.normal_scale);
+            }
+            j["extensions"]["KHR_materials_clearcoat"] = e;
+        }
         if m.ior != 1.5 {
             j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
         }
@@ -373,6 +390,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
         vec!["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_unlit"];
     if scene.materials.iter().any(|m| m.ior != 1.5) {
         extensions_used.push("KHR_materials_ior");
+    }
+    if scene.materials.iter().any(|m| m.clearcoat.is_some()) {
+        extensions_used.push("KHR_materials_clearcoat");
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");

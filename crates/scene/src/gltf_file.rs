@@ -844,6 +844,9 @@ impl Loader<'_> {
         if let Some(ir) = info("/extensions/KHR_materials_iridescence") {
             out.iridescence = self.iridescence(&at, ir)?;
         }
+        if let Some(cc) = info("/extensions/KHR_materials_clearcoat") {
+            out.clearcoat = self.clearcoat(&at, cc)?;
+        }
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
@@ -915,15 +918,25 @@ impl Loader<'_> {
                 ),
             ));
         }
+        let cc_tex =
+            |f: fn(&crate::clearcoat::Clearcoat) -> Option<TextureRef>| out.clearcoat.as_ref().and_then(f);
         let named = [
             ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),
             ("pbrMetallicRoughness.metallicRoughnessTexture", &out.metallic_roughness_texture),
             ("normalTexture", &out.normal_texture),
             ("occlusionTexture", &out.occlusion_texture),
             ("emissiveTexture", &out.emissive_texture),
+            ("extensions.KHR_materials_clearcoat.clearcoatTexture", &cc_tex(|c| c.texture)),
+            (
+                "extensions.KHR_materials_clearcoat.clearcoatRoughnessTexture",
+                &cc_tex(|c| c.roughness_texture),
+            ),
+            ("extensions.KHR_materials_clearcoat.clearcoatNormalTexture", &cc_tex(|c| c.normal_texture)),
         ];
+        // The coat's normal map is oriented by the same tangents as the base's (the extension
+        // asks both to share their UV set); tangents are made for it when the base has none.
         let needs = Needs {
-            normal_map_set: out.normal_texture.map(|t| t.tex_coord),
+            normal_map_set: out.normal_texture.or(cc_tex(|c| c.normal_texture)).map(|t| t.tex_coord),
             set1_user: named
                 .iter()
                 .find(|(_, t)| t.is_some_and(|t| t.tex_coord == 1))
@@ -934,6 +947,8 @@ impl Loader<'_> {
             // otherwise be added to it and make it a light source.
             out.emissive = Vec3::ZERO;
             out.emissive_texture = None;
+            // The extension excludes a coat on an unlit material, which reflects nothing.
+            out.clearcoat = None;
         }
         let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok((out, needs)) };
         let x = extras::material(self.ctx, &at, &map)?;
@@ -1026,6 +1041,47 @@ impl Loader<'_> {
             thickness_min,
             thickness_max,
             thickness_texture,
+        }))
+    }
+
+    /// `KHR_materials_clearcoat` (`cc` is its JSON), validated: `None` when its factor is 0
+    /// (the extension's default: no coat).
+    fn clearcoat(&mut self, at: &str, cc: &Value) -> Result<Option<crate::clearcoat::Clearcoat>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_clearcoat");
+        let number = |key: &str, default: f32, lo: f32, hi: f32, what: &str| -> Result<f32, SceneError> {
+            let Some(v) = cc.get(key) else { return Ok(default) };
+            match v.as_f64() {
+                Some(x) if x.is_finite() && (f64::from(lo)..=f64::from(hi)).contains(&x) => Ok(x as f32),
+                _ => Err(self.ctx.invalid(format!("{at}.{key}"), format!("{v} is not {what}"))),
+            }
+        };
+        let factor = number("clearcoatFactor", 0.0, 0.0, 1.0, "a number in [0, 1]")?;
+        let roughness = number("clearcoatRoughnessFactor", 0.0, 0.0, 1.0, "a number in [0, 1]")?;
+        let texture = self.extension_texture(&at, cc, "clearcoatTexture", false)?;
+        let roughness_texture = self.extension_texture(&at, cc, "clearcoatRoughnessTexture", false)?;
+        let normal_texture = self.extension_texture(&at, cc, "clearcoatNormalTexture", false)?;
+        let normal_scale = match cc.pointer("/clearcoatNormalTexture/scale") {
+            None => 1.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if x.is_finite() && x.abs() <= 1e6 => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.clearcoatNormalTexture.scale"),
+                        format!("{v} is not a finite number"),
+                    ));
+                }
+            },
+        };
+        if factor == 0.0 {
+            return Ok(None);
+        }
+        Ok(Some(crate::clearcoat::Clearcoat {
+            factor,
+            texture,
+            roughness,
+            roughness_texture,
+            normal_texture,
+            normal_scale,
         }))
     }
 

@@ -7,6 +7,7 @@
 
 mod accessors;
 pub mod builtin;
+pub mod clearcoat;
 mod context;
 pub mod emission;
 pub mod emitters;
@@ -239,6 +240,9 @@ pub struct Material {
     /// `KHR_materials_transmission` (with `_volume` and `_dispersion`): a see-through
     /// dielectric ([`transmission`]); `None` when the factor is 0 (opaque).
     pub transmission: Option<transmission::Transmission>,
+    /// `KHR_materials_clearcoat`: a clear coat over the whole material ([`clearcoat`]); `None`
+    /// when its factor is 0.
+    pub clearcoat: Option<clearcoat::Clearcoat>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
@@ -329,6 +333,7 @@ impl Default for Material {
             iridescence: None,
             ior: 1.5,
             transmission: None,
+            clearcoat: None,
         }
     }
 }

@@ -123,7 +123,9 @@ impl Scene {
     /// cannot be oriented; the loader refuses such a file, a scene built in code keeps it
     /// unoriented as before).
     fn normal_map_set(&self, m: &Mesh) -> Option<u32> {
-        let set = self.materials.get(m.material)?.normal_texture?.tex_coord;
+        let mat = self.materials.get(m.material)?;
+        // The coat's normal map shares the base's tangents (crate::clearcoat).
+        let set = mat.normal_texture.or(mat.clearcoat.as_ref().and_then(|c| c.normal_texture))?.tex_coord;
         let uv = if set == 1 { &m.uvs1 } else { &m.uvs };
         (!uv.is_empty()).then_some(set)
     }

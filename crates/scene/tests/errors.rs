@@ -92,8 +92,8 @@ fn unsupported_geometry_and_structure() {
         &["cameras[0].orthographic", "xmag"],
     );
     expect(
-        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_clearcoat"])),
-        &["extensionsRequired[0]", "KHR_materials_clearcoat", "not supported"],
+        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_sheen"])),
+        &["extensionsRequired[0]", "KHR_materials_sheen", "not supported"],
     );
     expect(
         &mutate(|d| d["materials"][0]["normalTexture"]["texCoord"] = json!(1)),

@@ -571,14 +571,14 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // Draco used with an uncompressed fallback: drawn, with a warning.
     let mut d = base.clone();
     d["extensionsUsed"] =
-        json!(["KHR_draco_mesh_compression", "KHR_materials_clearcoat", "KHR_materials_variants"]);
+        json!(["KHR_draco_mesh_compression", "KHR_materials_anisotropy", "KHR_materials_variants"]);
     d["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
     assert!(
-        s.warnings[1].starts_with("KHR_materials_clearcoat is not supported: ")
-            && s.warnings[1].contains("clear-coat layer is ignored")
+        s.warnings[1].starts_with("KHR_materials_anisotropy is not supported: ")
+            && s.warnings[1].contains("anisotropy is ignored")
     );
     // KTX2 only: a texture without a PNG/JPEG source.
     let mut d = base.clone();
@@ -604,7 +604,7 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // a warning. Extras are not extensions.
     let mut d = base.clone();
     d["materials"] = json!([{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}}]);
-    d["asset"]["extras"] = json!({"extensions": {"KHR_materials_clearcoat": {}}});
+    d["asset"]["extras"] = json!({"extensions": {"KHR_materials_anisotropy": {}}});
     d["meshes"][0]["primitives"][0]["material"] = json!(0);
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
@@ -913,6 +913,91 @@ fn iridescence_is_read_with_its_defaults_and_bad_values_are_named() {
         json!({"index": 7}),
         &[&format!("{at}.iridescenceTexture.index"), "no texture"],
     );
+}
+
+#[test]
+fn clearcoat_is_read_with_its_defaults_and_bad_values_are_named() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], "VEC2");
+    let cc = |x: Value| json!({"extensions": {"KHR_materials_clearcoat": x}});
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": m});
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_clearcoat"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2)]}],
+        "materials": [
+            cc(json!({"clearcoatFactor": 1.0})),
+            cc(json!({"clearcoatFactor": 0.5, "clearcoatRoughnessFactor": 0.25,
+                      "clearcoatTexture": {"index": 0}, "clearcoatRoughnessTexture": {"index": 0},
+                      "clearcoatNormalTexture": {"index": 0, "scale": 0.5}})),
+            // The extension's default factor is 0: no coat.
+            cc(json!({"clearcoatRoughnessFactor": 0.5})),
+        ],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    let s = load(&doc).unwrap();
+    // Both renderers draw the coat: no warning, and a file may require the extension.
+    let said = s.warnings.join("\n");
+    assert!(!said.contains("KHR_materials_clearcoat"), "{said}");
+    let mut required = doc.clone();
+    required["extensionsRequired"] = json!(["KHR_materials_clearcoat"]);
+    assert!(load(&required).unwrap().materials[0].clearcoat.is_some());
+    let c = s.materials[0].clearcoat.as_ref().expect("a coat");
+    assert_eq!((c.factor, c.roughness, c.normal_scale), (1.0, 0.0, 1.0));
+    assert!(c.texture.is_none() && c.roughness_texture.is_none() && c.normal_texture.is_none());
+    let t = s.materials[1].clearcoat.as_ref().unwrap();
+    assert_eq!((t.factor, t.roughness, t.normal_scale), (0.5, 0.25, 0.5));
+    assert!(!s.textures[t.texture.unwrap().index].srgb, "coat textures are data");
+    assert_eq!((t.weight_at(Some(0.5)), t.roughness_at(Some(0.5))), (0.25, 0.125));
+    assert!(s.materials[2].clearcoat.is_none());
+    // The coat's normal map alone makes the mesh's tangents.
+    for m in &s.meshes {
+        assert_eq!(m.tangents.is_empty(), m.material != 1, "tangents for the coat's normal map alone");
+    }
+
+    let bad = |key: &str, v: Value, parts: &[&str]| {
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_clearcoat"][key] = v;
+        assert_has(&error(&d), parts);
+    };
+    let at = "materials[1].extensions.KHR_materials_clearcoat";
+    bad("clearcoatFactor", json!(1.5), &[&format!("{at}.clearcoatFactor"), "[0, 1]"]);
+    bad("clearcoatFactor", json!("1"), &[&format!("{at}.clearcoatFactor"), "[0, 1]"]);
+    bad("clearcoatRoughnessFactor", json!(-0.1), &[&format!("{at}.clearcoatRoughnessFactor"), "[0, 1]"]);
+    bad("clearcoatTexture", json!({"index": 7}), &[&format!("{at}.clearcoatTexture.index"), "no texture"]);
+    bad(
+        "clearcoatNormalTexture",
+        json!({"index": 0, "scale": "big"}),
+        &[&format!("{at}.clearcoatNormalTexture.scale"), "finite"],
+    );
+    let mut d = doc.clone();
+    d["materials"][0]["extensions"]["KHR_materials_clearcoat"] = json!(1);
+    assert_has(&error(&d), &["materials[0].extensions.KHR_materials_clearcoat", "object"]);
+    // The extension excludes unlit materials: an unlit surface reflects nothing, coat included.
+    let mut d = doc.clone();
+    d["materials"][0]["extensions"]["KHR_materials_unlit"] = json!({});
+    assert!(load(&d).unwrap().materials[0].clearcoat.is_none());
+}
+
+#[test]
+fn clearcoat_survives_export() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_clearcoat"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0}]}],
+        "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.75,
+                       "clearcoatRoughnessFactor": 0.3}}}],
+    }));
+    let s = load(&doc).unwrap();
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert_eq!(back.materials[0].clearcoat, s.materials[0].clearcoat);
+    assert!(s.materials[0].clearcoat.is_some());
 }
 
 #[test]
