@@ -48,12 +48,22 @@ impl Gpu {
                 ),
             });
         }
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("spectra"),
-            required_features: features,
-            required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
-            ..Default::default()
-        }))
+        let (device, queue) = pollster::block_on(
+            adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("spectra"),
+                required_features: features,
+                // A coated scene's G-buffer holds 36 bytes a pixel (`passes::COAT_TARGET_BYTES`),
+                // past the 32 WebGPU guarantees: ask for what the adapter has.
+                required_limits: wgpu::Limits {
+                    max_color_attachment_bytes_per_sample: adapter
+                        .limits()
+                        .max_color_attachment_bytes_per_sample
+                        .max(wgpu::Limits::default().max_color_attachment_bytes_per_sample),
+                    ..wgpu::Limits::default().using_resolution(adapter.limits())
+                },
+                ..Default::default()
+            }),
+        )
         .map_err(|e| RenderError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
         Ok(Gpu { instance, adapter, device, queue, features })
     }

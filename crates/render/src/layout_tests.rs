@@ -172,7 +172,17 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
     check(
         &gbuffer,
         "MaterialUniforms",
-        rust_layout!(MaterialUniforms { base_color, emissive, params, alpha, uv, slot, film, transmission }),
+        rust_layout!(MaterialUniforms {
+            base_color,
+            emissive,
+            params,
+            alpha,
+            uv,
+            slot,
+            film,
+            transmission,
+            coat
+        }),
     );
     let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);
     check(&shadow_pass, "ShadowLayer", rust_layout!(shadow::LayerUniforms { view_proj, params }));

@@ -865,6 +865,7 @@ impl Renderer {
             fetch_base: scene.varying_colours.0,
             fetch_emission: scene.varying_colours.1,
             film: scene.has_film,
+            coat: scene.has_coat,
             ior: scene.has_ior,
             transmission: false,
             thin_walls: scene.has_thin_walls,
@@ -885,6 +886,7 @@ impl Renderer {
             // The layer searches its occlusion on its own depth.
             let layer_variant = Variant {
                 film: scene.has_transmission_film,
+                coat: false,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -901,7 +903,13 @@ impl Renderer {
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        let gbuffer_targets = if scene.has_film { GBufferTargets::Film } else { GBufferTargets::Plain };
+        let gbuffer_targets = if scene.has_coat {
+            GBufferTargets::Coat
+        } else if scene.has_film {
+            GBufferTargets::Film
+        } else {
+            GBufferTargets::Plain
+        };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         if layered {
             self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Layer)?;
@@ -916,11 +924,12 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_film_view];
+        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_film_view, &targets.gbuffer_coat_view];
         let colour = match gbuffer_targets {
             GBufferTargets::Plain => &all[..3],
             // (The transmissive layer's targets are its own, below.)
-            GBufferTargets::Film | GBufferTargets::Layer => &all[..],
+            GBufferTargets::Film | GBufferTargets::Layer => &all[..4],
+            GBufferTargets::Coat => &all[..],
         };
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
         self.gbuffer.record(

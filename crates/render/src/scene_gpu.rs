@@ -53,7 +53,7 @@ impl Vertex {
 
 /// Texture slots of a material, in binding order (textures at bindings 1..=7, their samplers at
 /// 8..=14; the order of `TEX_*` in `wgsl/material.wgsl`).
-pub const TEXTURE_SLOTS: usize = 9;
+pub const TEXTURE_SLOTS: usize = 12;
 
 /// `MaterialUniforms` in `wgsl/material.wgsl` (checked by `layout_tests`).
 #[repr(C)]
@@ -84,6 +84,10 @@ pub struct MaterialUniforms {
     /// transmissive layer's G-buffer writes × the texture's R, beside the volume's thickness
     /// texture's G and the film's two values (`passes::gbuffer::Targets::Layer`); yzw unused.
     pub transmission: [f32; 4],
+    /// `KHR_materials_clearcoat` ([`coat`]): x the strength (0: no coat), y the roughness,
+    /// z the coat's normal-map scale, w 1 with a coat normal map; the G-buffer's coat target
+    /// holds them × the coat's textures.
+    pub coat: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -122,6 +126,9 @@ impl MaterialUniforms {
                 _ => [0.0; 4],
             },
             transmission: [transmission(m).map_or(0.0, |t| t.factor), 0.0, 0.0, 0.0],
+            coat: coat(m).map_or([0.0; 4], |c| {
+                [c.factor, c.roughness, c.normal_scale, c.normal_texture.is_some() as u8 as f32]
+            }),
         }
     }
 }
@@ -133,12 +140,19 @@ pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmi
     m.transmission.as_ref().filter(|t| !m.unlit && t.factor > 0.0)
 }
 
+/// The material's clear coat as the real-time renderer draws it: on lit opaque materials (the
+/// transmissive layer's G-buffer has no room for it; the loader warns).
+pub fn coat(m: &scene::Material) -> Option<&scene::clearcoat::Clearcoat> {
+    m.clearcoat.as_ref().filter(|c| !m.unlit && c.factor > 0.0 && transmission(m).is_none())
+}
+
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
 /// occlusion, the film's weight (iridescence texture, R) and thickness (G), the transmission
-/// (R) and the volume's thickness (G).
+/// (R) and the volume's thickness (G), the coat's strength (R), roughness (G) and normal map.
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
     let t = transmission(m);
+    let c = coat(m);
     [
         m.base_color_texture,
         m.metallic_roughness_texture,
@@ -149,11 +163,14 @@ pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] 
         film.and_then(|f| f.thickness_texture),
         t.and_then(|t| t.texture),
         t.and_then(|t| t.volume.as_ref()).and_then(|v| v.thickness_texture),
+        c.and_then(|c| c.texture),
+        c.and_then(|c| c.roughness_texture),
+        c.and_then(|c| c.normal_texture),
     ]
 }
 
 /// The material bind group's layout (group 1 of the G-buffer and shadow passes): uniforms at
-/// 0, the nine textures at 1..=9 and their samplers at 10..=18.
+/// 0, the twelve textures at 1..=12 and their samplers at 13..=24.
 pub fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![crate::passes::uniform_entry(0, visibility)];
@@ -438,6 +455,9 @@ pub struct GpuScene {
     /// Whether some material has a thin film (`KHR_materials_iridescence` with a factor above
     /// 0): only then do the G-buffer and shading passes carry the film's code and target.
     pub has_film: bool,
+    /// Whether some material has a clear coat ([`coat`]): only then do the G-buffer and
+    /// shading passes carry the coat's code and target.
+    pub has_coat: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -605,6 +625,21 @@ impl GpuScene {
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
         let mut materials = Vec::new();
+        let coated_glass: Vec<&str> = s
+            .materials
+            .iter()
+            .filter(|m| m.clearcoat.is_some() && transmission(m).is_some())
+            .map(|m| m.name.as_str())
+            .collect();
+        if let Some(first) = coated_glass.first() {
+            warnings.push(format!(
+                "material '{first}'{}: the real-time renderer draws no clear coat on a see-through material (the path tracer does)",
+                match coated_glass.len() {
+                    1 => String::new(),
+                    n => format!(" and {} more", n - 1),
+                }
+            ));
+        }
         for (index, m) in s.materials.iter().enumerate() {
             let refs = texture_refs(m);
             for r in refs.iter().flatten() {
@@ -645,6 +680,9 @@ impl GpuScene {
                 &defaults.white_linear,
                 &defaults.white_linear,
                 &defaults.white_linear,
+                &defaults.white_linear,
+                &defaults.white_linear,
+                &defaults.flat_normal,
             ];
             let views: Vec<wgpu::TextureView> = refs
                 .iter()
@@ -723,6 +761,7 @@ impl GpuScene {
                 .materials
                 .iter()
                 .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
+            has_coat: s.materials.iter().any(|m| coat(m).is_some()),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s

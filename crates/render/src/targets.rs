@@ -3,7 +3,8 @@
 use crate::passes::accumulate::ACCUM_FORMAT;
 use crate::passes::back_faces::BACK_FACES_FORMAT;
 use crate::passes::{
-    DEPTH_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, HDR_FORMAT, LDR_FORMAT,
+    DEPTH_FORMAT, GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT,
+    HDR_FORMAT, LDR_FORMAT,
 };
 
 /// A 2D render target that passes also sample, with its view.
@@ -37,6 +38,9 @@ pub struct Targets {
     /// The thin film per pixel (written only for scenes with a film).
     pub gbuffer_film: wgpu::Texture,
     pub gbuffer_film_view: wgpu::TextureView,
+    /// The clear coat per pixel (written only for scenes with a coat).
+    pub gbuffer_coat: wgpu::Texture,
+    pub gbuffer_coat_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     /// The ambient light's screen-space occlusion (`passes::occlusion`), written only in frames
@@ -72,6 +76,7 @@ impl Targets {
         ];
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
+        let (gbuffer_coat, gbuffer_coat_view) = make("gbuffer coat", GBUFFER_COAT_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         // Written by the occlusion pass in its compute stage, like the HDR targets below.
         let storage = wgpu::TextureUsages::STORAGE_BINDING;
@@ -88,6 +93,8 @@ impl Targets {
             gbuffer_views: [v0, v1, v2],
             gbuffer_film,
             gbuffer_film_view,
+            gbuffer_coat,
+            gbuffer_coat_view,
             depth,
             depth_view,
             occlusion,

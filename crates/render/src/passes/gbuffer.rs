@@ -11,7 +11,7 @@
 //! ([`GBUFFER_FILM_FORMAT`]), built on first use, so that a scene without one samples no film
 //! texture and writes no film target.
 
-use super::{GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, SharedLayouts};
+use super::{GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, SharedLayouts};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -28,6 +28,8 @@ pub struct GBufferPass {
     film_pipelines: Option<Pipelines>,
     /// The transmissive layer's ([`Targets::Layer`]).
     layer_pipelines: Option<Pipelines>,
+    /// With the film and the coat, for scenes with a clear coat ([`Targets::Coat`]).
+    coat_pipelines: Option<Pipelines>,
 }
 
 /// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
@@ -53,6 +55,8 @@ pub enum Targets {
     Plain,
     /// And the film.
     Film,
+    /// And the film and the clear coat ([`GBUFFER_COAT_FORMAT`]).
+    Coat,
     /// And in four packed channels the transmission factor × texture, the volume's thickness
     /// texture and the film's two values: the transmissive layer's.
     Layer,
@@ -79,6 +83,7 @@ impl GBufferPass {
             pipelines,
             film_pipelines: None,
             layer_pipelines: None,
+            coat_pipelines: None,
         })
     }
 
@@ -88,6 +93,16 @@ impl GBufferPass {
             Targets::Plain => return Ok(()),
             Targets::Film => &mut self.film_pipelines,
             Targets::Layer => &mut self.layer_pipelines,
+            Targets::Coat => {
+                let have = device.limits().max_color_attachment_bytes_per_sample;
+                if have < super::COAT_TARGET_BYTES {
+                    return Err(crate::error::RenderError::Gpu(format!(
+                        "a scene with a clear coat (KHR_materials_clearcoat) needs G-buffer targets of {} bytes a pixel; this GPU's hold {have}",
+                        super::COAT_TARGET_BYTES
+                    )));
+                }
+                &mut self.coat_pipelines
+            }
         };
         if slot.is_none() {
             *slot = Some(build(device, &self.module, &self.layout, targets)?);
@@ -110,6 +125,7 @@ impl GBufferPass {
     ) {
         let pipelines = match (colour.len(), layer) {
             (3, _) => &self.pipelines,
+            (5, _) => self.coat_pipelines.as_ref().expect("prepare(Coat) before a G-buffer with coats"),
             (_, Layer::Transmissive) => {
                 self.layer_pipelines.as_ref().expect("prepare(Layer) before the transmissive layer")
             }
@@ -178,6 +194,7 @@ fn build(
         Targets::Plain => &GBUFFER_FORMATS,
         Targets::Film => &[base, normal, emission, GBUFFER_FILM_FORMAT],
         Targets::Layer => &[base, normal, emission, GBUFFER_LAYER_FORMAT],
+        Targets::Coat => &[base, normal, emission, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT],
     };
     let targets: Vec<_> = formats
         .iter()
@@ -193,6 +210,8 @@ fn build(
             (true, Targets::Film) => "fs_alpha_film",
             (false, Targets::Layer) => "fs_main_layer",
             (true, Targets::Layer) => "fs_alpha_layer",
+            (false, Targets::Coat) => "fs_main_coat",
+            (true, Targets::Coat) => "fs_alpha_coat",
         };
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -47,6 +47,16 @@ struct GBufferOut {
     @location(2) emission: vec4<f32>,
 };
 
+// The normal n (unit, towards the viewer's side) bent by a tangent-space normal map's texel
+// `tn_sample` (0–1 per channel) at `scale`, in the frame of the vertex tangent.
+fn normal_mapped(n: vec3<f32>, tangent: vec4<f32>, side: f32, tn_sample: vec3<f32>, scale: f32) -> vec3<f32> {
+    let t = normalize(tangent.xyz - n * dot(n, tangent.xyz)) * side;
+    let b = cross(n, t) * tangent.w;
+    var tn = tn_sample * 2.0 - 1.0;
+    tn = vec3<f32>(tn.xy * scale, tn.z);
+    return normalize(t * tn.x + b * tn.y + n * tn.z);
+}
+
 // `alpha_test`: the pipeline of MASK and BLEND materials (discards); opaque materials use one
 // without discard, which keeps early depth testing.
 fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
@@ -66,11 +76,7 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     let side = select(-1.0, 1.0, front);
     var n = normalize(v.normal) * side;
     if (material.params.z > 0.5 && dot(v.tangent.xyz, v.tangent.xyz) > 0.0) {
-        let t = normalize(v.tangent.xyz - n * dot(n, v.tangent.xyz)) * side;
-        let b = cross(n, t) * v.tangent.w;
-        var tn = tn_sample * 2.0 - 1.0;
-        tn = vec3<f32>(tn.xy * material.emissive.w, tn.z);
-        n = normalize(t * tn.x + b * tn.y + n * tn.z);
+        n = normal_mapped(n, v.tangent, side, tn_sample, material.emissive.w);
     }
     // Emission is one-sided, towards the vertex normals, as the path tracer's and the polygon
     // lights' (docs/environment.md): the back of a double-sided lamp glowed here and was black
@@ -175,4 +181,58 @@ fn fs_alpha_layer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLa
     let t = transmission_values(v);
     let f = film_values(v);
     return with_layer(gbuffer(v, front, true), t, f);
+}
+
+// Scenes with a clear coat (KHR_materials_clearcoat) add its per-pixel values beside the film's
+// (passes/gbuffer.rs `Targets::Coat`): the coat's own normal — its normal map in the vertex
+// tangents' frame, or the interpolated normal (not the base's normal map), as the extension
+// says —, its roughness and its strength, packed as the normal's target is (the strength as a
+// 16-bit fraction where the slot is).
+struct GBufferCoatOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<u32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) film: vec2<f32>,
+    @location(4) coat: vec4<u32>,
+};
+
+struct CoatSample {
+    strength: f32,
+    roughness: f32,
+    tn: vec3<f32>,
+};
+
+// The coat's textures (sampled before `gbuffer`'s discard, as the film's).
+fn coat_sample(v: VertexOut) -> CoatSample {
+    let c = textureSampleBias(coat_tex, coat_smp, material_uv(TEX_COAT, v.uv, v.uv1), frame.lod_bias).r;
+    let r = textureSampleBias(coat_rough_tex, coat_rough_smp, material_uv(TEX_COAT_ROUGH, v.uv, v.uv1), frame.lod_bias).g;
+    let tn = textureSampleBias(coat_normal_tex, coat_normal_smp, material_uv(TEX_COAT_NORMAL, v.uv, v.uv1), frame.lod_bias).xyz;
+    return CoatSample(clamp(c * material.coat.x, 0.0, 1.0), clamp(r * material.coat.y, 0.0, 1.0), tn);
+}
+
+fn with_coat(o: GBufferOut, f: vec2<f32>, c: CoatSample, v: VertexOut, front: bool) -> GBufferCoatOut {
+    let side = select(-1.0, 1.0, front);
+    var n = normalize(v.normal) * side;
+    if (material.coat.w > 0.5 && dot(v.tangent.xyz, v.tangent.xyz) > 0.0) {
+        n = normal_mapped(n, v.tangent, side, c.tn, material.coat.z);
+    }
+    // An unlit surface (UNLIT_MARK) reflects nothing: no coat, no film.
+    let unlit = o.base.a < 0.0;
+    let strength = select(c.strength, 0.0, unlit);
+    let coat = gbuffer_pack_normal(n, c.roughness, u32(round(strength * 65535.0)));
+    return GBufferCoatOut(o.base, o.normal, o.emission, select(f, vec2<f32>(0.0), unlit), coat);
+}
+
+@fragment
+fn fs_main_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatOut {
+    let f = film_values(v);
+    let c = coat_sample(v);
+    return with_coat(gbuffer(v, front, false), f, c, v, front);
+}
+
+@fragment
+fn fs_alpha_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatOut {
+    let f = film_values(v);
+    let c = coat_sample(v);
+    return with_coat(gbuffer(v, front, true), f, c, v, front);
 }

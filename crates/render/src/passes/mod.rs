@@ -80,6 +80,14 @@ pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Fl
 /// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,
 /// the other three take 24, and WebGPU counts an Rgba8Unorm target as 8.
 pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The clear coat per pixel (written only when the scene has one, beside the film's target):
+/// the coat's normal, roughness and strength packed as the normal's target is
+/// (`gbuffer_pack_normal`, the strength in place of the slot as 16-bit unorm). Its 8 bytes
+/// take the colour attachments to 36 a pixel, past WebGPU's guaranteed 32: the device asks
+/// for what the adapter allows ([`COAT_TARGET_BYTES`]; Vulkan's is 128).
+pub const GBUFFER_COAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Uint;
+/// Bytes a pixel of a coated scene's G-buffer targets: base, normal, emission, film, coat.
+pub const COAT_TARGET_BYTES: u32 = 8 + 8 + 8 + 4 + 8;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The camera's depth where nothing is drawn, what its depth targets are cleared to: depth is
 /// reversed (1 near, 0 far; [`crate::renderer::projection`]), so a nearer surface has the

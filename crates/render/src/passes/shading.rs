@@ -141,6 +141,9 @@ pub struct Variant {
     /// Some material has a thin film (`HAS_FILM`): the G-buffer's film target is read and
     /// filmed pixels take the film's Fresnel term (all modes).
     pub film: bool,
+    /// Some material has a clear coat (`HAS_COAT`, `KHR_materials_clearcoat`): the G-buffer's
+    /// coat target is read and coated pixels layer the coat over the rest (all modes).
+    pub coat: bool,
     /// Some dielectric's index is not 1.5 (`HAS_IOR`, `KHR_materials_ior`): F0 per material.
     pub ior: bool,
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
@@ -173,6 +176,7 @@ impl Variant {
         fetch_base: true,
         fetch_emission: true,
         film: true,
+        coat: true,
         ior: true,
         transmission: false,
         thin_walls: true,
@@ -184,7 +188,7 @@ impl Variant {
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
     /// environment, emission, film, ior, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 15] {
+    fn constants(&self) -> [(&'static str, f64); 16] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -196,6 +200,7 @@ impl Variant {
             ("FETCH_BASE", b(self.fetch_base)),
             ("FETCH_EMISSION", b(self.fetch_emission)),
             ("HAS_FILM", b(self.film)),
+            ("HAS_COAT", b(self.coat)),
             ("HAS_IOR", b(self.ior)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
@@ -214,6 +219,7 @@ impl Variant {
             emission: self.emission,
             emission_spectra: self.emission_spectra,
             film: self.film,
+            coat: self.coat,
             ior: self.ior,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
@@ -320,6 +326,8 @@ impl ShadingPass {
                     },
                     count: None,
                 },
+                // The coats (`gbuf_coat`).
+                super::uint_entry(8),
                 // The films (`gbuf_film`).
                 texture_entry(9),
                 // The transmissive layer's background (`background`, transmission.wgsl), its
@@ -530,6 +538,7 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
+                view_entry(8, &t.gbuffer_coat_view),
                 view_entry(9, &t.gbuffer_film_view),
                 // Not read outside the transmissive layer: any textures of their kinds the pass
                 // does not write.
@@ -588,6 +597,8 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
+                // The layer has no coat (`scene_gpu::coat`): any uint texture here.
+                view_entry(8, &g[1]),
                 // The layer's film is in `layer_packed`: any float texture here.
                 view_entry(9, &g[0]),
                 view_entry(10, &layer.background_view),

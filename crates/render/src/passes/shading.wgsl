@@ -30,6 +30,9 @@ override HAS_FILM: bool = true;
 // A dielectric whose index is not glTF's 1.5 (KHR_materials_ior): its F0 comes from the
 // material's record (every mode reads the G-buffer's material slot then).
 override HAS_IOR: bool = true;
+// A material with a clear coat (KHR_materials_clearcoat): the G-buffer's coat target is read,
+// and coated pixels layer the coat over everything under it (every mode).
+override HAS_COAT: bool = true;
 
 fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
@@ -47,6 +50,48 @@ struct ShadowUniforms {
 // The films: x weight (0: none), y the thickness between the material's minimum and maximum
 // (gbuffer.wgsl).
 @group(1) @binding(9) var gbuf_film: texture_2d<f32>;
+// The coats: normal, roughness and strength, packed as the normal's target (gbuffer.wgsl).
+@group(1) @binding(8) var gbuf_coat: texture_2d<u32>;
+
+// The clear coat at a pixel (KHR_materials_clearcoat; scene::clearcoat holds the rule both
+// renderers follow): its normal and roughness, and w = strength·F(|v·n_c|) (Schlick, F0 0.04),
+// the coat's share of what leaves the surface — 1 − w of everything under it (reflection,
+// emission) gets through. The weight does not depend on λ, so the coat reflects every
+// wavelength of the light alike. None (w = 0) without coats in the scene, on unlit surfaces and
+// in the Lambert-only comparison mode (whose BRDF has no Fresnel term).
+struct Coat {
+    normal: vec3<f32>,
+    roughness: f32,
+    w: f32,
+};
+
+fn no_coat() -> Coat {
+    return Coat(vec3<f32>(0.0, 0.0, 1.0), 0.0, 0.0);
+}
+
+fn load_coat(px: vec2<i32>, v: vec3<f32>, unlit: bool) -> Coat {
+    if (!HAS_COAT || HAS_TRANSMISSION || unlit || lambert_only()) {
+        return no_coat();
+    }
+    let t = textureLoad(gbuf_coat, px, 0);
+    // The strength is a 16-bit fraction where the normal's target has the slot.
+    let strength = f32(gbuffer_slot(t)) * (1.0 / 65535.0);
+    if (strength <= 0.0) {
+        return no_coat();
+    }
+    let n = gbuffer_normal(t);
+    let m = 1.0 - min(abs(dot(n, v)), 1.0);
+    let m2 = m * m;
+    return Coat(n, gbuffer_roughness(t), strength * (0.04 + 0.96 * m2 * m2 * m));
+}
+
+// The coat's reflection of the environment per unit strength of w: the prefiltered radiance
+// along its mirror direction at its roughness, times the split sum's directional albedo of a
+// lobe without Fresnel term (A + B; the Fresnel term is in w).
+fn env_coat(c: Coat, v: vec3<f32>) -> vec4<f32> {
+    let l = env_lobes(c.normal, v, c.roughness);
+    return l.spec * (l.ab.x + l.ab.y);
+}
 
 // The spectral capture (`Renderer::set_spectral_capture`, `spectra render --spectral-out`): per
 // pixel and group of four nodes, each node's radiance in weighted form summed over X, Y and Z
@@ -174,34 +219,23 @@ struct LightTerms {
     kd: f32,
     ks: f32,
     vh: f32,
+    // The clear coat's lobe (`Coat`): its D·V·cos·E per unit w, as `ks` without the coat's
+    // Fresnel term (which is in w). Zero without a coat.
+    kc: f32,
 };
 
-fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> LightTerms {
-    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
-        return polygon_terms(li, p, n, v, roughness);
-    }
-    let inc = light_incidence(li, p);
-    let wi = inc.xyz;
-    var atten = inc.w;
-    let nl = dot(n, wi);
-    if (nl <= 0.0 || atten <= 0.0) { return LightTerms(0.0, 0.0, 1.0); }
-    atten *= light_visibility(li, p, n);
-    let k = nl * atten;
-    if (lambert_only()) {
-        return LightTerms(k, 0.0, 1.0);
-    }
-    let h = normalize(wi + v);
+// GGX's distribution D and height-correlated Smith visibility V of a lobe of perceptual
+// roughness `roughness` about n, seen from v, lit from wi with nl = n·wi > 0 (h the half vector). A directional
+// light that stands for a disc of angular radius ρ (the environment's sun; 0 otherwise) widens
+// the lobe by the disc's image in half-vector space, an ellipse of semi-axes ρ/2 and
+// ρ/(2 n·v), taken as the round one of its area, radius ρ/(2√(n·v)), and added in quadrature
+// (the widths of a lobe convolved with the disc). A mirror then shows the disc at its own
+// radiance at the lobe's peak, where a delta light squeezes it into a point ~ρ²/4α² as bright;
+// rough lobes are left as they are, and D stays normalised (energy kept). Scenes without such a
+// light take the branch never (bit-identical images).
+fn ggx_dv(n: vec3<f32>, v: vec3<f32>, h: vec3<f32>, nl: f32, roughness: f32, rho: f32) -> vec2<f32> {
     let nv = max(dot(n, v), 1e-4);
     let nh = max(dot(n, h), 0.0);
-    let vh = max(dot(v, h), 0.0);
-    // A directional light that stands for a disc of angular radius ρ (the environment's sun;
-    // 0 otherwise) widens the lobe by the disc's image in half-vector space, an ellipse of
-    // semi-axes ρ/2 and ρ/(2 n·v), taken as the round one of its area, radius ρ/(2√(n·v)), and
-    // added in quadrature (the widths of a lobe convolved with the disc). A mirror then shows the
-    // disc at its own radiance at the lobe's peak, where a delta light squeezes it into a point
-    // ~ρ²/4α² as bright; rough lobes are left as they are, and D stays normalised (energy kept).
-    // Scenes without such a light take the branch never (bit-identical images).
-    let rho = select(0.0, lights[li].cone.y, u32(lights[li].pos_kind.w) == 0u);
     let alpha0 = max(roughness * roughness, 1e-3);
     var alpha = alpha0;
     if (rho > 0.0) {
@@ -211,7 +245,45 @@ fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32
     let dd = nh * nh * (a2 - 1.0) + 1.0;
     let dist = a2 / (PI * dd * dd);
     let vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));
-    return LightTerms(k, k * dist * vis, vh);
+    return vec2<f32>(dist, vis);
+}
+
+fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32, c: Coat) -> LightTerms {
+    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
+        var t = polygon_terms(li, p, n, v, roughness);
+        if (HAS_COAT && c.w > 0.0) {
+            t.kc = polygon_coat(li, p, c, v);
+        }
+        return t;
+    }
+    let inc = light_incidence(li, p);
+    let wi = inc.xyz;
+    var atten = inc.w;
+    let nl = dot(n, wi);
+    // The coat's normal may face a light the base's (normal-mapped) one does not, and back.
+    var nlc = 0.0;
+    if (HAS_COAT && c.w > 0.0) {
+        nlc = dot(c.normal, wi);
+    }
+    if ((nl <= 0.0 && nlc <= 0.0) || atten <= 0.0) { return LightTerms(0.0, 0.0, 1.0, 0.0); }
+    atten *= light_visibility(li, p, n);
+    let rho = select(0.0, lights[li].cone.y, u32(lights[li].pos_kind.w) == 0u);
+    let h = normalize(wi + v);
+    var kc = 0.0;
+    if (HAS_COAT && nlc > 0.0) {
+        let g = ggx_dv(c.normal, v, h, nlc, c.roughness, rho);
+        kc = nlc * atten * g.x * g.y;
+    }
+    if (HAS_COAT && nl <= 0.0) {
+        return LightTerms(0.0, 0.0, 1.0, kc);
+    }
+    let k = nl * atten;
+    if (lambert_only()) {
+        return LightTerms(k, 0.0, 1.0, 0.0);
+    }
+    let vh = max(dot(v, h), 0.0);
+    let g = ggx_dv(n, v, h, nl, roughness, rho);
+    return LightTerms(k, k * g.x * g.y, vh, kc);
 }
 
 // Wavelength-independent part of one light's contribution: radiance = E(λ)·(ρ(λ)·A + B),
@@ -291,7 +363,7 @@ fn edge_integral(a: vec3<f32>, b: vec3<f32>) -> f32 {
 // 2016: the GGX lobe's integral over the polygon, with the Fresnel term the lobe's mean, so
 // that `factors_of` weighs it by F0·A + B); shadowed by one shadow map from the centroid.
 fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> LightTerms {
-    let none = LightTerms(0.0, 0.0, 1.0);
+    let none = LightTerms(0.0, 0.0, 1.0, 0.0);
     let ln = polygon_normal(li);
     // One-sided: nothing reaches points behind the emitting side.
     if (dot(p - polygon_vertex(li, 0u), ln) <= 0.0) { return none; }
@@ -308,7 +380,7 @@ fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f
     if (g <= 0.0) { return none; }
     let vis = light_visibility(li, p, n);
     if (lambert_only()) {
-        return LightTerms(g * vis, 0.0, 1.0);
+        return LightTerms(g * vis, 0.0, 1.0, 0.0);
     }
     let cells = f32(LTC_SIZE - 1u);
     let half_texel = 0.5 / f32(LTC_SIZE);
@@ -320,7 +392,30 @@ fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f
     let albedo = ab.x + ab.y;
     // The lobe's mean Schlick weight B / (A + B) as the (1 − v·h)⁵ of one half vector.
     let fres = select(0.0, ab.y / albedo, albedo > 0.0);
-    return LightTerms(vis * g, vis * share * albedo, 1.0 - pow(fres, 0.2));
+    return LightTerms(vis * g, vis * share * albedo, 1.0 - pow(fres, 0.2), 0.0);
+}
+
+// The coat's lobe over polygon light li (`LightTerms::kc`): the LTC integral of a lobe of the
+// coat's roughness about its normal, shadowed as the base's terms are.
+fn polygon_coat(li: u32, p: vec3<f32>, c: Coat, v: vec3<f32>) -> f32 {
+    let n = c.normal;
+    if (dot(p - polygon_vertex(li, 0u), polygon_normal(li)) <= 0.0) { return 0.0; }
+    let nv = dot(n, v);
+    var t1 = v - n * nv;
+    if (dot(t1, t1) < 1e-12) {
+        t1 = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9) ;
+        t1 -= n * dot(n, t1);
+    }
+    t1 = normalize(t1);
+    let to_local = transpose(mat3x3<f32>(t1, cross(n, t1), n));
+    if (polygon_cosine(li, p, to_local) <= 0.0) { return 0.0; }
+    let cells = f32(LTC_SIZE - 1u);
+    let half_texel = 0.5 / f32(LTC_SIZE);
+    let uv = vec2<f32>(clamp(c.roughness, 0.0, 1.0), sqrt(1.0 - clamp(nv, 0.0, 1.0))) * (cells / f32(LTC_SIZE)) + half_texel;
+    let m = textureSampleLevel(ltc_table, env_sampler, uv, 0, 0.0);
+    let ab = textureSampleLevel(ltc_table, env_sampler, uv, 1, 0.0).xy;
+    let minv = mat3x3<f32>(vec3<f32>(m.x, 0.0, m.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(m.y, 0.0, m.w));
+    return light_visibility(li, p, n) * polygon_cosine(li, p, minv * to_local) / PI * (ab.x + ab.y);
 }
 
 // Cells per axis of `ltc_table` (src/ltc.rs `SIZE`).
@@ -499,6 +594,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
     var through = vec3<f32>(0.0);
     // Loaded once: the hook's irradiance below reads it too.
     var s: GSurface;
+    var coat = no_coat();
     if (!ctx.background) {
         s = load_surface(px);
         ctx.normal = s.normal;
@@ -516,16 +612,22 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         }
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
+        // What the coat reflects, per unit w.
+        var sum_c = vec3<f32>(0.0);
+        coat = load_coat(px, -ctx.view_dir, s.unlit);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lit; li++) {
             var e = lights[li].rgb.rgb;
             if (CUSTOM_LIGHT_T) {
                 e *= custom_light_transmittance_rgb(li, ctx);
             }
-            var t = light_terms(li, ctx.world_pos, s.normal, -ctx.view_dir, s.roughness);
+            var t = light_terms(li, ctx.world_pos, s.normal, -ctx.view_dir, s.roughness, coat);
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
+            if (HAS_COAT) {
+                sum_c = fma(vec3<f32>(t.kc * k), e, sum_c);
+            }
             // Light from behind a thin-walled see-through surface, tinted by the base colour.
             var behind = 0.0;
             if (HAS_TRANSMISSION) {
@@ -577,18 +679,29 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
                 et.b = vec4<f32>((1.0 - s.metallic) / PI * (1.0 - fd) * keep * s.base * l.irr.rgb
                     + ((1.0 - s.metallic) * fd + s.metallic * fm) * l.spec.rgb, 0.0);
             }
-            var env_rgb = (s.base * et.a.rgb + et.b.rgb) * ambient_visibility(in.pos.xy, ctx.world_pos, s);
+            let vis = ambient_visibility(in.pos.xy, ctx.world_pos, s);
+            var env_rgb = (s.base * et.a.rgb + et.b.rgb) * vis;
+            var coat_env = vec3<f32>(0.0);
+            if (HAS_COAT && coat.w > 0.0) {
+                coat_env = env_coat(coat, -ctx.view_dir).rgb * vis;
+            }
             if (CUSTOM_ENV_T) {
-                env_rgb *= custom_env_transmittance_rgb(ctx);
+                let t = custom_env_transmittance_rgb(ctx);
+                env_rgb *= t;
+                coat_env *= t;
             }
             rgb += env_rgb;
+            sum_c += coat_env;
+        }
+        if (HAS_COAT && coat.w > 0.0) {
+            rgb = rgb * (1.0 - coat.w) + sum_c * coat.w;
         }
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
     var out = custom_rgb(rgb, ctx) + through;
     if (CUSTOM_IRRADIANCE && !ctx.background) {
-        let lobe = diffuse_lobe(s);
+        let lobe = diffuse_lobe(s) * (1.0 - coat.w);
         if (lobe > 0.0) {
             out += s.base * (lobe * ambient_visibility(in.pos.xy, ctx.world_pos, s)) * custom_irradiance_rgb(ctx);
         }
@@ -822,11 +935,17 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         tr = load_transmissive(px, s);
     }
     let keep = 1.0 - tr.weight;
+    let coat = load_coat(px, v, s.unlit);
+    // What the coat reflects, per unit w: each light's XYZ once (it does not depend on ρ).
+    var coat_xyz = vec3<f32>(0.0);
     for (var li = 0u; li < n_lights; li++) {
-        var t = light_terms(li, p, s.normal, v, s.roughness);
+        var t = light_terms(li, p, s.normal, v, s.roughness, coat);
         let k = custom_light_surface(li, ctx);
         t.kd *= k;
         t.ks *= k;
+        if (HAS_COAT) {
+            coat_xyz = fma(vec3<f32>(t.kc * k), lights[li].xyz.xyz, coat_xyz);
+        }
         // Light from behind a thin-walled see-through surface, tinted like the reflectance.
         var through = 0.0;
         if (HAS_TRANSMISSION) {
@@ -883,6 +1002,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             et.b *= vis;
             xyz += env_xyz(et.b);
         }
+        if (HAS_COAT && coat.w > 0.0) {
+            coat_xyz += env_xyz(env_coat(coat, v)) * vis;
+        }
     }
     let lobe = diffuse_lobe(s) * vis;
     // Emission known for the whole material is added as its XYZ; only a varying (textured) one
@@ -919,6 +1041,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             xyz += s3_xyz(s3_scale(custom_irradiance(wavelengths[g].lambda, g, ctx), rho * lobe));
         }
     }
+    if (HAS_COAT && coat.w > 0.0) {
+        xyz = xyz * (1.0 - coat.w) + coat_xyz * coat.w;
+    }
     if (HAS_TRANSMISSION) {
         xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base, film);
     }
@@ -934,25 +1059,33 @@ struct NodeLight {
     b: f32,
 };
 
-fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool) -> NodeLight {
-    var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness);
+// Under a coat (`Coat`), what lies beneath is scaled by 1 − w and the coat's lobe, which does
+// not depend on ρ, joins `b` (a filmed pixel's `b` is the coat's alone).
+fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat) -> NodeLight {
+    var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness, c);
     let k = custom_light_surface(li, ctx);
     t.kd *= k;
     t.ks *= k;
+    var coat_b = 0.0;
+    if (HAS_COAT && c.w > 0.0) {
+        t.kd *= 1.0 - c.w;
+        t.ks *= 1.0 - c.w;
+        coat_b = t.kc * k * c.w;
+    }
     var through = 0.0;
     if (HAS_TRANSMISSION) {
         t.kd *= (1.0 - tr.weight);
         through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k;
     }
     if (filmed) {
-        return NodeLight(t, through, 0.0);
+        return NodeLight(t, through, coat_b);
     }
     let f = factors_of(t, s.metallic, s.f0);
     var a = f.x;
     if (HAS_TRANSMISSION) {
         a += through;
     }
-    return NodeLight(t, a, f.y);
+    return NodeLight(t, a, f.y + coat_b);
 }
 
 // Light `li`'s part of group g in weighted form, into the general loop's accumulators.
@@ -966,6 +1099,9 @@ fn add_node_light(acc_a: ptr<function, mat3x4<f32>>, acc_b: ptr<function, mat3x4
         *acc_f += s3_scale(w, film_light_node(nl.t, film, rho, metallic, lambda));
         if (HAS_TRANSMISSION) {
             *acc_f += s3_scale(w, nl.a * rho);
+        }
+        if (HAS_COAT) {
+            *acc_b += w * nl.b;
         }
     } else {
         *acc_a += w * nl.a;
@@ -1005,8 +1141,15 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     // which the background it reads has had already.
     var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
     var me = MeasuredEmission(false, 0.0, 0u, vec3<f32>(0.0));
+    // The coat (`Coat`): what lies beneath is kept by 1 − w (`under`); the coat's environment
+    // lobe, w times, in `coat_env`.
+    var coat = no_coat();
+    var under = 1.0;
+    var coat_env = vec4<f32>(0.0);
     if (!background) {
         s = load_surface(px);
+        coat = load_coat(px, -ctx.view_dir, s.unlit);
+        under = 1.0 - coat.w;
         // A measured emission goes through its own node weights; its RGB is not upsampled.
         me = measured_emission(px, s.emission);
         if (me.on) {
@@ -1016,6 +1159,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         metallic = s.metallic;
         if (HAS_TRANSMISSION) {
             tr = load_transmissive(px, s);
+        }
+        if (HAS_COAT && me.on) {
+            me.k *= under;
         }
         let keep = 1.0 - tr.weight;
         var vis = 1.0;
@@ -1030,6 +1176,10 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 if (HAS_TRANSMISSION) {
                     lobes.irr *= keep;
                 }
+                if (HAS_COAT) {
+                    lobes.irr *= under;
+                    lobes.spec *= under;
+                }
             } else {
                 if (HAS_TRANSMISSION) {
                     et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
@@ -1038,19 +1188,26 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 }
                 et.a *= vis;
                 et.b *= vis;
+                if (HAS_COAT) {
+                    et.a *= under;
+                    et.b *= under;
+                }
+            }
+            if (HAS_COAT && coat.w > 0.0) {
+                coat_env = env_coat(coat, -ctx.view_dir) * (vis * coat.w);
             }
         }
         base = s.base;
         emission = s.emission;
         ctx.normal = s.normal;
         // The hook's irradiance is ambient light too: occluded like the environment.
-        lobe = diffuse_lobe(s) * vis;
+        lobe = diffuse_lobe(s) * vis * under;
     }
     custom_prepare(ctx);
     if (!background) {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0);
+            let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0, coat);
             ft[li] = nl.t;
             fa[li] = nl.a;
             fb[li] = nl.b;
@@ -1094,12 +1251,16 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var xyz = vec3<f32>(0.0);
     // Without a spectral hook (capturing) the specular terms need no nodes for XYZ: each
     // light's XYZ once; the capture still takes them per node.
-    if (!CUSTOM_SPECTRAL && !filmed) {
+    if (!CUSTOM_SPECTRAL && (!filmed || HAS_COAT)) {
+        // (A filmed pixel's `fb` is its coat's.)
         for (var li = 0u; li < n_lights; li++) {
             xyz = fma(vec3<f32>(fb[li]), lights[li].xyz.xyz, xyz);
         }
-        if (has_env) {
+        if (has_env && !filmed) {
             xyz += env_xyz(et.b);
+        }
+        if (HAS_COAT) {
+            xyz += env_xyz(coat_env);
         }
     }
     let zero = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
@@ -1137,6 +1298,13 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 acc_a += wa;
                 acc_b += wb;
             }
+            if (HAS_COAT && coat.w > 0.0) {
+                var wc = env_w(coat_env, g, ng);
+                if (CUSTOM_ENV_T) {
+                    wc = s3_scale(wc, custom_env_transmittance(lambda, g, ctx));
+                }
+                acc_b += wc;
+            }
         }
         // This group's whole radiance in weighted form.
         var part = s3_scale(acc_a, rho) + acc_b;
@@ -1144,7 +1312,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             part += acc_f;
         }
         if (HAS_EMISSION) {
-            part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g));
+            part += s3_scale(white_weights(g), node_emission(em.xyz, em.w, emission, g) * under);
         }
         var measured = mat3x4<f32>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
         if (HAS_EMISSION_SPECTRA && me.on) {
@@ -1164,7 +1332,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 xyz += s3_xyz(acc_f);
             }
             if (HAS_EMISSION) {
-                xyz += node_emission(em.xyz, em.w, emission, g) * white_weights(g);
+                xyz += node_emission(em.xyz, em.w, emission, g) * under * white_weights(g);
             }
             if (HAS_EMISSION_SPECTRA) {
                 xyz += s3_xyz(measured);
