@@ -103,23 +103,28 @@ impl Brdf {
     }
 
     fn d(&self, n_h: f32) -> f32 {
-        let a2 = self.alpha * self.alpha;
-        let t = n_h * n_h * (a2 - 1.0) + 1.0;
-        a2 / (PI * t * t)
+        ggx_d(self.alpha, n_h)
     }
 
     fn vis(&self, n_l: f32, n_v: f32) -> f32 {
-        let a2 = self.alpha * self.alpha;
-        let gv = n_l * (n_v * n_v * (1.0 - a2) + a2).sqrt();
-        let gl = n_v * (n_l * n_l * (1.0 - a2) + a2).sqrt();
-        let s = gv + gl;
-        if s > 0.0 { 0.5 / s } else { 0.0 }
+        smith_vis(self.alpha, n_l, n_v)
     }
 
     /// Smith G1 for the visible-normal pdf.
     fn g1(&self, n_v: f32) -> f32 {
-        let a2 = self.alpha * self.alpha;
-        2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt())
+        smith_g1(self.alpha, n_v)
+    }
+
+    /// The directional albedo at `n_v` as [`Self::p_spec`] estimates it (Schlick at normal
+    /// incidence for the half vector, the diffuse share's complement), averaged over the lanes:
+    /// what the clear coat weighs its sampling probability against.
+    pub fn albedo_estimate(&self, n_v: f32) -> f32 {
+        if self.lambert {
+            return self.base.element_sum() * 0.25;
+        }
+        let f0 = self.f0();
+        let fr = f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5);
+        (fr + (Vec4::ONE - fr) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
     }
 
     /// Probability of sampling the specular lobe: its share of the Fresnel-weighted albedo
@@ -185,6 +190,81 @@ impl Brdf {
 
     fn sample_visible_normal(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
         visible_normal(self.alpha, wo, u)
+    }
+}
+
+/// The GGX (Trowbridge–Reitz) distribution of roughness α at n·h.
+#[inline]
+fn ggx_d(alpha: f32, n_h: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let t = n_h * n_h * (a2 - 1.0) + 1.0;
+    a2 / (PI * t * t)
+}
+
+/// glTF's height-correlated Smith visibility V = G / (4·n·l·n·v).
+#[inline]
+fn smith_vis(alpha: f32, n_l: f32, n_v: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let gv = n_l * (n_v * n_v * (1.0 - a2) + a2).sqrt();
+    let gl = n_v * (n_l * n_l * (1.0 - a2) + a2).sqrt();
+    let s = gv + gl;
+    if s > 0.0 { 0.5 / s } else { 0.0 }
+}
+
+/// Smith G1, the masking of the visible-normal pdf.
+#[inline]
+fn smith_g1(alpha: f32, n_v: f32) -> f32 {
+    let a2 = alpha * alpha;
+    2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt())
+}
+
+/// The clear coat's lobe (`KHR_materials_clearcoat`): glTF's specular microfacet term D·V
+/// without a Fresnel factor, which the layering weight carries (`scene::clearcoat`), in the
+/// coat's own frame (its normal +z). Sampled by visible normals, as the base's specular lobe.
+#[derive(Clone, Copy, Debug)]
+pub struct CoatLobe {
+    pub alpha: f32,
+}
+
+impl CoatLobe {
+    /// α = roughness², held at [`MIN_ALPHA`] as the base's lobe is: a smooth coat is a mirror
+    /// f32 can still evaluate.
+    pub fn new(roughness: f32) -> Self {
+        let r = roughness.clamp(0.0, 1.0);
+        CoatLobe { alpha: (r * r).max(MIN_ALPHA) }
+    }
+
+    /// f(wo, wi), zero unless both are above the coat.
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (n_v, n_l) = (wo.z, wi.z);
+        if n_v <= 0.0 || n_l <= 0.0 {
+            return 0.0;
+        }
+        let h = (wo + wi).normalize();
+        ggx_d(self.alpha, h.z) * smith_vis(self.alpha, n_l, n_v)
+    }
+
+    /// The pdf [`Self::sample`] draws `wi` with.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (n_v, n_l) = (wo.z, wi.z);
+        if n_v <= 0.0 || n_l <= 0.0 {
+            return 0.0;
+        }
+        let h = (wo + wi).normalize();
+        if wo.dot(h) <= 0.0 {
+            return 0.0;
+        }
+        smith_g1(self.alpha, n_v) * ggx_d(self.alpha, h.z) / (4.0 * n_v)
+    }
+
+    /// A direction reflected about a visible microfacet normal; `None` below the coat.
+    pub fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<Vec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let h = visible_normal(self.alpha, wo, u);
+        let wi = 2.0 * wo.dot(h) * h - wo;
+        (wi.z > 0.0).then_some(wi)
     }
 }
 

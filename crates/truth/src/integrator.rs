@@ -6,6 +6,7 @@
 use crate::accel::Hit;
 use crate::bsdf::{Brdf, FilmLanes};
 use crate::camera::CameraRay;
+use crate::coat::Coat;
 use crate::dielectric::Dielectric;
 use crate::material;
 use crate::medium::{Phase, phase_eval, phase_sample};
@@ -16,48 +17,100 @@ use crate::world::{World, offset, offset_distance};
 use glam::{Vec3, Vec4};
 
 /// Where a path scatters: a surface (BRDF in a shading frame; a see-through material mixes in
-/// the rough dielectric with weight T·(1 − metallic)) or a point in the medium.
+/// the rough dielectric with weight T·(1 − metallic); a clear coat mixes itself over all of
+/// that, [`Coat`]) or a point in the medium.
 // One lives on the stack per bounce; boxing the large variant would allocate per bounce.
 #[allow(clippy::large_enum_variant)]
 enum Vertex {
-    Surface { brdf: Brdf, frame: Frame, ng: Vec3, glass: Option<(Dielectric, f32)> },
+    Surface { brdf: Brdf, frame: Frame, ng: Vec3, glass: Option<(Dielectric, f32)>, coat: Option<Coat> },
     Medium { phase: Phase },
+}
+
+/// A direction sampled at a coated surface, with the estimator's weight f·|cos|/pdf and the
+/// pdf for MIS (0 for a delta, which nothing else can find).
+struct Scattered {
+    wi: Vec3,
+    crossed: bool,
+    weight: Vec4,
+    pdf: f32,
+}
+
+/// (f·|cos|, pdf) of the material under any coat (see [`Vertex::eval`]).
+fn eval_base(
+    brdf: &Brdf,
+    frame: &Frame,
+    ng: Vec3,
+    glass: &Option<(Dielectric, f32)>,
+    wo: Vec3,
+    wi: Vec3,
+) -> (Vec4, f32) {
+    let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
+    // The BRDF reflects only: both directions on the side of the (flipped) geometric normal.
+    let above = ng.dot(wi) > 0.0;
+    let Some((d, w)) = glass else {
+        if !above {
+            return (Vec4::ZERO, 0.0);
+        }
+        return (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li));
+    };
+    let (f_o, p_o) =
+        if above { (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li)) } else { (Vec4::ZERO, 0.0) };
+    // A transmission must really cross the surface (shading and geometric normal agree).
+    let (f_d, p_d) =
+        if above == (li.z > 0.0) { (d.eval(lo, li) * li.z.abs(), d.pdf(lo, li)) } else { (Vec4::ZERO, 0.0) };
+    (f_o * (1.0 - w) + f_d * *w, p_o * (1.0 - w) + p_d * w)
 }
 
 impl Vertex {
     /// (f·|cos| or phase value, pdf of sampling `wi`) for unit world directions; `wo` points
-    /// back along the path.
+    /// back along the path (for a coated surface, the `wo` its coat was made for).
     fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec4, f32) {
         match self {
-            Vertex::Surface { brdf, frame, ng, glass } => {
-                let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
-                // The BRDF reflects only: both directions on the side of the (flipped)
-                // geometric normal.
-                let above = ng.dot(wi) > 0.0;
-                let Some((d, w)) = glass else {
-                    if !above {
-                        return (Vec4::ZERO, 0.0);
-                    }
-                    return (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li));
-                };
-                let (f_o, p_o) = if above {
-                    (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li))
-                } else {
-                    (Vec4::ZERO, 0.0)
-                };
-                // A transmission must really cross the surface (shading and geometric normal agree).
-                let (f_d, p_d) = if above == (li.z > 0.0) {
-                    (d.eval(lo, li) * li.z.abs(), d.pdf(lo, li))
-                } else {
-                    (Vec4::ZERO, 0.0)
-                };
-                (f_o * (1.0 - w) + f_d * *w, p_o * (1.0 - w) + p_d * w)
+            Vertex::Surface { brdf, frame, ng, glass, coat } => {
+                let (fb, pb) = eval_base(brdf, frame, *ng, glass, wo, wi);
+                let Some(c) = coat else { return (fb, pb) };
+                let (fc, pc) = c.eval(*ng, wo, wi);
+                (fb * (1.0 - c.weight) + Vec4::splat(fc * c.weight), pb * (1.0 - c.p) + pc * c.p)
             }
             Vertex::Medium { phase } => {
                 let p = phase_eval(*phase, (-wo).dot(wi));
                 (Vec4::splat(p), p)
             }
         }
+    }
+
+    /// Samples a coated surface's mixture: the coat lobe with probability p, else the base as
+    /// an uncoated surface samples it. `None` for a lost sample or a vertex without a coat.
+    fn sample_coated(&self, wo: Vec3, rng: &mut Sampler) -> Option<Scattered> {
+        let Vertex::Surface { brdf, frame, ng, glass, coat: Some(c) } = self else { return None };
+        let lo = frame.to_local(wo);
+        let brdf_wi =
+            |rng: &mut Sampler| brdf.sample(lo, rng.uniform(), rng.next2()).map(|x| frame.to_world(x.wi));
+        let (wi, crossed, delta) = if rng.uniform() < c.p {
+            (c.sample(wo, rng.next2())?, false, None)
+        } else if let Some((d, wt)) = glass
+            && rng.uniform() < *wt
+        {
+            let x = d.sample(lo, rng.uniform(), rng.next2())?;
+            let delta = x.specular.then(|| x.f * (x.wi.z.abs() / x.pdf));
+            (frame.to_world(x.wi), x.transmitted, delta)
+        } else {
+            (brdf_wi(rng)?, false, None)
+        };
+        if (ng.dot(wi) <= 0.0) != crossed {
+            return None;
+        }
+        if let Some(weight) = delta {
+            // Drawn with probability (1 − p)·wt, weighing (1 − w)·wt times its own weight.
+            return Some(Scattered {
+                wi,
+                crossed,
+                weight: weight * ((1.0 - c.weight) / (1.0 - c.p)),
+                pdf: 0.0,
+            });
+        }
+        let (fv, pdf) = self.eval(wo, wi);
+        (pdf > 0.0 && pdf.is_finite()).then(|| Scattered { wi, crossed, weight: fv / pdf, pdf })
     }
 }
 
@@ -136,7 +189,7 @@ impl Integrator<'_, '_> {
                 let wi = to / dist;
                 // A sampled point where the emitter is cut out or see-through emits with the
                 // probability a ray would stop there (what BRDF sampling finds).
-                let le = w.emitted(&q, -wi, l) * w.coverage(tri, b1, b2, wi);
+                let le = self.coated(w.emitted(&q, -wi, l), &q, -wi) * w.coverage(tri, b1, b2, wi);
                 let cos_l = q.ng.dot(wi).abs();
                 if le != Vec4::ZERO && cos_l > 0.0 {
                     let (f, pdf_v) = v.eval(wo, wi);
@@ -327,7 +380,7 @@ impl Integrator<'_, '_> {
             let s = w.surface(&hit);
             let wo = -d;
 
-            let le = w.emitted(&s, wo, l);
+            let le = self.coated(w.emitted(&s, wo, l), &s, wo);
             if le != Vec4::ZERO {
                 let mis = if prev_pdf > 0.0 {
                     let pdf_l = w.emitters.pmf[s.tri as usize] / w.areas[s.tri as usize] * hit.t * hit.t
@@ -406,14 +459,33 @@ impl Integrator<'_, '_> {
                     }),
                     _ => None,
                 };
-            let vtx = Vertex::Surface { brdf, frame, ng, glass };
+            let coat = if self.lambert { None } else { w.coat(&s, wo) };
+            let coat = coat.map(|c| {
+                let a = brdf.albedo_estimate(frame.to_local(wo).z);
+                // A see-through base returns all it does not absorb, reflected or transmitted.
+                c.balanced(glass.map_or(a, |(_, wt)| a * (1.0 - wt) + wt))
+            });
+            let vtx = Vertex::Surface { brdf, frame, ng, glass, coat };
 
             if !passing {
                 radiance += f / mean(p) * self.direct(s.p, Some(ng), wo, &vtx, wl, rng);
             }
 
             let lo = frame.to_local(wo);
-            let (wi, crossed) = if let Some((d, wt)) = glass {
+            let (wi, crossed) = if coat.is_some() {
+                if passing && glass.is_none() {
+                    break;
+                }
+                let Some(x) = vtx.sample_coated(wo, rng) else { break };
+                if passing && !x.crossed {
+                    break;
+                }
+                f *= x.weight;
+                // A delta (pdf 0), or passing through where this vertex sampled no light: what
+                // the path meets next has full weight.
+                prev_pdf = if passing { 0.0 } else { x.pdf };
+                (x.wi, x.crossed)
+            } else if let Some((d, wt)) = glass {
                 // A delta lobe's weight, when the dielectric sampled one.
                 let mut delta = None;
                 let (wi, crossed) = if rng.uniform() < wt {
@@ -478,6 +550,18 @@ impl Integrator<'_, '_> {
         radiance
     }
 
+    /// Emission `le` leaving `s` towards `wo` through its clear coat, if any: 1 − w of it
+    /// (`KHR_materials_clearcoat`). The Lambertian comparison mode has no coat.
+    fn coated(&self, le: Vec4, s: &crate::world::SurfacePoint, wo: Vec3) -> Vec4 {
+        if le == Vec4::ZERO || self.lambert {
+            return le;
+        }
+        match self.world.coat(s, wo) {
+            Some(c) => le * (1.0 - c.weight),
+            None => le,
+        }
+    }
+
     /// Russian roulette from the fourth vertex on, survival ∝ the largest throughput lane.
     fn roulette(&self, f: &mut Vec4, p: Vec4, depth: u32, rng: &mut Sampler) -> bool {
         if depth < 4 || self.direct_only {
@@ -495,3 +579,7 @@ impl Integrator<'_, '_> {
 #[cfg(test)]
 #[path = "integrator_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "coat_tests.rs"]
+mod coat_tests;

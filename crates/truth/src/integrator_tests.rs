@@ -11,26 +11,32 @@ use crate::upsample::GreyOnly;
 use color::{Observer, Spectrum, WavelengthRange};
 use scene::{Emission, Light, LightKind, Material, SpectralReflectance};
 
-fn d65() -> Spectrum {
+pub(super) fn d65() -> Spectrum {
     color::illuminant::by_name("D65").unwrap()
 }
 
 /// One path with a uniformly chosen hero lane, results in the order of `wl`. The renderer
 /// gets this for free (the hero wavelength is uniform over the range); a test that fixes the
 /// wavelengths must randomise the hero itself, or spectral MIS is not unbiased.
-fn radiance_any_hero(integ: &Integrator, o: Vec3, d: Vec3, wl: &Wavelengths, rng: &mut Sampler) -> Vec4 {
+pub(super) fn radiance_any_hero(
+    integ: &Integrator,
+    o: Vec3,
+    d: Vec3,
+    wl: &Wavelengths,
+    rng: &mut Sampler,
+) -> Vec4 {
     let k = ((rng.uniform() * 4.0) as usize).min(3);
     let rotated = Wavelengths(Vec4::from_array(std::array::from_fn(|i| wl.0[(i + k) % 4])));
     let r = integ.radiance(o, d, &rotated, rng);
     Vec4::from_array(std::array::from_fn(|j| r[(j + 4 - k) % 4]))
 }
 
-fn spectrum_at(s: &Spectrum, wl: &Wavelengths) -> Vec4 {
+pub(super) fn spectrum_at(s: &Spectrum, wl: &Wavelengths) -> Vec4 {
     Vec4::from_array(wl.0.to_array().map(|l| s.eval(l as f64) as f32))
 }
 
 /// Mean and standard error of `n` independent one-path estimates per lane.
-fn estimate(n: usize, mut f: impl FnMut(&mut Sampler) -> Vec4) -> (Vec4, Vec4) {
+pub(super) fn estimate(n: usize, mut f: impl FnMut(&mut Sampler) -> Vec4) -> (Vec4, Vec4) {
     let mut rng = Sampler::new(42, 0);
     let (mut s, mut s2) = ([0.0f64; 4], [0.0f64; 4]);
     for _ in 0..n {
@@ -46,7 +52,7 @@ fn estimate(n: usize, mut f: impl FnMut(&mut Sampler) -> Vec4) -> (Vec4, Vec4) {
     (Vec4::from_array(mean.map(|v| v as f32)), Vec4::from_array(se.map(|v| v as f32)))
 }
 
-fn assert_within(mean: Vec4, se: Vec4, want: Vec4, what: &str) {
+pub(super) fn assert_within(mean: Vec4, se: Vec4, want: Vec4, what: &str) {
     for i in 0..4 {
         // 5 standard errors (p ≈ 6e-7 per lane if unbiased) plus float round-off.
         let tol = 5.0 * se[i] + 1e-4 * want[i].abs();
@@ -290,7 +296,7 @@ fn oblique_area_light_matches_quadrature() {
 
 // ---- The environment map (`crate::env_map`): NEE ∝ luminance, MIS with the BRDF/phase. ----
 
-fn with_env(mut scene: scene::Scene, env: scene::Environment) -> scene::Scene {
+pub(super) fn with_env(mut scene: scene::Scene, env: scene::Environment) -> scene::Scene {
     scene.environment = Some(env);
     scene
 }

@@ -15,6 +15,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod coat;
 pub mod dielectric;
 pub mod env_map;
 pub mod error;

@@ -194,11 +194,52 @@ pub fn mapped_normal(
     n: Vec3,
     tangent: Option<glam::Vec4>,
 ) -> Vec3 {
-    let (Some((t, uv)), Some(tan)) = (tex(textures, &m.normal_texture, tc), tangent) else { return n };
+    normal_from_map(textures, &m.normal_texture, m.normal_scale, tc, n, tangent)
+}
+
+/// The clear coat (`KHR_materials_clearcoat`) at a surface point: its strength (factor ×
+/// texture R) and perceptual roughness (factor × texture G); `None` without one, where the
+/// strength is 0, or on an unlit material (which reflects nothing).
+pub fn clearcoat(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(f32, f32)> {
+    let c = m.clearcoat.as_ref().filter(|_| !m.unlit)?;
+    let r = tex(textures, &c.texture, tc).map(|(t, uv)| texture::sample(t, uv).x);
+    let strength = c.weight_at(r);
+    if strength <= 0.0 {
+        return None;
+    }
+    let g = tex(textures, &c.roughness_texture, tc).map(|(t, uv)| texture::sample(t, uv).y);
+    Some((strength, c.roughness_at(g)))
+}
+
+/// The coat's normal: its own normal map in the base's tangent frame, or `n` (the interpolated
+/// normal, not the base's normal map) without one.
+pub fn coat_normal(
+    m: &Material,
+    textures: &[Texture],
+    tc: &TexCoords,
+    n: Vec3,
+    tangent: Option<glam::Vec4>,
+) -> Vec3 {
+    match &m.clearcoat {
+        Some(c) => normal_from_map(textures, &c.normal_texture, c.normal_scale, tc, n, tangent),
+        None => n,
+    }
+}
+
+/// `n` perturbed by the tangent-space normal map `map` scaled by `scale` in x and y.
+fn normal_from_map(
+    textures: &[Texture],
+    map: &Option<TextureRef>,
+    scale: f32,
+    tc: &TexCoords,
+    n: Vec3,
+    tangent: Option<glam::Vec4>,
+) -> Vec3 {
+    let (Some((t, uv)), Some(tan)) = (tex(textures, map, tc), tangent) else { return n };
     let s = texture::sample(t, uv);
     let mut v = Vec3::new(2.0 * s.x - 1.0, 2.0 * s.y - 1.0, 2.0 * s.z - 1.0);
-    v.x *= m.normal_scale;
-    v.y *= m.normal_scale;
+    v.x *= scale;
+    v.y *= scale;
     let f =
         crate::sampling::Frame::from_normal_tangent(n, tan.truncate(), if tan.w < 0.0 { -1.0 } else { 1.0 });
     let out = f.to_world(v).normalize_or_zero();

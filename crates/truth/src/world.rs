@@ -314,6 +314,22 @@ impl<'s> World<'s> {
         self.geometry.occluded_filtered(o, d, tmax, |tri, b1, b2| self.stops(tri, b1, b2, d, key))
     }
 
+    /// The clear coat at `s` seen from `wo` (`KHR_materials_clearcoat`); `None` without one.
+    /// Its normal is the coat's normal map about the interpolated normal, turned to the side
+    /// of `wo` as the base's shading normal is (the geometric normal where the map faces
+    /// away). The integrator's surface vertex and the coat over an emitter ([`Self::emitted`]'s
+    /// callers) both take it from here, so a coated lamp has one weight for both.
+    pub fn coat(&self, s: &SurfacePoint, wo: Vec3) -> Option<crate::coat::Coat> {
+        let m = &self.scene.materials[s.material];
+        let (strength, roughness) = material::clearcoat(m, &self.scene.textures, &s.tc)?;
+        let flip = if s.ng.dot(wo) >= 0.0 { 1.0 } else { -1.0 };
+        let mut n = material::coat_normal(m, &self.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
+        if n.dot(wo) <= 0.0 {
+            n = s.ng * flip;
+        }
+        Some(crate::coat::Coat::new(strength, roughness, n, wo))
+    }
+
     /// Radiance leaving `s` towards `wo` (unit, away from the surface); emission is one-sided,
     /// on the side the vertex normals point to.
     pub fn emitted(&self, s: &SurfacePoint, wo: Vec3, l: Vec4) -> Vec4 {
