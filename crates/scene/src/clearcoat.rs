@@ -7,7 +7,7 @@
 //!
 //! where `coat_brdf` is glTF's specular microfacet term (GGX D and Smith G, no Fresnel: it is in
 //! `w`) with α = clearcoatRoughness² about the coat's own normal N_c (its normal map, or the
-//! geometric normal: not the base's normal map). The weight depends on the view direction only,
+//! interpolated vertex normal: not the base's normal map). The weight depends on the view direction only,
 //! so the coat is a mixture, the same at every wavelength: it reflects each wavelength of the
 //! light alike and leaves the base's spectrum alone.
 
@@ -29,7 +29,7 @@ pub struct Clearcoat {
     /// `clearcoatRoughnessTexture`: its G channel multiplies `roughness`.
     pub roughness_texture: Option<TextureRef>,
     /// `clearcoatNormalTexture` (tangent space, as the base's `normalTexture`); without one the
-    /// coat follows the interpolated geometric normal.
+    /// coat follows the interpolated vertex normal.
     pub normal_texture: Option<TextureRef>,
     /// `clearcoatNormalTexture.scale`.
     pub normal_scale: f32,
