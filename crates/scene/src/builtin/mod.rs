@@ -4,6 +4,7 @@
 //! truth, and gives RGB renderers the colours those spectra actually have under D65, so RGB and
 //! spectral renders describe the same physical scene.
 
+pub mod clearcoat;
 mod colorchecker;
 mod cornell;
 mod dense;
@@ -23,8 +24,17 @@ use crate::{Emission, Material, Scene, SpectralReflectance, srgb};
 
 /// Names accepted by [`builtin`], besides `dense:N` (the Cornell box with a faceted sphere of
 /// about N triangles, for large-mesh measurements).
-pub const BUILTIN_NAMES: &[&str] =
-    &["cornell", "colorchecker", "metamerism", "iridescence", "glass", "underwater", "fog", "tinted-fog"];
+pub const BUILTIN_NAMES: &[&str] = &[
+    "cornell",
+    "colorchecker",
+    "metamerism",
+    "iridescence",
+    "glass",
+    "clearcoat",
+    "underwater",
+    "fog",
+    "tinted-fog",
+];
 
 /// Builds a built-in scene by name (case-insensitive). Its `source` is `builtin:NAME`.
 pub fn builtin(name: &str) -> Result<Scene, SceneError> {
@@ -35,6 +45,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "metamerism" => metamerism::build(&ctx),
         "iridescence" => iridescence::build(&ctx),
         "glass" => glass::build(&ctx),
+        "clearcoat" => clearcoat::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),

@@ -12,8 +12,9 @@ pub struct Args {
     #[arg(long)]
     pub quick: bool,
     /// Cases to run, comma-separated. Default: metamerism, colorchecker-d65, colorchecker-f11,
-    /// colorchecker-led and the underwater scene in Jerlov I (--quick) or I, IB, II, 3C (full);
-    /// any Jerlov type as underwater-TYPE (underwater-iii, underwater-ii.5).
+    /// colorchecker-led, iridescence-d65, iridescence-f11, glass and the underwater scene in
+    /// Jerlov I (--quick) or I, IB, II, 3C (full); also clearcoat, and any Jerlov type as
+    /// underwater-TYPE (underwater-iii, underwater-ii.5).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Override the ground-truth samples per pixel (every case, underwater included).

@@ -138,6 +138,10 @@ pub const CASE_IDS: &[&str] = &[
     "glass",
 ];
 
+/// Cases `spectra eval --scenes` accepts besides [`CASE_IDS`], outside the default suite (whose
+/// results are the README's contract): `clearcoat` (session 42).
+pub const OPT_IN_IDS: &[&str] = &["clearcoat"];
+
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
 pub fn water_id(ty: &str, depth: Option<f64>) -> String {
@@ -211,6 +215,12 @@ pub fn case(id: &str) -> Result<Case> {
             relight(&mut s, "F11").context("relighting the iridescence scene with F11")?;
             Ok(Case { id: id.into(), title: "Thin films on dielectric and metal spheres, F11 spots".into(), scene: s })
         }
+        "clearcoat" => Ok(Case {
+            id: id.into(),
+            title: "Clear coats (KHR_materials_clearcoat), glossy and satin, over measured ColorChecker bases; a D65 and an F11 spot"
+                .into(),
+            scene: scene::builtin("clearcoat")?,
+        }),
         "glass" => Ok(Case {
             id: id.into(),
             title: "See-through dielectrics (KHR_materials_transmission, _volume, _dispersion): clear, dispersive, \
@@ -245,8 +255,9 @@ pub fn case(id: &str) -> Result<Case> {
             })
         }
         other => bail!(
-            "unknown eval scene '{other}'; known: {}, underwater-TYPE (Jerlov type, e.g. underwater-ib)",
-            CASE_IDS.join(", ")
+            "unknown eval scene '{other}'; known: {}, {}, underwater-TYPE (Jerlov type, e.g. underwater-ib)",
+            CASE_IDS.join(", "),
+            OPT_IN_IDS.join(", ")
         ),
     }
 }
@@ -314,5 +325,18 @@ mod tests {
             }
         }
         assert!(notes(&["metamerism".to_string()]).is_empty());
+    }
+
+    #[test]
+    fn the_opt_in_cases_build_and_stay_out_of_the_default_suites() {
+        for id in OPT_IN_IDS {
+            let c = case(id).unwrap();
+            assert_eq!(c.id, *id);
+            for b in [Budget::quick(), Budget::full()] {
+                assert!(!default_ids(&b).iter().any(|d| d == id), "{id} in a default suite");
+            }
+        }
+        assert!(case("clearcoat").unwrap().scene.materials.iter().any(|m| m.clearcoat.is_some()));
+        assert!(case("nope").unwrap_err().to_string().contains("clearcoat"));
     }
 }
