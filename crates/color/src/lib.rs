@@ -19,6 +19,7 @@ pub mod progress;
 pub mod quadrature;
 pub mod signature;
 pub mod spectrum;
+pub mod table_text;
 pub mod upsample;
 pub mod water;
 pub mod wavelengths;

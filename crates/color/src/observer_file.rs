@@ -1,9 +1,9 @@
 //! Observers from a file (`--observer FILE`, issue 33): a camera's or any other three
 //! sensitivity curves, as
 //! - a CSV of wavelength (nm) and three columns — the layout camera databases and
-//!   `colour-science` export. Header and `#` comment lines are skipped; each line's separator
-//!   is a semicolon (then a comma is a decimal comma), a tab (likewise), a comma or runs of
-//!   spaces; UTF-8, UTF-16 with a BOM or Latin-1 text, any line ends (docs/cameras.md);
+//!   `colour-science` export, read as [`crate::table_text`] reads every table (a header,
+//!   `#` comments, semicolons, tabs, commas or spaces, decimal commas, UTF-16, any line ends;
+//!   docs/cameras.md);
 //! - the Academy's rawtoaces camera JSON (AcademySoftwareFoundation/rawtoaces-data,
 //!   `schema/spectral_1.0.0.json`): `spectral_data.index.main` names the channels (R, G and B
 //!   are taken by name), `spectral_data.data.main` maps each wavelength to its values.
@@ -39,68 +39,10 @@ pub fn read(path: &Path) -> Result<Observer> {
     // A regular file of bounded size: a FIFO or a device (/dev/zero) would hang or exhaust memory.
     let bytes = crate::input::read_regular(path, MAX_FILE_BYTES)
         .map_err(|e| ColorError::Table(format!("observer file {shown}: cannot read it: {e}")))?;
-    let text = decode(&bytes);
+    let text = crate::table_text::decode(&bytes);
     let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
         || text.trim_start_matches('\u{feff}').trim_start().starts_with('{');
     if json { parse_json(&text, &shown) } else { parse(&text, &shown) }
-}
-
-/// A file's text: UTF-8; UTF-16 with its byte-order mark (a spreadsheet's "Unicode text"); else
-/// Latin-1, byte for byte (a spreadsheet's CSV on Windows is Windows-1252: a header such as
-/// `x̄ 2°` or `Wellenlänge` refused the whole file as "not valid UTF-8"). The numbers are ASCII
-/// in all of them, so only the header's text can differ.
-fn decode(bytes: &[u8]) -> String {
-    let utf16 = |le: bool| {
-        let units = bytes[2..]
-            .chunks_exact(2)
-            .map(|c| if le { u16::from_le_bytes([c[0], c[1]]) } else { u16::from_be_bytes([c[0], c[1]]) });
-        char::decode_utf16(units).map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER)).collect()
-    };
-    match bytes {
-        [0xff, 0xfe, ..] => utf16(true),
-        [0xfe, 0xff, ..] => utf16(false),
-        _ => match std::str::from_utf8(bytes) {
-            Ok(s) => s.to_string(),
-            Err(_) => bytes.iter().map(|&b| b as char).collect(),
-        },
-    }
-}
-
-/// The fields of one CSV line. The separator is the line's: a semicolon if it has one (then a
-/// comma is a decimal comma, as European spreadsheets write `400;0,0143;…`), else a tab (also
-/// with decimal commas), else a comma, else runs of spaces. Quotes are taken off and a
-/// separator inside them is text (`"0,5"`). An empty field is kept as one — `400,,0.3,0.1`
-/// has an empty second column; the separators were runs, so it was read as three columns and
-/// `400,0.1,,0.2,0.3` as four, shifted — but empty fields after the fourth are dropped (a
-/// spreadsheet's trailing separators).
-fn split_fields(line: &str) -> Vec<String> {
-    let sep = [';', '\t', ','].into_iter().find(|&c| line.contains(c));
-    let mut fields: Vec<String> = match sep {
-        None => line.split_whitespace().map(|f| f.trim_matches('"').trim().to_string()).collect(),
-        Some(sep) => {
-            let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
-            for c in line.chars() {
-                match c {
-                    '"' => quoted = !quoted,
-                    c if c == sep && !quoted => out.push(std::mem::take(&mut cur)),
-                    c => cur.push(c),
-                }
-            }
-            out.push(cur);
-            out.into_iter().map(|f| f.trim().to_string()).collect()
-        }
-    };
-    while fields.len() > 4 && fields.last().is_some_and(|f| f.is_empty()) {
-        fields.pop();
-    }
-    // A decimal comma: one comma, no point (a comma-separated line cannot have one in a field
-    // unless it was quoted, which is how spreadsheets write a decimal comma there).
-    for f in &mut fields {
-        if f.matches(',').count() == 1 && !f.contains('.') {
-            *f = f.replace(',', ".");
-        }
-    }
-    fields
 }
 
 /// A field as it may be shown in an error: control characters escaped, at most 40 characters
@@ -117,56 +59,32 @@ pub fn parse(text: &str, source: &str) -> Result<Observer> {
     let mut lambda = Vec::new();
     let mut rows = Vec::new();
     let mut columns: [Vec<f64>; 3] = Default::default();
-    let mut first = true;
-    // Lines end in LF, CRLF or — a classic Mac OS export — CR alone (read as one line).
-    let text: std::borrow::Cow<str> =
-        if text.contains('\n') { text.into() } else { text.replace('\r', "\n").into() };
-    for (i, line) in text.lines().enumerate() {
-        let row = i + 1;
-        let line = line.trim().trim_start_matches('\u{feff}');
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let fields = split_fields(line);
-        // A header: the first line, if its first field is not a number. (Every such line was
-        // taken for one, so that a file of text ended as "0 data rows" naming no row.)
-        if std::mem::take(&mut first) && fields.first().is_some_and(|f| f.parse::<f64>().is_err()) {
-            continue;
-        }
-        if fields.len() != 4 {
-            let hint = if fields.len() > 8 {
-                "; one row per wavelength is expected (sensitivities given as rows, as in Jiang et al.'s \
-                 camera database, must be turned into columns: tools/camspec_to_csv.py)"
-            } else {
-                ""
-            };
-            return Err(bad(
-                row,
-                format!(
-                    "{} column{}; expected 4 (wavelength in nm and three sensitivities){hint}",
-                    fields.len(),
-                    if fields.len() == 1 { "" } else { "s" }
-                ),
-            ));
-        }
-        let mut nums = [0.0f64; 4];
-        for (c, f) in fields.iter().enumerate() {
-            nums[c] = match f.parse::<f64>() {
-                Ok(x) if x.is_finite() => x,
-                _ if f.is_empty() => {
-                    return Err(bad(
-                        row,
-                        format!("column {} is empty (write 0 where a sensitivity is zero)", c + 1),
-                    ));
+    for r in crate::table_text::rows(text, 4) {
+        let r = r.map_err(|e| {
+            use crate::table_text::TableError as T;
+            let what = match &e {
+                T::Columns { found, .. } => {
+                    let hint = if *found > 8 {
+                        "; one row per wavelength is expected (sensitivities given as rows, as in Jiang et al.'s \
+                         camera database, must be turned into columns: tools/camspec_to_csv.py)"
+                    } else {
+                        ""
+                    };
+                    format!(
+                        "{found} column{}; expected 4 (wavelength in nm and three sensitivities){hint}",
+                        if *found == 1 { "" } else { "s" }
+                    )
                 }
-                _ => {
-                    return Err(bad(
-                        row,
-                        format!("column {}: '{}' is not a finite number", c + 1, shown_field(f)),
-                    ));
+                T::Empty { column, .. } => {
+                    format!("column {column} is empty (write 0 where a sensitivity is zero)")
+                }
+                T::NotANumber { column, field, .. } => {
+                    format!("column {column}: '{}' is not a finite number", shown_field(field))
                 }
             };
-        }
+            bad(e.line(), what)
+        })?;
+        let (row, nums) = (r.line, r.values);
         if let Some(&prev) = lambda.last()
             && nums[0] <= prev
         {

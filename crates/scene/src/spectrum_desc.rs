@@ -4,8 +4,9 @@
 //! - `"D65"`, `"F11"`, `"LED-B3"`, `"3200K"`: a named illuminant ([`color::illuminant::by_name`]);
 //! - `{"blackbody": 3200}`: Planck's law at 3200 K;
 //! - `{"sampled": {"wavelengths": [..], "values": [..]}}`: nm, strictly increasing;
-//! - `{"csv": "path.csv"}`: two columns λ (nm), value; optional header line; `#` comments;
-//!   relative to the glTF file;
+//! - `{"csv": "path.csv"}`: two columns λ (nm), value, read by [`color::table_text`] (a
+//!   header line, `#` comments, semicolons, tabs or spaces, decimal commas, UTF-16); relative
+//!   to the glTF file;
 //! - `{"colorchecker": "red"}` or `{"colorchecker": 15}`: a ColorChecker Classic patch by name
 //!   (case-insensitive; a unique prefix such as `"white"` is enough) or 1-based chart index.
 //!
@@ -182,44 +183,28 @@ fn parse_csv(ctx: &Ctx, field: &str, file: &std::path::Path, bytes: &[u8]) -> Re
         line,
         message,
     };
-    let mut rdr = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(bytes);
+    // Read as observer files are (`color::table_text`), so a spectrophotometer's or a
+    // spreadsheet's export reads the same whichever file it is given as.
+    let text = color::table_text::decode(bytes);
     let (mut lambda, mut values, mut lines) = (Vec::new(), Vec::new(), Vec::new());
-    for (n, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| {
-            let line = e.position().map_or(0, |p| p.line());
-            csv_err(line, e.to_string())
+    for row in color::table_text::rows(&text, 2) {
+        let row = row.map_err(|e| {
+            use color::table_text::TableError as T;
+            // Which column, not its text: the file may not be a spectrum at all (a mistyped or
+            // hostile reference), and its content must not be echoed.
+            let col = |c: usize| if c == 1 { "1 (wavelength)" } else { "2 (value)" };
+            let message = match e {
+                T::Columns { found, .. } => {
+                    format!("expected 2 columns (wavelength in nm, value), found {found}")
+                }
+                T::Empty { column, .. } => format!("column {} is empty", col(column)),
+                T::NotANumber { column, .. } => format!("column {} is not a finite number", col(column)),
+            };
+            csv_err(e.line() as u64, message)
         })?;
-        let line = rec.position().map_or(n as u64 + 1, |p| p.line());
-        if rec.len() == 1 && rec[0].is_empty() {
-            continue;
-        }
-        if rec.len() != 2 {
-            return Err(csv_err(
-                line,
-                format!("expected 2 columns (wavelength in nm, value), found {}", rec.len()),
-            ));
-        }
-        let parse = |s: &str| s.parse::<f64>().ok().filter(|f| f.is_finite());
-        match (parse(&rec[0]), parse(&rec[1])) {
-            (Some(l), Some(v)) => {
-                lambda.push(l);
-                values.push(v);
-                lines.push(line);
-            }
-            // The first row may be a header such as `wavelength,value`.
-            _ if lambda.is_empty() && n == 0 && parse(&rec[0]).is_none() => {}
-            (l, _) => {
-                // Which column, not its text: the file may not be a spectrum at all (a
-                // mistyped or hostile reference), and its content must not be echoed.
-                let col = if l.is_none() { "1 (wavelength)" } else { "2 (value)" };
-                return Err(csv_err(line, format!("column {col} is not a finite number")));
-            }
-        }
+        lambda.push(row.values[0]);
+        values.push(row.values[1]);
+        lines.push(row.line as u64);
     }
     if lambda.len() < 2 {
         return Err(csv_err(
@@ -295,6 +280,73 @@ mod tests {
         assert!(e.contains("unknown spectrum kind"), "{e}");
         let e = msg(json!(5));
         assert!(e.contains("expected an illuminant name"), "{e}");
+    }
+
+    /// The spectrum every export below holds: 400, 500, 600 nm → 0.1, 0.5, 0.25.
+    fn three() -> Spectrum {
+        Spectrum::piecewise(vec![400.0, 500.0, 600.0], vec![0.1, 0.5, 0.25]).unwrap()
+    }
+
+    fn utf16le(text: &str) -> Vec<u8> {
+        [0xffu8, 0xfe].into_iter().chain(text.encode_utf16().flat_map(u16::to_le_bytes)).collect()
+    }
+
+    /// A measured spectrum as instruments and spreadsheets export it was refused (the `csv`
+    /// crate split on commas only: `400;0,1` was one field, a tab- or space-separated file one
+    /// column, a UTF-16 file not text) or, with a decimal comma after a comma-free separator,
+    /// misread. It is read as observer files are (`color::table_text`).
+    #[test]
+    fn csv_spectra_as_other_tools_write_them() {
+        let exports: Vec<(&str, Vec<u8>)> = vec![
+            // A spectrophotometer's export in a European locale: header, semicolons, decimal
+            // commas, CRLF.
+            ("xrite_de.csv", b"Wellenl\xe4nge [nm];Remission\r\n400;0,1\r\n500;0,5\r\n600;0,25\r\n".to_vec()),
+            // A spreadsheet's "Unicode text": UTF-16 LE with a BOM, tab-separated.
+            ("unicode.txt", utf16le("\u{3bb} (nm)\tR\r\n400\t0,1\r\n500\t0,5\r\n600\t0,25\r\n")),
+            // Tab-separated with a point, classic Mac OS line ends (CR alone).
+            ("mac.txt", b"nm\tR\r400\t0.1\r500\t0.5\r600\t0.25\r".to_vec()),
+            // Quoted fields with a UTF-8 BOM, a decimal comma inside quotes.
+            (
+                "quoted.csv",
+                "\u{feff}\"nm\",\"R\"\r\n\"400\",\"0,1\"\n\"500\",\"0,5\"\n\"600\",\"0,25\"\n".into(),
+            ),
+            // Comments, a blank line, trailing separators (a spreadsheet's empty columns).
+            (
+                "comments.csv",
+                b"# measured 2024-05-01\nnm;R;;\n400;0,1;;\n\n# lamp warm\n500;0,5;\n600;0,25;;\n".to_vec(),
+            ),
+            // A fixed-width table.
+            ("fixed.txt", b"  nm      R\n 400   0.10\n 500   0.50\n 600   0.25\n".to_vec()),
+        ];
+        for (name, bytes) in exports {
+            let s = csv_spectrum(name, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(s, three(), "{name}");
+        }
+        // Through a scene, from a file beside it.
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.txt"), utf16le("nm\tR\n400\t0,1\n500\t0,5\n600\t0,25\n")).unwrap();
+        let c = Ctx::file(&dir.path().join("s.gltf"));
+        assert_eq!(resolve(&c, "f", &json!({"csv": "r.txt"})).unwrap(), three());
+    }
+
+    /// An empty cell is named by its line (a run of separators was one separator, so
+    /// `400;;0,1` shifted the value into the wavelength's place); a field's text is never
+    /// echoed, since the file may not be a spectrum at all.
+    #[test]
+    fn csv_empty_cells_and_bad_lines_are_named() {
+        let cases: [(&[u8], &str); 6] = [
+            (b"nm;R\n400;0,1\n500;\n600;0,25\n", "line 3: column 2 (value) is empty"),
+            (b"400,0.1\n,0.5\n600,0.25\n", "line 2: column 1 (wavelength) is empty"),
+            (b"400;;0,1\n500;0,5\n", "line 1: expected 2 columns (wavelength in nm, value), found 3"),
+            (b"400\t0.1\r\n500\tsecret\r\n", "line 2: column 2 (value) is not a finite number"),
+            (b"400,0.1\r500,0.5\r450,0.3\r", "line 3: wavelengths must increase strictly"),
+            (b"nm,R\n# none\n400,0.1\n", "line 3: needs at least two rows of data, found 1"),
+        ];
+        for (bytes, want) in cases {
+            let e = csv_spectrum("m.csv", bytes).unwrap_err().to_string();
+            assert!(e.contains("m.csv") && e.contains(want) && !e.contains("secret"), "{bytes:?}: {e}");
+            assert!(matches!(csv_spectrum("m.csv", bytes), Err(SceneError::Csv { .. })));
+        }
     }
 
     #[test]
