@@ -886,7 +886,7 @@ impl Renderer {
             // The layer searches its occlusion on its own depth.
             let layer_variant = Variant {
                 film: scene.has_transmission_film,
-                coat: false,
+                coat: scene.has_transmission_coat,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -911,8 +911,10 @@ impl Renderer {
             GBufferTargets::Plain
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
+        let layer_targets =
+            if scene.has_transmission_coat { GBufferTargets::LayerCoat } else { GBufferTargets::Layer };
         if layered {
-            self.gbuffer.prepare(&self.gpu.device, GBufferTargets::Layer)?;
+            self.gbuffer.prepare(&self.gpu.device, layer_targets)?;
         }
         let (targets, bindings) = self.targets.as_ref().expect("checked above");
         let timer = self.timer.as_ref().filter(|_| settings.timestamps);
@@ -928,7 +930,7 @@ impl Renderer {
         let colour = match gbuffer_targets {
             GBufferTargets::Plain => &all[..3],
             // (The transmissive layer's targets are its own, below.)
-            GBufferTargets::Film | GBufferTargets::Layer => &all[..4],
+            GBufferTargets::Film | GBufferTargets::Layer | GBufferTargets::LayerCoat => &all[..4],
             GBufferTargets::Coat => &all[..],
         };
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
@@ -986,7 +988,8 @@ impl Renderer {
                     layer.depth.as_image_copy(),
                     wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
                 );
-                let views: Vec<&wgpu::TextureView> = layer.gbuffer_views.iter().collect();
+                let written = if layer_targets == GBufferTargets::LayerCoat { 5 } else { 4 };
+                let views: Vec<&wgpu::TextureView> = layer.gbuffer_views.iter().take(written).collect();
                 self.gbuffer.record(
                     &mut encoder,
                     &views,

@@ -140,10 +140,10 @@ pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmi
     m.transmission.as_ref().filter(|t| !m.unlit && t.factor > 0.0)
 }
 
-/// The material's clear coat as the real-time renderer draws it: on lit opaque materials (the
-/// transmissive layer's G-buffer has no room for it; the loader warns).
+/// The material's clear coat as the real-time renderer draws it: on lit materials, opaque and
+/// see-through (the transmissive layer's G-buffer then writes its coat target too).
 pub fn coat(m: &scene::Material) -> Option<&scene::clearcoat::Clearcoat> {
-    m.clearcoat.as_ref().filter(|c| !m.unlit && c.factor > 0.0 && transmission(m).is_none())
+    m.clearcoat.as_ref().filter(|c| !m.unlit && c.factor > 0.0)
 }
 
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
@@ -455,9 +455,11 @@ pub struct GpuScene {
     /// Whether some material has a thin film (`KHR_materials_iridescence` with a factor above
     /// 0): only then do the G-buffer and shading passes carry the film's code and target.
     pub has_film: bool,
-    /// Whether some material has a clear coat ([`coat`]): only then do the G-buffer and
+    /// Whether some opaque material has a clear coat ([`coat`]): only then do the G-buffer and
     /// shading passes carry the coat's code and target.
     pub has_coat: bool,
+    /// Whether some see-through material has one: the same for the transmissive layer.
+    pub has_transmission_coat: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -625,21 +627,6 @@ impl GpuScene {
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
         let mut materials = Vec::new();
-        let coated_glass: Vec<&str> = s
-            .materials
-            .iter()
-            .filter(|m| m.clearcoat.is_some() && transmission(m).is_some())
-            .map(|m| m.name.as_str())
-            .collect();
-        if let Some(first) = coated_glass.first() {
-            warnings.push(format!(
-                "material '{first}'{}: the real-time renderer draws no clear coat on a see-through material (the path tracer does)",
-                match coated_glass.len() {
-                    1 => String::new(),
-                    n => format!(" and {} more", n - 1),
-                }
-            ));
-        }
         for (index, m) in s.materials.iter().enumerate() {
             let refs = texture_refs(m);
             for r in refs.iter().flatten() {
@@ -761,7 +748,8 @@ impl GpuScene {
                 .materials
                 .iter()
                 .any(|m| !m.unlit && m.iridescence.as_ref().is_some_and(|f| f.factor > 0.0)),
-            has_coat: s.materials.iter().any(|m| coat(m).is_some()),
+            has_coat: s.materials.iter().any(|m| coat(m).is_some() && transmission(m).is_none()),
+            has_transmission_coat: s.materials.iter().any(|m| coat(m).is_some() && transmission(m).is_some()),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s

@@ -138,10 +138,11 @@ impl AccumTargets {
 
 /// The transmissive layer's targets (`passes::gbuffer::Layer::Transmissive`), made at the
 /// first frame of a scene with see-through materials: its own G-buffer (four targets, the
-/// fourth holding the transmission and the film) and depth, and the background — the opaque layer's shaded
+/// fourth holding the transmission and the film, and a fifth, the coat, written only where a
+/// see-through material has one) and depth, and the background — the opaque layer's shaded
 /// image, which the transmissive layer's shading samples where refracted rays leave the surface.
 pub struct LayerTargets {
-    pub gbuffer_views: [wgpu::TextureView; 4],
+    pub gbuffer_views: [wgpu::TextureView; 5],
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     pub background: wgpu::Texture,
@@ -162,6 +163,7 @@ impl LayerTargets {
             make("layer gbuffer normal", GBUFFER_FORMATS[1], none).1,
             make("layer gbuffer emission", GBUFFER_FORMATS[2], none).1,
             make("layer gbuffer transmission and film", GBUFFER_LAYER_FORMAT, none).1,
+            make("layer gbuffer coat", GBUFFER_COAT_FORMAT, none).1,
         ];
         let (depth, depth_view) = make("layer depth", DEPTH_FORMAT, wgpu::TextureUsages::COPY_DST);
         let (background, background_view) = make("background", HDR_FORMAT, wgpu::TextureUsages::COPY_DST);

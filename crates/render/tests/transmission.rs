@@ -745,3 +745,37 @@ fn the_environment_through_glass_takes_the_hooks_transmittance_in_every_mode() {
     println!("spectral against RGB, worst pixel {worst:.2e}");
     assert!(worst < 5e-3, "spectral and RGB differ by {worst}");
 }
+
+/// A clear coat (KHR_materials_clearcoat) on a see-through pane: what is seen through it is
+/// kept by 1 − w, w = clearcoat·F(|v·n|) = 0.04·clearcoat head-on (the orthographic camera
+/// looks along the pane's normal); with no light and no sky the coat reflects nothing. In the
+/// RGB and spectral modes and through the general node loop (the capture).
+#[test]
+fn a_coated_pane_keeps_one_minus_the_coats_weight_of_what_is_seen_through_it() {
+    let mut r = renderer();
+    for (mode, capture) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {
+        r.set_spectral_capture(capture);
+        let bare = render(&mut r, &scene(Some(glass(1.0, 1.5, 1.0, None, 0.0)), false), mode);
+        for strength in [1.0f32, 0.5] {
+            let mut pane = glass(1.0, 1.5, 1.0, None, 0.0);
+            pane.clearcoat = Some(scene::clearcoat::Clearcoat {
+                factor: strength,
+                texture: None,
+                roughness: 0.2,
+                roughness_texture: None,
+                normal_texture: None,
+                normal_scale: 1.0,
+            });
+            let img = render(&mut r, &scene(Some(pane), false), mode);
+            let keep = 1.0 - 0.04 * f64::from(strength);
+            close(
+                at(&img, CENTRE),
+                at(&bare, CENTRE).map(|c| keep * c),
+                1e-3,
+                &format!("{mode:?} capture {capture} clearcoat {strength}"),
+            );
+            assert_eq!(at(&img, BESIDE), at(&bare, BESIDE), "{mode:?}: the background changed");
+        }
+    }
+    r.set_spectral_capture(false);
+}

@@ -30,6 +30,8 @@ pub struct GBufferPass {
     layer_pipelines: Option<Pipelines>,
     /// With the film and the coat, for scenes with a clear coat ([`Targets::Coat`]).
     coat_pipelines: Option<Pipelines>,
+    /// The transmissive layer's with the coat ([`Targets::LayerCoat`]).
+    layer_coat_pipelines: Option<Pipelines>,
 }
 
 /// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
@@ -57,6 +59,8 @@ pub enum Targets {
     Film,
     /// And the film and the clear coat ([`GBUFFER_COAT_FORMAT`]).
     Coat,
+    /// The transmissive layer's ([`Targets::Layer`]) and the clear coat.
+    LayerCoat,
     /// And in four packed channels the transmission factor × texture, the volume's thickness
     /// texture and the film's two values: the transmissive layer's.
     Layer,
@@ -84,6 +88,7 @@ impl GBufferPass {
             film_pipelines: None,
             layer_pipelines: None,
             coat_pipelines: None,
+            layer_coat_pipelines: None,
         })
     }
 
@@ -93,7 +98,7 @@ impl GBufferPass {
             Targets::Plain => return Ok(()),
             Targets::Film => &mut self.film_pipelines,
             Targets::Layer => &mut self.layer_pipelines,
-            Targets::Coat => {
+            Targets::Coat | Targets::LayerCoat => {
                 let have = device.limits().max_color_attachment_bytes_per_sample;
                 if have < super::COAT_TARGET_BYTES {
                     return Err(crate::error::RenderError::Gpu(format!(
@@ -101,7 +106,11 @@ impl GBufferPass {
                         super::COAT_TARGET_BYTES
                     )));
                 }
-                &mut self.coat_pipelines
+                if targets == Targets::Coat {
+                    &mut self.coat_pipelines
+                } else {
+                    &mut self.layer_coat_pipelines
+                }
             }
         };
         if slot.is_none() {
@@ -124,11 +133,15 @@ impl GBufferPass {
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let pipelines = match (colour.len(), layer) {
-            (3, _) => &self.pipelines,
-            (5, _) => self.coat_pipelines.as_ref().expect("prepare(Coat) before a G-buffer with coats"),
+            (5, Layer::Transmissive) => self
+                .layer_coat_pipelines
+                .as_ref()
+                .expect("prepare(LayerCoat) before a coated transmissive layer"),
             (_, Layer::Transmissive) => {
                 self.layer_pipelines.as_ref().expect("prepare(Layer) before the transmissive layer")
             }
+            (3, _) => &self.pipelines,
+            (5, _) => self.coat_pipelines.as_ref().expect("prepare(Coat) before a G-buffer with coats"),
             _ => self.film_pipelines.as_ref().expect("prepare(Film) before a G-buffer with films"),
         };
         let attachments: Vec<_> = colour
@@ -195,6 +208,7 @@ fn build(
         Targets::Film => &[base, normal, emission, GBUFFER_FILM_FORMAT],
         Targets::Layer => &[base, normal, emission, GBUFFER_LAYER_FORMAT],
         Targets::Coat => &[base, normal, emission, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT],
+        Targets::LayerCoat => &[base, normal, emission, GBUFFER_LAYER_FORMAT, GBUFFER_COAT_FORMAT],
     };
     let targets: Vec<_> = formats
         .iter()
@@ -212,6 +226,8 @@ fn build(
             (true, Targets::Layer) => "fs_alpha_layer",
             (false, Targets::Coat) => "fs_main_coat",
             (true, Targets::Coat) => "fs_alpha_coat",
+            (false, Targets::LayerCoat) => "fs_main_layer_coat",
+            (true, Targets::LayerCoat) => "fs_alpha_layer_coat",
         };
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -236,3 +236,35 @@ fn fs_alpha_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoa
     let c = coat_sample(v);
     return with_coat(gbuffer(v, front, true), f, c, v, front);
 }
+
+// The transmissive layer's with a coat (passes/gbuffer.rs `Targets::LayerCoat`): see-through
+// materials under a clear coat.
+struct GBufferLayerCoatOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<u32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) layer: u32,
+    @location(4) coat: vec4<u32>,
+};
+
+fn with_layer_coat(o: GBufferOut, t: vec2<f32>, f: vec2<f32>, c: CoatSample, v: VertexOut, front: bool) -> GBufferLayerCoatOut {
+    let l = with_layer(o, t, f);
+    let k = with_coat(o, f, c, v, front);
+    return GBufferLayerCoatOut(l.base, l.normal, l.emission, l.layer, k.coat);
+}
+
+@fragment
+fn fs_main_layer_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerCoatOut {
+    let t = transmission_values(v);
+    let f = film_values(v);
+    let c = coat_sample(v);
+    return with_layer_coat(gbuffer(v, front, false), t, f, c, v, front);
+}
+
+@fragment
+fn fs_alpha_layer_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerCoatOut {
+    let t = transmission_values(v);
+    let f = film_values(v);
+    let c = coat_sample(v);
+    return with_layer_coat(gbuffer(v, front, true), t, f, c, v, front);
+}

@@ -597,8 +597,7 @@ impl ShadingPass {
                 },
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
-                // The layer has no coat (`scene_gpu::coat`): any uint texture here.
-                view_entry(8, &g[1]),
+                view_entry(8, &g[4]),
                 // The layer's film is in `layer_packed`: any float texture here.
                 view_entry(9, &g[0]),
                 view_entry(10, &layer.background_view),

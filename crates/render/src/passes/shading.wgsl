@@ -56,7 +56,7 @@ struct ShadowUniforms {
 // The clear coat at a pixel (KHR_materials_clearcoat; scene::clearcoat holds the rule both
 // renderers follow): its normal and roughness, and w = strength·F(|v·n_c|) (Schlick, F0 0.04),
 // the coat's share of what leaves the surface — 1 − w of everything under it (reflection,
-// emission) gets through. The weight does not depend on λ, so the coat reflects every
+// emission, what a see-through material transmits) gets through. The weight does not depend on λ, so the coat reflects every
 // wavelength of the light alike. None (w = 0) without coats in the scene, on unlit surfaces and
 // in the Lambert-only comparison mode (whose BRDF has no Fresnel term).
 struct Coat {
@@ -70,7 +70,7 @@ fn no_coat() -> Coat {
 }
 
 fn load_coat(px: vec2<i32>, v: vec3<f32>, unlit: bool) -> Coat {
-    if (!HAS_COAT || HAS_TRANSMISSION || unlit || lambert_only()) {
+    if (!HAS_COAT || unlit || lambert_only()) {
         return no_coat();
     }
     let t = textureLoad(gbuf_coat, px, 0);
@@ -699,7 +699,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
     } else if (shading_env() && env.flags.y != 0u) {
         rgb = env_background(ctx.view_dir).rgb;
     }
-    var out = custom_rgb(rgb, ctx) + through;
+    var out = custom_rgb(rgb, ctx) + through * (1.0 - coat.w);
     if (CUSTOM_IRRADIANCE && !ctx.background) {
         let lobe = diffuse_lobe(s) * (1.0 - coat.w);
         if (lobe > 0.0) {
@@ -1045,7 +1045,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         xyz = xyz * (1.0 - coat.w) + coat_xyz * coat.w;
     }
     if (HAS_TRANSMISSION) {
-        xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base, film);
+        xyz += transmitted_xyz(in.pos.xy, ctx, s, tr, c_base, film) * (1.0 - coat.w);
     }
     return hdr_out(frame.xyz_to_rgb * xyz, frame.exposure);
 }
@@ -1075,7 +1075,7 @@ fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Trans
     var through = 0.0;
     if (HAS_TRANSMISSION) {
         t.kd *= (1.0 - tr.weight);
-        through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k;
+        through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k * (1.0 - c.w);
     }
     if (filmed) {
         return NodeLight(t, through, coat_b);
@@ -1345,7 +1345,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         }
         if (HAS_TRANSMISSION && tp.k > 0.0) {
             let tn = transmitted_nodes(in.pos.xy, ctx, s, tr, c_base, film, tp, g);
-            var through = transmitted_weighted(tn, g);
+            var through = transmitted_weighted(tn, g) * under;
             if (CUSTOM_ENV_T && (tn.sky || any(tn.sky_lanes))) {
                 // What the hooks let through of the environment (`seen_through` took none).
                 let sky = select(vec4<bool>(tn.sky), tn.sky_lanes, tn.lanes);
