@@ -47,6 +47,24 @@ class DiffSummary(TypedDict):
     mae_linear: Stats
     mae_srgb: Stats
 
+class Placement(TypedDict):
+    """Where an image's pixels lie in its frame (an EXR's data window in its display window)."""
+
+    frame: Tuple[int, int]
+    x: int
+    y: int
+    width: int
+    height: int
+
+class Region(TypedDict):
+    """The part of the frame `diff` of two files compared, where it is not simply both images."""
+
+    frame: list[int]
+    x: int
+    y: int
+    width: int
+    height: int
+
 class Scene:
     """A loaded scene (from `load`); immutable. Pickles as `load` with the same arguments (a
     file by its absolute path), so it can be a Ray task's argument."""
@@ -287,8 +305,8 @@ def truth(
 ) -> Union[RGBImage, Tuple[RGBImage, _Bands, _Wavelengths]]: ...
 
 def diff(
-    a: _FloatImage,
-    b: _FloatImage,
+    a: Union[_FloatImage, _Path],
+    b: Union[_FloatImage, _Path],
     *,
     white_y: float = 1.0,
     flip: Optional[str] = None,
@@ -300,7 +318,9 @@ def diff(
     flip_tone_mapper: Optional[str] = None,
 ) -> dict[str, Any]:
     """`spectra diff --json`'s statistics of image `b` against the reference `a` (float32 or
-    float64 arrays of shape (H, W, 3), linear sRGB): ΔE2000, MAE linear and sRGB-encoded
+    float64 arrays of shape (H, W, 3), linear sRGB, compared pixel for pixel; or files, read and
+    lined up by their data windows as `spectra diff` does, `region` the part of the frame
+    compared, a `Region`, or None): ΔE2000, MAE linear and sRGB-encoded
     (a `DiffSummary`); flip="ldr"/"hdr" adds NVIDIA FLIP (`flip`, `flip_kind`, `flip_ppd`,
     and `flip_exposures`: HDR-FLIP's `start`, `stop`, `count`, `tone_mapper`, None for LDR-FLIP);
     flip_ppd and the HDR-FLIP options (`flip_start_exposure`, `flip_stop_exposure` (both needed
@@ -336,8 +356,14 @@ def chart(observer: _Path, illuminant: str = "D65", *, balanced: bool = False) -
     (24, 3), ∫ sensitivity·R·E dλ at 1 nm over 360–830 nm; balanced=True divides by the
     perfect white's response."""
 
-def read_image(path: _Path) -> RGBImage:
-    """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it."""
+@overload
+def read_image(path: _Path, *, placement: Literal[False] = False) -> RGBImage:
+    """An EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it (an EXR crop: its
+    data window); placement=True also returns where those pixels lie in the frame."""
+@overload
+def read_image(path: _Path, *, placement: Literal[True]) -> Tuple[RGBImage, Placement]: ...
+@overload
+def read_image(path: _Path, *, placement: bool = False) -> Union[RGBImage, Tuple[RGBImage, Placement]]: ...
 
 def write_image(path: _Path, image: _FloatImage) -> None:
     """Writes an (H, W, 3) linear RGB array as `.exr` (float32) or `.png` (sRGB, 8-bit),

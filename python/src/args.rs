@@ -267,6 +267,7 @@ arg_fns! {
     flip_exposures("flip_exposures") -> Option<i128> = opt_int;
     flip_tone_mapper("flip_tone_mapper") -> Option<String> = opt_string;
     maps("maps") -> bool = boolean;
+    placement("placement") -> bool = boolean;
     space("space") -> String = string;
     balanced("balanced") -> bool = boolean;
     medium("medium") -> Option<String> = opt_name_or_path;

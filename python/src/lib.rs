@@ -1338,10 +1338,19 @@ fn finite_image(what: &str, img: &compare::Image) -> PyResult<()> {
     }
 }
 
-/// How far image `b` is from the reference `a` (both linear sRGB arrays of shape (H, W, 3)):
-/// the statistics `spectra diff --json` prints, as a dict: `width`, `height`,
-/// `white_luminance`, and per-pixel `delta_e2000`, `mae_linear`, `mae_srgb`, each a dict of
-/// `mean`, `median`, `p95`, `p99`, `max`.
+/// How far image `b` is from the reference `a` (both linear sRGB arrays of shape (H, W, 3),
+/// compared pixel for pixel, or files): the statistics `spectra diff --json` prints, as a dict:
+/// `width`, `height`, `white_luminance`, and per-pixel `delta_e2000`, `mae_linear`, `mae_srgb`,
+/// each a dict of `mean`, `median`, `p95`, `p99`, `max`; and `region`.
+///
+/// a, b: an array, or a file (str or os.PathLike) read as `spectra diff` reads it (a spectral
+/// EXR integrated with CIE 1931 against its white, else D65). Files are lined up as `spectra
+/// diff` lines them up, by where their pixels lie in their frame (`read_image(placement=True)`):
+/// two crops of one frame, or a crop and the full frame, are compared over the pixels both
+/// hold, and `region` is that part of the frame, `{"frame": [W, H], "x", "y", "width",
+/// "height"}` (the maps count from its top-left); None where the images hold the same pixels,
+/// and for arrays. Crops of different frames, or sharing no pixel, are a ValueError saying
+/// where each lies.
 ///
 /// white_y: the luminance of the CIELAB reference white (D65 chromaticity), 1 by default.
 /// flip: also NVIDIA's FLIP (its reference C++ code, as `spectra diff --metric flip`):
@@ -1373,8 +1382,7 @@ fn diff<'py>(
     #[pyo3(from_py_with = args::flip_exposures)] flip_exposures: Option<i128>,
     #[pyo3(from_py_with = args::flip_tone_mapper)] flip_tone_mapper: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let reference = image_arg("a", a)?;
-    let test = image_arg("b", b)?;
+    let (reference, test, region) = diff_inputs(py, a, b)?;
     if reference.size() != test.size() {
         let (ra, rb) = (reference.size(), test.size());
         return Err(PyValueError::new_err(format!(
@@ -1482,6 +1490,19 @@ fn diff<'py>(
             )
             .map_err(value)?;
             let mut v = serde_json::to_value(dm.summary()).map_err(runtime)?;
+            v.as_object_mut().expect("a struct serialises to an object").insert(
+                "region".into(),
+                match region {
+                    Some(r) => serde_json::json!({
+                        "frame": [r.frame.0, r.frame.1],
+                        "x": r.origin.0,
+                        "y": r.origin.1,
+                        "width": r.size.0,
+                        "height": r.size.1,
+                    }),
+                    None => serde_json::Value::Null,
+                },
+            );
             let mut flip_map = None;
             if let Some(hdr) = hdr {
                 let map = if hdr {
@@ -1531,6 +1552,52 @@ fn diff<'py>(
         }
     }
     Ok(d)
+}
+
+/// `diff`'s reference and test: arrays as given, pixel for pixel; files (a str or an
+/// os.PathLike) read as `spectra diff` reads them and lined up as it lines them up, by where
+/// their pixels lie in their frame (two crops of one size at different places were compared
+/// pixel for pixel; a crop with its full frame refused for their sizes), with the region
+/// compared when it is not simply both images. An array holds the whole of its frame.
+fn diff_inputs(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+) -> PyResult<(compare::Image, compare::Image, Option<compare::Region>)> {
+    let is_file = |o: &Bound<'_, PyAny>| {
+        o.is_instance_of::<pyo3::types::PyString>() || o.hasattr("__fspath__").unwrap_or(false)
+    };
+    if !is_file(a) && !is_file(b) {
+        return Ok((image_arg("a", a)?, image_arg("b", b)?, None));
+    }
+    let input = |what: &str,
+                 role: &str,
+                 o: &Bound<'_, PyAny>|
+     -> PyResult<(compare::Image, compare::Placement)> {
+        if is_file(o) {
+            let path = args::path(o, what)?;
+            let (img, placed, _) = py.detach(|| {
+                fork_safe(|| spectra::cmd::diff::read_input(&path, role, None, None, false).map_err(value))
+            })?;
+            Ok((img, placed))
+        } else {
+            let img = image_arg(what, o)?;
+            let placed = compare::Placement::whole(img.size());
+            Ok((img, placed))
+        }
+    };
+    let (reference, rp) = input("a", "reference", a)?;
+    let (test, tp) = input("b", "test", b)?;
+    let shown = |o: &Bound<'_, PyAny>, what: &str| {
+        if is_file(o) {
+            args::path(o, what).map(|p| p.display().to_string()).unwrap_or_default()
+        } else {
+            format!("the array {what}")
+        }
+    };
+    compare::align(reference, rp, test, tp)
+        .with_context(|| format!("comparing {} with {}", shown(a, "a"), shown(b, "b")))
+        .map_err(|e| value(e).into())
 }
 
 /// An array of any shape (…, 3) of float32/float64 as f64 values and its leading shape, or a
@@ -1709,16 +1776,30 @@ fn illuminant<'py>(
 /// Reads an EXR (linear) or PNG (sRGB-decoded) file as `spectra diff` reads it: a float32
 /// array of shape (height, width, 3) of the pixels it holds. An EXR cropped from a larger frame
 /// (its data window inside its display window, as `truth --crop` writes) gives the crop alone;
-/// `spectra diff` lines two such files up by where they lie in the frame, while `diff` here
-/// compares the arrays as given, pixel for pixel.
+/// placement=True returns `(array, placement)` as well, where `placement` says where those
+/// pixels lie: `{"frame": (W, H), "x": x, "y": y, "width": w, "height": h}` (the crop's
+/// top-left pixel in the frame, negative for overscan; a PNG or a whole-frame EXR is at (0, 0)
+/// and its frame's size). `diff` of two files lines crops up by it, as `spectra diff` does.
 #[pyfunction]
-fn read_image(
-    py: Python<'_>,
+#[pyo3(signature = (path, *, placement = false))]
+fn read_image<'py>(
+    py: Python<'py>,
     #[pyo3(from_py_with = args::path_arg)] path: PathBuf,
-) -> PyResult<Bound<'_, numpy::PyArray3<f32>>> {
-    let img = py.detach(|| compare::read_image(&path).map_err(value))?;
+    #[pyo3(from_py_with = args::placement)] placement: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (img, placed) = py.detach(|| compare::read_image_placed(&path).map_err(value))?;
     let (w, h) = img.size();
-    rgb_array(py, w, h, img.data.into_iter().flatten().collect())
+    let array = rgb_array(py, w, h, img.data.into_iter().flatten().collect())?.into_any();
+    if !placement {
+        return Ok(array);
+    }
+    let d = pyo3::types::PyDict::new(py);
+    d.set_item("frame", placed.frame)?;
+    d.set_item("x", placed.origin.0)?;
+    d.set_item("y", placed.origin.1)?;
+    d.set_item("width", placed.size.0)?;
+    d.set_item("height", placed.size.1)?;
+    Ok((array, d).into_pyobject(py)?.into_any())
 }
 
 /// Writes an (H, W, 3) float32/float64 linear RGB array as `spectra truth` and `spectra render`

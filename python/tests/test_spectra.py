@@ -403,6 +403,71 @@ def test_diff_equals_the_cli(tmp_path):
     )
 
 
+def test_diff_of_two_files_lines_crops_up_as_the_cli(tmp_path):
+    """`spectra diff` lines EXR crops up by where they lie in their frame; `diff` of the two
+    files does too (it took arrays only, which read_image gives as the crop alone: two crops of
+    one size at different places were compared pixel for pixel, and a crop with its full frame
+    refused for their sizes), and `read_image(placement=True)` says where each lies. Arrays
+    given directly still compare as given."""
+    import json
+
+    exe = spectra_bin()
+    env = {**os.environ, "XDG_RUNTIME_DIR": os.environ.get("XDG_RUNTIME_DIR", str(tmp_path))}
+    size = ["--size", "40x30", "--direct-only", "--spp", "2"]
+
+    def truth(out, *extra):
+        subprocess.run([exe, "truth", "metamerism", *size, *extra, "--out", str(out)], check=True, env=env)
+        return out
+
+    full = truth(tmp_path / "full.exr", "--seed", "1")
+    c1 = truth(tmp_path / "c1.exr", "--seed", "1", "--crop", "4,2,20,16")
+    c2 = truth(tmp_path / "c2.exr", "--seed", "2", "--crop", "10,6,20,16")
+    far = truth(tmp_path / "far.exr", "--seed", "2", "--crop", "30,20,6,6")
+
+    img, placed = spectra.read_image(c1, placement=True)
+    assert img.shape == (16, 20, 3)
+    assert placed == {"frame": (40, 30), "x": 4, "y": 2, "width": 20, "height": 16}
+    whole = {"frame": (40, 30), "x": 0, "y": 0, "width": 40, "height": 30}
+    assert spectra.read_image(full, placement=True)[1] == whole
+    assert np.array_equal(spectra.read_image(c1), img)
+
+    def cli(a, b):
+        out = subprocess.run(
+            [exe, "diff", str(a), str(b), "--json"], check=True, env=env, capture_output=True, text=True
+        ).stdout
+        return json.loads(out)
+
+    keys = ("width", "height", "delta_e2000", "mae_linear", "mae_srgb", "region")
+    for a, b in [(c1, c2), (full, c2), (c1, full)]:
+        want = cli(a, b)
+        for a_, b_ in [(a, b), (str(a), str(b))]:
+            got = spectra.diff(a_, b_)
+            assert {k: got[k] for k in keys} == {k: want[k] for k in keys}, (a.name, b.name)
+    # The overlap of the two crops: x 10…23, y 6…17 of the frame.
+    r = spectra.diff(c1, c2, maps=True)
+    assert r["region"] == {"frame": [40, 30], "x": 10, "y": 6, "width": 14, "height": 12}
+    assert r["delta_e2000_map"].shape == (12, 14)
+    a, b = spectra.read_image(c1)[4:16, 6:20], spectra.read_image(c2)[0:12, 0:14]
+    assert spectra.diff(a, b)["delta_e2000"] == r["delta_e2000"]
+    # A crop against its full frame: the crop's pixels of the frame.
+    r = spectra.diff(full, c2)
+    assert r["region"] == {"frame": [40, 30], "x": 10, "y": 6, "width": 20, "height": 16}
+    cut = spectra.read_image(full)[6:22, 10:30]
+    assert spectra.diff(cut, spectra.read_image(c2))["delta_e2000"] == r["delta_e2000"]
+    # Arrays as given: pixel for pixel, no region.
+    arrays = spectra.diff(spectra.read_image(c1), spectra.read_image(c2))
+    assert arrays["region"] is None and (arrays["width"], arrays["height"]) == (20, 16)
+    assert spectra.diff(str(c1), str(c1))["region"] is None
+    with pytest.raises(ValueError, match="differ in size"):
+        spectra.diff(spectra.read_image(full), spectra.read_image(c2))
+    # Crops that share no pixel: refused, saying where each lies.
+    with pytest.raises(ValueError, match="share no pixel") as e:
+        spectra.diff(c1, far)
+    assert "c1.exr" in str(e.value) and "6×6 pixels at (30, 20)" in str(e.value)
+    with pytest.raises(FileNotFoundError, match="nope.exr"):
+        spectra.diff(tmp_path / "nope.exr", c1)
+
+
 def test_demo_table_equals_spectra_demo(tmp_path):
     import importlib.util
 

@@ -95,10 +95,15 @@ fn check_size(path: &Path, format: &'static str, w: u64, h: u64) -> Result<()> {
 /// PNG: 8- or 16-bit, grey, grey+alpha, RGB, RGBA or palette; values are sRGB-decoded.
 /// Alpha is dropped, not composited: renders and references are opaque.
 pub fn read_image(path: impl AsRef<Path>) -> Result<Image> {
+    read_image_placed(path).map(|(image, _)| image)
+}
+
+/// [`read_image`], and where its pixels lie in the image's frame ([`decode_image_placed`]).
+pub fn read_image_placed(path: impl AsRef<Path>) -> Result<(Image, Placement)> {
     let path = path.as_ref();
     format_of(path)?;
     let bytes = color::input::read_regular(path, MAX_INPUT_BYTES).map_err(|e| CompareError::io(path, e))?;
-    decode_image(path, &bytes)
+    decode_image_placed(path, &bytes)
 }
 
 /// The bits per sample of the PNG at `path` (8 for 1–8-bit files, 16), `None` for any other

@@ -26,7 +26,7 @@ pub use heatmap::{ColorMap, Heatmap, HeatmapOptions};
 pub use image::Image;
 pub use io::{
     ExrPrecision, PngBitDepth, WriteOptions, decode_image, decode_image_placed, encode_exr_framed,
-    encode_image, read_image, write_exr_framed, write_image,
+    encode_image, read_image, read_image_placed, write_exr_framed, write_image,
 };
 pub use spectral::{
     SpectralImage, SpectralKind, encode_spectral_exr_framed, read_spectral_exr, write_spectral_exr,

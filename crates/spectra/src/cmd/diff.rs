@@ -83,12 +83,26 @@ pub struct Args {
     flip_ppd: f32,
 }
 
-/// Reads an input; a spectral EXR is integrated to linear sRGB with the chosen observer and
-/// white. Returns where its pixels lie in its frame, and a note saying how, for spectral inputs.
+/// Reads an input with the command's options.
 fn load(
     path: &std::path::Path,
     what: &str,
     args: &Args,
+) -> anyhow::Result<(Image, compare::Placement, Option<String>)> {
+    read_input(path, what, args.observer.as_deref(), args.white.as_deref(), args.camera_to_display)
+}
+
+/// Reads an input as `spectra diff` does (the Python package's `diff` of two files reads them
+/// through here, so both read a file alike): an EXR or PNG as it is, a spectral EXR integrated
+/// to linear sRGB with `observer` (default CIE 1931) against `white` (default the file's, else
+/// D65). Returns where its pixels lie in its frame ([`compare::align`]), and a note saying how a
+/// spectral input was integrated; `what` names the input in errors.
+pub fn read_input(
+    path: &std::path::Path,
+    what: &str,
+    observer: Option<&str>,
+    white: Option<&str>,
+    camera_to_display: bool,
 ) -> anyhow::Result<(Image, compare::Placement, Option<String>)> {
     let bytes = color::input::read_regular(path, compare::io::MAX_INPUT_BYTES)
         .with_context(|| format!("reading the {what} image {}", path.display()))?;
@@ -100,12 +114,12 @@ fn load(
     }
     let (spec, placed) = compare::spectral::decode_spectral_exr_placed(path, &bytes)
         .with_context(|| format!("reading the {what} image"))?;
-    let obs_name = args.observer.as_deref().unwrap_or("cie1931");
+    let obs_name = observer.unwrap_or("cie1931");
     let observer = color::Observer::by_name(obs_name).context("--observer")?;
-    let white_name = args.white.clone().or(spec.white.clone()).unwrap_or_else(|| "D65".into());
+    let white_name = white.map(str::to_string).or(spec.white.clone()).unwrap_or_else(|| "D65".into());
     let white = color::illuminant::by_name(&white_name).with_context(|| format!("white {white_name}"))?;
     let img = spec
-        .to_display(&observer, &white, color::film::CameraView::from_flag(args.camera_to_display))
+        .to_display(&observer, &white, color::film::CameraView::from_flag(camera_to_display))
         .with_context(|| format!("integrating the {what} image {}", path.display()))?;
     let edges = &spec.edges;
     let note = format!(
