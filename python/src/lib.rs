@@ -1490,19 +1490,9 @@ fn diff<'py>(
             )
             .map_err(value)?;
             let mut v = serde_json::to_value(dm.summary()).map_err(runtime)?;
-            v.as_object_mut().expect("a struct serialises to an object").insert(
-                "region".into(),
-                match region {
-                    Some(r) => serde_json::json!({
-                        "frame": [r.frame.0, r.frame.1],
-                        "x": r.origin.0,
-                        "y": r.origin.1,
-                        "width": r.size.0,
-                        "height": r.size.1,
-                    }),
-                    None => serde_json::Value::Null,
-                },
-            );
+            v.as_object_mut()
+                .expect("a struct serialises to an object")
+                .insert("region".into(), spectra::cmd::diff::region_json(region.as_ref()));
             let mut flip_map = None;
             if let Some(hdr) = hdr {
                 let map = if hdr {

@@ -324,19 +324,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             },
         );
         o.insert("per_pixel_out".into(), args.per_pixel_out.as_ref().map(|p| p.display().to_string()).into());
-        o.insert(
-            "region".into(),
-            match region {
-                Some(r) => serde_json::json!({
-                    "frame": [r.frame.0, r.frame.1],
-                    "x": r.origin.0,
-                    "y": r.origin.1,
-                    "width": r.size.0,
-                    "height": r.size.1,
-                }),
-                None => serde_json::Value::Null,
-            },
-        );
+        o.insert("region".into(), region_json(region.as_ref()));
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         print_table(&args, &summary, heatmap, [&ref_note, &test_note], flip_stats.as_ref(), region);
@@ -411,6 +399,21 @@ fn print_table(
 fn table_cell(v: f64, prec: usize) -> String {
     let s = if v.is_finite() && v.abs() >= 1e6 { format!("{v:.4e}") } else { format!("{v:.prec$}") };
     format!(" {s:>11}")
+}
+
+/// The compared region as `--json` and Python's `diff` report it: `{"frame": [W, H], "x", "y",
+/// "width", "height"}`, or null where both images hold the same pixels.
+pub fn region_json(region: Option<&compare::Region>) -> serde_json::Value {
+    match region {
+        Some(r) => serde_json::json!({
+            "frame": [r.frame.0, r.frame.1],
+            "x": r.origin.0,
+            "y": r.origin.1,
+            "width": r.size.0,
+            "height": r.size.1,
+        }),
+        None => serde_json::Value::Null,
+    }
 }
 
 #[cfg(test)]
