@@ -367,32 +367,48 @@ fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f
     let ln = polygon_normal(li);
     // One-sided: nothing reaches points behind the emitting side.
     if (dot(p - polygon_vertex(li, 0u), ln) <= 0.0) { return none; }
-    // The shading frame (t1, n × t1, n), t1 towards the viewer: the table's frame.
-    let nv = dot(n, v);
-    var t1 = v - n * nv;
-    if (dot(t1, t1) < 1e-12) {
-        t1 = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9) ;
-        t1 -= n * dot(n, t1);
-    }
-    t1 = normalize(t1);
-    let to_local = transpose(mat3x3<f32>(t1, cross(n, t1), n));
+    let to_local = ltc_frame(n, v);
     let g = polygon_cosine(li, p, to_local);
     if (g <= 0.0) { return none; }
     let vis = light_visibility(li, p, n);
     if (lambert_only()) {
         return LightTerms(g * vis, 0.0, 1.0, 0.0);
     }
+    let lobe = ltc_lobe(roughness, dot(n, v));
+    let share = polygon_cosine(li, p, lobe.minv * to_local) / PI;
+    let albedo = lobe.ab.x + lobe.ab.y;
+    // The lobe's mean Schlick weight B / (A + B) as the (1 − v·h)⁵ of one half vector.
+    let fres = select(0.0, lobe.ab.y / albedo, albedo > 0.0);
+    return LightTerms(vis * g, vis * share * albedo, 1.0 - pow(fres, 0.2), 0.0);
+}
+
+// The shading frame (t1, n × t1, n) as a world-to-local matrix, t1 towards the viewer: the LTC
+// table's frame.
+fn ltc_frame(n: vec3<f32>, v: vec3<f32>) -> mat3x3<f32> {
+    var t1 = v - n * dot(n, v);
+    if (dot(t1, t1) < 1e-12) {
+        t1 = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9) ;
+        t1 -= n * dot(n, t1);
+    }
+    t1 = normalize(t1);
+    return transpose(mat3x3<f32>(t1, cross(n, t1), n));
+}
+
+// The GGX lobe of perceptual `roughness` seen at n·v = `nv` as a linearly transformed cosine
+// (src/ltc.rs): M⁻¹, and the split sum's A and B of the lobe.
+struct LtcLobe {
+    minv: mat3x3<f32>,
+    ab: vec2<f32>,
+};
+
+fn ltc_lobe(roughness: f32, nv: f32) -> LtcLobe {
     let cells = f32(LTC_SIZE - 1u);
     let half_texel = 0.5 / f32(LTC_SIZE);
     let uv = vec2<f32>(clamp(roughness, 0.0, 1.0), sqrt(1.0 - clamp(nv, 0.0, 1.0))) * (cells / f32(LTC_SIZE)) + half_texel;
     let c = textureSampleLevel(ltc_table, env_sampler, uv, 0, 0.0);
     let ab = textureSampleLevel(ltc_table, env_sampler, uv, 1, 0.0).xy;
     let minv = mat3x3<f32>(vec3<f32>(c.x, 0.0, c.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(c.y, 0.0, c.w));
-    let share = polygon_cosine(li, p, minv * to_local) / PI;
-    let albedo = ab.x + ab.y;
-    // The lobe's mean Schlick weight B / (A + B) as the (1 − v·h)⁵ of one half vector.
-    let fres = select(0.0, ab.y / albedo, albedo > 0.0);
-    return LightTerms(vis * g, vis * share * albedo, 1.0 - pow(fres, 0.2), 0.0);
+    return LtcLobe(minv, ab);
 }
 
 // The coat's lobe over polygon light li (`LightTerms::kc`): the LTC integral of a lobe of the
@@ -400,22 +416,10 @@ fn polygon_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f
 fn polygon_coat(li: u32, p: vec3<f32>, c: Coat, v: vec3<f32>) -> f32 {
     let n = c.normal;
     if (dot(p - polygon_vertex(li, 0u), polygon_normal(li)) <= 0.0) { return 0.0; }
-    let nv = dot(n, v);
-    var t1 = v - n * nv;
-    if (dot(t1, t1) < 1e-12) {
-        t1 = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9) ;
-        t1 -= n * dot(n, t1);
-    }
-    t1 = normalize(t1);
-    let to_local = transpose(mat3x3<f32>(t1, cross(n, t1), n));
+    let to_local = ltc_frame(n, v);
     if (polygon_cosine(li, p, to_local) <= 0.0) { return 0.0; }
-    let cells = f32(LTC_SIZE - 1u);
-    let half_texel = 0.5 / f32(LTC_SIZE);
-    let uv = vec2<f32>(clamp(c.roughness, 0.0, 1.0), sqrt(1.0 - clamp(nv, 0.0, 1.0))) * (cells / f32(LTC_SIZE)) + half_texel;
-    let m = textureSampleLevel(ltc_table, env_sampler, uv, 0, 0.0);
-    let ab = textureSampleLevel(ltc_table, env_sampler, uv, 1, 0.0).xy;
-    let minv = mat3x3<f32>(vec3<f32>(m.x, 0.0, m.z), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(m.y, 0.0, m.w));
-    return light_visibility(li, p, n) * polygon_cosine(li, p, minv * to_local) / PI * (ab.x + ab.y);
+    let lobe = ltc_lobe(c.roughness, dot(n, v));
+    return light_visibility(li, p, n) * polygon_cosine(li, p, lobe.minv * to_local) / PI * (lobe.ab.x + lobe.ab.y);
 }
 
 // Cells per axis of `ltc_table` (src/ltc.rs `SIZE`).
