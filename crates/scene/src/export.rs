@@ -236,6 +236,16 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_clearcoat"] = e;
         }
+        if let Some(sp) = &m.specular {
+            let mut e = json!({ "specularFactor": sp.factor, "specularColorFactor": sp.color.to_array() });
+            if let Some(t) = &sp.texture {
+                e["specularTexture"] = tex(t);
+            }
+            if let Some(t) = &sp.color_texture {
+                e["specularColorTexture"] = tex(t);
+            }
+            j["extensions"]["KHR_materials_specular"] = e;
+        }
         if m.ior != 1.5 {
             j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
         }
@@ -393,6 +403,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     }
     if scene.materials.iter().any(|m| m.clearcoat.is_some()) {
         extensions_used.push("KHR_materials_clearcoat");
+    }
+    if scene.materials.iter().any(|m| m.specular.is_some()) {
+        extensions_used.push("KHR_materials_specular");
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");

@@ -27,6 +27,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_volume",
     "KHR_materials_dispersion",
     "KHR_materials_clearcoat",
+    "KHR_materials_specular",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -67,10 +68,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
         "KHR_materials_sheen" => ("sheen (cloth, velvet) is ignored", "this renderer has no sheen"),
-        "KHR_materials_specular" => (
-            "specular strength and colour are ignored (a dielectric's F0 comes from its index of refraction: 0.04 at the default 1.5)",
-            "this renderer has no specular extension",
-        ),
         "KHR_materials_anisotropy" => {
             ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
         }

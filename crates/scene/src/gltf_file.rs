@@ -847,6 +847,9 @@ impl Loader<'_> {
         if let Some(cc) = info("/extensions/KHR_materials_clearcoat") {
             out.clearcoat = self.clearcoat(&at, cc)?;
         }
+        if let Some(sp) = info("/extensions/KHR_materials_specular") {
+            out.specular = self.specular(&at, sp)?;
+        }
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
@@ -920,6 +923,8 @@ impl Loader<'_> {
         }
         let cc_tex =
             |f: fn(&crate::clearcoat::Clearcoat) -> Option<TextureRef>| out.clearcoat.as_ref().and_then(f);
+        let sp_tex =
+            |f: fn(&crate::specular::Specular) -> Option<TextureRef>| out.specular.as_ref().and_then(f);
         let named = [
             ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),
             ("pbrMetallicRoughness.metallicRoughnessTexture", &out.metallic_roughness_texture),
@@ -932,6 +937,8 @@ impl Loader<'_> {
                 &cc_tex(|c| c.roughness_texture),
             ),
             ("extensions.KHR_materials_clearcoat.clearcoatNormalTexture", &cc_tex(|c| c.normal_texture)),
+            ("extensions.KHR_materials_specular.specularTexture", &sp_tex(|s| s.texture)),
+            ("extensions.KHR_materials_specular.specularColorTexture", &sp_tex(|s| s.color_texture)),
         ];
         // The coat's normal map is oriented by the same tangents as the base's (the extension
         // asks both to share their UV set); tangents are made for it when the base has none.
@@ -947,8 +954,21 @@ impl Loader<'_> {
             // otherwise be added to it and make it a light source.
             out.emissive = Vec3::ZERO;
             out.emissive_texture = None;
-            // The extension excludes a coat on an unlit material, which reflects nothing.
+            // The extensions exclude a coat or a specular on an unlit material, which reflects
+            // nothing.
             out.clearcoat = None;
+            out.specular = None;
+        }
+        if out.specular.is_some() && (out.iridescence.is_some() || out.transmission.is_some()) {
+            let with = if out.iridescence.is_some() {
+                "a thin film (KHR_materials_iridescence)"
+            } else {
+                "a transmission (KHR_materials_transmission)"
+            };
+            self.warnings.push(format!(
+                "{at}: KHR_materials_specular is ignored on a material with {with}; its reflection comes from its index of refraction alone"
+            ));
+            out.specular = None;
         }
         let Some(map) = extras::object(self.ctx, &at, m.extras())? else { return Ok((out, needs)) };
         let x = extras::material(self.ctx, &at, &map)?;
@@ -1083,6 +1103,51 @@ impl Loader<'_> {
             normal_texture,
             normal_scale,
         }))
+    }
+
+    /// `KHR_materials_specular` (`sp` is its JSON), validated: `None` at its defaults (weight 1,
+    /// white, no textures), which change nothing.
+    fn specular(&mut self, at: &str, sp: &Value) -> Result<Option<crate::specular::Specular>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_specular");
+        let factor = match sp.get("specularFactor") {
+            None => 1.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
+                _ => {
+                    return Err(self
+                        .ctx
+                        .invalid(format!("{at}.specularFactor"), format!("{v} is not a number in [0, 1]")));
+                }
+            },
+        };
+        let color = match sp.get("specularColorFactor") {
+            None => Vec3::ONE,
+            Some(v) => {
+                let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
+                match nums.as_deref() {
+                    Some(&[r, g, b])
+                        if [r, g, b]
+                            .iter()
+                            .all(|c| (0.0..=f64::from(crate::specular::MAX_COLOR)).contains(c)) =>
+                    {
+                        Vec3::new(r as f32, g as f32, b as f32)
+                    }
+                    _ => {
+                        return Err(self.ctx.invalid(
+                            format!("{at}.specularColorFactor"),
+                            format!(
+                                "{v} is not three numbers from 0 to {:e} (linear RGB; above 1 raises F0 up to 1)",
+                                crate::specular::MAX_COLOR
+                            ),
+                        ));
+                    }
+                }
+            }
+        };
+        let texture = self.extension_texture(&at, sp, "specularTexture", false)?;
+        let color_texture = self.extension_texture(&at, sp, "specularColorTexture", true)?;
+        let s = crate::specular::Specular { factor, texture, color, color_texture };
+        Ok((!s.is_default()).then_some(s))
     }
 
     /// `KHR_materials_transmission` with the material's `KHR_materials_volume` and

@@ -26,6 +26,7 @@ mod primitive;
 pub mod sky;
 pub mod spec_gloss;
 pub mod spectrum_desc;
+pub mod specular;
 pub mod srgb;
 mod tangents;
 pub mod transmission;
@@ -243,6 +244,10 @@ pub struct Material {
     /// `KHR_materials_clearcoat`: a clear coat over the whole material ([`clearcoat`]); `None`
     /// when its factor is 0.
     pub clearcoat: Option<clearcoat::Clearcoat>,
+    /// `KHR_materials_specular`: the dielectric's specular strength and F0 colour
+    /// ([`specular`]); `None` when absent or at its defaults, and on unlit, filmed and
+    /// see-through materials (dropped there with a warning).
+    pub specular: Option<specular::Specular>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
@@ -334,6 +339,7 @@ impl Default for Material {
             ior: 1.5,
             transmission: None,
             clearcoat: None,
+            specular: None,
         }
     }
 }

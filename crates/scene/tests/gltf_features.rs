@@ -1174,3 +1174,86 @@ fn clip_planes_that_leave_out_the_whole_scene_are_warned_about() {
         assert!(load(&doc).unwrap().warnings.is_empty(), "{znear} {zfar}");
     }
 }
+
+/// `KHR_materials_specular`: read with its defaults (a material at them has none), textures as
+/// data (the strength's A) and sRGB colour, bad values named by field; dropped with a warning
+/// where the renderers draw the reflection from the index alone (a film, a transmission), and
+/// on unlit materials, which the extension excludes; survives export.
+#[test]
+fn specular_is_read_with_its_defaults_and_bad_values_are_named() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], "VEC2");
+    let sp = |x: Value| json!({"extensions": {"KHR_materials_specular": x}});
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": m});
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_specular"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2)]}],
+        "materials": [
+            sp(json!({"specularFactor": 0.25})),
+            sp(json!({"specularColorFactor": [25.0, 0.5, 0.0],
+                      "specularTexture": {"index": 0}, "specularColorTexture": {"index": 0}})),
+            sp(json!({"specularFactor": 1.0, "specularColorFactor": [1.0, 1.0, 1.0]})),
+        ],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    let s = load(&doc).unwrap();
+    let said = s.warnings.join("\n");
+    assert!(!said.contains("KHR_materials_specular"), "{said}");
+    let mut required = doc.clone();
+    required["extensionsRequired"] = json!(["KHR_materials_specular"]);
+    assert!(load(&required).unwrap().materials[0].specular.is_some());
+    let a = s.materials[0].specular.as_ref().expect("a specular");
+    assert_eq!((a.factor, a.color), (0.25, Vec3::ONE));
+    let t = s.materials[1].specular.as_ref().unwrap();
+    assert_eq!((t.factor, t.color), (1.0, Vec3::new(25.0, 0.5, 0.0)));
+    assert!(!s.textures[t.texture.unwrap().index].srgb, "the strength is data");
+    assert!(s.textures[t.color_texture.unwrap().index].srgb, "the colour is sRGB");
+    assert!(s.materials[2].specular.is_none(), "defaults change nothing");
+    assert_eq!(scene::specular::f0_color(s.materials[1].dielectric_f0(), t.color), Vec3::new(1.0, 0.02, 0.0));
+
+    let bad = |key: &str, v: Value, parts: &[&str]| {
+        let mut d = doc.clone();
+        d["materials"][1]["extensions"]["KHR_materials_specular"][key] = v;
+        assert_has(&error(&d), parts);
+    };
+    let at = "materials[1].extensions.KHR_materials_specular";
+    bad("specularFactor", json!(1.5), &[&format!("{at}.specularFactor"), "[0, 1]"]);
+    bad("specularFactor", json!("1"), &[&format!("{at}.specularFactor"), "[0, 1]"]);
+    bad(
+        "specularColorFactor",
+        json!([1.0, -0.1, 1.0]),
+        &[&format!("{at}.specularColorFactor"), "three numbers"],
+    );
+    bad("specularColorFactor", json!([1.0, 1.0]), &[&format!("{at}.specularColorFactor"), "three numbers"]);
+    bad(
+        "specularColorFactor",
+        json!([1.0, 1.0, 1e300]),
+        &[&format!("{at}.specularColorFactor"), "three numbers"],
+    );
+    bad("specularTexture", json!({"index": 7}), &[&format!("{at}.specularTexture.index"), "no texture"]);
+    // Excluded: unlit (silently, as the coat), a film or a transmission (with a warning).
+    let mut d = doc.clone();
+    d["materials"][0]["extensions"]["KHR_materials_unlit"] = json!({});
+    assert!(load(&d).unwrap().materials[0].specular.is_none());
+    for (ext, v) in [
+        ("KHR_materials_iridescence", json!({"iridescenceFactor": 1.0})),
+        ("KHR_materials_transmission", json!({"transmissionFactor": 1.0})),
+    ] {
+        let mut d = doc.clone();
+        d["materials"][0]["extensions"][ext] = v;
+        let s = load(&d).unwrap();
+        assert!(s.materials[0].specular.is_none(), "{ext}");
+        let said = s.warnings.join("\n");
+        assert!(
+            said.contains("materials[0]") && said.contains("KHR_materials_specular is ignored"),
+            "{said}"
+        );
+    }
+    let back =
+        scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
+            .unwrap();
+    assert_eq!(back.materials[0].specular, s.materials[0].specular);
+}
