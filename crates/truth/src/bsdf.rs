@@ -11,11 +11,20 @@
 //! reflectance (`scene::film`) over the dielectric base and over the metal (its base colour
 //! as F0, the extension's convention), at v·h.
 //!
+//! With `KHR_materials_specular` (`scene::specular`, [`SpecularLanes`]), the dielectric's
+//! Fresnel term takes the weight s and the F0 colour F0c (an RGB reflectance, upsampled per
+//! lane as the base colour is): F_d(λ) = s·(F0c(λ) + (1 − F0c(λ))(1 − v·h)⁵), and what the
+//! diffuse loses is the scalar F_dmax = s·(F0c_max + (1 − F0c_max)(1 − v·h)⁵), F0c_max the
+//! largest RGB channel of F0c; with F_m(λ) = base + (1 − base)(1 − v·h)⁵ the metal's,
+//! f = (1 − [(1 − m)·F_dmax + m·F_m])·c_diff/π + [(1 − m)·F_d + m·F_m]·D·V. Without it
+//! (`None`) the arithmetic is the plain glTF BRDF's above, unchanged.
+//!
 //! Directions are in the local shading frame (normal = +z). Sampling mixes a cosine lobe with
 //! GGX visible-normal sampling (Heitz 2018); the mixture weight is the same for all four
 //! wavelengths, so one pdf serves the whole path.
 
 use crate::sampling::cosine_hemisphere;
+use crate::upsample::RgbToSpectrum;
 use glam::{Vec3, Vec4};
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -33,6 +42,34 @@ pub struct Brdf {
     pub film: Option<FilmLanes>,
     /// The dielectric's index of refraction (`KHR_materials_ior`; 1.5 by default).
     pub ior: f32,
+    /// `KHR_materials_specular`'s weight and F0 colour; `None`: the index's F0 at full weight.
+    pub specular: Option<SpecularLanes>,
+}
+
+/// `KHR_materials_specular` at a surface point, at the four wavelengths of the lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpecularLanes {
+    /// s = specularFactor × specularTexture.a, in [0, 1].
+    pub weight: f32,
+    /// F0c(λ): the F0 colour at each lane's wavelength, in [0, 1].
+    pub f0: Vec4,
+    /// F0c_max: the largest RGB channel of the F0 colour (not the largest lane), the diffuse's
+    /// share in every mode.
+    pub f0_max: f32,
+}
+
+impl SpecularLanes {
+    /// The weight `weight` and the F0 colour `f0_rgb` (linear RGB, `scene::specular::f0_color`)
+    /// at wavelengths `l`: F0c upsampled as a reflectance exactly as the base colour is
+    /// ([`crate::upsample::reflectance`]), a grey F0c the constant itself (no table).
+    pub fn new(weight: f32, f0_rgb: Vec3, up: &dyn RgbToSpectrum, l: Vec4) -> Self {
+        let f0 = if f0_rgb.x == f0_rgb.y && f0_rgb.y == f0_rgb.z {
+            Vec4::splat(f0_rgb.x.clamp(0.0, 1.0))
+        } else {
+            crate::upsample::reflectance(up, f0_rgb.to_array(), l)
+        };
+        SpecularLanes { weight: weight.clamp(0.0, 1.0), f0, f0_max: f0_rgb.max_element().clamp(0.0, 1.0) }
+    }
 }
 
 /// A thin film over the BRDF, at the four wavelengths of the lanes.
@@ -62,11 +99,12 @@ impl Brdf {
             lambert: false,
             film: None,
             ior: 1.5,
+            specular: None,
         }
     }
 
     pub fn lambertian(base: Vec4) -> Self {
-        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true, film: None, ior: 1.5 }
+        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true, film: None, ior: 1.5, specular: None }
     }
 
     /// This BRDF with the dielectric's index `ior` (≥ 1; `scene::Material::ior`).
@@ -79,6 +117,29 @@ impl Brdf {
     pub fn with_film(mut self, film: Option<FilmLanes>) -> Self {
         self.film = film.filter(|f| f.weight > 0.0 && !self.lambert);
         self
+    }
+
+    /// This BRDF with `KHR_materials_specular` (`None`: without). Lambert has no Fresnel term
+    /// to change, and a material with a thin film takes none (the loader drops the pair).
+    pub fn with_specular(mut self, specular: Option<SpecularLanes>) -> Self {
+        self.specular = specular.filter(|_| !self.lambert && self.film.is_none());
+        self
+    }
+
+    /// (what multiplies D·V, what the diffuse loses) at `cos` (v·h, or n·v for the sampling's
+    /// estimate): the Fresnel term twice without a specular; with one,
+    /// ((1 − m)·F_d + m·F_m, (1 − m)·F_dmax + m·F_m).
+    fn fresnel_pair(&self, cos: f32, fr: impl FnOnce() -> Vec4) -> (Vec4, Vec4) {
+        let Some(sp) = &self.specular else {
+            let fr = fr();
+            return (fr, fr);
+        };
+        let x = (1.0 - cos).max(0.0).powi(5);
+        let m = self.metallic;
+        let metal = self.base + (Vec4::ONE - self.base) * x;
+        let dielectric = (sp.f0 + (Vec4::ONE - sp.f0) * x) * sp.weight;
+        let dielectric_max = sp.weight * (sp.f0_max + (1.0 - sp.f0_max) * x);
+        (dielectric * (1.0 - m) + metal * m, Vec4::splat(dielectric_max * (1.0 - m)) + metal * m)
     }
 
     /// The Fresnel term at v·h: Schlick's with the glTF F0, blended with the film's.
@@ -116,15 +177,18 @@ impl Brdf {
     }
 
     /// The directional albedo at `n_v` as [`Self::p_spec`] estimates it (Schlick at normal
-    /// incidence for the half vector, the diffuse share's complement), averaged over the lanes:
+    /// incidence for the half vector, the diffuse share's complement; with a specular, its
+    /// weighted F0 colour and the F0c_max share), averaged over the lanes:
     /// what the clear coat weighs its sampling probability against.
     pub fn albedo_estimate(&self, n_v: f32) -> f32 {
         if self.lambert {
             return self.base.element_sum() * 0.25;
         }
-        let f0 = self.f0();
-        let fr = f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5);
-        (fr + (Vec4::ONE - fr) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
+        let (fs, fd) = self.fresnel_pair(n_v, || {
+            let f0 = self.f0();
+            f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5)
+        });
+        (fs + (Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
     }
 
     /// Probability of sampling the specular lobe: its share of the Fresnel-weighted albedo
@@ -133,10 +197,12 @@ impl Brdf {
         if self.lambert {
             return 0.0;
         }
-        let f0 = self.f0();
-        let fr = f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5);
-        let spec = fr.element_sum();
-        let diff = ((Vec4::ONE - fr) * self.base * (1.0 - self.metallic)).element_sum();
+        let (fs, fd) = self.fresnel_pair(n_v, || {
+            let f0 = self.f0();
+            f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5)
+        });
+        let spec = fs.element_sum();
+        let diff = ((Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum();
         if spec + diff <= 0.0 { 1.0 } else { (spec / (spec + diff)).clamp(0.05, 1.0) }
     }
 
@@ -151,9 +217,9 @@ impl Brdf {
         }
         let h = (wo + wi).normalize();
         let v_h = wo.dot(h).abs();
-        let fr = self.fresnel(v_h);
-        let diffuse = (Vec4::ONE - fr) * self.base * ((1.0 - self.metallic) * FRAC_1_PI);
-        diffuse + fr * (self.d(h.z) * self.vis(n_l, n_v))
+        let (fs, fd) = self.fresnel_pair(v_h, || self.fresnel(v_h));
+        let diffuse = (Vec4::ONE - fd) * self.base * ((1.0 - self.metallic) * FRAC_1_PI);
+        diffuse + fs * (self.d(h.z) * self.vis(n_l, n_v))
     }
 
     /// The pdf [`Self::sample`] draws `wi` with.

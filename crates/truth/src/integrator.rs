@@ -4,7 +4,7 @@
 //! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
 use crate::accel::Hit;
-use crate::bsdf::{Brdf, FilmLanes};
+use crate::bsdf::{Brdf, FilmLanes, SpecularLanes};
 use crate::camera::CameraRay;
 use crate::coat::Coat;
 use crate::dielectric::Dielectric;
@@ -435,7 +435,9 @@ impl Integrator<'_, '_> {
             let brdf = if self.lambert {
                 Brdf::lambertian(base)
             } else {
-                Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film)
+                let specular = material::specular(mat, &w.scene.textures, &s.tc)
+                    .map(|(weight, f0)| SpecularLanes::new(weight, f0, w.upsampler, l));
+                Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film).with_specular(specular)
             };
             let frame = Frame::from_normal(ns);
             let glass =
@@ -583,3 +585,7 @@ mod tests;
 #[cfg(test)]
 #[path = "coat_tests.rs"]
 mod coat_tests;
+
+#[cfg(test)]
+#[path = "specular_tests.rs"]
+mod specular_tests;

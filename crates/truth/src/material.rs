@@ -211,6 +211,18 @@ pub fn clearcoat(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(
     Some((strength, c.roughness_at(g)))
 }
 
+/// `KHR_materials_specular` at a surface point: the weight s (factor × texture A) and the F0
+/// colour min(F0(η)·colour, 1) (`scene::specular::f0_color`, colour = factor × the colour
+/// texture's RGB, linear), both read as the clear coat's textures are; `None` without one or
+/// on an unlit material (the loader drops it on filmed and see-through ones).
+pub fn specular(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(f32, Vec3)> {
+    let sp = m.specular.as_ref().filter(|_| !m.unlit)?;
+    let a = tex(textures, &sp.texture, tc).map(|(t, uv)| texture::sample(t, uv).w);
+    let rgb = tex(textures, &sp.color_texture, tc).map(|(t, uv)| texture::sample(t, uv).truncate());
+    let f0 = scene::dielectric_f0(m.ior.max(1.0));
+    Some((sp.weight_at(a), scene::specular::f0_color(f0, sp.color_at(rgb))))
+}
+
 /// The coat's normal: its own normal map in the base's tangent frame, or `n` (the interpolated
 /// normal, not the base's normal map) without one.
 pub fn coat_normal(
