@@ -181,7 +181,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             slot,
             film,
             transmission,
-            coat
+            coat,
+            specular
         }),
     );
     let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);

@@ -867,6 +867,7 @@ impl Renderer {
             film: scene.has_film,
             coat: scene.has_coat,
             ior: scene.has_ior,
+            specular: scene.has_specular,
             transmission: false,
             thin_walls: scene.has_thin_walls,
             dispersion: scene.has_dispersion,
@@ -887,6 +888,8 @@ impl Renderer {
             let layer_variant = Variant {
                 film: scene.has_transmission_film,
                 coat: scene.has_transmission_coat,
+                // The loader keeps no specular on see-through materials.
+                specular: false,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -903,12 +906,12 @@ impl Renderer {
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        let gbuffer_targets = if scene.has_coat {
-            GBufferTargets::Coat
-        } else if scene.has_film {
-            GBufferTargets::Film
-        } else {
-            GBufferTargets::Plain
+        let gbuffer_targets = match (scene.has_coat, scene.has_specular) {
+            (true, true) => GBufferTargets::CoatSpec,
+            (true, false) => GBufferTargets::Coat,
+            (false, true) => GBufferTargets::FilmSpec,
+            (false, false) if scene.has_film => GBufferTargets::Film,
+            (false, false) => GBufferTargets::Plain,
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         let layer_targets =
@@ -926,17 +929,23 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        let all = [&g[0], &g[1], &g[2], &targets.gbuffer_film_view, &targets.gbuffer_coat_view];
-        let colour = match gbuffer_targets {
-            GBufferTargets::Plain => &all[..3],
+        let (film, coat, spec) =
+            (&targets.gbuffer_film_view, &targets.gbuffer_coat_view, &targets.gbuffer_specular_view);
+        let colour: Vec<&wgpu::TextureView> = match gbuffer_targets {
+            GBufferTargets::Plain => vec![&g[0], &g[1], &g[2]],
             // (The transmissive layer's targets are its own, below.)
-            GBufferTargets::Film | GBufferTargets::Layer | GBufferTargets::LayerCoat => &all[..4],
-            GBufferTargets::Coat => &all[..],
+            GBufferTargets::Film | GBufferTargets::Layer | GBufferTargets::LayerCoat => {
+                vec![&g[0], &g[1], &g[2], film]
+            }
+            GBufferTargets::Coat => vec![&g[0], &g[1], &g[2], film, coat],
+            GBufferTargets::FilmSpec => vec![&g[0], &g[1], &g[2], film, spec],
+            GBufferTargets::CoatSpec => vec![&g[0], &g[1], &g[2], film, coat, spec],
         };
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
         self.gbuffer.record(
             &mut encoder,
-            colour,
+            gbuffer_targets,
+            &colour,
             &targets.depth_view,
             &self.frame_bind_group,
             scene,
@@ -992,6 +1001,7 @@ impl Renderer {
                 let views: Vec<&wgpu::TextureView> = layer.gbuffer_views.iter().take(written).collect();
                 self.gbuffer.record(
                     &mut encoder,
+                    layer_targets,
                     &views,
                     &layer.depth_view,
                     &self.frame_bind_group,

@@ -51,9 +51,9 @@ impl Vertex {
     }
 }
 
-/// Texture slots of a material, in binding order (textures at bindings 1..=7, their samplers at
-/// 8..=14; the order of `TEX_*` in `wgsl/material.wgsl`).
-pub const TEXTURE_SLOTS: usize = 12;
+/// Texture slots of a material, in binding order (textures at bindings 1..=14, their samplers
+/// at 15..=28; the order of `TEX_*` in `wgsl/material.wgsl`).
+pub const TEXTURE_SLOTS: usize = 14;
 
 /// `MaterialUniforms` in `wgsl/material.wgsl` (checked by `layout_tests`).
 #[repr(C)]
@@ -88,6 +88,10 @@ pub struct MaterialUniforms {
     /// z the coat's normal-map scale, w 1 with a coat normal map; the G-buffer's coat target
     /// holds them × the coat's textures.
     pub coat: [f32; 4],
+    /// `KHR_materials_specular` ([`specular`]): x the weight, yzw F0(η) × the colour factor;
+    /// the G-buffer's specular target holds min(yzw × the colour texture, 1) and x × the
+    /// strength texture's A. (1, F0, F0, F0) without: the plain dielectric.
+    pub specular: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -129,6 +133,11 @@ impl MaterialUniforms {
             coat: coat(m).map_or([0.0; 4], |c| {
                 [c.factor, c.roughness, c.normal_scale, c.normal_texture.is_some() as u8 as f32]
             }),
+            specular: {
+                let f0 = m.dielectric_f0();
+                let (w, c) = specular(m).map_or((1.0, glam::Vec3::ONE), |s| (s.factor, s.color));
+                [w, f0 * c.x, f0 * c.y, f0 * c.z]
+            },
         }
     }
 }
@@ -146,9 +155,16 @@ pub fn coat(m: &scene::Material) -> Option<&scene::clearcoat::Clearcoat> {
     m.clearcoat.as_ref().filter(|c| !m.unlit && c.factor > 0.0)
 }
 
+/// The material's specular strength and colour as the real-time renderer draws them: the
+/// loader keeps them only on lit, film-less, opaque materials (`scene::Material::specular`).
+pub fn specular(m: &scene::Material) -> Option<&scene::specular::Specular> {
+    m.specular.as_ref().filter(|_| !m.unlit && transmission(m).is_none())
+}
+
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
 /// occlusion, the film's weight (iridescence texture, R) and thickness (G), the transmission
-/// (R) and the volume's thickness (G), the coat's strength (R), roughness (G) and normal map.
+/// (R) and the volume's thickness (G), the coat's strength (R), roughness (G) and normal map,
+/// the specular strength (A) and colour (sRGB).
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
     let t = transmission(m);
@@ -166,11 +182,13 @@ pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] 
         c.and_then(|c| c.texture),
         c.and_then(|c| c.roughness_texture),
         c.and_then(|c| c.normal_texture),
+        specular(m).and_then(|s| s.texture),
+        specular(m).and_then(|s| s.color_texture),
     ]
 }
 
 /// The material bind group's layout (group 1 of the G-buffer and shadow passes): uniforms at
-/// 0, the twelve textures at 1..=12 and their samplers at 13..=24.
+/// 0, the fourteen textures at 1..=14 and their samplers at 15..=28.
 pub fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![crate::passes::uniform_entry(0, visibility)];
@@ -460,6 +478,9 @@ pub struct GpuScene {
     pub has_coat: bool,
     /// Whether some see-through material has one: the same for the transmissive layer.
     pub has_transmission_coat: bool,
+    /// Whether some opaque material has a specular strength or colour ([`specular`]): only then
+    /// do the G-buffer and shading passes carry its target and code.
+    pub has_specular: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -670,6 +691,8 @@ impl GpuScene {
                 &defaults.white_linear,
                 &defaults.white_linear,
                 &defaults.flat_normal,
+                &defaults.white_linear,
+                &defaults.white_srgb,
             ];
             let views: Vec<wgpu::TextureView> = refs
                 .iter()
@@ -751,6 +774,7 @@ impl GpuScene {
             has_coat: s.materials.iter().any(|m| coat(m).is_some() && transmission(m).is_none()),
             has_transmission_coat: s.materials.iter().any(|m| coat(m).is_some() && transmission(m).is_some()),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
+            has_specular: s.materials.iter().any(|m| specular(m).is_some()),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s
                 .materials

@@ -41,6 +41,10 @@ pub struct Targets {
     /// The clear coat per pixel (written only for scenes with a coat).
     pub gbuffer_coat: wgpu::Texture,
     pub gbuffer_coat_view: wgpu::TextureView,
+    /// The specular strength and colour per pixel (written only for scenes with
+    /// `KHR_materials_specular`).
+    pub gbuffer_specular: wgpu::Texture,
+    pub gbuffer_specular_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     /// The ambient light's screen-space occlusion (`passes::occlusion`), written only in frames
@@ -77,6 +81,8 @@ impl Targets {
         let [(g0, v0), (g1, v1), (g2, v2)] = g;
         let (gbuffer_film, gbuffer_film_view) = make("gbuffer film", GBUFFER_FILM_FORMAT, none);
         let (gbuffer_coat, gbuffer_coat_view) = make("gbuffer coat", GBUFFER_COAT_FORMAT, none);
+        let (gbuffer_specular, gbuffer_specular_view) =
+            make("gbuffer specular", crate::passes::GBUFFER_SPECULAR_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         // Written by the occlusion pass in its compute stage, like the HDR targets below.
         let storage = wgpu::TextureUsages::STORAGE_BINDING;
@@ -95,6 +101,8 @@ impl Targets {
             gbuffer_film_view,
             gbuffer_coat,
             gbuffer_coat_view,
+            gbuffer_specular,
+            gbuffer_specular_view,
             depth,
             depth_view,
             occlusion,

@@ -144,27 +144,6 @@ fn a_coat_reflects_about_its_own_normal_and_keeps_one_minus_its_weight_of_the_ba
     }
 }
 
-fn sphere(n: u32) -> scene::Mesh {
-    let mut m = scene::Mesh::default();
-    for i in 0..=n {
-        let theta = std::f32::consts::PI * i as f32 / n as f32;
-        for j in 0..=2 * n {
-            let phi = std::f32::consts::PI * j as f32 / n as f32;
-            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-            m.positions.push(p);
-            m.normals.push(p);
-        }
-    }
-    let row = 2 * n + 1;
-    for i in 0..n {
-        for j in 0..2 * n {
-            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
-            m.indices.extend([a, b, c, b, d, c]);
-        }
-    }
-    m
-}
-
 /// A black dielectric sphere in a uniform environment of radiance 1: uncoated it shows only
 /// its own specular; a smooth coat of strength s adds w = s·F(|v·n|) of the sky and keeps 1 − w
 /// of the rest, so coated = (1 − w)·uncoated + w·A, with A the split sum's albedo of a mirror

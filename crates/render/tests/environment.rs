@@ -5,32 +5,10 @@
 
 mod common;
 
-use common::renderer;
+use common::{renderer, sphere};
 use glam::{Vec2, Vec3, Vec4};
 use render::{Mode, RenderSettings};
 use scene::{Camera, Environment, Material, Mesh, Scene, SpectralSettings};
-
-fn sphere(n: u32) -> Mesh {
-    let mut m = Mesh::default();
-    for i in 0..=n {
-        let theta = std::f32::consts::PI * i as f32 / n as f32;
-        for j in 0..=2 * n {
-            let phi = std::f32::consts::PI * j as f32 / n as f32;
-            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-            m.positions.push(p);
-            m.normals.push(p);
-            m.uvs.push(Vec2::new(j as f32 / (2 * n) as f32, i as f32 / n as f32));
-        }
-    }
-    let row = 2 * n + 1;
-    for i in 0..n {
-        for j in 0..2 * n {
-            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
-            m.indices.extend([a, b, c, b, d, c]);
-        }
-    }
-    m
-}
 
 fn sphere_scene(env: Environment) -> Scene {
     Scene {

@@ -11,7 +11,10 @@
 //! ([`GBUFFER_FILM_FORMAT`]), built on first use, so that a scene without one samples no film
 //! texture and writes no film target.
 
-use super::{GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, SharedLayouts};
+use super::{
+    GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SPECULAR_FORMAT,
+    SharedLayouts,
+};
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
@@ -32,6 +35,10 @@ pub struct GBufferPass {
     coat_pipelines: Option<Pipelines>,
     /// The transmissive layer's with the coat ([`Targets::LayerCoat`]).
     layer_coat_pipelines: Option<Pipelines>,
+    /// With the film and the specular ([`Targets::FilmSpec`]).
+    spec_pipelines: Option<Pipelines>,
+    /// With the film, the coat and the specular ([`Targets::CoatSpec`]).
+    coat_spec_pipelines: Option<Pipelines>,
 }
 
 /// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
@@ -64,6 +71,11 @@ pub enum Targets {
     /// And in four packed channels the transmission factor × texture, the volume's thickness
     /// texture and the film's two values: the transmissive layer's.
     Layer,
+    /// [`Targets::Film`] and the specular strength and colour ([`GBUFFER_SPECULAR_FORMAT`],
+    /// `KHR_materials_specular`).
+    FilmSpec,
+    /// [`Targets::Coat`] and the specular.
+    CoatSpec,
 }
 
 impl GBufferPass {
@@ -89,6 +101,8 @@ impl GBufferPass {
             layer_pipelines: None,
             coat_pipelines: None,
             layer_coat_pipelines: None,
+            spec_pipelines: None,
+            coat_spec_pipelines: None,
         })
     }
 
@@ -98,18 +112,28 @@ impl GBufferPass {
             Targets::Plain => return Ok(()),
             Targets::Film => &mut self.film_pipelines,
             Targets::Layer => &mut self.layer_pipelines,
-            Targets::Coat | Targets::LayerCoat => {
+            Targets::Coat | Targets::LayerCoat | Targets::FilmSpec | Targets::CoatSpec => {
                 let have = device.limits().max_color_attachment_bytes_per_sample;
-                if have < super::COAT_TARGET_BYTES {
+                let (need, what) = match targets {
+                    Targets::FilmSpec => {
+                        (super::SPECULAR_TARGET_BYTES, "a specular colour (KHR_materials_specular)")
+                    }
+                    Targets::CoatSpec => (
+                        super::COAT_SPECULAR_TARGET_BYTES,
+                        "a clear coat and a specular colour (KHR_materials_clearcoat, KHR_materials_specular)",
+                    ),
+                    _ => (super::COAT_TARGET_BYTES, "a clear coat (KHR_materials_clearcoat)"),
+                };
+                if have < need {
                     return Err(crate::error::RenderError::Gpu(format!(
-                        "a scene with a clear coat (KHR_materials_clearcoat) needs G-buffer targets of {} bytes a pixel; this GPU's hold {have}",
-                        super::COAT_TARGET_BYTES
+                        "a scene with {what} needs G-buffer targets of {need} bytes a pixel; this GPU's hold {have}"
                     )));
                 }
-                if targets == Targets::Coat {
-                    &mut self.coat_pipelines
-                } else {
-                    &mut self.layer_coat_pipelines
+                match targets {
+                    Targets::Coat => &mut self.coat_pipelines,
+                    Targets::LayerCoat => &mut self.layer_coat_pipelines,
+                    Targets::FilmSpec => &mut self.spec_pipelines,
+                    _ => &mut self.coat_spec_pipelines,
                 }
             }
         };
@@ -119,12 +143,13 @@ impl GBufferPass {
         Ok(())
     }
 
-    /// Records the pass into `colour`: the three G-buffer targets, and the film's or the
-    /// transmissive layer's as a fourth, as the [`Targets`] prepared ([`Self::prepare`]).
+    /// Records the pass into `colour`: the three G-buffer targets and those of `targets`
+    /// (prepared: [`Self::prepare`]).
     #[allow(clippy::too_many_arguments)] // a pass's inputs, each its own kind
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
+        targets: Targets,
         colour: &[&wgpu::TextureView],
         depth: &wgpu::TextureView,
         frame: &wgpu::BindGroup,
@@ -132,18 +157,17 @@ impl GBufferPass {
         layer: Layer,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let pipelines = match (colour.len(), layer) {
-            (5, Layer::Transmissive) => self
-                .layer_coat_pipelines
-                .as_ref()
-                .expect("prepare(LayerCoat) before a coated transmissive layer"),
-            (_, Layer::Transmissive) => {
-                self.layer_pipelines.as_ref().expect("prepare(Layer) before the transmissive layer")
-            }
-            (3, _) => &self.pipelines,
-            (5, _) => self.coat_pipelines.as_ref().expect("prepare(Coat) before a G-buffer with coats"),
-            _ => self.film_pipelines.as_ref().expect("prepare(Film) before a G-buffer with films"),
+        let pipelines = match targets {
+            Targets::Plain => Some(&self.pipelines),
+            Targets::Film => self.film_pipelines.as_ref(),
+            Targets::Layer => self.layer_pipelines.as_ref(),
+            Targets::Coat => self.coat_pipelines.as_ref(),
+            Targets::LayerCoat => self.layer_coat_pipelines.as_ref(),
+            Targets::FilmSpec => self.spec_pipelines.as_ref(),
+            Targets::CoatSpec => self.coat_spec_pipelines.as_ref(),
         };
+        let pipelines = pipelines.unwrap_or_else(|| panic!("prepare({targets:?}) before recording"));
+        debug_assert_eq!(colour.len(), formats(targets).len(), "{targets:?}");
         let attachments: Vec<_> = colour
             .iter()
             .map(|view| {
@@ -195,6 +219,22 @@ impl GBufferPass {
     }
 }
 
+/// The formats of the targets `which` names, in location order.
+pub fn formats(which: Targets) -> &'static [wgpu::TextureFormat] {
+    const B: wgpu::TextureFormat = GBUFFER_FORMATS[0];
+    const N: wgpu::TextureFormat = GBUFFER_FORMATS[1];
+    const E: wgpu::TextureFormat = GBUFFER_FORMATS[2];
+    match which {
+        Targets::Plain => &GBUFFER_FORMATS,
+        Targets::Film => &[B, N, E, GBUFFER_FILM_FORMAT],
+        Targets::Layer => &[B, N, E, GBUFFER_LAYER_FORMAT],
+        Targets::Coat => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT],
+        Targets::LayerCoat => &[B, N, E, GBUFFER_LAYER_FORMAT, GBUFFER_COAT_FORMAT],
+        Targets::FilmSpec => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_SPECULAR_FORMAT],
+        Targets::CoatSpec => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT, GBUFFER_SPECULAR_FORMAT],
+    }
+}
+
 /// The four pipelines (single/double-sided × opaque/alpha-tested) writing `which` targets.
 fn build(
     device: &wgpu::Device,
@@ -202,15 +242,7 @@ fn build(
     layout: &wgpu::PipelineLayout,
     which: Targets,
 ) -> Result<Pipelines> {
-    let [base, normal, emission] = GBUFFER_FORMATS;
-    let formats: &[wgpu::TextureFormat] = match which {
-        Targets::Plain => &GBUFFER_FORMATS,
-        Targets::Film => &[base, normal, emission, GBUFFER_FILM_FORMAT],
-        Targets::Layer => &[base, normal, emission, GBUFFER_LAYER_FORMAT],
-        Targets::Coat => &[base, normal, emission, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT],
-        Targets::LayerCoat => &[base, normal, emission, GBUFFER_LAYER_FORMAT, GBUFFER_COAT_FORMAT],
-    };
-    let targets: Vec<_> = formats
+    let targets: Vec<_> = formats(which)
         .iter()
         .map(|&format| {
             Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
@@ -228,6 +260,10 @@ fn build(
             (true, Targets::Coat) => "fs_alpha_coat",
             (false, Targets::LayerCoat) => "fs_main_layer_coat",
             (true, Targets::LayerCoat) => "fs_alpha_layer_coat",
+            (false, Targets::FilmSpec) => "fs_main_spec",
+            (true, Targets::FilmSpec) => "fs_alpha_spec",
+            (false, Targets::CoatSpec) => "fs_main_coat_spec",
+            (true, Targets::CoatSpec) => "fs_alpha_coat_spec",
         };
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -268,3 +268,73 @@ fn fs_alpha_layer_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBuf
     let c = coat_sample(v);
     return with_layer_coat(gbuffer(v, front, true), t, f, c, v, front);
 }
+
+// Scenes with KHR_materials_specular add its per-pixel values after the film's (and the
+// coat's) targets (passes/gbuffer.rs `Targets::FilmSpec`, `Targets::CoatSpec`): rgb the F0
+// colour min(F0(η)·colour factor·colour texture, 1), a the weight (factor × strength texture's
+// A) — scene::specular. Materials without the extension write the plain dielectric's
+// (F0, F0, F0, 1); unlit surfaces reflect nothing, whatever is written.
+// 16-bit fractions (passes/mod.rs GBUFFER_SPECULAR_FORMAT).
+fn specular_values(v: VertexOut) -> vec4<u32> {
+    let a = textureSampleBias(specular_tex, specular_smp, material_uv(TEX_SPECULAR, v.uv, v.uv1), frame.lod_bias).a;
+    let c = textureSampleBias(specular_color_tex, specular_color_smp, material_uv(TEX_SPECULAR_COLOR, v.uv, v.uv1), frame.lod_bias).rgb;
+    let sp = vec4<f32>(min(material.specular.yzw * c, vec3<f32>(1.0)), clamp(material.specular.x * a, 0.0, 1.0));
+    return vec4<u32>(round(clamp(sp, vec4<f32>(0.0), vec4<f32>(1.0)) * 65535.0));
+}
+
+struct GBufferFilmSpecOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<u32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) film: vec2<f32>,
+    @location(4) specular: vec4<u32>,
+};
+
+fn with_film_spec(o: GBufferOut, f: vec2<f32>, sp: vec4<u32>) -> GBufferFilmSpecOut {
+    let k = with_film(o, f);
+    return GBufferFilmSpecOut(k.base, k.normal, k.emission, k.film, sp);
+}
+
+@fragment
+fn fs_main_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmSpecOut {
+    let f = film_values(v);
+    let sp = specular_values(v);
+    return with_film_spec(gbuffer(v, front, false), f, sp);
+}
+
+@fragment
+fn fs_alpha_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmSpecOut {
+    let f = film_values(v);
+    let sp = specular_values(v);
+    return with_film_spec(gbuffer(v, front, true), f, sp);
+}
+
+struct GBufferCoatSpecOut {
+    @location(0) base: vec4<f32>,
+    @location(1) normal: vec4<u32>,
+    @location(2) emission: vec4<f32>,
+    @location(3) film: vec2<f32>,
+    @location(4) coat: vec4<u32>,
+    @location(5) specular: vec4<u32>,
+};
+
+fn with_coat_spec(o: GBufferOut, f: vec2<f32>, c: CoatSample, sp: vec4<u32>, v: VertexOut, front: bool) -> GBufferCoatSpecOut {
+    let k = with_coat(o, f, c, v, front);
+    return GBufferCoatSpecOut(k.base, k.normal, k.emission, k.film, k.coat, sp);
+}
+
+@fragment
+fn fs_main_coat_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatSpecOut {
+    let f = film_values(v);
+    let c = coat_sample(v);
+    let sp = specular_values(v);
+    return with_coat_spec(gbuffer(v, front, false), f, c, sp, v, front);
+}
+
+@fragment
+fn fs_alpha_coat_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatSpecOut {
+    let f = film_values(v);
+    let c = coat_sample(v);
+    let sp = specular_values(v);
+    return with_coat_spec(gbuffer(v, front, true), f, c, sp, v, front);
+}

@@ -88,6 +88,15 @@ pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Ui
 pub const GBUFFER_COAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Uint;
 /// Bytes a pixel of a coated scene's G-buffer targets: base, normal, emission, film, coat.
 pub const COAT_TARGET_BYTES: u32 = 8 + 8 + 8 + 4 + 8;
+/// `KHR_materials_specular` per pixel (written only when the scene has it, after the film's and
+/// the coat's targets): the F0 colour min(F0(η)·colour, 1) and the weight (`scene::specular`),
+/// each a 16-bit fraction (to 1.5·10⁻⁵; the textures have 8 bits). Unsigned integers: the
+/// shading pass reads it where the see-through layer's packed target is bound (`specular_at`).
+pub const GBUFFER_SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Uint;
+/// Bytes a pixel of the G-buffer targets with the specular's: 36 beside the film's, 44 with
+/// the coat's too (past WebGPU's guaranteed 32, as the coat's).
+pub const SPECULAR_TARGET_BYTES: u32 = 8 + 8 + 8 + 4 + 8;
+pub const COAT_SPECULAR_TARGET_BYTES: u32 = COAT_TARGET_BYTES + 8;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The camera's depth where nothing is drawn, what its depth targets are cleared to: depth is
 /// reversed (1 near, 0 far; [`crate::renderer::projection`]), so a nearer surface has the

@@ -146,6 +146,9 @@ pub struct Variant {
     pub coat: bool,
     /// Some dielectric's index is not 1.5 (`HAS_IOR`, `KHR_materials_ior`): F0 per material.
     pub ior: bool,
+    /// Some material has a specular strength or colour (`HAS_SPECULAR`,
+    /// `KHR_materials_specular`): the G-buffer's specular target is read (all modes).
+    pub specular: bool,
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
     /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
     pub transmission: bool,
@@ -178,6 +181,7 @@ impl Variant {
         film: true,
         coat: true,
         ior: true,
+        specular: true,
         transmission: false,
         thin_walls: true,
         dispersion: true,
@@ -186,9 +190,9 @@ impl Variant {
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, emission, film, ior, transmission, thin walls, dispersion) and the occlusion's; its
+    /// environment, emission, film, ior, specular, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 16] {
+    fn constants(&self) -> [(&'static str, f64); 17] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -202,6 +206,7 @@ impl Variant {
             ("HAS_FILM", b(self.film)),
             ("HAS_COAT", b(self.coat)),
             ("HAS_IOR", b(self.ior)),
+            ("HAS_SPECULAR", b(self.specular)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
             ("HAS_DISPERSION", b(self.dispersion)),
@@ -221,6 +226,7 @@ impl Variant {
             film: self.film,
             coat: self.coat,
             ior: self.ior,
+            specular: self.specular,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
             dispersion: self.dispersion,
@@ -335,7 +341,10 @@ impl ShadingPass {
                 super::filterable_entry(10),
                 texture_entry(11),
                 super::depth_entry(12),
-                // The transmissive layer's transmission and film, packed (`layer_packed`).
+                // The transmissive layer's transmission and film, packed (`layer_packed`); the
+                // opaque layer's specular strength and colour (`specular_at`), which the
+                // see-through one never has: a sampled texture of its own would be the 17th of
+                // the stage, past WebGPU's guaranteed 16.
                 super::uint_entry(13),
                 // The opaque layer's shaded image (`shading_out`).
                 super::storage_output_entry(14, HDR_FORMAT),
@@ -546,7 +555,7 @@ impl ShadingPass {
                 // The occlusion pass's output (`aux_map`, read with `OCCLUSION_MAP`).
                 view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),
-                view_entry(13, &g[1]),
+                view_entry(13, &t.gbuffer_specular_view),
                 view_entry(14, output),
             ],
         })

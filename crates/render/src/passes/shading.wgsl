@@ -33,6 +33,9 @@ override HAS_IOR: bool = true;
 // A material with a clear coat (KHR_materials_clearcoat): the G-buffer's coat target is read,
 // and coated pixels layer the coat over everything under it (every mode).
 override HAS_COAT: bool = true;
+// A material with a specular strength or colour (KHR_materials_specular): the G-buffer's
+// specular target is read (every mode); a tinted F0 takes the film's per-node path.
+override HAS_SPECULAR: bool = true;
 
 fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
@@ -52,6 +55,12 @@ struct ShadowUniforms {
 @group(1) @binding(9) var gbuf_film: texture_2d<f32>;
 // The coats: normal, roughness and strength, packed as the normal's target (gbuffer.wgsl).
 @group(1) @binding(8) var gbuf_coat: texture_2d<u32>;
+// The specular at a pixel (gbuffer.wgsl; bound where the see-through layer has its packed
+// target, `layer_packed`, which a specular never needs): rgb the F0 colour, a the weight
+// (scene::specular).
+fn specular_at(px: vec2<i32>) -> vec4<f32> {
+    return vec4<f32>(textureLoad(layer_packed, px, 0)) * (1.0 / 65535.0);
+}
 
 // The clear coat at a pixel (KHR_materials_clearcoat; scene::clearcoat holds the rule both
 // renderers follow): its normal and roughness, and w = strength·F(|v·n_c|) (Schlick, F0 0.04),
@@ -290,12 +299,14 @@ fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32
 // where ρ is the base-colour reflectance. This folds Lambert + GGX (glTF metallic-roughness,
 // Schlick Fresnel, height-correlated Smith) into two scalars so that the per-wavelength loop
 // costs two fma per light.
-fn factors_of(t: LightTerms, metallic: f32, f0: f32) -> vec2<f32> {
+// `w` is the dielectric's specular weight (KHR_materials_specular; 1 without), which scales its
+// Fresnel term for the lobe and for what the diffuse loses alike (an untinted F0).
+fn factors_of(t: LightTerms, metallic: f32, f0: f32, w: f32) -> vec2<f32> {
     if (lambert_only()) {
         return vec2<f32>(t.kd / PI, 0.0);
     }
     let fres = pow(1.0 - t.vh, 5.0);
-    let f_dielectric = f0 + (1.0 - f0) * fres;
+    let f_dielectric = w * (f0 + (1.0 - f0) * fres);
     let a = t.kd * (1.0 - metallic) * (1.0 - f_dielectric) / PI + t.ks * metallic * (1.0 - fres);
     let b = t.ks * ((1.0 - metallic) * f_dielectric + metallic * fres);
     return vec2<f32>(a, b);
@@ -455,15 +466,26 @@ struct GSurface {
     occlusion: f32,
     // KHR_materials_unlit: only `emission` (its base colour) leaves the surface.
     unlit: bool,
-    // The dielectric's normal-incidence reflectance (KHR_materials_ior; glTF's 0.04 at 1.5).
+    // The dielectric's normal-incidence reflectance (KHR_materials_ior; glTF's 0.04 at 1.5);
+    // with KHR_materials_specular the largest channel of its F0 colour, which sets what the
+    // diffuse loses (and the whole F0 where the colour is grey).
     f0: f32,
+    // KHR_materials_specular's weight (1 without).
+    spec_w: f32,
 };
 
 fn load_surface(px: vec2<i32>) -> GSurface {
     let b = textureLoad(gbuf_base, px, 0);
     let nr = textureLoad(gbuf_normal, px, 0);
     let e = textureLoad(gbuf_emission, px, 0);
-    return GSurface(b.rgb, e.rgb, gbuffer_normal(nr), max(b.a, 0.0), gbuffer_roughness(nr), e.a, b.a < 0.0, surface_f0(px));
+    var f0 = vec2<f32>(0.0, 1.0);
+    if (HAS_SPECULAR) {
+        let sp = specular_at(px);
+        f0 = vec2<f32>(max(sp.r, max(sp.g, sp.b)), sp.a);
+    } else {
+        f0.x = surface_f0(px);
+    }
+    return GSurface(b.rgb, e.rgb, gbuffer_normal(nr), max(b.a, 0.0), gbuffer_roughness(nr), e.a, b.a < 0.0, f0.x, f0.y);
 }
 
 // The index of the material's record (src/material_spectra.rs) at pixel px, by its slot.
@@ -490,7 +512,7 @@ fn surface_f0(px: vec2<i32>) -> f32 {
 fn diffuse_lobe(s: GSurface) -> f32 {
     if (s.unlit) { return 0.0; }
     if (lambert_only()) { return 1.0 / PI; }
-    return (1.0 - s.metallic) * (1.0 - (s.f0 + (1.0 - s.f0) / 21.0)) / PI;
+    return (1.0 - s.metallic) * (1.0 - s.spec_w * (s.f0 + (1.0 - s.f0) / 21.0)) / PI;
 }
 
 // The thin film at a pixel (KHR_materials_iridescence): how much of the Fresnel term is the
@@ -503,11 +525,53 @@ struct FilmSurface {
     // The dielectric base's F0 and index (glTF's 0.04 and 1.5 without KHR_materials_ior).
     f0: f32,
     base_ior: f32,
+    // KHR_materials_specular (never with a film: the loader drops it there): rgb the F0
+    // colour, a the weight; `tinted` where the colour is not grey, whose Fresnel term then
+    // depends on λ and takes this path; `spec_c` its coefficients (the spectral modes'
+    // `spec_coeffs`).
+    spec: vec4<f32>,
+    tinted: bool,
+    spec_c: vec3<f32>,
 };
 
+fn no_film() -> FilmSurface {
+    return FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5, vec4<f32>(0.04, 0.04, 0.04, 1.0), false, vec3<f32>(0.0));
+}
+
+// Whether a pixel's Fresnel term depends on λ: a film, or a tinted specular colour.
+fn is_filmed(f: FilmSurface) -> bool {
+    return (HAS_FILM && f.weight > 0.0) || (HAS_SPECULAR && f.tinted);
+}
+
+// The tinted specular's F0 at group g's nodes: its colour's reflectance spectrum, made as the
+// base colour's is (zero where it is not tinted).
+fn spec_nodes(f: FilmSurface, g: u32) -> vec4<f32> {
+    if (!HAS_SPECULAR || !f.tinted) {
+        return vec4<f32>(0.0);
+    }
+    return node_reflectance(f.spec_c, f.spec.rgb, g);
+}
+
+// The spectral modes' coefficients of a tinted specular colour (fetched per pixel: the colour
+// may come from a texture).
+fn spec_coeffs(f: FilmSurface) -> vec3<f32> {
+    if (!HAS_SPECULAR || !f.tinted || NAIVE) {
+        return vec3<f32>(0.0);
+    }
+    return fetch_coeffs(f.spec.rgb, frame.table_res);
+}
+
 fn load_film(px: vec2<i32>) -> FilmSurface {
-    if (!HAS_FILM || lambert_only()) {
-        return FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
+    var r = no_film();
+    if (lambert_only()) {
+        return r;
+    }
+    if (HAS_SPECULAR) {
+        r.spec = specular_at(px);
+        r.tinted = r.spec.r != r.spec.g || r.spec.g != r.spec.b;
+    }
+    if (!HAS_FILM) {
+        return r;
     }
     var f = textureLoad(gbuf_film, px, 0);
     let mat = material_at(px);
@@ -522,23 +586,34 @@ fn load_film(px: vec2<i32>) -> FilmSurface {
         f0 = m.w;
         base_ior = film_ior_from_f0(vec4<f32>(f0)).x;
     }
-    return FilmSurface(f.x, mix(m.y, m.z, f.y), max(m.x, 1.0), f0, base_ior);
+    return FilmSurface(f.x, mix(m.y, m.z, f.y), max(m.x, 1.0), f0, base_ior, r.spec, r.tinted, vec3<f32>(0.0));
 }
 
 // The Fresnel terms under a film at four node wavelengths and the cosine c: the dielectric
 // base's (index 1.5 and F0 0.04 unless KHR_materials_ior says otherwise) and the metal's (its reflectance ρ(λ) as F0, the
 // extension's convention), each Schlick's blended with the film's exact reflectance
 // (wgsl/film.wgsl) by the film's weight — the truth's `Brdf::fresnel`, per node.
+// A tinted specular (KHR_materials_specular, `f0n` its F0 at the nodes) instead: the
+// dielectric's w·(F0(λ) + (1 − F0(λ))(1 − c)⁵), and what the diffuse keeps by the largest
+// channel of the F0 colour, 1 − w·(F0_max + (1 − F0_max)(1 − c)⁵) (scene::specular).
 struct FilmFresnel {
     dielectric: vec4<f32>,
     metal: vec4<f32>,
+    diffuse: vec4<f32>,
 };
 
-fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, c: f32) -> FilmFresnel {
+fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, c: f32, f0n: vec4<f32>) -> FilmFresnel {
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
     var r: FilmFresnel;
-    r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
-        film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing), f.weight);
+    if (HAS_SPECULAR && f.tinted) {
+        let f0_max = max(f.spec.r, max(f.spec.g, f.spec.b));
+        r.dielectric = f.spec.w * (f0n + (1.0 - f0n) * fres);
+        r.diffuse = vec4<f32>(1.0 - f.spec.w * (f0_max + (1.0 - f0_max) * fres));
+    } else {
+        r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
+            film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing), f.weight);
+        r.diffuse = 1.0 - r.dielectric;
+    }
     if (metallic > 0.0) {
         r.metal = mix(rho + (1.0 - rho) * fres,
             film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho), frame.node_spacing), f.weight);
@@ -548,10 +623,10 @@ fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>
 
 // One light's radiance over E(λ) at a filmed surface, per node: the factors of `factors_of`
 // with the film's Fresnel terms, which depend on λ.
-fn film_light_node(t: LightTerms, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> vec4<f32> {
-    let fr = film_fresnel(f, rho, metallic, lambda, t.vh);
+fn film_light_node(t: LightTerms, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, f0n: vec4<f32>) -> vec4<f32> {
+    let fr = film_fresnel(f, rho, metallic, lambda, t.vh, f0n);
     let spec = (1.0 - metallic) * fr.dielectric + metallic * fr.metal;
-    return t.kd * (1.0 - metallic) / PI * (1.0 - fr.dielectric) * rho + t.ks * spec;
+    return t.kd * (1.0 - metallic) / PI * fr.diffuse * rho + t.ks * spec;
 }
 
 // The environment at a filmed surface, per node: what multiplies the irradiance's node weights
@@ -563,9 +638,19 @@ struct FilmEnvNode {
     spec: vec4<f32>,
 };
 
-fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>) -> FilmEnvNode {
+fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>, f0n: vec4<f32>) -> FilmEnvNode {
     let a = l.ab.x;
     let b = l.ab.y;
+    if (HAS_SPECULAR && f.tinted) {
+        // A tinted specular: w·(F0(λ)·A + B) for the lobe, the largest channel's for the diffuse.
+        let f0_max = max(f.spec.r, max(f.spec.g, f.spec.b));
+        var fm = vec4<f32>(0.0);
+        if (metallic > 0.0) {
+            fm = rho * a + b;
+        }
+        let keep = 1.0 - f.spec.w * (f0_max * a + b);
+        return FilmEnvNode(vec4<f32>((1.0 - metallic) / PI * keep) * rho, (1.0 - metallic) * f.spec.w * (f0n * a + b) + metallic * fm);
+    }
     var fd = mix(vec4<f32>(f.f0 * a + b), film_band_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing) * (a + b), f.weight);
     var fm = vec4<f32>(0.0);
     if (metallic > 0.0) {
@@ -576,14 +661,21 @@ fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lam
 
 // RGB mode's film (the extension's Belcour–Barla evaluation in RGB, wgsl/film.wgsl): the
 // dielectric and metal Fresnel terms at cosine c, blended with Schlick's by the weight.
-fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> mat2x3<f32> {
+// A tinted specular instead: the dielectric's w·(F0c + (1 − F0c)(1 − c)⁵) per channel; the
+// third column is what the diffuse keeps (by the largest channel for a tinted specular).
+fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> mat3x3<f32> {
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
-    let fd = mix(vec3<f32>(f.f0 + (1.0 - f.f0) * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(f.f0)), f.weight);
     var fm = vec3<f32>(0.0);
     if (metallic > 0.0) {
         fm = mix(base + (1.0 - base) * fres, film_rgb(c, f.thickness_nm, f.ior, base), f.weight);
     }
-    return mat2x3<f32>(fd, fm);
+    if (HAS_SPECULAR && f.tinted) {
+        let f0_max = max(f.spec.r, max(f.spec.g, f.spec.b));
+        let fd = f.spec.w * (f.spec.rgb + (1.0 - f.spec.rgb) * fres);
+        return mat3x3<f32>(fd, fm, vec3<f32>(1.0 - f.spec.w * (f0_max + (1.0 - f0_max) * fres)));
+    }
+    let fd = mix(vec3<f32>(f.f0 + (1.0 - f.f0) * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(f.f0)), f.weight);
+    return mat3x3<f32>(fd, fm, 1.0 - fd);
 }
 
 // RGB mode: one pass over the lights, nothing kept. Its own entry points (pipelines of their
@@ -608,7 +700,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         var keep = 1.0;
         var tr = Transmissive(0.0, 0.0, 1.5, 0.0, vec3<f32>(0.0));
         let film = load_film(px);
-        let filmed = HAS_FILM && film.weight > 0.0;
+        let filmed = is_filmed(film);
         if (HAS_TRANSMISSION) {
             tr = load_transmissive(px, s);
             keep = 1.0 - tr.weight;
@@ -642,10 +734,10 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
                 // The film's Fresnel terms are colours: the whole reflection goes into sum_b.
                 let fr = film_fresnel_rgb(film, s.base, s.metallic, t.vh);
                 let spec = (1.0 - s.metallic) * fr[0] + s.metallic * fr[1];
-                let r = (t.kd * (1.0 - s.metallic) / PI * (1.0 - fr[0]) + behind) * s.base + t.ks * spec;
+                let r = (t.kd * (1.0 - s.metallic) / PI * fr[2] + behind) * s.base + t.ks * spec;
                 sum_b = fma(r, e, sum_b);
             } else {
-                var f = factors_of(t, s.metallic, s.f0);
+                var f = factors_of(t, s.metallic, s.f0, s.spec_w);
                 f.x += behind;
                 sum_a = fma(vec3<f32>(f.x), e, sum_a);
                 sum_b = fma(vec3<f32>(f.y), e, sum_b);
@@ -667,20 +759,33 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
             if (HAS_TRANSMISSION && !filmed) {
-                et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+                et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else if (!filmed) {
-                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
+                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
             } else {
                 let l = env_lobes(s.normal, -ctx.view_dir, s.roughness);
                 let a = l.ab.x;
                 let b = l.ab.y;
-                let fd = mix(vec3<f32>(film.f0 * a + b), film_rgb(l.nv, film.thickness_nm, film.ior, vec3<f32>(film.f0)) * (a + b), film.weight);
+                var fd: vec3<f32>;
+                var fd_keep: vec3<f32>;
                 var fm = vec3<f32>(0.0);
-                if (s.metallic > 0.0) {
-                    fm = mix(s.base * a + b, film_rgb(l.nv, film.thickness_nm, film.ior, s.base) * (a + b), film.weight);
+                if (HAS_SPECULAR && film.tinted) {
+                    // A tinted specular: w·(F0c·A + B), the diffuse by the largest channel.
+                    let f0_max = max(film.spec.r, max(film.spec.g, film.spec.b));
+                    fd = film.spec.w * (film.spec.rgb * a + b);
+                    fd_keep = vec3<f32>(1.0 - film.spec.w * (f0_max * a + b));
+                    if (s.metallic > 0.0) {
+                        fm = s.base * a + b;
+                    }
+                } else {
+                    fd = mix(vec3<f32>(film.f0 * a + b), film_rgb(l.nv, film.thickness_nm, film.ior, vec3<f32>(film.f0)) * (a + b), film.weight);
+                    fd_keep = 1.0 - fd;
+                    if (s.metallic > 0.0) {
+                        fm = mix(s.base * a + b, film_rgb(l.nv, film.thickness_nm, film.ior, s.base) * (a + b), film.weight);
+                    }
                 }
                 et.a = vec4<f32>(0.0);
-                et.b = vec4<f32>((1.0 - s.metallic) / PI * (1.0 - fd) * keep * s.base * l.irr.rgb
+                et.b = vec4<f32>((1.0 - s.metallic) / PI * fd_keep * keep * s.base * l.irr.rgb
                     + ((1.0 - s.metallic) * fd + s.metallic * fm) * l.spec.rgb, 0.0);
             }
             let vis = ambient_visibility(in.pos.xy, ctx.world_pos, s);
@@ -915,8 +1020,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     let ng_unknown = select(ng, 0u, known);
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
-    let film = load_film(px);
-    let filmed = HAS_FILM && film.weight > 0.0;
+    var film = load_film(px);
+    film.spec_c = spec_coeffs(film);
+    let filmed = is_filmed(film);
     // A varying colour's reflectance at the first four groups (N ≤ 16) once per pixel, in four
     // registers, instead of once per light and group (a sigmoid per node against three selects
     // per group); a filmed pixel has its own loop. Loops, not branches, bound by the group
@@ -960,10 +1066,10 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             // Under a film the specular part depends on λ too: all of it through the nodes.
             for (var g = 0u; g < ng; g++) {
                 let rho = node_reflectance(c_base, s.base, g);
-                xyz += (film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda) + through * rho) * light_w(li, g, ng);
+                xyz += (film_light_node(t, film, rho, s.metallic, wavelengths[g].lambda, spec_nodes(film, g)) + through * rho) * light_w(li, g, ng);
             }
         } else {
-            var f = factors_of(t, s.metallic, s.f0);
+            var f = factors_of(t, s.metallic, s.f0, s.spec_w);
             f.x += through;
             // The specular part does not depend on the reflectance: the light's XYZ once.
             // A branch, not a select, which would load for every pixel: a textured material's
@@ -998,9 +1104,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             lobes.spec *= vis;
         } else {
             if (HAS_TRANSMISSION) {
-                et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+                et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else {
-                et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0);
+                et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
             }
             et.a *= vis;
             et.b *= vis;
@@ -1033,7 +1139,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     for (var g = 0u; g < ng_rest; g++) {
         let rho = node_reflectance(c_base, s.base, g);
         if (film_env) {
-            let fe = film_env_node(lobes, film, rho, s.metallic, wavelengths[g].lambda);
+            let fe = film_env_node(lobes, film, rho, s.metallic, wavelengths[g].lambda, spec_nodes(film, g));
             xyz += fe.irr * env_w(lobes.irr, g, ng) + fe.spec * env_w(lobes.spec, g, ng);
         } else if (has_env && !env_known) {
             xyz += rho * env_w(et.a, g, ng);
@@ -1084,7 +1190,7 @@ fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Trans
     if (filmed) {
         return NodeLight(t, through, coat_b);
     }
-    let f = factors_of(t, s.metallic, s.f0);
+    let f = factors_of(t, s.metallic, s.f0, s.spec_w);
     var a = f.x;
     if (HAS_TRANSMISSION) {
         a += through;
@@ -1099,8 +1205,8 @@ fn add_node_light(acc_a: ptr<function, mat3x4<f32>>, acc_b: ptr<function, mat3x4
     if (CUSTOM_LIGHT_T) {
         w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
     }
-    if (HAS_FILM && film.weight > 0.0) {
-        *acc_f += s3_scale(w, film_light_node(nl.t, film, rho, metallic, lambda));
+    if (is_filmed(film)) {
+        *acc_f += s3_scale(w, film_light_node(nl.t, film, rho, metallic, lambda, spec_nodes(film, g)));
         if (HAS_TRANSMISSION) {
             *acc_f += s3_scale(w, nl.a * rho);
         }
@@ -1133,7 +1239,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     let has_env = shading_env();
     // A filmed pixel keeps each light's terms instead (its Fresnel term depends on λ), and the
     // environment's lobes.
-    var film = FilmSurface(0.0, 0.0, 1.0, 0.04, 1.5);
+    var film = no_film();
     var ft: array<LightTerms, MAX_LIGHTS>;
     var lobes: EnvLobes;
     var metallic = 0.0;
@@ -1160,6 +1266,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             s.emission = vec3<f32>(0.0);
         }
         film = load_film(px);
+        film.spec_c = spec_coeffs(film);
         metallic = s.metallic;
         if (HAS_TRANSMISSION) {
             tr = load_transmissive(px, s);
@@ -1173,7 +1280,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             vis = ambient_visibility(in.pos.xy, p, s);
         }
         if (has_env && !s.unlit) {
-            if (HAS_FILM && film.weight > 0.0) {
+            if (is_filmed(film)) {
                 lobes = env_lobes(s.normal, -ctx.view_dir, s.roughness);
                 lobes.irr *= vis;
                 lobes.spec *= vis;
@@ -1186,9 +1293,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 }
             } else {
                 if (HAS_TRANSMISSION) {
-                    et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep);
+                    et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
                 } else {
-                    et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0);
+                    et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
                 }
                 et.a *= vis;
                 et.b *= vis;
@@ -1211,13 +1318,13 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     if (!background) {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, HAS_FILM && film.weight > 0.0, coat);
+            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat);
             ft[li] = nl.t;
             fa[li] = nl.a;
             fb[li] = nl.b;
         }
     }
-    let filmed = HAS_FILM && film.weight > 0.0;
+    let filmed = is_filmed(film);
 
     var c_base = vec3<f32>(0.0);
     var em = vec4<f32>(0.0);
@@ -1282,7 +1389,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         }
         if (has_env && !background) {
             if (filmed) {
-                let fe = film_env_node(lobes, film, rho, metallic, lambda);
+                let fe = film_env_node(lobes, film, rho, metallic, lambda, spec_nodes(film, g));
                 var wi = s3_scale(env_w(lobes.irr, g, ng), fe.irr);
                 var ws = s3_scale(env_w(lobes.spec, g, ng), fe.spec);
                 if (CUSTOM_ENV_T) {

@@ -479,7 +479,7 @@ fn transmitted_nodes(pix: vec2<f32>, ctx: SurfaceContext, s: GSurface, tr: Trans
     if (HAS_FILM && film.weight > 0.0) {
         // Under a thin film: 1 − its Fresnel term per node (`film_fresnel`'s dielectric).
         let nv = max(dot(s.normal, -ctx.view_dir), 0.0);
-        kn = tr.weight * (1.0 - film_fresnel(film, rho, 0.0, wavelengths[g].lambda, nv).dielectric);
+        kn = tr.weight * (1.0 - film_fresnel(film, rho, 0.0, wavelengths[g].lambda, nv, vec4<f32>(0.0)).dielectric);
     }
     if (disperses(tr)) {
         // A ray per run of `span` lanes, at the run's mean wavelength.

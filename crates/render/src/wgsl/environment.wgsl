@@ -72,13 +72,14 @@ fn env_lobes(n: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
     return l;
 }
 
-fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32) -> EnvTerms {
-    return env_terms_keep(n, v, metallic, roughness, lambert, f0, 1.0);
+fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, w: f32) -> EnvTerms {
+    return env_terms_keep(n, v, metallic, roughness, lambert, f0, 1.0, w);
 }
 
 // `env_terms` with the diffuse layer scaled by `keep` (a see-through dielectric's diffuse is
-// 1 − its transmission, wgsl/transmission.wgsl); `keep` = 1 leaves every product exact.
-fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, keep: f32) -> EnvTerms {
+// 1 − its transmission, wgsl/transmission.wgsl); `keep` = 1 leaves every product exact. `w` is
+// the dielectric's specular weight (KHR_materials_specular; 1 without, exact too).
+fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, keep: f32, w: f32) -> EnvTerms {
     var t: EnvTerms;
     if (!env_enabled()) {
         return t;
@@ -89,7 +90,7 @@ fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lam
     }
     let l = env_lobes(n, v, roughness);
     // Directional albedo of the dielectric specular lobe: what the diffuse layer does not get.
-    let f_d = f0 * l.ab.x + l.ab.y;
+    let f_d = w * (f0 * l.ab.x + l.ab.y);
     t.a = (1.0 - metallic) * (1.0 - f_d) / PI * keep * l.irr + metallic * l.ab.x * l.spec;
     t.b = ((1.0 - metallic) * f_d + metallic * l.ab.y) * l.spec;
     return t;

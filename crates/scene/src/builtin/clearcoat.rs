@@ -11,11 +11,11 @@
 
 use glam::Vec3;
 
-use super::{empty, light_emission, measured_material, patch, patch_index, shapes};
+use super::{empty, measured_material, patch, patch_index, shapes, showcase_spots};
 use crate::clearcoat::Clearcoat;
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Camera, Light, LightKind, Scene};
+use crate::{Camera, Scene};
 
 /// The bases, left to right (ColorChecker patch names).
 pub const BASES: [&str; 4] = ["red", "green", "blue", "yellow"];
@@ -53,28 +53,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
     s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));
 
     // Two spots aimed at the middle of the rows, ≈ π lux there each: D65 in front, F11 aside.
-    let target = Vec3::new(0.0, 0.1, 0.0);
-    for (name, illuminant, position) in [
-        ("front spot (D65)", "D65", Vec3::new(0.2, 1.3, 1.2)),
-        ("side spot (F11)", "F11", Vec3::new(-1.2, 0.9, 0.3)),
-    ] {
-        let shape =
-            color::illuminant::by_name(illuminant).map_err(|e| ctx.invalid(illuminant, e.to_string()))?;
-        let to = target - position;
-        let intensity = std::f32::consts::PI * to.length_squared();
-        s.lights.push(Light {
-            name: name.into(),
-            kind: LightKind::Spot {
-                position,
-                direction: to.normalize(),
-                inner_cone: 40f32.to_radians(),
-                outer_cone: 65f32.to_radians(),
-                range: None,
-            },
-            emission: light_emission(ctx, name, &shape, intensity)?,
-            stands_in_for: None,
-        });
-    }
+    s.lights = showcase_spots(ctx, ("front spot (D65)", "D65"), ("side spot (F11)", "F11"))?;
     Ok(s)
 }
 

@@ -11,10 +11,10 @@
 
 use glam::{Vec3, Vec4};
 
-use super::{empty, light_emission, measured_material, patch, patch_index, shapes};
+use super::{empty, measured_material, patch, patch_index, shapes, showcase_spots};
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Camera, Iridescence, Light, LightKind, Material, Scene};
+use crate::{Camera, Iridescence, Material, Scene};
 
 /// (thickness nm, film IOR) of the back row's dielectric spheres, left to right.
 pub const DIELECTRIC_FILMS: [(f32, f32); 4] = [(200.0, 1.33), (400.0, 1.5), (600.0, 1.33), (800.0, 1.8)];
@@ -71,26 +71,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
     s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));
 
     // Two D65 spots aimed at the middle of the rows: ≈ π lux there each.
-    let d65 = color::illuminant::by_name("D65").map_err(|e| ctx.invalid("D65", e.to_string()))?;
-    let target = Vec3::new(0.0, 0.1, 0.0);
-    for (name, position) in
-        [("front spot", Vec3::new(0.2, 1.3, 1.2)), ("side spot", Vec3::new(-1.2, 0.9, 0.3))]
-    {
-        let to = target - position;
-        let intensity = std::f32::consts::PI * to.length_squared();
-        s.lights.push(Light {
-            name: name.into(),
-            kind: LightKind::Spot {
-                position,
-                direction: to.normalize(),
-                inner_cone: 40f32.to_radians(),
-                outer_cone: 65f32.to_radians(),
-                range: None,
-            },
-            emission: light_emission(ctx, name, &d65, intensity)?,
-            stands_in_for: None,
-        });
-    }
+    s.lights = showcase_spots(ctx, ("front spot", "D65"), ("side spot", "D65"))?;
     Ok(s)
 }
 

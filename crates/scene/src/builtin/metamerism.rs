@@ -15,12 +15,10 @@
 use color::{Observer, SpectralIntegrator, Spectrum, WavelengthRange};
 use glam::{DMat3, DVec3, Vec3};
 
-use super::{empty, light_emission, measured_material, patch, patch_index, reflectance_rgb, shapes};
+use super::{empty, measured_material, patch, patch_index, reflectance_rgb, shapes, spot_at};
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{
-    Camera, Light, LightKind, Material, PaletteEntry, Scene, SpectralReflectance, Texture, TextureRef, srgb,
-};
+use crate::{Camera, Material, PaletteEntry, Scene, SpectralReflectance, Texture, TextureRef, srgb};
 
 /// The wavelengths of the metameric pair's samples: the ColorChecker grid, 380–780 nm at 5 nm.
 fn grid() -> Vec<f64> {
@@ -167,20 +165,9 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
     for (name, illum, x) in [("F11 spot", "F11", -0.7f32), ("LED-RGB1 spot", "LED-RGB1", 0.7)] {
         let position = Vec3::new(x, 1.1, 0.6);
         let to = target - position;
-        let shape = color::illuminant::by_name(illum).map_err(|e| ctx.invalid(name, e.to_string()))?;
         let intensity = std::f32::consts::PI * to.length_squared() / (to.normalize().dot(-Vec3::Y));
-        s.lights.push(Light {
-            name: name.into(),
-            kind: LightKind::Spot {
-                position,
-                direction: to.normalize(),
-                inner_cone: 35f32.to_radians(),
-                outer_cone: 60f32.to_radians(),
-                range: None,
-            },
-            emission: light_emission(ctx, name, &shape, intensity)?,
-            stands_in_for: None,
-        });
+        let cones = (35f32.to_radians(), 60f32.to_radians());
+        s.lights.push(spot_at(ctx, name, illum, position, target, intensity, cones)?);
     }
     Ok(s)
 }

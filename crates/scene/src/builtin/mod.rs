@@ -13,6 +13,7 @@ pub mod glass;
 pub mod iridescence;
 mod metamerism;
 pub(crate) mod shapes;
+pub mod specular;
 mod underwater;
 
 use color::{Observer, SpectralIntegrator, Spectrum, WavelengthRange};
@@ -31,6 +32,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "iridescence",
     "glass",
     "clearcoat",
+    "specular",
     "underwater",
     "fog",
     "tinted-fog",
@@ -46,6 +48,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "iridescence" => iridescence::build(&ctx),
         "glass" => glass::build(&ctx),
         "clearcoat" => clearcoat::build(&ctx),
+        "specular" => specular::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),
@@ -97,6 +100,59 @@ pub(crate) fn light_emission(
     intensity: f32,
 ) -> Result<Emission, SceneError> {
     Emission::of_shape(shape, intensity).map_err(|m| ctx.invalid(what, m))
+}
+
+/// A spot of CIE illuminant `illuminant` at `position` aimed at `target`, of `intensity`
+/// (candela of the shape's luminance) and cones (inner, outer) in radians; errors placed at
+/// `name`. The built-ins' studio lights.
+pub(crate) fn spot_at(
+    ctx: &Ctx,
+    name: &str,
+    illuminant: &str,
+    position: Vec3,
+    target: Vec3,
+    intensity: f32,
+    cones: (f32, f32),
+) -> Result<crate::Light, SceneError> {
+    let shape = color::illuminant::by_name(illuminant).map_err(|e| ctx.invalid(name, e.to_string()))?;
+    Ok(crate::Light {
+        name: name.into(),
+        kind: crate::LightKind::Spot {
+            position,
+            direction: (target - position).normalize(),
+            inner_cone: cones.0,
+            outer_cone: cones.1,
+            range: None,
+        },
+        emission: light_emission(ctx, name, &shape, intensity)?,
+        stands_in_for: None,
+    })
+}
+
+/// The two spots of the material showcases (`iridescence`, `clearcoat`, `specular`): one above
+/// and in front of the camera, one from the side, aimed at the middle of the rows at
+/// (0, 0.1, 0), ≈ π lux there each; cones 40°/65°.
+pub(crate) fn showcase_spots(
+    ctx: &Ctx,
+    front: (&str, &str),
+    side: (&str, &str),
+) -> Result<Vec<crate::Light>, SceneError> {
+    let target = Vec3::new(0.0, 0.1, 0.0);
+    [(front, Vec3::new(0.2, 1.3, 1.2)), (side, Vec3::new(-1.2, 0.9, 0.3))]
+        .into_iter()
+        .map(|((name, illuminant), position)| {
+            let intensity = std::f32::consts::PI * (target - position).length_squared();
+            spot_at(
+                ctx,
+                name,
+                illuminant,
+                position,
+                target,
+                intensity,
+                (40f32.to_radians(), 65f32.to_radians()),
+            )
+        })
+        .collect()
 }
 
 /// The ColorChecker patch spectrum by 0-based chart index.

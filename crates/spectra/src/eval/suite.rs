@@ -139,8 +139,8 @@ pub const CASE_IDS: &[&str] = &[
 ];
 
 /// Cases `spectra eval --scenes` accepts besides [`CASE_IDS`], outside the default suite (whose
-/// results are the README's contract): `clearcoat` (session 42).
-pub const OPT_IN_IDS: &[&str] = &["clearcoat"];
+/// results are the README's contract): `clearcoat` (session 42), `specular` (session 43).
+pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular"];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
@@ -220,6 +220,13 @@ pub fn case(id: &str) -> Result<Case> {
             title: "Clear coats (KHR_materials_clearcoat), glossy and satin, over measured ColorChecker bases; a D65 and an F11 spot"
                 .into(),
             scene: scene::builtin("clearcoat")?,
+        }),
+        "specular" => Ok(Case {
+            id: id.into(),
+            title: "Specular strength and colour (KHR_materials_specular): tinted F0s over black, grey F0s of four strengths \
+                    over measured ColorChecker bases; a D65 and an F11 spot"
+                .into(),
+            scene: scene::builtin("specular")?,
         }),
         "glass" => Ok(Case {
             id: id.into(),
@@ -337,6 +344,7 @@ mod tests {
             }
         }
         assert!(case("clearcoat").unwrap().scene.materials.iter().any(|m| m.clearcoat.is_some()));
+        assert!(case("specular").unwrap().scene.materials.iter().any(|m| m.specular.is_some()));
         assert!(case("nope").unwrap_err().to_string().contains("clearcoat"));
     }
 }
