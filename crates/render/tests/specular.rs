@@ -20,9 +20,20 @@ fn decode8(v: u8) -> f64 {
     color::colorspace::srgb_decode(v as f64 / 255.0)
 }
 
-/// Radiance per unit irradiance × n·l of a dielectric (metallic 0) of albedo `rho` with
-/// specular weight `w` and F0 colour `f0c`, as the extension writes it.
-fn fresnel_mix(n: Vec3, v: Vec3, wi: Vec3, roughness: f64, rho: [f64; 3], w: f64, f0c: [f64; 3]) -> [f64; 3] {
+/// Radiance per unit irradiance × n·l of a material of albedo `rho` with specular weight `w`
+/// and F0 colour `f0c`, as the extension writes its dielectric, mixed with glTF's metal by
+/// `metallic` (glTF 2.0 appendix B: mix(dielectric_brdf, metal_brdf, metallic)).
+#[allow(clippy::too_many_arguments)]
+fn fresnel_mix(
+    n: Vec3,
+    v: Vec3,
+    wi: Vec3,
+    roughness: f64,
+    rho: [f64; 3],
+    w: f64,
+    f0c: [f64; 3],
+    metallic: f64,
+) -> [f64; 3] {
     let nl = n.dot(wi) as f64;
     if nl <= 0.0 {
         return [0.0; 3];
@@ -39,12 +50,16 @@ fn fresnel_mix(n: Vec3, v: Vec3, wi: Vec3, roughness: f64, rho: [f64; 3], w: f64
     let f0_max = f0c[0].max(f0c[1]).max(f0c[2]);
     let keep = 1.0 - w * (f0_max + (1.0 - f0_max) * fres);
     std::array::from_fn(|c| {
-        nl * (rho[c] * keep / std::f64::consts::PI + d * vis * w * (f0c[c] + (1.0 - f0c[c]) * fres))
+        let dielectric =
+            rho[c] * keep / std::f64::consts::PI + d * vis * w * (f0c[c] + (1.0 - f0c[c]) * fres);
+        let metal = d * vis * (rho[c] + (1.0 - rho[c]) * fres);
+        nl * ((1.0 - metallic) * dielectric + metallic * metal)
     })
 }
 
-/// A test case: its name, the base albedo, the specular, its weight and colour at the pixels.
-type Case = (&'static str, [f64; 3], Specular, f64, [f64; 3]);
+/// A test case: its name, the base albedo, the specular, its weight and colour at the pixels,
+/// and the metallic factor.
+type Case = (&'static str, [f64; 3], Specular, f64, [f64; 3], f64);
 
 fn texture(name: &str, rgba: [u8; 4], srgb: bool) -> Texture {
     Texture {
@@ -75,6 +90,7 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
             Specular { factor: 0.3, texture: None, color: Vec3::ONE, color_texture: None },
             0.3,
             [1.0; 3],
+            0.0,
         ),
         (
             "yellow",
@@ -82,6 +98,15 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
             Specular { factor: 1.0, texture: None, color: Vec3::new(10.0, 10.0, 0.0), color_texture: None },
             1.0,
             [10.0, 10.0, 0.0],
+            0.0,
+        ),
+        (
+            "yellow-half-metal",
+            [0.3, 0.5, 0.8],
+            Specular { factor: 1.0, texture: None, color: Vec3::new(10.0, 10.0, 0.0), color_texture: None },
+            1.0,
+            [10.0, 10.0, 0.0],
+            0.5,
         ),
         (
             "red-over-white",
@@ -89,6 +114,7 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
             Specular { factor: 1.0, texture: None, color: Vec3::new(12.0, 1.0, 1.0), color_texture: None },
             1.0,
             [12.0, 1.0, 1.0],
+            0.0,
         ),
         (
             "textures",
@@ -96,11 +122,12 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
             Specular { factor: 0.9, texture: tex(0), color: Vec3::splat(8.0), color_texture: tex(1) },
             0.9 * 128.0 / 255.0,
             colour_texel.map(|c| 8.0 * decode8(c))[..3].try_into().unwrap(),
+            0.0,
         ),
     ];
     let mut r = renderer();
-    for (name, rho, specular, w, colour) in cases {
-        let mut scene = chart.scene(white_light(2.0, None), 0.3, 0.0);
+    for (name, rho, specular, w, colour, metallic) in cases {
+        let mut scene = chart.scene(white_light(2.0, None), 0.3, metallic as f32);
         scene.lights[0].kind = scene::LightKind::Directional { direction: -wi };
         scene.textures =
             vec![texture("strength", strength_texel, false), texture("colour", colour_texel, true)];
@@ -115,8 +142,9 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
                 let (p, d) = pixel_to_chart(x, y, W, H);
                 let v = -d;
                 expected.push(chart.patch_at(p, 0.05).map(|_| {
-                    let want = fresnel_mix(Vec3::Z, v, wi, 0.3, rho, w, f0c).map(|l| l * 2.0);
-                    let plain = fresnel_mix(Vec3::Z, v, wi, 0.3, rho, 1.0, [0.04; 3]).map(|l| l * 2.0);
+                    let want = fresnel_mix(Vec3::Z, v, wi, 0.3, rho, w, f0c, metallic).map(|l| l * 2.0);
+                    let plain =
+                        fresnel_mix(Vec3::Z, v, wi, 0.3, rho, 1.0, [0.04; 3], metallic).map(|l| l * 2.0);
                     effect.push(color::ciede2000(lab(want), lab(plain)));
                     want
                 }));

@@ -606,14 +606,18 @@ fn film_fresnel(f: FilmSurface, rho: vec4<f32>, metallic: f32, lambda: vec4<f32>
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
     var r: FilmFresnel;
     if (HAS_SPECULAR && f.tinted) {
+        // (No film here: the loader keeps no specular on a filmed material.)
         let f0_max = max(f.spec.r, max(f.spec.g, f.spec.b));
         r.dielectric = f.spec.w * (f0n + (1.0 - f0n) * fres);
         r.diffuse = vec4<f32>(1.0 - f.spec.w * (f0_max + (1.0 - f0_max) * fres));
-    } else {
-        r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
-            film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing), f.weight);
-        r.diffuse = 1.0 - r.dielectric;
+        if (metallic > 0.0) {
+            r.metal = rho + (1.0 - rho) * fres;
+        }
+        return r;
     }
+    r.dielectric = mix(vec4<f32>(f.f0 + (1.0 - f.f0) * fres),
+        film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing), f.weight);
+    r.diffuse = 1.0 - r.dielectric;
     if (metallic > 0.0) {
         r.metal = mix(rho + (1.0 - rho) * fres,
             film_band_reflectance4(lambda, c, f.thickness_nm, f.ior, film_ior_from_f0(rho), frame.node_spacing), f.weight);
@@ -665,14 +669,15 @@ fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lam
 // third column is what the diffuse keeps (by the largest channel for a tinted specular).
 fn film_fresnel_rgb(f: FilmSurface, base: vec3<f32>, metallic: f32, c: f32) -> mat3x3<f32> {
     let fres = pow(1.0 - clamp(c, 0.0, 1.0), 5.0);
-    var fm = vec3<f32>(0.0);
-    if (metallic > 0.0) {
-        fm = mix(base + (1.0 - base) * fres, film_rgb(c, f.thickness_nm, f.ior, base), f.weight);
-    }
     if (HAS_SPECULAR && f.tinted) {
         let f0_max = max(f.spec.r, max(f.spec.g, f.spec.b));
         let fd = f.spec.w * (f.spec.rgb + (1.0 - f.spec.rgb) * fres);
+        let fm = base + (1.0 - base) * fres;
         return mat3x3<f32>(fd, fm, vec3<f32>(1.0 - f.spec.w * (f0_max + (1.0 - f0_max) * fres)));
+    }
+    var fm = vec3<f32>(0.0);
+    if (metallic > 0.0) {
+        fm = mix(base + (1.0 - base) * fres, film_rgb(c, f.thickness_nm, f.ior, base), f.weight);
     }
     let fd = mix(vec3<f32>(f.f0 + (1.0 - f.f0) * fres), film_rgb(c, f.thickness_nm, f.ior, vec3<f32>(f.f0)), f.weight);
     return mat3x3<f32>(fd, fm, 1.0 - fd);
