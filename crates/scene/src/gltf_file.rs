@@ -1019,7 +1019,18 @@ impl Loader<'_> {
             .and_then(Value::as_u64)
             .and_then(|i| self.doc.textures().nth(usize::try_from(i).ok()?))
             .ok_or_else(|| self.ctx.invalid(format!("{field}.index"), "names no texture of the file"))?;
-        let tex_coord = info.get("texCoord").and_then(Value::as_u64).unwrap_or(0).min(u32::MAX as u64) as u32;
+        // A texCoord that is not a non-negative integer (-1, 1.5, "1") fell back to TEXCOORD_0
+        // without a word, and 2³² was named as 4294967295 (found by a sweep); the core
+        // textureInfo rejects them, so the extensions' do too.
+        let tex_coord = match info.get("texCoord") {
+            None => 0,
+            Some(v) => v.as_u64().and_then(|n| u32::try_from(n).ok()).ok_or_else(|| {
+                self.ctx.invalid(
+                    format!("{field}.texCoord"),
+                    format!("{v} is not a texture coordinate set (TEXCOORD_0 and TEXCOORD_1 are supported)"),
+                )
+            })?,
+        };
         self.texture(&field, t, tex_coord, srgb, Some(info)).map(Some)
     }
 

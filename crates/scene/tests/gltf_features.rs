@@ -1175,6 +1175,41 @@ fn clip_planes_that_leave_out_the_whole_scene_are_warned_about() {
     }
 }
 
+/// An extension's textureInfo takes its texCoord as the core one does: a non-negative integer.
+/// -1, 1.5 and "1" were read as TEXCOORD_0 without a word, and 2³² was named as 4294967295.
+#[test]
+fn extension_textures_reject_a_tex_coord_that_is_not_a_set_index() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], "VEC2");
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": 0}]}],
+        "materials": [{"extensions": {
+            "KHR_materials_specular": {"specularTexture": {"index": 0, "texCoord": 0}},
+            "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatTexture": {"index": 0}},
+        }}],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    assert!(load(&doc).unwrap().materials[0].specular.is_some());
+    for (ext, key) in
+        [("KHR_materials_specular", "specularTexture"), ("KHR_materials_clearcoat", "clearcoatTexture")]
+    {
+        for (v, shown) in [
+            (json!(-1), "-1"),
+            (json!(1.5), "1.5"),
+            (json!("1"), "\"1\""),
+            (json!(4_294_967_296u64), "4294967296"),
+        ] {
+            let mut d = doc.clone();
+            d["materials"][0]["extensions"][ext][key]["texCoord"] = v;
+            assert_has(&error(&d), &[&format!("materials[0].extensions.{ext}.{key}.texCoord"), shown]);
+        }
+    }
+}
+
 /// `KHR_materials_specular`: read with its defaults (a material at them has none), textures as
 /// data (the strength's A) and sRGB colour, bad values named by field; dropped with a warning
 /// where the renderers draw the reflection from the index alone (a film, a transmission), and
