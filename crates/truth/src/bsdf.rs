@@ -1,22 +1,29 @@
-//! The glTF 2.0 metallic-roughness BRDF (specification, appendix B), one lane per wavelength:
+//! The glTF 2.0 metallic-roughness BRDF (specification, appendix B), one lane per wavelength,
+//! as the appendix's normative mix(dielectric_brdf, metal_brdf, m) — the real-time renderer's
+//! form (`factors_of` in crates/render's shading.wgsl):
 //!
-//! f = (1 − F)·c_diff/π + F·D·V, with c_diff = base·(1 − metallic),
-//! F = f0 + (1 − f0)(1 − |v·h|)⁵, f0 = lerp(F0(η), base, metallic), α = roughness², with the
+//! f = (1 − m)·(1 − F_d)·base/π + F·D·V, with F_d = F0(η) + (1 − F0(η))(1 − |v·h|)⁵ the
+//! dielectric's Fresnel term and F = f0 + (1 − f0)(1 − |v·h|)⁵, f0 = lerp(F0(η), base, m)
+//! (= (1 − m)·F_d + m·F_m, F_m the metal's Schlick with F0 = base), α = roughness², with the
 //! dielectric's F0(η) = ((η − 1)/(η + 1))², 0.04 at glTF's default η = 1.5 (`KHR_materials_ior`),
 //! D the Trowbridge–Reitz (GGX) distribution and V the height-correlated Smith visibility
 //! V = 0.5 / (n·l·√(n·v²(1−α²)+α²) + n·v·√(n·l²(1−α²)+α²)) the appendix's implementation uses.
+//! The diffuse loses the dielectric's Fresnel term only: the appendix's non-normative shortcut
+//! (1 − F)·c_diff/π, which the tracer used before, takes the metal's too and is darker for
+//! 0 < m < 1 (the same at m = 0 and 1).
 //!
 //! With a thin film (`KHR_materials_iridescence`), F at each lane's wavelength is
 //! lerp(F, (1 − metallic)·R_film(η) + metallic·R_film(η(base)), weight): the exact film
 //! reflectance (`scene::film`) over the dielectric base and over the metal (its base colour
-//! as F0, the extension's convention), at v·h.
+//! as F0, the extension's convention), at v·h; the diffuse loses the dielectric's part alone,
+//! F_d = lerp(F_d, R_film(η), weight).
 //!
 //! With `KHR_materials_specular` (`scene::specular`, [`SpecularLanes`]), the dielectric's
 //! Fresnel term takes the weight s and the F0 colour F0c (an RGB reflectance, upsampled per
 //! lane as the base colour is): F_d(λ) = s·(F0c(λ) + (1 − F0c(λ))(1 − v·h)⁵), and what the
 //! diffuse loses is the scalar F_dmax = s·(F0c_max + (1 − F0c_max)(1 − v·h)⁵), F0c_max the
 //! largest RGB channel of F0c; with F_m(λ) = base + (1 − base)(1 − v·h)⁵ the metal's,
-//! f = (1 − [(1 − m)·F_dmax + m·F_m])·c_diff/π + [(1 − m)·F_d + m·F_m]·D·V. Without it
+//! f = (1 − F_dmax)·c_diff/π + [(1 − m)·F_d + m·F_m]·D·V, c_diff = base·(1 − m). Without it
 //! (`None`) the arithmetic is the plain glTF BRDF's above, unchanged.
 //!
 //! Directions are in the local shading frame (normal = +z). Sampling mixes a cosine lobe with
@@ -126,37 +133,49 @@ impl Brdf {
         self
     }
 
-    /// (what multiplies D·V, what the diffuse loses) at `cos` (v·h, or n·v for the sampling's
-    /// estimate): the Fresnel term twice without a specular; with one,
-    /// ((1 − m)·F_d + m·F_m, (1 − m)·F_dmax + m·F_m).
-    fn fresnel_pair(&self, cos: f32, fr: impl FnOnce() -> Vec4) -> (Vec4, Vec4) {
-        let Some(sp) = &self.specular else {
-            let fr = fr();
-            return (fr, fr);
-        };
+    /// (what multiplies D·V, the dielectric's Fresnel term the diffuse loses) at `cos` (v·h, or
+    /// n·v for the sampling's estimate): `fr`'s pair without a specular; with one,
+    /// ((1 − m)·F_d + m·F_m, F_dmax).
+    fn fresnel_pair(&self, cos: f32, fr: impl FnOnce() -> (Vec4, Vec4)) -> (Vec4, Vec4) {
+        let Some(sp) = &self.specular else { return fr() };
         let x = (1.0 - cos).max(0.0).powi(5);
         let m = self.metallic;
         let metal = self.base + (Vec4::ONE - self.base) * x;
         let dielectric = (sp.f0 + (Vec4::ONE - sp.f0) * x) * sp.weight;
         let dielectric_max = sp.weight * (sp.f0_max + (1.0 - sp.f0_max) * x);
-        (dielectric * (1.0 - m) + metal * m, Vec4::splat(dielectric_max * (1.0 - m)) + metal * m)
+        (dielectric * (1.0 - m) + metal * m, Vec4::splat(dielectric_max))
     }
 
-    /// The Fresnel term at v·h: Schlick's with the glTF F0, blended with the film's.
-    fn fresnel(&self, v_h: f32) -> Vec4 {
-        let f0 = self.f0();
-        let schlick = f0 + (Vec4::ONE - f0) * (1.0 - v_h).max(0.0).powi(5);
-        let Some(f) = &self.film else { return schlick };
+    /// Schlick's Fresnel term at `cos` twice: with the glTF F0 = lerp(F0(η), base, m) (the
+    /// specular lobe's, (1 − m)·F_d + m·F_m) and with the dielectric's F0(η) alone (F_d, what
+    /// the diffuse loses).
+    fn schlick_pair(&self, cos: f32) -> (Vec4, Vec4) {
+        let x = (1.0 - cos).max(0.0).powi(5);
+        let (f0, f0_d) = (self.f0(), Vec4::splat(scene::dielectric_f0(self.ior)));
+        (f0 + (Vec4::ONE - f0) * x, f0_d + (Vec4::ONE - f0_d) * x)
+    }
+
+    /// The Fresnel terms at v·h, as [`Self::schlick_pair`]'s, each blended with the film's:
+    /// the lobe's with (1 − m)·R_film(η) + m·R_film(η(base)), the diffuse's with the
+    /// dielectric's R_film(η) alone.
+    fn fresnel(&self, v_h: f32) -> (Vec4, Vec4) {
+        let (schlick, schlick_d) = self.schlick_pair(v_h);
+        let Some(f) = &self.film else { return (schlick, schlick_d) };
         let m = f64::from(self.metallic);
         let c = f64::from(v_h);
         let dielectric_base = f64::from(self.ior);
+        let mut film_d = [0.0f32; 4];
         let lanes: [f32; 4] = std::array::from_fn(|i| {
             let l = f64::from(f.lambda[i]);
             let dielectric = if m < 1.0 { f.film.over_dielectric(l, c, dielectric_base) } else { 0.0 };
             let metal = if m > 0.0 { f.film.over_f0(l, c, f64::from(self.base[i])) } else { 0.0 };
+            film_d[i] = dielectric as f32;
             ((1.0 - m) * dielectric + m * metal) as f32
         });
-        schlick + (Vec4::from_array(lanes) - schlick) * f.weight
+        (
+            schlick + (Vec4::from_array(lanes) - schlick) * f.weight,
+            schlick_d + (Vec4::from_array(film_d) - schlick_d) * f.weight,
+        )
     }
 
     fn f0(&self) -> Vec4 {
@@ -176,18 +195,15 @@ impl Brdf {
         smith_g1(self.alpha, n_v)
     }
 
-    /// The directional albedo at `n_v` as [`Self::p_spec`] estimates it (Schlick at normal
-    /// incidence for the half vector, the diffuse share's complement; with a specular, its
-    /// weighted F0 colour and the F0c_max share), averaged over the lanes:
+    /// The directional albedo at `n_v` as [`Self::p_spec`] estimates it (Schlick with n·v for
+    /// v·h: the lobe's F, plus (1 − m)·(1 − F_d)·base with F_d the dielectric's term alone; with
+    /// a specular, its weighted F0 colour and the F0c_max share), averaged over the lanes:
     /// what the clear coat weighs its sampling probability against.
     pub fn albedo_estimate(&self, n_v: f32) -> f32 {
         if self.lambert {
             return self.base.element_sum() * 0.25;
         }
-        let (fs, fd) = self.fresnel_pair(n_v, || {
-            let f0 = self.f0();
-            f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5)
-        });
+        let (fs, fd) = self.fresnel_pair(n_v, || self.schlick_pair(n_v));
         (fs + (Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
     }
 
@@ -197,10 +213,7 @@ impl Brdf {
         if self.lambert {
             return 0.0;
         }
-        let (fs, fd) = self.fresnel_pair(n_v, || {
-            let f0 = self.f0();
-            f0 + (Vec4::ONE - f0) * (1.0 - n_v).max(0.0).powi(5)
-        });
+        let (fs, fd) = self.fresnel_pair(n_v, || self.schlick_pair(n_v));
         let spec = fs.element_sum();
         let diff = ((Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum();
         if spec + diff <= 0.0 { 1.0 } else { (spec / (spec + diff)).clamp(0.05, 1.0) }
@@ -439,6 +452,173 @@ mod tests {
         }
     }
 
+    /// glTF 2.0 appendix B's normative material in f64, apart from the tracer's code:
+    /// mix(dielectric_brdf, metal_brdf, m) with dielectric_brdf = (1 − F_dd)·base/π + F_d·D·V
+    /// and metal_brdf = F_m·D·V, where `fresnel(v·h, lane)` gives (F_d, F_dd, F_m): the
+    /// dielectric's Fresnel term on the specular lobe, what its diffuse loses (the same but
+    /// for a specular's neutral F_dmax) and the metal's.
+    fn normative(
+        base: Vec4,
+        m: f32,
+        alpha: f32,
+        wo: Vec3,
+        wi: Vec3,
+        fresnel: impl Fn(f64, usize) -> (f64, f64, f64),
+    ) -> [f64; 4] {
+        let (wo, wi) = (wo.to_array().map(f64::from), wi.to_array().map(f64::from));
+        let h = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
+        let hl = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+        let h = h.map(|x| x / hl);
+        let v_h = (wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2]).abs();
+        let a2 = f64::from(alpha).powi(2);
+        let t = h[2] * h[2] * (a2 - 1.0) + 1.0;
+        let d = a2 / (std::f64::consts::PI * t * t);
+        let (nv, nl) = (wo[2], wi[2]);
+        let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+        let m = f64::from(m);
+        std::array::from_fn(|i| {
+            let b = f64::from(base[i]);
+            let (f_d, f_dd, f_m) = fresnel(v_h, i);
+            let dielectric = (1.0 - f_dd) * b / std::f64::consts::PI + f_d * d * vis;
+            let metal = f_m * d * vis;
+            (1.0 - m) * dielectric + m * metal
+        })
+    }
+
+    fn schlick64(f0: f64, v_h: f64) -> f64 {
+        f0 + (1.0 - f0) * (1.0 - v_h).max(0.0).powi(5)
+    }
+
+    const DIRS: [(f32, f32, f32, f32); 4] =
+        [(0.2, 0.0, 0.5, 2.5), (0.9, 0.3, 1.2, 3.0), (1.3, 0.0, 0.4, 1.0), (0.6, 1.0, 0.6, 4.0)];
+
+    /// Worst relative error of `b.eval` against `want` over [`DIRS`]; panics beyond `tol`.
+    fn check_normative(b: &Brdf, tol: f64, what: &str, want: impl Fn(Vec3, Vec3) -> [f64; 4]) -> f64 {
+        let mut worst = 0.0f64;
+        for (t0, p0, t1, p1) in DIRS {
+            let (wo, wi) = (dir(t0, p0), dir(t1, p1));
+            let (got, want) = (b.eval(wo, wi), want(wo, wi));
+            for i in 0..4 {
+                let e = (f64::from(got[i]) - want[i]).abs() / want[i].max(1e-3);
+                worst = worst.max(e);
+                assert!(e < tol, "{what}, θ {t0}/{t1}, lane {i}: {} vs the normative {}", got[i], want[i]);
+            }
+        }
+        worst
+    }
+
+    /// Partial metals are glTF's normative mix (appendix B): the diffuse loses the dielectric's
+    /// Fresnel term only, (1 − m)·(1 − F_d)·base/π, as the real-time renderer's `factors_of`
+    /// has it; the shortcut (1 − F)·c_diff/π with F from lerp(F0, base, m) takes the metal's
+    /// Fresnel term from it too (m = 0.5, base 0.5: a diffuse weight of 0.73 instead of 0.96).
+    #[test]
+    fn partial_metals_are_the_normative_mix() {
+        let base = Vec4::new(0.8, 0.55, 0.3, 0.1);
+        let mut worst = 0.0f64;
+        for m in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            for (r, ior) in [(0.4, 1.5), (0.7, 1.8), (0.25, 1.33)] {
+                let b = Brdf::new(base, m, r).with_ior(ior);
+                let f0 = ((f64::from(ior) - 1.0) / (f64::from(ior) + 1.0)).powi(2);
+                worst = worst.max(check_normative(&b, 5e-5, &format!("m {m} r {r} η {ior}"), |wo, wi| {
+                    normative(base, m, b.alpha, wo, wi, |v_h, i| {
+                        let f_d = schlick64(f0, v_h);
+                        (f_d, f_d, schlick64(f64::from(base[i]), v_h))
+                    })
+                }));
+            }
+        }
+        println!("partial metals vs the normative mix: worst relative error {worst:.2e}");
+    }
+
+    /// The same with a thin film: the dielectric's Fresnel term (the lobe's and the diffuse's)
+    /// is lerp(Schlick(F0(η)), R_film(η), w), the metal's lerp(Schlick(base), R_film(η(base)), w).
+    #[test]
+    fn partial_metals_with_a_film_are_the_normative_mix() {
+        let base = Vec4::new(0.8, 0.55, 0.3, 0.1);
+        for m in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            for (w, d) in [(1.0, 300.0), (0.6, 520.0)] {
+                let fl = film(w, d);
+                let b = Brdf::new(base, m, 0.4).with_film(Some(fl));
+                check_normative(&b, 1e-4, &format!("m {m} film {w} × {d} nm"), |wo, wi| {
+                    normative(base, m, b.alpha, wo, wi, |v_h, i| {
+                        let l = f64::from(fl.lambda[i]);
+                        let w = f64::from(w);
+                        let glass = num_complex::Complex64::new(1.5, 0.0);
+                        let r_d = scene::film::reflectance(l, v_h, d, 1.33, glass);
+                        let (s_d, s_m) = (schlick64(0.04, v_h), schlick64(f64::from(base[i]), v_h));
+                        let f_d = s_d + (r_d - s_d) * w;
+                        let f_m = s_m + (fl.film.over_f0(l, v_h, f64::from(base[i])) - s_m) * w;
+                        (f_d, f_d, f_m)
+                    })
+                });
+            }
+        }
+    }
+
+    /// The same with `KHR_materials_specular`: the lobe's dielectric term is
+    /// F_d(λ) = s·Schlick(F0c(λ)), the diffuse loses the neutral F_dmax = s·Schlick(F0c_max)
+    /// alone: (1 − m)·(1 − F_dmax)·base/π.
+    #[test]
+    fn partial_metals_with_a_specular_are_the_normative_mix() {
+        let base = Vec4::new(0.8, 0.55, 0.3, 0.1);
+        for m in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            for (s, f0, f0_max) in
+                [(0.5, Vec4::new(0.9, 0.6, 0.2, 0.05), 0.95), (1.0, Vec4::splat(0.04), 0.04)]
+            {
+                let sp = SpecularLanes { weight: s, f0, f0_max };
+                let b = Brdf::new(base, m, 0.4).with_specular(Some(sp));
+                check_normative(&b, 1e-5, &format!("m {m} s {s} F0c {f0}"), |wo, wi| {
+                    normative(base, m, b.alpha, wo, wi, |v_h, i| {
+                        let s = f64::from(s);
+                        let f_d = s * schlick64(f64::from(f0[i]), v_h);
+                        let f_dmax = s * schlick64(f64::from(f0_max), v_h);
+                        (f_d, f_dmax, schlick64(f64::from(base[i]), v_h))
+                    })
+                });
+            }
+        }
+    }
+
+    /// ∫ f·cos over the hemisphere of `wo` (midpoint quadrature in cos θ and φ).
+    fn albedo(b: &Brdf, wo: Vec3) -> Vec4 {
+        let (nt, np) = (300, 200);
+        let mut alb = Vec4::ZERO;
+        for i in 0..nt {
+            let c = (i as f32 + 0.5) / nt as f32;
+            for j in 0..np {
+                alb += b.eval(wo, dir(c.acos(), 2.0 * PI * (j as f32 + 0.5) / np as f32)) * c;
+            }
+        }
+        alb * (2.0 * PI / (nt * np) as f32)
+    }
+
+    /// Furnace: a white half metal reflects at most what arrives — and, the normative mix being
+    /// linear in m, exactly the mean of the white dielectric's and the white metal's albedos
+    /// (the shortcut's is darker: its diffuse loses the metal's Fresnel term, which is 1 for a
+    /// white metal, and so keeps a quarter of the base instead of a half). Where glTF's
+    /// dielectric itself returns more than 1 (grazing, `mix_excess`), the bound is half its excess.
+    #[test]
+    fn a_white_half_metal_keeps_energy() {
+        for r in [0.4, 0.6, 0.9] {
+            let at = |m: f32| Brdf::new(Vec4::ONE, m, r);
+            for theta in [0.1f32, 0.8, 1.3] {
+                let wo = dir(theta, 0.0);
+                let (half, diel, metal) = (albedo(&at(0.5), wo), albedo(&at(0.0), wo), albedo(&at(1.0), wo));
+                let mean = (diel + metal) * 0.5;
+                let bound = 1.0 + 0.5 * mix_excess(&at(0.0), wo) + 1e-3;
+                println!("r {r} θ {theta}: half metal {} (dielectric {}, metal {})", half.x, diel.x, metal.x);
+                assert!(
+                    (half - mean).abs().max_element() < 1e-4,
+                    "r {r} θ {theta}: {half} vs the mean {mean}"
+                );
+                assert!(half.max_element() <= bound, "r {r} θ {theta}: albedo {half} > {bound}");
+                if theta < 1.0 {
+                    assert!(half.max_element() <= 1.0 + 1e-3, "r {r} θ {theta}: albedo {half}");
+                }
+            }
+        }
+    }
+
     fn film(weight: f32, thickness_nm: f64) -> FilmLanes {
         FilmLanes {
             weight,
@@ -460,7 +640,7 @@ mod tests {
         let plain = b.eval(wo, wi);
         assert_eq!(b.with_film(Some(film(0.0, 300.0))).eval(wo, wi), plain);
         let f = b.with_film(Some(film(1.0, 300.0)));
-        let fr = f.fresnel(v_h);
+        let fr = f.fresnel(v_h).0;
         for i in 0..4 {
             let want = scene::film::reflectance(
                 f64::from(f.film.unwrap().lambda[i]),
@@ -472,11 +652,11 @@ mod tests {
             assert!((f64::from(fr[i]) - want).abs() < 1e-6, "lane {i}: {} vs {want}", fr[i]);
         }
         assert!(fr.max_element() - fr.min_element() > 0.01, "no interference colour: {fr}");
-        let bare = b.with_film(Some(film(1.0, 0.0))).fresnel(v_h);
-        let schlick = b.fresnel(v_h);
+        let bare = b.with_film(Some(film(1.0, 0.0))).fresnel(v_h).0;
+        let schlick = b.fresnel(v_h).0;
         assert!((bare - schlick).abs().max_element() < 0.01, "{bare} vs {schlick}");
         // Half the weight is half way.
-        let half = b.with_film(Some(film(0.5, 300.0))).fresnel(v_h);
+        let half = b.with_film(Some(film(0.5, 300.0))).fresnel(v_h).0;
         assert!((half - (schlick + fr) * 0.5).abs().max_element() < 1e-6);
         // Lambert has no Fresnel term to replace.
         assert!(Brdf::lambertian(Vec4::ONE).with_film(Some(film(1.0, 300.0))).film.is_none());
