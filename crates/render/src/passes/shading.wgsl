@@ -652,7 +652,7 @@ fn film_env_node(l: EnvLobes, f: FilmSurface, rho: vec4<f32>, metallic: f32, lam
         if (metallic > 0.0) {
             fm = rho * a + b;
         }
-        let keep = 1.0 - f.spec.w * (f0_max * a + b);
+        let keep = 1.0 - f.spec.w * fresnel_diffuse(f0_max, l.nv);
         return FilmEnvNode(vec4<f32>((1.0 - metallic) / PI * keep) * rho, (1.0 - metallic) * f.spec.w * (f0n * a + b) + metallic * fm);
     }
     var fd = mix(vec4<f32>(f.f0 * a + b), film_band_reflectance4(lambda, l.nv, f.thickness_nm, f.ior, vec4<f32>(f.base_ior), frame.node_spacing) * (a + b), f.weight);
@@ -778,7 +778,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
                     // A tinted specular: w·(F0c·A + B), the diffuse by the largest channel.
                     let f0_max = max(film.spec.r, max(film.spec.g, film.spec.b));
                     fd = film.spec.w * (film.spec.rgb * a + b);
-                    fd_keep = vec3<f32>(1.0 - film.spec.w * (f0_max * a + b));
+                    fd_keep = vec3<f32>(1.0 - film.spec.w * fresnel_diffuse(f0_max, l.nv));
                     if (s.metallic > 0.0) {
                         fm = s.base * a + b;
                     }
