@@ -966,7 +966,8 @@ impl Loader<'_> {
                 "a transmission (KHR_materials_transmission)"
             };
             self.warnings.push(format!(
-                "{at}: KHR_materials_specular is ignored on a material with {with}; its reflection comes from its index of refraction alone"
+                "{at} ('{}'): KHR_materials_specular is ignored on a material with {with}; its reflection comes from its index of refraction alone",
+                out.name
             ));
             out.specular = None;
         }

@@ -36,8 +36,8 @@ pub struct Specular {
     pub color_texture: Option<TextureRef>,
 }
 
-/// Largest `specularColorFactor` channel accepted: past 1/F0 the F0 colour is clamped to 1 at
-/// any index ≥ 1.0002, so larger values change nothing; this bound only keeps f32 finite.
+/// Largest `specularColorFactor` channel accepted: the F0 colour is clamped at 1 past 1/F0(η),
+/// which 10⁶ reaches at any index ≥ 1.002 (F0 ≥ 10⁻⁶); the bound keeps f32 finite.
 pub const MAX_COLOR: f32 = 1.0e6;
 
 impl Specular {
