@@ -151,27 +151,9 @@ fn a_coat_reflects_about_its_own_normal_and_keeps_one_minus_its_weight_of_the_ba
 #[test]
 fn a_coat_in_the_furnace_weighs_sky_and_base_by_its_fresnel_term() {
     const SIZE: u32 = 48;
-    let yfov = 0.6f32;
-    let mut scene = scene::Scene {
-        warnings: vec![],
-        source: "test:sphere".into(),
-        meshes: vec![sphere(96)],
-        materials: vec![scene::Material {
-            base_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
-            roughness: 0.5,
-            ..Default::default()
-        }],
-        textures: vec![],
-        lights: vec![],
-        camera: scene::Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, yfov),
-        spectral: scene::SpectralSettings::default(),
-        water: None,
-        environment: Some(Environment::uniform(Vec3::ONE)),
-        medium: None,
-        inputs: vec![],
-        origin: glam::DVec3::ZERO,
-        input_stamps: vec![],
-    };
+    let material =
+        scene::Material { base_color: Vec4::new(0.0, 0.0, 0.0, 1.0), roughness: 0.5, ..Default::default() };
+    let mut scene = sphere_scene(material, Environment::uniform(Vec3::ONE), 96);
     let mut r = renderer();
     let mut render_it = |scene: &scene::Scene, mode: Mode, capture: bool| {
         r.set_scene(scene).unwrap();
@@ -181,7 +163,6 @@ fn a_coat_in_the_furnace_weighs_sky_and_base_by_its_fresnel_term() {
         r.render(&scene.camera, &s).unwrap();
         r.read_hdr().unwrap()
     };
-    let t = (yfov / 2.0).tan();
     for strength in [1.0f32, 0.5] {
         for (mode, capture) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {
             scene.materials[0].clearcoat = None;
@@ -193,20 +174,9 @@ fn a_coat_in_the_furnace_weighs_sky_and_base_by_its_fresnel_term() {
             let mut largest_w = 0.0f64;
             for y in 0..SIZE {
                 for x in 0..SIZE {
-                    let ndc = (
-                        (x as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0,
-                        1.0 - (y as f32 + 0.5) / SIZE as f32 * 2.0,
-                    );
-                    let d = Vec3::new(ndc.0 * t, ndc.1 * t, -1.0).normalize();
-                    let o = Vec3::new(0.0, 0.0, 4.0);
-                    // Ray and unit sphere; pixels whose ray passes near the rim are left out (the
-                    // mesh's silhouette is not the sphere's).
-                    let b = o.dot(d);
-                    let disc = b * b - (o.dot(o) - 1.0);
-                    if disc <= 0.0 {
-                        continue;
-                    }
-                    let n = (o + d * (-b - disc.sqrt())).normalize();
+                    // Pixels whose ray passes near the rim are left out (the mesh's silhouette
+                    // is not the sphere's).
+                    let Some((n, d)) = sphere_hit(x, y, SIZE) else { continue };
                     let cos = n.dot(-d) as f64;
                     if cos < 0.25 {
                         continue;

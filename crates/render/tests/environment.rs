@@ -5,28 +5,13 @@
 
 mod common;
 
-use common::{renderer, sphere};
+use common::renderer;
 use glam::{Vec2, Vec3, Vec4};
 use render::{Mode, RenderSettings};
 use scene::{Camera, Environment, Material, Mesh, Scene, SpectralSettings};
 
 fn sphere_scene(env: Environment) -> Scene {
-    Scene {
-        warnings: vec![],
-        source: "test:sphere".into(),
-        meshes: vec![sphere(48)],
-        materials: vec![Material { base_color: Vec4::ONE, ..Default::default() }],
-        textures: vec![],
-        lights: vec![],
-        camera: Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 0.6),
-        spectral: SpectralSettings::default(),
-        water: None,
-        environment: Some(env),
-        medium: None,
-        inputs: vec![],
-        origin: glam::DVec3::ZERO,
-        input_stamps: vec![],
-    }
+    common::sphere_scene(Material { base_color: Vec4::ONE, ..Default::default() }, env, 48)
 }
 
 const SIZE: u32 = 48;
@@ -104,7 +89,6 @@ fn furnace_reference(nv: f64, roughness: f64, f0: f64) -> f64 {
 #[test]
 fn a_dielectric_in_the_furnace_is_the_brdfs_albedo() {
     let mut scene = sphere_scene(Environment::uniform(Vec3::ONE));
-    let t = (0.3f32).tan();
     for (roughness, ior) in [(0.2, 1.5), (0.6, 1.5), (1.0, 1.5), (0.5, scene::MAX_IOR)] {
         scene.materials[0].roughness = roughness;
         scene.materials[0].ior = ior;
@@ -116,16 +100,8 @@ fn a_dielectric_in_the_furnace_is_the_brdfs_albedo() {
             // The centre row from the middle outwards: n·v from 1 down to ~0.3.
             for x in (SIZE / 2..SIZE).step_by(2) {
                 let y = SIZE / 2;
-                let ndc =
-                    ((x as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / SIZE as f32 * 2.0);
-                let d = Vec3::new(ndc.0 * t, ndc.1 * t, -1.0).normalize();
-                let o = Vec3::new(0.0, 0.0, 4.0);
-                let b = o.dot(d);
-                let disc = b * b - (o.dot(o) - 1.0);
-                if disc <= 0.0 {
-                    continue;
-                }
-                let nv = f64::from((o + d * (-b - disc.sqrt())).normalize().dot(-d));
+                let Some((n, d)) = common::sphere_hit(x, y, SIZE) else { continue };
+                let nv = f64::from(n.dot(-d));
                 if nv < 0.3 {
                     continue;
                 }

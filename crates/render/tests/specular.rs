@@ -179,26 +179,9 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
 #[test]
 fn in_the_furnace_the_weight_scales_and_the_colour_tints_the_reflection() {
     const SIZE: u32 = 40;
-    let mut scene = scene::Scene {
-        warnings: vec![],
-        source: "test:sphere".into(),
-        meshes: vec![sphere(64)],
-        materials: vec![scene::Material {
-            base_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
-            roughness: 0.4,
-            ..Default::default()
-        }],
-        textures: vec![],
-        lights: vec![],
-        camera: scene::Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 0.6),
-        spectral: scene::SpectralSettings::default(),
-        water: None,
-        environment: Some(Environment::uniform(Vec3::ONE)),
-        medium: None,
-        inputs: vec![],
-        origin: glam::DVec3::ZERO,
-        input_stamps: vec![],
-    };
+    let material =
+        scene::Material { base_color: Vec4::new(0.0, 0.0, 0.0, 1.0), roughness: 0.4, ..Default::default() };
+    let mut scene = sphere_scene(material, Environment::uniform(Vec3::ONE), 64);
     let mut r = renderer();
     let mut render_it = |scene: &scene::Scene, mode: Mode, capture: bool| {
         r.set_scene(scene).unwrap();
@@ -222,17 +205,11 @@ fn in_the_furnace_the_weight_scales_and_the_colour_tints_the_reflection() {
         let tinted = render_it(&scene, mode, capture);
         let (mut worst_w, mut worst_c, mut compared) = (0.0f64, [0.0f64; 3], 0);
         let mut ratios = [0.0f64; 3];
-        let t = (0.3f32).tan();
         for i in 0..(SIZE * SIZE) as usize {
             // Pixels whose ray meets the sphere away from its rim (the background is the sky).
-            let (x, y) = ((i as u32 % SIZE) as f32, (i as u32 / SIZE) as f32);
-            let ndc = ((x + 0.5) / SIZE as f32 * 2.0 - 1.0, 1.0 - (y + 0.5) / SIZE as f32 * 2.0);
-            let d = Vec3::new(ndc.0 * t, ndc.1 * t, -1.0).normalize();
-            let o = Vec3::new(0.0, 0.0, 4.0);
-            let b = o.dot(d);
-            let disc = b * b - (o.dot(o) - 1.0);
-            if disc <= 0.0 || (o + d * (-b - disc.sqrt())).normalize().dot(-d) < 0.3 {
-                continue;
+            match sphere_hit(i as u32 % SIZE, i as u32 / SIZE, SIZE) {
+                Some((n, d)) if n.dot(-d) >= 0.3 => {}
+                _ => continue,
             }
             compared += 1;
             for c in 0..3 {

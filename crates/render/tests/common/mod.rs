@@ -470,3 +470,39 @@ pub fn sphere(n: u32) -> Mesh {
     }
     m
 }
+
+/// Where [`sphere_scene`]'s camera stands, and its vertical field of view.
+pub const SPHERE_EYE: Vec3 = Vec3::new(0.0, 0.0, 4.0);
+pub const SPHERE_YFOV: f32 = 0.6;
+
+/// A unit sphere (`rings` rings) of `material` at the origin in the environment `env`, seen
+/// from [`SPHERE_EYE`] with a vertical field of view of [`SPHERE_YFOV`].
+pub fn sphere_scene(material: Material, env: scene::Environment, rings: u32) -> Scene {
+    Scene {
+        warnings: vec![],
+        source: "test:sphere".into(),
+        meshes: vec![sphere(rings)],
+        materials: vec![material],
+        textures: vec![],
+        lights: vec![],
+        camera: Camera::look_at(SPHERE_EYE, Vec3::ZERO, Vec3::Y, SPHERE_YFOV),
+        spectral: SpectralSettings::default(),
+        water: None,
+        environment: Some(env),
+        medium: None,
+        inputs: vec![],
+        origin: glam::DVec3::ZERO,
+        input_stamps: vec![],
+    }
+}
+
+/// The ray through the centre of pixel (x, y) of a size × size image of [`sphere_scene`] and the
+/// true sphere's unit normal where it meets it: (normal, direction), or None where it misses.
+pub fn sphere_hit(x: u32, y: u32, size: u32) -> Option<(Vec3, Vec3)> {
+    let t = (SPHERE_YFOV / 2.0).tan();
+    let ndc = ((x as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / size as f32 * 2.0);
+    let d = Vec3::new(ndc.0 * t, ndc.1 * t, -1.0).normalize();
+    let b = SPHERE_EYE.dot(d);
+    let disc = b * b - (SPHERE_EYE.dot(SPHERE_EYE) - 1.0);
+    (disc > 0.0).then(|| ((SPHERE_EYE + d * (-b - disc.sqrt())).normalize(), d))
+}

@@ -9,13 +9,11 @@
 //! spot from above and in front of the camera, one CIE F11 spot from the side (a narrow-band
 //! fluorescent, where the bases' spectra matter: the coat itself reflects every wavelength alike).
 
-use glam::Vec3;
-
-use super::{empty, measured_material, patch, patch_index, shapes, showcase_spots};
+use super::{Showcase, measured_material, patch, patch_index};
+use crate::Scene;
 use crate::clearcoat::Clearcoat;
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Camera, Scene};
 
 /// The bases, left to right (ColorChecker patch names).
 pub const BASES: [&str; 4] = ["red", "green", "blue", "yellow"];
@@ -24,14 +22,8 @@ pub const BASES: [&str; 4] = ["red", "green", "blue", "yellow"];
 pub const COATS: [(f32, f32); 2] = [(1.0, 0.05), (0.5, 0.3)];
 
 pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
-    let camera =
-        Camera::look_at(Vec3::new(0.0, 0.75, 1.55), Vec3::new(0.0, 0.12, 0.0), Vec3::Y, 40f32.to_radians());
-    let mut s = empty(ctx, camera);
-    s.materials
-        .push(measured_material("floor (ColorChecker neutral 5)", &patch(patch_index("neutral 5 (.70 D)"))));
-    let floor = 0;
-    let (r, step) = (0.12f32, 0.3f32);
-    for (row, (&(strength, roughness), z)) in COATS.iter().zip([-0.2f32, 0.15]).enumerate() {
+    let mut stage = Showcase::new(ctx);
+    for (row, &(strength, roughness)) in COATS.iter().enumerate() {
         for (i, name) in BASES.iter().enumerate() {
             let what = if row == 0 { "glossy" } else { "satin" };
             let mut m = measured_material(&format!("{name} under a {what} coat"), &patch(patch_index(name)));
@@ -44,17 +36,11 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
                 normal_texture: None,
                 normal_scale: 1.0,
             });
-            s.materials.push(m);
-            let x = (i as f32 - 1.5) * step;
-            s.meshes.push(shapes::sphere(Vec3::new(x, r, z), r, 14, 22, s.materials.len() - 1));
+            stage.sphere(row, i, m);
         }
     }
-    let fw = 2.0f32;
-    s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));
-
     // Two spots aimed at the middle of the rows, ≈ π lux there each: D65 in front, F11 aside.
-    s.lights = showcase_spots(ctx, ("front spot (D65)", "D65"), ("side spot (F11)", "F11"))?;
-    Ok(s)
+    stage.finish(ctx, ("front spot (D65)", "D65"), ("side spot (F11)", "F11"))
 }
 
 #[cfg(test)]

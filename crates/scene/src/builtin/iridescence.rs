@@ -9,12 +9,12 @@
 //! angles. One D65 spot from above and in front of the camera, one from the side (the eval's
 //! `iridescence-f11` case relights both with F11).
 
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 
-use super::{empty, measured_material, patch, patch_index, shapes, showcase_spots};
+use super::{Showcase, measured_material, patch, patch_index};
 use crate::context::Ctx;
 use crate::error::SceneError;
-use crate::{Camera, Iridescence, Material, Scene};
+use crate::{Iridescence, Material, Scene};
 
 /// (thickness nm, film IOR) of the back row's dielectric spheres, left to right.
 pub const DIELECTRIC_FILMS: [(f32, f32); 4] = [(200.0, 1.33), (400.0, 1.5), (600.0, 1.33), (800.0, 1.8)];
@@ -39,40 +39,27 @@ fn film(thickness: f32, ior: f32) -> Option<Iridescence> {
 }
 
 pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
-    let camera =
-        Camera::look_at(Vec3::new(0.0, 0.75, 1.55), Vec3::new(0.0, 0.12, 0.0), Vec3::Y, 40f32.to_radians());
-    let mut s = empty(ctx, camera);
-    s.materials
-        .push(measured_material("floor (ColorChecker neutral 5)", &patch(patch_index("neutral 5 (.70 D)"))));
-    let floor = 0;
+    let mut stage = Showcase::new(ctx);
     let black = patch(patch_index("black 2 (1.5 D)"));
-    let (r, step) = (0.12f32, 0.3f32);
     for (i, &(d, n)) in DIELECTRIC_FILMS.iter().enumerate() {
         let mut m = measured_material(&format!("dark dielectric, film {d} nm of index {n}"), &black);
         m.roughness = 0.5;
         m.iridescence = film(d, n);
-        s.materials.push(m);
-        let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, -0.2), r, 14, 22, s.materials.len() - 1));
+        stage.sphere(0, i, m);
     }
     for (i, &(c, d, n)) in METAL_FILMS.iter().enumerate() {
-        s.materials.push(Material {
+        let m = Material {
             name: format!("metal, film {d} nm of index {n}"),
             base_color: Vec4::new(c[0], c[1], c[2], 1.0),
             metallic: 1.0,
             roughness: 0.5,
             iridescence: film(d, n),
             ..Material::default()
-        });
-        let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, 0.15), r, 14, 22, s.materials.len() - 1));
+        };
+        stage.sphere(1, i, m);
     }
-    let fw = 2.0f32;
-    s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));
-
     // Two D65 spots aimed at the middle of the rows: ≈ π lux there each.
-    s.lights = showcase_spots(ctx, ("front spot", "D65"), ("side spot", "D65"))?;
-    Ok(s)
+    stage.finish(ctx, ("front spot", "D65"), ("side spot", "D65"))
 }
 
 #[cfg(test)]

@@ -129,6 +129,60 @@ pub(crate) fn spot_at(
     })
 }
 
+/// The stage of the material showcases (`iridescence`, `clearcoat`, `specular`): two rows of
+/// four spheres of radius 0.12, 0.3 apart (the back row at z = −0.2, the front at 0.15), on a
+/// 2 m floor of ColorChecker neutral 5, seen from above and in front; two spots
+/// ([`showcase_spots`]).
+pub(crate) struct Showcase {
+    scene: Scene,
+}
+
+impl Showcase {
+    /// The camera and the floor's material (material 0).
+    pub(crate) fn new(ctx: &Ctx) -> Self {
+        let camera = crate::Camera::look_at(
+            Vec3::new(0.0, 0.75, 1.55),
+            Vec3::new(0.0, 0.12, 0.0),
+            Vec3::Y,
+            40f32.to_radians(),
+        );
+        let mut scene = empty(ctx, camera);
+        scene.materials.push(measured_material(
+            "floor (ColorChecker neutral 5)",
+            &patch(patch_index("neutral 5 (.70 D)")),
+        ));
+        Showcase { scene }
+    }
+
+    /// Sphere `i` (0–3, left to right) of row `row` (0 back, 1 front), of material `m`.
+    pub(crate) fn sphere(&mut self, row: usize, i: usize, m: Material) {
+        let (r, step) = (0.12f32, 0.3f32);
+        let z = [-0.2f32, 0.15][row];
+        self.scene.materials.push(m);
+        let x = (i as f32 - 1.5) * step;
+        let index = self.scene.materials.len() - 1;
+        self.scene.meshes.push(shapes::sphere(Vec3::new(x, r, z), r, 14, 22, index));
+    }
+
+    /// The floor's quad and the spots: the finished scene.
+    pub(crate) fn finish(
+        mut self,
+        ctx: &Ctx,
+        front: (&str, &str),
+        side: (&str, &str),
+    ) -> Result<Scene, SceneError> {
+        let fw = 2.0f32;
+        self.scene.meshes.push(shapes::quad(
+            Vec3::new(-fw * 0.5, 0.0, fw * 0.5),
+            Vec3::X * fw,
+            -Vec3::Z * fw,
+            0,
+        ));
+        self.scene.lights = showcase_spots(ctx, front, side)?;
+        Ok(self.scene)
+    }
+}
+
 /// The two spots of the material showcases (`iridescence`, `clearcoat`, `specular`): one above
 /// and in front of the camera, one from the side, aimed at the middle of the rows at
 /// (0, 0.1, 0), ≈ π lux there each; cones 40°/65°.

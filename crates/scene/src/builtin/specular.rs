@@ -11,11 +11,11 @@
 
 use glam::Vec3;
 
-use super::{empty, measured_material, patch, patch_index, shapes, showcase_spots};
+use super::{Showcase, measured_material, patch, patch_index};
+use crate::Scene;
 use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::specular::Specular;
-use crate::{Camera, Scene};
 
 /// The back row's F0 tints (linear RGB, × [`TINT_SCALE`]).
 pub const TINTS: [(&str, [f32; 3]); 4] = [
@@ -32,13 +32,7 @@ pub const TINT_SCALE: f32 = 10.0;
 pub const WEIGHTED: [(&str, f32); 4] = [("red", 0.25), ("green", 0.5), ("blue", 0.75), ("yellow", 1.0)];
 
 pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
-    let camera =
-        Camera::look_at(Vec3::new(0.0, 0.75, 1.55), Vec3::new(0.0, 0.12, 0.0), Vec3::Y, 40f32.to_radians());
-    let mut s = empty(ctx, camera);
-    s.materials
-        .push(measured_material("floor (ColorChecker neutral 5)", &patch(patch_index("neutral 5 (.70 D)"))));
-    let floor = 0;
-    let (r, step) = (0.12f32, 0.3f32);
+    let mut stage = Showcase::new(ctx);
     let black = patch(patch_index("black 2 (1.5 D)"));
     for (i, (name, tint)) in TINTS.iter().enumerate() {
         let mut m = measured_material(&format!("black under a {name} F0"), &black);
@@ -49,9 +43,7 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
             color: Vec3::from(*tint) * TINT_SCALE,
             color_texture: None,
         });
-        s.materials.push(m);
-        let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, -0.2), r, 14, 22, s.materials.len() - 1));
+        stage.sphere(0, i, m);
     }
     for (i, (name, weight)) in WEIGHTED.iter().enumerate() {
         let mut m =
@@ -59,14 +51,9 @@ pub(crate) fn build(ctx: &Ctx) -> Result<Scene, SceneError> {
         m.roughness = 0.4;
         m.specular =
             Some(Specular { factor: *weight, texture: None, color: Vec3::splat(5.0), color_texture: None });
-        s.materials.push(m);
-        let x = (i as f32 - 1.5) * step;
-        s.meshes.push(shapes::sphere(Vec3::new(x, r, 0.15), r, 14, 22, s.materials.len() - 1));
+        stage.sphere(1, i, m);
     }
-    let fw = 2.0f32;
-    s.meshes.push(shapes::quad(Vec3::new(-fw * 0.5, 0.0, fw * 0.5), Vec3::X * fw, -Vec3::Z * fw, floor));
-    s.lights = showcase_spots(ctx, ("front spot (D65)", "D65"), ("side spot (F11)", "F11"))?;
-    Ok(s)
+    stage.finish(ctx, ("front spot (D65)", "D65"), ("side spot (F11)", "F11"))
 }
 
 #[cfg(test)]
