@@ -23,6 +23,7 @@ mod instancing;
 pub mod medium;
 mod meshopt_decode;
 mod primitive;
+pub mod sheen;
 pub mod sky;
 pub mod spec_gloss;
 pub mod spectrum_desc;
