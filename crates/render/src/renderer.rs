@@ -9,7 +9,7 @@ use crate::material_spectra::MaterialSpectrum;
 use crate::passes::accumulate::AccumulatePass;
 use crate::passes::custom::{CustomPass, CustomShader, CustomUniforms};
 use crate::passes::gbuffer::GBufferPass;
-use crate::passes::gbuffer::{Layer as GBufferLayer, Targets as GBufferTargets};
+use crate::passes::gbuffer::{Fourth as GBufferFourth, Layer as GBufferLayer, Targets as GBufferTargets};
 use crate::passes::post::PostPass;
 use crate::passes::shading::{ShadingPass, ShadingStage, Variant};
 use crate::passes::shadow::ShadowPass;
@@ -906,16 +906,19 @@ impl Renderer {
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        let gbuffer_targets = match (scene.has_coat, scene.has_specular) {
-            (true, true) => GBufferTargets::CoatSpec,
-            (true, false) => GBufferTargets::Coat,
-            (false, true) => GBufferTargets::FilmSpec,
-            (false, false) if scene.has_film => GBufferTargets::Film,
-            (false, false) => GBufferTargets::Plain,
+        // The film's target comes with a coat's or a specular's: the shading pass reads it beside them.
+        let filmed = scene.has_film || scene.has_coat || scene.has_specular;
+        let gbuffer_targets = GBufferTargets {
+            fourth: if filmed { GBufferFourth::Film } else { GBufferFourth::None },
+            coat: scene.has_coat,
+            specular: scene.has_specular,
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
-        let layer_targets =
-            if scene.has_transmission_coat { GBufferTargets::LayerCoat } else { GBufferTargets::Layer };
+        let layer_targets = GBufferTargets {
+            fourth: GBufferFourth::Layer,
+            coat: scene.has_transmission_coat,
+            specular: false,
+        };
         if layered {
             self.gbuffer.prepare(&self.gpu.device, layer_targets)?;
         }
@@ -931,16 +934,13 @@ impl Renderer {
         let g = &targets.gbuffer_views;
         let (film, coat, spec) =
             (&targets.gbuffer_film_view, &targets.gbuffer_coat_view, &targets.gbuffer_specular_view);
-        let colour: Vec<&wgpu::TextureView> = match gbuffer_targets {
-            GBufferTargets::Plain => vec![&g[0], &g[1], &g[2]],
-            // (The transmissive layer's targets are its own, below.)
-            GBufferTargets::Film | GBufferTargets::Layer | GBufferTargets::LayerCoat => {
-                vec![&g[0], &g[1], &g[2], film]
-            }
-            GBufferTargets::Coat => vec![&g[0], &g[1], &g[2], film, coat],
-            GBufferTargets::FilmSpec => vec![&g[0], &g[1], &g[2], film, spec],
-            GBufferTargets::CoatSpec => vec![&g[0], &g[1], &g[2], film, coat, spec],
-        };
+        // (The transmissive layer's targets are its own, below.)
+        let colour: Vec<&wgpu::TextureView> = [&g[0], &g[1], &g[2]]
+            .into_iter()
+            .chain(filmed.then_some(film))
+            .chain(gbuffer_targets.coat.then_some(coat))
+            .chain(gbuffer_targets.specular.then_some(spec))
+            .collect();
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
         self.gbuffer.record(
             &mut encoder,
@@ -997,7 +997,7 @@ impl Renderer {
                     layer.depth.as_image_copy(),
                     wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
                 );
-                let written = if layer_targets == GBufferTargets::LayerCoat { 5 } else { 4 };
+                let written = layer_targets.formats().len();
                 let views: Vec<&wgpu::TextureView> = layer.gbuffer_views.iter().take(written).collect();
                 self.gbuffer.record(
                     &mut encoder,

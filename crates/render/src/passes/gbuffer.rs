@@ -8,8 +8,10 @@
 //! without discard so that early depth testing stays on. Every mode writes the same three
 //! targets (the material's slot travels with the normal: `gbuffer_pack_normal` in
 //! wgsl/common.wgsl); a scene with a thin film adds a fourth, the film's values
-//! ([`GBUFFER_FILM_FORMAT`]), built on first use, so that a scene without one samples no film
-//! texture and writes no film target.
+//! ([`GBUFFER_FILM_FORMAT`]), and the clear coat's and the specular's after it ([`Targets`]),
+//! built on first use, so that a scene without them samples none of their textures and writes
+//! none of their targets. Each set of targets has its output struct and entry points generated
+//! ([`Targets::wgsl`]) around gbuffer.wgsl's one function per target.
 
 use super::{
     GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SPECULAR_FORMAT,
@@ -18,6 +20,7 @@ use super::{
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
 use crate::shader;
+use std::collections::HashMap;
 
 /// `[double_sided][alpha_tested]`.
 type Pipelines = [[wgpu::RenderPipeline; 2]; 2];
@@ -26,19 +29,8 @@ pub struct GBufferPass {
     pub material_layout: wgpu::BindGroupLayout,
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
-    pipelines: Pipelines,
-    /// With the film, for scenes with a thin film ([`Self::prepare`]).
-    film_pipelines: Option<Pipelines>,
-    /// The transmissive layer's ([`Targets::Layer`]).
-    layer_pipelines: Option<Pipelines>,
-    /// With the film and the coat, for scenes with a clear coat ([`Targets::Coat`]).
-    coat_pipelines: Option<Pipelines>,
-    /// The transmissive layer's with the coat ([`Targets::LayerCoat`]).
-    layer_coat_pipelines: Option<Pipelines>,
-    /// With the film and the specular ([`Targets::FilmSpec`]).
-    spec_pipelines: Option<Pipelines>,
-    /// With the film, the coat and the specular ([`Targets::CoatSpec`]).
-    coat_spec_pipelines: Option<Pipelines>,
+    /// Per set of targets, built on first use ([`Self::prepare`]; the plain set at once).
+    pipelines: HashMap<Targets, Pipelines>,
 }
 
 /// Which draws a G-buffer pass rasterises. A scene with see-through materials is drawn in two
@@ -53,93 +45,189 @@ pub enum Layer {
     /// Every draw but the see-through ones.
     Opaque,
     /// Only the see-through ones, depth-tested against the opaque layer's depth, which the
-    /// caller copied into `depth`, into [`Targets::Layer`].
+    /// caller copied into `depth`, into the layer's targets ([`Fourth::Layer`]).
     Transmissive,
 }
 
-/// Which targets a G-buffer pass writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Targets {
-    /// Base, normal (with the material's slot), emission.
-    Plain,
-    /// And the film.
+/// The target after the three every pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Fourth {
+    None,
+    /// The thin film's values ([`GBUFFER_FILM_FORMAT`]); scenes with a film, a coat or a
+    /// specular write it (the shading pass reads the film beside them).
     Film,
-    /// And the film and the clear coat ([`GBUFFER_COAT_FORMAT`]).
-    Coat,
-    /// The transmissive layer's ([`Targets::Layer`]) and the clear coat.
-    LayerCoat,
-    /// And in four packed channels the transmission factor × texture, the volume's thickness
-    /// texture and the film's two values: the transmissive layer's.
+    /// The transmissive layer's packed values ([`GBUFFER_LAYER_FORMAT`]: the transmission, the
+    /// volume's thickness texture and the film's two values).
     Layer,
-    /// [`Targets::Film`] and the specular strength and colour ([`GBUFFER_SPECULAR_FORMAT`],
-    /// `KHR_materials_specular`).
-    FilmSpec,
-    /// [`Targets::Coat`] and the specular.
-    CoatSpec,
+}
+
+/// Which targets a G-buffer pass writes, in location order: base, normal (with the slot),
+/// emission, then the [`Fourth`], the clear coat's ([`GBUFFER_COAT_FORMAT`]) and the specular
+/// strength and colour ([`GBUFFER_SPECULAR_FORMAT`], `KHR_materials_specular`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Targets {
+    pub fourth: Fourth,
+    pub coat: bool,
+    pub specular: bool,
+}
+
+impl Targets {
+    pub const PLAIN: Targets = Targets { fourth: Fourth::None, coat: false, specular: false };
+
+    /// Every set the renderer draws with: a coat comes with the film's or the layer's target
+    /// (which the shading pass reads beside it), a specular with the film's (the loader keeps
+    /// none on see-through materials).
+    pub fn all() -> impl Iterator<Item = Targets> {
+        [Fourth::None, Fourth::Film, Fourth::Layer].into_iter().flat_map(|fourth| {
+            [(false, false), (true, false), (false, true), (true, true)]
+                .into_iter()
+                .map(move |(coat, specular)| Targets { fourth, coat, specular })
+                .filter(|t| {
+                    (!t.coat || t.fourth != Fourth::None) && (!t.specular || t.fourth == Fourth::Film)
+                })
+        })
+    }
+
+    /// The formats of the targets, in location order.
+    pub fn formats(self) -> Vec<wgpu::TextureFormat> {
+        let mut f = GBUFFER_FORMATS.to_vec();
+        match self.fourth {
+            Fourth::None => {}
+            Fourth::Film => f.push(GBUFFER_FILM_FORMAT),
+            Fourth::Layer => f.push(GBUFFER_LAYER_FORMAT),
+        }
+        if self.coat {
+            f.push(GBUFFER_COAT_FORMAT);
+        }
+        if self.specular {
+            f.push(GBUFFER_SPECULAR_FORMAT);
+        }
+        f
+    }
+
+    /// The bytes a pixel's targets take past WebGPU's guaranteed 32, and what needs them.
+    fn bytes_needed(self) -> Option<(u32, &'static str)> {
+        match (self.coat, self.specular) {
+            (true, true) => Some((
+                super::COAT_SPECULAR_TARGET_BYTES,
+                "a clear coat and a specular colour (KHR_materials_clearcoat, KHR_materials_specular)",
+            )),
+            (false, true) => {
+                Some((super::SPECULAR_TARGET_BYTES, "a specular colour (KHR_materials_specular)"))
+            }
+            (true, false) => Some((super::COAT_TARGET_BYTES, "a clear coat (KHR_materials_clearcoat)")),
+            (false, false) => None,
+        }
+    }
+
+    fn name(self) -> String {
+        let fourth = match self.fourth {
+            Fourth::None => "plain",
+            Fourth::Film => "film",
+            Fourth::Layer => "layer",
+        };
+        format!(
+            "{fourth}{}{}",
+            if self.coat { "_coat" } else { "" },
+            if self.specular { "_spec" } else { "" }
+        )
+    }
+
+    /// The fragment entry point writing these targets, with or without the alpha test.
+    fn entry(self, alpha: bool) -> String {
+        format!("fs_{}_{}", self.name(), if alpha { "alpha" } else { "main" })
+    }
+
+    /// The output struct and the two entry points (opaque, alpha-tested) of these targets:
+    /// every texture is sampled before `gbuffer`, whose discard would leave later samples'
+    /// derivatives undefined, and each extra target is its own function's (gbuffer.wgsl).
+    fn wgsl(self) -> String {
+        let name = self.name();
+        let mut fields = vec![
+            "@location(0) base: vec4<f32>".to_string(),
+            "@location(1) normal: vec4<u32>".into(),
+            "@location(2) emission: vec4<f32>".into(),
+        ];
+        let mut samples = Vec::new();
+        let mut writes = Vec::new();
+        match self.fourth {
+            Fourth::None => {}
+            Fourth::Film => {
+                fields.push(format!("@location({}) film: vec2<f32>", fields.len()));
+                samples.push("let f = film_values(v);");
+                writes.push("r.film = film_target(o, f);");
+            }
+            Fourth::Layer => {
+                fields.push(format!("@location({}) layer: u32", fields.len()));
+                samples.push("let t = transmission_values(v);");
+                samples.push("let f = film_values(v);");
+                writes.push("r.layer = layer_target(o, t, f);");
+            }
+        }
+        if self.coat {
+            fields.push(format!("@location({}) coat: vec4<u32>", fields.len()));
+            samples.push("let c = coat_sample(v);");
+            writes.push("r.coat = coat_target(o, c, v, front);");
+        }
+        if self.specular {
+            fields.push(format!("@location({}) specular: vec4<u32>", fields.len()));
+            samples.push("let sp = specular_values(v);");
+            writes.push("r.specular = sp;");
+        }
+        let mut out = format!("struct GBufferOut_{name} {{\n    {},\n}};\n", fields.join(",\n    "));
+        for alpha in [false, true] {
+            out.push_str(&format!(
+                "@fragment\nfn {}(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut_{name} {{\n",
+                self.entry(alpha)
+            ));
+            for line in
+                samples.iter().copied().chain([format!("let o = gbuffer(v, front, {alpha});").as_str()])
+            {
+                out.push_str(&format!("    {line}\n"));
+            }
+            out.push_str(&format!("    var r: GBufferOut_{name};\n    r.base = o.base;\n    r.normal = o.normal;\n    r.emission = o.emission;\n"));
+            for line in &writes {
+                out.push_str(&format!("    {line}\n"));
+            }
+            out.push_str("    return r;\n}\n");
+        }
+        out
+    }
 }
 
 impl GBufferPass {
     pub fn new(device: &wgpu::Device, shared: &SharedLayouts) -> Result<Self> {
         let material_layout = scene_gpu::material_layout(device);
+        let entry_points: String = Targets::all().map(Targets::wgsl).collect();
         let module = shader::compile(
             device,
             "gbuffer",
-            &[shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl")],
+            &[shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl"), &entry_points],
         )?;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),
             bind_group_layouts: &[Some(&shared.frame), Some(&material_layout)],
             immediate_size: 0,
         });
-        let pipelines = build(device, &module, &layout, Targets::Plain)?;
-        Ok(GBufferPass {
-            material_layout,
-            module,
-            layout,
-            pipelines,
-            film_pipelines: None,
-            layer_pipelines: None,
-            coat_pipelines: None,
-            layer_coat_pipelines: None,
-            spec_pipelines: None,
-            coat_spec_pipelines: None,
-        })
+        let pipelines = HashMap::from([(Targets::PLAIN, build(device, &module, &layout, Targets::PLAIN)?)]);
+        Ok(GBufferPass { material_layout, module, layout, pipelines })
     }
 
     /// Builds the pipelines for `targets` unless they exist.
     pub fn prepare(&mut self, device: &wgpu::Device, targets: Targets) -> Result<()> {
-        let slot = match targets {
-            Targets::Plain => return Ok(()),
-            Targets::Film => &mut self.film_pipelines,
-            Targets::Layer => &mut self.layer_pipelines,
-            Targets::Coat | Targets::LayerCoat | Targets::FilmSpec | Targets::CoatSpec => {
-                let have = device.limits().max_color_attachment_bytes_per_sample;
-                let (need, what) = match targets {
-                    Targets::FilmSpec => {
-                        (super::SPECULAR_TARGET_BYTES, "a specular colour (KHR_materials_specular)")
-                    }
-                    Targets::CoatSpec => (
-                        super::COAT_SPECULAR_TARGET_BYTES,
-                        "a clear coat and a specular colour (KHR_materials_clearcoat, KHR_materials_specular)",
-                    ),
-                    _ => (super::COAT_TARGET_BYTES, "a clear coat (KHR_materials_clearcoat)"),
-                };
-                if have < need {
-                    return Err(crate::error::RenderError::Gpu(format!(
-                        "a scene with {what} needs G-buffer targets of {need} bytes a pixel; this GPU's hold {have}"
-                    )));
-                }
-                match targets {
-                    Targets::Coat => &mut self.coat_pipelines,
-                    Targets::LayerCoat => &mut self.layer_coat_pipelines,
-                    Targets::FilmSpec => &mut self.spec_pipelines,
-                    _ => &mut self.coat_spec_pipelines,
-                }
-            }
-        };
-        if slot.is_none() {
-            *slot = Some(build(device, &self.module, &self.layout, targets)?);
+        if self.pipelines.contains_key(&targets) {
+            return Ok(());
         }
+        if let Some((need, what)) = targets.bytes_needed() {
+            let have = device.limits().max_color_attachment_bytes_per_sample;
+            if have < need {
+                return Err(crate::error::RenderError::Gpu(format!(
+                    "a scene with {what} needs G-buffer targets of {need} bytes a pixel; this GPU's hold {have}"
+                )));
+            }
+        }
+        let built = build(device, &self.module, &self.layout, targets)?;
+        self.pipelines.insert(targets, built);
         Ok(())
     }
 
@@ -157,17 +245,9 @@ impl GBufferPass {
         layer: Layer,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let pipelines = match targets {
-            Targets::Plain => Some(&self.pipelines),
-            Targets::Film => self.film_pipelines.as_ref(),
-            Targets::Layer => self.layer_pipelines.as_ref(),
-            Targets::Coat => self.coat_pipelines.as_ref(),
-            Targets::LayerCoat => self.layer_coat_pipelines.as_ref(),
-            Targets::FilmSpec => self.spec_pipelines.as_ref(),
-            Targets::CoatSpec => self.coat_spec_pipelines.as_ref(),
-        };
-        let pipelines = pipelines.unwrap_or_else(|| panic!("prepare({targets:?}) before recording"));
-        debug_assert_eq!(colour.len(), formats(targets).len(), "{targets:?}");
+        let pipelines =
+            self.pipelines.get(&targets).unwrap_or_else(|| panic!("prepare({targets:?}) before recording"));
+        debug_assert_eq!(colour.len(), targets.formats().len(), "{targets:?}");
         let attachments: Vec<_> = colour
             .iter()
             .map(|view| {
@@ -219,22 +299,6 @@ impl GBufferPass {
     }
 }
 
-/// The formats of the targets `which` names, in location order.
-pub fn formats(which: Targets) -> &'static [wgpu::TextureFormat] {
-    const B: wgpu::TextureFormat = GBUFFER_FORMATS[0];
-    const N: wgpu::TextureFormat = GBUFFER_FORMATS[1];
-    const E: wgpu::TextureFormat = GBUFFER_FORMATS[2];
-    match which {
-        Targets::Plain => &GBUFFER_FORMATS,
-        Targets::Film => &[B, N, E, GBUFFER_FILM_FORMAT],
-        Targets::Layer => &[B, N, E, GBUFFER_LAYER_FORMAT],
-        Targets::Coat => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT],
-        Targets::LayerCoat => &[B, N, E, GBUFFER_LAYER_FORMAT, GBUFFER_COAT_FORMAT],
-        Targets::FilmSpec => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_SPECULAR_FORMAT],
-        Targets::CoatSpec => &[B, N, E, GBUFFER_FILM_FORMAT, GBUFFER_COAT_FORMAT, GBUFFER_SPECULAR_FORMAT],
-    }
-}
-
 /// The four pipelines (single/double-sided × opaque/alpha-tested) writing `which` targets.
 fn build(
     device: &wgpu::Device,
@@ -242,29 +306,15 @@ fn build(
     layout: &wgpu::PipelineLayout,
     which: Targets,
 ) -> Result<Pipelines> {
-    let targets: Vec<_> = formats(which)
-        .iter()
-        .map(|&format| {
+    let targets: Vec<_> = which
+        .formats()
+        .into_iter()
+        .map(|format| {
             Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
         })
         .collect();
     let pipeline = |double_sided: bool, alpha: bool| {
-        let entry = match (alpha, which) {
-            (false, Targets::Plain) => "fs_main",
-            (true, Targets::Plain) => "fs_alpha",
-            (false, Targets::Film) => "fs_main_film",
-            (true, Targets::Film) => "fs_alpha_film",
-            (false, Targets::Layer) => "fs_main_layer",
-            (true, Targets::Layer) => "fs_alpha_layer",
-            (false, Targets::Coat) => "fs_main_coat",
-            (true, Targets::Coat) => "fs_alpha_coat",
-            (false, Targets::LayerCoat) => "fs_main_layer_coat",
-            (true, Targets::LayerCoat) => "fs_alpha_layer_coat",
-            (false, Targets::FilmSpec) => "fs_main_spec",
-            (true, Targets::FilmSpec) => "fs_alpha_spec",
-            (false, Targets::CoatSpec) => "fs_main_coat_spec",
-            (true, Targets::CoatSpec) => "fs_alpha_coat_spec",
-        };
+        let entry = which.entry(alpha);
         shader::checked(device, "gbuffer pipeline", || {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("gbuffer"),
@@ -283,7 +333,7 @@ fn build(
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module,
-                    entry_point: Some(entry),
+                    entry_point: Some(&entry),
                     compilation_options: Default::default(),
                     targets: &targets,
                 }),
@@ -293,4 +343,54 @@ fn build(
         })
     };
     Ok([[pipeline(false, false)?, pipeline(false, true)?], [pipeline(true, false)?, pipeline(true, true)?]])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every set's generated entry points parse, write one output per format in location order,
+    /// with the scalar kind the format stores (a float output into a float target, `u32` into an
+    /// unsigned one).
+    #[test]
+    fn generated_entry_points_write_each_target_in_order() {
+        let all: Vec<Targets> = Targets::all().collect();
+        assert_eq!(all.len(), 7, "{all:?}");
+        let entry_points: String = all.iter().map(|t| t.wgsl()).collect();
+        let source =
+            [shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl"), &entry_points]
+                .join("\n");
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+        for t in all {
+            let formats = t.formats();
+            for alpha in [false, true] {
+                let name = t.entry(alpha);
+                let ep =
+                    module.entry_points.iter().find(|e| e.name == name).unwrap_or_else(|| panic!("{name}"));
+                let result = ep.function.result.as_ref().expect("an output struct");
+                let naga::TypeInner::Struct { members, .. } = &module.types[result.ty].inner else {
+                    panic!("{name}: not a struct");
+                };
+                assert_eq!(members.len(), formats.len(), "{name}");
+                for (i, (m, format)) in members.iter().zip(&formats).enumerate() {
+                    let location = match m.binding {
+                        Some(naga::Binding::Location { location, .. }) => location,
+                        ref other => panic!("{name} member {i}: {other:?}"),
+                    };
+                    assert_eq!(location, i as u32, "{name} member {i}");
+                    let kind = match module.types[m.ty].inner {
+                        naga::TypeInner::Scalar(s) | naga::TypeInner::Vector { scalar: s, .. } => s.kind,
+                        ref other => panic!("{name} member {i}: {other:?}"),
+                    };
+                    let uint = matches!(format.sample_type(None, None), Some(wgpu::TextureSampleType::Uint));
+                    assert_eq!(
+                        kind == naga::ScalarKind::Uint,
+                        uint,
+                        "{name} member {i}: {kind:?} into {format:?}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -100,109 +100,49 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     return o;
 }
 
-@fragment
-fn fs_main(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
-    return gbuffer(v, front, false);
-}
+// The extra targets' values, each sampled by one function and written by another
+// (passes/gbuffer.rs `Targets::wgsl` generates each set's output struct and entry points, which
+// sample every texture before `gbuffer`'s discard: derivatives need uniform control flow).
 
-@fragment
-fn fs_alpha(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut {
-    return gbuffer(v, front, true);
-}
-
-// Scenes with a thin film (KHR_materials_iridescence) add its per-pixel values, in RGB mode as
-// in the spectral ones.
-struct GBufferFilmOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    // x weight (factor × texture R; 0: no film), y the thickness texture's G: where the thickness
-    // lies between the material's minimum and maximum.
-    @location(3) film: vec2<f32>,
-};
-
-// The film's values (sampled before `gbuffer`, whose discard would leave the derivatives of
-// later samples undefined): weight and thickness fraction.
+// Scenes with a thin film (KHR_materials_iridescence), a coat or a specular write the film's
+// values, in RGB mode as in the spectral ones: x weight (factor × texture R; 0: no film), y the
+// thickness texture's G, where the thickness lies between the material's minimum and maximum.
 fn film_values(v: VertexOut) -> vec2<f32> {
     let weight = textureSampleBias(film_tex, film_smp, material_uv(TEX_FILM, v.uv, v.uv1), frame.lod_bias).r * material.film.x;
     let t = textureSampleBias(film_thickness_tex, film_thickness_smp, material_uv(TEX_FILM_THICKNESS, v.uv, v.uv1), frame.lod_bias).g;
     return vec2<f32>(clamp(weight, 0.0, 1.0), clamp(t, 0.0, 1.0));
 }
 
-fn with_film(o: GBufferOut, f: vec2<f32>) -> GBufferFilmOut {
+fn film_target(o: GBufferOut, f: vec2<f32>) -> vec2<f32> {
     // An unlit surface (UNLIT_MARK) reflects nothing, so it has no film either.
-    let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
-    return GBufferFilmOut(o.base, o.normal, o.emission, film);
+    return select(f, vec2<f32>(0.0), o.base.a < 0.0);
 }
 
-@fragment
-fn fs_main_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmOut {
-    let f = film_values(v);
-    return with_film(gbuffer(v, front, false), f);
-}
-
-@fragment
-fn fs_alpha_film(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmOut {
-    let f = film_values(v);
-    return with_film(gbuffer(v, front, true), f);
-}
-
-// The transmissive layer (passes/gbuffer.rs `Targets::Layer`): the film's values beside the
+// The transmissive layer (passes/gbuffer.rs `Fourth::Layer`): the film's values beside the
 // see-through material's own, packed in one 32-bit target (`layer_values` in the shading pass) —
 // x the transmission factor × its texture's R, y the volume's thickness texture's G (the share of
 // the thickness factor), z and w the film's weight and thickness fraction as `film_values`.
-struct GBufferLayerOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) layer: u32,
-};
-
 fn transmission_values(v: VertexOut) -> vec2<f32> {
     let t = textureSampleBias(transmission_tex, transmission_smp, material_uv(TEX_TRANSMISSION, v.uv, v.uv1), frame.lod_bias).r * material.transmission.x;
     let d = textureSampleBias(volume_thickness_tex, volume_thickness_smp, material_uv(TEX_VOLUME_THICKNESS, v.uv, v.uv1), frame.lod_bias).g;
     return vec2<f32>(clamp(t, 0.0, 1.0), clamp(d, 0.0, 1.0));
 }
 
-fn with_layer(o: GBufferOut, t: vec2<f32>, f: vec2<f32>) -> GBufferLayerOut {
-    let film = select(f, vec2<f32>(0.0), o.base.a < 0.0);
-    return GBufferLayerOut(o.base, o.normal, o.emission, pack4x8unorm(vec4<f32>(t, film)));
+fn layer_target(o: GBufferOut, t: vec2<f32>, f: vec2<f32>) -> u32 {
+    return pack4x8unorm(vec4<f32>(t, film_target(o, f)));
 }
 
-@fragment
-fn fs_main_layer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerOut {
-    let t = transmission_values(v);
-    let f = film_values(v);
-    return with_layer(gbuffer(v, front, false), t, f);
-}
-
-@fragment
-fn fs_alpha_layer(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerOut {
-    let t = transmission_values(v);
-    let f = film_values(v);
-    return with_layer(gbuffer(v, front, true), t, f);
-}
-
-// Scenes with a clear coat (KHR_materials_clearcoat) add its per-pixel values beside the film's
-// (passes/gbuffer.rs `Targets::Coat`): the coat's own normal — its normal map in the vertex
-// tangents' frame, or the interpolated normal (not the base's normal map), as the extension
-// says —, its roughness and its strength, packed as the normal's target is (the strength as a
-// 16-bit fraction where the slot is).
-struct GBufferCoatOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) film: vec2<f32>,
-    @location(4) coat: vec4<u32>,
-};
-
+// Scenes with a clear coat (KHR_materials_clearcoat) add its per-pixel values after the film's
+// or the layer's: the coat's own normal — its normal map in the vertex tangents' frame, or the
+// interpolated normal (not the base's normal map), as the extension says —, its roughness and
+// its strength, packed as the normal's target is (the strength as a 16-bit fraction where the
+// slot is).
 struct CoatSample {
     strength: f32,
     roughness: f32,
     tn: vec3<f32>,
 };
 
-// The coat's textures (sampled before `gbuffer`'s discard, as the film's).
 fn coat_sample(v: VertexOut) -> CoatSample {
     let c = textureSampleBias(coat_tex, coat_smp, material_uv(TEX_COAT, v.uv, v.uv1), frame.lod_bias).r;
     let r = textureSampleBias(coat_rough_tex, coat_rough_smp, material_uv(TEX_COAT_ROUGH, v.uv, v.uv1), frame.lod_bias).g;
@@ -210,67 +150,19 @@ fn coat_sample(v: VertexOut) -> CoatSample {
     return CoatSample(clamp(c * material.coat.x, 0.0, 1.0), clamp(r * material.coat.y, 0.0, 1.0), tn);
 }
 
-fn with_coat(o: GBufferOut, f: vec2<f32>, c: CoatSample, v: VertexOut, front: bool) -> GBufferCoatOut {
+fn coat_target(o: GBufferOut, c: CoatSample, v: VertexOut, front: bool) -> vec4<u32> {
     let side = select(-1.0, 1.0, front);
     var n = normalize(v.normal) * side;
     if (material.coat.w > 0.5 && dot(v.tangent.xyz, v.tangent.xyz) > 0.0) {
         n = normal_mapped(n, v.tangent, side, c.tn, material.coat.z);
     }
-    // An unlit surface (UNLIT_MARK) reflects nothing: no coat, no film.
-    let unlit = o.base.a < 0.0;
-    let strength = select(c.strength, 0.0, unlit);
-    let coat = gbuffer_pack_normal(n, c.roughness, u32(round(strength * 65535.0)));
-    return GBufferCoatOut(o.base, o.normal, o.emission, select(f, vec2<f32>(0.0), unlit), coat);
-}
-
-@fragment
-fn fs_main_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatOut {
-    let f = film_values(v);
-    let c = coat_sample(v);
-    return with_coat(gbuffer(v, front, false), f, c, v, front);
-}
-
-@fragment
-fn fs_alpha_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatOut {
-    let f = film_values(v);
-    let c = coat_sample(v);
-    return with_coat(gbuffer(v, front, true), f, c, v, front);
-}
-
-// The transmissive layer's with a coat (passes/gbuffer.rs `Targets::LayerCoat`): see-through
-// materials under a clear coat.
-struct GBufferLayerCoatOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) layer: u32,
-    @location(4) coat: vec4<u32>,
-};
-
-fn with_layer_coat(o: GBufferOut, t: vec2<f32>, f: vec2<f32>, c: CoatSample, v: VertexOut, front: bool) -> GBufferLayerCoatOut {
-    let l = with_layer(o, t, f);
-    let k = with_coat(o, f, c, v, front);
-    return GBufferLayerCoatOut(l.base, l.normal, l.emission, l.layer, k.coat);
-}
-
-@fragment
-fn fs_main_layer_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerCoatOut {
-    let t = transmission_values(v);
-    let f = film_values(v);
-    let c = coat_sample(v);
-    return with_layer_coat(gbuffer(v, front, false), t, f, c, v, front);
-}
-
-@fragment
-fn fs_alpha_layer_coat(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferLayerCoatOut {
-    let t = transmission_values(v);
-    let f = film_values(v);
-    let c = coat_sample(v);
-    return with_layer_coat(gbuffer(v, front, true), t, f, c, v, front);
+    // An unlit surface (UNLIT_MARK) reflects nothing: no coat.
+    let strength = select(c.strength, 0.0, o.base.a < 0.0);
+    return gbuffer_pack_normal(n, c.roughness, u32(round(strength * 65535.0)));
 }
 
 // Scenes with KHR_materials_specular add its per-pixel values after the film's (and the
-// coat's) targets (passes/gbuffer.rs `Targets::FilmSpec`, `Targets::CoatSpec`): rgb the F0
+// coat's) targets (passes/gbuffer.rs `Targets::specular`): rgb the F0
 // colour min(F0(η)·colour factor·colour texture, 1), a the weight (factor × strength texture's
 // A) — scene::specular. Materials without the extension write the plain dielectric's
 // (F0, F0, F0, 1); unlit surfaces reflect nothing, whatever is written.
@@ -280,61 +172,4 @@ fn specular_values(v: VertexOut) -> vec4<u32> {
     let c = textureSampleBias(specular_color_tex, specular_color_smp, material_uv(TEX_SPECULAR_COLOR, v.uv, v.uv1), frame.lod_bias).rgb;
     let sp = vec4<f32>(min(material.specular.yzw * c, vec3<f32>(1.0)), clamp(material.specular.x * a, 0.0, 1.0));
     return vec4<u32>(round(clamp(sp, vec4<f32>(0.0), vec4<f32>(1.0)) * 65535.0));
-}
-
-struct GBufferFilmSpecOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) film: vec2<f32>,
-    @location(4) specular: vec4<u32>,
-};
-
-fn with_film_spec(o: GBufferOut, f: vec2<f32>, sp: vec4<u32>) -> GBufferFilmSpecOut {
-    let k = with_film(o, f);
-    return GBufferFilmSpecOut(k.base, k.normal, k.emission, k.film, sp);
-}
-
-@fragment
-fn fs_main_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmSpecOut {
-    let f = film_values(v);
-    let sp = specular_values(v);
-    return with_film_spec(gbuffer(v, front, false), f, sp);
-}
-
-@fragment
-fn fs_alpha_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferFilmSpecOut {
-    let f = film_values(v);
-    let sp = specular_values(v);
-    return with_film_spec(gbuffer(v, front, true), f, sp);
-}
-
-struct GBufferCoatSpecOut {
-    @location(0) base: vec4<f32>,
-    @location(1) normal: vec4<u32>,
-    @location(2) emission: vec4<f32>,
-    @location(3) film: vec2<f32>,
-    @location(4) coat: vec4<u32>,
-    @location(5) specular: vec4<u32>,
-};
-
-fn with_coat_spec(o: GBufferOut, f: vec2<f32>, c: CoatSample, sp: vec4<u32>, v: VertexOut, front: bool) -> GBufferCoatSpecOut {
-    let k = with_coat(o, f, c, v, front);
-    return GBufferCoatSpecOut(k.base, k.normal, k.emission, k.film, k.coat, sp);
-}
-
-@fragment
-fn fs_main_coat_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatSpecOut {
-    let f = film_values(v);
-    let c = coat_sample(v);
-    let sp = specular_values(v);
-    return with_coat_spec(gbuffer(v, front, false), f, c, sp, v, front);
-}
-
-@fragment
-fn fs_alpha_coat_spec(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferCoatSpecOut {
-    let f = film_values(v);
-    let c = coat_sample(v);
-    let sp = specular_values(v);
-    return with_coat_spec(gbuffer(v, front, true), f, c, sp, v, front);
 }

@@ -76,7 +76,7 @@ pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
 /// and the layer's target below takes the place of this one beside the other three's 24.
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 /// The transmissive layer's fourth G-buffer target: transmission, volume thickness, and the
-/// film's weight and thickness (`passes::gbuffer::Targets::Layer`), each in [0, 1] and from
+/// film's weight and thickness (`passes::gbuffer::Fourth::Layer`), each in [0, 1] and from
 /// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,
 /// the other three take 24, and WebGPU counts an Rgba8Unorm target as 8.
 pub const GBUFFER_LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
