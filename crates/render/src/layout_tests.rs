@@ -144,7 +144,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             emission_xyz,
             film,
             refraction,
-            absorption
+            absorption,
+            specular
         }),
     );
     check(

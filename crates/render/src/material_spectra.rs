@@ -35,6 +35,9 @@ pub struct MaterialSpectrum {
     pub refraction: [f32; 4],
     /// Its interior's absorption per scene unit, linear RGB (box-upsampled per node); w unused.
     pub absorption: [f32; 4],
+    /// `KHR_materials_specular`'s F0 colour where it is constant ([`ConstantColour::specular`]):
+    /// its coefficients, w = 1; zero where a texture varies it or the material has none.
+    pub specular: [f32; 4],
 }
 
 impl MaterialSpectrum {
@@ -81,7 +84,11 @@ impl MaterialSpectrum {
         }
         let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
         let [refraction, absorption] = refraction;
-        MaterialSpectrum { base, emission, emission_xyz, film, refraction, absorption }
+        let specular = c.specular.map_or([0.0; 4], |rgb| {
+            let [c0, c1, c2] = coeffs(rgb);
+            [c0, c1, c2, 1.0]
+        });
+        MaterialSpectrum { base, emission, emission_xyz, film, refraction, absorption, specular }
     }
 
     /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
@@ -134,6 +141,12 @@ pub fn reflected_stride(n_lights: usize) -> usize {
 /// (w = 0); the last one holds the environment's basis j in lane j of column c = X, Y, Z. A
 /// material whose base colour varies (`record.base[3] == 0`) has zeros: the shader fetches
 /// and loops for it.
+///
+/// Where some record has a constant specular F0 colour (`record.specular[3] == 1`), the same
+/// follows for that colour's reflectance, a second block of `records.len() · stride` entries
+/// in the same layout (at `n_lights · n_groups + (records.len() + record) · stride + k`): a
+/// tinted F0's part of the specular lobe is Σᵢ F0(λᵢ)·Wᵢ times a factor that does not depend on
+/// λ. Scenes without one get no second block.
 pub fn reflected_xyz(
     records: &[MaterialSpectrum],
     lights: &[Vec<[f64; 3]>],
@@ -142,38 +155,45 @@ pub fn reflected_xyz(
 ) -> Vec<GroupWeights> {
     let lights = &lights[..lights.len().min(MAX_LIGHTS)];
     let stride = reflected_stride(lights.len());
-    let mut out = vec![[[0f32; 4]; 3]; records.len() * stride];
-    for (m, rec) in records.iter().enumerate() {
-        if rec.base[3] == 0.0 {
-            continue;
-        }
-        let [c0, c1, c2, _] = rec.base.map(f64::from);
-        let poly = SigmoidPolynomial::new(c0, c1, c2);
-        // At the f32 nodes the shader reads.
-        let rho = |i: usize| poly.eval(f64::from(groups[i / 4].lambda[i % 4]));
-        let integrate = |w: &[[f64; 3]]| {
-            let mut xyz = [0f64; 3];
-            for (i, wi) in w.iter().enumerate() {
-                let r = rho(i);
+    let block = |coeffs: &dyn Fn(&MaterialSpectrum) -> [f32; 4]| {
+        let mut out = vec![[[0f32; 4]; 3]; records.len() * stride];
+        for (m, rec) in records.iter().enumerate() {
+            let [c0, c1, c2, known] = coeffs(rec).map(f64::from);
+            if known == 0.0 {
+                continue;
+            }
+            let poly = SigmoidPolynomial::new(c0, c1, c2);
+            // At the f32 nodes the shader reads.
+            let rho = |i: usize| poly.eval(f64::from(groups[i / 4].lambda[i % 4]));
+            let integrate = |w: &[[f64; 3]]| {
+                let mut xyz = [0f64; 3];
+                for (i, wi) in w.iter().enumerate() {
+                    let r = rho(i);
+                    for c in 0..3 {
+                        xyz[c] += r * wi[c];
+                    }
+                }
+                xyz
+            };
+            let row = &mut out[m * stride..(m + 1) * stride];
+            for (l, w) in lights.iter().enumerate() {
+                let xyz = integrate(w);
                 for c in 0..3 {
-                    xyz[c] += r * wi[c];
+                    row[l / 3][l % 3][c] = xyz[c] as f32;
                 }
             }
-            xyz
-        };
-        let row = &mut out[m * stride..(m + 1) * stride];
-        for (l, w) in lights.iter().enumerate() {
-            let xyz = integrate(w);
-            for c in 0..3 {
-                row[l / 3][l % 3][c] = xyz[c] as f32;
+            for (j, w) in basis.iter().enumerate().take(4) {
+                let xyz = integrate(w);
+                for c in 0..3 {
+                    row[stride - 1][c][j] = xyz[c] as f32;
+                }
             }
         }
-        for (j, w) in basis.iter().enumerate().take(4) {
-            let xyz = integrate(w);
-            for c in 0..3 {
-                row[stride - 1][c][j] = xyz[c] as f32;
-            }
-        }
+        out
+    };
+    let mut out = block(&|r| r.base);
+    if records.iter().any(|r| r.specular[3] != 0.0) {
+        out.extend(block(&|r| r.specular));
     }
     out
 }
@@ -241,5 +261,48 @@ mod tests {
             }
         }
         assert!(out[2 * stride..].iter().all(|e| *e == [[0.0; 4]; 3]));
+    }
+
+    /// A constant specular F0 colour's sums follow every material's base colours' in the same
+    /// layout, at its own record's row; none of it where no record has one.
+    #[test]
+    fn reflected_xyz_appends_the_specular_colours_block() {
+        let lambda = [420.0, 480.0, 560.0, 610.0, 680.0];
+        let g = groups(&lambda);
+        let weights = |k: f64| -> Vec<[f64; 3]> {
+            (0..lambda.len()).map(|i| [k + i as f64, 1.0 + k, 0.25 * i as f64]).collect()
+        };
+        let lights: Vec<_> = (0..4).map(|l| weights(l as f64)).collect();
+        let basis: Vec<_> = (0..2).map(|j| weights(3.0 * j as f64 + 0.5)).collect();
+        let plain = MaterialSpectrum { base: [0.0, 0.0, 0.0, 1.0], ..Default::default() };
+        let tinted = MaterialSpectrum {
+            base: [0.0, 0.0, 0.0, 1.0],
+            specular: [0.0, 0.02, -9.0, 1.0],
+            ..Default::default()
+        };
+        let stride = reflected_stride(4);
+        assert_eq!(reflected_xyz(&[plain, plain], &lights, &basis, &g).len(), 2 * stride);
+        let out = reflected_xyz(&[plain, tinted], &lights, &basis, &g);
+        assert_eq!(out.len(), 4 * stride);
+        // The base colours' block is the one without specular colours.
+        assert_eq!(out[..2 * stride], reflected_xyz(&[plain, plain], &lights, &basis, &g)[..]);
+        let sig = |x: f64| 0.5 + 0.5 * x / (1.0 + x * x).sqrt();
+        let f0 = |l: f64| sig(0.02 * l - 9.0);
+        let close = |a: f32, b: f64| ((f64::from(a) - b) / b.abs().max(1e-6)).abs() < 1e-6;
+        let spec_row = &out[3 * stride..4 * stride];
+        for (l, w) in lights.iter().enumerate() {
+            for c in 0..3 {
+                let e: f64 = lambda.iter().zip(w).map(|(x, wi)| f0(f64::from(*x)) * wi[c]).sum();
+                assert!(close(spec_row[l / 3][l % 3][c], e), "light {l}, channel {c}");
+            }
+        }
+        for (j, w) in basis.iter().enumerate() {
+            for c in 0..3 {
+                let e: f64 = lambda.iter().zip(w).map(|(x, wi)| f0(f64::from(*x)) * wi[c]).sum();
+                assert!(close(spec_row[stride - 1][c][j], e), "basis {j}, channel {c}");
+            }
+        }
+        // The material without one has none.
+        assert!(out[2 * stride..3 * stride].iter().all(|e| *e == [[0.0; 4]; 3]));
     }
 }

@@ -82,7 +82,7 @@ pub struct MaterialUniforms {
     pub film: [f32; 4],
     /// `KHR_materials_transmission`: x the factor (0: opaque; [`transmission`]), which the
     /// transmissive layer's G-buffer writes × the texture's R, beside the volume's thickness
-    /// texture's G and the film's two values (`passes::gbuffer::Targets::Layer`); yzw unused.
+    /// texture's G and the film's two values (`passes::gbuffer::Fourth::Layer`); yzw unused.
     pub transmission: [f32; 4],
     /// `KHR_materials_clearcoat` ([`coat`]): x the strength (0: no coat), y the roughness,
     /// z the coat's normal-map scale, w 1 with a coat normal map; the G-buffer's coat target
@@ -514,6 +514,9 @@ pub struct GpuScene {
 pub struct ConstantColour {
     pub base: Option<[f32; 3]>,
     pub emission: Option<[f32; 3]>,
+    /// `KHR_materials_specular`'s F0 colour min(F0(η)·colour, 1) where it has no colour
+    /// texture (`scene::specular`; the G-buffer's specular target before its 16-bit rounding).
+    pub specular: Option<[f32; 3]>,
 }
 
 impl ConstantColour {
@@ -523,11 +526,16 @@ impl ConstantColour {
             (m.base_color_texture.is_none() && !vertex_coloured).then(|| m.base_color.truncate().to_array());
         if m.unlit {
             // The G-buffer stores an unlit surface's colour as emission and black as its base.
-            return ConstantColour { base: base.map(|_| [0.0; 3]), emission: base };
+            return ConstantColour { base: base.map(|_| [0.0; 3]), emission: base, specular: None };
         }
         // A texture times a zero (or negative) factor emits nothing anywhere.
         let constant_emission = m.emissive_texture.is_none() || m.emissive.max_element() <= 0.0;
-        ConstantColour { base, emission: constant_emission.then(|| m.emissive.to_array()) }
+        // In f32 as `MaterialUniforms::specular` and the G-buffer make it.
+        let f0 = m.dielectric_f0();
+        let specular = specular(m)
+            .filter(|s| s.color_texture.is_none())
+            .map(|s| [s.color.x, s.color.y, s.color.z].map(|c| (f0 * c).min(1.0)));
+        ConstantColour { base, emission: constant_emission.then(|| m.emissive.to_array()), specular }
     }
 }
 

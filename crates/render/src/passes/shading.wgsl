@@ -912,6 +912,8 @@ struct MaterialSpectrum {
     refraction: vec4<f32>,
     // Its interior's absorption per scene unit, linear RGB (a box spectrum per node).
     absorption: vec4<f32>,
+    // KHR_materials_specular's F0 colour where constant: its coefficients, w = 1 (else 0).
+    specular: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
 
@@ -928,6 +930,9 @@ struct SurfaceCoeffs {
     // (`material_spectra::reflected_xyz`): such a pixel needs no node loop for them.
     base_known: bool,
     reflected: u32,
+    // The same for a constant specular F0 colour (KHR_materials_specular): where its block of
+    // reflected XYZs starts, after every material's base colour's; 0 where it is not constant.
+    spec_reflected: u32,
 };
 
 // Entries of the reflected XYZs per material: a column per shaded light, three to an entry,
@@ -946,6 +951,16 @@ fn reflected_env(sc: SurfaceCoeffs, c: vec4<f32>) -> vec3<f32> {
     return c * light_weights[sc.reflected + reflected_stride() - 1u];
 }
 
+// What a constant specular F0 colour reflects under light li and of the environment's
+// coefficients c (`SurfaceCoeffs::spec_reflected` ≠ 0).
+fn reflected_spec_light(sc: SurfaceCoeffs, li: u32) -> vec3<f32> {
+    return light_weights[sc.spec_reflected + li / 3u][li % 3u].xyz;
+}
+
+fn reflected_spec_env(sc: SurfaceCoeffs, c: vec4<f32>) -> vec3<f32> {
+    return c * light_weights[sc.spec_reflected + reflected_stride() - 1u];
+}
+
 // The spectral mode's coefficients at pixel `px`: the material's precomputed ones where its
 // colours are constant, else fetched from the G-buffer's colours. Emission is upsampled with the
 // "illuminant" variant, s·sigmoid(rgb / s)·white(λ) with s = 2·max(rgb), so that an emissive
@@ -955,6 +970,10 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
     let m = material_spectra[index];
     let base_known = !FETCH_BASE || m.base.w != 0.0;
     let reflected = frame.n_lights * frame.n_groups + index * reflected_stride();
+    var spec_reflected = 0u;
+    if (HAS_SPECULAR && m.specular.w != 0.0) {
+        spec_reflected = reflected + arrayLength(&material_spectra) * reflected_stride();
+    }
     var base = m.base.xyz;
     // A constant emission (w = its scale ≥ 0) where the surface is seen from its emitting side.
     let em_seen = emitter_seen(s.emission, m.emission.w);
@@ -976,10 +995,10 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
         emission = select(vec4<f32>(fetched.b, scale), emission, em_known);
     }
     if (!HAS_EMISSION) {
-        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected);
+        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected, spec_reflected);
     }
     let known = m.emission.w >= 0.0;
-    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known && em_seen), base_known, reflected);
+    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known && em_seen), base_known, reflected, spec_reflected);
 }
 
 // Spectral and naive modes.
@@ -1014,7 +1033,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     custom_prepare(ctx);
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
-    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u);
+    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u, 0u);
     if (!NAIVE) {
         sc = surface_coeffs(px, s);
     }
@@ -1026,8 +1045,18 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     var xyz = vec3<f32>(0.0);
     let n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
     var film = load_film(px);
-    film.spec_c = spec_coeffs(film);
-    let filmed = is_filmed(film);
+    // A thin film makes the whole Fresnel term depend on λ: such a pixel goes through the
+    // nodes per light. A tinted specular F0 colour makes only one term of it depend on λ, and
+    // linearly (F0(λ) times a factor): that term has its own sum, read from the CPU's where
+    // the colour is constant (`reflected_spec_light`), else over the colour's nodes.
+    let filmed = HAS_FILM && film.weight > 0.0;
+    let tinted = HAS_SPECULAR && film.tinted;
+    let spec_known = tinted && sc.spec_reflected != 0u;
+    let ng_spec = select(0u, ng, tinted && !spec_known);
+    // A loop of none or one trip, not a branch, which a CPU driver would run for every pixel.
+    for (var i = select(0u, 1u, ng_spec > 0u && !NAIVE); i > 0u; i--) {
+        film.spec_c = fetch_coeffs(film.spec.rgb, frame.table_res);
+    }
     // A varying colour's reflectance at the first four groups (N ≤ 16) once per pixel, in four
     // registers, instead of once per light and group (a sigmoid per node against three selects
     // per group); a filmed pixel has its own loop. Loops, not branches, bound by the group
@@ -1076,6 +1105,21 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         } else {
             var f = factors_of(t, s.metallic, s.f0, s.spec_w);
             f.x += through;
+            if (tinted) {
+                // The dielectric lobe's w·(F0(λ) + (1 − F0(λ))·(1 − v·h)⁵): its F0(λ)·w·(1 − (1 −
+                // v·h)⁵) part on its own, the rest (and the metal's edge) in f.y. The diffuse
+                // keeps what f.x gives it, by the largest channel (s.f0).
+                let fres = pow(1.0 - t.vh, 5.0);
+                f.y = t.ks * fres * ((1.0 - s.metallic) * s.spec_w + s.metallic);
+                var rs = vec3<f32>(0.0);
+                if (spec_known) {
+                    rs = reflected_spec_light(sc, li);
+                }
+                for (var g = 0u; g < ng_spec; g++) {
+                    rs += spec_nodes(film, g) * light_w(li, g, ng);
+                }
+                xyz = fma(vec3<f32>(t.ks * (1.0 - s.metallic) * s.spec_w * (1.0 - fres)), rs, xyz);
+            }
             // The specular part does not depend on the reflectance: the light's XYZ once.
             // A branch, not a select, which would load for every pixel: a textured material's
             // pixels skip the load where the GPU branches per material.
@@ -1115,6 +1159,17 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             }
             et.a *= vis;
             et.b *= vis;
+            if (tinted) {
+                // As per light: the lobe's F0 part by the colour's reflectance, not F0_max.
+                et.f0 *= vis;
+                et.b -= s.f0 * et.f0;
+                if (spec_known) {
+                    xyz += reflected_spec_env(sc, et.f0);
+                }
+                for (var g = 0u; g < ng_spec; g++) {
+                    xyz += spec_nodes(film, g) * env_w(et.f0, g, ng);
+                }
+            }
             xyz += env_xyz(et.b);
         }
         if (HAS_COAT && coat.w > 0.0) {

@@ -47,6 +47,9 @@ fn env_background(d: vec3<f32>) -> vec4<f32> {
 struct EnvTerms {
     a: vec4<f32>,
     b: vec4<f32>,
+    // The part of `b` that the dielectric's F0 multiplies, per unit F0: a tinted specular
+    // colour's reflectance F0(λ) takes it in place of the F0 that `b` was made with.
+    f0: vec4<f32>,
 };
 
 // The environment's two lobes at a surface, before any material weighs them: the irradiance
@@ -96,6 +99,7 @@ fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lam
     let lost = w * fresnel_diffuse(f0, l.nv);
     t.a = (1.0 - metallic) * (1.0 - lost) / PI * keep * l.irr + metallic * l.ab.x * l.spec;
     t.b = ((1.0 - metallic) * f_d + metallic * l.ab.y) * l.spec;
+    t.f0 = (1.0 - metallic) * w * l.ab.x * l.spec;
     return t;
 }
 
