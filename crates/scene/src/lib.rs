@@ -249,6 +249,9 @@ pub struct Material {
     /// ([`specular`]); `None` when absent or at its defaults, and on unlit, filmed and
     /// see-through materials (dropped there with a warning).
     pub specular: Option<specular::Specular>,
+    /// `KHR_materials_sheen`: a layer of fibres over the whole material ([`sheen`]); `None`
+    /// when absent or off (a zero colour factor), and on unlit materials.
+    pub sheen: Option<sheen::Sheen>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
@@ -341,6 +344,7 @@ impl Default for Material {
             transmission: None,
             clearcoat: None,
             specular: None,
+            sheen: None,
         }
     }
 }
