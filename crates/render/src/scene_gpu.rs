@@ -652,6 +652,21 @@ impl GpuScene {
         let emitter_polygons = (area.polygons, area.dropped_power);
         let emitters = area.lights;
         let mut warnings = Vec::new();
+        // The loader reads the sheen for the path tracer; this renderer draws the base alone.
+        let sheened: Vec<String> = s
+            .materials
+            .iter()
+            .filter(|m| m.sheen.is_some() && !m.unlit)
+            .map(|m| format!("'{}'", m.name))
+            .collect();
+        if !sheened.is_empty() {
+            warnings.push(format!(
+                "KHR_materials_sheen is not drawn by the real-time renderer (material{} {}): drawn without its \
+                 sheen; the path tracer (`spectra truth`) draws it",
+                if sheened.len() > 1 { "s" } else { "" },
+                sheened.join(", ")
+            ));
+        }
         let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
