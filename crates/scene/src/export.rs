@@ -246,6 +246,17 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_specular"] = e;
         }
+        if let Some(sh) = &m.sheen {
+            let mut e =
+                json!({ "sheenColorFactor": sh.color.to_array(), "sheenRoughnessFactor": sh.roughness });
+            if let Some(t) = &sh.color_texture {
+                e["sheenColorTexture"] = tex(t);
+            }
+            if let Some(t) = &sh.roughness_texture {
+                e["sheenRoughnessTexture"] = tex(t);
+            }
+            j["extensions"]["KHR_materials_sheen"] = e;
+        }
         if m.ior != 1.5 {
             j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
         }
@@ -406,6 +417,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     }
     if scene.materials.iter().any(|m| m.specular.is_some()) {
         extensions_used.push("KHR_materials_specular");
+    }
+    if scene.materials.iter().any(|m| m.sheen.is_some()) {
+        extensions_used.push("KHR_materials_sheen");
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");

@@ -850,6 +850,9 @@ impl Loader<'_> {
         if let Some(sp) = info("/extensions/KHR_materials_specular") {
             out.specular = self.specular(&at, sp)?;
         }
+        if let Some(sh) = info("/extensions/KHR_materials_sheen") {
+            out.sheen = self.sheen(&at, sh)?;
+        }
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
@@ -921,10 +924,30 @@ impl Loader<'_> {
                 ),
             ));
         }
+        // The sheen extension excludes unlit and specular-glossiness materials. Dropped (after
+        // its values and textures were checked) before the UV sets are gathered, so that a
+        // texture nothing draws asks no TEXCOORD_1 of the meshes.
+        if out.sheen.is_some() {
+            let with = if out.unlit {
+                Some("an unlit material (KHR_materials_unlit), which reflects nothing")
+            } else if info("/extensions/KHR_materials_pbrSpecularGlossiness").is_some() {
+                Some("a specular-glossiness material (KHR_materials_pbrSpecularGlossiness)")
+            } else {
+                None
+            };
+            if let Some(with) = with {
+                self.warnings.push(format!(
+                    "{at} ('{}'): KHR_materials_sheen is ignored on {with}; the extension excludes the two",
+                    out.name
+                ));
+                out.sheen = None;
+            }
+        }
         let cc_tex =
             |f: fn(&crate::clearcoat::Clearcoat) -> Option<TextureRef>| out.clearcoat.as_ref().and_then(f);
         let sp_tex =
             |f: fn(&crate::specular::Specular) -> Option<TextureRef>| out.specular.as_ref().and_then(f);
+        let sh_tex = |f: fn(&crate::sheen::Sheen) -> Option<TextureRef>| out.sheen.as_ref().and_then(f);
         let named = [
             ("pbrMetallicRoughness.baseColorTexture", &out.base_color_texture),
             ("pbrMetallicRoughness.metallicRoughnessTexture", &out.metallic_roughness_texture),
@@ -939,6 +962,8 @@ impl Loader<'_> {
             ("extensions.KHR_materials_clearcoat.clearcoatNormalTexture", &cc_tex(|c| c.normal_texture)),
             ("extensions.KHR_materials_specular.specularTexture", &sp_tex(|s| s.texture)),
             ("extensions.KHR_materials_specular.specularColorTexture", &sp_tex(|s| s.color_texture)),
+            ("extensions.KHR_materials_sheen.sheenColorTexture", &sh_tex(|s| s.color_texture)),
+            ("extensions.KHR_materials_sheen.sheenRoughnessTexture", &sh_tex(|s| s.roughness_texture)),
         ];
         // The coat's normal map is oriented by the same tangents as the base's (the extension
         // asks both to share their UV set); tangents are made for it when the base has none.
@@ -1160,6 +1185,47 @@ impl Loader<'_> {
         let color_texture = self.extension_texture(&at, sp, "specularColorTexture", true)?;
         let s = crate::specular::Specular { factor, texture, color, color_texture };
         Ok((!s.is_default()).then_some(s))
+    }
+
+    /// `KHR_materials_sheen` (`sh` is its JSON), validated: `None` when its colour factor is
+    /// zero (the extension's default), which turns the layer off whatever the textures hold.
+    /// The colour texture is decoded as sRGB colour, the roughness texture (its A channel) as
+    /// data.
+    fn sheen(&mut self, at: &str, sh: &Value) -> Result<Option<crate::sheen::Sheen>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_sheen");
+        let color = match sh.get("sheenColorFactor") {
+            None => Vec3::ZERO,
+            Some(v) => {
+                let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
+                match nums.as_deref() {
+                    Some(&[r, g, b]) if [r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) => {
+                        Vec3::new(r as f32, g as f32, b as f32)
+                    }
+                    _ => {
+                        return Err(self.ctx.invalid(
+                            format!("{at}.sheenColorFactor"),
+                            format!("{v} is not three numbers in [0, 1] (linear RGB)"),
+                        ));
+                    }
+                }
+            }
+        };
+        let roughness = match sh.get("sheenRoughnessFactor") {
+            None => 0.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.sheenRoughnessFactor"),
+                        format!("{v} is not a number in [0, 1]"),
+                    ));
+                }
+            },
+        };
+        let color_texture = self.extension_texture(&at, sh, "sheenColorTexture", true)?;
+        let roughness_texture = self.extension_texture(&at, sh, "sheenRoughnessTexture", false)?;
+        let s = crate::sheen::Sheen { color, color_texture, roughness, roughness_texture };
+        Ok((!s.is_off()).then_some(s))
     }
 
     /// `KHR_materials_transmission` with the material's `KHR_materials_volume` and

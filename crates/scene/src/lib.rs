@@ -250,7 +250,10 @@ pub struct Material {
     /// see-through materials (dropped there with a warning).
     pub specular: Option<specular::Specular>,
     /// `KHR_materials_sheen`: a layer of fibres over the whole material ([`sheen`]); `None`
-    /// when absent or off (a zero colour factor), and on unlit materials.
+    /// when absent or off (a zero `sheenColorFactor`, the extension's default, disables the
+    /// layer whatever its textures hold), and on unlit and specular-glossiness materials, which
+    /// the extension excludes (dropped there with a warning). It may sit with a coat, a
+    /// specular, a transmission or a film.
     pub sheen: Option<sheen::Sheen>,
 }
 

@@ -92,8 +92,8 @@ fn unsupported_geometry_and_structure() {
         &["cameras[0].orthographic", "xmag"],
     );
     expect(
-        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_sheen"])),
-        &["extensionsRequired[0]", "KHR_materials_sheen", "not supported"],
+        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_anisotropy"])),
+        &["extensionsRequired[0]", "KHR_materials_anisotropy", "not supported"],
     );
     expect(
         &mutate(|d| d["materials"][0]["normalTexture"]["texCoord"] = json!(1)),
@@ -121,6 +121,48 @@ fn unsupported_geometry_and_structure() {
         &mutate(|d| d["buffers"][0]["uri"] = json!(uri)),
         &["meshes[0].primitives[0].indices", "index number 0 is out of range", "4 vertices"],
     );
+}
+
+/// `KHR_materials_sheen` is read and checked like the other material extensions: each bad
+/// member is one error naming the file and the field; a good one loads, even when required.
+#[test]
+fn bad_sheen() {
+    let sheen = |v: Value| {
+        mutate(|d| {
+            d["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_materials_sheen"));
+            d["extensionsRequired"] = json!(["KHR_materials_sheen"]);
+            d["materials"][1]["extensions"] = json!({"KHR_materials_sheen": v});
+        })
+    };
+    let good = sheen(json!({"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessTexture": {"index": 0}}));
+    let s = scene::load_slice("good.gltf", good.to_string().as_bytes(), Some(&data(""))).unwrap();
+    assert!(s.materials[1].sheen.is_some(), "{:?}", s.warnings);
+    let at = "materials[1].extensions.KHR_materials_sheen";
+    let cases = [
+        (json!({"sheenColorFactor": [0.5, 1.01, 0.5]}), format!("{at}.sheenColorFactor")),
+        (json!({"sheenColorFactor": [-0.5, 0.5, 0.5]}), format!("{at}.sheenColorFactor")),
+        (json!({"sheenColorFactor": [0.5, 0.5]}), format!("{at}.sheenColorFactor")),
+        (json!({"sheenColorFactor": "white"}), format!("{at}.sheenColorFactor")),
+        (
+            json!({"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 2}),
+            format!("{at}.sheenRoughnessFactor"),
+        ),
+        (
+            json!({"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": null}),
+            format!("{at}.sheenRoughnessFactor"),
+        ),
+        (
+            json!({"sheenColorFactor": [1, 1, 1], "sheenColorTexture": {"index": 3}}),
+            format!("{at}.sheenColorTexture.index"),
+        ),
+        (
+            json!({"sheenColorFactor": [1, 1, 1], "sheenRoughnessTexture": {"index": 0, "texCoord": -1}}),
+            format!("{at}.sheenRoughnessTexture.texCoord"),
+        ),
+    ];
+    for (v, field) in cases {
+        expect(&sheen(v), &[&field]);
+    }
 }
 
 /// Coordinates beyond what single precision renders (the path tracer's hierarchy panicked at

@@ -598,17 +598,22 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     assert_has(&error(&d), &["images[0]: is a KTX2 image", "ktxdecompress"]);
     // A required material extension: refused, naming it.
     let mut d = base.clone();
-    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_sheen"]);
-    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_sheen"]);
+    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_anisotropy"]);
+    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_anisotropy"]);
     // Found by a sweep: an extension used but missing from extensionsUsed was ignored without
     // a warning. Extras are not extensions.
     let mut d = base.clone();
-    d["materials"] = json!([{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}}]);
+    d["materials"] =
+        json!([{"extensions": {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}}]);
     d["asset"]["extras"] = json!({"extensions": {"KHR_materials_anisotropy": {}}});
     d["meshes"][0]["primitives"][0]["material"] = json!(0);
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(s.warnings[0].starts_with("KHR_materials_sheen is not supported"), "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].starts_with("KHR_materials_diffuse_transmission is not supported"),
+        "{:?}",
+        s.warnings
+    );
 }
 
 #[test]
@@ -1291,4 +1296,174 @@ fn specular_is_read_with_its_defaults_and_bad_values_are_named() {
         scene::load_slice("t.gltf", scene::export::to_gltf_json(&s).unwrap().to_string().as_bytes(), None)
             .unwrap();
     assert_eq!(back.materials[0].specular, s.materials[0].specular);
+}
+
+/// `KHR_materials_sheen`: read with its defaults (a zero colour, the default, turns the layer
+/// off: none), the colour texture as sRGB colour and the roughness texture as data, each with
+/// its UV set and transform; bad values named by field; dropped with a warning on unlit and
+/// specular-glossiness materials, which the extension excludes, and kept beside a coat, a
+/// specular, a transmission and a film; survives export.
+#[test]
+fn sheen_is_read_with_its_defaults_and_bad_values_are_named() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], "VEC2");
+    let sh = |x: Value| json!({"extensions": {"KHR_materials_sheen": x}});
+    let prim = |m: usize| json!({"attributes": {"POSITION": pos, "TEXCOORD_0": uv, "TEXCOORD_1": uv}, "material": m});
+    let mut doc = b.finish(json!({
+        "extensionsUsed": ["KHR_materials_sheen", "KHR_texture_transform"],
+        "extensionsRequired": ["KHR_materials_sheen"],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [prim(0), prim(1), prim(2), prim(3), prim(4)]}],
+        "materials": [
+            sh(json!({"sheenColorFactor": [0.5, 0.25, 1.0], "sheenRoughnessFactor": 0.75,
+                      "sheenColorTexture": {"index": 0, "extensions": {"KHR_texture_transform":
+                          {"offset": [0.5, 0.0], "scale": [2.0, 2.0]}}},
+                      "sheenRoughnessTexture": {"index": 0, "texCoord": 1}})),
+            // Only a colour: roughness 0, no textures; an unknown member is ignored.
+            sh(json!({"sheenColorFactor": [1, 1, 1], "sheenTexture": {"index": 0}})),
+            // The defaults: a zero colour, no layer.
+            sh(json!({})),
+            // A zero colour turns the layer off whatever the rest says.
+            sh(json!({"sheenColorFactor": [0, 0, 0], "sheenRoughnessFactor": 1.0,
+                      "sheenColorTexture": {"index": 0}})),
+            // Beside every other layer it may sit with.
+            json!({"extensions": {
+                "KHR_materials_sheen": {"sheenColorFactor": [0.1, 0.2, 0.3], "sheenRoughnessFactor": 0.5},
+                "KHR_materials_clearcoat": {"clearcoatFactor": 1.0},
+                "KHR_materials_specular": {"specularFactor": 0.5},
+                "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                "KHR_materials_iridescence": {"iridescenceFactor": 1.0},
+            }}),
+        ],
+    }));
+    doc["images"] = json!([{"uri": png_uri()}]);
+    doc["textures"] = json!([{"source": 0}]);
+    let s = load(&doc).unwrap();
+    let said = s.warnings.join("\n");
+    assert!(!said.contains("KHR_materials_sheen"), "{said}");
+    let a = s.materials[0].sheen.as_ref().expect("a sheen");
+    assert_eq!((a.color, a.roughness), (Vec3::new(0.5, 0.25, 1.0), 0.75));
+    let (c, r) = (a.color_texture.unwrap(), a.roughness_texture.unwrap());
+    assert!(s.textures[c.index].srgb, "the colour is sRGB");
+    assert!(!s.textures[r.index].srgb, "the roughness (A) is data");
+    assert_ne!(c.index, r.index);
+    assert_eq!(c.tex_coord, 0);
+    assert_eq!(
+        c.transform,
+        Some(TextureTransform { offset: Vec2::new(0.5, 0.0), rotation: 0.0, scale: Vec2::splat(2.0) })
+    );
+    assert_eq!((r.tex_coord, r.transform), (1, None));
+    let d = s.materials[1].sheen.as_ref().expect("a sheen");
+    let white = scene::sheen::Sheen {
+        color: Vec3::ONE,
+        color_texture: None,
+        roughness: 0.0,
+        roughness_texture: None,
+    };
+    assert_eq!(d, &white, "defaults besides the colour");
+    assert!(s.materials[2].sheen.is_none(), "the default colour is zero: no layer");
+    assert!(s.materials[3].sheen.is_none(), "a zero colour turns the layer off");
+    let all = &s.materials[4];
+    assert_eq!(all.sheen.as_ref().map(|x| (x.color, x.roughness)), Some((Vec3::new(0.1, 0.2, 0.3), 0.5)));
+    assert!(all.clearcoat.is_some() && all.transmission.is_some() && all.iridescence.is_some());
+
+    let at = "materials[0].extensions.KHR_materials_sheen";
+    let bad = |key: &str, v: Value, parts: &[&str]| {
+        let mut d = doc.clone();
+        d["materials"][0]["extensions"]["KHR_materials_sheen"][key] = v;
+        assert_has(&error(&d), parts);
+    };
+    let color = format!("{at}.sheenColorFactor");
+    for v in [
+        json!([1.5, 0.5, 0.5]),
+        json!([0.5, -0.1, 0.5]),
+        json!([0.5, 0.5, 1e300]),
+        json!([0.5, 0.5]),
+        json!([0.5, 0.5, 0.5, 1.0]),
+        json!([0.5, f64::NAN, 0.5]),
+        json!([0.5, "0.5", 0.5]),
+        json!("0.5"),
+        json!(0.5),
+    ] {
+        bad("sheenColorFactor", v, &[&color, "three numbers in [0, 1]"]);
+    }
+    let rough = format!("{at}.sheenRoughnessFactor");
+    for v in [json!(1.5), json!(-0.25), json!(f64::NAN), json!("0.5"), json!([0.5])] {
+        bad("sheenRoughnessFactor", v, &[&rough, "[0, 1]"]);
+    }
+    for key in ["sheenColorTexture", "sheenRoughnessTexture"] {
+        bad(key, json!({"index": 7}), &[&format!("{at}.{key}.index"), "no texture"]);
+        bad(key, json!({"index": "0"}), &[&format!("{at}.{key}.index"), "no texture"]);
+        for (v, shown) in [(json!(-1), "-1"), (json!(1.5), "1.5"), (json!("1"), "\"1\""), (json!(2), "2")] {
+            bad(key, json!({"index": 0, "texCoord": v}), &[&format!("{at}.{key}.texCoord"), shown]);
+        }
+        bad(
+            key,
+            json!({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [1]}}}),
+            &[&format!("{at}.{key}.extensions.KHR_texture_transform.scale")],
+        );
+    }
+    // The roughness texture reads TEXCOORD_1: a mesh without one is refused, naming it.
+    let mut d = doc.clone();
+    d["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove("TEXCOORD_1");
+    assert_has(&error(&d), &["meshes[0].primitives[0]", &format!("{at}.sheenRoughnessTexture")]);
+
+    // Excluded: unlit and specular-glossiness materials, with one warning naming the material.
+    for (ext, v, what) in [
+        ("KHR_materials_unlit", json!({}), "unlit"),
+        ("KHR_materials_pbrSpecularGlossiness", json!({"glossinessFactor": 0.5}), "specular-glossiness"),
+    ] {
+        let mut d = doc.clone();
+        d["materials"][1]["name"] = json!("velvet");
+        d["materials"][1]["extensions"][ext] = v;
+        let s = load(&d).unwrap();
+        assert!(s.materials[1].sheen.is_none(), "{ext}");
+        assert!(s.materials[0].sheen.is_some(), "{ext}");
+        let w: Vec<_> = s.warnings.iter().filter(|w| w.contains("KHR_materials_sheen")).collect();
+        assert_eq!(w.len(), 1, "{ext}: {:?}", s.warnings);
+        assert!(
+            w[0].starts_with("materials[1] ('velvet'): KHR_materials_sheen is ignored")
+                && w[0].contains(ext)
+                && w[0].contains(what),
+            "{}",
+            w[0]
+        );
+    }
+    // A sheen that is off loses nothing there: no warning. Nor does a dropped sheen's texture
+    // on TEXCOORD_1 ask the mesh for one.
+    let mut d = doc.clone();
+    d["materials"][2]["extensions"]["KHR_materials_unlit"] = json!({});
+    d["materials"][0]["extensions"]["KHR_materials_unlit"] = json!({});
+    d["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove("TEXCOORD_1");
+    let s = load(&d).unwrap();
+    assert_eq!(
+        s.warnings.iter().filter(|w| w.contains("KHR_materials_sheen")).count(),
+        1,
+        "{:?}",
+        s.warnings
+    );
+    assert!(s.warnings.iter().any(|w| w.starts_with("materials[0] (")), "{:?}", s.warnings);
+
+    // Export: the factors, textures, UV sets and transforms come back as they were.
+    let s = load(&doc).unwrap();
+    let out = scene::export::to_gltf_json(&s).unwrap();
+    let used: Vec<&str> =
+        out["extensionsUsed"].as_array().unwrap().iter().filter_map(Value::as_str).collect();
+    assert!(used.contains(&"KHR_materials_sheen") && used.contains(&"KHR_texture_transform"), "{used:?}");
+    assert!(out["materials"][2]["extensions"].get("KHR_materials_sheen").is_none());
+    let back = scene::load_slice("t.gltf", out.to_string().as_bytes(), None).unwrap();
+    for (i, (m, n)) in s.materials.iter().zip(&back.materials).enumerate() {
+        assert_eq!(m.sheen, n.sheen, "material {i}");
+    }
+    let (bc, br) = {
+        let x = back.materials[0].sheen.as_ref().unwrap();
+        (x.color_texture.unwrap(), x.roughness_texture.unwrap())
+    };
+    assert!(back.textures[bc.index].srgb && !back.textures[br.index].srgb);
+    // A scene without a sheen does not list the extension.
+    let mut plain = s.clone();
+    plain.materials.iter_mut().for_each(|m| m.sheen = None);
+    let out = scene::export::to_gltf_json(&plain).unwrap();
+    assert!(!out["extensionsUsed"].to_string().contains("KHR_materials_sheen"));
 }
