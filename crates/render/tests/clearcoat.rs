@@ -156,12 +156,8 @@ fn a_coat_in_the_furnace_weighs_sky_and_base_by_its_fresnel_term() {
     let mut scene = sphere_scene(material, Environment::uniform(Vec3::ONE), 96);
     let mut r = renderer();
     let mut render_it = |scene: &scene::Scene, mode: Mode, capture: bool| {
-        r.set_scene(scene).unwrap();
-        r.resize(SIZE, SIZE).unwrap();
-        r.set_spectral_capture(capture);
         let s = RenderSettings { mode, wavelengths: 8, shadows: false, ..Default::default() };
-        r.render(&scene.camera, &s).unwrap();
-        r.read_hdr().unwrap()
+        render_frame(&mut r, scene, SIZE, &s, capture)
     };
     for strength in [1.0f32, 0.5] {
         for (mode, capture) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {

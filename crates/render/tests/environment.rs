@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::renderer;
+use common::{render_frame, renderer};
 use glam::{Vec2, Vec3, Vec4};
 use render::{Mode, RenderSettings};
 use scene::{Camera, Environment, Material, Mesh, Scene, SpectralSettings};
@@ -17,11 +17,7 @@ fn sphere_scene(env: Environment) -> Scene {
 const SIZE: u32 = 48;
 
 fn render(scene: &Scene, settings: &RenderSettings) -> Vec<[f32; 4]> {
-    let mut r = renderer();
-    r.set_scene(scene).unwrap();
-    r.resize(SIZE, SIZE).unwrap();
-    r.render(&scene.camera, settings).unwrap();
-    r.read_hdr().unwrap()
+    render_frame(&mut renderer(), scene, SIZE, settings, false)
 }
 
 fn settings(mode: Mode, n: usize) -> RenderSettings {

@@ -184,12 +184,8 @@ fn in_the_furnace_the_weight_scales_and_the_colour_tints_the_reflection() {
     let mut scene = sphere_scene(material, Environment::uniform(Vec3::ONE), 64);
     let mut r = renderer();
     let mut render_it = |scene: &scene::Scene, mode: Mode, capture: bool| {
-        r.set_scene(scene).unwrap();
-        r.resize(SIZE, SIZE).unwrap();
-        r.set_spectral_capture(capture);
         let s = RenderSettings { mode, wavelengths: 8, shadows: false, ..Default::default() };
-        r.render(&scene.camera, &s).unwrap();
-        r.read_hdr().unwrap()
+        render_frame(&mut r, scene, SIZE, &s, capture)
     };
     let spec =
         |factor: f32, color: Vec3| Some(Specular { factor, texture: None, color, color_texture: None });

@@ -29,6 +29,22 @@ pub fn renderer() -> Renderer {
     }
 }
 
+/// One `size`×`size` frame of `scene` through `r` (the scene set and the targets sized anew),
+/// with the spectral capture on or off: the HDR image.
+pub fn render_frame(
+    r: &mut Renderer,
+    scene: &Scene,
+    size: u32,
+    settings: &RenderSettings,
+    capture: bool,
+) -> Vec<[f32; 4]> {
+    r.set_scene(scene).unwrap();
+    r.resize(size, size).unwrap();
+    r.set_spectral_capture(capture);
+    r.render(&scene.camera, settings).unwrap();
+    r.read_hdr().unwrap()
+}
+
 pub fn output_dir() -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/test-output");
     std::fs::create_dir_all(&dir).expect("creating target/test-output");
