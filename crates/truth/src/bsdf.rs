@@ -26,9 +26,19 @@
 //! f = (1 − F_dmax)·c_diff/π + [(1 − m)·F_d + m·F_m]·D·V, c_diff = base·(1 − m). Without it
 //! (`None`) the arithmetic is the plain glTF BRDF's above, unchanged.
 //!
+//! With `KHR_materials_sheen` (`scene::sheen`, [`SheenLanes`]), a layer of fibres over all of
+//! the above: f = sheenColor(λ)·D_c·V_c + s·f_base, D_c·V_c the Charlie lobe
+//! (`scene::sheen::brdf`, white), s = min(1 − c·E(n·v), 1 − c·E(n·l)) the albedo scaling
+//! (`scene::sheen::albedo_scaling`, c the sheen colour's largest RGB channel, E the lobe's
+//! directional albedo from `scene::sheen::albedo`). It scales the whole base — diffuse and
+//! specular, dielectric and metal, film or specular colour included. A clear coat lies over the
+//! sheened base (`crate::coat`). Without it (`None`) the arithmetic is the one above, unchanged.
+//!
 //! Directions are in the local shading frame (normal = +z). Sampling mixes a cosine lobe with
 //! GGX visible-normal sampling (Heitz 2018); the mixture weight is the same for all four
-//! wavelengths, so one pdf serves the whole path.
+//! wavelengths, so one pdf serves the whole path. A sheen adds a third, cosine-weighted choice
+//! (Charlie has no closed-form inversion; the lobe is broad), chosen with a probability
+//! proportional to its albedo estimate ([`Brdf::p_sheen`]).
 
 use crate::sampling::cosine_hemisphere;
 use crate::upsample::RgbToSpectrum;
@@ -51,6 +61,46 @@ pub struct Brdf {
     pub ior: f32,
     /// `KHR_materials_specular`'s weight and F0 colour; `None`: the index's F0 at full weight.
     pub specular: Option<SpecularLanes>,
+    /// `KHR_materials_sheen`'s colour and roughness; `None`: no sheen.
+    pub sheen: Option<SheenLanes>,
+}
+
+/// `KHR_materials_sheen` at a surface point, at the four wavelengths of the lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SheenLanes {
+    /// sheenColor(λ): the sheen colour at each lane's wavelength, in [0, 1].
+    pub color: Vec4,
+    /// c = max3(sheenColor): the largest RGB channel (not the largest lane), what the albedo
+    /// scaling takes from the base.
+    pub max_color: f32,
+    /// The perceptual sheenRoughness (factor × texture A); `scene::sheen`'s functions square it
+    /// and raise α to 0.07 themselves.
+    pub roughness: f32,
+}
+
+impl SheenLanes {
+    /// The sheen colour `rgb` (linear, factor × texture) and roughness `roughness` at
+    /// wavelengths `l`: the colour upsampled as a reflectance exactly as the base colour is
+    /// ([`crate::upsample::reflectance`]), a grey colour the constant itself (no table), as
+    /// [`SpecularLanes::new`] does.
+    pub fn new(rgb: Vec3, roughness: f32, up: &dyn RgbToSpectrum, l: Vec4) -> Self {
+        let color = if rgb.x == rgb.y && rgb.y == rgb.z {
+            Vec4::splat(rgb.x.clamp(0.0, 1.0))
+        } else {
+            crate::upsample::reflectance(up, rgb.to_array(), l)
+        };
+        SheenLanes { color, max_color: rgb.max_element().clamp(0.0, 1.0), roughness }
+    }
+
+    /// E(μ), the white lobe's directional albedo at n·ω = `mu` (the table's lookup).
+    fn albedo(&self, mu: f32) -> f32 {
+        scene::sheen::albedo_f32(mu, self.roughness)
+    }
+
+    /// The base's share s at n·v with albedo `e_v` and n·l = `n_l`.
+    fn scaling(&self, e_v: f32, n_l: f32) -> f32 {
+        scene::sheen::albedo_scaling_f32(self.max_color, e_v, self.albedo(n_l))
+    }
 }
 
 /// `KHR_materials_specular` at a surface point, at the four wavelengths of the lanes.
@@ -107,11 +157,21 @@ impl Brdf {
             film: None,
             ior: 1.5,
             specular: None,
+            sheen: None,
         }
     }
 
     pub fn lambertian(base: Vec4) -> Self {
-        Brdf { base, metallic: 0.0, alpha: 1.0, lambert: true, film: None, ior: 1.5, specular: None }
+        Brdf {
+            base,
+            metallic: 0.0,
+            alpha: 1.0,
+            lambert: true,
+            film: None,
+            ior: 1.5,
+            specular: None,
+            sheen: None,
+        }
     }
 
     /// This BRDF with the dielectric's index `ior` (≥ 1; `scene::Material::ior`).
@@ -130,6 +190,14 @@ impl Brdf {
     /// to change, and a material with a thin film takes none (the loader drops the pair).
     pub fn with_specular(mut self, specular: Option<SpecularLanes>) -> Self {
         self.specular = specular.filter(|_| !self.lambert && self.film.is_none());
+        self
+    }
+
+    /// This BRDF under `KHR_materials_sheen` (`None`: without). A black sheen is none (the
+    /// extension switches the layer off; its scaling would be exactly 1), and Lambert, the
+    /// comparison mode, takes none.
+    pub fn with_sheen(mut self, sheen: Option<SheenLanes>) -> Self {
+        self.sheen = sheen.filter(|s| !self.lambert && s.max_color > 0.0 && s.color != Vec4::ZERO);
         self
     }
 
@@ -199,12 +267,43 @@ impl Brdf {
     /// v·h: the lobe's F, plus (1 − m)·(1 − F_d)·base with F_d the dielectric's term alone; with
     /// a specular, its weighted F0 colour and the F0c_max share), averaged over the lanes:
     /// what the clear coat weighs its sampling probability against.
+    ///
+    /// With a sheen: its lobe's albedo mean(sheenColor)·E(n·v) plus the base's estimate times
+    /// the scaling at n·v, 1 − c·E(n·v) (the largest s can be for this view).
     pub fn albedo_estimate(&self, n_v: f32) -> f32 {
+        let base = self.base_albedo_estimate(n_v);
+        match &self.sheen {
+            None => base,
+            Some(sh) => {
+                let (a_sheen, a_base) = Self::sheen_estimates(sh, n_v, base);
+                a_sheen + a_base
+            }
+        }
+    }
+
+    /// [`Self::albedo_estimate`] without the sheen.
+    fn base_albedo_estimate(&self, n_v: f32) -> f32 {
         if self.lambert {
             return self.base.element_sum() * 0.25;
         }
         let (fs, fd) = self.fresnel_pair(n_v, || self.schlick_pair(n_v));
         (fs + (Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
+    }
+
+    /// (the sheen lobe's albedo, the scaled base's) at n·v, from the base's own estimate.
+    fn sheen_estimates(sh: &SheenLanes, n_v: f32, base: f32) -> (f32, f32) {
+        let e_v = sh.albedo(n_v);
+        (sh.color.element_sum() * 0.25 * e_v, base * sh.scaling(e_v, n_v))
+    }
+
+    /// Probability of sampling the sheen lobe (cosine-weighted) rather than the base: its share
+    /// of [`Self::albedo_estimate`], kept in [0.05, 0.95] so that neither the sheen nor the
+    /// base (a metal's, which has no cosine lobe of its own) goes unsampled. 0 without a sheen.
+    pub fn p_sheen(&self, n_v: f32) -> f32 {
+        let Some(sh) = &self.sheen else { return 0.0 };
+        let (a_sheen, a_base) = Self::sheen_estimates(sh, n_v, self.base_albedo_estimate(n_v));
+        let total = a_sheen + a_base;
+        if total > 0.0 { (a_sheen / total).clamp(0.05, 0.95) } else { 0.5 }
     }
 
     /// Probability of sampling the specular lobe: its share of the Fresnel-weighted albedo
@@ -221,6 +320,18 @@ impl Brdf {
 
     /// f(wo, wi), zero unless both are above the surface.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec4 {
+        let Some(sh) = &self.sheen else { return self.eval_base(wo, wi) };
+        let (n_v, n_l) = (wo.z, wi.z);
+        if n_v <= 0.0 || n_l <= 0.0 {
+            return Vec4::ZERO;
+        }
+        let n_h = (wo + wi).normalize().z;
+        let f_sheen = sh.color * scene::sheen::brdf_f32(n_l, n_v, n_h, sh.roughness);
+        f_sheen + self.eval_base(wo, wi) * sh.scaling(sh.albedo(n_v), n_l)
+    }
+
+    /// f without the sheen: the glTF BRDF (with its film or specular).
+    fn eval_base(&self, wo: Vec3, wi: Vec3) -> Vec4 {
         let (n_v, n_l) = (wo.z, wi.z);
         if n_v <= 0.0 || n_l <= 0.0 {
             return Vec4::ZERO;
@@ -235,8 +346,21 @@ impl Brdf {
         diffuse + fs * (self.d(h.z) * self.vis(n_l, n_v))
     }
 
-    /// The pdf [`Self::sample`] draws `wi` with.
+    /// The pdf [`Self::sample`] draws `wi` with: with a sheen, p·cos θ_i/π + (1 − p)·pdf_base,
+    /// p = [`Self::p_sheen`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.sheen.is_none() {
+            return self.pdf_base(wo, wi);
+        }
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let p = self.p_sheen(wo.z);
+        p * wi.z * FRAC_1_PI + (1.0 - p) * self.pdf_base(wo, wi)
+    }
+
+    /// The pdf the base (diffuse and specular lobes) draws `wi` with.
+    fn pdf_base(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (n_v, n_l) = (wo.z, wi.z);
         if n_v <= 0.0 || n_l <= 0.0 {
             return 0.0;
@@ -252,6 +376,17 @@ impl Brdf {
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BrdfSample> {
         if wo.z <= 0.0 {
             return None;
+        }
+        let mut u_lobe = u_lobe;
+        if self.sheen.is_some() {
+            // The sheen with probability p, the base with the rest of `u_lobe` rescaled.
+            let p = self.p_sheen(wo.z);
+            if u_lobe < p {
+                let wi = cosine_hemisphere(u);
+                let pdf = self.pdf(wo, wi);
+                return (pdf > 0.0).then(|| BrdfSample { wi, f: self.eval(wo, wi), pdf });
+            }
+            u_lobe = ((u_lobe - p) / (1.0 - p)).min(1.0 - f32::EPSILON);
         }
         let wi = if u_lobe < self.p_spec(wo.z) {
             let h = self.sample_visible_normal(wo, u);

@@ -4,7 +4,7 @@
 //! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
 use crate::accel::Hit;
-use crate::bsdf::{Brdf, FilmLanes, SpecularLanes};
+use crate::bsdf::{Brdf, FilmLanes, SheenLanes, SpecularLanes};
 use crate::camera::CameraRay;
 use crate::coat::Coat;
 use crate::dielectric::Dielectric;
@@ -437,7 +437,13 @@ impl Integrator<'_, '_> {
             } else {
                 let specular = material::specular(mat, &w.scene.textures, &s.tc)
                     .map(|(weight, f0)| SpecularLanes::new(weight, f0, w.upsampler, l));
-                Brdf::new(base, metallic, roughness).with_ior(mat.ior).with_film(film).with_specular(specular)
+                let sheen = material::sheen(mat, &w.scene.textures, &s.tc)
+                    .map(|(color, roughness)| SheenLanes::new(color, roughness, w.upsampler, l));
+                Brdf::new(base, metallic, roughness)
+                    .with_ior(mat.ior)
+                    .with_film(film)
+                    .with_specular(specular)
+                    .with_sheen(sheen)
             };
             let frame = Frame::from_normal(ns);
             let glass =
@@ -589,3 +595,7 @@ mod coat_tests;
 #[cfg(test)]
 #[path = "specular_tests.rs"]
 mod specular_tests;
+
+#[cfg(test)]
+#[path = "sheen_tests.rs"]
+mod sheen_tests;

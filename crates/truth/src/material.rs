@@ -223,6 +223,22 @@ pub fn specular(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(f
     Some((sp.weight_at(a), scene::specular::f0_color(f0, sp.color_at(rgb))))
 }
 
+/// `KHR_materials_sheen` at a surface point: the sheen colour (factor × the colour texture's
+/// RGB, sRGB-decoded as the other colour textures are) and the perceptual sheen roughness
+/// (factor × the roughness texture's A), both read as the specular's textures are
+/// (`scene::sheen::Sheen::{color_at, roughness_at}`); `None` without one, where the layer is
+/// off (a zero colour factor, or a colour that is black at this point) or on an unlit material.
+pub fn sheen(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(Vec3, f32)> {
+    let sh = m.sheen.as_ref().filter(|s| !m.unlit && !s.is_off())?;
+    let rgb = tex(textures, &sh.color_texture, tc).map(|(t, uv)| texture::sample(t, uv).truncate());
+    let color = sh.color_at(rgb);
+    if color.max_element() <= 0.0 {
+        return None;
+    }
+    let a = tex(textures, &sh.roughness_texture, tc).map(|(t, uv)| texture::sample(t, uv).w);
+    Some((color, sh.roughness_at(a)))
+}
+
 /// The coat's normal: its own normal map in the base's tangent frame, or `n` (the interpolated
 /// normal, not the base's normal map) without one.
 pub fn coat_normal(
