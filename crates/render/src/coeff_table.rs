@@ -50,7 +50,8 @@ impl GpuCoeffTable {
 
     /// What the shader's `coeff_scale` holds: the brightness levels (`res`), the chroma nodes
     /// (`res`), the chroma weight's [`CHROMA_WARP`] and [`CHROMA_WARP_SLOPE`], then each axis's
-    /// interval index ([`interval_index`], [`AXIS_INDEX`] entries: brightness, then chroma), so
+    /// interval index ([`interval_index`], [`AXIS_INDEX`] entries: brightness, then chroma),
+    /// then the sheen's albedo table (`scene::sheen::AlbedoTable`, μ fastest), so
     /// the WGSL fetch takes the table's grids and the weight's constants from the CPU side and
     /// cannot drift from `CoeffTable::fetch`.
     ///
@@ -63,6 +64,9 @@ impl GpuCoeffTable {
         v.extend_from_slice(&[CHROMA_WARP, CHROMA_WARP_SLOPE]);
         v.extend(interval_index(&table.scale).into_iter().map(|i| i as f32));
         v.extend(interval_index(&table.chroma).into_iter().map(|i| i as f32));
+        // Last, `KHR_materials_sheen`'s directional-albedo table (wgsl/sheen.wgsl
+        // `sheen_albedo`, found from the end), so that both renderers read scene::sheen's values.
+        v.extend(scene::sheen::albedo_table().values_f32());
         v
     }
 }

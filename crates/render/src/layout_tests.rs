@@ -145,7 +145,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             film,
             refraction,
             absorption,
-            specular
+            specular,
+            sheen
         }),
     );
     check(
@@ -183,7 +184,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             film,
             transmission,
             coat,
-            specular
+            specular,
+            sheen
         }),
     );
     let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);

@@ -38,6 +38,9 @@ pub struct MaterialSpectrum {
     /// `KHR_materials_specular`'s F0 colour where it is constant ([`ConstantColour::specular`]):
     /// its coefficients, w = 1; zero where a texture varies it or the material has none.
     pub specular: [f32; 4],
+    /// `KHR_materials_sheen`'s colour where it is constant ([`ConstantColour::sheen`]): its
+    /// coefficients, w = 1; zero where a texture varies it or the material has none.
+    pub sheen: [f32; 4],
 }
 
 impl MaterialSpectrum {
@@ -84,11 +87,14 @@ impl MaterialSpectrum {
         }
         let emission_xyz = [xyz[0] as f32, xyz[1] as f32, xyz[2] as f32, 0.0];
         let [refraction, absorption] = refraction;
-        let specular = c.specular.map_or([0.0; 4], |rgb| {
-            let [c0, c1, c2] = coeffs(rgb);
-            [c0, c1, c2, 1.0]
-        });
-        MaterialSpectrum { base, emission, emission_xyz, film, refraction, absorption, specular }
+        let known = |rgb: Option<[f32; 3]>| {
+            rgb.map_or([0.0; 4], |rgb| {
+                let [c0, c1, c2] = coeffs(rgb);
+                [c0, c1, c2, 1.0]
+            })
+        };
+        let (specular, sheen) = (known(c.specular), known(c.sheen));
+        MaterialSpectrum { base, emission, emission_xyz, film, refraction, absorption, specular, sheen }
     }
 
     /// The records of a scene's materials at the frame's node groups (one zero record for a scene without any: a storage
@@ -146,7 +152,9 @@ pub fn reflected_stride(n_lights: usize) -> usize {
 /// follows for that colour's reflectance, a second block of `records.len() · stride` entries
 /// in the same layout (at `n_lights · n_groups + (records.len() + record) · stride + k`): a
 /// tinted F0's part of the specular lobe is Σᵢ F0(λᵢ)·Wᵢ times a factor that does not depend on
-/// λ. Scenes without one get no second block.
+/// λ. Where some record has a constant sheen colour (`record.sheen[3] == 1`), a third block
+/// for it (after the second, which is then there even if zero): the sheen lobe is its colour
+/// times a factor too. Scenes without either get neither block.
 pub fn reflected_xyz(
     records: &[MaterialSpectrum],
     lights: &[Vec<[f64; 3]>],
@@ -192,8 +200,12 @@ pub fn reflected_xyz(
         out
     };
     let mut out = block(&|r| r.base);
-    if records.iter().any(|r| r.specular[3] != 0.0) {
+    let sheen = records.iter().any(|r| r.sheen[3] != 0.0);
+    if sheen || records.iter().any(|r| r.specular[3] != 0.0) {
         out.extend(block(&|r| r.specular));
+    }
+    if sheen {
+        out.extend(block(&|r| r.sheen));
     }
     out
 }
@@ -304,5 +316,15 @@ mod tests {
         }
         // The material without one has none.
         assert!(out[2 * stride..3 * stride].iter().all(|e| *e == [[0.0; 4]; 3]));
+        // A constant sheen colour's block comes third, after a specular block (zero here).
+        let sheened = MaterialSpectrum {
+            base: [0.0, 0.0, 0.0, 1.0],
+            sheen: [0.0, 0.02, -9.0, 1.0],
+            ..Default::default()
+        };
+        let out = reflected_xyz(&[plain, sheened], &lights, &basis, &g);
+        assert_eq!(out.len(), 6 * stride);
+        assert!(out[2 * stride..4 * stride].iter().all(|e| *e == [[0.0; 4]; 3]));
+        assert_eq!(out[5 * stride..6 * stride], spec_row[..]);
     }
 }

@@ -868,6 +868,7 @@ impl Renderer {
             coat: scene.has_coat,
             ior: scene.has_ior,
             specular: scene.has_specular,
+            sheen: scene.has_sheen,
             transmission: false,
             thin_walls: scene.has_thin_walls,
             dispersion: scene.has_dispersion,
@@ -888,8 +889,10 @@ impl Renderer {
             let layer_variant = Variant {
                 film: scene.has_transmission_film,
                 coat: scene.has_transmission_coat,
-                // The loader keeps no specular on see-through materials.
+                // The loader keeps no specular on see-through materials, and this renderer
+                // draws no sheen there.
                 specular: false,
+                sheen: false,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -912,12 +915,14 @@ impl Renderer {
             fourth: if filmed { GBufferFourth::Film } else { GBufferFourth::None },
             coat: scene.has_coat,
             specular: scene.has_specular,
+            sheen: scene.has_sheen,
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         let layer_targets = GBufferTargets {
             fourth: GBufferFourth::Layer,
             coat: scene.has_transmission_coat,
             specular: false,
+            sheen: false,
         };
         if layered {
             self.gbuffer.prepare(&self.gpu.device, layer_targets)?;
@@ -932,14 +937,19 @@ impl Renderer {
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
-        let (film, coat, spec) =
-            (&targets.gbuffer_film_view, &targets.gbuffer_coat_view, &targets.gbuffer_specular_view);
+        let (film, coat, spec, sheen) = (
+            &targets.gbuffer_film_view,
+            &targets.gbuffer_coat_view,
+            &targets.gbuffer_specular_view,
+            &targets.gbuffer_sheen_view,
+        );
         // (The transmissive layer's targets are its own, below.)
         let colour: Vec<&wgpu::TextureView> = [&g[0], &g[1], &g[2]]
             .into_iter()
             .chain(filmed.then_some(film))
             .chain(gbuffer_targets.coat.then_some(coat))
             .chain(gbuffer_targets.specular.then_some(spec))
+            .chain(gbuffer_targets.sheen.then_some(sheen))
             .collect();
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };
         self.gbuffer.record(

@@ -51,9 +51,10 @@ impl Vertex {
     }
 }
 
-/// Texture slots of a material, in binding order (textures at bindings 1..=14, their samplers
-/// at 15..=28; the order of `TEX_*` in `wgsl/material.wgsl`).
-pub const TEXTURE_SLOTS: usize = 14;
+/// Texture slots of a material, in binding order (textures at bindings 1..=16, their samplers
+/// at 17..=32; the order of `TEX_*` in `wgsl/material.wgsl`). Sixteen: WebGPU's guaranteed
+/// sampled textures and samplers per stage, which the G-buffer's fragment stage uses up.
+pub const TEXTURE_SLOTS: usize = 16;
 
 /// `MaterialUniforms` in `wgsl/material.wgsl` (checked by `layout_tests`).
 #[repr(C)]
@@ -92,6 +93,10 @@ pub struct MaterialUniforms {
     /// the G-buffer's specular target holds min(yzw × the colour texture, 1) and x × the
     /// strength texture's A. (1, F0, F0, F0) without: the plain dielectric.
     pub specular: [f32; 4],
+    /// `KHR_materials_sheen` ([`sheen`]): rgb the colour factor, w the roughness factor; the
+    /// G-buffer's specular-and-sheen target holds them × the colour texture's RGB and the
+    /// roughness texture's A. Zero without (no sheen).
+    pub sheen: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -138,6 +143,7 @@ impl MaterialUniforms {
                 let (w, c) = specular(m).map_or((1.0, glam::Vec3::ONE), |s| (s.factor, s.color));
                 [w, f0 * c.x, f0 * c.y, f0 * c.z]
             },
+            sheen: sheen(m).map_or([0.0; 4], |sh| sh.color.extend(sh.roughness).to_array()),
         }
     }
 }
@@ -153,6 +159,13 @@ pub fn transmission(m: &scene::Material) -> Option<&scene::transmission::Transmi
 /// see-through (the transmissive layer's G-buffer then writes its coat target too).
 pub fn coat(m: &scene::Material) -> Option<&scene::clearcoat::Clearcoat> {
     m.clearcoat.as_ref().filter(|c| !m.unlit && c.factor > 0.0)
+}
+
+/// The material's sheen as the real-time renderer draws it: on lit, opaque materials (the
+/// transmissive layer's G-buffer has no room for it; such a material is drawn without, and the
+/// upload says so).
+pub fn sheen(m: &scene::Material) -> Option<&scene::sheen::Sheen> {
+    m.sheen.as_ref().filter(|s| !m.unlit && transmission(m).is_none() && !s.is_off())
 }
 
 /// The material's specular strength and colour as the real-time renderer draws them: the
@@ -184,11 +197,13 @@ pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] 
         c.and_then(|c| c.normal_texture),
         specular(m).and_then(|s| s.texture),
         specular(m).and_then(|s| s.color_texture),
+        sheen(m).and_then(|s| s.color_texture),
+        sheen(m).and_then(|s| s.roughness_texture),
     ]
 }
 
 /// The material bind group's layout (group 1 of the G-buffer and shadow passes): uniforms at
-/// 0, the fourteen textures at 1..=14 and their samplers at 15..=28.
+/// 0, the sixteen textures at 1..=16 and their samplers at 17..=32.
 pub fn material_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::FRAGMENT;
     let mut entries = vec![crate::passes::uniform_entry(0, visibility)];
@@ -481,6 +496,9 @@ pub struct GpuScene {
     /// Whether some opaque material has a specular strength or colour ([`specular`]): only then
     /// do the G-buffer and shading passes carry its target and code.
     pub has_specular: bool,
+    /// Whether some opaque material has a sheen ([`sheen`]): only then does the G-buffer write
+    /// it and the shading pass compile it (`HAS_SHEEN`).
+    pub has_sheen: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -517,6 +535,8 @@ pub struct ConstantColour {
     /// `KHR_materials_specular`'s F0 colour min(F0(η)·colour, 1) where it has no colour
     /// texture (`scene::specular`; the G-buffer's specular target before its 16-bit rounding).
     pub specular: Option<[f32; 3]>,
+    /// `KHR_materials_sheen`'s colour where it has no colour texture.
+    pub sheen: Option<[f32; 3]>,
 }
 
 impl ConstantColour {
@@ -526,7 +546,12 @@ impl ConstantColour {
             (m.base_color_texture.is_none() && !vertex_coloured).then(|| m.base_color.truncate().to_array());
         if m.unlit {
             // The G-buffer stores an unlit surface's colour as emission and black as its base.
-            return ConstantColour { base: base.map(|_| [0.0; 3]), emission: base, specular: None };
+            return ConstantColour {
+                base: base.map(|_| [0.0; 3]),
+                emission: base,
+                specular: None,
+                sheen: None,
+            };
         }
         // A texture times a zero (or negative) factor emits nothing anywhere.
         let constant_emission = m.emissive_texture.is_none() || m.emissive.max_element() <= 0.0;
@@ -535,7 +560,8 @@ impl ConstantColour {
         let specular = specular(m)
             .filter(|s| s.color_texture.is_none())
             .map(|s| [s.color.x, s.color.y, s.color.z].map(|c| (f0 * c).min(1.0)));
-        ConstantColour { base, emission: constant_emission.then(|| m.emissive.to_array()), specular }
+        let sheen = sheen(m).filter(|s| s.color_texture.is_none()).map(|s| s.color.to_array());
+        ConstantColour { base, emission: constant_emission.then(|| m.emissive.to_array()), specular, sheen }
     }
 }
 
@@ -652,17 +678,19 @@ impl GpuScene {
         let emitter_polygons = (area.polygons, area.dropped_power);
         let emitters = area.lights;
         let mut warnings = Vec::new();
-        // The loader reads the sheen for the path tracer; this renderer draws the base alone.
+        // A see-through material's sheen has no room in the transmissive layer's G-buffer.
         let sheened: Vec<String> = s
             .materials
             .iter()
-            .filter(|m| m.sheen.is_some() && !m.unlit)
+            .filter(|m| {
+                m.sheen.as_ref().is_some_and(|sh| !sh.is_off()) && !m.unlit && transmission(m).is_some()
+            })
             .map(|m| format!("'{}'", m.name))
             .collect();
         if !sheened.is_empty() {
             warnings.push(format!(
-                "KHR_materials_sheen is not drawn by the real-time renderer (material{} {}): drawn without its \
-                 sheen; the path tracer (`spectra truth`) draws it",
+                "KHR_materials_sheen on a see-through material is not drawn by the real-time renderer \
+                 (material{} {}): drawn without its sheen; the path tracer (`spectra truth`) draws it",
                 if sheened.len() > 1 { "s" } else { "" },
                 sheened.join(", ")
             ));
@@ -701,7 +729,9 @@ impl GpuScene {
                 contents: bytemuck::bytes_of(&u),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
-            let fallback = [
+            // Per slot, what a material without the texture reads (typed: a slot added without
+            // its fallback does not compile).
+            let fallback: [&wgpu::TextureView; TEXTURE_SLOTS] = [
                 &defaults.white_srgb,
                 &defaults.white_linear,
                 &defaults.flat_normal,
@@ -716,6 +746,8 @@ impl GpuScene {
                 &defaults.flat_normal,
                 &defaults.white_linear,
                 &defaults.white_srgb,
+                &defaults.white_srgb,
+                &defaults.white_linear,
             ];
             let views: Vec<wgpu::TextureView> = refs
                 .iter()
@@ -798,6 +830,7 @@ impl GpuScene {
             has_transmission_coat: s.materials.iter().any(|m| coat(m).is_some() && transmission(m).is_some()),
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
             has_specular: s.materials.iter().any(|m| specular(m).is_some()),
+            has_sheen: s.materials.iter().any(|m| sheen(m).is_some()),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s
                 .materials

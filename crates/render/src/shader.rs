@@ -13,6 +13,8 @@ pub(crate) const HASH: &str = include_str!("wgsl/hash.wgsl");
 pub(crate) const MATERIAL: &str = include_str!("wgsl/material.wgsl");
 /// Thin-film interference: `scene::film` in WGSL, and the RGB mode's Belcour–Barla film.
 pub(crate) const FILM: &str = include_str!("wgsl/film.wgsl");
+/// `KHR_materials_sheen` (shading pass).
+pub(crate) const SHEEN: &str = include_str!("wgsl/sheen.wgsl");
 
 /// Concatenates `parts` and compiles them, turning validation errors into a [`RenderError`]
 /// instead of wgpu's default panic (custom shaders come from users).

@@ -45,6 +45,9 @@ pub struct Targets {
     /// `KHR_materials_specular`).
     pub gbuffer_specular: wgpu::Texture,
     pub gbuffer_specular_view: wgpu::TextureView,
+    /// The sheen per pixel (written only for scenes with `KHR_materials_sheen`).
+    pub gbuffer_sheen: wgpu::Texture,
+    pub gbuffer_sheen_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
     /// The ambient light's screen-space occlusion (`passes::occlusion`), written only in frames
@@ -83,6 +86,8 @@ impl Targets {
         let (gbuffer_coat, gbuffer_coat_view) = make("gbuffer coat", GBUFFER_COAT_FORMAT, none);
         let (gbuffer_specular, gbuffer_specular_view) =
             make("gbuffer specular", crate::passes::GBUFFER_SPECULAR_FORMAT, none);
+        let (gbuffer_sheen, gbuffer_sheen_view) =
+            make("gbuffer sheen", crate::passes::GBUFFER_SHEEN_FORMAT, none);
         let (depth, depth_view) = make("depth", DEPTH_FORMAT, none);
         // Written by the occlusion pass in its compute stage, like the HDR targets below.
         let storage = wgpu::TextureUsages::STORAGE_BINDING;
@@ -103,6 +108,8 @@ impl Targets {
             gbuffer_coat_view,
             gbuffer_specular,
             gbuffer_specular_view,
+            gbuffer_sheen,
+            gbuffer_sheen_view,
             depth,
             depth_view,
             occlusion,

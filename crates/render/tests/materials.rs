@@ -82,31 +82,3 @@ fn textured_and_normal_mapped_patch_matches_cpu_brdf() {
     // The tilt towards the light must matter (≈ 1/cos 45°), or the test proves nothing.
     assert!(flat_ratio.iter().all(|&k| k > 1.3), "normal map barely changes shading: {:?}", &flat_ratio[..3]);
 }
-
-/// A sheen (KHR_materials_sheen, which the path tracer draws) is not drawn here: the upload says
-/// so, naming the material, and the frame is the one without it.
-#[test]
-fn a_sheen_is_reported_as_not_drawn() {
-    let chart = Chart { colours: vec![[0.5, 0.4, 0.3]], cols: 1, rows: 1, gap: 0.0 };
-    let plain = chart.scene(white_light(2.0, None), 0.7, 0.0);
-    let mut sheened = plain.clone();
-    sheened.materials[0].name = "velvet".into();
-    sheened.materials[0].sheen = Some(scene::sheen::Sheen {
-        color: Vec3::new(1.0, 0.3, 0.1),
-        color_texture: None,
-        roughness: 0.8,
-        roughness_texture: None,
-    });
-    let mut r = renderer();
-    r.set_scene(&plain).unwrap();
-    assert!(r.scene_warnings().is_empty(), "{:?}", r.scene_warnings());
-    r.resize(W, H).unwrap();
-    let settings = RenderSettings { mode: Mode::Spectral, ..Default::default() };
-    r.render(&plain.camera, &settings).unwrap();
-    let without = r.read_hdr().unwrap();
-    r.set_scene(&sheened).unwrap();
-    let w = r.scene_warnings();
-    assert!(w.len() == 1 && w[0].contains("KHR_materials_sheen") && w[0].contains("'velvet'"), "{w:?}");
-    r.render(&sheened.camera, &settings).unwrap();
-    assert!(r.read_hdr().unwrap() == without);
-}

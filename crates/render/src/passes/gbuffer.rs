@@ -14,8 +14,8 @@
 //! ([`Targets::wgsl`]) around gbuffer.wgsl's one function per target.
 
 use super::{
-    GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SPECULAR_FORMAT,
-    SharedLayouts,
+    GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SHEEN_FORMAT,
+    GBUFFER_SPECULAR_FORMAT, SharedLayouts,
 };
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
@@ -62,28 +62,37 @@ pub enum Fourth {
 }
 
 /// Which targets a G-buffer pass writes, in location order: base, normal (with the slot),
-/// emission, then the [`Fourth`], the clear coat's ([`GBUFFER_COAT_FORMAT`]) and the specular
-/// strength and colour ([`GBUFFER_SPECULAR_FORMAT`], `KHR_materials_specular`).
+/// emission, then the [`Fourth`], the clear coat's ([`GBUFFER_COAT_FORMAT`]), the specular
+/// strength and colour ([`GBUFFER_SPECULAR_FORMAT`], `KHR_materials_specular`) and the sheen
+/// ([`GBUFFER_SHEEN_FORMAT`], `KHR_materials_sheen`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Targets {
     pub fourth: Fourth,
     pub coat: bool,
     pub specular: bool,
+    pub sheen: bool,
 }
 
 impl Targets {
-    pub const PLAIN: Targets = Targets { fourth: Fourth::None, coat: false, specular: false };
+    pub const PLAIN: Targets = Targets { fourth: Fourth::None, coat: false, specular: false, sheen: false };
 
     /// Every set the renderer draws with: a coat comes with the film's or the layer's target
-    /// (which the shading pass reads beside it), a specular with the film's (the loader keeps
-    /// none on see-through materials).
+    /// (which the shading pass reads beside it), a specular with the film's (the loader keeps no
+    /// specular on see-through materials), a sheen anywhere but the see-through layer's (the
+    /// real-time renderer draws no sheen there).
     pub fn all() -> impl Iterator<Item = Targets> {
         [Fourth::None, Fourth::Film, Fourth::Layer].into_iter().flat_map(|fourth| {
-            [(false, false), (true, false), (false, true), (true, true)]
-                .into_iter()
-                .map(move |(coat, specular)| Targets { fourth, coat, specular })
+            (0..8u8)
+                .map(move |bits| Targets {
+                    fourth,
+                    coat: bits & 1 != 0,
+                    specular: bits & 2 != 0,
+                    sheen: bits & 4 != 0,
+                })
                 .filter(|t| {
-                    (!t.coat || t.fourth != Fourth::None) && (!t.specular || t.fourth == Fourth::Film)
+                    (!t.coat || t.fourth != Fourth::None)
+                        && (!t.specular || t.fourth == Fourth::Film)
+                        && (!t.sheen || t.fourth != Fourth::Layer)
                 })
         })
     }
@@ -102,22 +111,31 @@ impl Targets {
         if self.specular {
             f.push(GBUFFER_SPECULAR_FORMAT);
         }
+        if self.sheen {
+            f.push(GBUFFER_SHEEN_FORMAT);
+        }
         f
     }
 
-    /// The bytes a pixel's targets take past WebGPU's guaranteed 32, and what needs them.
-    fn bytes_needed(self) -> Option<(u32, &'static str)> {
-        match (self.coat, self.specular) {
-            (true, true) => Some((
-                super::COAT_SPECULAR_TARGET_BYTES,
-                "a clear coat and a specular colour (KHR_materials_clearcoat, KHR_materials_specular)",
-            )),
-            (false, true) => {
-                Some((super::SPECULAR_TARGET_BYTES, "a specular colour (KHR_materials_specular)"))
-            }
-            (true, false) => Some((super::COAT_TARGET_BYTES, "a clear coat (KHR_materials_clearcoat)")),
-            (false, false) => None,
+    /// The bytes a pixel's targets take where it is past WebGPU's guaranteed 32 (the device
+    /// asks for what the adapter allows), and the extensions that need them.
+    fn bytes_needed(self) -> Option<(u32, String)> {
+        // Base, normal and emission; the film's or the layer's 4.
+        let mut bytes = 8 + 8 + 8 + if self.fourth == Fourth::None { 0 } else { 4 };
+        let mut what = Vec::new();
+        if self.coat {
+            bytes += 8;
+            what.push("a clear coat (KHR_materials_clearcoat)");
         }
+        if self.specular {
+            bytes += 8;
+            what.push("a specular colour (KHR_materials_specular)");
+        }
+        if self.sheen {
+            bytes += super::SHEEN_TARGET_BYTES;
+            what.push("a sheen (KHR_materials_sheen)");
+        }
+        (bytes > 32).then(|| (bytes, what.join(" and ")))
     }
 
     fn name(self) -> String {
@@ -127,9 +145,10 @@ impl Targets {
             Fourth::Layer => "layer",
         };
         format!(
-            "{fourth}{}{}",
+            "{fourth}{}{}{}",
             if self.coat { "_coat" } else { "" },
-            if self.specular { "_spec" } else { "" }
+            if self.specular { "_spec" } else { "" },
+            if self.sheen { "_sheen" } else { "" }
         )
     }
 
@@ -173,6 +192,11 @@ impl Targets {
             fields.push(format!("@location({}) specular: vec4<u32>", fields.len()));
             samples.push("let sp = specular_values(v);");
             writes.push("r.specular = sp;");
+        }
+        if self.sheen {
+            fields.push(format!("@location({}) sheen: vec4<f32>", fields.len()));
+            samples.push("let sh = sheen_values(v);");
+            writes.push("r.sheen = sheen_target(o, sh);");
         }
         let mut out = format!("struct GBufferOut_{name} {{\n    {},\n}};\n", fields.join(",\n    "));
         for alpha in [false, true] {
@@ -355,7 +379,7 @@ mod tests {
     #[test]
     fn generated_entry_points_write_each_target_in_order() {
         let all: Vec<Targets> = Targets::all().collect();
-        assert_eq!(all.len(), 7, "{all:?}");
+        assert_eq!(all.len(), 12, "{all:?}");
         let entry_points: String = all.iter().map(|t| t.wgsl()).collect();
         let source =
             [shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl"), &entry_points]
@@ -364,6 +388,11 @@ mod tests {
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
         for t in all {
             let formats = t.formats();
+            let bytes: u32 = formats.iter().map(|f| f.target_pixel_byte_cost().unwrap()).sum();
+            match t.bytes_needed() {
+                Some((need, _)) => assert_eq!(need, bytes, "{t:?}"),
+                None => assert!(bytes <= 32, "{t:?}: {bytes}"),
+            }
             for alpha in [false, true] {
                 let name = t.entry(alpha);
                 let ep =

@@ -173,3 +173,17 @@ fn specular_values(v: VertexOut) -> vec4<u32> {
     let sp = vec4<f32>(min(material.specular.yzw * c, vec3<f32>(1.0)), clamp(material.specular.x * a, 0.0, 1.0));
     return vec4<u32>(round(clamp(sp, vec4<f32>(0.0), vec4<f32>(1.0)) * 65535.0));
 }
+
+// Scenes with KHR_materials_sheen add it after every other target (passes/gbuffer.rs
+// `Targets::sheen`): rgb the colour (factor × colour texture, sRGB-decoded), a the roughness
+// (factor × roughness texture's A) — scene::sheen. Materials without one write a zero colour.
+fn sheen_values(v: VertexOut) -> vec4<f32> {
+    let c = textureSampleBias(sheen_color_tex, sheen_color_smp, material_uv(TEX_SHEEN_COLOR, v.uv, v.uv1), frame.lod_bias).rgb;
+    let r = textureSampleBias(sheen_rough_tex, sheen_rough_smp, material_uv(TEX_SHEEN_ROUGH, v.uv, v.uv1), frame.lod_bias).a;
+    return clamp(vec4<f32>(material.sheen.rgb * c, material.sheen.w * r), vec4<f32>(0.0), vec4<f32>(1.0));
+}
+
+fn sheen_target(o: GBufferOut, sh: vec4<f32>) -> vec4<f32> {
+    // An unlit surface (UNLIT_MARK) reflects nothing: no sheen.
+    return select(sh, vec4<f32>(0.0), o.base.a < 0.0);
+}

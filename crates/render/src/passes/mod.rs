@@ -97,6 +97,13 @@ pub const GBUFFER_SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg
 /// the coat's too (past WebGPU's guaranteed 32, as the coat's).
 pub const SPECULAR_TARGET_BYTES: u32 = 8 + 8 + 8 + 4 + 8;
 pub const COAT_SPECULAR_TARGET_BYTES: u32 = COAT_TARGET_BYTES + 8;
+/// `KHR_materials_sheen` per pixel (written only when the scene has it, after every other
+/// target): rgb the sheen colour (linear), a its roughness (`scene::sheen`). Float: the shading
+/// pass reads it where the see-through layer's background is bound (`sheen_at`), which a sheen
+/// never needs (the real-time renderer draws no sheen on see-through materials).
+pub const GBUFFER_SHEEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Bytes a pixel of the G-buffer targets with the sheen's: 8 more than without it.
+pub const SHEEN_TARGET_BYTES: u32 = 8;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The camera's depth where nothing is drawn, what its depth targets are cleared to: depth is
 /// reversed (1 near, 0 far; [`crate::renderer::projection`]), so a nearer surface has the

@@ -149,6 +149,9 @@ pub struct Variant {
     /// Some material has a specular strength or colour (`HAS_SPECULAR`,
     /// `KHR_materials_specular`): the G-buffer's specular target is read (all modes).
     pub specular: bool,
+    /// Some opaque material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`): the G-buffer's
+    /// sheen target is read and each light's sheen lobe added (all modes).
+    pub sheen: bool,
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
     /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
     pub transmission: bool,
@@ -182,6 +185,7 @@ impl Variant {
         coat: true,
         ior: true,
         specular: true,
+        sheen: true,
         transmission: false,
         thin_walls: true,
         dispersion: true,
@@ -190,9 +194,9 @@ impl Variant {
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, emission, film, ior, specular, transmission, thin walls, dispersion) and the occlusion's; its
+    /// environment, emission, film, ior, specular, sheen, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 17] {
+    fn constants(&self) -> [(&'static str, f64); 18] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -207,6 +211,7 @@ impl Variant {
             ("HAS_COAT", b(self.coat)),
             ("HAS_IOR", b(self.ior)),
             ("HAS_SPECULAR", b(self.specular)),
+            ("HAS_SHEEN", b(self.sheen)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
             ("HAS_DISPERSION", b(self.dispersion)),
@@ -227,6 +232,7 @@ impl Variant {
             coat: self.coat,
             ior: self.ior,
             specular: self.specular,
+            sheen: self.sheen,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
             dispersion: self.dispersion,
@@ -238,13 +244,14 @@ impl Variant {
 
 /// The shading module's parts in order, with `hooks` the custom shader as assembled
 /// ([`CustomShader::assembled`]); `layout_tests` parses the same.
-pub(crate) fn sources(hooks: &str) -> [&str; 10] {
+pub(crate) fn sources(hooks: &str) -> [&str; 11] {
     [
         shader::COMMON,
         shader::HASH,
         shader::SPECTRAL,
         shader::ENVIRONMENT,
         shader::FILM,
+        shader::SHEEN,
         shader::CUSTOM_API,
         hooks,
         include_str!("shading.wgsl"),
@@ -549,9 +556,9 @@ impl ShadingPass {
                 buffer_entry(7, capture),
                 view_entry(8, &t.gbuffer_coat_view),
                 view_entry(9, &t.gbuffer_film_view),
-                // Not read outside the transmissive layer: any textures of their kinds the pass
-                // does not write.
-                view_entry(10, &t.ldr_view),
+                // The sheen (`sheen_at`; the transmissive layer's background there). Not read
+                // outside the transmissive layer: any texture of its kind the pass does not write.
+                view_entry(10, &t.gbuffer_sheen_view),
                 // The occlusion pass's output (`aux_map`, read with `OCCLUSION_MAP`).
                 view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),

@@ -36,6 +36,34 @@ override HAS_COAT: bool = true;
 // A material with a specular strength or colour (KHR_materials_specular): the G-buffer's
 // specular target is read (every mode); a tinted F0 takes the film's per-node path.
 override HAS_SPECULAR: bool = true;
+// A material with a sheen (KHR_materials_sheen, wgsl/sheen.wgsl): the G-buffer's sheen target is
+// read and each light's sheen lobe added, the base scaled by what the sheen leaves (every mode).
+override HAS_SHEEN: bool = true;
+
+// The sheen at a pixel (gbuffer.wgsl; bound where the see-through layer has its background,
+// which a sheen never needs): rgb the colour, a the roughness (scene::sheen).
+fn sheen_at(px: vec2<i32>) -> vec4<f32> {
+    return textureLoad(background, px, 0);
+}
+
+// The pixel's sheen, seen from v: none without sheens in the scene, on unlit surfaces and in
+// the Lambert-only comparison mode.
+fn load_sheen(px: vec2<i32>, s: GSurface, v: vec3<f32>) -> SheenSurface {
+    if (!HAS_SHEEN || s.unlit || lambert_only()) {
+        return no_sheen();
+    }
+    let t = sheen_at(px);
+    return sheen_surface(t.rgb, t.a, s.normal, v);
+}
+
+// The unit direction from p towards light li (an emissive polygon's centroid: the sheen's
+// lobe and share are taken there, the light's irradiance from the polygon's exact form).
+fn light_dir(li: u32, p: vec3<f32>) -> vec3<f32> {
+    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
+        return normalize(polygon_centroid(li) - p);
+    }
+    return light_incidence(li, p).xyz;
+}
 
 fn shading_env() -> bool {
     return HAS_ENV && env_enabled();
@@ -552,6 +580,11 @@ fn spec_nodes(f: FilmSurface, g: u32) -> vec4<f32> {
     return node_reflectance(f.spec_c, f.spec.rgb, g);
 }
 
+// The sheen colour's reflectance at group g's nodes, made as the base colour's is.
+fn sheen_nodes(sh: SheenSurface, g: u32) -> vec4<f32> {
+    return node_reflectance(sh.coeffs, sh.color, g);
+}
+
 // The spectral modes' coefficients of a tinted specular colour (fetched per pixel: the colour
 // may come from a texture).
 fn spec_coeffs(f: FilmSurface) -> vec3<f32> {
@@ -716,6 +749,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         // What the coat reflects, per unit w.
         var sum_c = vec3<f32>(0.0);
         coat = load_coat(px, -ctx.view_dir, s.unlit);
+        let sh = load_sheen(px, s, -ctx.view_dir);
+        // What the sheen reflects, per unit colour.
+        var sum_sheen = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lit; li++) {
             var e = lights[li].rgb.rgb;
@@ -726,6 +762,13 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
+            if (HAS_SHEEN && sh.on) {
+                // The sheen's lobe, and the base under it scaled by what it leaves.
+                let q = sheen_light(sh, s.normal, -ctx.view_dir, light_dir(li, ctx.world_pos), t.kd);
+                t.kd *= q.y;
+                t.ks *= q.y;
+                sum_sheen = fma(vec3<f32>(q.x), e, sum_sheen);
+            }
             if (HAS_COAT) {
                 sum_c = fma(vec3<f32>(t.kc * k), e, sum_c);
             }
@@ -749,6 +792,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             }
         }
         rgb = fma(s.base, sum_a, sum_b);
+        if (HAS_SHEEN) {
+            rgb = fma(sh.color, sum_sheen, rgb);
+        }
         if (HAS_EMISSION) {
             // Without emission in the scene, and without ambient light (whose occlusion shares
             // the texel), the emission target is not read.
@@ -795,6 +841,10 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             }
             let vis = ambient_visibility(in.pos.xy, ctx.world_pos, s);
             var env_rgb = (s.base * et.a.rgb + et.b.rgb) * vis;
+            if (HAS_SHEEN && sh.on) {
+                let q = sheen_env(sh);
+                env_rgb = env_rgb * q.x + sh.color * (q.y * vis) * env_irradiance_at(s.normal).rgb;
+            }
             var coat_env = vec3<f32>(0.0);
             if (HAS_COAT && coat.w > 0.0) {
                 coat_env = env_coat(coat, -ctx.view_dir).rgb * vis;
@@ -914,6 +964,8 @@ struct MaterialSpectrum {
     absorption: vec4<f32>,
     // KHR_materials_specular's F0 colour where constant: its coefficients, w = 1 (else 0).
     specular: vec4<f32>,
+    // KHR_materials_sheen's colour where constant: its coefficients, w = 1 (else 0).
+    sheen: vec4<f32>,
 };
 @group(2) @binding(11) var<storage, read> material_spectra: array<MaterialSpectrum>;
 
@@ -933,6 +985,8 @@ struct SurfaceCoeffs {
     // The same for a constant specular F0 colour (KHR_materials_specular): where its block of
     // reflected XYZs starts, after every material's base colour's; 0 where it is not constant.
     spec_reflected: u32,
+    // And for a constant sheen colour (KHR_materials_sheen), after the specular's block.
+    sheen_reflected: u32,
 };
 
 // Entries of the reflected XYZs per material: a column per shaded light, three to an entry,
@@ -961,6 +1015,15 @@ fn reflected_spec_env(sc: SurfaceCoeffs, c: vec4<f32>) -> vec3<f32> {
     return c * light_weights[sc.spec_reflected + reflected_stride() - 1u];
 }
 
+// The same for a constant sheen colour (`SurfaceCoeffs::sheen_reflected` ≠ 0).
+fn reflected_sheen_light(sc: SurfaceCoeffs, li: u32) -> vec3<f32> {
+    return light_weights[sc.sheen_reflected + li / 3u][li % 3u].xyz;
+}
+
+fn reflected_sheen_env(sc: SurfaceCoeffs, c: vec4<f32>) -> vec3<f32> {
+    return c * light_weights[sc.sheen_reflected + reflected_stride() - 1u];
+}
+
 // The spectral mode's coefficients at pixel `px`: the material's precomputed ones where its
 // colours are constant, else fetched from the G-buffer's colours. Emission is upsampled with the
 // "illuminant" variant, s·sigmoid(rgb / s)·white(λ) with s = 2·max(rgb), so that an emissive
@@ -973,6 +1036,10 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
     var spec_reflected = 0u;
     if (HAS_SPECULAR && m.specular.w != 0.0) {
         spec_reflected = reflected + arrayLength(&material_spectra) * reflected_stride();
+    }
+    var sheen_reflected = 0u;
+    if (HAS_SHEEN && m.sheen.w != 0.0) {
+        sheen_reflected = reflected + 2u * arrayLength(&material_spectra) * reflected_stride();
     }
     var base = m.base.xyz;
     // A constant emission (w = its scale ≥ 0) where the surface is seen from its emitting side.
@@ -995,10 +1062,10 @@ fn surface_coeffs(px: vec2<i32>, s: GSurface) -> SurfaceCoeffs {
         emission = select(vec4<f32>(fetched.b, scale), emission, em_known);
     }
     if (!HAS_EMISSION) {
-        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected, spec_reflected);
+        return SurfaceCoeffs(base, vec4<f32>(0.0), true, vec3<f32>(0.0), base_known, reflected, spec_reflected, sheen_reflected);
     }
     let known = m.emission.w >= 0.0;
-    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known && em_seen), base_known, reflected, spec_reflected);
+    return SurfaceCoeffs(base, emission, known, select(vec3<f32>(0.0), m.emission_xyz.xyz, known && em_seen), base_known, reflected, spec_reflected, sheen_reflected);
 }
 
 // Spectral and naive modes.
@@ -1033,7 +1100,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     custom_prepare(ctx);
     let v = -ctx.view_dir;
     let ng = frame.n_groups;
-    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u, 0u);
+    var sc = SurfaceCoeffs(vec3<f32>(0.0), vec4<f32>(0.0), false, vec3<f32>(0.0), false, 0u, 0u, 0u);
     if (!NAIVE) {
         sc = surface_coeffs(px, s);
     }
@@ -1050,12 +1117,20 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     // linearly (F0(λ) times a factor): that term has its own sum, read from the CPU's where
     // the colour is constant (`reflected_spec_light`), else over the colour's nodes.
     let filmed = HAS_FILM && film.weight > 0.0;
-    let tinted = HAS_SPECULAR && film.tinted;
-    let spec_known = tinted && sc.spec_reflected != 0u;
-    let ng_spec = select(0u, ng, tinted && !spec_known);
-    // A loop of none or one trip, not a branch, which a CPU driver would run for every pixel.
-    for (var i = select(0u, 1u, ng_spec > 0u && !NAIVE); i > 0u; i--) {
-        film.spec_c = fetch_coeffs(film.spec.rgb, frame.table_res);
+    // Each extension's set-up under its constant as a whole: a scene without it compiles none of
+    // it (measured: left to the conditions' constants, lavapipe kept 5 % of the shading pass of
+    // scenes without either).
+    var tinted = false;
+    var spec_known = false;
+    var ng_spec = 0u;
+    if (HAS_SPECULAR) {
+        tinted = film.tinted;
+        spec_known = tinted && sc.spec_reflected != 0u;
+        ng_spec = select(0u, ng, tinted && !spec_known);
+        // A loop of none or one trip, not a branch, which a CPU driver would run for every pixel.
+        for (var i = select(0u, 1u, ng_spec > 0u && !NAIVE); i > 0u; i--) {
+            film.spec_c = fetch_coeffs(film.spec.rgb, frame.table_res);
+        }
     }
     // A varying colour's reflectance at the first four groups (N ≤ 16) once per pixel, in four
     // registers, instead of once per light and group (a sigmoid per node against three selects
@@ -1080,6 +1155,19 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     }
     let keep = 1.0 - tr.weight;
     let coat = load_coat(px, v, s.unlit);
+    // The sheen's colour is a reflectance too (its lobe is the colour times a factor): summed
+    // per light from the CPU's XYZs where constant, else over its nodes (fetched once).
+    var sh = no_sheen();
+    var ng_sheen = 0u;
+    var sheen_known = false;
+    if (HAS_SHEEN) {
+        sh = load_sheen(px, s, v);
+        sheen_known = sh.on && sc.sheen_reflected != 0u;
+        ng_sheen = select(0u, ng, sh.on && !sheen_known);
+        for (var i = select(0u, 1u, ng_sheen > 0u && !NAIVE); i > 0u; i--) {
+            sh.coeffs = fetch_coeffs(sh.color, frame.table_res);
+        }
+    }
     // What the coat reflects, per unit w: each light's XYZ once (it does not depend on ρ).
     var coat_xyz = vec3<f32>(0.0);
     for (var li = 0u; li < n_lights; li++) {
@@ -1087,6 +1175,19 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         let k = custom_light_surface(li, ctx);
         t.kd *= k;
         t.ks *= k;
+        if (HAS_SHEEN && sh.on) {
+            let q = sheen_light(sh, s.normal, v, light_dir(li, p), t.kd);
+            t.kd *= q.y;
+            t.ks *= q.y;
+            var rs = vec3<f32>(0.0);
+            if (sheen_known) {
+                rs = reflected_sheen_light(sc, li);
+            }
+            for (var g = 0u; g < ng_sheen; g++) {
+                rs += sheen_nodes(sh, g) * light_w(li, g, ng);
+            }
+            xyz = fma(vec3<f32>(q.x), rs, xyz);
+        }
         if (HAS_COAT) {
             coat_xyz = fma(vec3<f32>(t.kc * k), lights[li].xyz.xyz, coat_xyz);
         }
@@ -1105,7 +1206,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         } else {
             var f = factors_of(t, s.metallic, s.f0, s.spec_w);
             f.x += through;
-            if (tinted) {
+            if (HAS_SPECULAR && tinted) {
                 // The dielectric lobe's w·(F0(λ) + (1 − F0(λ))·(1 − v·h)⁵): its F0(λ)·w·(1 − (1 −
                 // v·h)⁵) part on its own, the rest (and the metal's edge) in f.y. The diffuse
                 // keeps what f.x gives it, by the largest channel (s.f0).
@@ -1151,6 +1252,11 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             // A see-through surface's diffuse layer is what its transmission leaves.
             lobes.irr *= vis * keep;
             lobes.spec *= vis;
+            if (HAS_SHEEN && sh.on) {
+                let q = sheen_env(sh);
+                lobes.irr *= q.x;
+                lobes.spec *= q.x;
+            }
         } else {
             if (HAS_TRANSMISSION) {
                 et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
@@ -1159,7 +1265,13 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             }
             et.a *= vis;
             et.b *= vis;
-            if (tinted) {
+            if (HAS_SHEEN && sh.on) {
+                let q = sheen_env(sh);
+                et.a *= q.x;
+                et.b *= q.x;
+                et.f0 *= q.x;
+            }
+            if (HAS_SPECULAR && tinted) {
                 // As per light: the lobe's F0 part by the colour's reflectance, not F0_max.
                 et.f0 *= vis;
                 et.b -= s.f0 * et.f0;
@@ -1174,6 +1286,16 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         }
         if (HAS_COAT && coat.w > 0.0) {
             coat_xyz += env_xyz(env_coat(coat, v)) * vis;
+        }
+        if (HAS_SHEEN && sh.on) {
+            // The sheen's reflection of the irradiance, E(n·v)/π of it per unit colour.
+            let c = env_irradiance_at(s.normal) * (sheen_env(sh).y * vis);
+            if (sheen_known) {
+                xyz += reflected_sheen_env(sc, c);
+            }
+            for (var g = 0u; g < ng_sheen; g++) {
+                xyz += sheen_nodes(sh, g) * env_w(c, g, ng);
+            }
         }
     }
     let lobe = diffuse_lobe(s) * vis;
@@ -1222,25 +1344,34 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
 
 // One light at a pixel for the general loop: its terms, what multiplies ρ (`a`, with a thin
 // wall's light from behind) and what does not (`b`); a filmed pixel uses the terms (and `a`
-// for the light from behind) instead.
+// for the light from behind) instead. `sheen`: what multiplies the sheen colour's reflectance.
 struct NodeLight {
     t: LightTerms,
     a: f32,
     b: f32,
+    sheen: f32,
 };
 
 // Under a coat (`Coat`), what lies beneath is scaled by 1 − w and the coat's lobe, which does
 // not depend on ρ, joins `b` (a filmed pixel's `b` is the coat's alone).
-fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat) -> NodeLight {
+fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat, sh: SheenSurface) -> NodeLight {
     var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness, c);
     let k = custom_light_surface(li, ctx);
     t.kd *= k;
     t.ks *= k;
+    var sheen = 0.0;
+    if (HAS_SHEEN && sh.on) {
+        let q = sheen_light(sh, s.normal, -ctx.view_dir, light_dir(li, p), t.kd);
+        t.kd *= q.y;
+        t.ks *= q.y;
+        sheen = q.x;
+    }
     var coat_b = 0.0;
     if (HAS_COAT && c.w > 0.0) {
         t.kd *= 1.0 - c.w;
         t.ks *= 1.0 - c.w;
         coat_b = t.kc * k * c.w;
+        sheen *= 1.0 - c.w;
     }
     var through = 0.0;
     if (HAS_TRANSMISSION) {
@@ -1248,14 +1379,14 @@ fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Trans
         through = thin_transmission(li, p, s, -ctx.view_dir, tr) * k * (1.0 - c.w);
     }
     if (filmed) {
-        return NodeLight(t, through, coat_b);
+        return NodeLight(t, through, coat_b, sheen);
     }
     let f = factors_of(t, s.metallic, s.f0, s.spec_w);
     var a = f.x;
     if (HAS_TRANSMISSION) {
         a += through;
     }
-    return NodeLight(t, a, f.y + coat_b);
+    return NodeLight(t, a, f.y + coat_b, sheen);
 }
 
 // Light `li`'s part of group g in weighted form, into the general loop's accumulators.
@@ -1316,10 +1447,21 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var coat = no_coat();
     var under = 1.0;
     var coat_env = vec4<f32>(0.0);
+    // The sheen (KHR_materials_sheen): per light what its colour's reflectance multiplies in
+    // `fsh`, the environment's in `sheen_env_c`, both under the coat.
+    var sh = no_sheen();
+    var fsh: array<f32, MAX_LIGHTS>;
+    var sheen_env_c = vec4<f32>(0.0);
     if (!background) {
         s = load_surface(px);
         coat = load_coat(px, -ctx.view_dir, s.unlit);
         under = 1.0 - coat.w;
+        if (HAS_SHEEN) {
+            sh = load_sheen(px, s, -ctx.view_dir);
+            if (sh.on && !NAIVE) {
+                sh.coeffs = fetch_coeffs(sh.color, frame.table_res);
+            }
+        }
         // A measured emission goes through its own node weights; its RGB is not upsampled.
         me = measured_emission(px, s.emission);
         if (me.on) {
@@ -1351,6 +1493,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                     lobes.irr *= under;
                     lobes.spec *= under;
                 }
+                if (HAS_SHEEN && sh.on) {
+                    let q = sheen_env(sh).x;
+                    lobes.irr *= q;
+                    lobes.spec *= q;
+                }
             } else {
                 if (HAS_TRANSMISSION) {
                     et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
@@ -1363,9 +1510,17 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                     et.a *= under;
                     et.b *= under;
                 }
+                if (HAS_SHEEN && sh.on) {
+                    let q = sheen_env(sh).x;
+                    et.a *= q;
+                    et.b *= q;
+                }
             }
             if (HAS_COAT && coat.w > 0.0) {
                 coat_env = env_coat(coat, -ctx.view_dir) * (vis * coat.w);
+            }
+            if (HAS_SHEEN && sh.on) {
+                sheen_env_c = env_irradiance_at(s.normal) * (sheen_env(sh).y * vis * under);
             }
         }
         base = s.base;
@@ -1378,10 +1533,13 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     if (!background) {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat);
+            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat, sh);
             ft[li] = nl.t;
             fa[li] = nl.a;
             fb[li] = nl.b;
+            if (HAS_SHEEN) {
+                fsh[li] = nl.sheen;
+            }
         }
     }
     let filmed = is_filmed(film);
@@ -1444,8 +1602,28 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         // A filmed pixel's reflection, all of it (it is not a multiple of ρ).
         var acc_f = zero;
         for (var li = 0u; li < n_lights; li++) {
-            let nl = NodeLight(ft[li], fa[li], fb[li]);
+            let nl = NodeLight(ft[li], fa[li], fb[li], 0.0);
             add_node_light(&acc_a, &acc_b, &acc_f, nl, li, g, lambda, rho, film, metallic, ctx);
+        }
+        // The sheen's lobe under every light and the environment, times its colour's reflectance.
+        var acc_s = zero;
+        var s_nodes = vec4<f32>(0.0);
+        if (HAS_SHEEN && sh.on) {
+            s_nodes = sheen_nodes(sh, g);
+            for (var li = 0u; li < n_lights; li++) {
+                var w = light_w(li, g, ng);
+                if (CUSTOM_LIGHT_T) {
+                    w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
+                }
+                acc_s += w * fsh[li];
+            }
+            if (has_env) {
+                var ws = env_w(sheen_env_c, g, ng);
+                if (CUSTOM_ENV_T) {
+                    ws = s3_scale(ws, custom_env_transmittance(lambda, g, ctx));
+                }
+                acc_s += ws;
+            }
         }
         if (has_env && !background) {
             if (filmed) {
@@ -1479,6 +1657,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         }
         // This group's whole radiance in weighted form.
         var part = s3_scale(acc_a, rho) + acc_b;
+        if (HAS_SHEEN) {
+            part += s3_scale(acc_s, s_nodes);
+        }
         if (filmed) {
             part += acc_f;
         }
@@ -1499,6 +1680,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         } else {
             // The specular terms are in xyz already (a filmed pixel has them in acc_f).
             xyz += rho * acc_a;
+            if (HAS_SHEEN) {
+                xyz += s_nodes * acc_s;
+            }
             if (filmed) {
                 xyz += s3_xyz(acc_f);
             }

@@ -75,6 +75,14 @@ fn env_lobes(n: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
     return l;
 }
 
+// The irradiance coefficients at normal n (`EnvLobes::irr` alone).
+fn env_irradiance_at(n: vec3<f32>) -> vec4<f32> {
+    if (!env_enabled()) {
+        return vec4<f32>(0.0);
+    }
+    return textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * env.params.z;
+}
+
 fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, w: f32) -> EnvTerms {
     return env_terms_keep(n, v, metallic, roughness, lambert, f0, 1.0, w);
 }

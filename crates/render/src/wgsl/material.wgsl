@@ -1,4 +1,4 @@
-// A material (bind group 1 of the G-buffer and shadow passes): factors, fourteen textures each
+// A material (bind group 1 of the G-buffer and shadow passes): factors, sixteen textures each
 // with its own sampler, UV set and KHR_texture_transform, and the alpha mode. Prepended to
 // passes/gbuffer.wgsl and passes/shadow.wgsl.
 
@@ -14,7 +14,7 @@ struct MaterialUniforms {
     alpha: vec4<f32>,
     // Per texture slot (TEX_*), two rows of its UV transform: (m00, m01, m02, UV set),
     // (m10, m11, m12, 0); uv' = M · (u, v, 1).
-    uv_rows: array<vec4<f32>, 28>,
+    uv_rows: array<vec4<f32>, 32>,
     // x: the material's index + 1 (`MaterialUniforms::slot`), written by the G-buffer beside the normal.
     slot: vec4<u32>,
     // KHR_materials_iridescence: x factor (0: none), y film index, z/w thickness min/max (nm).
@@ -27,6 +27,8 @@ struct MaterialUniforms {
     // KHR_materials_specular: x the weight, yzw F0(η) × the colour factor; (1, F0, F0, F0)
     // without.
     specular: vec4<f32>,
+    // KHR_materials_sheen: rgb the colour factor, w the roughness factor; zero without.
+    sheen: vec4<f32>,
 };
 
 const ALPHA_OPAQUE: u32 = 0u;
@@ -47,6 +49,8 @@ const TEX_COAT_ROUGH: u32 = 10u;
 const TEX_COAT_NORMAL: u32 = 11u;
 const TEX_SPECULAR: u32 = 12u;
 const TEX_SPECULAR_COLOR: u32 = 13u;
+const TEX_SHEEN_COLOR: u32 = 14u;
+const TEX_SHEEN_ROUGH: u32 = 15u;
 
 @group(1) @binding(0) var<uniform> material: MaterialUniforms;
 @group(1) @binding(1) var base_color_tex: texture_2d<f32>;
@@ -63,20 +67,24 @@ const TEX_SPECULAR_COLOR: u32 = 13u;
 @group(1) @binding(12) var coat_normal_tex: texture_2d<f32>;
 @group(1) @binding(13) var specular_tex: texture_2d<f32>;
 @group(1) @binding(14) var specular_color_tex: texture_2d<f32>;
-@group(1) @binding(15) var base_color_smp: sampler;
-@group(1) @binding(16) var metal_rough_smp: sampler;
-@group(1) @binding(17) var normal_smp: sampler;
-@group(1) @binding(18) var emissive_smp: sampler;
-@group(1) @binding(19) var occlusion_smp: sampler;
-@group(1) @binding(20) var film_smp: sampler;
-@group(1) @binding(21) var film_thickness_smp: sampler;
-@group(1) @binding(22) var transmission_smp: sampler;
-@group(1) @binding(23) var volume_thickness_smp: sampler;
-@group(1) @binding(24) var coat_smp: sampler;
-@group(1) @binding(25) var coat_rough_smp: sampler;
-@group(1) @binding(26) var coat_normal_smp: sampler;
-@group(1) @binding(27) var specular_smp: sampler;
-@group(1) @binding(28) var specular_color_smp: sampler;
+@group(1) @binding(15) var sheen_color_tex: texture_2d<f32>;
+@group(1) @binding(16) var sheen_rough_tex: texture_2d<f32>;
+@group(1) @binding(17) var base_color_smp: sampler;
+@group(1) @binding(18) var metal_rough_smp: sampler;
+@group(1) @binding(19) var normal_smp: sampler;
+@group(1) @binding(20) var emissive_smp: sampler;
+@group(1) @binding(21) var occlusion_smp: sampler;
+@group(1) @binding(22) var film_smp: sampler;
+@group(1) @binding(23) var film_thickness_smp: sampler;
+@group(1) @binding(24) var transmission_smp: sampler;
+@group(1) @binding(25) var volume_thickness_smp: sampler;
+@group(1) @binding(26) var coat_smp: sampler;
+@group(1) @binding(27) var coat_rough_smp: sampler;
+@group(1) @binding(28) var coat_normal_smp: sampler;
+@group(1) @binding(29) var specular_smp: sampler;
+@group(1) @binding(30) var specular_color_smp: sampler;
+@group(1) @binding(31) var sheen_color_smp: sampler;
+@group(1) @binding(32) var sheen_rough_smp: sampler;
 
 // The texture coordinates of slot `slot`: its UV set, transformed.
 fn material_uv(slot: u32, uv0: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {

@@ -38,8 +38,19 @@ pub fn render_frame(
     settings: &RenderSettings,
     capture: bool,
 ) -> Vec<[f32; 4]> {
+    render_frame_wh(r, scene, (size, size), settings, capture)
+}
+
+/// [`render_frame`] at `width`×`height`.
+pub fn render_frame_wh(
+    r: &mut Renderer,
+    scene: &Scene,
+    (width, height): (u32, u32),
+    settings: &RenderSettings,
+    capture: bool,
+) -> Vec<[f32; 4]> {
     r.set_scene(scene).unwrap();
-    r.resize(size, size).unwrap();
+    r.resize(width, height).unwrap();
     r.set_spectral_capture(capture);
     r.render(&scene.camera, settings).unwrap();
     r.read_hdr().unwrap()
