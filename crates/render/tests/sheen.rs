@@ -173,3 +173,29 @@ fn in_the_furnace_a_white_sheen_reflects_its_albedo() {
         }
     }
 }
+
+/// A sheen on a see-through material has no room in the transmissive layer's G-buffer: the
+/// upload says it is not drawn, naming the material, and the frame is the one without it.
+#[test]
+fn a_see_through_sheen_is_reported_and_left_out() {
+    let chart = Chart { colours: vec![[0.5, 0.4, 0.3]], cols: 1, rows: 1, gap: 0.0 };
+    let mut plain = chart.scene(white_light(2.0, None), 0.7, 0.0);
+    plain.materials[0].name = "tulle".into();
+    plain.materials[0].transmission =
+        Some(scene::transmission::Transmission { factor: 0.5, texture: None, volume: None, dispersion: 0.0 });
+    let mut sheened = plain.clone();
+    sheened.materials[0].sheen = Some(Sheen {
+        color: Vec3::new(1.0, 0.3, 0.1),
+        color_texture: None,
+        roughness: 0.8,
+        roughness_texture: None,
+    });
+    let mut r = renderer();
+    let s = RenderSettings { mode: Mode::Spectral, shadows: false, ..Default::default() };
+    let without = render_frame_wh(&mut r, &plain, (W, H), &s, false);
+    assert!(r.scene_warnings().is_empty(), "{:?}", r.scene_warnings());
+    let with = render_frame_wh(&mut r, &sheened, (W, H), &s, false);
+    let w = r.scene_warnings();
+    assert!(w.len() == 1 && w[0].contains("KHR_materials_sheen") && w[0].contains("'tulle'"), "{w:?}");
+    assert!(with == without);
+}
