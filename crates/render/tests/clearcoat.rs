@@ -15,10 +15,6 @@ use scene::{Environment, Texture, TextureRef};
 const W: u32 = 48;
 const H: u32 = 32;
 
-fn decode8(v: u8) -> f64 {
-    color::colorspace::srgb_decode(v as f64 / 255.0)
-}
-
 /// The coat's weight: strength × Schlick's Fresnel with F0 0.04 at |v·n_c|.
 fn weight(strength: f64, n_c: Vec3, v: Vec3) -> f64 {
     let m = 1.0 - (n_c.dot(v) as f64).abs().min(1.0);

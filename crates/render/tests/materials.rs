@@ -11,10 +11,6 @@ use scene::{Texture, TextureRef};
 const W: u32 = 48;
 const H: u32 = 32;
 
-fn decode8(v: u8) -> f64 {
-    color::colorspace::srgb_decode(v as f64 / 255.0)
-}
-
 #[test]
 fn textured_and_normal_mapped_patch_matches_cpu_brdf() {
     let chart = Chart { colours: vec![[1.0, 1.0, 1.0]], cols: 1, rows: 1, gap: 0.0 };

@@ -10,25 +10,10 @@ use common::*;
 use glam::{Vec3, Vec4};
 use render::{Mode, RenderSettings};
 use scene::sheen::Sheen;
-use scene::{Environment, Texture, TextureRef};
+use scene::{Environment, TextureRef};
 
 const W: u32 = 48;
 const H: u32 = 32;
-
-fn decode8(v: u8) -> f64 {
-    color::colorspace::srgb_decode(v as f64 / 255.0)
-}
-
-fn texture(name: &str, rgba: [u8; 4], srgb: bool) -> Texture {
-    Texture {
-        sampler: Default::default(),
-        name: name.into(),
-        width: 1,
-        height: 1,
-        rgba8: rgba.to_vec(),
-        srgb,
-    }
-}
 
 /// Radiance per unit irradiance of a dielectric of albedo `rho` (roughness 0.5) under a sheen
 /// of colour `sheen` and roughness `r`, lit from `wi`, seen from `v` (normal +z).
@@ -95,7 +80,7 @@ fn the_sheen_follows_the_extension_under_a_directional_light() {
         let mut scene = chart.scene(white_light(2.0, None), 0.5, 0.0);
         scene.lights[0].kind = scene::LightKind::Directional { direction: -wi };
         scene.textures =
-            vec![texture("colour", colour_texel, true), texture("roughness", rough_texel, false)];
+            vec![texel_texture("colour", colour_texel, true), texel_texture("roughness", rough_texel, false)];
         let m = &mut scene.materials[0];
         m.base_color = Vec4::new(rho[0] as f32, rho[1] as f32, rho[2] as f32, 1.0);
         m.sheen = Some(sheen);

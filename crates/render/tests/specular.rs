@@ -11,14 +11,10 @@ use common::*;
 use glam::{Vec3, Vec4};
 use render::{Mode, RenderSettings};
 use scene::specular::Specular;
-use scene::{Environment, Texture, TextureRef};
+use scene::{Environment, TextureRef};
 
 const W: u32 = 48;
 const H: u32 = 32;
-
-fn decode8(v: u8) -> f64 {
-    color::colorspace::srgb_decode(v as f64 / 255.0)
-}
 
 /// Radiance per unit irradiance × n·l of a material of albedo `rho` with specular weight `w`
 /// and F0 colour `f0c`, as the extension writes its dielectric, mixed with glTF's metal by
@@ -60,17 +56,6 @@ fn fresnel_mix(
 /// A test case: its name, the base albedo, the specular, its weight and colour at the pixels,
 /// and the metallic factor.
 type Case = (&'static str, [f64; 3], Specular, f64, [f64; 3], f64);
-
-fn texture(name: &str, rgba: [u8; 4], srgb: bool) -> Texture {
-    Texture {
-        sampler: Default::default(),
-        name: name.into(),
-        width: 1,
-        height: 1,
-        rgba8: rgba.to_vec(),
-        srgb,
-    }
-}
 
 /// A patch under a directional light near its mirror direction, with the specular as factors
 /// (grey weight; a yellow colour; a strong red colour over a white base, whose diffuse must stay
@@ -129,8 +114,10 @@ fn the_specular_weight_and_colour_follow_fresnel_mix() {
     for (name, rho, specular, w, colour, metallic) in cases {
         let mut scene = chart.scene(white_light(2.0, None), 0.3, metallic as f32);
         scene.lights[0].kind = scene::LightKind::Directional { direction: -wi };
-        scene.textures =
-            vec![texture("strength", strength_texel, false), texture("colour", colour_texel, true)];
+        scene.textures = vec![
+            texel_texture("strength", strength_texel, false),
+            texel_texture("colour", colour_texel, true),
+        ];
         let m = &mut scene.materials[0];
         m.base_color = Vec4::new(rho[0] as f32, rho[1] as f32, rho[2] as f32, 1.0);
         m.specular = Some(specular);

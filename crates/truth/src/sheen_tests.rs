@@ -10,15 +10,14 @@ use super::tests::{assert_within, d65, estimate, radiance_any_hero, spectrum_at,
 use super::*;
 use crate::bsdf::{SheenLanes, SpecularLanes};
 use crate::material::TexCoords;
-use crate::render::{Settings, render};
 use crate::spectral::XyzSensor;
-use crate::testing::{quad, scene_with, sphere};
+use crate::testing::{scene_with, sphere};
 use crate::upsample::GreyOnly;
 use color::{Observer, Spectrum, WavelengthRange};
 use glam::Vec2;
 use scene::clearcoat::Clearcoat;
 use scene::sheen::Sheen;
-use scene::{Camera, Emission, Light, LightKind, Material, SpectralReflectance, Texture, TextureRef};
+use scene::{Camera, Material, SpectralReflectance, Texture, TextureRef};
 use std::f64::consts::PI;
 
 fn sheen(color: Vec3, roughness: f32) -> Sheen {
@@ -663,39 +662,27 @@ fn two_material_scene(sh: Option<Sheen>) -> scene::Scene {
             ..Default::default()
         },
     ];
-    let meshes = vec![sphere(Vec3::ZERO, 0.8, 16, 0), quad(Vec3::new(0.0, -0.8, 0.0), Vec3::Y, 3.0, 1)];
-    let light = Light {
-        name: "p".into(),
-        kind: LightKind::Point { position: Vec3::new(1.0, 2.0, 1.5), range: None },
-        emission: Emission { rgb: Vec3::ONE, intensity: 3.0, spectrum: None },
-        stands_in_for: None,
-    };
-    let mut s =
-        with_env(scene_with(meshes, materials, vec![light]), scene::Environment::uniform(Vec3::splat(0.3)));
-    s.camera = Camera::look_at(Vec3::new(0.0, 0.7, 3.0), Vec3::ZERO, Vec3::Y, 0.9);
-    s
-}
-
-fn render_image(scene: &scene::Scene, lambert: bool) -> crate::XyzImage {
-    let st = Settings { seed: 3, lambert, ..Settings::new(16, 12, 8).unwrap() };
-    render(scene, &GreyOnly, &st, &Default::default(), &|_| {}).unwrap()
+    crate::testing::sphere_on_floor(materials)
 }
 
 /// Renders: a sheen that is off (colour factor 0, whatever its texture) renders to the same
 /// bits as none; `--lambert` ignores the extension; otherwise a sheen shows.
 #[test]
 fn without_the_extension_renders_are_unchanged() {
-    let plain = render_image(&two_material_scene(None), false);
+    let plain = crate::testing::small_render(&two_material_scene(None), false);
     let off = Sheen {
         color: Vec3::ZERO,
         color_texture: Some(TextureRef { index: 0, tex_coord: 0, transform: None }),
         roughness: 0.5,
         roughness_texture: None,
     };
-    assert!(render_image(&two_material_scene(Some(off)), false).xyz == plain.xyz);
+    assert!(crate::testing::small_render(&two_material_scene(Some(off)), false).xyz == plain.xyz);
     let on = two_material_scene(Some(sheen(Vec3::new(0.9, 0.7, 0.8), 0.5)));
-    assert!(render_image(&on, true).xyz == render_image(&two_material_scene(None), true).xyz);
-    let lit = render_image(&on, false);
+    assert!(
+        crate::testing::small_render(&on, true).xyz
+            == crate::testing::small_render(&two_material_scene(None), true).xyz
+    );
+    let lit = crate::testing::small_render(&on, false);
     let (a, b) = (plain.mean(), lit.mean());
     println!("image mean with a sheen {b:?}, without {a:?}");
     assert!(lit.xyz != plain.xyz);

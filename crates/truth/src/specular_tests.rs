@@ -556,22 +556,7 @@ fn two_material_scene(sp: Option<Specular>) -> scene::Scene {
             ..Default::default()
         },
     ];
-    let meshes = vec![sphere(Vec3::ZERO, 0.8, 16, 0), quad(Vec3::new(0.0, -0.8, 0.0), Vec3::Y, 3.0, 1)];
-    let light = Light {
-        name: "p".into(),
-        kind: LightKind::Point { position: Vec3::new(1.0, 2.0, 1.5), range: None },
-        emission: Emission { rgb: Vec3::ONE, intensity: 3.0, spectrum: None },
-        stands_in_for: None,
-    };
-    let mut s =
-        with_env(scene_with(meshes, materials, vec![light]), scene::Environment::uniform(Vec3::splat(0.3)));
-    s.camera = Camera::look_at(Vec3::new(0.0, 0.7, 3.0), Vec3::ZERO, Vec3::Y, 0.9);
-    s
-}
-
-fn render_image(scene: &scene::Scene, lambert: bool) -> crate::XyzImage {
-    let st = Settings { seed: 3, lambert, ..Settings::new(16, 12, 8).unwrap() };
-    render(scene, &GreyOnly, &st, &Default::default(), &|_| {}).unwrap()
+    crate::testing::sphere_on_floor(materials)
 }
 
 /// The extension at its defaults' values (weight 1, white) is the BRDF without it up to
@@ -580,13 +565,16 @@ fn render_image(scene: &scene::Scene, lambert: bool) -> crate::XyzImage {
 /// extension entirely, as it ignores films and coats; without it a weight of 0.3 shows.
 #[test]
 fn without_the_extension_renders_are_unchanged() {
-    let plain = render_image(&two_material_scene(None), false);
+    let plain = crate::testing::small_render(&two_material_scene(None), false);
     assert_eq!(plain.dropped, 0);
-    let default = render_image(&two_material_scene(Some(specular(1.0, Vec3::ONE))), false);
+    let default = crate::testing::small_render(&two_material_scene(Some(specular(1.0, Vec3::ONE))), false);
     let (a, b) = (plain.mean(), default.mean());
     println!("defaults' values: image mean {b:?} vs {a:?}");
     assert!((0..3).all(|c| (a[c] - b[c]).abs() <= 1e-3 * a[c]), "{b:?} vs {a:?}");
     let weak = two_material_scene(Some(specular(0.3, Vec3::new(1.0, 0.5, 2.0))));
-    assert!(render_image(&weak, true).xyz == render_image(&two_material_scene(None), true).xyz);
-    assert!(render_image(&weak, false).xyz != plain.xyz);
+    assert!(
+        crate::testing::small_render(&weak, true).xyz
+            == crate::testing::small_render(&two_material_scene(None), true).xyz
+    );
+    assert!(crate::testing::small_render(&weak, false).xyz != plain.xyz);
 }

@@ -109,3 +109,27 @@ fn sphere_faces_outwards() {
         assert!(n.dot((a + b + c) / 3.0 - Vec3::new(1.0, 2.0, 3.0)) > 0.0, "{t:?}");
     }
 }
+
+/// The extension tests' stage (specular, sheen): `materials[0]` on a sphere of radius 0.8 at
+/// the origin, `materials[1]` on a floor under it, a point light above and in front, and a
+/// uniform sky of 0.3, seen from the front.
+pub fn sphere_on_floor(materials: Vec<Material>) -> Scene {
+    let meshes = vec![sphere(Vec3::ZERO, 0.8, 16, 0), quad(Vec3::new(0.0, -0.8, 0.0), Vec3::Y, 3.0, 1)];
+    let light = Light {
+        name: "p".into(),
+        kind: scene::LightKind::Point { position: Vec3::new(1.0, 2.0, 1.5), range: None },
+        emission: scene::Emission { rgb: Vec3::ONE, intensity: 3.0, spectrum: None },
+        stands_in_for: None,
+    };
+    let mut s = scene_with(meshes, materials, vec![light]);
+    s.environment = Some(scene::Environment::uniform(Vec3::splat(0.3)));
+    s.camera = Camera::look_at(Vec3::new(0.0, 0.7, 3.0), Vec3::ZERO, Vec3::Y, 0.9);
+    s
+}
+
+/// A 16×12 render of `scene` at 8 samples a pixel (seed 3) with grey upsampling, Lambert-only or
+/// not.
+pub fn small_render(scene: &Scene, lambert: bool) -> crate::XyzImage {
+    let st = crate::render::Settings { seed: 3, lambert, ..crate::render::Settings::new(16, 12, 8).unwrap() };
+    crate::render::render(scene, &crate::upsample::GreyOnly, &st, &Default::default(), &|_| {}).unwrap()
+}

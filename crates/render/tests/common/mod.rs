@@ -56,6 +56,23 @@ pub fn render_frame_wh(
     r.read_hdr().unwrap()
 }
 
+/// An 8-bit sRGB-encoded value, linear.
+pub fn decode8(v: u8) -> f64 {
+    color::colorspace::srgb_decode(v as f64 / 255.0)
+}
+
+/// A 1×1 texture of `rgba` (sRGB-encoded colour or linear data).
+pub fn texel_texture(name: &str, rgba: [u8; 4], srgb: bool) -> scene::Texture {
+    scene::Texture {
+        sampler: Default::default(),
+        name: name.into(),
+        width: 1,
+        height: 1,
+        rgba8: rgba.to_vec(),
+        srgb,
+    }
+}
+
 pub fn output_dir() -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/test-output");
     std::fs::create_dir_all(&dir).expect("creating target/test-output");
