@@ -559,20 +559,7 @@ fn a_coat_over_a_sheen_layers_as_over_any_base() {
             let c = Coat::new(0.9, 0.4, Vec3::new(0.15, 0.0, 1.0).normalize(), wo)
                 .balanced(b.albedo_estimate(wo.z));
             let vtx = Vertex::Surface { brdf: b, frame, ng: Vec3::Z, glass: None, coat: Some(c) };
-            let (nt, np) = (1200, 400);
-            let (mut ip, mut if_) = (0.0f64, Vec4::ZERO);
-            for i in 0..nt {
-                let z = -1.0 + 2.0 * (i as f32 + 0.5) / nt as f32;
-                let s = (1.0 - z * z).max(0.0).sqrt();
-                for j in 0..np {
-                    let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / np as f32;
-                    let (f, p) = vtx.eval(wo, Vec3::new(s * phi.cos(), s * phi.sin(), z));
-                    ip += f64::from(p);
-                    if_ += f;
-                }
-            }
-            let dw = (2.0 / nt as f32) * (2.0 * std::f32::consts::PI / np as f32);
-            let (ip, if_) = (ip * f64::from(dw), if_ * dw);
+            let (ip, if_) = super::coat_tests::sphere_integrals(&vtx, wo);
             let mut rng = Sampler::new(7, 1);
             let n = 200_000;
             let (mut est, mut returned) = (Vec4::ZERO, 0);
