@@ -219,5 +219,15 @@ fn main() {
         }
     };
     drop(runtime_dir);
+    if code != 0 {
+        // A command that stopped early (Ctrl-C, an error mid-frame) may leave work in the GPU
+        // driver's threads: `exit` would run the driver's static destructors under them, and
+        // lavapipe then crashes (SIGSEGV after "interrupted: stopped", one run in 30 with the
+        // machine loaded). Outputs appear only by rename, so nothing is lost by skipping them.
+        use std::io::Write;
+        let _ = std::io::stdout().flush();
+        // SAFETY: _exit(2) has no preconditions.
+        unsafe { libc::_exit(code) }
+    }
     std::process::exit(code);
 }
