@@ -13,6 +13,7 @@ pub mod glass;
 pub mod iridescence;
 mod metamerism;
 pub(crate) mod shapes;
+pub mod sheen;
 pub mod specular;
 mod underwater;
 
@@ -33,6 +34,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "glass",
     "clearcoat",
     "specular",
+    "sheen",
     "underwater",
     "fog",
     "tinted-fog",
@@ -49,6 +51,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "glass" => glass::build(&ctx),
         "clearcoat" => clearcoat::build(&ctx),
         "specular" => specular::build(&ctx),
+        "sheen" => sheen::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),
@@ -129,7 +132,7 @@ pub(crate) fn spot_at(
     })
 }
 
-/// The stage of the material showcases (`iridescence`, `clearcoat`, `specular`): two rows of
+/// The stage of the material showcases (`iridescence`, `clearcoat`, `specular`, `sheen`): two rows of
 /// four spheres of radius 0.12, 0.3 apart (the back row at z = −0.2, the front at 0.15), on a
 /// 2 m floor of ColorChecker neutral 5, seen from above and in front; two spots
 /// ([`showcase_spots`]).
@@ -183,7 +186,7 @@ impl Showcase {
     }
 }
 
-/// The two spots of the material showcases (`iridescence`, `clearcoat`, `specular`): one above
+/// The two spots of the material showcases (`iridescence`, `clearcoat`, `specular`, `sheen`): one above
 /// and in front of the camera, one from the side, aimed at the middle of the rows at
 /// (0, 0.1, 0), ≈ π lux there each; cones 40°/65°.
 pub(crate) fn showcase_spots(

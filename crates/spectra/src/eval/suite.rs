@@ -139,8 +139,9 @@ pub const CASE_IDS: &[&str] = &[
 ];
 
 /// Cases `spectra eval --scenes` accepts besides [`CASE_IDS`], outside the default suite (whose
-/// results are the README's contract): `clearcoat` (session 42), `specular` (session 43).
-pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular"];
+/// results are the README's contract): `clearcoat` (session 42), `specular` (session 43),
+/// `sheen` (session 45).
+pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular", "sheen"];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
@@ -227,6 +228,13 @@ pub fn case(id: &str) -> Result<Case> {
                     over measured ColorChecker bases; a D65 and an F11 spot"
                 .into(),
             scene: scene::builtin("specular")?,
+        }),
+        "sheen" => Ok(Case {
+            id: id.into(),
+            title: "Sheen (KHR_materials_sheen): saturated sheens over black, white and pale sheens over measured ColorChecker \
+                    bases; a D65 and an F11 spot"
+                .into(),
+            scene: scene::builtin("sheen")?,
         }),
         "glass" => Ok(Case {
             id: id.into(),
@@ -345,6 +353,7 @@ mod tests {
         }
         assert!(case("clearcoat").unwrap().scene.materials.iter().any(|m| m.clearcoat.is_some()));
         assert!(case("specular").unwrap().scene.materials.iter().any(|m| m.specular.is_some()));
+        assert!(case("sheen").unwrap().scene.materials.iter().any(|m| m.sheen.is_some()));
         assert!(case("nope").unwrap_err().to_string().contains("clearcoat"));
     }
 }
