@@ -9,14 +9,10 @@ const MEDIUM_INV_4PI: f32 = 0.0795774715459476;
 // relative error at x = 10⁻³. Below x = 1/8 the Taylor series (Horner, six terms: truncation
 // x⁶/5040 < 10⁻⁸) is used instead, and above it the loss is at most 8× exp's error.
 fn medium_path_integral(k: vec4<f32>, d: f32) -> vec4<f32> {
-    return medium_path_integral_by(k, d, exp(-k * d));
-}
-
-// The same where the caller has the decay e^{−k·d} already (it carries it on along the ray).
-fn medium_path_integral_by(k: vec4<f32>, d: f32, decay: vec4<f32>) -> vec4<f32> {
     let x = k * d;
     let series = d * (1.0 - x / 2.0 * (1.0 - x / 3.0 * (1.0 - x / 4.0 * (1.0 - x / 5.0 * (1.0 - x / 6.0)))));
-    return select((1.0 - decay) / k, series, abs(x) < vec4<f32>(0.125));
+    let exact = (1.0 - exp(-x)) / k;
+    return select(exact, series, abs(x) < vec4<f32>(0.125));
 }
 
 // Henyey–Greenstein phase function (per steradian) at the cosine between the light's

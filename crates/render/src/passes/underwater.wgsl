@@ -481,10 +481,13 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
         let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
-        // The decay across the piece, which the next piece starts from.
+        // medium_path_integral's, keeping its exponential: the decay across the piece.
         let len = max(uw_pl[p], 0.0);
-        let decay = exp(-rate * len);
-        sum += start * select(medium_path_integral_by(rate, len, decay), 1.0 / rate, infinite);
+        let x = rate * len;
+        let decay = exp(-x);
+        let series = len * (1.0 - x / 2.0 * (1.0 - x / 3.0 * (1.0 - x / 4.0 * (1.0 - x / 5.0 * (1.0 - x / 6.0)))));
+        let finite = select((1.0 - decay) / rate, series, abs(x) < vec4<f32>(0.125));
+        sum += start * select(finite, 1.0 / rate, infinite);
         start *= decay;
         // A column not positive at a node was held flat across the segment (`uw_rate`), so it
         // may not meet the next segment's value at the node.
@@ -712,17 +715,14 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb:
         var sum = vec4<f32>(0.0);
         let dir = uw_dir[j];
         let base = j * UW_MAX_STEPS;
-        // Loops of none or one trip, not branches, of which a CPU driver would run every side.
-        let lit = dir.y > 0.0 && uw_lit[j];
-        for (var n = select(0u, 1u, lit); n > 0u; n--) {
+        if (dir.y > 0.0 && uw_lit[j]) {
             // Directional, nothing in the way: the whole ray in closed form.
-            sum = uw_w[base] * exp(-c * uw_s[base]) * uw_ray_integral(c * dir.x - dc);
-        }
-        for (var n = select(0u, 1u, dir.y > 0.0 && !lit); n > 0u; n--) {
+            let cq = c * dir.x - dc;
+            sum = uw_w[base] * exp(-c * uw_s[base]) * uw_ray_integral(cq);
+        } else if (dir.y > 0.0) {
             // Directional: the optical path grows by dt·q per segment, so the attenuations
             // form a geometric sequence (two exponentials per group instead of one per step);
-            // each segment's exponential is integrated exactly (its decay is the sequence's
-            // ratio), the tail unshadowed from where the sequence ends.
+            // each segment's exponential is integrated exactly, the tail unshadowed.
             let cq = c * dir.x - dc;
             let ratio = exp(-cq * dir.y);
             var att = exp(-c * uw_s[base]);
@@ -730,15 +730,15 @@ fn uw_single_scatter(b: vec4<f32>, c: vec4<f32>, cv: vec4<f32>, group: u32, rgb:
                 sum = fma(vec4<f32>(uw_w[base + k]), att, sum);
                 att *= ratio;
             }
-            sum = sum * medium_path_integral_by(cq, dir.y, ratio);
-            // The tail starts dir.y·steps metres along the view, where the sequence is at `att`
-            // (= e^{−c·dir.w + (c − cv)·dir.y·steps}).
-            sum += select(vec4<f32>(0.0), dir.z * att / cq, dir.z > 0.0);
-        }
-        // Point and spot lights (dir.y = 0): equiangular steps.
-        for (var k = select(uw_steps, 0u, dir.y > 0.0); k > 0u; k--) {
-            let s = base + uw_steps - k;
-            sum = fma(vec4<f32>(uw_w[s]), exp(-c * uw_s[s] + dc * uw_tv[s]), sum);
+            sum = sum * medium_path_integral(cq, dir.y);
+            if (dir.z > 0.0) {
+                // The tail starts dir.y·steps metres along the view.
+                sum += dir.z * exp(-c * dir.w + dc * (dir.y * f32(uw_steps))) / cq;
+            }
+        } else {
+            for (var k = 0u; k < uw_steps; k++) {
+                sum = fma(vec4<f32>(uw_w[base + k]), exp(-c * uw_s[base + k] + dc * uw_tv[base + k]), sum);
+            }
         }
         total += s3_scale(uw_emission(uw_light[j], group, rgb), b * sum);
     }
