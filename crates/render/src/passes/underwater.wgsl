@@ -429,11 +429,6 @@ fn uw_rate(a: vec4<f32>, b: vec4<f32>, i: u32) -> vec4<f32> {
 // Consecutive pieces share a node (going down piece p ends at the node where p + 1 starts, going
 // up it starts where p + 1 ends), so the last piece's two nodes are kept: one table read of four
 // directions per piece instead of two, where the table does not change between them.
-// The integrand J·e^{−c·t} is continuous from piece to piece (J's interpolation meets the node's
-// value from both sides), so a piece starts at the value the previous one ended at, which the
-// piece's integral gives for free (e^{−rate·length}): one exponential per piece, where the start's
-// own exponential made two. Only the first piece, and one after a change of table or after a
-// piece whose column was flat across a jump (a node value not positive), start afresh.
 fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> {
     var sum = vec4<f32>(0.0);
     // Keys (table · 1024 + node) of the previous piece's ends, and their values.
@@ -441,25 +436,20 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
     var key_b = 0xffffffffu;
     var prev_a = vec4<f32>(0.0);
     var prev_b = vec4<f32>(0.0);
-    // J·e^{−c·t} at the piece's start, and whether it must be computed rather than carried.
-    var start = vec4<f32>(0.0);
-    var fresh = true;
-    var prev_table = 0u;
     for (var p = 0u; p < uw_np; p++) {
         let i = uw_pn[p];
-        let table = uw_pd[p];
-        let ka = table * 1024u + i;
+        let ka = uw_pd[p] * 1024u + i;
         var ja: vec4<f32>;
         var jb: vec4<f32>;
         if (ka == key_b) {
             ja = prev_b;
         } else {
-            ja = uw_j_node(table, i, group, rgb);
+            ja = uw_j_node(uw_pd[p], i, group, rgb);
         }
         if (ka + 1u == key_a) {
             jb = prev_a;
         } else {
-            jb = uw_j_node(table, i + 1u, group, rgb);
+            jb = uw_j_node(uw_pd[p], i + 1u, group, rgb);
         }
         key_a = ka;
         key_b = ka + 1u;
@@ -471,29 +461,13 @@ fn uw_table_integral(c: vec4<f32>, group: u32, rgb: bool, wy: f32) -> vec4<f32> 
         let beyond = ((uw_beyond >> p) & 1u) != 0u;
         let k0 = uw_rate(ja, jb, i);
         let k = select(k0, max(k0, vec4<f32>(0.0)), beyond);
-        fresh = fresh || table != prev_table;
-        // J at the piece's start and the view's attenuation up to it, in one exponential. A loop
-        // of none or one trip, not a branch, which a CPU driver would run for every piece.
-        for (var n = select(0u, 1u, fresh); n > 0u; n--) {
-            let z_from = select(0.0, uw_depth_node(i + 1u) - uw_depth_node(i), beyond);
-            start = select(ja, jb, beyond) * exp(-k * (uw_pz[p] - z_from) - c * uw_pt[p]);
-        }
+        let z_from = select(0.0, uw_depth_node(i + 1u) - uw_depth_node(i), beyond);
+        // J at the piece's start and the view's attenuation up to it, in one exponential.
+        let j0 = select(ja, jb, beyond) * exp(-k * (uw_pz[p] - z_from) - c * uw_pt[p]);
         let infinite = uw_pl[p] < 0.0;
         // A ray to infinity needs c − k·ω_y > 0; the deep field decays, so this only guards noise.
         let rate = select(c - k * wy, max(c - k * wy, 1e-3 * c), infinite);
-        // medium_path_integral's, keeping its exponential: the decay across the piece.
-        let len = max(uw_pl[p], 0.0);
-        let x = rate * len;
-        let decay = exp(-x);
-        let series = len * (1.0 - x / 2.0 * (1.0 - x / 3.0 * (1.0 - x / 4.0 * (1.0 - x / 5.0 * (1.0 - x / 6.0)))));
-        let finite = select((1.0 - decay) / rate, series, abs(x) < vec4<f32>(0.125));
-        sum += start * select(finite, 1.0 / rate, infinite);
-        start *= decay;
-        // A column not positive at a node was held flat across the segment (`uw_rate`), so it
-        // may not meet the next segment's value at the node.
-        let positive = (ja > vec4<f32>(0.0)) & (jb > vec4<f32>(0.0));
-        fresh = any(!positive & (ja != jb));
-        prev_table = table;
+        sum += j0 * uw_integral_to(rate, uw_pl[p], infinite);
     }
     return sum;
 }
