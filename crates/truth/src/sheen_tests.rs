@@ -631,25 +631,9 @@ fn the_textures_scale_colour_and_roughness() {
     assert_eq!(material::sheen(&Material::default(), &textures, &tc), None);
 }
 
-/// A coloured metallic sphere and a grey floor under a point light and a grey surround,
-/// `sh` on both.
+/// The extension tests' sphere on a floor (`testing::two_materials_on_floor`), `sh` on both.
 fn two_material_scene(sh: Option<Sheen>) -> scene::Scene {
-    let materials = vec![
-        Material {
-            base_color: Vec4::new(0.8, 0.5, 0.2, 1.0),
-            metallic: 0.4,
-            roughness: 0.35,
-            sheen: sh.clone(),
-            ..Default::default()
-        },
-        Material {
-            base_color: Vec4::new(0.6, 0.6, 0.6, 1.0),
-            roughness: 0.7,
-            sheen: sh,
-            ..Default::default()
-        },
-    ];
-    crate::testing::sphere_on_floor(materials)
+    crate::testing::two_materials_on_floor(|m| m.sheen = sh.clone())
 }
 
 /// Renders: a sheen that is off (colour factor 0, whatever its texture) renders to the same

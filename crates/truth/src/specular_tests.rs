@@ -537,26 +537,12 @@ fn the_textures_scale_weight_and_colour() {
     assert_eq!(material::specular(&Material::default(), &textures, &TexCoords::default()), None);
 }
 
-/// A coloured metallic sphere and a grey floor of index 1.8 under a point light and a grey
-/// surround; `sp` on both materials.
+/// The extension tests' sphere on a floor (`testing::two_materials_on_floor`), the floor of
+/// index 1.8; `sp` on both materials.
 fn two_material_scene(sp: Option<Specular>) -> scene::Scene {
-    let materials = vec![
-        Material {
-            base_color: Vec4::new(0.8, 0.5, 0.2, 1.0),
-            metallic: 0.4,
-            roughness: 0.35,
-            specular: sp.clone(),
-            ..Default::default()
-        },
-        Material {
-            base_color: Vec4::new(0.6, 0.6, 0.6, 1.0),
-            roughness: 0.7,
-            ior: 1.8,
-            specular: sp,
-            ..Default::default()
-        },
-    ];
-    crate::testing::sphere_on_floor(materials)
+    let mut s = crate::testing::two_materials_on_floor(|m| m.specular = sp.clone());
+    s.materials[1].ior = 1.8;
+    s
 }
 
 /// The extension at its defaults' values (weight 1, white) is the BRDF without it up to

@@ -1,6 +1,6 @@
 //! Small scenes built in code for the tests.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 use scene::{Camera, Light, Material, Mesh, Scene, SpectralSettings};
 
 pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light>) -> Scene {
@@ -125,6 +125,23 @@ pub fn sphere_on_floor(materials: Vec<Material>) -> Scene {
     s.environment = Some(scene::Environment::uniform(Vec3::splat(0.3)));
     s.camera = Camera::look_at(Vec3::new(0.0, 0.7, 3.0), Vec3::ZERO, Vec3::Y, 0.9);
     s
+}
+
+/// [`sphere_on_floor`] with the extension tests' two materials: a coloured part-metal sphere
+/// (base (0.8, 0.5, 0.2), metallic 0.4, roughness 0.35) and a grey floor (0.6, roughness 0.7),
+/// each given the extension under test by `extend`.
+pub fn two_materials_on_floor(extend: impl Fn(&mut Material)) -> Scene {
+    let mut materials = vec![
+        Material {
+            base_color: Vec4::new(0.8, 0.5, 0.2, 1.0),
+            metallic: 0.4,
+            roughness: 0.35,
+            ..Default::default()
+        },
+        Material { base_color: Vec4::new(0.6, 0.6, 0.6, 1.0), roughness: 0.7, ..Default::default() },
+    ];
+    materials.iter_mut().for_each(extend);
+    sphere_on_floor(materials)
 }
 
 /// A 16×12 render of `scene` at 8 samples a pixel (seed 3) with grey upsampling, Lambert-only or
