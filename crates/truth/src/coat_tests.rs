@@ -60,23 +60,6 @@ fn coat_albedo_masked(alpha: f64, c: f64, masking: bool) -> f64 {
     sum * (2.0 * PI / np as f64) / nt as f64
 }
 
-/// The base BRDF's directional albedo at cos θ_o = `c` (midpoint quadrature; the furnace of
-/// `integrator_tests` checks the tracer reflects it without a coat).
-fn base_albedo(b: &Brdf, c: f32) -> Vec4 {
-    let wo = Vec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
-    let (nt, np) = (600, 300);
-    let mut a = Vec4::ZERO;
-    for i in 0..nt {
-        let ci = (i as f32 + 0.5) / nt as f32;
-        let si = (1.0 - ci * ci).sqrt();
-        for j in 0..np {
-            let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / np as f32;
-            a += b.eval(wo, Vec3::new(si * phi.cos(), si * phi.sin(), ci)) * ci;
-        }
-    }
-    a * (2.0 * std::f32::consts::PI / (nt * np) as f32)
-}
-
 /// The coat quadrature is right where it is known. Seen head-on, without masking, it is the
 /// share of GGX microfacet normals within 45° of the normal (beyond, the reflection goes
 /// below the horizon): tan²45°/(α² + tan²45°) = 1/(1 + α²), 0.941 at α = 0.25 (GGX's long
@@ -140,7 +123,7 @@ fn coated_sphere_furnace_is_the_extensions_mix_pixel_by_pixel() {
             } else {
                 coat_albedo(f64::from(coat_roughness * coat_roughness), f64::from(cos)) as f32
             };
-            let a_base = base_albedo(&brdf, cos);
+            let a_base = crate::testing::directional_albedo(&brdf, cos);
             let want = le * (a_base * (1.0 - wt) + Vec4::splat(wt * a_coat));
             let (m, se) = estimate(3000, |rng| radiance_any_hero(&integ, r.o, r.d, &wl, rng));
             assert_within(m, se, want, &format!("coat roughness {coat_roughness}, pixel {i}, cos {cos:.3}"));

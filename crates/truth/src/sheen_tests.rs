@@ -471,22 +471,6 @@ fn a_sheened_black_sphere_in_a_furnace_reflects_the_sheens_albedo() {
     }
 }
 
-/// Directional albedo of `b` at cos θ_o = `c` (midpoint quadrature of the tracer's eval).
-fn quadrature_albedo(b: &Brdf, c: f32) -> Vec4 {
-    let wo = wo_at(c);
-    let (nt, np) = (600, 300);
-    let mut a = Vec4::ZERO;
-    for i in 0..nt {
-        let ci = (i as f32 + 0.5) / nt as f32;
-        let si = (1.0 - ci * ci).sqrt();
-        for j in 0..np {
-            let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / np as f32;
-            a += b.eval(wo, Vec3::new(si * phi.cos(), si * phi.sin(), ci)) * ci;
-        }
-    }
-    a * (2.0 * std::f32::consts::PI / (nt * np) as f32)
-}
-
 /// A clear coat over a sheen: the coat layers over the sheened base exactly as over any base.
 /// A sphere (coloured rough dielectric, grey sheen 0.8 of roughness 0.4, smooth clearcoat 0.8)
 /// in a uniform surround reflects Le·((1 − w)·A + w) at each pixel, w = 0.8·F(cos) and A the
@@ -532,12 +516,12 @@ fn a_coat_over_a_sheen_layers_as_over_any_base() {
         let Some(hit) = world.geometry.intersect(r.o, r.d, f32::INFINITY) else { continue };
         let cos = world.surface(&hit).ng.dot(-r.d);
         let wt = factor * (0.04 + 0.96 * (1.0 - cos.abs()).powi(5));
-        let a = quadrature_albedo(&brdf, cos);
+        let a = crate::testing::directional_albedo(&brdf, cos);
         let want = le * (a * (1.0 - wt) + Vec4::splat(wt));
         let (m, se) = estimate(3000, |rng| radiance_any_hero(&integ, r.o, r.d, &wl, rng));
         assert_within(m, se, want, &format!("coat over sheen, pixel {i}, cos {cos:.3}"));
         worst = worst.max(((m - want).abs() / se.max(Vec4::splat(1e-12))).max_element());
-        let without = le * (quadrature_albedo(&plain, cos) * (1.0 - wt) + Vec4::splat(wt));
+        let without = le * (crate::testing::directional_albedo(&plain, cos) * (1.0 - wt) + Vec4::splat(wt));
         change = change.max(((want - without) / without).abs().max_element());
         pixels += 1;
     }

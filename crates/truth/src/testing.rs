@@ -144,6 +144,23 @@ pub fn two_materials_on_floor(extend: impl Fn(&mut Material)) -> Scene {
     sphere_on_floor(materials)
 }
 
+/// The directional albedo of `b` at cos θ_o = `c`, ∫ f·cos θ_i over the hemisphere by a midpoint
+/// rule (600 × 300) of the tracer's own eval: what a furnace around the BRDF reflects.
+pub fn directional_albedo(b: &crate::bsdf::Brdf, c: f32) -> Vec4 {
+    let wo = Vec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
+    let (nt, np) = (600, 300);
+    let mut a = Vec4::ZERO;
+    for i in 0..nt {
+        let ci = (i as f32 + 0.5) / nt as f32;
+        let si = (1.0 - ci * ci).sqrt();
+        for j in 0..np {
+            let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / np as f32;
+            a += b.eval(wo, Vec3::new(si * phi.cos(), si * phi.sin(), ci)) * ci;
+        }
+    }
+    a * (2.0 * std::f32::consts::PI / (nt * np) as f32)
+}
+
 /// A 16×12 render of `scene` at 8 samples a pixel (seed 3) with grey upsampling, Lambert-only or
 /// not.
 pub fn small_render(scene: &Scene, lambert: bool) -> crate::XyzImage {
