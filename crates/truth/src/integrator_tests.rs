@@ -125,18 +125,7 @@ fn absorbing_box_follows_beer_lambert() {
 
 /// Directional albedo of the glTF BRDF at `wo` by quadrature (independent of the sampler).
 fn albedo(b: &Brdf, wo: Vec3) -> Vec4 {
-    let (nt, np) = (2000, 1000);
-    let mut a = Vec4::ZERO;
-    for i in 0..nt {
-        let c = (i as f32 + 0.5) / nt as f32;
-        let s = (1.0 - c * c).sqrt();
-        for j in 0..np {
-            let phi = 2.0 * std::f32::consts::PI * (j as f32 + 0.5) / np as f32;
-            let wi = Vec3::new(s * phi.cos(), s * phi.sin(), c);
-            a += b.eval(wo, wi) * c;
-        }
-    }
-    a * (2.0 * std::f32::consts::PI / (nt * np) as f32)
+    crate::testing::hemisphere_albedo(b, wo, 2000, 1000)
 }
 
 /// Surface white furnace: a glTF-material quad under uniform background emission reflects

@@ -147,8 +147,12 @@ pub fn two_materials_on_floor(extend: impl Fn(&mut Material)) -> Scene {
 /// The directional albedo of `b` at cos θ_o = `c`, ∫ f·cos θ_i over the hemisphere by a midpoint
 /// rule (600 × 300) of the tracer's own eval: what a furnace around the BRDF reflects.
 pub fn directional_albedo(b: &crate::bsdf::Brdf, c: f32) -> Vec4 {
-    let wo = Vec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
-    let (nt, np) = (600, 300);
+    hemisphere_albedo(b, Vec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c), 600, 300)
+}
+
+/// ∫ f(wo, wi)·cos θ_i over the hemisphere by a midpoint rule of `nt` cos θ_i × `np` φ cells
+/// (independent of the sampler).
+pub fn hemisphere_albedo(b: &crate::bsdf::Brdf, wo: Vec3, nt: u32, np: u32) -> Vec4 {
     let mut a = Vec4::ZERO;
     for i in 0..nt {
         let ci = (i as f32 + 0.5) / nt as f32;
