@@ -257,6 +257,13 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_sheen"] = e;
         }
+        if let Some(an) = &m.anisotropy {
+            let mut e = json!({ "anisotropyStrength": an.strength, "anisotropyRotation": an.rotation });
+            if let Some(t) = &an.texture {
+                e["anisotropyTexture"] = tex(t);
+            }
+            j["extensions"]["KHR_materials_anisotropy"] = e;
+        }
         if m.ior != 1.5 {
             j["extensions"]["KHR_materials_ior"] = json!({ "ior": m.ior });
         }
@@ -420,6 +427,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     }
     if scene.materials.iter().any(|m| m.sheen.is_some()) {
         extensions_used.push("KHR_materials_sheen");
+    }
+    if scene.materials.iter().any(|m| m.anisotropy.is_some()) {
+        extensions_used.push("KHR_materials_anisotropy");
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");

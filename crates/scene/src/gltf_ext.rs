@@ -29,6 +29,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_specular",
     "KHR_materials_sheen",
+    "KHR_materials_anisotropy",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -68,9 +69,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         }
         "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
-        "KHR_materials_anisotropy" => {
-            ("anisotropy is ignored: highlights are isotropic", "this renderer has no anisotropy")
-        }
         "KHR_materials_diffuse_transmission" => {
             ("diffuse transmission is ignored", "this renderer has no translucency")
         }
@@ -277,20 +275,22 @@ mod tests {
     #[test]
     fn optional_extensions_warn_required_ones_refuse_with_advice() {
         let raw = json!({
-            "extensionsUsed": ["KHR_materials_anisotropy", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
+            "extensionsUsed": ["KHR_materials_diffuse_transmission", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
             "extensionsRequired": ["KHR_draco_mesh_compression"],
         });
         let w = warnings(&raw);
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].contains("KHR_materials_anisotropy") && w[0].contains("ignored"), "{w:?}");
+        assert!(w[0].contains("KHR_materials_diffuse_transmission") && w[0].contains("ignored"), "{w:?}");
         let e = check_required(&Ctx::builtin("t"), &raw).unwrap_err().to_string();
         assert!(e.contains("extensionsRequired[0]") && e.contains("KHR_draco_mesh_compression"), "{e}");
         assert!(e.contains("@gltf-transform/cli copy"), "{e}");
-        // Sheen is read (the loader stores it for the renderers): a file may require it.
-        let sheen =
-            json!({"extensionsUsed": ["KHR_materials_sheen"], "extensionsRequired": ["KHR_materials_sheen"]});
-        assert!(warnings(&sheen).is_empty());
-        assert!(check_required(&Ctx::builtin("t"), &sheen).is_ok());
+        // Sheen and anisotropy are read (the loader stores them for the renderers): a file may
+        // require them.
+        for ext in ["KHR_materials_sheen", "KHR_materials_anisotropy"] {
+            let raw = json!({"extensionsUsed": [ext], "extensionsRequired": [ext]});
+            assert!(warnings(&raw).is_empty());
+            assert!(check_required(&Ctx::builtin("t"), &raw).is_ok());
+        }
     }
 
     #[test]

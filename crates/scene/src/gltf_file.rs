@@ -853,6 +853,9 @@ impl Loader<'_> {
         if let Some(sh) = info("/extensions/KHR_materials_sheen") {
             out.sheen = self.sheen(&at, sh)?;
         }
+        if let Some(an) = info("/extensions/KHR_materials_anisotropy") {
+            out.anisotropy = self.anisotropy(&at, an)?;
+        }
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
@@ -927,21 +930,29 @@ impl Loader<'_> {
         // The sheen extension excludes unlit and specular-glossiness materials. Dropped (after
         // its values and textures were checked) before the UV sets are gathered, so that a
         // texture nothing draws asks no TEXCOORD_1 of the meshes.
-        if out.sheen.is_some() {
-            let with = if out.unlit {
-                Some("an unlit material (KHR_materials_unlit), which reflects nothing")
-            } else if info("/extensions/KHR_materials_pbrSpecularGlossiness").is_some() {
-                Some("a specular-glossiness material (KHR_materials_pbrSpecularGlossiness)")
-            } else {
-                None
-            };
-            if let Some(with) = with {
-                self.warnings.push(format!(
-                    "{at} ('{}'): KHR_materials_sheen is ignored on {with}; the extension excludes the two",
-                    out.name
-                ));
-                out.sheen = None;
+        // The anisotropy extension excludes the same two (it extends the metallic-roughness
+        // specular lobe, which neither has).
+        let excluded = if out.unlit {
+            Some("an unlit material (KHR_materials_unlit), which reflects nothing")
+        } else if info("/extensions/KHR_materials_pbrSpecularGlossiness").is_some() {
+            Some("a specular-glossiness material (KHR_materials_pbrSpecularGlossiness)")
+        } else {
+            None
+        };
+        if let Some(with) = excluded {
+            for (ext, on) in [
+                ("KHR_materials_sheen", out.sheen.is_some()),
+                ("KHR_materials_anisotropy", out.anisotropy.is_some()),
+            ] {
+                if on {
+                    self.warnings.push(format!(
+                        "{at} ('{}'): {ext} is ignored on {with}; the extension excludes the two",
+                        out.name
+                    ));
+                }
             }
+            out.sheen = None;
+            out.anisotropy = None;
         }
         let cc_tex =
             |f: fn(&crate::clearcoat::Clearcoat) -> Option<TextureRef>| out.clearcoat.as_ref().and_then(f);
@@ -964,11 +975,16 @@ impl Loader<'_> {
             ("extensions.KHR_materials_specular.specularColorTexture", &sp_tex(|s| s.color_texture)),
             ("extensions.KHR_materials_sheen.sheenColorTexture", &sh_tex(|s| s.color_texture)),
             ("extensions.KHR_materials_sheen.sheenRoughnessTexture", &sh_tex(|s| s.roughness_texture)),
+            (
+                "extensions.KHR_materials_anisotropy.anisotropyTexture",
+                &out.anisotropy.as_ref().and_then(|a| a.texture),
+            ),
         ];
         // The coat's normal map is oriented by the same tangents as the base's (the extension
-        // asks both to share their UV set); tangents are made for it when the base has none.
+        // asks both to share their UV set); tangents are made for it when the base has none, and
+        // for an anisotropy's direction.
         let needs = Needs {
-            normal_map_set: out.normal_texture.or(cc_tex(|c| c.normal_texture)).map(|t| t.tex_coord),
+            tangents: out.tangent_need(),
             set1_user: named
                 .iter()
                 .find(|(_, t)| t.is_some_and(|t| t.tex_coord == 1))
@@ -1226,6 +1242,45 @@ impl Loader<'_> {
         let roughness_texture = self.extension_texture(&at, sh, "sheenRoughnessTexture", false)?;
         let s = crate::sheen::Sheen { color, color_texture, roughness, roughness_texture };
         Ok((!s.is_off()).then_some(s))
+    }
+
+    /// `KHR_materials_anisotropy` (`an` is its JSON), validated: `None` at strength 0 (the
+    /// extension's default), where the lobe is isotropic whatever the texture holds. The
+    /// texture is data (linear).
+    fn anisotropy(
+        &mut self,
+        at: &str,
+        an: &Value,
+    ) -> Result<Option<crate::anisotropy::Anisotropy>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_anisotropy");
+        let strength = match an.get("anisotropyStrength") {
+            None => 0.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.anisotropyStrength"),
+                        format!("{v} is not a number in [0, 1]"),
+                    ));
+                }
+            },
+        };
+        let max = crate::anisotropy::MAX_ROTATION;
+        let rotation = match an.get("anisotropyRotation") {
+            None => 0.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if x.abs() <= f64::from(max) => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.anisotropyRotation"),
+                        format!("{v} is not an angle in radians within ±{max:e}"),
+                    ));
+                }
+            },
+        };
+        let texture = self.extension_texture(&at, an, "anisotropyTexture", false)?;
+        let a = crate::anisotropy::Anisotropy { strength, rotation, texture };
+        Ok((!a.is_off()).then_some(a))
     }
 
     /// `KHR_materials_transmission` with the material's `KHR_materials_volume` and

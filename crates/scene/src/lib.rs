@@ -6,6 +6,7 @@
 //! [`color::Spectrum`] values at load time, so errors surface with the file and field named.
 
 mod accessors;
+pub mod anisotropy;
 pub mod builtin;
 pub mod clearcoat;
 mod context;
@@ -255,6 +256,11 @@ pub struct Material {
     /// the extension excludes (dropped there with a warning). It may sit with a coat, a
     /// specular, a transmission or a film.
     pub sheen: Option<sheen::Sheen>,
+    /// `KHR_materials_anisotropy`: the specular lobe stretched along a direction in the tangent
+    /// frame ([`anisotropy`]); `None` when absent or at strength 0, and on unlit and
+    /// specular-glossiness materials (dropped there with a warning). Meshes with it get
+    /// tangents ([`Material::tangent_set`]).
+    pub anisotropy: Option<anisotropy::Anisotropy>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
@@ -279,6 +285,39 @@ impl Material {
     pub fn dielectric_f0(&self) -> f32 {
         dielectric_f0(self.ior)
     }
+
+    /// What tangent frame the material's meshes need, if any: a normal map's (the base's, or
+    /// the coat's, which shares it) on that map's UV set, else an anisotropy's on its texture's
+    /// set (TEXCOORD_0 without one).
+    pub fn tangent_need(&self) -> Option<TangentNeed> {
+        let map = self.normal_texture.or(self.clearcoat.as_ref().and_then(|c| c.normal_texture));
+        if let Some(t) = map {
+            return Some(TangentNeed { set: t.tex_coord, uv_required: true });
+        }
+        let a = self.anisotropy.as_ref()?;
+        Some(TangentNeed { set: a.texture.map_or(0, |t| t.tex_coord), uv_required: false })
+    }
+}
+
+/// The tangent frame a mesh's material needs ([`Material::tangent_need`]): MikkTSpace tangents
+/// on UV set `set` when the mesh has none. A normal map cannot be oriented without that set
+/// (`uv_required`: the loader refuses the file); an anisotropy direction can, by the tangent
+/// [`fallback_tangent`] makes from the normal alone, the same in both renderers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TangentNeed {
+    pub set: u32,
+    pub uv_required: bool,
+}
+
+/// A unit tangent perpendicular to unit normal `n` that depends on `n` alone (Duff et al. 2017's
+/// branchless basis), with handedness +1: the frame of meshes whose anisotropy has no UV set to
+/// orient it. The loader makes it from the mesh's own normals, before its node's transform,
+/// which then turns it as it turns every tangent (a brushed part keeps its grain when moved).
+pub fn fallback_tangent(n: Vec3) -> Vec4 {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x).extend(1.0)
 }
 
 /// `KHR_materials_iridescence` of a material: a thin dielectric film whose interference
@@ -348,6 +387,7 @@ impl Default for Material {
             clearcoat: None,
             specular: None,
             sheen: None,
+            anisotropy: None,
         }
     }
 }

@@ -36,8 +36,8 @@ fn triangulate(ctx: &Ctx, at: &str, mode: Mode, idx: Vec<u32>) -> Result<Vec<u32
 /// What the primitive's material asks of its vertex data.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Needs {
-    /// The UV set of the material's normal map, which orients generated tangents.
-    pub normal_map_set: Option<u32>,
+    /// The tangent frame the material needs ([`crate::Material::tangent_need`]).
+    pub tangents: Option<crate::TangentNeed>,
     /// The field of a texture that reads `TEXCOORD_1`, if any (named in the error when the
     /// primitive has none).
     pub set1_user: Option<String>,
@@ -134,7 +134,7 @@ pub(crate) fn build(
         indices,
         material,
     };
-    mesh.complete(needs.normal_map_set).map_err(|m| ctx.invalid(at, m))
+    mesh.complete(needs.tangents).map_err(|m| ctx.invalid(at, m))
 }
 
 /// Applies a node transform: positions by the matrix, normals by its inverse transpose,

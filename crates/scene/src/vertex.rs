@@ -10,7 +10,7 @@ use std::borrow::Cow;
 
 use glam::Vec3;
 
-use crate::{Mesh, Scene, tangents};
+use crate::{Mesh, Scene, TangentNeed, tangents};
 
 /// A normal map on a UV set the mesh does not have (nothing to orient its tangents by).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -44,10 +44,11 @@ impl Mesh {
 
     /// The mesh with the vertex convention of this module applied: flat normals when it has
     /// none (its tangents dropped), normals made unit length, and MikkTSpace tangents on the
-    /// UV set `normal_map_set` when its material has a normal map and the mesh no tangents
-    /// (tangents are dropped when there is no normal map). Indices must be in range. The error
-    /// is for the caller to place: a normal map whose UV set the mesh lacks.
-    pub fn complete(self, normal_map_set: Option<u32>) -> Result<Mesh, MissingUvError> {
+    /// UV set of `need` when its material needs a tangent frame ([`Material::tangent_need`])
+    /// and the mesh has no tangents, or [`crate::fallback_tangent`]s where that set is missing
+    /// and not required (tangents are dropped when nothing needs them). Indices must be in
+    /// range. The error is for the caller to place: a normal map whose UV set the mesh lacks.
+    pub fn complete(self, need: Option<TangentNeed>) -> Result<Mesh, MissingUvError> {
         let mut mesh = if self.normals.is_empty() {
             let mut m = Mesh { tangents: Vec::new(), ..self }.unindexed();
             m.normals = m
@@ -89,11 +90,15 @@ impl Mesh {
         for nrm in &mut mesh.normals {
             *nrm = nrm.try_normalize().unwrap_or(Vec3::Z);
         }
-        match normal_map_set {
-            Some(set) if mesh.tangents.is_empty() => {
+        match need {
+            Some(TangentNeed { set, uv_required }) if mesh.tangents.is_empty() => {
                 let uv = if set == 1 { &mesh.uvs1 } else { &mesh.uvs };
                 if uv.is_empty() {
-                    return Err(MissingUvError { set });
+                    if uv_required {
+                        return Err(MissingUvError { set });
+                    }
+                    mesh.tangents = mesh.normals.iter().map(|&n| crate::fallback_tangent(n)).collect();
+                    return Ok(mesh);
                 }
                 let t = tangents::generate(&mesh.positions, &mesh.normals, uv, &mesh.indices);
                 mesh = mesh.unindexed();
@@ -119,15 +124,13 @@ impl Mesh {
 }
 
 impl Scene {
-    /// The UV set a mesh's normal map reads, when the mesh has it (without it the normal map
-    /// cannot be oriented; the loader refuses such a file, a scene built in code keeps it
-    /// unoriented as before).
-    fn normal_map_set(&self, m: &Mesh) -> Option<u32> {
-        let mat = self.materials.get(m.material)?;
-        // The coat's normal map shares the base's tangents (crate::clearcoat).
-        let set = mat.normal_texture.or(mat.clearcoat.as_ref().and_then(|c| c.normal_texture))?.tex_coord;
-        let uv = if set == 1 { &m.uvs1 } else { &m.uvs };
-        (!uv.is_empty()).then_some(set)
+    /// The tangent frame a mesh's material needs ([`Material::tangent_need`]), unless it is a
+    /// normal map's whose UV set the mesh lacks (the loader refuses such a file; a scene built
+    /// in code keeps it unoriented as before).
+    fn tangent_need(&self, m: &Mesh) -> Option<TangentNeed> {
+        let need = self.materials.get(m.material)?.tangent_need()?;
+        let uv = if need.set == 1 { &m.uvs1 } else { &m.uvs };
+        (!uv.is_empty() || !need.uv_required).then_some(need)
     }
 
     /// The scene with the vertex convention ([`Mesh::complete`]) applied to every mesh that
@@ -136,7 +139,7 @@ impl Scene {
     pub fn completed(&self) -> Cow<'_, Scene> {
         let needs = |m: &Mesh| {
             m.is_well_formed(self.materials.len())
-                && (m.normals.is_empty() || (m.tangents.is_empty() && self.normal_map_set(m).is_some()))
+                && (m.normals.is_empty() || (m.tangents.is_empty() && self.tangent_need(m).is_some()))
         };
         if !self.meshes.iter().any(needs) {
             return Cow::Borrowed(self);
@@ -150,8 +153,8 @@ impl Scene {
                     return m.clone();
                 }
                 // `complete` fails only for a normal map whose UV set is missing, which
-                // `normal_map_set` rules out; the mesh is kept as it is should that change.
-                m.clone().complete(self.normal_map_set(m)).unwrap_or_else(|_| m.clone())
+                // `tangent_need` rules out; the mesh is kept as it is should that change.
+                m.clone().complete(self.tangent_need(m)).unwrap_or_else(|_| m.clone())
             })
             .collect();
         Cow::Owned(s)

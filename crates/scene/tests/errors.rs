@@ -92,8 +92,8 @@ fn unsupported_geometry_and_structure() {
         &["cameras[0].orthographic", "xmag"],
     );
     expect(
-        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_anisotropy"])),
-        &["extensionsRequired[0]", "KHR_materials_anisotropy", "not supported"],
+        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_diffuse_transmission"])),
+        &["extensionsRequired[0]", "KHR_materials_diffuse_transmission", "not supported"],
     );
     expect(
         &mutate(|d| d["materials"][0]["normalTexture"]["texCoord"] = json!(1)),
@@ -162,6 +162,85 @@ fn bad_sheen() {
     ];
     for (v, field) in cases {
         expect(&sheen(v), &[&field]);
+    }
+}
+
+/// `KHR_materials_anisotropy` is read and checked like the other material extensions; its
+/// meshes get tangents even without a normal map: MikkTSpace ones on the UV set, or the normal's
+/// fallback frame on a mesh without UVs.
+#[test]
+fn bad_anisotropy() {
+    let aniso = |v: Value| {
+        mutate(|d| {
+            d["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_materials_anisotropy"));
+            d["extensionsRequired"] = json!(["KHR_materials_anisotropy"]);
+            d["materials"][0]["extensions"]["KHR_materials_anisotropy"] = v;
+            // Without its normal map, so that the tangents come from the anisotropy.
+            d["materials"][0].as_object_mut().unwrap().remove("normalTexture");
+        })
+    };
+    let load = |d: &Value| scene::load_slice("good.gltf", d.to_string().as_bytes(), Some(&data(""))).unwrap();
+    let good = aniso(
+        json!({"anisotropyStrength": 0.6, "anisotropyRotation": 1.0, "anisotropyTexture": {"index": 0}}),
+    );
+    let s = load(&good);
+    let a = s.materials[0].anisotropy.as_ref().expect("read");
+    assert_eq!((a.strength, a.rotation, a.texture.map(|t| t.tex_coord)), (0.6, 1.0, Some(0)));
+    let users: Vec<_> = s.meshes.iter().filter(|m| m.material == 0).collect();
+    assert!(!users.is_empty());
+    for m in &users {
+        assert_eq!(m.tangents.len(), m.positions.len(), "tangents made for the anisotropy");
+        for (t, n) in m.tangents.iter().zip(&m.normals) {
+            assert!(t.truncate().is_normalized() && t.truncate().dot(*n).abs() < 1e-3, "{t} vs {n}");
+        }
+    }
+    // Strength 0 (the default) is off, whatever else is given.
+    assert!(load(&aniso(json!({"anisotropyRotation": 2.0}))).materials[0].anisotropy.is_none());
+    // On a mesh without normals or UVs (the fixture's triangle): the fallback frame
+    // (scene::fallback_tangent), perpendicular to the (flat) normal.
+    let mut no_uv = good.clone();
+    no_uv["materials"][1]["extensions"] = json!({"KHR_materials_anisotropy": {"anisotropyStrength": 1.0}});
+    let s = load(&no_uv);
+    assert!(s.materials[1].anisotropy.is_some());
+    for m in s.meshes.iter().filter(|m| m.material == 1) {
+        assert!(m.uvs.is_empty());
+        assert_eq!(m.tangents.len(), m.positions.len());
+        for (t, n) in m.tangents.iter().zip(&m.normals) {
+            // Made in the mesh's own frame, then turned with its node as every tangent is.
+            assert!(t.truncate().is_normalized() && t.truncate().dot(*n).abs() < 1e-6, "{t} vs {n}");
+        }
+    }
+    // On an unlit material: dropped with a warning naming the material.
+    let mut unlit = good.clone();
+    unlit["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_materials_unlit"));
+    unlit["materials"][0]["extensions"]["KHR_materials_unlit"] = json!({});
+    let s = load(&unlit);
+    assert!(s.materials[0].anisotropy.is_none());
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("materials[0]") && w.contains("KHR_materials_anisotropy is ignored")),
+        "{:?}",
+        s.warnings
+    );
+    let at = "materials[0].extensions.KHR_materials_anisotropy";
+    let cases = [
+        (json!({"anisotropyStrength": 1.5}), format!("{at}.anisotropyStrength")),
+        (json!({"anisotropyStrength": -0.1}), format!("{at}.anisotropyStrength")),
+        (json!({"anisotropyStrength": "max"}), format!("{at}.anisotropyStrength")),
+        (json!({"anisotropyStrength": 1, "anisotropyRotation": 1e30}), format!("{at}.anisotropyRotation")),
+        (json!({"anisotropyStrength": 1, "anisotropyRotation": null}), format!("{at}.anisotropyRotation")),
+        (
+            json!({"anisotropyStrength": 1, "anisotropyTexture": {"index": 3}}),
+            format!("{at}.anisotropyTexture.index"),
+        ),
+        (
+            json!({"anisotropyStrength": 1, "anisotropyTexture": {"index": 0, "texCoord": 1.5}}),
+            format!("{at}.anisotropyTexture.texCoord"),
+        ),
+    ];
+    for (v, field) in cases {
+        expect(&aniso(v), &[&field]);
     }
 }
 
