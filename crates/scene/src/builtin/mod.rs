@@ -4,6 +4,7 @@
 //! truth, and gives RGB renderers the colours those spectra actually have under D65, so RGB and
 //! spectral renders describe the same physical scene.
 
+pub mod anisotropy;
 pub mod clearcoat;
 mod colorchecker;
 mod cornell;
@@ -35,6 +36,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "clearcoat",
     "specular",
     "sheen",
+    "anisotropy",
     "underwater",
     "fog",
     "tinted-fog",
@@ -52,6 +54,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "clearcoat" => clearcoat::build(&ctx),
         "specular" => specular::build(&ctx),
         "sheen" => sheen::build(&ctx),
+        "anisotropy" => anisotropy::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),
@@ -132,7 +135,8 @@ pub(crate) fn spot_at(
     })
 }
 
-/// The stage of the material showcases (`iridescence`, `clearcoat`, `specular`, `sheen`): two rows of
+/// The stage of the material showcases (`iridescence`, `clearcoat`, `specular`, `sheen`,
+/// `anisotropy`): two rows of
 /// four spheres of radius 0.12, 0.3 apart (the back row at z = −0.2, the front at 0.15), on a
 /// 2 m floor of ColorChecker neutral 5, seen from above and in front; two spots
 /// ([`showcase_spots`]).

@@ -140,8 +140,8 @@ pub const CASE_IDS: &[&str] = &[
 
 /// Cases `spectra eval --scenes` accepts besides [`CASE_IDS`], outside the default suite (whose
 /// results are the README's contract): `clearcoat` (session 42), `specular` (session 43),
-/// `sheen` (session 45).
-pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular", "sheen"];
+/// `sheen` (session 45), `anisotropy` (session 46).
+pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular", "sheen", "anisotropy"];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
@@ -235,6 +235,13 @@ pub fn case(id: &str) -> Result<Case> {
                     bases; a D65 and an F11 spot"
                 .into(),
             scene: scene::builtin("sheen")?,
+        }),
+        "anisotropy" => Ok(Case {
+            id: id.into(),
+            title: "Anisotropy (KHR_materials_anisotropy): coloured metals stretched from 0.25 to 1, measured ColorChecker \
+                    dielectrics at 0.8 turned by 0-135 degrees; a D65 and an F11 spot"
+                .into(),
+            scene: scene::builtin("anisotropy")?,
         }),
         "glass" => Ok(Case {
             id: id.into(),
@@ -354,6 +361,7 @@ mod tests {
         assert!(case("clearcoat").unwrap().scene.materials.iter().any(|m| m.clearcoat.is_some()));
         assert!(case("specular").unwrap().scene.materials.iter().any(|m| m.specular.is_some()));
         assert!(case("sheen").unwrap().scene.materials.iter().any(|m| m.sheen.is_some()));
+        assert!(case("anisotropy").unwrap().scene.materials.iter().any(|m| m.anisotropy.is_some()));
         assert!(case("nope").unwrap_err().to_string().contains("clearcoat"));
     }
 }
