@@ -185,7 +185,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             transmission,
             coat,
             specular,
-            sheen
+            sheen,
+            anisotropy
         }),
     );
     let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);

@@ -791,8 +791,13 @@ impl Renderer {
             settings.shadows,
             frame_index,
         );
-        if remade {
-            // The shading inputs hold the old depth array.
+        // An anisotropic scene's film target is another (`Targets::bind_film_anisotropy`).
+        let film_changed = self
+            .targets
+            .as_mut()
+            .is_some_and(|(t, _)| t.bind_film_anisotropy(&self.gpu.device, scene.has_anisotropy));
+        if remade || film_changed {
+            // The shading inputs hold the old depth array, or the old film target.
             let device = &self.gpu.device;
             if let Some((t, b)) = self.targets.as_mut() {
                 b.shading = self.shading.bind_both(device, t, &self.shadow, &self.capture_dummy);
@@ -869,6 +874,7 @@ impl Renderer {
             ior: scene.has_ior,
             specular: scene.has_specular,
             sheen: scene.has_sheen,
+            anisotropy: scene.has_anisotropy,
             transmission: false,
             thin_walls: scene.has_thin_walls,
             dispersion: scene.has_dispersion,
@@ -893,6 +899,7 @@ impl Renderer {
                 // draws no sheen there.
                 specular: false,
                 sheen: false,
+                anisotropy: false,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -909,13 +916,15 @@ impl Renderer {
         }
         let layer_key = self.shading.current();
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
-        // The film's target comes with a coat's or a specular's: the shading pass reads it beside them.
-        let filmed = scene.has_film || scene.has_coat || scene.has_specular;
+        // The film's target comes with a coat's or a specular's: the shading pass reads it beside
+        // them; and with an anisotropy, which it carries.
+        let filmed = scene.has_film || scene.has_coat || scene.has_specular || scene.has_anisotropy;
         let gbuffer_targets = GBufferTargets {
             fourth: if filmed { GBufferFourth::Film } else { GBufferFourth::None },
             coat: scene.has_coat,
             specular: scene.has_specular,
             sheen: scene.has_sheen,
+            anisotropy: scene.has_anisotropy,
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         let layer_targets = GBufferTargets {
@@ -923,6 +932,7 @@ impl Renderer {
             coat: scene.has_transmission_coat,
             specular: false,
             sheen: false,
+            anisotropy: false,
         };
         if layered {
             self.gbuffer.prepare(&self.gpu.device, layer_targets)?;
@@ -938,7 +948,7 @@ impl Renderer {
         self.shadow.record(&mut encoder, scene, ts(0));
         let g = &targets.gbuffer_views;
         let (film, coat, spec, sheen) = (
-            &targets.gbuffer_film_view,
+            targets.film_view(),
             &targets.gbuffer_coat_view,
             &targets.gbuffer_specular_view,
             &targets.gbuffer_sheen_view,

@@ -97,6 +97,10 @@ pub struct MaterialUniforms {
     /// G-buffer's specular-and-sheen target holds them × the colour texture's RGB and the
     /// roughness texture's A. Zero without (no sheen).
     pub sheen: [f32; 4],
+    /// `KHR_materials_anisotropy` ([`anisotropy`]): x the strength (0: none), y and z the
+    /// rotation's cosine and sine, w 1 with a texture (read at the transmission's slot, which
+    /// an anisotropic material never uses: [`texture_refs`]). Zero without.
+    pub anisotropy: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -144,6 +148,10 @@ impl MaterialUniforms {
                 [w, f0 * c.x, f0 * c.y, f0 * c.z]
             },
             sheen: sheen(m).map_or([0.0; 4], |sh| sh.color.extend(sh.roughness).to_array()),
+            anisotropy: anisotropy(m).map_or([0.0; 4], |a| {
+                let (sin, cos) = a.rotation.sin_cos();
+                [a.strength, cos, sin, a.texture.is_some() as u8 as f32]
+            }),
         }
     }
 }
@@ -168,6 +176,13 @@ pub fn sheen(m: &scene::Material) -> Option<&scene::sheen::Sheen> {
     m.sheen.as_ref().filter(|s| !m.unlit && transmission(m).is_none() && !s.is_off())
 }
 
+/// The material's anisotropy as the real-time renderer draws it: on lit, opaque materials at a
+/// strength above 0 (the transmissive layer's G-buffer has no room for it; such a material is
+/// drawn without, and the upload says so).
+pub fn anisotropy(m: &scene::Material) -> Option<&scene::anisotropy::Anisotropy> {
+    m.anisotropy.as_ref().filter(|a| !m.unlit && transmission(m).is_none() && !a.is_off())
+}
+
 /// The material's specular strength and colour as the real-time renderer draws them: the
 /// loader keeps them only on lit, film-less, opaque materials (`scene::Material::specular`).
 pub fn specular(m: &scene::Material) -> Option<&scene::specular::Specular> {
@@ -177,7 +192,10 @@ pub fn specular(m: &scene::Material) -> Option<&scene::specular::Specular> {
 /// A material's textures in slot order: base colour, metallic-roughness, normal, emissive,
 /// occlusion, the film's weight (iridescence texture, R) and thickness (G), the transmission
 /// (R) and the volume's thickness (G), the coat's strength (R), roughness (G) and normal map,
-/// the specular strength (A) and colour (sRGB).
+/// the specular strength (A) and colour (sRGB), the sheen's colour (sRGB) and roughness (A). The
+/// anisotropy's texture (linear; RG the direction, B the strength) takes the transmission's
+/// slot: a material has one or the other ([`anisotropy`] is on opaque materials only), and the
+/// G-buffer's fragment stage has no 17th texture.
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
     let t = transmission(m);
@@ -190,7 +208,7 @@ pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] 
         m.occlusion_texture,
         film.and_then(|f| f.texture),
         film.and_then(|f| f.thickness_texture),
-        t.and_then(|t| t.texture),
+        t.and_then(|t| t.texture).or_else(|| anisotropy(m).and_then(|a| a.texture)),
         t.and_then(|t| t.volume.as_ref()).and_then(|v| v.thickness_texture),
         c.and_then(|c| c.texture),
         c.and_then(|c| c.roughness_texture),
@@ -499,6 +517,10 @@ pub struct GpuScene {
     /// Whether some opaque material has a sheen ([`sheen`]): only then does the G-buffer write
     /// it and the shading pass compile it (`HAS_SHEEN`).
     pub has_sheen: bool,
+    /// Whether some opaque material has an anisotropy ([`anisotropy`]): only then does the
+    /// G-buffer write it (beside the film's values) and the shading pass compile it
+    /// (`HAS_ANISOTROPY`).
+    pub has_anisotropy: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -695,6 +717,23 @@ impl GpuScene {
                 sheened.join(", ")
             ));
         }
+        // Nor has it room for an anisotropy.
+        let anisotropic: Vec<String> = s
+            .materials
+            .iter()
+            .filter(|m| {
+                m.anisotropy.as_ref().is_some_and(|a| !a.is_off()) && !m.unlit && transmission(m).is_some()
+            })
+            .map(|m| format!("'{}'", m.name))
+            .collect();
+        if !anisotropic.is_empty() {
+            warnings.push(format!(
+                "KHR_materials_anisotropy on a see-through material is not drawn by the real-time renderer \
+                 (material{} {}): drawn with an isotropic specular lobe; the path tracer (`spectra truth`) draws it",
+                if anisotropic.len() > 1 { "s" } else { "" },
+                anisotropic.join(", ")
+            ));
+        }
         let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
         let mut samplers = SamplerCache::default();
@@ -831,6 +870,7 @@ impl GpuScene {
             has_ior: s.materials.iter().any(|m| !m.unlit && m.ior != 1.5),
             has_specular: s.materials.iter().any(|m| specular(m).is_some()),
             has_sheen: s.materials.iter().any(|m| sheen(m).is_some()),
+            has_anisotropy: s.materials.iter().any(|m| anisotropy(m).is_some()),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s
                 .materials

@@ -38,6 +38,13 @@ pub struct Targets {
     /// The thin film per pixel (written only for scenes with a film).
     pub gbuffer_film: wgpu::Texture,
     pub gbuffer_film_view: wgpu::TextureView,
+    /// The film's values and the anisotropy per pixel, in place of `gbuffer_film` for scenes
+    /// with `KHR_materials_anisotropy` (`passes::GBUFFER_FILM_ANISOTROPY_FORMAT`), made at the
+    /// first such scene ([`Self::bind_film_anisotropy`]).
+    pub gbuffer_film_anisotropy: Option<(wgpu::Texture, wgpu::TextureView)>,
+    /// Whether the shading inputs bind `gbuffer_film_anisotropy` where the film's target is read
+    /// (the bind groups made while it is set do).
+    pub film_anisotropy: bool,
     /// The clear coat per pixel (written only for scenes with a coat).
     pub gbuffer_coat: wgpu::Texture,
     pub gbuffer_coat_view: wgpu::TextureView,
@@ -104,6 +111,8 @@ impl Targets {
             gbuffer_views: [v0, v1, v2],
             gbuffer_film,
             gbuffer_film_view,
+            gbuffer_film_anisotropy: None,
+            film_anisotropy: false,
             gbuffer_coat,
             gbuffer_coat_view,
             gbuffer_specular,
@@ -122,6 +131,34 @@ impl Targets {
             ldr,
             ldr_view,
             layer: None,
+        }
+    }
+}
+
+impl Targets {
+    /// Makes the film's target the anisotropic scenes' (`on`) or the others', making the
+    /// former at its first use; true when that changed which one is bound (the caller then
+    /// remakes the shading inputs).
+    pub fn bind_film_anisotropy(&mut self, device: &wgpu::Device, on: bool) -> bool {
+        if on && self.gbuffer_film_anisotropy.is_none() {
+            self.gbuffer_film_anisotropy = Some(target(
+                device,
+                (self.width, self.height),
+                "gbuffer film and anisotropy",
+                crate::passes::GBUFFER_FILM_ANISOTROPY_FORMAT,
+                wgpu::TextureUsages::COPY_SRC,
+            ));
+        }
+        let changed = self.film_anisotropy != on;
+        self.film_anisotropy = on;
+        changed
+    }
+
+    /// The film's target the G-buffer writes and the shading reads ([`Self::bind_film_anisotropy`]).
+    pub fn film_view(&self) -> &wgpu::TextureView {
+        match (&self.gbuffer_film_anisotropy, self.film_anisotropy) {
+            (Some((_, view)), true) => view,
+            _ => &self.gbuffer_film_view,
         }
     }
 }

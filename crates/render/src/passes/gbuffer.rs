@@ -14,8 +14,8 @@
 //! ([`Targets::wgsl`]) around gbuffer.wgsl's one function per target.
 
 use super::{
-    GBUFFER_COAT_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS, GBUFFER_LAYER_FORMAT, GBUFFER_SHEEN_FORMAT,
-    GBUFFER_SPECULAR_FORMAT, SharedLayouts,
+    GBUFFER_COAT_FORMAT, GBUFFER_FILM_ANISOTROPY_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS,
+    GBUFFER_LAYER_FORMAT, GBUFFER_SHEEN_FORMAT, GBUFFER_SPECULAR_FORMAT, SharedLayouts,
 };
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
@@ -64,35 +64,43 @@ pub enum Fourth {
 /// Which targets a G-buffer pass writes, in location order: base, normal (with the slot),
 /// emission, then the [`Fourth`], the clear coat's ([`GBUFFER_COAT_FORMAT`]), the specular
 /// strength and colour ([`GBUFFER_SPECULAR_FORMAT`], `KHR_materials_specular`) and the sheen
-/// ([`GBUFFER_SHEEN_FORMAT`], `KHR_materials_sheen`).
+/// ([`GBUFFER_SHEEN_FORMAT`], `KHR_materials_sheen`). An anisotropy (`KHR_materials_anisotropy`)
+/// adds no target: it widens the film's to [`GBUFFER_FILM_ANISOTROPY_FORMAT`] (film values in
+/// xy, the anisotropy's angle and strength in zw), which the shading pass reads where it reads
+/// the film's (no sampled texture to spare there, nor a colour attachment with a sheen here).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Targets {
     pub fourth: Fourth,
     pub coat: bool,
     pub specular: bool,
     pub sheen: bool,
+    pub anisotropy: bool,
 }
 
 impl Targets {
-    pub const PLAIN: Targets = Targets { fourth: Fourth::None, coat: false, specular: false, sheen: false };
+    pub const PLAIN: Targets =
+        Targets { fourth: Fourth::None, coat: false, specular: false, sheen: false, anisotropy: false };
 
     /// Every set the renderer draws with: a coat comes with the film's or the layer's target
     /// (which the shading pass reads beside it), a specular with the film's (the loader keeps no
     /// specular on see-through materials), a sheen anywhere but the see-through layer's (the
-    /// real-time renderer draws no sheen there).
+    /// real-time renderer draws no sheen there), an anisotropy with the film's (which it
+    /// widens; none in the see-through layer either).
     pub fn all() -> impl Iterator<Item = Targets> {
         [Fourth::None, Fourth::Film, Fourth::Layer].into_iter().flat_map(|fourth| {
-            (0..8u8)
+            (0..16u8)
                 .map(move |bits| Targets {
                     fourth,
                     coat: bits & 1 != 0,
                     specular: bits & 2 != 0,
                     sheen: bits & 4 != 0,
+                    anisotropy: bits & 8 != 0,
                 })
                 .filter(|t| {
                     (!t.coat || t.fourth != Fourth::None)
                         && (!t.specular || t.fourth == Fourth::Film)
                         && (!t.sheen || t.fourth != Fourth::Layer)
+                        && (!t.anisotropy || t.fourth == Fourth::Film)
                 })
         })
     }
@@ -102,6 +110,7 @@ impl Targets {
         let mut f = GBUFFER_FORMATS.to_vec();
         match self.fourth {
             Fourth::None => {}
+            Fourth::Film if self.anisotropy => f.push(GBUFFER_FILM_ANISOTROPY_FORMAT),
             Fourth::Film => f.push(GBUFFER_FILM_FORMAT),
             Fourth::Layer => f.push(GBUFFER_LAYER_FORMAT),
         }
@@ -123,6 +132,10 @@ impl Targets {
         // Base, normal and emission; the film's or the layer's 4.
         let mut bytes = 8 + 8 + 8 + if self.fourth == Fourth::None { 0 } else { 4 };
         let mut what = Vec::new();
+        if self.anisotropy {
+            bytes += super::ANISOTROPY_TARGET_BYTES;
+            what.push("an anisotropy (KHR_materials_anisotropy)");
+        }
         if self.coat {
             bytes += 8;
             what.push("a clear coat (KHR_materials_clearcoat)");
@@ -145,10 +158,11 @@ impl Targets {
             Fourth::Layer => "layer",
         };
         format!(
-            "{fourth}{}{}{}",
+            "{fourth}{}{}{}{}",
             if self.coat { "_coat" } else { "" },
             if self.specular { "_spec" } else { "" },
-            if self.sheen { "_sheen" } else { "" }
+            if self.sheen { "_sheen" } else { "" },
+            if self.anisotropy { "_aniso" } else { "" }
         )
     }
 
@@ -171,6 +185,12 @@ impl Targets {
         let mut writes = Vec::new();
         match self.fourth {
             Fourth::None => {}
+            Fourth::Film if self.anisotropy => {
+                fields.push(format!("@location({}) film: vec4<f32>", fields.len()));
+                samples.push("let f = film_values(v);");
+                samples.push("let an = anisotropy_values(v);");
+                writes.push("r.film = vec4<f32>(film_target(o, f), anisotropy_target(o, an, v));");
+            }
             Fourth::Film => {
                 fields.push(format!("@location({}) film: vec2<f32>", fields.len()));
                 samples.push("let f = film_values(v);");
@@ -379,7 +399,7 @@ mod tests {
     #[test]
     fn generated_entry_points_write_each_target_in_order() {
         let all: Vec<Targets> = Targets::all().collect();
-        assert_eq!(all.len(), 12, "{all:?}");
+        assert_eq!(all.len(), 20, "{all:?}");
         let entry_points: String = all.iter().map(|t| t.wgsl()).collect();
         let source =
             [shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl"), &entry_points]

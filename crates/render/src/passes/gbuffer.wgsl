@@ -187,3 +187,41 @@ fn sheen_target(o: GBufferOut, sh: vec4<f32>) -> vec4<f32> {
     // An unlit surface (UNLIT_MARK) reflects nothing: no sheen.
     return select(sh, vec4<f32>(0.0), o.base.a < 0.0);
 }
+
+// Scenes with KHR_materials_anisotropy write it beside the film's values, in the fourth target
+// widened to four channels (passes/gbuffer.rs `Targets::anisotropy`, GBUFFER_FILM_ANISOTROPY_FORMAT):
+// z the direction's angle (`anisotropy_angle`, wgsl/common.wgsl), w the strength s (0: none) —
+// scene::anisotropy's convention: the texture's RG (linear, [0, 1] → [−1, 1]) rotated by the
+// rotation, in the vertex tangent frame about the shading normal, t0 = normalize(T − n·(n·T)),
+// b0 = n × t0 · T.w; s = strength × the texture's B. The texture is read at the transmission's
+// slot (TEX_ANISOTROPY), which an anisotropic material never has.
+fn anisotropy_values(v: VertexOut) -> vec3<f32> {
+    let c = textureSampleBias(transmission_tex, transmission_smp, material_uv(TEX_ANISOTROPY, v.uv, v.uv1), frame.lod_bias).rgb;
+    // Without a texture: direction (1, 0), strength factor 1.
+    return select(vec3<f32>(1.0, 0.5, 1.0), c, material.anisotropy.w > 0.5);
+}
+
+fn anisotropy_target(o: GBufferOut, c: vec3<f32>, v: VertexOut) -> vec2<f32> {
+    let s = clamp(material.anisotropy.x * c.b, 0.0, 1.0);
+    // An unlit surface (UNLIT_MARK) reflects nothing: no anisotropy.
+    if (s <= 0.0 || o.base.a < 0.0) {
+        return vec2<f32>(0.0);
+    }
+    // The normal as the shading pass will decode it.
+    let n = gbuffer_normal(o.normal);
+    // Meshes of anisotropic materials carry tangents (MikkTSpace or scene::fallback_tangent).
+    var tangent = v.tangent;
+    if (dot(tangent.xyz, tangent.xyz) <= 0.0) {
+        tangent = vec4<f32>(canonical_tangent(n), 1.0);
+    }
+    let t0 = normalize(tangent.xyz - n * dot(n, tangent.xyz));
+    let b0 = cross(n, t0) * tangent.w;
+    let cr = material.anisotropy.y;
+    let sr = material.anisotropy.z;
+    let d0 = c.rg * 2.0 - 1.0;
+    var d = vec2<f32>(cr * d0.x - sr * d0.y, sr * d0.x + cr * d0.y);
+    // A zero direction reads as the rotated tangent (scene::anisotropy::Anisotropy::at).
+    d = select(vec2<f32>(cr, sr), d, dot(d, d) > 1e-12);
+    let t = normalize(d.x * t0 + d.y * b0);
+    return vec2<f32>(anisotropy_angle(n, t), s);
+}

@@ -75,6 +75,15 @@ pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] =
 /// Two channels: the colour attachments of a sample may hold 32 bytes (WebGPU's guarantee),
 /// and the layer's target below takes the place of this one beside the other three's 24.
 pub const GBUFFER_FILM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+/// The film's target of scenes with `KHR_materials_anisotropy` (`passes::gbuffer::Targets::anisotropy`):
+/// xy the film's values as [`GBUFFER_FILM_FORMAT`], z the anisotropy direction's angle about the
+/// normal in half turns from a frame the normal alone sets (`anisotropy_angle` in
+/// wgsl/common.wgsl; f16: 1.5·10⁻³ rad at worst), w its strength. A target of its own would be
+/// a ninth colour attachment beside a coat, a specular and a sheen, and a 17th sampled texture
+/// in the shading stage; widened, the film's costs 4 bytes more a pixel and is read where it was.
+pub const GBUFFER_FILM_ANISOTROPY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The bytes a pixel an anisotropy adds to the G-buffer's targets.
+pub const ANISOTROPY_TARGET_BYTES: u32 = 4;
 /// The transmissive layer's fourth G-buffer target: transmission, volume thickness, and the
 /// film's weight and thickness (`passes::gbuffer::Fourth::Layer`), each in [0, 1] and from
 /// 8-bit textures, packed by `pack4x8unorm`: the colour attachments may hold 32 bytes a pixel,

@@ -152,6 +152,9 @@ pub struct Variant {
     /// Some opaque material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`): the G-buffer's
     /// sheen target is read and each light's sheen lobe added (all modes).
     pub sheen: bool,
+    /// Some opaque material has an anisotropy (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`):
+    /// the film's target carries it, and the base's specular lobe is anisotropic (all modes).
+    pub anisotropy: bool,
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
     /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
     pub transmission: bool,
@@ -186,6 +189,7 @@ impl Variant {
         ior: true,
         specular: true,
         sheen: true,
+        anisotropy: true,
         transmission: false,
         thin_walls: true,
         dispersion: true,
@@ -194,9 +198,9 @@ impl Variant {
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, emission, film, ior, specular, sheen, transmission, thin walls, dispersion) and the occlusion's; its
+    /// environment, emission, film, ior, specular, sheen, anisotropy, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 18] {
+    fn constants(&self) -> [(&'static str, f64); 19] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -212,6 +216,7 @@ impl Variant {
             ("HAS_IOR", b(self.ior)),
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_SHEEN", b(self.sheen)),
+            ("HAS_ANISOTROPY", b(self.anisotropy)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
             ("HAS_DISPERSION", b(self.dispersion)),
@@ -233,6 +238,7 @@ impl Variant {
             ior: self.ior,
             specular: self.specular,
             sheen: self.sheen,
+            anisotropy: self.anisotropy,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
             dispersion: self.dispersion,
@@ -555,7 +561,8 @@ impl ShadingPass {
                 buffer_entry(6, &shadow.uniforms),
                 buffer_entry(7, capture),
                 view_entry(8, &t.gbuffer_coat_view),
-                view_entry(9, &t.gbuffer_film_view),
+                // The film's values (with an anisotropy's where the scene has one).
+                view_entry(9, t.film_view()),
                 // The sheen (`sheen_at`; the transmissive layer's background there). Not read
                 // outside the transmissive layer: any texture of its kind the pass does not write.
                 view_entry(10, &t.gbuffer_sheen_view),

@@ -39,6 +39,50 @@ override HAS_SPECULAR: bool = true;
 // A material with a sheen (KHR_materials_sheen, wgsl/sheen.wgsl): the G-buffer's sheen target is
 // read and each light's sheen lobe added, the base scaled by what the sheen leaves (every mode).
 override HAS_SHEEN: bool = true;
+// A material with an anisotropy (KHR_materials_anisotropy, scene::anisotropy): the film's target
+// carries it (gbuffer.wgsl), and the base's specular lobe is anisotropic GGX for every light,
+// its environment lookup about a bent normal (every mode).
+override HAS_ANISOTROPY: bool = true;
+
+// The anisotropy at a pixel: the unit direction t ⟂ n along which the lobe is stretched and the
+// strength s (0: an isotropic lobe).
+struct Aniso {
+    t: vec3<f32>,
+    s: f32,
+};
+
+fn no_aniso() -> Aniso {
+    return Aniso(vec3<f32>(1.0, 0.0, 0.0), 0.0);
+}
+
+// None without anisotropies in the scene, on unlit surfaces and in the Lambert-only comparison
+// mode (which has no specular lobe).
+fn load_aniso(px: vec2<i32>, s: GSurface) -> Aniso {
+    if (!HAS_ANISOTROPY || s.unlit || lambert_only()) {
+        return no_aniso();
+    }
+    let f = textureLoad(gbuf_film, px, 0).zw;
+    if (f.y <= 0.0) {
+        return no_aniso();
+    }
+    return Aniso(anisotropy_direction(s.normal, f.x), f.y);
+}
+
+// The normal about which the environment's prefiltered radiance is looked up for an
+// anisotropic lobe: the Khronos sample viewer's bent normal, the normal tilted towards the
+// plane across the direction of least roughness b = n × t (the highlight's streak), as much as
+// the lobe is stretched (bendFactor = 1 − s·(1 − roughness), to the fourth). n itself without.
+fn anisotropy_env_normal(a: Aniso, n: vec3<f32>, v: vec3<f32>, roughness: f32) -> vec3<f32> {
+    if (!HAS_ANISOTROPY || a.s <= 0.0) {
+        return n;
+    }
+    let dir = cross(n, a.t);
+    let an = cross(cross(dir, v), dir);
+    let bend = 1.0 - a.s * (1.0 - roughness);
+    let b2 = bend * bend;
+    let m = mix(an, n, b2 * b2);
+    return select(n, normalize(m), dot(m, m) > 1e-12);
+}
 
 // The sheen at a pixel (gbuffer.wgsl; bound where the see-through layer has its background,
 // which a sheen never needs): rgb the colour, a the roughness (scene::sheen).
@@ -79,7 +123,7 @@ struct ShadowUniforms {
 };
 @group(1) @binding(6) var<uniform> shadows: ShadowUniforms;
 // The films: x weight (0: none), y the thickness between the material's minimum and maximum
-// (gbuffer.wgsl).
+// (gbuffer.wgsl); in scenes with an anisotropy z and w its angle and strength (`load_aniso`).
 @group(1) @binding(9) var gbuf_film: texture_2d<f32>;
 // The coats: normal, roughness and strength, packed as the normal's target (gbuffer.wgsl).
 @group(1) @binding(8) var gbuf_coat: texture_2d<u32>;
@@ -285,7 +329,34 @@ fn ggx_dv(n: vec3<f32>, v: vec3<f32>, h: vec3<f32>, nl: f32, roughness: f32, rho
     return vec2<f32>(dist, vis);
 }
 
-fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32, c: Coat) -> LightTerms {
+// `ggx_dv` of an anisotropic lobe (scene::anisotropy): α_t = mix(α, 1, s²) along t, α_b = α
+// across it (α the floored isotropic width), D and the height-correlated V of anisotropic GGX;
+// a sun's disc widens both widths as it widens α.
+fn ggx_dv_aniso(n: vec3<f32>, v: vec3<f32>, l: vec3<f32>, h: vec3<f32>, nl: f32, roughness: f32, rho: f32, a: Aniso) -> vec2<f32> {
+    let nv = max(dot(n, v), 1e-4);
+    let nh = max(dot(n, h), 0.0);
+    let alpha = max(roughness * roughness, 1e-3);
+    var at = alpha + (1.0 - alpha) * a.s * a.s;
+    var ab = alpha;
+    if (rho > 0.0) {
+        let w2 = rho * rho / (4.0 * nv);
+        at = min(sqrt(at * at + w2), 1.0);
+        ab = min(sqrt(ab * ab + w2), 1.0);
+    }
+    let b = cross(n, a.t);
+    let a2 = at * ab;
+    // 1/(π·α_t·α_b·((t·h/α_t)² + (b·h/α_b)² + (n·h)²)²), in the form that keeps f32 in range.
+    let f = vec3<f32>(ab * dot(a.t, h), at * dot(b, h), a2 * nh);
+    let w2 = a2 / dot(f, f);
+    let dist = a2 * w2 * w2 / PI;
+    let gv = nl * length(vec3<f32>(at * dot(a.t, v), ab * dot(b, v), nv));
+    let gl = nv * length(vec3<f32>(at * dot(a.t, l), ab * dot(b, l), nl));
+    return vec2<f32>(dist, 0.5 / (gv + gl));
+}
+
+// `a`: the base's anisotropy (`load_aniso`; not the coat's lobe, which stays isotropic). A
+// polygon light's LTC lobe stays isotropic, at the base's roughness.
+fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32, a: Aniso, c: Coat) -> LightTerms {
     if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
         var t = polygon_terms(li, p, n, v, roughness);
         if (HAS_COAT && c.w > 0.0) {
@@ -319,7 +390,12 @@ fn light_terms(li: u32, p: vec3<f32>, n: vec3<f32>, v: vec3<f32>, roughness: f32
         return LightTerms(k, 0.0, 1.0, 0.0);
     }
     let vh = max(dot(v, h), 0.0);
-    let g = ggx_dv(n, v, h, nl, roughness, rho);
+    var g: vec2<f32>;
+    if (HAS_ANISOTROPY && a.s > 0.0) {
+        g = ggx_dv_aniso(n, v, wi, h, nl, roughness, rho, a);
+    } else {
+        g = ggx_dv(n, v, h, nl, roughness, rho);
+    }
     return LightTerms(k, k * g.x * g.y, vh, kc);
 }
 
@@ -750,6 +826,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         var sum_c = vec3<f32>(0.0);
         coat = load_coat(px, -ctx.view_dir, s.unlit);
         let sh = load_sheen(px, s, -ctx.view_dir);
+        let an = load_aniso(px, s);
         // What the sheen reflects, per unit colour.
         var sum_sheen = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
@@ -758,7 +835,7 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             if (CUSTOM_LIGHT_T) {
                 e *= custom_light_transmittance_rgb(li, ctx);
             }
-            var t = light_terms(li, ctx.world_pos, s.normal, -ctx.view_dir, s.roughness, coat);
+            var t = light_terms(li, ctx.world_pos, s.normal, -ctx.view_dir, s.roughness, an, coat);
             let k = custom_light_surface(li, ctx);
             t.kd *= k;
             t.ks *= k;
@@ -809,12 +886,13 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         }
         if (shading_env() && !s.unlit) {
             var et: EnvTerms;
+            let nr = anisotropy_env_normal(an, s.normal, -ctx.view_dir, s.roughness);
             if (HAS_TRANSMISSION && !filmed) {
                 et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else if (!filmed) {
-                et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
+                et = env_terms_bent(s.normal, nr, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, 1.0, s.spec_w);
             } else {
-                let l = env_lobes(s.normal, -ctx.view_dir, s.roughness);
+                let l = env_lobes_bent(s.normal, nr, -ctx.view_dir, s.roughness);
                 let a = l.ab.x;
                 let b = l.ab.y;
                 var fd: vec3<f32>;
@@ -1155,6 +1233,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     }
     let keep = 1.0 - tr.weight;
     let coat = load_coat(px, v, s.unlit);
+    let an = load_aniso(px, s);
     // The sheen's colour is a reflectance too (its lobe is the colour times a factor): summed
     // per light from the CPU's XYZs where constant, else over its nodes (fetched once).
     var sh = no_sheen();
@@ -1171,7 +1250,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     // What the coat reflects, per unit w: each light's XYZ once (it does not depend on ρ).
     var coat_xyz = vec3<f32>(0.0);
     for (var li = 0u; li < n_lights; li++) {
-        var t = light_terms(li, p, s.normal, v, s.roughness, coat);
+        var t = light_terms(li, p, s.normal, v, s.roughness, an, coat);
         let k = custom_light_surface(li, ctx);
         t.kd *= k;
         t.ks *= k;
@@ -1247,8 +1326,9 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
     var lobes: EnvLobes;
     let film_env = filmed && has_env;
     if (has_env && !s.unlit) {
+        let nr = anisotropy_env_normal(an, s.normal, v, s.roughness);
         if (film_env) {
-            lobes = env_lobes(s.normal, v, s.roughness);
+            lobes = env_lobes_bent(s.normal, nr, v, s.roughness);
             // A see-through surface's diffuse layer is what its transmission leaves.
             lobes.irr *= vis * keep;
             lobes.spec *= vis;
@@ -1261,7 +1341,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             if (HAS_TRANSMISSION) {
                 et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else {
-                et = env_terms(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
+                et = env_terms_bent(s.normal, nr, v, s.metallic, s.roughness, lambert_only(), s.f0, 1.0, s.spec_w);
             }
             et.a *= vis;
             et.b *= vis;
@@ -1354,8 +1434,8 @@ struct NodeLight {
 
 // Under a coat (`Coat`), what lies beneath is scaled by 1 − w and the coat's lobe, which does
 // not depend on ρ, joins `b` (a filmed pixel's `b` is the coat's alone).
-fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat, sh: SheenSurface) -> NodeLight {
-    var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness, c);
+fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat, sh: SheenSurface, an: Aniso) -> NodeLight {
+    var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness, an, c);
     let k = custom_light_surface(li, ctx);
     t.kd *= k;
     t.ks *= k;
@@ -1452,8 +1532,10 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var sh = no_sheen();
     var fsh: array<f32, MAX_LIGHTS>;
     var sheen_env_c = vec4<f32>(0.0);
+    var an = no_aniso();
     if (!background) {
         s = load_surface(px);
+        an = load_aniso(px, s);
         coat = load_coat(px, -ctx.view_dir, s.unlit);
         under = 1.0 - coat.w;
         if (HAS_SHEEN) {
@@ -1482,8 +1564,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             vis = ambient_visibility(in.pos.xy, p, s);
         }
         if (has_env && !s.unlit) {
+            let nr = anisotropy_env_normal(an, s.normal, -ctx.view_dir, s.roughness);
             if (is_filmed(film)) {
-                lobes = env_lobes(s.normal, -ctx.view_dir, s.roughness);
+                lobes = env_lobes_bent(s.normal, nr, -ctx.view_dir, s.roughness);
                 lobes.irr *= vis;
                 lobes.spec *= vis;
                 if (HAS_TRANSMISSION) {
@@ -1502,7 +1585,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 if (HAS_TRANSMISSION) {
                     et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
                 } else {
-                    et = env_terms(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, s.spec_w);
+                    et = env_terms_bent(s.normal, nr, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, 1.0, s.spec_w);
                 }
                 et.a *= vis;
                 et.b *= vis;
@@ -1533,7 +1616,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     if (!background) {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat, sh);
+            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat, sh, an);
             ft[li] = nl.t;
             fa[li] = nl.a;
             fb[li] = nl.b;

@@ -353,7 +353,7 @@ fn thin_transmission(li: u32, p: vec3<f32>, s: GSurface, v: vec3<f32>, tr: Trans
         return 0.0;
     }
     let n = s.normal;
-    let t = light_terms(li, p, -n, v - 2.0 * dot(n, v) * n, s.roughness, no_coat());
+    let t = light_terms(li, p, -n, v - 2.0 * dot(n, v) * n, s.roughness, no_aniso(), no_coat());
     let f = s.f0 + (1.0 - s.f0) * pow(1.0 - t.vh, 5.0);
     return tr.weight * t.ks * (1.0 - f);
 }

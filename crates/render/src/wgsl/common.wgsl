@@ -155,3 +155,27 @@ fn gbuffer_roughness(t: vec4<u32>) -> f32 {
 fn gbuffer_slot(t: vec4<u32>) -> u32 {
     return t.w;
 }
+
+// KHR_materials_anisotropy's direction in the G-buffer (the fourth target's z,
+// passes::GBUFFER_FILM_ANISOTROPY_FORMAT): a unit t ⟂ n as its angle about n from
+// `canonical_tangent(n)`, in half turns, in [0, 1] (t and −t are the same lobe). Both passes take
+// n as `gbuffer_normal` decodes it from the same bits, so that the frame is the same in both.
+// `canonical_tangent` is scene::fallback_tangent (Duff et al. 2017's branchless basis).
+fn canonical_tangent(n: vec3<f32>) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+}
+
+fn anisotropy_angle(n: vec3<f32>, t: vec3<f32>) -> f32 {
+    let e1 = canonical_tangent(n);
+    let x = atan2(dot(t, cross(n, e1)), dot(t, e1)) * (1.0 / PI);
+    return select(x, x + 1.0, x < 0.0);
+}
+
+fn anisotropy_direction(n: vec3<f32>, angle: f32) -> vec3<f32> {
+    let e1 = canonical_tangent(n);
+    let phi = angle * PI;
+    return normalize(cos(phi) * e1 + sin(phi) * cross(n, e1));
+}

@@ -1,4 +1,4 @@
-// A material (bind group 1 of the G-buffer and shadow passes): factors, sixteen textures each
+// A material (bind group 1 of the G-buffer and shadow passes): factors, sixteen texture slots each
 // with its own sampler, UV set and KHR_texture_transform, and the alpha mode. Prepended to
 // passes/gbuffer.wgsl and passes/shadow.wgsl.
 
@@ -29,6 +29,9 @@ struct MaterialUniforms {
     specular: vec4<f32>,
     // KHR_materials_sheen: rgb the colour factor, w the roughness factor; zero without.
     sheen: vec4<f32>,
+    // KHR_materials_anisotropy: x the strength (0: none), y/z the rotation's cosine and sine,
+    // w = 1 with a texture (at TEX_ANISOTROPY, the transmission's slot); zero without.
+    anisotropy: vec4<f32>,
 };
 
 const ALPHA_OPAQUE: u32 = 0u;
@@ -43,6 +46,9 @@ const TEX_OCCLUSION: u32 = 4u;
 const TEX_FILM: u32 = 5u;
 const TEX_FILM_THICKNESS: u32 = 6u;
 const TEX_TRANSMISSION: u32 = 7u;
+// The anisotropy's texture shares the transmission's slot (and binding): only opaque materials
+// draw an anisotropy (src/scene_gpu.rs `texture_refs`).
+const TEX_ANISOTROPY: u32 = 7u;
 const TEX_VOLUME_THICKNESS: u32 = 8u;
 const TEX_COAT: u32 = 9u;
 const TEX_COAT_ROUGH: u32 = 10u;
