@@ -34,6 +34,15 @@
 //! specular, dielectric and metal, film or specular colour included. A clear coat lies over the
 //! sheened base (`crate::coat`). Without it (`None`) the arithmetic is the one above, unchanged.
 //!
+//! With `KHR_materials_anisotropy` (`scene::anisotropy`, [`Brdf::with_anisotropy`]), the
+//! specular lobe — the dielectric's and the metal's, not a sheen's or a clear coat's — is GGX
+//! with two roughnesses, (α_x, α_y) = `scene::anisotropy::alphas_f32(α, s)` along the local x
+//! and y axes: the caller's shading frame has its x axis along the anisotropy direction. D, the
+//! height-correlated V, Smith's G₁ and the visible-normal sampling take the anisotropic forms
+//! (Heitz 2014, 2018); the Fresnel terms, the diffuse and the lobe-choice estimates are the
+//! isotropic BRDF's. Without it (`None`, or strength 0) the arithmetic is the one above,
+//! unchanged to the bit.
+//!
 //! Directions are in the local shading frame (normal = +z). Sampling mixes a cosine lobe with
 //! GGX visible-normal sampling (Heitz 2018); the mixture weight is the same for all four
 //! wavelengths, so one pdf serves the whole path. A sheen adds a third, cosine-weighted choice
@@ -63,6 +72,9 @@ pub struct Brdf {
     pub specular: Option<SpecularLanes>,
     /// `KHR_materials_sheen`'s colour and roughness; `None`: no sheen.
     pub sheen: Option<SheenLanes>,
+    /// `KHR_materials_anisotropy`: the specular lobe's (α_x, α_y) along the local x axis (the
+    /// anisotropy direction t) and y axis (b = n × t); `None`: isotropic, α = `alpha`.
+    pub alphas: Option<(f32, f32)>,
 }
 
 /// `KHR_materials_sheen` at a surface point, at the four wavelengths of the lanes.
@@ -158,6 +170,7 @@ impl Brdf {
             ior: 1.5,
             specular: None,
             sheen: None,
+            alphas: None,
         }
     }
 
@@ -171,6 +184,7 @@ impl Brdf {
             ior: 1.5,
             specular: None,
             sheen: None,
+            alphas: None,
         }
     }
 
@@ -198,6 +212,17 @@ impl Brdf {
     /// comparison mode, takes none.
     pub fn with_sheen(mut self, sheen: Option<SheenLanes>) -> Self {
         self.sheen = sheen.filter(|s| !self.lambert && s.max_color > 0.0 && s.color != Vec4::ZERO);
+        self
+    }
+
+    /// This BRDF under `KHR_materials_anisotropy` of strength `strength` at the point (`None`:
+    /// without): (α_t, α_b) = `scene::anisotropy::alphas_f32(alpha, s)` along the local x and y
+    /// axes. Strength 0 is none (the isotropic lobe, to the bit), and Lambert, the comparison
+    /// mode, takes none.
+    pub fn with_anisotropy(mut self, strength: Option<f32>) -> Self {
+        self.alphas = strength
+            .filter(|&s| s > 0.0 && !self.lambert)
+            .map(|s| scene::anisotropy::alphas_f32(self.alpha, s.min(1.0)));
         self
     }
 
@@ -261,6 +286,25 @@ impl Brdf {
     /// Smith G1 for the visible-normal pdf.
     fn g1(&self, n_v: f32) -> f32 {
         smith_g1(self.alpha, n_v)
+    }
+
+    /// D(h)·V(wi, wo), the specular lobe without its Fresnel term: anisotropic with
+    /// [`Self::alphas`], else the isotropic `d`·`vis`.
+    #[inline]
+    fn lobe(&self, wo: Vec3, wi: Vec3, h: Vec3) -> f32 {
+        match self.alphas {
+            None => self.d(h.z) * self.vis(wi.z, wo.z),
+            Some((ax, ay)) => ggx_d_aniso(ax, ay, h) * smith_vis_aniso(ax, ay, wi, wo),
+        }
+    }
+
+    /// G1(wo)·D(h), the visible-normal pdf of h times 4·n·v (with the reflection's Jacobian).
+    #[inline]
+    fn g1_d(&self, wo: Vec3, h: Vec3) -> f32 {
+        match self.alphas {
+            None => self.g1(wo.z) * self.d(h.z),
+            Some((ax, ay)) => smith_g1_aniso(ax, ay, wo) * ggx_d_aniso(ax, ay, h),
+        }
     }
 
     /// The directional albedo at `n_v` as [`Self::p_spec`] estimates it (Schlick with n·v for
@@ -343,7 +387,7 @@ impl Brdf {
         let v_h = wo.dot(h).abs();
         let (fs, fd) = self.fresnel_pair(v_h, || self.fresnel(v_h));
         let diffuse = (Vec4::ONE - fd) * self.base * ((1.0 - self.metallic) * FRAC_1_PI);
-        diffuse + fs * (self.d(h.z) * self.vis(n_l, n_v))
+        diffuse + fs * self.lobe(wo, wi, h)
     }
 
     /// The pdf [`Self::sample`] draws `wi` with: with a sheen, p·cos θ_i/π + (1 − p)·pdf_base,
@@ -369,7 +413,7 @@ impl Brdf {
         let h = (wo + wi).normalize();
         let v_h = wo.dot(h).max(0.0);
         // Visible-normal pdf of h, then the reflection Jacobian 1/(4·v·h).
-        let pdf_spec = if v_h > 0.0 { self.g1(n_v) * self.d(h.z) / (4.0 * n_v) } else { 0.0 };
+        let pdf_spec = if v_h > 0.0 { self.g1_d(wo, h) / (4.0 * n_v) } else { 0.0 };
         ps * pdf_spec + (1.0 - ps) * n_l * FRAC_1_PI
     }
 
@@ -403,7 +447,10 @@ impl Brdf {
     }
 
     fn sample_visible_normal(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
-        visible_normal(self.alpha, wo, u)
+        match self.alphas {
+            None => visible_normal(self.alpha, wo, u),
+            Some((ax, ay)) => visible_normal_aniso(ax, ay, wo, u),
+        }
     }
 }
 
@@ -430,6 +477,34 @@ fn smith_vis(alpha: f32, n_l: f32, n_v: f32) -> f32 {
 fn smith_g1(alpha: f32, n_v: f32) -> f32 {
     let a2 = alpha * alpha;
     2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt())
+}
+
+/// Anisotropic GGX (`scene::anisotropy::ggx_d` in f32): roughness `ax` along local x, `ay`
+/// along y, at the unit half vector `h`; 0 below the surface.
+#[inline]
+fn ggx_d_aniso(ax: f32, ay: f32, h: Vec3) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let (x, y) = (h.x / ax, h.y / ay);
+    let k = x * x + y * y + h.z * h.z;
+    1.0 / (PI * ax * ay * k * k)
+}
+
+/// The anisotropic height-correlated Smith visibility G₂/(4·n·l·n·v)
+/// (`scene::anisotropy::visibility` in f32) for light `l` and view `v`.
+#[inline]
+fn smith_vis_aniso(ax: f32, ay: f32, l: Vec3, v: Vec3) -> f32 {
+    let gv = l.z * Vec3::new(ax * v.x, ay * v.y, v.z).length();
+    let gl = v.z * Vec3::new(ax * l.x, ay * l.y, l.z).length();
+    let s = gv + gl;
+    if s > 0.0 { 0.5 / s } else { 0.0 }
+}
+
+/// Anisotropic Smith G1 = 1/(1 + Λ(w)) = 2·w_z/(w_z + |(ax·w_x, ay·w_y, w_z)|).
+#[inline]
+fn smith_g1_aniso(ax: f32, ay: f32, w: Vec3) -> f32 {
+    2.0 * w.z / (w.z + Vec3::new(ax * w.x, ay * w.y, w.z).length())
 }
 
 /// The clear coat's lobe (`KHR_materials_clearcoat`): glTF's specular microfacet term D·V
@@ -486,9 +561,16 @@ impl CoatLobe {
 /// GGX distribution of roughness α seen from `wo` (above the surface). Shared by the BRDF and
 /// the dielectric BSDF (`crate::dielectric`).
 pub fn visible_normal(alpha: f32, wo: Vec3, u: [f32; 2]) -> Vec3 {
+    visible_normal_aniso(alpha, alpha, wo, u)
+}
+
+/// [`visible_normal`] for anisotropic GGX, roughness `ax` along local x and `ay` along y:
+/// `wo` stretched by (ax, ay) to the hemisphere configuration, a normal sampled there and
+/// unstretched (Heitz 2018). With ax = ay the isotropic sampler's arithmetic exactly.
+#[inline]
+pub fn visible_normal_aniso(ax: f32, ay: f32, wo: Vec3, u: [f32; 2]) -> Vec3 {
     {
-        let a = alpha;
-        let vh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
+        let vh = Vec3::new(ax * wo.x, ay * wo.y, wo.z).normalize();
         let len2 = vh.x * vh.x + vh.y * vh.y;
         let t1 = if len2 > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt() } else { Vec3::X };
         let t2 = vh.cross(t1);
@@ -498,7 +580,7 @@ pub fn visible_normal(alpha: f32, wo: Vec3, u: [f32; 2]) -> Vec3 {
         let s = 0.5 * (1.0 + vh.z);
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
         let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-        Vec3::new(a * nh.x, a * nh.y, nh.z.max(1e-6)).normalize()
+        Vec3::new(ax * nh.x, ay * nh.y, nh.z.max(1e-6)).normalize()
     }
 }
 

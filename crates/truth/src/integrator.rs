@@ -432,6 +432,8 @@ impl Integrator<'_, '_> {
                 film,
                 lambda: l,
             });
+            let anisotropy =
+                if self.lambert { None } else { material::anisotropy(mat, &w.scene.textures, &s.tc) };
             let brdf = if self.lambert {
                 Brdf::lambertian(base)
             } else {
@@ -444,8 +446,14 @@ impl Integrator<'_, '_> {
                     .with_film(film)
                     .with_specular(specular)
                     .with_sheen(sheen)
+                    .with_anisotropy(anisotropy.map(|(_, strength)| strength))
             };
-            let frame = Frame::from_normal(ns);
+            // An anisotropic lobe's frame has x along its direction (see-through materials: the
+            // BRDF's share only; the dielectric's lobes stay isotropic).
+            let frame = match anisotropy {
+                Some((dir, _)) if brdf.alphas.is_some() => material::anisotropy_frame(ns, s.tangent, dir),
+                _ => Frame::from_normal(ns),
+            };
             let glass =
                 match (mat.transmission.as_ref(), self.lambert) {
                     (Some(t), false) => material::transmission(mat, &w.scene.textures, &s.tc).map(|weight| {

@@ -239,6 +239,29 @@ pub fn sheen(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(Vec3
     Some((color, sh.roughness_at(a)))
 }
 
+/// `KHR_materials_anisotropy` at a surface point: the direction in the tangent frame (unit) and
+/// the strength, from the anisotropy texture's RGB (linear data) as `scene::anisotropy::
+/// Anisotropy::at` reads it; `None` without one, at strength 0 (`is_off`) or on an unlit
+/// material (the loader drops it there).
+pub fn anisotropy(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(Vec2, f32)> {
+    let an = m.anisotropy.as_ref().filter(|a| !m.unlit && !a.is_off())?;
+    let rgb = tex(textures, &an.texture, tc).map(|(t, uv)| texture::sample(t, uv).truncate());
+    Some(an.at(rgb))
+}
+
+/// The shading frame of an anisotropic lobe at shading normal `n` (after the normal map):
+/// x along the anisotropy direction t = normalize(d.x·t₀ + d.y·b₀), y along b = n × t. (t₀, b₀)
+/// is the tangent frame the normal map uses (`tangent`'s xyz projected to the plane of `n`,
+/// b₀ = n × t₀ × handedness), so that both renderers orient the direction alike; a point
+/// without a tangent takes `scene::fallback_tangent(n)`.
+pub fn anisotropy_frame(n: Vec3, tangent: Option<Vec4>, d: Vec2) -> crate::sampling::Frame {
+    use crate::sampling::Frame;
+    let tan = tangent.unwrap_or_else(|| scene::fallback_tangent(n));
+    let f0 = Frame::from_normal_tangent(n, tan.truncate(), if tan.w < 0.0 { -1.0 } else { 1.0 });
+    let t = (f0.t * d.x + f0.b * d.y).normalize_or_zero();
+    Frame::from_normal_tangent(n, if t == Vec3::ZERO { f0.t } else { t }, 1.0)
+}
+
 /// The coat's normal: its own normal map in the base's tangent frame, or `n` (the interpolated
 /// normal, not the base's normal map) without one.
 pub fn coat_normal(
