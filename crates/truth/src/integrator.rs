@@ -607,3 +607,7 @@ mod specular_tests;
 #[cfg(test)]
 #[path = "sheen_tests.rs"]
 mod sheen_tests;
+
+#[cfg(test)]
+#[path = "anisotropy_tests.rs"]
+mod anisotropy_tests;

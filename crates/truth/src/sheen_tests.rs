@@ -104,7 +104,7 @@ fn reference(
 
 /// Random direction pairs above the surface, cos θ from 0.02 to 1 (grazing, where the sheen
 /// lives, included), fixed seed.
-fn random_pairs(n: usize) -> Vec<(Vec3, Vec3)> {
+pub(super) fn random_pairs(n: usize) -> Vec<(Vec3, Vec3)> {
     let mut rng = Sampler::new(11, 5);
     let mut d = || {
         let [a, b] = rng.next2();
@@ -215,7 +215,7 @@ fn the_sheen_colour_is_upsampled_as_a_reflectance() {
 
 /// Quadrature of the pdf over the hemisphere of `wo` in (cos θ, φ) cells: the expected share
 /// of samples in each of `nc` × `np` bins (sub-sampled `k` × `k` by the midpoint rule).
-fn binned_pdf(b: &Brdf, wo: Vec3, nc: usize, np: usize, k: usize) -> Vec<f64> {
+pub(super) fn binned_pdf(b: &Brdf, wo: Vec3, nc: usize, np: usize, k: usize) -> Vec<f64> {
     let mut bins = vec![0.0f64; nc * np];
     let (dc, dp) = (1.0 / (nc * k) as f64, 2.0 * PI / (np * k) as f64);
     for i in 0..nc * k {
