@@ -63,17 +63,10 @@ struct EnvLobes {
 };
 
 fn env_lobes(n: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
-    return env_lobes_bent(n, n, v, roughness);
-}
-
-// `env_lobes` with the prefiltered radiance looked up around the mirror direction of `nr`
-// instead of n (an anisotropic lobe's bent normal, `anisotropy_env_normal` in the shading pass;
-// n itself elsewhere, which is `env_lobes` exactly).
-fn env_lobes_bent(n: vec3<f32>, nr: vec3<f32>, v: vec3<f32>, roughness: f32) -> EnvLobes {
     var l: EnvLobes;
     let k = env.params.z;
     l.nv = max(dot(n, v), 1e-4);
-    let r = reflect(-v, nr);
+    let r = reflect(-v, n);
     let half_texel = 0.5 / ENV_LUT_SIZE;
     let lut_uv = clamp(vec2<f32>(l.nv, roughness), vec2<f32>(half_texel), vec2<f32>(1.0 - half_texel));
     l.ab = textureSampleLevel(env_lut, env_sampler, lut_uv, 0.0).xy;
@@ -98,12 +91,6 @@ fn env_terms(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert:
 // 1 − its transmission, wgsl/transmission.wgsl); `keep` = 1 leaves every product exact. `w` is
 // the dielectric's specular weight (KHR_materials_specular; 1 without, exact too).
 fn env_terms_keep(n: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, keep: f32, w: f32) -> EnvTerms {
-    return env_terms_bent(n, n, v, metallic, roughness, lambert, f0, keep, w);
-}
-
-// `env_terms_keep` with the specular lobe's radiance around the mirror direction of `nr`
-// (`env_lobes_bent`); the directional albedo and the irradiance stay n's.
-fn env_terms_bent(n: vec3<f32>, nr: vec3<f32>, v: vec3<f32>, metallic: f32, roughness: f32, lambert: bool, f0: f32, keep: f32, w: f32) -> EnvTerms {
     var t: EnvTerms;
     if (!env_enabled()) {
         return t;
@@ -112,7 +99,7 @@ fn env_terms_bent(n: vec3<f32>, nr: vec3<f32>, v: vec3<f32>, metallic: f32, roug
         t.a = textureSampleLevel(env_irradiance, env_sampler, env_uv(n), 0.0) * env.params.z / PI;
         return t;
     }
-    let l = env_lobes_bent(n, nr, v, roughness);
+    let l = env_lobes(n, v, roughness);
     // The dielectric specular lobe's directional albedo, and what the diffuse layer loses: the
     // Fresnel term averaged over the light it receives (`fresnel_diffuse`), not the lobe's
     // albedo, which counts the lobe's own energy loss (at F0 = 1 it left diffuse light).
