@@ -7,7 +7,7 @@
 //! says (the highlight along the direction, the rotation counter-clockwise from the tangent
 //! towards the bitangent).
 
-use super::sheen_tests::{binned_pdf, random_pairs};
+use super::sheen_tests::{binned_pdf, chi2_per_bin, random_pairs, sampled_bins};
 use super::tests::{assert_within, estimate};
 use super::*;
 use crate::testing::{quad, scene_with};
@@ -170,33 +170,9 @@ fn sampling_matches_its_pdf() {
             let ip: f64 = expected.iter().sum();
             let mut rng = Sampler::new(23, 7);
             let n = 400_000usize;
-            let mut counts = vec![0u32; nc * np];
-            let mut returned = 0usize;
-            for _ in 0..n {
-                let Some(x) = b.sample(wo, rng.uniform(), rng.next2()) else { continue };
-                assert_eq!((x.f, x.pdf), (b.eval(wo, x.wi), b.pdf(wo, x.wi)), "{name}");
-                returned += 1;
-                let ci = ((x.wi.z * nc as f32) as usize).min(nc - 1);
-                let phi = x.wi.y.atan2(x.wi.x).rem_euclid(2.0 * std::f32::consts::PI);
-                let pj = ((phi / (2.0 * std::f32::consts::PI) * np as f32) as usize).min(np - 1);
-                counts[ci * np + pj] += 1;
-            }
+            let (counts, returned, _) = sampled_bins(&b, wo, (nc, np), n, &mut rng, name);
             let frac = returned as f64 / n as f64;
-            let (mut chi2, mut dof, mut z_max) = (0.0f64, 0usize, 0.0f64);
-            for (o, e) in counts.iter().zip(&expected) {
-                let (e, o) = (e * n as f64, f64::from(*o));
-                if e >= 20.0 {
-                    chi2 += (o - e).powi(2) / e;
-                    dof += 1;
-                    z_max = z_max.max((o - e).abs() / e.sqrt());
-                } else {
-                    assert!(
-                        o <= e + 5.0 * e.sqrt() + 10.0,
-                        "{name} θ {theta}: {o} samples where {e} expected"
-                    );
-                }
-            }
-            let chi2 = chi2 / dof as f64;
+            let (chi2, dof, z_max) = chi2_per_bin(&counts, &expected, n, &format!("{name} θ {theta}"));
             let what = format!("{name} θ {theta} φ {phi}");
             println!(
                 "{what}: χ²/bin {chi2:.3} over {dof} bins, worst bin {z_max:.2} σ; ∫pdf {ip:.4} vs returned {frac:.4}"

@@ -213,6 +213,50 @@ fn the_sheen_colour_is_upsampled_as_a_reflectance() {
     assert!(c.color.x < c.color.w, "not orange: {}", c.color);
 }
 
+/// `n` samples of `b` at `wo`, each carrying exactly `eval`'s and `pdf`'s values, counted in the
+/// `nc` × `np` (cos θ, φ) bins of [`binned_pdf`]: the counts, how many samples were returned and
+/// the mean of f·cos/pdf over all `n`.
+pub(super) fn sampled_bins(
+    b: &Brdf,
+    wo: Vec3,
+    (nc, np): (usize, usize),
+    n: usize,
+    rng: &mut Sampler,
+    name: &str,
+) -> (Vec<u32>, usize, Vec4) {
+    let mut counts = vec![0u32; nc * np];
+    let (mut est, mut returned) = (Vec4::ZERO, 0usize);
+    for _ in 0..n {
+        let Some(x) = b.sample(wo, rng.uniform(), rng.next2()) else { continue };
+        assert_eq!((x.f, x.pdf), (b.eval(wo, x.wi), b.pdf(wo, x.wi)), "{name}");
+        returned += 1;
+        est += x.f * x.wi.z / x.pdf;
+        let ci = ((x.wi.z * nc as f32) as usize).min(nc - 1);
+        let phi = x.wi.y.atan2(x.wi.x).rem_euclid(2.0 * std::f32::consts::PI);
+        let pj = ((phi / (2.0 * std::f32::consts::PI) * np as f32) as usize).min(np - 1);
+        counts[ci * np + pj] += 1;
+    }
+    (counts, returned, est / n as f32)
+}
+
+/// Pearson's χ² per bin of `counts` (of `n` samples) against the expected shares, over the bins
+/// that expect at least 20 samples, the number of those bins and the worst one's deviation in
+/// standard deviations; where the pdf says nearly nothing lands, nearly nothing may.
+pub(super) fn chi2_per_bin(counts: &[u32], expected: &[f64], n: usize, what: &str) -> (f64, usize, f64) {
+    let (mut chi2, mut dof, mut z_max) = (0.0f64, 0usize, 0.0f64);
+    for (o, e) in counts.iter().zip(expected) {
+        let (e, o) = (e * n as f64, f64::from(*o));
+        if e >= 20.0 {
+            chi2 += (o - e).powi(2) / e;
+            dof += 1;
+            z_max = z_max.max((o - e).abs() / e.sqrt());
+        } else {
+            assert!(o <= e + 5.0 * e.sqrt() + 10.0, "{what}: {o} samples where {e} expected");
+        }
+    }
+    (chi2 / dof as f64, dof, z_max)
+}
+
 /// Quadrature of the pdf over the hemisphere of `wo` in (cos θ, φ) cells: the expected share
 /// of samples in each of `nc` × `np` bins (sub-sampled `k` × `k` by the midpoint rule).
 pub(super) fn binned_pdf(b: &Brdf, wo: Vec3, nc: usize, np: usize, k: usize) -> Vec<f64> {
@@ -267,37 +311,9 @@ fn sampling_with_a_sheen_matches_its_pdf() {
             ialb *= 2.0 * std::f32::consts::PI / (nt * nphi) as f32;
             let mut rng = Sampler::new(17, 3);
             let n = 400_000usize;
-            let mut counts = vec![0u32; nc * np];
-            let (mut est, mut returned) = (Vec4::ZERO, 0usize);
-            for _ in 0..n {
-                let Some(x) = b.sample(wo, rng.uniform(), rng.next2()) else { continue };
-                assert_eq!((x.f, x.pdf), (b.eval(wo, x.wi), b.pdf(wo, x.wi)), "{name}");
-                returned += 1;
-                est += x.f * x.wi.z / x.pdf;
-                let ci = ((x.wi.z * nc as f32) as usize).min(nc - 1);
-                let phi = x.wi.y.atan2(x.wi.x).rem_euclid(2.0 * std::f32::consts::PI);
-                let pj = ((phi / (2.0 * std::f32::consts::PI) * np as f32) as usize).min(np - 1);
-                counts[ci * np + pj] += 1;
-            }
-            est /= n as f32;
+            let (counts, returned, est) = sampled_bins(&b, wo, (nc, np), n, &mut rng, name);
             let frac = returned as f64 / n as f64;
-            let (mut chi2, mut dof, mut z_max) = (0.0f64, 0usize, 0.0f64);
-            for (o, e) in counts.iter().zip(&expected) {
-                let e = e * n as f64;
-                let o = f64::from(*o);
-                if e >= 20.0 {
-                    chi2 += (o - e).powi(2) / e;
-                    dof += 1;
-                    z_max = z_max.max((o - e).abs() / e.sqrt());
-                } else {
-                    // Where the pdf says nearly nothing lands, nearly nothing does.
-                    assert!(
-                        o <= e + 5.0 * e.sqrt() + 10.0,
-                        "{name} θ {theta}: {o} samples where {e} expected"
-                    );
-                }
-            }
-            let chi2 = chi2 / dof as f64;
+            let (chi2, dof, z_max) = chi2_per_bin(&counts, &expected, n, &format!("{name} θ {theta}"));
             let what = format!("{name} θ {theta} (sheen drawn with p = {:.3})", b.p_sheen(wo.z));
             println!(
                 "{what}: χ²/bin {chi2:.3} over {dof} bins, worst bin {z_max:.2} σ; ∫pdf {ip:.4} vs returned {frac:.4}; ∫f·cos {ialb} vs sampled {est}"
