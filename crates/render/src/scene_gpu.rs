@@ -700,39 +700,30 @@ impl GpuScene {
         let emitter_polygons = (area.polygons, area.dropped_power);
         let emitters = area.lights;
         let mut warnings = Vec::new();
-        // A see-through material's sheen has no room in the transmissive layer's G-buffer.
-        let sheened: Vec<String> = s
-            .materials
-            .iter()
-            .filter(|m| {
-                m.sheen.as_ref().is_some_and(|sh| !sh.is_off()) && !m.unlit && transmission(m).is_some()
-            })
-            .map(|m| format!("'{}'", m.name))
-            .collect();
-        if !sheened.is_empty() {
-            warnings.push(format!(
-                "KHR_materials_sheen on a see-through material is not drawn by the real-time renderer \
-                 (material{} {}): drawn without its sheen; the path tracer (`spectra truth`) draws it",
-                if sheened.len() > 1 { "s" } else { "" },
-                sheened.join(", ")
-            ));
-        }
-        // Nor has it room for an anisotropy.
-        let anisotropic: Vec<String> = s
-            .materials
-            .iter()
-            .filter(|m| {
-                m.anisotropy.as_ref().is_some_and(|a| !a.is_off()) && !m.unlit && transmission(m).is_some()
-            })
-            .map(|m| format!("'{}'", m.name))
-            .collect();
-        if !anisotropic.is_empty() {
-            warnings.push(format!(
-                "KHR_materials_anisotropy on a see-through material is not drawn by the real-time renderer \
-                 (material{} {}): drawn with an isotropic specular lobe; the path tracer (`spectra truth`) draws it",
-                if anisotropic.len() > 1 { "s" } else { "" },
-                anisotropic.join(", ")
-            ));
+        // A see-through material's sheen and anisotropy have no room in the transmissive layer's
+        // G-buffer.
+        type Has = fn(&scene::Material) -> bool;
+        let layers: [(&str, &str, Has); 2] = [
+            ("KHR_materials_sheen", "without its sheen", |m| m.sheen.as_ref().is_some_and(|sh| !sh.is_off())),
+            ("KHR_materials_anisotropy", "with an isotropic specular lobe", |m| {
+                m.anisotropy.as_ref().is_some_and(|a| !a.is_off())
+            }),
+        ];
+        for (ext, drawn, has) in layers {
+            let names: Vec<String> = s
+                .materials
+                .iter()
+                .filter(|m| has(m) && !m.unlit && transmission(m).is_some())
+                .map(|m| format!("'{}'", m.name))
+                .collect();
+            if !names.is_empty() {
+                warnings.push(format!(
+                    "{ext} on a see-through material is not drawn by the real-time renderer (material{} {}): \
+                     drawn {drawn}; the path tracer (`spectra truth`) draws it",
+                    if names.len() > 1 { "s" } else { "" },
+                    names.join(", ")
+                ));
+            }
         }
         let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
