@@ -257,6 +257,19 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
             }
             j["extensions"]["KHR_materials_sheen"] = e;
         }
+        if let Some(d) = &m.diffuse_transmission {
+            let mut e = json!({
+                "diffuseTransmissionFactor": d.factor,
+                "diffuseTransmissionColorFactor": d.color.to_array()
+            });
+            if let Some(t) = &d.texture {
+                e["diffuseTransmissionTexture"] = tex(t);
+            }
+            if let Some(t) = &d.color_texture {
+                e["diffuseTransmissionColorTexture"] = tex(t);
+            }
+            j["extensions"]["KHR_materials_diffuse_transmission"] = e;
+        }
         if let Some(an) = &m.anisotropy {
             let mut e = json!({ "anisotropyStrength": an.strength, "anisotropyRotation": an.rotation });
             if let Some(t) = &an.texture {
@@ -430,6 +443,9 @@ pub fn to_gltf_json(scene: &Scene) -> Result<Value, ExportError> {
     }
     if scene.materials.iter().any(|m| m.anisotropy.is_some()) {
         extensions_used.push("KHR_materials_anisotropy");
+    }
+    if scene.materials.iter().any(|m| m.diffuse_transmission.is_some()) {
+        extensions_used.push("KHR_materials_diffuse_transmission");
     }
     if scene.materials.iter().any(|m| m.iridescence.is_some()) {
         extensions_used.push("KHR_materials_iridescence");

@@ -30,6 +30,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_sheen",
     "KHR_materials_anisotropy",
+    "KHR_materials_diffuse_transmission",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -69,9 +70,10 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         }
         "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
-        "KHR_materials_diffuse_transmission" => {
-            ("diffuse transmission is ignored", "this renderer has no translucency")
-        }
+        "KHR_materials_volume_scatter" => (
+            "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
+            "this renderer has no scattering inside a volume",
+        ),
         "KHR_materials_variants" => ("material variants are ignored; the default materials are drawn", ""),
         "KHR_animation_pointer" => ("animations are ignored; the scene is drawn at rest", ""),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
@@ -275,18 +277,18 @@ mod tests {
     #[test]
     fn optional_extensions_warn_required_ones_refuse_with_advice() {
         let raw = json!({
-            "extensionsUsed": ["KHR_materials_diffuse_transmission", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
+            "extensionsUsed": ["KHR_materials_volume_scatter", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
             "extensionsRequired": ["KHR_draco_mesh_compression"],
         });
         let w = warnings(&raw);
         assert_eq!(w.len(), 1, "{w:?}");
-        assert!(w[0].contains("KHR_materials_diffuse_transmission") && w[0].contains("ignored"), "{w:?}");
+        assert!(w[0].contains("KHR_materials_volume_scatter") && w[0].contains("ignored"), "{w:?}");
         let e = check_required(&Ctx::builtin("t"), &raw).unwrap_err().to_string();
         assert!(e.contains("extensionsRequired[0]") && e.contains("KHR_draco_mesh_compression"), "{e}");
         assert!(e.contains("@gltf-transform/cli copy"), "{e}");
-        // Sheen and anisotropy are read (the loader stores them for the renderers): a file may
-        // require them.
-        for ext in ["KHR_materials_sheen", "KHR_materials_anisotropy"] {
+        // Sheen, anisotropy and diffuse transmission are read (the loader stores them for the
+        // renderers): a file may require them.
+        for ext in ["KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_diffuse_transmission"] {
             let raw = json!({"extensionsUsed": [ext], "extensionsRequired": [ext]});
             assert!(warnings(&raw).is_empty());
             assert!(check_required(&Ctx::builtin("t"), &raw).is_ok());

@@ -856,6 +856,9 @@ impl Loader<'_> {
         if let Some(an) = info("/extensions/KHR_materials_anisotropy") {
             out.anisotropy = self.anisotropy(&at, an)?;
         }
+        if let Some(dt) = info("/extensions/KHR_materials_diffuse_transmission") {
+            out.diffuse_transmission = self.diffuse_transmission(&at, dt)?;
+        }
         if let Some(v) = info("/extensions/KHR_materials_ior").and_then(|e| e.get("ior")) {
             out.ior = match v.as_f64() {
                 Some(x) if x.is_finite() && (1.0..=f64::from(crate::MAX_IOR)).contains(&x) => x as f32,
@@ -943,6 +946,7 @@ impl Loader<'_> {
             for (ext, on) in [
                 ("KHR_materials_sheen", out.sheen.is_some()),
                 ("KHR_materials_anisotropy", out.anisotropy.is_some()),
+                ("KHR_materials_diffuse_transmission", out.diffuse_transmission.is_some()),
             ] {
                 if on {
                     self.warnings.push(format!(
@@ -953,6 +957,7 @@ impl Loader<'_> {
             }
             out.sheen = None;
             out.anisotropy = None;
+            out.diffuse_transmission = None;
         }
         let cc_tex =
             |f: fn(&crate::clearcoat::Clearcoat) -> Option<TextureRef>| out.clearcoat.as_ref().and_then(f);
@@ -978,6 +983,14 @@ impl Loader<'_> {
             (
                 "extensions.KHR_materials_anisotropy.anisotropyTexture",
                 &out.anisotropy.as_ref().and_then(|a| a.texture),
+            ),
+            (
+                "extensions.KHR_materials_diffuse_transmission.diffuseTransmissionTexture",
+                &out.diffuse_transmission.as_ref().and_then(|d| d.texture),
+            ),
+            (
+                "extensions.KHR_materials_diffuse_transmission.diffuseTransmissionColorTexture",
+                &out.diffuse_transmission.as_ref().and_then(|d| d.color_texture),
             ),
         ];
         // The coat's normal map is oriented by the same tangents as the base's (the extension
@@ -1242,6 +1255,50 @@ impl Loader<'_> {
         let roughness_texture = self.extension_texture(&at, sh, "sheenRoughnessTexture", false)?;
         let s = crate::sheen::Sheen { color, color_texture, roughness, roughness_texture };
         Ok((!s.is_off()).then_some(s))
+    }
+
+    /// `KHR_materials_diffuse_transmission` (`dt` is its JSON), validated: `None` at factor 0
+    /// (the extension's default), where the diffuse BRDF is unchanged whatever the textures
+    /// hold. The factor texture (its A channel) is data, the colour texture sRGB colour.
+    fn diffuse_transmission(
+        &mut self,
+        at: &str,
+        dt: &Value,
+    ) -> Result<Option<crate::diffuse_transmission::DiffuseTransmission>, SceneError> {
+        let at = format!("{at}.extensions.KHR_materials_diffuse_transmission");
+        let factor = match dt.get("diffuseTransmissionFactor") {
+            None => 0.0,
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
+                _ => {
+                    return Err(self.ctx.invalid(
+                        format!("{at}.diffuseTransmissionFactor"),
+                        format!("{v} is not a number in [0, 1]"),
+                    ));
+                }
+            },
+        };
+        let color = match dt.get("diffuseTransmissionColorFactor") {
+            None => Vec3::ONE,
+            Some(v) => {
+                let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
+                match nums.as_deref() {
+                    Some(&[r, g, b]) if [r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) => {
+                        Vec3::new(r as f32, g as f32, b as f32)
+                    }
+                    _ => {
+                        return Err(self.ctx.invalid(
+                            format!("{at}.diffuseTransmissionColorFactor"),
+                            format!("{v} is not three numbers in [0, 1] (linear RGB)"),
+                        ));
+                    }
+                }
+            }
+        };
+        let texture = self.extension_texture(&at, dt, "diffuseTransmissionTexture", false)?;
+        let color_texture = self.extension_texture(&at, dt, "diffuseTransmissionColorTexture", true)?;
+        let d = crate::diffuse_transmission::DiffuseTransmission { factor, texture, color, color_texture };
+        Ok((!d.is_off()).then_some(d))
     }
 
     /// `KHR_materials_anisotropy` (`an` is its JSON), validated: `None` at strength 0 (the

@@ -10,6 +10,7 @@ pub mod anisotropy;
 pub mod builtin;
 pub mod clearcoat;
 mod context;
+pub mod diffuse_transmission;
 pub mod emission;
 pub mod emitters;
 pub mod environment;
@@ -261,6 +262,10 @@ pub struct Material {
     /// specular-glossiness materials (dropped there with a warning). Meshes with it get
     /// tangents ([`Material::tangent_set`]).
     pub anisotropy: Option<anisotropy::Anisotropy>,
+    /// `KHR_materials_diffuse_transmission`: part of the dielectric's diffuse light passed to
+    /// the other side of the surface ([`diffuse_transmission`]); `None` when absent or at factor
+    /// 0, and on unlit and specular-glossiness materials (dropped there with a warning).
+    pub diffuse_transmission: Option<diffuse_transmission::DiffuseTransmission>,
 }
 
 /// Largest index of refraction a material may give (diamond is 2.42; KHR_materials_ior sets no
@@ -388,6 +393,7 @@ impl Default for Material {
             specular: None,
             sheen: None,
             anisotropy: None,
+            diffuse_transmission: None,
         }
     }
 }

@@ -92,8 +92,8 @@ fn unsupported_geometry_and_structure() {
         &["cameras[0].orthographic", "xmag"],
     );
     expect(
-        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_diffuse_transmission"])),
-        &["extensionsRequired[0]", "KHR_materials_diffuse_transmission", "not supported"],
+        &mutate(|d| d["extensionsRequired"] = json!(["KHR_materials_volume_scatter"])),
+        &["extensionsRequired[0]", "KHR_materials_volume_scatter", "not supported"],
     );
     expect(
         &mutate(|d| d["materials"][0]["normalTexture"]["texCoord"] = json!(1)),
@@ -241,6 +241,79 @@ fn bad_anisotropy() {
     ];
     for (v, field) in cases {
         expect(&aniso(v), &[&field]);
+    }
+}
+
+#[test]
+fn bad_diffuse_transmission() {
+    let ext = "KHR_materials_diffuse_transmission";
+    let dt = |v: Value| {
+        mutate(|d| {
+            d["extensionsUsed"].as_array_mut().unwrap().push(json!(ext));
+            d["extensionsRequired"] = json!([ext]);
+            d["materials"][0]["extensions"][ext] = v;
+        })
+    };
+    let load = |d: &Value| scene::load_slice("good.gltf", d.to_string().as_bytes(), Some(&data(""))).unwrap();
+    let good = dt(json!({
+        "diffuseTransmissionFactor": 0.4,
+        "diffuseTransmissionTexture": {"index": 0},
+        "diffuseTransmissionColorFactor": [1.0, 0.5, 0.25],
+        "diffuseTransmissionColorTexture": {"index": 0}
+    }));
+    let s = load(&good);
+    let d = s.materials[0].diffuse_transmission.as_ref().expect("read");
+    assert_eq!((d.factor, d.color.to_array()), (0.4, [1.0, 0.5, 0.25]));
+    assert!(d.texture.is_some() && d.color_texture.is_some());
+    // The colour texture is sRGB colour, the factor's (A channel) data: both read here.
+    let defaults = load(&dt(json!({"diffuseTransmissionFactor": 1.0})));
+    let d = defaults.materials[0].diffuse_transmission.as_ref().expect("read");
+    assert_eq!((d.factor, d.color.to_array()), (1.0, [1.0; 3]));
+    // Factor 0 (the default) is off, whatever else is given.
+    assert!(
+        load(&dt(json!({"diffuseTransmissionColorFactor": [1, 0, 0]}))).materials[0]
+            .diffuse_transmission
+            .is_none()
+    );
+    // Exported and read back unchanged.
+    let json = scene::export::to_gltf_json(&s).unwrap().to_string();
+    let back = scene::load_slice("back.gltf", json.as_bytes(), None).unwrap();
+    assert_eq!(back.materials[0].diffuse_transmission, s.materials[0].diffuse_transmission);
+    // On an unlit material: dropped with a warning naming the material.
+    let mut unlit = good.clone();
+    unlit["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_materials_unlit"));
+    unlit["materials"][0]["extensions"]["KHR_materials_unlit"] = json!({});
+    let s = load(&unlit);
+    assert!(s.materials[0].diffuse_transmission.is_none());
+    assert!(
+        s.warnings.iter().any(|w| w.contains("materials[0]") && w.contains(&format!("{ext} is ignored"))),
+        "{:?}",
+        s.warnings
+    );
+    let at = format!("materials[0].extensions.{ext}");
+    let cases = [
+        (json!({"diffuseTransmissionFactor": 1.5}), format!("{at}.diffuseTransmissionFactor")),
+        (json!({"diffuseTransmissionFactor": -0.1}), format!("{at}.diffuseTransmissionFactor")),
+        (json!({"diffuseTransmissionFactor": "half"}), format!("{at}.diffuseTransmissionFactor")),
+        (
+            json!({"diffuseTransmissionFactor": 1, "diffuseTransmissionColorFactor": [1, 2, 0]}),
+            format!("{at}.diffuseTransmissionColorFactor"),
+        ),
+        (
+            json!({"diffuseTransmissionFactor": 1, "diffuseTransmissionColorFactor": [1, 1]}),
+            format!("{at}.diffuseTransmissionColorFactor"),
+        ),
+        (
+            json!({"diffuseTransmissionFactor": 1, "diffuseTransmissionTexture": {"index": 3}}),
+            format!("{at}.diffuseTransmissionTexture.index"),
+        ),
+        (
+            json!({"diffuseTransmissionFactor": 1, "diffuseTransmissionColorTexture": {"index": 0, "texCoord": -1}}),
+            format!("{at}.diffuseTransmissionColorTexture.texCoord"),
+        ),
+    ];
+    for (v, field) in cases {
+        expect(&dt(v), &[&field]);
     }
 }
 

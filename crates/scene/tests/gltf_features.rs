@@ -571,14 +571,14 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // Draco used with an uncompressed fallback: drawn, with a warning.
     let mut d = base.clone();
     d["extensionsUsed"] =
-        json!(["KHR_draco_mesh_compression", "KHR_materials_diffuse_transmission", "KHR_materials_variants"]);
+        json!(["KHR_draco_mesh_compression", "KHR_materials_volume_scatter", "KHR_materials_variants"]);
     d["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
     assert!(
-        s.warnings[1].starts_with("KHR_materials_diffuse_transmission is not supported: ")
-            && s.warnings[1].contains("diffuse transmission is ignored")
+        s.warnings[1].starts_with("KHR_materials_volume_scatter is not supported: ")
+            && s.warnings[1].contains("scattering is ignored")
     );
     // KTX2 only: a texture without a PNG/JPEG source.
     let mut d = base.clone();
@@ -598,22 +598,18 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     assert_has(&error(&d), &["images[0]: is a KTX2 image", "ktxdecompress"]);
     // A required material extension: refused, naming it.
     let mut d = base.clone();
-    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_diffuse_transmission"]);
-    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_diffuse_transmission"]);
+    d["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_volume_scatter"]);
+    assert_has(&error(&d), &["extensionsRequired[1]", "KHR_materials_volume_scatter"]);
     // Found by a sweep: an extension used but missing from extensionsUsed was ignored without
     // a warning. Extras are not extensions.
     let mut d = base.clone();
     d["materials"] =
-        json!([{"extensions": {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}}]);
+        json!([{"extensions": {"KHR_materials_volume_scatter": {"multiscatterColor": [0.5, 0.5, 0.5]}}}]);
     d["asset"]["extras"] = json!({"extensions": {"KHR_materials_anisotropy": {}}});
     d["meshes"][0]["primitives"][0]["material"] = json!(0);
     let s = load(&d).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(
-        s.warnings[0].starts_with("KHR_materials_diffuse_transmission is not supported"),
-        "{:?}",
-        s.warnings
-    );
+    assert!(s.warnings[0].starts_with("KHR_materials_volume_scatter is not supported"), "{:?}", s.warnings);
 }
 
 #[test]
