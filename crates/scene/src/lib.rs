@@ -314,6 +314,17 @@ pub struct TangentNeed {
     pub uv_required: bool,
 }
 
+/// The tangent frame of a double-sided surface seen from `side` (+1 its front, −1 its back) as
+/// glTF's Khronos sample viewer turns it: on a back face the normal, the tangent and the
+/// bitangent are all negated, so that a normal map's normal there is the exact opposite of the
+/// front's (the same bump seen from behind) and an anisotropy's direction keeps its axis. With
+/// the normal flipped, b = n × t · w stays −b when the handedness w flips with the tangent:
+/// both renderers pass the vertex tangent through this (the real-time renderer's
+/// `normal_mapped` and `anisotropy_target` in passes/gbuffer.wgsl by the same rule).
+pub fn facing_tangent(tangent: Vec4, side: f32) -> Vec4 {
+    tangent * side
+}
+
 /// A unit tangent perpendicular to unit normal `n` that depends on `n` alone (Duff et al. 2017's
 /// branchless basis), with handedness +1: the frame of meshes whose anisotropy has no UV set to
 /// orient it. The loader makes it from the mesh's own normals, before its node's transform,

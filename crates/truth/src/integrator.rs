@@ -413,7 +413,9 @@ impl Integrator<'_, '_> {
             let front = s.ng.dot(wo) >= 0.0;
             let flip = if front { 1.0 } else { -1.0 };
             let ng = s.ng * flip;
-            let mut ns = material::mapped_normal(mat, &w.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
+            // Seen from behind, the tangent frame turns with the normal (`scene::facing_tangent`).
+            let tangent = s.tangent.map(|t| scene::facing_tangent(t, flip));
+            let mut ns = material::mapped_normal(mat, &w.scene.textures, &s.tc, s.n_vertex * flip, tangent);
             if ns.dot(wo) <= 0.0 {
                 ns = ng;
             }
@@ -451,7 +453,7 @@ impl Integrator<'_, '_> {
             // An anisotropic lobe's frame has x along its direction (see-through materials: the
             // BRDF's share only; the dielectric's lobes stay isotropic).
             let frame = match anisotropy {
-                Some((dir, _)) if brdf.alphas.is_some() => material::anisotropy_frame(ns, s.tangent, dir),
+                Some((dir, _)) if brdf.alphas.is_some() => material::anisotropy_frame(ns, tangent, dir),
                 _ => Frame::from_normal(ns),
             };
             let glass =

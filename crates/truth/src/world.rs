@@ -323,7 +323,8 @@ impl<'s> World<'s> {
         let m = &self.scene.materials[s.material];
         let (strength, roughness) = material::clearcoat(m, &self.scene.textures, &s.tc)?;
         let flip = if s.ng.dot(wo) >= 0.0 { 1.0 } else { -1.0 };
-        let mut n = material::coat_normal(m, &self.scene.textures, &s.tc, s.n_vertex * flip, s.tangent);
+        let tangent = s.tangent.map(|t| scene::facing_tangent(t, flip));
+        let mut n = material::coat_normal(m, &self.scene.textures, &s.tc, s.n_vertex * flip, tangent);
         if n.dot(wo) <= 0.0 {
             n = s.ng * flip;
         }

@@ -189,7 +189,7 @@ impl Targets {
                 fields.push(format!("@location({}) film: vec4<f32>", fields.len()));
                 samples.push("let f = film_values(v);");
                 samples.push("let an = anisotropy_values(v);");
-                writes.push("r.film = vec4<f32>(film_target(o, f), anisotropy_target(o, an, v));");
+                writes.push("r.film = vec4<f32>(film_target(o, f), anisotropy_target(o, an, v, front));");
             }
             Fourth::Film => {
                 fields.push(format!("@location({}) film: vec2<f32>", fields.len()));

@@ -49,9 +49,12 @@ struct GBufferOut {
 
 // The normal n (unit, towards the viewer's side) bent by a tangent-space normal map's texel
 // `tn_sample` (0–1 per channel) at `scale`, in the frame of the vertex tangent.
+// `n` is already turned to the viewer's side; on a back face the tangent and the bitangent turn
+// with it (scene::facing_tangent: all three negated, as the Khronos sample viewer does), so
+// that the mapped normal there is the front's negated.
 fn normal_mapped(n: vec3<f32>, tangent: vec4<f32>, side: f32, tn_sample: vec3<f32>, scale: f32) -> vec3<f32> {
     let t = normalize(tangent.xyz - n * dot(n, tangent.xyz)) * side;
-    let b = cross(n, t) * tangent.w;
+    let b = cross(n, t) * tangent.w * side;
     var tn = tn_sample * 2.0 - 1.0;
     tn = vec3<f32>(tn.xy * scale, tn.z);
     return normalize(t * tn.x + b * tn.y + n * tn.z);
@@ -201,7 +204,7 @@ fn anisotropy_values(v: VertexOut) -> vec3<f32> {
     return select(vec3<f32>(1.0, 0.5, 1.0), c, material.anisotropy.w > 0.5);
 }
 
-fn anisotropy_target(o: GBufferOut, c: vec3<f32>, v: VertexOut) -> vec2<f32> {
+fn anisotropy_target(o: GBufferOut, c: vec3<f32>, v: VertexOut, front: bool) -> vec2<f32> {
     let s = clamp(material.anisotropy.x * c.b, 0.0, 1.0);
     // An unlit surface (UNLIT_MARK) reflects nothing: no anisotropy.
     if (s <= 0.0 || o.base.a < 0.0) {
@@ -209,8 +212,10 @@ fn anisotropy_target(o: GBufferOut, c: vec3<f32>, v: VertexOut) -> vec2<f32> {
     }
     // The normal as the shading pass will decode it.
     let n = gbuffer_normal(o.normal);
-    // Meshes of anisotropic materials carry tangents (MikkTSpace or scene::fallback_tangent).
-    var tangent = v.tangent;
+    // Meshes of anisotropic materials carry tangents (MikkTSpace or scene::fallback_tangent);
+    // on a back face the frame turns with the normal (scene::facing_tangent), so that the
+    // direction keeps its axis on both sides.
+    var tangent = v.tangent * select(-1.0, 1.0, front);
     if (dot(tangent.xyz, tangent.xyz) <= 0.0) {
         tangent = vec4<f32>(canonical_tangent(n), 1.0);
     }
