@@ -89,7 +89,7 @@ def load(
     env_sun_share: Optional[float] = None,
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
-    clearcoat, specular, sheen, anisotropy, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
+    clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
     without lights gets the default environment (rendered with `water=`, by `Renderer` or
     `truth`, a sun overhead instead, as `spectra render FILE --water` lights it).
     `allow_outside_scene_dir`: let the file's references leave its folder. `env`: an equirectangular .hdr/.exr, "default" or "none"

@@ -224,7 +224,7 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 }
 
 /// Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
-/// clearcoat, specular, sheen, anisotropy, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does.
+/// clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does.
 ///
 /// `allow_outside_scene_dir`: let the file's references (buffers, images, spectra,
 /// environment maps) leave its folder (off by default, as on the command line).

@@ -230,7 +230,7 @@ def test_bad_input_raises_the_right_exception(cornell, renderer):
 
 def test_every_builtin_loads():
     assert set(spectra.BUILTINS) >= {
-        "cornell", "colorchecker", "metamerism", "iridescence", "glass", "clearcoat", "specular", "sheen", "anisotropy", "underwater", "fog", "tinted-fog",
+        "cornell", "colorchecker", "metamerism", "iridescence", "glass", "clearcoat", "specular", "sheen", "anisotropy", "translucent", "underwater", "fog", "tinted-fog",
     }
     for name in spectra.BUILTINS:
         s = spectra.load(name)

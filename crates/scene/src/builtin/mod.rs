@@ -16,6 +16,7 @@ mod metamerism;
 pub(crate) mod shapes;
 pub mod sheen;
 pub mod specular;
+pub mod translucent;
 mod underwater;
 
 use color::{Observer, SpectralIntegrator, Spectrum, WavelengthRange};
@@ -37,6 +38,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "specular",
     "sheen",
     "anisotropy",
+    "translucent",
     "underwater",
     "fog",
     "tinted-fog",
@@ -55,6 +57,7 @@ pub fn builtin(name: &str) -> Result<Scene, SceneError> {
         "specular" => specular::build(&ctx),
         "sheen" => sheen::build(&ctx),
         "anisotropy" => anisotropy::build(&ctx),
+        "translucent" => translucent::build(&ctx),
         "underwater" => underwater::build(&ctx),
         "fog" => fog::build(&ctx, false),
         "tinted-fog" => fog::build(&ctx, true),

@@ -41,7 +41,7 @@ pub const MAX_FRAMES: usize = 10_000;
 
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Built-in scene name (cornell, colorchecker, metamerism, iridescence, glass, clearcoat, specular, sheen, anisotropy, underwater, fog, tinted-fog) or a
+    /// Built-in scene name (cornell, colorchecker, metamerism, iridescence, glass, clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a
     /// .gltf/.glb file. Not with --suite, which runs its own scenes.
     #[arg(required_unless_present = "suite")]
     pub scene: Option<String>,

@@ -13,8 +13,8 @@ pub struct Args {
     pub quick: bool,
     /// Cases to run, comma-separated. Default: metamerism, colorchecker-d65, colorchecker-f11,
     /// colorchecker-led, iridescence-d65, iridescence-f11, glass and the underwater scene in
-    /// Jerlov I (--quick) or I, IB, II, 3C (full); also clearcoat, specular, sheen and
-    /// anisotropy, and any Jerlov type as
+    /// Jerlov I (--quick) or I, IB, II, 3C (full); also clearcoat, specular, sheen,
+    /// anisotropy and translucent, and any Jerlov type as
     /// underwater-TYPE (underwater-iii, underwater-ii.5).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,

@@ -19,7 +19,7 @@ use std::sync::Arc;
 /// environment light put into it.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
-    /// Built-in scene name (cornell, colorchecker, metamerism, iridescence, glass, clearcoat, specular, sheen, anisotropy, underwater, fog, tinted-fog) or a .gltf/.glb file.
+    /// Built-in scene name (cornell, colorchecker, metamerism, iridescence, glass, clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a .gltf/.glb file.
     pub scene: String,
     #[command(flatten)]
     pub files: SceneFileArgs,

@@ -140,8 +140,8 @@ pub const CASE_IDS: &[&str] = &[
 
 /// Cases `spectra eval --scenes` accepts besides [`CASE_IDS`], outside the default suite (whose
 /// results are the README's contract): `clearcoat` (session 42), `specular` (session 43),
-/// `sheen` (session 45), `anisotropy` (session 46).
-pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular", "sheen", "anisotropy"];
+/// `sheen` (session 45), `anisotropy` (session 46), `translucent` (session 47).
+pub const OPT_IN_IDS: &[&str] = &["clearcoat", "specular", "sheen", "anisotropy", "translucent"];
 
 /// Case id of the underwater scene in Jerlov water `ty` (`underwater-ib`), at the built-in's
 /// depth or at `depth` m (`underwater-ib-5m`).
@@ -242,6 +242,14 @@ pub fn case(id: &str) -> Result<Case> {
                     dielectrics at 0.8 turned by 0-135 degrees; a D65 and an F11 spot"
                 .into(),
             scene: scene::builtin("anisotropy")?,
+        }),
+        "translucent" => Ok(Case {
+            id: id.into(),
+            title: "Diffuse transmission (KHR_materials_diffuse_transmission): thin panels of measured ColorChecker \
+                    reflectances passing 0.4-0.9 of their diffuse light in another patch's colour, lit from behind \
+                    by a D65 spot and from the front by an F11 spot"
+                .into(),
+            scene: scene::builtin("translucent")?,
         }),
         "glass" => Ok(Case {
             id: id.into(),
@@ -362,6 +370,9 @@ mod tests {
         assert!(case("specular").unwrap().scene.materials.iter().any(|m| m.specular.is_some()));
         assert!(case("sheen").unwrap().scene.materials.iter().any(|m| m.sheen.is_some()));
         assert!(case("anisotropy").unwrap().scene.materials.iter().any(|m| m.anisotropy.is_some()));
+        assert!(
+            case("translucent").unwrap().scene.materials.iter().any(|m| m.diffuse_transmission.is_some())
+        );
         assert!(case("nope").unwrap_err().to_string().contains("clearcoat"));
     }
 }
