@@ -43,6 +43,17 @@
 //! isotropic BRDF's. Without it (`None`, or strength 0) the arithmetic is the one above,
 //! unchanged to the bit.
 //!
+//! With `KHR_materials_diffuse_transmission` (`scene::diffuse_transmission`,
+//! [`DiffuseTransmissionLanes`]), the dielectric's diffuse is the extension's mix of a Lambertian
+//! BRDF and BTDF under the same layers: (1 − m)·(1 − F_d)·(1 − t)·base/π for `wi` above and
+//! (1 − m)·(1 − F_d')·t·colour(λ)/π for `wi` below the surface, F_d' the diffuse's Fresnel term
+//! at the half vector of `wo` and `wi` mirrored through the surface (the light crosses the
+//! interface it would have reflected at), times a sheen's scaling at (n·v, |n·l|). The specular
+//! lobe and the metal are untouched. The diffuse choice of the sampler goes to the far side with
+//! the transmitted lobe's share of the two diffuse weights ([`Brdf::p_transmit`]), the cosine
+//! lobe mirrored. Without it (`None`, or t = 0) the arithmetic is the one above, unchanged to
+//! the bit.
+//!
 //! Directions are in the local shading frame (normal = +z). Sampling mixes a cosine lobe with
 //! GGX visible-normal sampling (Heitz 2018); the mixture weight is the same for all four
 //! wavelengths, so one pdf serves the whole path. A sheen adds a third, cosine-weighted choice
@@ -75,6 +86,33 @@ pub struct Brdf {
     /// `KHR_materials_anisotropy`: the specular lobe's (α_x, α_y) along the local x axis (the
     /// anisotropy direction t) and y axis (b = n × t); `None`: isotropic, α = `alpha`.
     pub alphas: Option<(f32, f32)>,
+    /// `KHR_materials_diffuse_transmission`'s share and colour; `None`: the diffuse lobe
+    /// reflects only.
+    pub diffuse_transmission: Option<DiffuseTransmissionLanes>,
+}
+
+/// `KHR_materials_diffuse_transmission` at a surface point, at the four wavelengths of the
+/// lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiffuseTransmissionLanes {
+    /// t = diffuseTransmissionFactor × texture A, in (0, 1]: the share of the dielectric's
+    /// diffuse light sent to the far side.
+    pub weight: f32,
+    /// diffuseTransmissionColor(λ) at each lane's wavelength, in [0, 1].
+    pub color: Vec4,
+}
+
+impl DiffuseTransmissionLanes {
+    /// The share `weight` and the colour `rgb` (linear, factor × texture) at wavelengths `l`:
+    /// the colour upsampled exactly as the base colour is ([`crate::material::base_reflectance`]
+    /// calls the same [`crate::upsample::reflectance`], no grey shortcut), so that a colour equal
+    /// to the base colour gives the same lanes in every upsampling mode.
+    pub fn new(weight: f32, rgb: Vec3, up: &dyn RgbToSpectrum, l: Vec4) -> Self {
+        DiffuseTransmissionLanes {
+            weight: weight.clamp(0.0, 1.0),
+            color: crate::upsample::reflectance(up, rgb.to_array(), l),
+        }
+    }
 }
 
 /// `KHR_materials_sheen` at a surface point, at the four wavelengths of the lanes.
@@ -171,6 +209,7 @@ impl Brdf {
             specular: None,
             sheen: None,
             alphas: None,
+            diffuse_transmission: None,
         }
     }
 
@@ -185,6 +224,7 @@ impl Brdf {
             specular: None,
             sheen: None,
             alphas: None,
+            diffuse_transmission: None,
         }
     }
 
@@ -224,6 +264,42 @@ impl Brdf {
             .filter(|&s| s > 0.0 && !self.lambert)
             .map(|s| scene::anisotropy::alphas_f32(self.alpha, s.min(1.0)));
         self
+    }
+
+    /// This BSDF with `KHR_materials_diffuse_transmission` (`None`: without). Share 0 is none
+    /// (the reflecting code path, to the bit), and Lambert, the comparison mode, takes none.
+    pub fn with_diffuse_transmission(mut self, dt: Option<DiffuseTransmissionLanes>) -> Self {
+        self.diffuse_transmission = dt.filter(|d| d.weight > 0.0 && !self.lambert);
+        self
+    }
+
+    /// The colour of the reflected diffuse lobe: the base colour, times 1 − t with a diffuse
+    /// transmission.
+    #[inline]
+    fn reflected_color(&self) -> Vec4 {
+        match &self.diffuse_transmission {
+            None => self.base,
+            Some(d) => self.base * (1.0 - d.weight),
+        }
+    }
+
+    /// What the diffuse returns on both sides together: (1 − t)·base + t·colour (the base
+    /// colour without a diffuse transmission), for the albedo estimates.
+    #[inline]
+    fn diffuse_color(&self) -> Vec4 {
+        match &self.diffuse_transmission {
+            None => self.base,
+            Some(d) => self.base * (1.0 - d.weight) + d.color * d.weight,
+        }
+    }
+
+    /// The probability that a diffuse sample goes to the far side: the transmitted lobe's share
+    /// of the two diffuse lobes' weights (averaged over the lanes); 0 without a transmission.
+    pub fn p_transmit(&self) -> f32 {
+        let Some(d) = &self.diffuse_transmission else { return 0.0 };
+        let t = d.color.element_sum() * d.weight;
+        let r = self.base.element_sum() * (1.0 - d.weight);
+        if t + r > 0.0 { t / (t + r) } else { 0.5 }
     }
 
     /// (what multiplies D·V, the dielectric's Fresnel term the diffuse loses) at `cos` (v·h, or
@@ -331,7 +407,7 @@ impl Brdf {
             return self.base.element_sum() * 0.25;
         }
         let (fs, fd) = self.fresnel_pair(n_v, || self.schlick_pair(n_v));
-        (fs + (Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum() * 0.25
+        (fs + (Vec4::ONE - fd) * self.diffuse_color() * (1.0 - self.metallic)).element_sum() * 0.25
     }
 
     /// (the sheen lobe's albedo, the scaled base's) at n·v, from the base's own estimate.
@@ -358,12 +434,18 @@ impl Brdf {
         }
         let (fs, fd) = self.fresnel_pair(n_v, || self.schlick_pair(n_v));
         let spec = fs.element_sum();
-        let diff = ((Vec4::ONE - fd) * self.base * (1.0 - self.metallic)).element_sum();
+        let diff = ((Vec4::ONE - fd) * self.diffuse_color() * (1.0 - self.metallic)).element_sum();
         if spec + diff <= 0.0 { 1.0 } else { (spec / (spec + diff)).clamp(0.05, 1.0) }
     }
 
-    /// f(wo, wi), zero unless both are above the surface.
+    /// f(wo, wi), zero unless both are above the surface — or, with a diffuse transmission,
+    /// `wo` above and `wi` below ([`Self::eval_transmitted`]).
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec4 {
+        if wi.z < 0.0
+            && let Some(dt) = &self.diffuse_transmission
+        {
+            return self.eval_transmitted(dt, wo, wi);
+        }
         let Some(sh) = &self.sheen else { return self.eval_base(wo, wi) };
         let (n_v, n_l) = (wo.z, wi.z);
         if n_v <= 0.0 || n_l <= 0.0 {
@@ -372,6 +454,27 @@ impl Brdf {
         let n_h = (wo + wi).normalize().z;
         let f_sheen = sh.color * scene::sheen::brdf_f32(n_l, n_v, n_h, sh.roughness);
         f_sheen + self.eval_base(wo, wi) * sh.scaling(sh.albedo(n_v), n_l)
+    }
+
+    /// The diffuse BTDF under the same layers as the reflected diffuse: (1 − m)·(1 − F_d)·t·
+    /// colour/π, F_d the dielectric's Fresnel term the reflected diffuse loses (with its film or
+    /// specular), taken at the half vector of `wo` and `wi` mirrored through the surface — the
+    /// light crosses the same specular interface, at the angle it would have reflected at — and
+    /// times a sheen's albedo scaling at (n·v, |n·l|), the light passing the fibres at |n·l| on
+    /// the far side. Reciprocal: the mirrored half vector of (wi, wo) makes the same angle.
+    fn eval_transmitted(&self, dt: &DiffuseTransmissionLanes, wo: Vec3, wi: Vec3) -> Vec4 {
+        let (n_v, n_l) = (wo.z, -wi.z);
+        if n_v <= 0.0 || n_l <= 0.0 {
+            return Vec4::ZERO;
+        }
+        let h = (wo + Vec3::new(wi.x, wi.y, n_l)).normalize();
+        let v_h = wo.dot(h).abs();
+        let (_, fd) = self.fresnel_pair(v_h, || self.fresnel(v_h));
+        let f = (Vec4::ONE - fd) * dt.color * (dt.weight * (1.0 - self.metallic) * FRAC_1_PI);
+        match &self.sheen {
+            None => f,
+            Some(sh) => f * sh.scaling(sh.albedo(n_v), n_l),
+        }
     }
 
     /// f without the sheen: the glTF BRDF (with its film or specular).
@@ -386,13 +489,16 @@ impl Brdf {
         let h = (wo + wi).normalize();
         let v_h = wo.dot(h).abs();
         let (fs, fd) = self.fresnel_pair(v_h, || self.fresnel(v_h));
-        let diffuse = (Vec4::ONE - fd) * self.base * ((1.0 - self.metallic) * FRAC_1_PI);
+        let diffuse = (Vec4::ONE - fd) * self.reflected_color() * ((1.0 - self.metallic) * FRAC_1_PI);
         diffuse + fs * self.lobe(wo, wi, h)
     }
 
     /// The pdf [`Self::sample`] draws `wi` with: with a sheen, p·cos θ_i/π + (1 − p)·pdf_base,
     /// p = [`Self::p_sheen`].
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wi.z < 0.0 && self.diffuse_transmission.is_some() {
+            return self.pdf_transmitted(wo, wi);
+        }
         if self.sheen.is_none() {
             return self.pdf_base(wo, wi);
         }
@@ -401,6 +507,16 @@ impl Brdf {
         }
         let p = self.p_sheen(wo.z);
         p * wi.z * FRAC_1_PI + (1.0 - p) * self.pdf_base(wo, wi)
+    }
+
+    /// The pdf of a far-side `wi`: the diffuse choice (1 − p_spec) times the far side's share
+    /// of it ([`Self::p_transmit`]) times the mirrored cosine lobe, under a sheen's 1 − p.
+    fn pdf_transmitted(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z >= 0.0 {
+            return 0.0;
+        }
+        let base = (1.0 - self.p_spec(wo.z)) * self.p_transmit() * -wi.z * FRAC_1_PI;
+        if self.sheen.is_none() { base } else { (1.0 - self.p_sheen(wo.z)) * base }
     }
 
     /// The pdf the base (diffuse and specular lobes) draws `wi` with.
@@ -414,6 +530,9 @@ impl Brdf {
         let v_h = wo.dot(h).max(0.0);
         // Visible-normal pdf of h, then the reflection Jacobian 1/(4·v·h).
         let pdf_spec = if v_h > 0.0 { self.g1_d(wo, h) / (4.0 * n_v) } else { 0.0 };
+        if self.diffuse_transmission.is_some() {
+            return ps * pdf_spec + (1.0 - ps) * (1.0 - self.p_transmit()) * n_l * FRAC_1_PI;
+        }
         ps * pdf_spec + (1.0 - ps) * n_l * FRAC_1_PI
     }
 
@@ -432,13 +551,18 @@ impl Brdf {
             }
             u_lobe = ((u_lobe - p) / (1.0 - p)).min(1.0 - f32::EPSILON);
         }
-        let wi = if u_lobe < self.p_spec(wo.z) {
+        let ps = self.p_spec(wo.z);
+        let wi = if u_lobe < ps {
             let h = self.sample_visible_normal(wo, u);
             let wi = 2.0 * wo.dot(h) * h - wo;
             if wi.z <= 0.0 {
                 return None;
             }
             wi
+        } else if self.diffuse_transmission.is_some() && (u_lobe - ps) / (1.0 - ps) < self.p_transmit() {
+            // The far side's cosine lobe: the near side's mirrored.
+            let w = cosine_hemisphere(u);
+            Vec3::new(w.x, w.y, -w.z)
         } else {
             cosine_hemisphere(u)
         };

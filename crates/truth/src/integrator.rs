@@ -4,7 +4,7 @@
 //! free-flight sampling in a homogeneous medium with spectral MIS over the four hero wavelengths.
 
 use crate::accel::Hit;
-use crate::bsdf::{Brdf, FilmLanes, SheenLanes, SpecularLanes};
+use crate::bsdf::{Brdf, DiffuseTransmissionLanes, FilmLanes, SheenLanes, SpecularLanes};
 use crate::camera::CameraRay;
 use crate::coat::Coat;
 use crate::dielectric::Dielectric;
@@ -31,6 +31,9 @@ enum Vertex {
 struct Scattered {
     wi: Vec3,
     crossed: bool,
+    /// Crossed by the diffuse BTDF (`KHR_materials_diffuse_transmission`): a scattering event,
+    /// unlike a refraction.
+    diffuse: bool,
     weight: Vec4,
     pdf: f32,
 }
@@ -47,14 +50,31 @@ fn eval_base(
     let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
     // The BRDF reflects only: both directions on the side of the (flipped) geometric normal.
     let above = ng.dot(wi) > 0.0;
+    // With a diffuse transmission it transmits too, where `wi` is on the far side of both the
+    // shading and the geometric plane (as the dielectric's transmission below).
+    let bsdf = || {
+        if above == (li.z > 0.0) {
+            (brdf.eval(lo, li) * li.z.abs(), brdf.pdf(lo, li))
+        } else {
+            (Vec4::ZERO, 0.0)
+        }
+    };
     let Some((d, w)) = glass else {
+        if brdf.diffuse_transmission.is_some() {
+            return bsdf();
+        }
         if !above {
             return (Vec4::ZERO, 0.0);
         }
         return (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li));
     };
-    let (f_o, p_o) =
-        if above { (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li)) } else { (Vec4::ZERO, 0.0) };
+    let (f_o, p_o) = if brdf.diffuse_transmission.is_some() {
+        bsdf()
+    } else if above {
+        (brdf.eval(lo, li) * li.z.max(0.0), brdf.pdf(lo, li))
+    } else {
+        (Vec4::ZERO, 0.0)
+    };
     // A transmission must really cross the surface (shading and geometric normal agree).
     let (f_d, p_d) =
         if above == (li.z > 0.0) { (d.eval(lo, li) * li.z.abs(), d.pdf(lo, li)) } else { (Vec4::ZERO, 0.0) };
@@ -84,18 +104,18 @@ impl Vertex {
     fn sample_coated(&self, wo: Vec3, rng: &mut Sampler) -> Option<Scattered> {
         let Vertex::Surface { brdf, frame, ng, glass, coat: Some(c) } = self else { return None };
         let lo = frame.to_local(wo);
-        let brdf_wi =
-            |rng: &mut Sampler| brdf.sample(lo, rng.uniform(), rng.next2()).map(|x| frame.to_world(x.wi));
-        let (wi, crossed, delta) = if rng.uniform() < c.p {
-            (c.sample(wo, rng.next2())?, false, None)
+        let (wi, crossed, delta, diffuse) = if rng.uniform() < c.p {
+            (c.sample(wo, rng.next2())?, false, None, false)
         } else if let Some((d, wt)) = glass
             && rng.uniform() < *wt
         {
             let x = d.sample(lo, rng.uniform(), rng.next2())?;
             let delta = x.specular.then(|| x.f * (x.wi.z.abs() / x.pdf));
-            (frame.to_world(x.wi), x.transmitted, delta)
+            (frame.to_world(x.wi), x.transmitted, delta, false)
         } else {
-            (brdf_wi(rng)?, false, None)
+            // Below the shading plane only by a diffuse transmission.
+            let x = brdf.sample(lo, rng.uniform(), rng.next2())?;
+            (frame.to_world(x.wi), x.wi.z < 0.0, None, x.wi.z < 0.0)
         };
         if (ng.dot(wi) <= 0.0) != crossed {
             return None;
@@ -105,12 +125,13 @@ impl Vertex {
             return Some(Scattered {
                 wi,
                 crossed,
+                diffuse,
                 weight: weight * ((1.0 - c.weight) / (1.0 - c.p)),
                 pdf: 0.0,
             });
         }
         let (fv, pdf) = self.eval(wo, wi);
-        (pdf > 0.0 && pdf.is_finite()).then(|| Scattered { wi, crossed, weight: fv / pdf, pdf })
+        (pdf > 0.0 && pdf.is_finite()).then(|| Scattered { wi, crossed, diffuse, weight: fv / pdf, pdf })
     }
 }
 
@@ -443,12 +464,18 @@ impl Integrator<'_, '_> {
                     .map(|(weight, f0)| SpecularLanes::new(weight, f0, w.upsampler, l));
                 let sheen = material::sheen(mat, &w.scene.textures, &s.tc)
                     .map(|(color, roughness)| SheenLanes::new(color, roughness, w.upsampler, l));
+                // Past a direct-only path's bounce it goes on through refractions only: a diffuse
+                // transmission there would be a second bounce.
+                let dt = material::diffuse_transmission(mat, &w.scene.textures, &s.tc)
+                    .filter(|_| !passing)
+                    .map(|(weight, color)| DiffuseTransmissionLanes::new(weight, color, w.upsampler, l));
                 Brdf::new(base, metallic, roughness)
                     .with_ior(mat.ior)
                     .with_film(film)
                     .with_specular(specular)
                     .with_sheen(sheen)
                     .with_anisotropy(anisotropy.map(|(_, strength)| strength))
+                    .with_diffuse_transmission(dt)
             };
             // An anisotropic lobe's frame has x along its direction (see-through materials: the
             // BRDF's share only; the dielectric's lobes stay isotropic).
@@ -490,7 +517,9 @@ impl Integrator<'_, '_> {
             }
 
             let lo = frame.to_local(wo);
-            let (wi, crossed) = if coat.is_some() {
+            // `diffuse`: crossed by the diffuse BTDF, which scatters (a bounce) rather than
+            // refracts.
+            let (wi, crossed, diffuse) = if coat.is_some() {
                 if passing && glass.is_none() {
                     break;
                 }
@@ -502,19 +531,19 @@ impl Integrator<'_, '_> {
                 // A delta (pdf 0), or passing through where this vertex sampled no light: what
                 // the path meets next has full weight.
                 prev_pdf = if passing { 0.0 } else { x.pdf };
-                (x.wi, x.crossed)
+                (x.wi, x.crossed, x.diffuse)
             } else if let Some((d, wt)) = glass {
                 // A delta lobe's weight, when the dielectric sampled one.
                 let mut delta = None;
-                let (wi, crossed) = if rng.uniform() < wt {
+                let (wi, crossed, diffuse) = if rng.uniform() < wt {
                     let Some(x) = d.sample(lo, rng.uniform(), rng.next2()) else { break };
                     if x.specular {
                         delta = Some(x.f * (x.wi.z.abs() / x.pdf));
                     }
-                    (frame.to_world(x.wi), x.transmitted)
+                    (frame.to_world(x.wi), x.transmitted, false)
                 } else {
                     let Some(x) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
-                    (frame.to_world(x.wi), false)
+                    (frame.to_world(x.wi), x.wi.z < 0.0, x.wi.z < 0.0)
                 };
                 if (ng.dot(wi) <= 0.0) != crossed || (passing && !crossed) {
                     break;
@@ -536,29 +565,33 @@ impl Integrator<'_, '_> {
                     // next has full weight.
                     prev_pdf = if passing { 0.0 } else { pdf };
                 }
-                (wi, crossed)
+                (wi, crossed, diffuse)
             } else {
                 if passing {
                     break;
                 }
                 let Some(bs) = brdf.sample(lo, rng.uniform(), rng.next2()) else { break };
                 let wi = frame.to_world(bs.wi);
-                if ng.dot(wi) <= 0.0 {
+                // Below the shading plane only by a diffuse transmission, which must cross the
+                // geometric plane too.
+                let crossed = bs.wi.z < 0.0;
+                if (ng.dot(wi) <= 0.0) != crossed {
                     break;
                 }
                 // The BRDF pdf is the same for every lane, so it only scales `f`.
-                f *= bs.f * (bs.wi.z / bs.pdf);
+                f *= bs.f * (bs.wi.z.abs() / bs.pdf);
                 prev_pdf = bs.pdf;
-                (wi, false)
+                (wi, crossed, crossed)
             };
             o = offset(s.p, ng, wi, self.world.offset_floor);
             d = wi;
             depth += 1;
-            if crossed {
-                if glass.is_some_and(|(d, _)| !d.thin) {
-                    inside = if front { Some(s.material) } else { None };
-                }
-            } else {
+            // A closed volume (`KHR_materials_volume`) is entered or left by whatever crosses its
+            // boundary, refraction or diffuse transmission.
+            if crossed && !self.lambert && mat.transmission.as_ref().is_some_and(|t| t.volume.is_some()) {
+                inside = if front { Some(s.material) } else { None };
+            }
+            if !crossed || diffuse {
                 bounces += 1;
             }
             if !self.roulette(&mut f, p, depth, rng) {
@@ -613,3 +646,7 @@ mod sheen_tests;
 #[cfg(test)]
 #[path = "anisotropy_tests.rs"]
 mod anisotropy_tests;
+
+#[cfg(test)]
+#[path = "diffuse_transmission_tests.rs"]
+mod diffuse_transmission_tests;

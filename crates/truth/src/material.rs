@@ -239,6 +239,22 @@ pub fn sheen(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(Vec3
     Some((color, sh.roughness_at(a)))
 }
 
+/// `KHR_materials_diffuse_transmission` at a surface point: the share t (factor × the
+/// texture's A, linear) and the colour (factor × the colour texture's RGB, sRGB-decoded as the
+/// other colour textures are), as `scene::diffuse_transmission::DiffuseTransmission::{factor_at,
+/// color_at}` combine them; `None` without one, where t is 0 (a zero factor, or a texel of
+/// alpha 0) or on an unlit material (the loader drops it there and on spec-gloss ones).
+pub fn diffuse_transmission(m: &Material, textures: &[Texture], tc: &TexCoords) -> Option<(f32, Vec3)> {
+    let dt = m.diffuse_transmission.as_ref().filter(|d| !m.unlit && !d.is_off())?;
+    let a = tex(textures, &dt.texture, tc).map(|(t, uv)| texture::sample(t, uv).w);
+    let weight = dt.factor_at(a);
+    if weight <= 0.0 {
+        return None;
+    }
+    let rgb = tex(textures, &dt.color_texture, tc).map(|(t, uv)| texture::sample(t, uv).truncate());
+    Some((weight, dt.color_at(rgb)))
+}
+
 /// `KHR_materials_anisotropy` at a surface point: the direction in the tangent frame (unit) and
 /// the strength, from the anisotropy texture's RGB (linear data) as `scene::anisotropy::
 /// Anisotropy::at` reads it; `None` without one, at strength 0 (`is_off`) or on an unlit
