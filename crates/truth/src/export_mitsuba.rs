@@ -8,7 +8,8 @@
 //! textures, alpha modes, single-sided materials, vertex colours, samplers) is listed under `"unsupported"` rather than silently approximated.
 //! The BSDF beyond the base colour — metallic-roughness, thin films, transmission, clear coats
 //! (with a coat's dimming of the emission under it), `KHR_materials_specular`,
-//! `KHR_materials_sheen` — is not listed: the comparison renders ours with `--lambert`, which
+//! `KHR_materials_sheen`, `KHR_materials_anisotropy`, `KHR_materials_diffuse_transmission` — is
+//! not listed: the comparison renders ours with `--lambert`, which
 //! drops all of it too, so both sides see the same Lambertian scene.
 
 use crate::error::{Result, TruthError};
