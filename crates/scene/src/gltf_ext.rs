@@ -31,6 +31,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_sheen",
     "KHR_materials_anisotropy",
     "KHR_materials_diffuse_transmission",
+    "EXT_texture_webp",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -40,16 +41,12 @@ const PARTLY_SUPPORTED: &[&str] = &[];
 pub(crate) const DECOMPRESS: &str =
     "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
 pub(crate) const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
-pub(crate) const WEBP: &str =
-    "convert its WebP textures first, e.g. `npx @gltf-transform/cli png in.glb out.glb`";
 pub(crate) const DDS: &str = "re-export the file with PNG or JPEG textures";
 
 /// An image format recognised by its first bytes that the loader cannot decode, with what to do.
 pub(crate) fn undecodable_image(bytes: &[u8]) -> Option<(&'static str, &'static str)> {
     if bytes.starts_with(b"\xabKTX 20\xbb") {
         Some(("KTX2", KTX2))
-    } else if bytes.starts_with(b"RIFF") && bytes.get(8..12) == Some(b"WEBP") {
-        Some(("WebP", WEBP))
     } else if bytes.starts_with(b"DDS ") {
         Some(("DDS", DDS))
     } else {
@@ -68,7 +65,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
         "KHR_texture_basisu" => {
             ("its KTX2/Basis textures are not decoded; the PNG/JPEG fallbacks are used", KTX2)
         }
-        "EXT_texture_webp" => ("its WebP textures are not decoded; the PNG/JPEG fallbacks are used", WEBP),
         "MSFT_texture_dds" => ("its DDS textures are not decoded; the PNG/JPEG fallbacks are used", DDS),
         "KHR_materials_volume_scatter" => (
             "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
@@ -172,9 +168,7 @@ pub(crate) fn precheck(ctx: &Ctx, raw: &Value) -> Result<(), SceneError> {
         if t.get("source").is_some() {
             continue;
         }
-        for (ext, advice) in
-            [("KHR_texture_basisu", KTX2), ("EXT_texture_webp", WEBP), ("MSFT_texture_dds", DDS)]
-        {
+        for (ext, advice) in [("KHR_texture_basisu", KTX2), ("MSFT_texture_dds", DDS)] {
             if t.pointer(&format!("/extensions/{ext}")).is_some() {
                 return Err(ctx.invalid(
                     format!("textures[{ti}]"),

@@ -129,6 +129,28 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
     // Checked by `gltf_ext::precheck` against what this loader implements; the crate's own check
     // only knows the extensions it parses itself.
     root.extensions_required.clear();
+    // EXT_texture_webp's image index is checked here, and a texture whose only image is its
+    // WebP one (no `source`, which the crate's validation requires) gets it as its source; the
+    // loader prefers the WebP image anyway (`Loader::texture_image`).
+    let images = root.images.len();
+    for (i, t) in root.textures.iter_mut().enumerate() {
+        let Some(webp) = raw.pointer(&format!("/textures/{i}/extensions/EXT_texture_webp")) else { continue };
+        let at = format!("textures[{i}].extensions.EXT_texture_webp.source");
+        let w = match webp.get("source") {
+            Some(v) => match v.as_u64().filter(|&w| (w as usize) < images) {
+                Some(w) => w as u32,
+                None => {
+                    return Err(
+                        ctx.invalid(at, format!("{v} is not the index of one of the file's {images} images"))
+                    );
+                }
+            },
+            None => return Err(ctx.invalid(at, "is missing (the extension names its WebP image there)")),
+        };
+        if raw.pointer(&format!("/textures/{i}/source")).is_none() {
+            t.source = gltf::json::Index::new(w);
+        }
+    }
     precheck(ctx, &root)?;
     let document = gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
@@ -1505,6 +1527,17 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// The image a texture shows: its `EXT_texture_webp` source where it has one (the extension
+    /// asks a client that decodes WebP to prefer it; `source`, if any, is the PNG/JPEG fallback
+    /// for others), else its `source`.
+    fn texture_image(&self, t: &gltf::Texture) -> usize {
+        self.raw
+            .pointer(&format!("/textures/{}/extensions/EXT_texture_webp/source", t.index()))
+            .and_then(Value::as_u64)
+            // Checked against the images in `from_slice`.
+            .map_or_else(|| t.source().index(), |i| i as usize)
+    }
+
     /// The texture of a textureInfo at `at` (`info` is its JSON): decoded once per glTF texture
     /// and colour space, with its UV set and `KHR_texture_transform`.
     fn texture(
@@ -1528,7 +1561,8 @@ impl Loader<'_> {
         if let Some(&index) = self.tex_map.get(&(t.index(), srgb)) {
             return Ok(TextureRef { transform, index, tex_coord });
         }
-        let img = t.source();
+        let doc = self.doc;
+        let img = doc.images().nth(self.texture_image(&t)).expect("an index checked against the images");
         let iat = format!("images[{}]", img.index());
         if !self.images.contains_key(&img.index()) {
             let bytes: Vec<u8> = match img.source() {

@@ -1463,3 +1463,59 @@ fn sheen_is_read_with_its_defaults_and_bad_values_are_named() {
     let out = scene::export::to_gltf_json(&plain).unwrap();
     assert!(!out["extensionsUsed"].to_string().contains("KHR_materials_sheen"));
 }
+
+/// A 2×1 lossless WebP of `rgba` as a data URI (the `image` crate's encoder).
+fn webp_uri(rgba: [u8; 8]) -> String {
+    let img = image::RgbaImage::from_raw(2, 1, rgba.to_vec()).unwrap();
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::WebP).unwrap();
+    data_uri("image/webp", &out.into_inner())
+}
+
+/// EXT_texture_webp: the WebP image is preferred to the PNG/JPEG fallback in `source`, a texture
+/// may have only the WebP image, a file may require the extension; a WebP image given as an
+/// ordinary image decodes too; a bad index and a damaged WebP are named.
+#[test]
+fn webp_textures_are_decoded() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let uv = b.f32s(&[0.0; 6], "VEC2");
+    let mut doc = single_mesh(
+        b,
+        json!([{"attributes": {"POSITION": pos, "TEXCOORD_0": uv}, "material": 0}]),
+        json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]),
+    );
+    let webp = [200, 10, 20, 255, 30, 220, 40, 128];
+    doc["extensionsUsed"] = json!(["EXT_texture_webp"]);
+    doc["extensionsRequired"] = json!(["EXT_texture_webp"]);
+    doc["images"] = json!([{"uri": png_uri()}, {"uri": webp_uri(webp)}]);
+    doc["textures"] = json!([{"source": 0, "extensions": {"EXT_texture_webp": {"source": 1}}}]);
+    let texels = |doc: &Value| {
+        let s = load(doc).unwrap();
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        let t = &s.textures[s.materials[0].base_color_texture.unwrap().index];
+        ((t.width, t.height), t.rgba8.clone())
+    };
+    assert_eq!(texels(&doc), ((2, 1), webp.to_vec()), "the WebP image, not the PNG fallback");
+    // Only the WebP image.
+    let mut only = doc.clone();
+    only["textures"][0].as_object_mut().unwrap().remove("source");
+    assert_eq!(texels(&only), ((2, 1), webp.to_vec()));
+    // A WebP image as a texture's plain source.
+    let mut plain = doc.clone();
+    plain["textures"] = json!([{"source": 1}]);
+    assert_eq!(texels(&plain), ((2, 1), webp.to_vec()));
+    // A bad index, a missing one, a damaged image.
+    let at = "textures[0].extensions.EXT_texture_webp.source";
+    for v in [json!(7), json!(-1), json!("1")] {
+        let mut bad = only.clone();
+        bad["textures"][0]["extensions"]["EXT_texture_webp"]["source"] = v;
+        assert_has(&error(&bad), &[at, "is not the index of one of the file's 2 images"]);
+    }
+    let mut bad = only.clone();
+    bad["textures"][0]["extensions"]["EXT_texture_webp"] = json!({});
+    assert_has(&error(&bad), &[at, "is missing"]);
+    let mut bad = only.clone();
+    bad["images"][1]["uri"] = json!(data_uri("image/webp", b"RIFF\x1a\0\0\0WEBPVP8L\x0d\0\0\0 not a webp"));
+    assert_has(&error(&bad), &["images[1]", "cannot"]);
+}
