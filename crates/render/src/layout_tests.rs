@@ -186,7 +186,8 @@ fn uniform_and_storage_structs_match_their_rust_mirrors() {
             coat,
             specular,
             sheen,
-            anisotropy
+            anisotropy,
+            diffuse_transmission
         }),
     );
     let shadow_pass = parse(&[shader::HASH, shader::MATERIAL, include_str!("passes/shadow.wgsl")]);

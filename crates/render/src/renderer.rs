@@ -796,6 +796,12 @@ impl Renderer {
             .targets
             .as_mut()
             .is_some_and(|(t, _)| t.bind_film_anisotropy(&self.gpu.device, scene.has_anisotropy));
+        // So is a diffuse-transmitting scene's specular target (`Targets::bind_specular_dt`).
+        let specular_changed = self
+            .targets
+            .as_mut()
+            .is_some_and(|(t, _)| t.bind_specular_dt(&self.gpu.device, scene.has_diffuse_transmission));
+        let film_changed = film_changed || specular_changed;
         if remade || film_changed {
             // The shading inputs hold the old depth array, or the old film target.
             let device = &self.gpu.device;
@@ -875,6 +881,7 @@ impl Renderer {
             specular: scene.has_specular,
             sheen: scene.has_sheen,
             anisotropy: scene.has_anisotropy,
+            diffuse_transmission: scene.has_diffuse_transmission,
             transmission: false,
             thin_walls: scene.has_thin_walls,
             dispersion: scene.has_dispersion,
@@ -900,6 +907,7 @@ impl Renderer {
                 specular: false,
                 sheen: false,
                 anisotropy: false,
+                diffuse_transmission: false,
                 transmission: true,
                 occlusion_map: false,
                 ..variant
@@ -918,13 +926,19 @@ impl Renderer {
         self.shading.select(&self.gpu.device, variant, settings.mode == Mode::Rgb)?;
         // The film's target comes with a coat's or a specular's: the shading pass reads it beside
         // them; and with an anisotropy, which it carries.
-        let filmed = scene.has_film || scene.has_coat || scene.has_specular || scene.has_anisotropy;
+        // A diffuse transmission is carried by the specular's target, which comes with the film's.
+        let filmed = scene.has_film
+            || scene.has_coat
+            || scene.has_specular
+            || scene.has_anisotropy
+            || scene.has_diffuse_transmission;
         let gbuffer_targets = GBufferTargets {
             fourth: if filmed { GBufferFourth::Film } else { GBufferFourth::None },
             coat: scene.has_coat,
             specular: scene.has_specular,
             sheen: scene.has_sheen,
             anisotropy: scene.has_anisotropy,
+            diffuse_transmission: scene.has_diffuse_transmission,
         };
         self.gbuffer.prepare(&self.gpu.device, gbuffer_targets)?;
         let layer_targets = GBufferTargets {
@@ -933,6 +947,7 @@ impl Renderer {
             specular: false,
             sheen: false,
             anisotropy: false,
+            diffuse_transmission: false,
         };
         if layered {
             self.gbuffer.prepare(&self.gpu.device, layer_targets)?;
@@ -950,7 +965,7 @@ impl Renderer {
         let (film, coat, spec, sheen) = (
             targets.film_view(),
             &targets.gbuffer_coat_view,
-            &targets.gbuffer_specular_view,
+            targets.specular_view(),
             &targets.gbuffer_sheen_view,
         );
         // (The transmissive layer's targets are its own, below.)
@@ -958,7 +973,7 @@ impl Renderer {
             .into_iter()
             .chain(filmed.then_some(film))
             .chain(gbuffer_targets.coat.then_some(coat))
-            .chain(gbuffer_targets.specular.then_some(spec))
+            .chain((gbuffer_targets.specular || gbuffer_targets.diffuse_transmission).then_some(spec))
             .chain(gbuffer_targets.sheen.then_some(sheen))
             .collect();
         let first = if layered { GBufferLayer::Opaque } else { GBufferLayer::All };

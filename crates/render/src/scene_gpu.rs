@@ -101,6 +101,10 @@ pub struct MaterialUniforms {
     /// rotation's cosine and sine, w 1 with a texture (read at the transmission's slot, which
     /// an anisotropic material never uses: [`texture_refs`]). Zero without.
     pub anisotropy: [f32; 4],
+    /// `KHR_materials_diffuse_transmission` ([`diffuse_transmission`]): rgb the colour factor,
+    /// w the factor (0: none), negative where the factor's texture is the colour's and read
+    /// from its slot's A ([`diffuse_transmission_slots`]). Zero without.
+    pub diffuse_transmission: [f32; 4],
 }
 
 pub const ALPHA_OPAQUE: f32 = 0.0;
@@ -152,6 +156,10 @@ impl MaterialUniforms {
                 let (sin, cos) = a.rotation.sin_cos();
                 [a.strength, cos, sin, a.texture.is_some() as u8 as f32]
             }),
+            diffuse_transmission: diffuse_transmission(m).map_or([0.0; 4], |d| {
+                let shared = diffuse_transmission_slots(m).factor_in_color_slot;
+                d.color.extend(if shared { -d.factor } else { d.factor }).to_array()
+            }),
         }
     }
 }
@@ -183,6 +191,53 @@ pub fn anisotropy(m: &scene::Material) -> Option<&scene::anisotropy::Anisotropy>
     m.anisotropy.as_ref().filter(|a| !m.unlit && transmission(m).is_none() && !a.is_off())
 }
 
+/// The material's diffuse transmission as the real-time renderer draws it: on lit, opaque
+/// materials at a factor above 0 (the transmissive layer's G-buffer has no room for it; such a
+/// material is drawn without, and the upload says so).
+pub fn diffuse_transmission(
+    m: &scene::Material,
+) -> Option<&scene::diffuse_transmission::DiffuseTransmission> {
+    m.diffuse_transmission.as_ref().filter(|d| !m.unlit && transmission(m).is_none() && !d.is_off())
+}
+
+/// Where a diffuse transmission's two textures go among the slots: the colour's (sRGB; each
+/// texture is decoded by its own format) at the volume thickness's slot, which an opaque
+/// material never uses; the factor's (A) at the transmission's slot unless an anisotropy's
+/// texture is there, or at the colour's when it is the same texture (the extension's packing:
+/// colour in RGB, factor in A).
+pub struct DiffuseTransmissionSlots {
+    /// The texture at the transmission's slot (`TEX_DIFFUSE_TRANSMISSION`).
+    pub factor: Option<TextureRef>,
+    /// The texture at the volume thickness's slot (`TEX_DIFFUSE_TRANSMISSION_COLOR`).
+    pub color: Option<TextureRef>,
+    /// The factor's A is read from the colour's slot.
+    pub factor_in_color_slot: bool,
+    /// The factor's texture found no slot (an anisotropy's texture besides, and no colour
+    /// texture that is the same): drawn with the factor alone, and the upload says so.
+    pub factor_dropped: bool,
+}
+
+pub fn diffuse_transmission_slots(m: &scene::Material) -> DiffuseTransmissionSlots {
+    let none = DiffuseTransmissionSlots {
+        factor: None,
+        color: None,
+        factor_in_color_slot: false,
+        factor_dropped: false,
+    };
+    let Some(d) = diffuse_transmission(m) else { return none };
+    let Some(ft) = d.texture else { return DiffuseTransmissionSlots { color: d.color_texture, ..none } };
+    let anisotropy_texture = anisotropy(m).is_some_and(|a| a.texture.is_some());
+    match d.color_texture {
+        Some(ct) if ct == ft => {
+            DiffuseTransmissionSlots { color: Some(ct), factor_in_color_slot: true, ..none }
+        }
+        _ if anisotropy_texture => {
+            DiffuseTransmissionSlots { color: d.color_texture, factor_dropped: true, ..none }
+        }
+        ct => DiffuseTransmissionSlots { factor: Some(ft), color: ct, ..none },
+    }
+}
+
 /// The material's specular strength and colour as the real-time renderer draws them: the
 /// loader keeps them only on lit, film-less, opaque materials (`scene::Material::specular`).
 pub fn specular(m: &scene::Material) -> Option<&scene::specular::Specular> {
@@ -195,11 +250,13 @@ pub fn specular(m: &scene::Material) -> Option<&scene::specular::Specular> {
 /// the specular strength (A) and colour (sRGB), the sheen's colour (sRGB) and roughness (A). The
 /// anisotropy's texture (linear; RG the direction, B the strength) takes the transmission's
 /// slot: a material has one or the other ([`anisotropy`] is on opaque materials only), and the
-/// G-buffer's fragment stage has no 17th texture.
+/// G-buffer's fragment stage has no 17th texture. A diffuse transmission's textures take the
+/// transmission's and the volume thickness's slots ([`diffuse_transmission_slots`]).
 pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] {
     let film = m.iridescence.as_ref();
     let t = transmission(m);
     let c = coat(m);
+    let dt = diffuse_transmission_slots(m);
     [
         m.base_color_texture,
         m.metallic_roughness_texture,
@@ -208,8 +265,8 @@ pub fn texture_refs(m: &scene::Material) -> [Option<TextureRef>; TEXTURE_SLOTS] 
         m.occlusion_texture,
         film.and_then(|f| f.texture),
         film.and_then(|f| f.thickness_texture),
-        t.and_then(|t| t.texture).or_else(|| anisotropy(m).and_then(|a| a.texture)),
-        t.and_then(|t| t.volume.as_ref()).and_then(|v| v.thickness_texture),
+        t.and_then(|t| t.texture).or_else(|| anisotropy(m).and_then(|a| a.texture)).or(dt.factor),
+        t.and_then(|t| t.volume.as_ref()).and_then(|v| v.thickness_texture).or(dt.color),
         c.and_then(|c| c.texture),
         c.and_then(|c| c.roughness_texture),
         c.and_then(|c| c.normal_texture),
@@ -521,6 +578,10 @@ pub struct GpuScene {
     /// G-buffer write it (beside the film's values) and the shading pass compile it
     /// (`HAS_ANISOTROPY`).
     pub has_anisotropy: bool,
+    /// Whether some opaque material has a diffuse transmission ([`diffuse_transmission`]): only
+    /// then does the G-buffer write it (beside the specular's values, in the specular's target
+    /// widened) and the shading pass compile it (`HAS_DIFFUSE_TRANSMISSION`).
+    pub has_diffuse_transmission: bool,
     /// Whether some (lit) material's dielectric index is not glTF's 1.5 (`KHR_materials_ior`):
     /// only then does the shading pass read F0 per material.
     pub has_ior: bool,
@@ -703,10 +764,13 @@ impl GpuScene {
         // A see-through material's sheen and anisotropy have no room in the transmissive layer's
         // G-buffer.
         type Has = fn(&scene::Material) -> bool;
-        let layers: [(&str, &str, Has); 2] = [
+        let layers: [(&str, &str, Has); 3] = [
             ("KHR_materials_sheen", "without its sheen", |m| m.sheen.as_ref().is_some_and(|sh| !sh.is_off())),
             ("KHR_materials_anisotropy", "with an isotropic specular lobe", |m| {
                 m.anisotropy.as_ref().is_some_and(|a| !a.is_off())
+            }),
+            ("KHR_materials_diffuse_transmission", "without its diffuse transmission", |m| {
+                m.diffuse_transmission.as_ref().is_some_and(|d| !d.is_off())
             }),
         ];
         for (ext, drawn, has) in layers {
@@ -724,6 +788,17 @@ impl GpuScene {
                     names.join(", ")
                 ));
             }
+        }
+        // Nor has the G-buffer's fragment stage a 17th texture slot for a third texture beside
+        // an anisotropy's (`diffuse_transmission_slots`).
+        for m in s.materials.iter().filter(|m| diffuse_transmission_slots(m).factor_dropped) {
+            warnings.push(format!(
+                "KHR_materials_diffuse_transmission's diffuseTransmissionTexture on material '{}' is not \
+                 drawn by the real-time renderer beside an anisotropy texture unless it is the \
+                 diffuseTransmissionColorTexture too: drawn with its factor alone; the path tracer \
+                 (`spectra truth`) draws it",
+                m.name
+            ));
         }
         let textures = upload_textures(device, queue, s, &mut warnings)?;
         let defaults = DefaultTextures::new(device, queue);
@@ -862,6 +937,7 @@ impl GpuScene {
             has_specular: s.materials.iter().any(|m| specular(m).is_some()),
             has_sheen: s.materials.iter().any(|m| sheen(m).is_some()),
             has_anisotropy: s.materials.iter().any(|m| anisotropy(m).is_some()),
+            has_diffuse_transmission: s.materials.iter().any(|m| diffuse_transmission(m).is_some()),
             has_transmission: s.materials.iter().any(|m| transmission(m).is_some()),
             has_transmission_film: s
                 .materials

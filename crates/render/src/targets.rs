@@ -52,6 +52,13 @@ pub struct Targets {
     /// `KHR_materials_specular`).
     pub gbuffer_specular: wgpu::Texture,
     pub gbuffer_specular_view: wgpu::TextureView,
+    /// The specular's values and the diffuse transmission per pixel, in place of
+    /// `gbuffer_specular` for scenes with `KHR_materials_diffuse_transmission`
+    /// (`passes::GBUFFER_SPECULAR_DT_FORMAT`), made at the first such scene
+    /// ([`Self::bind_specular_dt`]).
+    pub gbuffer_specular_dt: Option<(wgpu::Texture, wgpu::TextureView)>,
+    /// Whether the shading inputs bind `gbuffer_specular_dt` where the specular's target is read.
+    pub specular_dt: bool,
     /// The sheen per pixel (written only for scenes with `KHR_materials_sheen`).
     pub gbuffer_sheen: wgpu::Texture,
     pub gbuffer_sheen_view: wgpu::TextureView,
@@ -117,6 +124,8 @@ impl Targets {
             gbuffer_coat_view,
             gbuffer_specular,
             gbuffer_specular_view,
+            gbuffer_specular_dt: None,
+            specular_dt: false,
             gbuffer_sheen,
             gbuffer_sheen_view,
             depth,
@@ -152,6 +161,31 @@ impl Targets {
         let changed = self.film_anisotropy != on;
         self.film_anisotropy = on;
         changed
+    }
+
+    /// [`Self::bind_film_anisotropy`] for the specular's target of scenes with a diffuse
+    /// transmission.
+    pub fn bind_specular_dt(&mut self, device: &wgpu::Device, on: bool) -> bool {
+        if on && self.gbuffer_specular_dt.is_none() {
+            self.gbuffer_specular_dt = Some(target(
+                device,
+                (self.width, self.height),
+                "gbuffer specular and diffuse transmission",
+                crate::passes::GBUFFER_SPECULAR_DT_FORMAT,
+                wgpu::TextureUsages::COPY_SRC,
+            ));
+        }
+        let changed = self.specular_dt != on;
+        self.specular_dt = on;
+        changed
+    }
+
+    /// The specular's target the G-buffer writes and the shading reads ([`Self::bind_specular_dt`]).
+    pub fn specular_view(&self) -> &wgpu::TextureView {
+        match (&self.gbuffer_specular_dt, self.specular_dt) {
+            (Some((_, view)), true) => view,
+            _ => &self.gbuffer_specular_view,
+        }
     }
 
     /// The film's target the G-buffer writes and the shading reads ([`Self::bind_film_anisotropy`]).

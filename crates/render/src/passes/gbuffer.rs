@@ -15,7 +15,8 @@
 
 use super::{
     GBUFFER_COAT_FORMAT, GBUFFER_FILM_ANISOTROPY_FORMAT, GBUFFER_FILM_FORMAT, GBUFFER_FORMATS,
-    GBUFFER_LAYER_FORMAT, GBUFFER_SHEEN_FORMAT, GBUFFER_SPECULAR_FORMAT, SharedLayouts,
+    GBUFFER_LAYER_FORMAT, GBUFFER_SHEEN_FORMAT, GBUFFER_SPECULAR_DT_FORMAT, GBUFFER_SPECULAR_FORMAT,
+    SharedLayouts,
 };
 use crate::error::Result;
 use crate::scene_gpu::{self, GpuScene, Vertex};
@@ -68,6 +69,8 @@ pub enum Fourth {
 /// adds no target: it widens the film's to [`GBUFFER_FILM_ANISOTROPY_FORMAT`] (film values in
 /// xy, the anisotropy's angle and strength in zw), which the shading pass reads where it reads
 /// the film's (no sampled texture to spare there, nor a colour attachment with a sheen here).
+/// A diffuse transmission (`KHR_materials_diffuse_transmission`) widens the specular's to
+/// [`GBUFFER_SPECULAR_DT_FORMAT`] for the same reasons, and writes it without a specular too.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Targets {
     pub fourth: Fourth,
@@ -75,32 +78,42 @@ pub struct Targets {
     pub specular: bool,
     pub sheen: bool,
     pub anisotropy: bool,
+    pub diffuse_transmission: bool,
 }
 
 impl Targets {
-    pub const PLAIN: Targets =
-        Targets { fourth: Fourth::None, coat: false, specular: false, sheen: false, anisotropy: false };
+    pub const PLAIN: Targets = Targets {
+        fourth: Fourth::None,
+        coat: false,
+        specular: false,
+        sheen: false,
+        anisotropy: false,
+        diffuse_transmission: false,
+    };
 
     /// Every set the renderer draws with: a coat comes with the film's or the layer's target
     /// (which the shading pass reads beside it), a specular with the film's (the loader keeps no
     /// specular on see-through materials), a sheen anywhere but the see-through layer's (the
     /// real-time renderer draws no sheen there), an anisotropy with the film's (which it
-    /// widens; none in the see-through layer either).
+    /// widens; none in the see-through layer either), a diffuse transmission with the film's
+    /// (the specular's, which it widens, comes with the film's; none in the see-through layer).
     pub fn all() -> impl Iterator<Item = Targets> {
         [Fourth::None, Fourth::Film, Fourth::Layer].into_iter().flat_map(|fourth| {
-            (0..16u8)
+            (0..32u8)
                 .map(move |bits| Targets {
                     fourth,
                     coat: bits & 1 != 0,
                     specular: bits & 2 != 0,
                     sheen: bits & 4 != 0,
                     anisotropy: bits & 8 != 0,
+                    diffuse_transmission: bits & 16 != 0,
                 })
                 .filter(|t| {
                     (!t.coat || t.fourth != Fourth::None)
                         && (!t.specular || t.fourth == Fourth::Film)
                         && (!t.sheen || t.fourth != Fourth::Layer)
                         && (!t.anisotropy || t.fourth == Fourth::Film)
+                        && (!t.diffuse_transmission || t.fourth == Fourth::Film)
                 })
         })
     }
@@ -117,7 +130,9 @@ impl Targets {
         if self.coat {
             f.push(GBUFFER_COAT_FORMAT);
         }
-        if self.specular {
+        if self.diffuse_transmission {
+            f.push(GBUFFER_SPECULAR_DT_FORMAT);
+        } else if self.specular {
             f.push(GBUFFER_SPECULAR_FORMAT);
         }
         if self.sheen {
@@ -144,6 +159,10 @@ impl Targets {
             bytes += 8;
             what.push("a specular colour (KHR_materials_specular)");
         }
+        if self.diffuse_transmission {
+            bytes += super::DIFFUSE_TRANSMISSION_TARGET_BYTES + if self.specular { 0 } else { 8 };
+            what.push("a diffuse transmission (KHR_materials_diffuse_transmission)");
+        }
         if self.sheen {
             bytes += super::SHEEN_TARGET_BYTES;
             what.push("a sheen (KHR_materials_sheen)");
@@ -158,11 +177,12 @@ impl Targets {
             Fourth::Layer => "layer",
         };
         format!(
-            "{fourth}{}{}{}{}",
+            "{fourth}{}{}{}{}{}",
             if self.coat { "_coat" } else { "" },
             if self.specular { "_spec" } else { "" },
             if self.sheen { "_sheen" } else { "" },
-            if self.anisotropy { "_aniso" } else { "" }
+            if self.anisotropy { "_aniso" } else { "" },
+            if self.diffuse_transmission { "_dt" } else { "" }
         )
     }
 
@@ -208,7 +228,16 @@ impl Targets {
             samples.push("let c = coat_sample(v);");
             writes.push("r.coat = coat_target(o, c, v, front);");
         }
-        if self.specular {
+        if self.diffuse_transmission {
+            fields.push(format!("@location({}) specular: vec4<u32>", fields.len()));
+            if self.specular {
+                samples.push("let sp = specular_values(v);");
+            } else {
+                samples.push("let sp = vec4<u32>(0u);");
+            }
+            samples.push("let dt = diffuse_transmission_values(v);");
+            writes.push("r.specular = sp | (diffuse_transmission_target(o, dt) << vec4<u32>(16u));");
+        } else if self.specular {
             fields.push(format!("@location({}) specular: vec4<u32>", fields.len()));
             samples.push("let sp = specular_values(v);");
             writes.push("r.specular = sp;");
@@ -399,7 +428,7 @@ mod tests {
     #[test]
     fn generated_entry_points_write_each_target_in_order() {
         let all: Vec<Targets> = Targets::all().collect();
-        assert_eq!(all.len(), 20, "{all:?}");
+        assert_eq!(all.len(), 36, "{all:?}");
         let entry_points: String = all.iter().map(|t| t.wgsl()).collect();
         let source =
             [shader::COMMON, shader::HASH, shader::MATERIAL, include_str!("gbuffer.wgsl"), &entry_points]

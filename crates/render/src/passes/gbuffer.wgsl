@@ -230,3 +230,22 @@ fn anisotropy_target(o: GBufferOut, c: vec3<f32>, v: VertexOut, front: bool) -> 
     let t = normalize(d.x * t0 + d.y * b0);
     return vec2<f32>(anisotropy_angle(n, t), s);
 }
+
+// Scenes with KHR_materials_diffuse_transmission write it in the high 16 bits of the specular's
+// target (passes/gbuffer.rs `Targets::diffuse_transmission`, GBUFFER_SPECULAR_DT_FORMAT): rgb the
+// colour (factor × the colour texture's RGB, sRGB-decoded), a the factor (× the factor texture's
+// A) — scene::diffuse_transmission — as 16-bit fractions. Materials without one write zero.
+fn diffuse_transmission_values(v: VertexOut) -> vec4<f32> {
+    let d = material.diffuse_transmission;
+    let c = textureSampleBias(volume_thickness_tex, volume_thickness_smp, material_uv(TEX_DIFFUSE_TRANSMISSION_COLOR, v.uv, v.uv1), frame.lod_bias);
+    let a = textureSampleBias(transmission_tex, transmission_smp, material_uv(TEX_DIFFUSE_TRANSMISSION, v.uv, v.uv1), frame.lod_bias).a;
+    // A negative factor: its texture is the colour's (the extension's packing: RGB and A).
+    let t = abs(d.w) * select(a, c.a, d.w < 0.0);
+    return clamp(vec4<f32>(d.rgb * c.rgb, t), vec4<f32>(0.0), vec4<f32>(1.0));
+}
+
+fn diffuse_transmission_target(o: GBufferOut, dt: vec4<f32>) -> vec4<u32> {
+    // An unlit surface (UNLIT_MARK) transmits nothing.
+    let d = select(dt, vec4<f32>(0.0), o.base.a < 0.0);
+    return vec4<u32>(round(d * 65535.0));
+}

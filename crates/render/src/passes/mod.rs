@@ -111,6 +111,18 @@ pub const COAT_SPECULAR_TARGET_BYTES: u32 = COAT_TARGET_BYTES + 8;
 /// pass reads it where the see-through layer's background is bound (`sheen_at`), which a sheen
 /// never needs (the real-time renderer draws no sheen on see-through materials).
 pub const GBUFFER_SHEEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The specular's target of scenes with `KHR_materials_diffuse_transmission`
+/// (`passes::gbuffer::Targets::diffuse_transmission`), written whether or not the scene has a
+/// specular: each channel's low 16 bits the specular's as [`GBUFFER_SPECULAR_FORMAT`], the high
+/// 16 bits the diffuse transmission's colour (rgb, linear) and factor (a) as 16-bit fractions. A
+/// target of its own would be a ninth colour attachment beside a coat, a specular and a sheen,
+/// and a 17th sampled texture in the shading stage; widened, the specular's (unsigned integers
+/// either way: the same binding) is read where it was.
+pub const GBUFFER_SPECULAR_DT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// The bytes a pixel a diffuse transmission adds to the G-buffer's targets: the widened
+/// specular's 16, or 8 where the scene has a specular's already; and the film's 4 where the
+/// scene has none (the specular's target comes with the film's).
+pub const DIFFUSE_TRANSMISSION_TARGET_BYTES: u32 = 8;
 /// Bytes a pixel of the G-buffer targets with the sheen's: 8 more than without it.
 pub const SHEEN_TARGET_BYTES: u32 = 8;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;

@@ -155,6 +155,10 @@ pub struct Variant {
     /// Some opaque material has an anisotropy (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`):
     /// the film's target carries it, and the base's specular lobe is anisotropic (all modes).
     pub anisotropy: bool,
+    /// Some opaque material has a diffuse transmission (`HAS_DIFFUSE_TRANSMISSION`,
+    /// `KHR_materials_diffuse_transmission`): the specular's target carries it, and each light
+    /// behind the surface and the environment there reach the viewer through it (all modes).
+    pub diffuse_transmission: bool,
     /// The transmissive layer's shading (`HAS_TRANSMISSION`, passes/transmission.wgsl): the
     /// G-buffer is the see-through layer's, `background` the opaque layer's shaded image.
     pub transmission: bool,
@@ -190,6 +194,7 @@ impl Variant {
         specular: true,
         sheen: true,
         anisotropy: true,
+        diffuse_transmission: true,
         transmission: false,
         thin_walls: true,
         dispersion: true,
@@ -198,9 +203,9 @@ impl Variant {
     };
 
     /// The constants this variant sets. The RGB entry point reads only the scene's (polygons,
-    /// environment, emission, film, ior, specular, sheen, anisotropy, transmission, thin walls, dispersion) and the occlusion's; its
+    /// environment, emission, film, ior, specular, sheen, anisotropy, diffuse transmission, transmission, thin walls, dispersion) and the occlusion's; its
     /// pipelines are keyed by [`Self::rgb`].
-    fn constants(&self) -> [(&'static str, f64); 19] {
+    fn constants(&self) -> [(&'static str, f64); 20] {
         let b = |v: bool| f64::from(u8::from(v));
         [
             ("HAS_POLYGONS", b(self.polygons)),
@@ -217,6 +222,7 @@ impl Variant {
             ("HAS_SPECULAR", b(self.specular)),
             ("HAS_SHEEN", b(self.sheen)),
             ("HAS_ANISOTROPY", b(self.anisotropy)),
+            ("HAS_DIFFUSE_TRANSMISSION", b(self.diffuse_transmission)),
             ("HAS_TRANSMISSION", b(self.transmission)),
             ("HAS_THIN_WALLS", b(self.thin_walls)),
             ("HAS_DISPERSION", b(self.dispersion)),
@@ -239,6 +245,7 @@ impl Variant {
             specular: self.specular,
             sheen: self.sheen,
             anisotropy: self.anisotropy,
+            diffuse_transmission: self.diffuse_transmission,
             transmission: self.transmission,
             thin_walls: self.thin_walls,
             dispersion: self.dispersion,
@@ -569,7 +576,8 @@ impl ShadingPass {
                 // The occlusion pass's output (`aux_map`, read with `OCCLUSION_MAP`).
                 view_entry(11, &t.occlusion_view),
                 view_entry(12, &t.depth_view),
-                view_entry(13, &t.gbuffer_specular_view),
+                // The specular's values (with a diffuse transmission's where the scene has one).
+                view_entry(13, t.specular_view()),
                 view_entry(14, output),
             ],
         })

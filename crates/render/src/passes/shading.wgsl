@@ -43,6 +43,93 @@ override HAS_SHEEN: bool = true;
 // carries it (gbuffer.wgsl), and the base's specular lobe is anisotropic GGX for every light,
 // the environment's lobe and polygon lights' its isotropic stand-in (every mode).
 override HAS_ANISOTROPY: bool = true;
+// A material with a diffuse transmission (KHR_materials_diffuse_transmission,
+// scene::diffuse_transmission): the specular's target carries it (gbuffer.wgsl), the reflected
+// diffuse loses its share, and lights and the environment on the far side of the surface reach
+// the viewer through its Lambertian lobe (every mode).
+override HAS_DIFFUSE_TRANSMISSION: bool = true;
+
+// The diffuse transmission at a pixel: its share t of the diffuse (0: none) and its colour.
+struct DiffTrans {
+    t: f32,
+    color: vec3<f32>,
+    // The colour's coefficients (the spectral modes'; fetched once per pixel).
+    coeffs: vec3<f32>,
+};
+
+fn no_dt() -> DiffTrans {
+    return DiffTrans(0.0, vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+// None without diffuse transmissions in the scene, on unlit surfaces and in the Lambert-only
+// comparison mode (whose BRDF is the reflected Lambertian alone).
+fn load_dt(px: vec2<i32>, s: GSurface) -> DiffTrans {
+    if (!HAS_DIFFUSE_TRANSMISSION || s.unlit || lambert_only()) {
+        return no_dt();
+    }
+    let d = vec4<f32>(textureLoad(layer_packed, px, 0) >> vec4<u32>(16u)) * (1.0 / 65535.0);
+    if (d.a <= 0.0) {
+        return no_dt();
+    }
+    return DiffTrans(d.a, d.rgb, vec3<f32>(0.0));
+}
+
+// What the reflected diffuse keeps: 1 − t (exactly 1 without a diffuse transmission).
+fn dt_keep(d: DiffTrans) -> f32 {
+    if (!HAS_DIFFUSE_TRANSMISSION) {
+        return 1.0;
+    }
+    return 1.0 - d.t;
+}
+
+// One light's transmitted diffuse at a surface whose light is on the far side of n, per unit
+// colour: t·(1 − metallic)·(1 − w·F(v·h'))/π·|n·l|·E·visibility, the dielectric's weighting of
+// its reflected diffuse with the light mirrored through the surface (h' the half vector of v and
+// the mirrored l, as the Khronos sample viewer takes it), times the sheen's albedo scaling at the
+// mirrored direction. The shadow lookup is offset towards the far side (−n): the surface does not
+// shadow the light that crosses it, what lies between it and the light does. Polygon lights: the
+// exact clipped cosine over the polygon on the far side, the Fresnel term at its centroid's
+// mirrored direction. Zero where the light is on the near side or does not reach p.
+fn dt_light(li: u32, p: vec3<f32>, s: GSurface, v: vec3<f32>, d: DiffTrans, sh: SheenSurface) -> f32 {
+    let n = s.normal;
+    var wi: vec3<f32>;
+    var e = 0.0;
+    if (HAS_POLYGONS && u32(lights[li].pos_kind.w) == 3u) {
+        if (dot(p - polygon_vertex(li, 0u), polygon_normal(li)) <= 0.0) { return 0.0; }
+        let g = polygon_cosine(li, p, ltc_frame(-n, v));
+        if (g <= 0.0) { return 0.0; }
+        wi = normalize(polygon_centroid(li) - p);
+        e = g;
+    } else {
+        let inc = light_incidence(li, p);
+        wi = inc.xyz;
+        let nl = dot(n, wi);
+        if (nl >= 0.0 || inc.w <= 0.0) { return 0.0; }
+        e = -nl * inc.w;
+    }
+    e *= light_visibility(li, p, -n);
+    let lm = wi - 2.0 * dot(n, wi) * n;
+    let vh = max(dot(v, normalize(lm + v)), 0.0);
+    let fres = pow(1.0 - vh, 5.0);
+    var k = e * d.t * (1.0 - s.metallic) * (1.0 - s.spec_w * (s.f0 + (1.0 - s.f0) * fres)) / PI;
+    if (HAS_SHEEN && sh.on) {
+        k *= sheen_light(sh, n, v, lm, 0.0).y;
+    }
+    return k;
+}
+
+// The environment's transmitted diffuse per unit colour: the irradiance about −n (the far side's
+// hemisphere) times t·(1 − metallic)·(1 − w·F̄(n·v))/π, the reflected diffuse's weighting
+// (`env_terms_keep`), and the sheen's scaling of the base. Occluded by the material's occlusion
+// texture only: the screen-space horizons are the near side's.
+fn dt_env(s: GSurface, v: vec3<f32>, d: DiffTrans, sh: SheenSurface) -> vec4<f32> {
+    let nv = max(dot(s.normal, v), 1e-4);
+    var k = d.t * (1.0 - s.metallic) * (1.0 - s.spec_w * fresnel_diffuse(s.f0, nv)) / PI * s.occlusion;
+    if (HAS_SHEEN && sh.on) {
+        k *= sheen_env(sh).x;
+    }
+    return env_irradiance_at(-s.normal) * k;
+}
 
 // The anisotropy at a pixel: the unit direction t ⟂ n along which the lobe is stretched and the
 // strength s (0: an isotropic lobe).
@@ -134,7 +221,12 @@ struct ShadowUniforms {
 // target, `layer_packed`, which a specular never needs): rgb the F0 colour, a the weight
 // (scene::specular).
 fn specular_at(px: vec2<i32>) -> vec4<f32> {
-    return vec4<f32>(textureLoad(layer_packed, px, 0)) * (1.0 / 65535.0);
+    var t = textureLoad(layer_packed, px, 0);
+    if (HAS_DIFFUSE_TRANSMISSION) {
+        // The high 16 bits are the diffuse transmission's (`load_dt`).
+        t &= vec4<u32>(0xffffu);
+    }
+    return vec4<f32>(t) * (1.0 / 65535.0);
 }
 
 // The clear coat at a pixel (KHR_materials_clearcoat; scene::clearcoat holds the rule both
@@ -665,6 +757,11 @@ fn sheen_nodes(sh: SheenSurface, g: u32) -> vec4<f32> {
     return node_reflectance(sh.coeffs, sh.color, g);
 }
 
+// The diffuse transmission colour's reflectance at group g's nodes, made as the base colour's is.
+fn dt_nodes(d: DiffTrans, g: u32) -> vec4<f32> {
+    return node_reflectance(d.coeffs, d.color, g);
+}
+
 // The spectral modes' coefficients of a tinted specular colour (fetched per pixel: the colour
 // may come from a texture).
 fn spec_coeffs(f: FilmSurface) -> vec3<f32> {
@@ -831,6 +928,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         coat = load_coat(px, -ctx.view_dir, s.unlit);
         let sh = load_sheen(px, s, -ctx.view_dir);
         let an = load_aniso(px, s);
+        let dt = load_dt(px, s);
+        // What the diffuse transmission lets through, per unit colour.
+        var sum_dt = vec3<f32>(0.0);
         // What the sheen reflects, per unit colour.
         var sum_sheen = vec3<f32>(0.0);
         let n_lit = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
@@ -852,6 +952,10 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             }
             if (HAS_COAT) {
                 sum_c = fma(vec3<f32>(t.kc * k), e, sum_c);
+            }
+            if (HAS_DIFFUSE_TRANSMISSION && dt.t > 0.0) {
+                t.kd *= dt_keep(dt);
+                sum_dt = fma(vec3<f32>(dt_light(li, ctx.world_pos, s, -ctx.view_dir, dt, sh) * k), e, sum_dt);
             }
             // Light from behind a thin-walled see-through surface, tinted by the base colour.
             var behind = 0.0;
@@ -876,6 +980,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
         if (HAS_SHEEN) {
             rgb = fma(sh.color, sum_sheen, rgb);
         }
+        if (HAS_DIFFUSE_TRANSMISSION) {
+            rgb = fma(dt.color, sum_dt, rgb);
+        }
         if (HAS_EMISSION) {
             // Without emission in the scene, and without ambient light (whose occlusion shares
             // the texel), the emission target is not read.
@@ -893,9 +1000,10 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             if (HAS_TRANSMISSION && !filmed) {
                 et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else if (!filmed) {
-                et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, 1.0, s.spec_w);
+                et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, dt_keep(dt), s.spec_w);
             } else {
-                let l = env_lobes(s.normal, -ctx.view_dir, anisotropy_iso_roughness(an, s.roughness));
+                var l = env_lobes(s.normal, -ctx.view_dir, anisotropy_iso_roughness(an, s.roughness));
+                l.irr *= dt_keep(dt);
                 let a = l.ab.x;
                 let b = l.ab.y;
                 var fd: vec3<f32>;
@@ -929,6 +1037,9 @@ fn shade_rgb(in: FullscreenOut) -> vec4<f32> {
             var coat_env = vec3<f32>(0.0);
             if (HAS_COAT && coat.w > 0.0) {
                 coat_env = env_coat(coat, -ctx.view_dir).rgb * vis;
+            }
+            if (HAS_DIFFUSE_TRANSMISSION && dt.t > 0.0) {
+                env_rgb += dt.color * dt_env(s, -ctx.view_dir, dt, sh).rgb;
             }
             if (CUSTOM_ENV_T) {
                 let t = custom_env_transmittance_rgb(ctx);
@@ -1250,6 +1361,17 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             sh.coeffs = fetch_coeffs(sh.color, frame.table_res);
         }
     }
+    // The diffuse transmission's colour is a reflectance too: summed per light over its nodes
+    // (fetched once).
+    var dt = no_dt();
+    var ng_dt = 0u;
+    if (HAS_DIFFUSE_TRANSMISSION) {
+        dt = load_dt(px, s);
+        ng_dt = select(0u, ng, dt.t > 0.0);
+        for (var i = select(0u, 1u, ng_dt > 0u && !NAIVE); i > 0u; i--) {
+            dt.coeffs = fetch_coeffs(dt.color, frame.table_res);
+        }
+    }
     // What the coat reflects, per unit w: each light's XYZ once (it does not depend on ρ).
     var coat_xyz = vec3<f32>(0.0);
     for (var li = 0u; li < n_lights; li++) {
@@ -1272,6 +1394,15 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         }
         if (HAS_COAT) {
             coat_xyz = fma(vec3<f32>(t.kc * k), lights[li].xyz.xyz, coat_xyz);
+        }
+        if (HAS_DIFFUSE_TRANSMISSION && ng_dt > 0u) {
+            t.kd *= dt_keep(dt);
+            let kt = dt_light(li, p, s, v, dt, sh) * k;
+            var rt = vec3<f32>(0.0);
+            for (var g = 0u; g < ng_dt; g++) {
+                rt += dt_nodes(dt, g) * light_w(li, g, ng);
+            }
+            xyz = fma(vec3<f32>(kt), rt, xyz);
         }
         // Light from behind a thin-walled see-through surface, tinted like the reflectance.
         var through = 0.0;
@@ -1333,6 +1464,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             lobes = env_lobes(s.normal, v, anisotropy_iso_roughness(an, s.roughness));
             // A see-through surface's diffuse layer is what its transmission leaves.
             lobes.irr *= vis * keep;
+            lobes.irr *= dt_keep(dt);
             lobes.spec *= vis;
             if (HAS_SHEEN && sh.on) {
                 let q = sheen_env(sh);
@@ -1343,7 +1475,7 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
             if (HAS_TRANSMISSION) {
                 et = env_terms_keep(s.normal, v, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
             } else {
-                et = env_terms_keep(s.normal, v, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, 1.0, s.spec_w);
+                et = env_terms_keep(s.normal, v, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, dt_keep(dt), s.spec_w);
             }
             et.a *= vis;
             et.b *= vis;
@@ -1368,6 +1500,12 @@ fn shade_spectral(in: FullscreenOut) -> vec4<f32> {
         }
         if (HAS_COAT && coat.w > 0.0) {
             coat_xyz += env_xyz(env_coat(coat, v)) * vis;
+        }
+        if (HAS_DIFFUSE_TRANSMISSION && ng_dt > 0u) {
+            let c = dt_env(s, v, dt, sh);
+            for (var g = 0u; g < ng_dt; g++) {
+                xyz += dt_nodes(dt, g) * env_w(c, g, ng);
+            }
         }
         if (HAS_SHEEN && sh.on) {
             // The sheen's reflection of the irradiance, E(n·v)/π of it per unit colour.
@@ -1436,7 +1574,9 @@ struct NodeLight {
 
 // Under a coat (`Coat`), what lies beneath is scaled by 1 − w and the coat's lobe, which does
 // not depend on ρ, joins `b` (a filmed pixel's `b` is the coat's alone).
-fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat, sh: SheenSurface, an: Aniso) -> NodeLight {
+// A diffuse transmission (`dt`) takes its share of the reflected diffuse here; what it lets
+// through is the caller's (`dt_light`).
+fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Transmissive, filmed: bool, c: Coat, sh: SheenSurface, an: Aniso, dt: DiffTrans) -> NodeLight {
     var t = light_terms(li, p, s.normal, -ctx.view_dir, s.roughness, an, c);
     let k = custom_light_surface(li, ctx);
     t.kd *= k;
@@ -1447,6 +1587,9 @@ fn node_light(li: u32, p: vec3<f32>, s: GSurface, ctx: SurfaceContext, tr: Trans
         t.kd *= q.y;
         t.ks *= q.y;
         sheen = q.x;
+    }
+    if (HAS_DIFFUSE_TRANSMISSION && dt.t > 0.0) {
+        t.kd *= dt_keep(dt);
     }
     var coat_b = 0.0;
     if (HAS_COAT && c.w > 0.0) {
@@ -1535,6 +1678,11 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     var fsh: array<f32, MAX_LIGHTS>;
     var sheen_env_c = vec4<f32>(0.0);
     var an = no_aniso();
+    // The diffuse transmission (KHR_materials_diffuse_transmission): per light what its colour's
+    // reflectance multiplies in `fdt`, the environment's in `dt_env_c`, both under the coat.
+    var dt = no_dt();
+    var fdt: array<f32, MAX_LIGHTS>;
+    var dt_env_c = vec4<f32>(0.0);
     if (!background) {
         s = load_surface(px);
         an = load_aniso(px, s);
@@ -1560,6 +1708,12 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         if (HAS_COAT && me.on) {
             me.k *= under;
         }
+        if (HAS_DIFFUSE_TRANSMISSION) {
+            dt = load_dt(px, s);
+            if (dt.t > 0.0 && !NAIVE) {
+                dt.coeffs = fetch_coeffs(dt.color, frame.table_res);
+            }
+        }
         let keep = 1.0 - tr.weight;
         var vis = 1.0;
         if ((has_env || CUSTOM_IRRADIANCE) && !s.unlit) {
@@ -1568,7 +1722,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         if (has_env && !s.unlit) {
             if (is_filmed(film)) {
                 lobes = env_lobes(s.normal, -ctx.view_dir, anisotropy_iso_roughness(an, s.roughness));
-                lobes.irr *= vis;
+                lobes.irr *= vis * dt_keep(dt);
                 lobes.spec *= vis;
                 if (HAS_TRANSMISSION) {
                     lobes.irr *= keep;
@@ -1586,7 +1740,7 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 if (HAS_TRANSMISSION) {
                     et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, s.roughness, lambert_only(), s.f0, keep, s.spec_w);
                 } else {
-                    et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, 1.0, s.spec_w);
+                    et = env_terms_keep(s.normal, -ctx.view_dir, s.metallic, anisotropy_iso_roughness(an, s.roughness), lambert_only(), s.f0, dt_keep(dt), s.spec_w);
                 }
                 et.a *= vis;
                 et.b *= vis;
@@ -1606,6 +1760,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             if (HAS_SHEEN && sh.on) {
                 sheen_env_c = env_irradiance_at(s.normal) * (sheen_env(sh).y * vis * under);
             }
+            if (HAS_DIFFUSE_TRANSMISSION && dt.t > 0.0) {
+                dt_env_c = dt_env(s, -ctx.view_dir, dt, sh) * under;
+            }
         }
         base = s.base;
         emission = s.emission;
@@ -1617,12 +1774,15 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
     if (!background) {
         n_lights = select(min(frame.n_lights, MAX_LIGHTS), 0u, s.unlit);
         for (var li = 0u; li < n_lights; li++) {
-            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat, sh, an);
+            let nl = node_light(li, p, s, ctx, tr, is_filmed(film), coat, sh, an, dt);
             ft[li] = nl.t;
             fa[li] = nl.a;
             fb[li] = nl.b;
             if (HAS_SHEEN) {
                 fsh[li] = nl.sheen;
+            }
+            if (HAS_DIFFUSE_TRANSMISSION) {
+                fdt[li] = select(0.0, dt_light(li, p, s, -ctx.view_dir, dt, sh) * custom_light_surface(li, ctx) * under, dt.t > 0.0);
             }
         }
     }
@@ -1709,6 +1869,27 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
                 acc_s += ws;
             }
         }
+        // The diffuse transmission's lobe under every light behind and the environment there,
+        // times its colour's reflectance.
+        var acc_t = zero;
+        var t_nodes = vec4<f32>(0.0);
+        if (HAS_DIFFUSE_TRANSMISSION && dt.t > 0.0) {
+            t_nodes = dt_nodes(dt, g);
+            for (var li = 0u; li < n_lights; li++) {
+                var w = light_w(li, g, ng);
+                if (CUSTOM_LIGHT_T) {
+                    w = s3_scale(w, custom_light_transmittance(li, lambda, g, ctx));
+                }
+                acc_t += w * fdt[li];
+            }
+            if (has_env) {
+                var wt = env_w(dt_env_c, g, ng);
+                if (CUSTOM_ENV_T) {
+                    wt = s3_scale(wt, custom_env_transmittance(lambda, g, ctx));
+                }
+                acc_t += wt;
+            }
+        }
         if (has_env && !background) {
             if (filmed) {
                 let fe = film_env_node(lobes, film, rho, metallic, lambda, spec_nodes(film, g));
@@ -1744,6 +1925,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
         if (HAS_SHEEN) {
             part += s3_scale(acc_s, s_nodes);
         }
+        if (HAS_DIFFUSE_TRANSMISSION) {
+            part += s3_scale(acc_t, t_nodes);
+        }
         if (filmed) {
             part += acc_f;
         }
@@ -1766,6 +1950,9 @@ fn shade_nodes(in: FullscreenOut) -> vec3<f32> {
             xyz += rho * acc_a;
             if (HAS_SHEEN) {
                 xyz += s_nodes * acc_s;
+            }
+            if (HAS_DIFFUSE_TRANSMISSION) {
+                xyz += t_nodes * acc_t;
             }
             if (filmed) {
                 xyz += s3_xyz(acc_f);

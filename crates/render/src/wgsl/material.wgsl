@@ -32,6 +32,9 @@ struct MaterialUniforms {
     // KHR_materials_anisotropy: x the strength (0: none), y/z the rotation's cosine and sine,
     // w = 1 with a texture (at TEX_ANISOTROPY, the transmission's slot); zero without.
     anisotropy: vec4<f32>,
+    // KHR_materials_diffuse_transmission: rgb the colour factor, w the factor (0: none),
+    // negative where the factor's texture is read from the colour's slot's A; zero without.
+    diffuse_transmission: vec4<f32>,
 };
 
 const ALPHA_OPAQUE: u32 = 0u;
@@ -50,6 +53,10 @@ const TEX_TRANSMISSION: u32 = 7u;
 // draw an anisotropy (src/scene_gpu.rs `texture_refs`).
 const TEX_ANISOTROPY: u32 = 7u;
 const TEX_VOLUME_THICKNESS: u32 = 8u;
+// A diffuse transmission's textures take the transmission's and the volume thickness's slots
+// (opaque materials only; src/scene_gpu.rs `diffuse_transmission_slots`).
+const TEX_DIFFUSE_TRANSMISSION: u32 = 7u;
+const TEX_DIFFUSE_TRANSMISSION_COLOR: u32 = 8u;
 const TEX_COAT: u32 = 9u;
 const TEX_COAT_ROUGH: u32 = 10u;
 const TEX_COAT_NORMAL: u32 = 11u;
