@@ -364,23 +364,6 @@ fn the_environment_reflects_the_stand_in_lobe() {
     }
 }
 
-/// The anisotropic lobe's directional albedo at view `v` (in its (t, b, n) frame) with Fresnel 1:
-/// ∫ D·V·(n·l) dl by the midpoint rule in (cos θ, φ), f64.
-fn lobe_albedo(at: f64, ab: f64, v: DVec3) -> f64 {
-    let n = 400;
-    let mut sum = 0.0;
-    for i in 0..n {
-        let mu = (i as f64 + 0.5) / n as f64;
-        let st = (1.0 - mu * mu).sqrt();
-        for j in 0..2 * n {
-            let phi = (j as f64 + 0.5) / (2 * n) as f64 * std::f64::consts::TAU;
-            let l = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
-            sum += scene::anisotropy::lobe(at, ab, l, v) * mu;
-        }
-    }
-    sum / n as f64 * (std::f64::consts::PI / n as f64)
-}
-
 /// In a uniform white environment (a furnace) a white metal (Fresnel 1) reflects its lobe's
 /// directional albedo. The split sum has no anisotropic albedo: it looks its own up at the
 /// stand-in roughness (α = √((α_t² + α_b²)/2), `anisotropy_iso_roughness`), which must stay
@@ -415,10 +398,10 @@ fn the_environment_keeps_the_anisotropic_lobes_energy() {
             let t = (t0 - n * n.dot(t0)).normalize();
             let b = n.cross(t);
             let local = DVec3::new(v.dot(t), v.dot(b), v.dot(n));
-            let want = lobe_albedo(at, ab, local);
+            let want = scene::anisotropy::albedo(at, ab, local, 400);
             let got = img[i][1];
             err = err.max((got - want).abs());
-            err_iso = err_iso.max((lobe_albedo(alpha, alpha, local) - want).abs());
+            err_iso = err_iso.max((scene::anisotropy::albedo(alpha, alpha, local, 400) - want).abs());
             count += 1;
         }
         println!(

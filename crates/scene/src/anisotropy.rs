@@ -111,9 +111,44 @@ pub fn lobe(at: f64, ab: f64, l: DVec3, v: DVec3) -> f64 {
     ggx_d(at, ab, h) * visibility(at, ab, l, v)
 }
 
+/// The lobe's directional albedo with Fresnel 1 (a white metal's), ∫ D·V·(n·l) dl over the
+/// hemisphere at view `v` (unit, in the (t, b, n) frame), by the midpoint rule in (cos θ, φ)
+/// with `n` × 2`n` nodes: the reference both renderers' energy tests measure against (n = 400
+/// is within 10⁻³ of n = 1500 away from grazing views).
+pub fn albedo(at: f64, ab: f64, v: DVec3, n: usize) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..n {
+        let mu = (i as f64 + 0.5) / n as f64;
+        let st = (1.0 - mu * mu).sqrt();
+        for j in 0..2 * n {
+            let phi = (j as f64 + 0.5) / (2 * n) as f64 * 2.0 * PI;
+            sum += lobe(at, ab, DVec3::new(st * phi.cos(), st * phi.sin(), mu), v) * mu;
+        }
+    }
+    sum * PI / (n * n) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The albedo never exceeds 1, nears it for a smooth lobe seen head-on, is the same for the
+    /// lobe turned a quarter turn with the view, and agrees across node counts.
+    #[test]
+    fn the_albedo_is_bounded_symmetric_and_converged() {
+        let v = dir(0.7, 0.3);
+        let turned = DVec3::new(-v.y, v.x, v.z);
+        for (at, ab) in [(0.05, 0.05), (0.3, 0.1), (0.8, 0.2), (1.0, 1.0)] {
+            let a = albedo(at, ab, v, 400);
+            assert!(a > 0.3 && a <= 1.0, "{at} {ab}: {a}");
+            assert!((a - albedo(ab, at, turned, 400)).abs() < 1e-9, "{at} {ab}");
+            assert!((a - albedo(at, ab, v, 1500)).abs() < 1e-3, "{at} {ab}");
+        }
+        // Head-on, a smoother lobe loses less to masking: towards 1 as α → 0.
+        let head_on = [0.6, 0.3, 0.1].map(|a| albedo(a, a, DVec3::Z, 1500));
+        println!("head-on at α = 0.6, 0.3, 0.1: {head_on:?}");
+        assert!(head_on[0] < head_on[1] && head_on[1] < head_on[2] && head_on[2] > 0.98, "{head_on:?}");
+    }
 
     fn dir(theta: f64, phi: f64) -> DVec3 {
         DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
