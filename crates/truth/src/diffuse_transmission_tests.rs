@@ -826,3 +826,71 @@ fn without_the_extension_renders_are_unchanged() {
     println!("image mean with a diffuse transmission {:?}, without {:?}", lit.mean(), plain.mean());
     assert!(lit.xyz != plain.xyz);
 }
+
+/// `--direct-only`: past its one bounce a path goes on through refractions only, and a diffuse
+/// transmission is a bounce. A mirror floor under a thin see-through sheet (T = 0.5, smooth) with
+/// a diffuse transmission (t = 0.8) in a white sky, seen from between them: the path bounces off
+/// the mirror and passes the sheet by refraction alone, Le·T·(1 − F(cos θ)) (F by Fresnel's
+/// equations, within 0.5 % as the see-through test allows for the mirror's lobe), to the bit what
+/// the sheet without the extension passes; with all bounces the diffuse transmission changes
+/// the light between the sheet and the mirror (by more than 5 standard errors).
+#[test]
+fn direct_only_passes_a_sheet_by_refraction_alone() {
+    let sheet = |d: Option<DiffuseTransmission>| Material {
+        roughness: 0.0,
+        double_sided: true,
+        transmission: Some(scene::transmission::Transmission {
+            factor: 0.5,
+            texture: None,
+            volume: None,
+            dispersion: 0.0,
+        }),
+        diffuse_transmission: d,
+        ..Default::default()
+    };
+    let mirror = Material { metallic: 1.0, roughness: 0.0, ..Default::default() };
+    let range = WavelengthRange::VISIBLE;
+    let wl = XyzSensor::new(&Observer::cie1931(), &d65(), range).sample(0.35);
+    let render = |d: Option<DiffuseTransmission>, direct_only: bool, theta: f32| {
+        let meshes =
+            vec![quad(Vec3::ZERO, Vec3::Y, 50.0, 0), quad(Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 50.0, 1)];
+        let mut scene = scene_with(meshes, vec![mirror.clone(), sheet(d)], vec![]);
+        scene.environment = Some(scene::Environment::uniform(Vec3::ONE));
+        let world = World::new(&scene, &GreyOnly, &d65(), range, None).unwrap();
+        let integ = Integrator { world: &world, direct_only, max_depth: 100, lambert: false };
+        let d = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+        let o = Vec3::new(0.0, 0.5, 0.0) - d * 0.5;
+        estimate(40_000, |rng| radiance_any_hero(&integ, o, d, &wl, rng))
+    };
+    let le = world_le(&wl);
+    for theta in [0.2f32, 0.9] {
+        let c = f64::from(theta.cos());
+        let f = scene::transmission::fresnel_dielectric(c, 1.5);
+        let want = (0.5 * (1.0 - f)) as f32;
+        let (m, se) = render(Some(dt(0.8, Vec3::ONE)), true, theta);
+        let plain = render(None, true, theta);
+        let got = m.x / le.x;
+        println!("direct only, θ {theta}: {got:.5} ± {:.5} (want {want:.5})", se.x / le.x);
+        assert!((got - want).abs() < 0.005 + 5.0 * se.x / le.x, "θ {theta}: {got} vs {want}");
+        assert_eq!((m, se), plain, "θ {theta}: the diffuse transmission counted after the bounce");
+        let (all, all_se) = render(Some(dt(0.8, Vec3::ONE)), false, theta);
+        let (all_plain, plain_se) = render(None, false, theta);
+        println!(
+            "all bounces, θ {theta}: {:.5} ± {:.5}, without it {:.5} ± {:.5}",
+            all.x / le.x,
+            all_se.x / le.x,
+            all_plain.x / le.x,
+            plain_se.x / le.x
+        );
+        let sigma = (all_se.x * all_se.x + plain_se.x * plain_se.x).sqrt();
+        assert!((all.x - all_plain.x).abs() > 5.0 * sigma, "θ {theta}: all bounces {all} vs {all_plain}");
+    }
+}
+
+/// The white sky's radiance at the lanes of `wl`.
+fn world_le(wl: &crate::spectral::Wavelengths) -> Vec4 {
+    let mut scene = scene_with(vec![], vec![], vec![]);
+    scene.environment = Some(scene::Environment::uniform(Vec3::ONE));
+    let world = World::new(&scene, &GreyOnly, &d65(), WavelengthRange::VISIBLE, None).unwrap();
+    world.units.rgb(Vec3::ONE, &GreyOnly, wl.0)
+}
