@@ -87,6 +87,7 @@ def load(
     env_rotation: Optional[float] = None,
     env_sun: bool = True,
     env_sun_share: Optional[float] = None,
+    variant: Optional[str] = None,
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
@@ -96,8 +97,9 @@ def load(
     (`--env`), scaled by `env_intensity`, turned by `env_rotation` degrees about +Y; `env_sun`:
     the map's sun, where it has one, as a shadowed directional light in real time (False:
     `--no-env-sun`); `env_sun_share`: the share of the map's light a compact bright region must
-    give to be that sun, in (0, 1] (`--env-sun-share`; default 0.15). Raises
-    ValueError (bad scene), FileNotFoundError."""
+    give to be that sun, in (0, 1] (`--env-sun-share`; default 0.15); `variant`: the file's
+    KHR_materials_variants variant to draw, by name (`--variant`). Raises
+    ValueError (bad scene, unknown variant), FileNotFoundError."""
 
 class Renderer:
     """The real-time renderer (wgpu; lavapipe without a GPU) for one scene at one size. The GPU

@@ -227,6 +227,7 @@ arg_fns! {
     path_or_builtin("path_or_builtin") -> std::path::PathBuf = path;
     path_arg("path") -> std::path::PathBuf = path;
     allow_outside_scene_dir("allow_outside_scene_dir") -> bool = boolean;
+    variant("variant") -> Option<String> = opt_string;
     env("env") -> Option<String> = opt_name_or_path;
     env_intensity("env_intensity") -> Option<f32> = opt_float32;
     env_rotation("env_rotation") -> Option<f32> = opt_float32;

@@ -128,6 +128,7 @@ struct Scene {
 struct LoadArgs {
     name: String,
     allow_outside_scene_dir: bool,
+    variant: Option<String>,
     env: Option<String>,
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
@@ -196,6 +197,7 @@ impl Scene {
             h.env_rotation,
             h.env_sun,
             h.env_sun_share,
+            h.variant.clone(),
         )
             .into_pyobject(py)?;
         Ok((load, args))
@@ -228,6 +230,7 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 ///
 /// `allow_outside_scene_dir`: let the file's references (buffers, images, spectra,
 /// environment maps) leave its folder (off by default, as on the command line).
+/// `variant`: the file's KHR_materials_variants variant to draw, by name (`--variant`).
 /// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
 /// environment when the scene has no lights (rendered with `water`, by `Renderer` or `truth`, the
@@ -238,7 +241,7 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 /// sun, in (0, 1] (`--env-sun-share`; default 0.15).
 #[pyfunction]
 #[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false, env = None, env_intensity = None,
-                    env_rotation = None, env_sun = true, env_sun_share = None))]
+                    env_rotation = None, env_sun = true, env_sun_share = None, variant = None))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
 fn load(
     py: Python<'_>,
@@ -249,6 +252,7 @@ fn load(
     #[pyo3(from_py_with = args::env_rotation)] env_rotation: Option<f32>,
     #[pyo3(from_py_with = args::env_sun)] env_sun: bool,
     #[pyo3(from_py_with = args::env_sun_share)] env_sun_share: Option<f32>,
+    #[pyo3(from_py_with = args::variant)] variant: Option<String>,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
@@ -275,6 +279,7 @@ fn load(
     let how = LoadArgs {
         name: abs,
         allow_outside_scene_dir,
+        variant: variant.clone(),
         env: env_abs,
         env_intensity,
         env_rotation,
@@ -291,7 +296,7 @@ fn load(
         });
         let args = setup::SceneArgs {
             scene: name.clone(),
-            files: setup::SceneFileArgs { allow_outside_scene_dir },
+            files: setup::SceneFileArgs { allow_outside_scene_dir, variant },
             env: setup::EnvArgs {
                 env: h.env,
                 env_intensity: h.env_intensity,

@@ -312,6 +312,82 @@ def test_scene_pickles_as_a_reload(tmp_path):
     assert not np.array_equal(a, spectra.truth(spectra.load("cornell"), spp=1, size=(16, 12)))
 
 
+def test_material_variants_are_chosen_and_survive_pickling(tmp_path):
+    """`variant=` is `--variant`: the file's KHR_materials_variants variant by name, kept by a
+    pickled scene; an unknown name is a ValueError listing the file's variants."""
+    import base64
+    import json
+    import pickle
+    import struct
+
+    pos = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
+    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    buf = pos + idx
+    doc = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_variants", "KHR_lights_punctual"],
+        "extensions": {
+            "KHR_materials_variants": {"variants": [{"name": "red"}, {"name": "green"}]},
+            "KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 3}]},
+        },
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [
+            {"mesh": 0},
+            {"camera": 0, "translation": [0, 0, 3]},
+            {"extensions": {"KHR_lights_punctual": {"light": 0}}},
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+        "materials": [
+            {"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}},
+            {"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1]}},
+            {"name": "green", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.8, 0.1, 1]}},
+        ],
+        "meshes": [
+            {
+                "primitives": [
+                    {
+                        "attributes": {"POSITION": 0},
+                        "indices": 1,
+                        "material": 0,
+                        "extensions": {
+                            "KHR_materials_variants": {
+                                "mappings": [{"material": 1, "variants": [0]}, {"material": 2, "variants": [1]}]
+                            }
+                        },
+                    }
+                ]
+            }
+        ],
+        "buffers": [
+            {"byteLength": len(buf), "uri": "data:application/octet-stream;base64," + base64.b64encode(buf).decode()}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteLength": len(pos)},
+            {"buffer": 0, "byteOffset": len(pos), "byteLength": len(idx)},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
+    path = tmp_path / "variants.gltf"
+    path.write_text(json.dumps(doc))
+    mean = {}
+    for v in (None, "red", "GREEN"):
+        s = spectra.load(str(path), variant=v)
+        img = spectra.truth(s, spp=1, size=(8, 6))
+        mean[v] = img[2:4, 3:5].reshape(-1, 3).mean(axis=0)
+        t = pickle.loads(pickle.dumps(s))
+        assert np.array_equal(img, spectra.truth(t, spp=1, size=(8, 6)))
+    assert any("'red' and 'green'" in w for w in spectra.load(str(path)).warnings)
+    assert mean["red"][0] > 2 * mean["red"][1] and mean["GREEN"][1] > 2 * mean["GREEN"][0]
+    assert abs(mean[None][0] - mean[None][1]) < 0.05 * mean[None][1]
+    with pytest.raises(ValueError, match="'red' and 'green'"):
+        spectra.load(str(path), variant="blue")
+    with pytest.raises(ValueError, match="built-in"):
+        spectra.load("cornell", variant="red")
+
+
 def test_env_sun_switch_is_the_clis_and_survives_pickling():
     """`env_sun=False` is `--no-env-sun`: rooitou_park's sun is then not a shadowed light, and
     the real-time image changes; a pickled scene keeps the choice."""

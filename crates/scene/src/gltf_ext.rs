@@ -32,6 +32,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_anisotropy",
     "KHR_materials_diffuse_transmission",
     "EXT_texture_webp",
+    "KHR_materials_variants",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -70,7 +71,6 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
             "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
             "this renderer has no scattering inside a volume",
         ),
-        "KHR_materials_variants" => ("material variants are ignored; the default materials are drawn", ""),
         "KHR_animation_pointer" => ("animations are ignored; the scene is drawn at rest", ""),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
         _ => ("it is ignored", ""),

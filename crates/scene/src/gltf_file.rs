@@ -41,12 +41,15 @@ pub const MAX_LIGHT_INTENSITY: f32 = 1.0e9;
 pub const MAX_EMISSIVE: f32 = 1.0e6;
 
 /// How a scene file may be loaded.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
     /// Let file references (buffers, images, CSV spectra, environment maps) leave the scene's
     /// folder: absolute paths, `..`, symlinks pointing elsewhere. Off by default, so a scene
     /// from elsewhere cannot read other files (`--allow-outside-scene-dir`).
     pub allow_outside_scene_dir: bool,
+    /// The `KHR_materials_variants` variant to draw, by name (`--variant`); `None`: the
+    /// primitives' own materials. A name the file does not have is an error listing those it has.
+    pub variant: Option<String>,
 }
 
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
@@ -64,7 +67,7 @@ pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Sc
     let mut ctx = Ctx::file(path);
     ctx.allow_outside = opts.allow_outside_scene_dir;
     let bytes = color::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| ctx.io(path, e))?;
-    from_slice(&ctx, &bytes)
+    from_slice(&ctx, &bytes, opts.variant.as_deref())
 }
 
 /// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
@@ -77,7 +80,7 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
         inputs: Vec::new().into(),
         stamps: Vec::new().into(),
     };
-    from_slice(&ctx, bytes)
+    from_slice(&ctx, bytes, None)
 }
 
 /// The document's JSON as written (the `gltf` crate drops what it does not know, such as most
@@ -118,7 +121,7 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     serde_json::from_slice(&json).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))
 }
 
-pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
+pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Result<Scene, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
     // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
     // problems (a wrong type in a sampler field) with a less helpful message.
@@ -155,6 +158,8 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
     let document = gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
     let mut warnings = gltf_ext::warnings(&raw);
+    let variants = crate::variants::read(ctx, &raw, variant)?;
+    warnings.extend(variants.unchosen_warning());
     let mut buffers = load_buffers(ctx, doc, g.blob.as_deref(), &raw)?;
     meshopt_decode::decode(ctx, &raw, &mut buffers)?;
     let gscene = doc
@@ -227,7 +232,8 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8]) -> Result<Scene, SceneError> {
                     }
                     continue;
                 }
-                let mi = match prim.material().index() {
+                let mapped = variants.material(ctx, &raw, (mesh.index(), prim.index()), default_material)?;
+                let mi = match mapped.or(prim.material().index()) {
                     Some(i) => i,
                     None => {
                         uses_default = true;

@@ -34,6 +34,7 @@ pub mod srgb;
 mod tangents;
 pub mod transmission;
 mod uri;
+mod variants;
 pub mod vertex;
 pub mod water;
 

@@ -571,7 +571,7 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // Draco used with an uncompressed fallback: drawn, with a warning.
     let mut d = base.clone();
     d["extensionsUsed"] =
-        json!(["KHR_draco_mesh_compression", "KHR_materials_volume_scatter", "KHR_materials_variants"]);
+        json!(["KHR_draco_mesh_compression", "KHR_materials_volume_scatter", "KHR_animation_pointer"]);
     d["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let s = load(&d).unwrap();
@@ -1518,4 +1518,65 @@ fn webp_textures_are_decoded() {
     let mut bad = only.clone();
     bad["images"][1]["uri"] = json!(data_uri("image/webp", b"RIFF\x1a\0\0\0WEBPVP8L\x0d\0\0\0 not a webp"));
     assert_has(&error(&bad), &["images[1]", "cannot"]);
+}
+
+/// KHR_materials_variants: without a choice the primitives' own materials, and a warning naming
+/// the variants; `--variant NAME` (exact, else any case) draws each primitive's mapped material
+/// where a mapping names it, its own elsewhere; an unknown name lists the file's variants; bad
+/// indices are named.
+#[test]
+fn material_variants_are_chosen_by_name() {
+    let mut b = Bin::default();
+    let pos = b.triangle();
+    let mut doc = single_mesh(
+        b,
+        json!([{"attributes": {"POSITION": pos}, "material": 0,
+                "extensions": {"KHR_materials_variants": {"mappings": [
+                    {"material": 1, "variants": [0, 2]}, {"material": 2, "variants": [1]}]}}},
+               {"attributes": {"POSITION": pos}, "material": 0}]),
+        json!([{"name": "plain"}, {"name": "red"}, {"name": "blue"}]),
+    );
+    doc["extensionsUsed"] = json!(["KHR_materials_variants"]);
+    doc["extensions"] = json!({"KHR_materials_variants": {"variants": [{"name": "Midnight"}, {"name": "beach"}, {"name": "street"}]}});
+    let drawn = |variant: Option<&str>| -> Result<(Vec<String>, Vec<String>), String> {
+        let opts = scene::LoadOptions { variant: variant.map(String::from), ..Default::default() };
+        let s = scene_with_options(&doc, &opts)?;
+        Ok((s.meshes.iter().map(|m| s.materials[m.material].name.clone()).collect(), s.warnings.clone()))
+    };
+    let (names, warnings) = drawn(None).unwrap();
+    assert_eq!(names, ["plain", "plain"]);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("'Midnight', 'beach' and 'street'") && warnings[0].contains("--variant"));
+    for (v, want) in [("Midnight", "red"), ("midnight", "red"), ("beach", "blue"), ("street", "red")] {
+        let (names, warnings) = drawn(Some(v)).unwrap();
+        assert_eq!(names, [want, "plain"], "{v}");
+        assert!(warnings.is_empty(), "{warnings:?}");
+    }
+    assert_has(&drawn(Some("night")).unwrap_err(), &["--variant night", "'Midnight', 'beach' and 'street'"]);
+    let at = "meshes[0].primitives[0].extensions.KHR_materials_variants.mappings";
+    let mut bad = doc.clone();
+    bad["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][1]["material"] =
+        json!(3);
+    assert_has(&error(&bad), &[&format!("{at}[1].material"), "3 materials"]);
+    let mut bad = doc.clone();
+    bad["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][0]["variants"][1] =
+        json!(5);
+    assert_has(&error(&bad), &[&format!("{at}[0].variants[1]"), "3 variants"]);
+    let mut bad = doc.clone();
+    bad["extensions"]["KHR_materials_variants"]["variants"][1] = json!({});
+    assert_has(&error(&bad), &["extensions.KHR_materials_variants.variants[1].name"]);
+    // A file without variants, asked for one.
+    let mut none = doc.clone();
+    none.as_object_mut().unwrap().remove("extensions");
+    none["meshes"][0]["primitives"][0].as_object_mut().unwrap().remove("extensions");
+    let opts = scene::LoadOptions { variant: Some("red".into()), ..Default::default() };
+    assert_has(&scene_with_options(&none, &opts).unwrap_err(), &["--variant red", "no material variants"]);
+}
+
+/// `doc` written to a temporary file and loaded with `opts` (variants are a file-load option).
+fn scene_with_options(doc: &Value, opts: &scene::LoadOptions) -> Result<Scene, String> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    scene::load_with(&path, opts).map_err(|e| e.to_string())
 }

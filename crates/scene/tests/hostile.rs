@@ -59,7 +59,7 @@ fn write(dir: &Path, doc: &Value) -> PathBuf {
 
 fn load(p: &Path, allow: bool) -> Result<scene::Scene, String> {
     let t = Instant::now();
-    let r = scene::load_with(p, &scene::LoadOptions { allow_outside_scene_dir: allow })
+    let r = scene::load_with(p, &scene::LoadOptions { allow_outside_scene_dir: allow, ..Default::default() })
         .map_err(|e| e.to_string());
     assert!(t.elapsed() < Duration::from_secs(10), "took {:?}", t.elapsed());
     r

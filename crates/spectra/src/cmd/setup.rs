@@ -768,12 +768,25 @@ pub struct SceneFileArgs {
     /// from elsewhere cannot read your other files (docs/scene-format.md, "File references").
     #[arg(long)]
     pub allow_outside_scene_dir: bool,
+    /// Draw this KHR_materials_variants variant of the file's materials (by name; the loader's
+    /// warning lists a file's variants). Default: the primitives' own materials.
+    #[arg(long, value_name = "NAME")]
+    pub variant: Option<String>,
 }
 
 impl SceneFileArgs {
     /// Loads a built-in scene or a .gltf/.glb file, with these options.
     pub fn load(&self, name: &str) -> Result<scene::Scene> {
-        let opts = scene::LoadOptions { allow_outside_scene_dir: self.allow_outside_scene_dir };
+        let lower = name.to_ascii_lowercase();
+        if let Some(v) = &self.variant
+            && !(lower.ends_with(".gltf") || lower.ends_with(".glb"))
+        {
+            bail!("--variant {v}: material variants belong to glTF files; '{name}' is a built-in scene");
+        }
+        let opts = scene::LoadOptions {
+            allow_outside_scene_dir: self.allow_outside_scene_dir,
+            variant: self.variant.clone(),
+        };
         scene::load_any_with(name, &opts).with_context(|| format!("loading scene '{name}'"))
     }
 }
