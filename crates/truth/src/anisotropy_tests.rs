@@ -11,7 +11,6 @@ use super::sheen_tests::{binned_pdf, chi2_per_bin, random_pairs, sampled_bins};
 use super::tests::{assert_within, estimate};
 use super::*;
 use crate::testing::{quad, scene_with};
-use glam::DVec3;
 use scene::anisotropy::{self as an, Anisotropy};
 use scene::{Camera, Material};
 use std::f64::consts::PI;
