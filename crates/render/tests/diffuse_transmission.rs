@@ -109,6 +109,45 @@ fn a_sheet_lit_from_behind_passes_its_transmitted_lobe() {
     assert_eq!(plain[c], [0.0; 3], "no light reaches the front without the extension");
 }
 
+/// The naive mode (box spectra, which do not give back an RGB colour) upsamples the colour as it
+/// does a base colour: the sheet lit from behind shows t times what the same sheet without the
+/// extension, of that base colour and lit from the mirrored direction, reflects in its diffuse
+/// (its reflection less a black sheet's, the specular lobe; the half vector and the cosine are
+/// the same).
+#[test]
+fn the_naive_mode_upsamples_the_colour_as_a_base_colour() {
+    let wi = Vec3::new(0.35, -0.2, -0.9).normalize();
+    let mirrored = Vec3::new(wi.x, wi.y, -wi.z);
+    let colour = [0.9f32, 0.55, 0.2];
+    let t = 0.7;
+    let through = sheet(wi, [0.2, 0.6, 0.3], Some(dt(t, Vec3::from_array(colour))));
+    let mut r = renderer();
+    for capture in [false, true] {
+        let a = render(&mut r, &through, Mode::Naive, 16, capture, false);
+        let b = render(&mut r, &sheet(mirrored, colour, None), Mode::Naive, 16, capture, false);
+        let b0 = render(&mut r, &sheet(mirrored, [0.0; 3], None), Mode::Naive, 16, capture, false);
+        let inside = on_sheet(|_| Some([0.0; 3]));
+        let c = (H / 2 * W + W / 2) as usize;
+        let want: [f64; 3] = std::array::from_fn(|k| t as f64 * (b[c][k] - b0[c][k]));
+        println!("dt-naive-{capture}: centre {:?}, t·(reflected − specular) {want:?}", a[c]);
+        let mut worst = 0.0f64;
+        for (i, e) in inside.iter().enumerate() {
+            if e.is_some() {
+                for k in 0..3 {
+                    let w = t as f64 * (b[i][k] - b0[i][k]);
+                    worst = worst.max((a[i][k] - w).abs() / w);
+                }
+            }
+        }
+        println!("dt-naive-{capture}: worst relative difference {worst:.2e}");
+        // The images are half floats: three of them a few f16 steps (2⁻¹¹) apart at most.
+        assert!(worst < 4e-3, "naive {capture}: {worst:.2e} from t times the base colour's diffuse");
+        // And the box spectra are not the RGB colour: the test compares what the mode does.
+        let rgb = colour.map(|x| x as f64 * transmitted(wi, t as f64));
+        assert!(color::ciede2000(lab(a[c]), lab(rgb)) > 1.0);
+    }
+}
+
 /// Lit from the front, the reflected diffuse keeps 1 − t; the specular lobe is untouched.
 #[test]
 fn a_sheet_lit_from_the_front_loses_the_transmitted_share_of_its_diffuse() {
@@ -294,6 +333,82 @@ fn an_environment_behind_the_sheet_shines_through_it() {
             actual[c], expected[c]
         );
         assert_delta_e(&format!("dt-env-{mode:?}-{n}-{capture}"), W, H, &actual, &expected, 0.3, 0.6);
+    }
+}
+
+/// An emissive polygon behind the sheet (radiance 1, the square |x|, |y| ≤ 1.5 at z = −1,
+/// facing the sheet): t·colour/π·∫ L·(1 − F(v·h'(l)))·cos θ dω over it, integrated here in f64
+/// (the renderer takes the clipped cosine exactly and F at the polygon's centroid), with and
+/// without shadows (the sheet does not shadow the light that crosses it).
+#[test]
+fn a_polygon_light_behind_the_sheet_shines_through_it() {
+    let colour = [0.85, 0.7, 0.4];
+    let t = 0.75;
+    let mut scene =
+        sheet(Vec3::Z, [0.4, 0.4, 0.4], Some(dt(t as f32, Vec3::from_array(colour.map(|c| c as f32)))));
+    scene.lights.clear();
+    let s = 1.5f32;
+    let emitter = Mesh {
+        colors: vec![],
+        uvs1: vec![],
+        positions: [(-s, -s), (s, -s), (s, s), (-s, s)].map(|(x, y)| Vec3::new(x, y, -1.0)).to_vec(),
+        normals: vec![Vec3::Z; 4],
+        tangents: vec![],
+        uvs: vec![Vec2::ZERO; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: 1,
+    };
+    scene.meshes.push(emitter);
+    scene.materials.push(scene::Material {
+        name: "emitter".into(),
+        base_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
+        emissive: Vec3::ONE,
+        ..Default::default()
+    });
+    // ∫ (1 − F(v·h')) cos θ_s cos θ_e / r² dA over the square, at the sheet's point p (z = 0):
+    // both cosines are 1/r (the square is 1 below, parallel), so the integrand is (1 − F)/r⁴.
+    let steps = 150;
+    let irradiance = |p: Vec2| -> f64 {
+        let (px, py) = (p.x as f64, p.y as f64);
+        let da = (2.0 * s as f64 / steps as f64).powi(2);
+        let mut sum = 0.0;
+        for i in 0..steps {
+            for j in 0..steps {
+                let u = -(s as f64) + (i as f64 + 0.5) * 2.0 * s as f64 / steps as f64;
+                let w = -(s as f64) + (j as f64 + 0.5) * 2.0 * s as f64 / steps as f64;
+                let d = glam::DVec3::new(u - px, w - py, -1.0);
+                let r2 = d.length_squared();
+                let mirrored = glam::DVec3::new(d.x, d.y, 1.0) / r2.sqrt();
+                let h = (mirrored + glam::DVec3::Z).normalize();
+                let f = 0.04 + 0.96 * (1.0 - h.z).powi(5);
+                sum += (1.0 - f) / (r2 * r2) * da;
+            }
+        }
+        sum
+    };
+    let expected = on_sheet(|p| {
+        let e = irradiance(p);
+        Some(colour.map(|c| t * c * e / PI))
+    });
+    let mut r = renderer();
+    for shadows in [false, true] {
+        for (mode, n, capture) in modes() {
+            let actual = render(&mut r, &scene, mode, n, capture, shadows);
+            let c = (H / 2 * W + W / 2) as usize;
+            println!(
+                "dt-polygon-{mode:?}-{capture}-shadows{shadows}: centre {:?} expected {:?}",
+                actual[c], expected[c]
+            );
+            assert_delta_e(
+                &format!("dt-polygon-{mode:?}-{n}-{capture}-shadows{shadows}"),
+                W,
+                H,
+                &actual,
+                &expected,
+                0.3,
+                0.6,
+            );
+        }
     }
 }
 
