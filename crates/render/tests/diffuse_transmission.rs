@@ -437,3 +437,73 @@ fn both_shading_stages_agree() {
         assert!(a[c][0] > 0.0, "{mode:?}: the sheet is lit");
     }
 }
+
+/// Under a clear coat and a sheen the transmitted lobe is weighted as the reflected diffuse is:
+/// × (1 − w_c) with w_c = strength·F_coat(n·v) (the coat reflects nothing of a light behind), ×
+/// the sheen's albedo scaling min(1 − c·E(n·v), 1 − c·E(|n·l|)) at the mirrored direction (the
+/// sheen's lobe, a reflection, takes nothing from behind either).
+#[test]
+fn a_coat_and_a_sheen_weigh_the_transmitted_lobe_as_the_diffuse() {
+    let wi = Vec3::new(0.8, -0.2, -0.35).normalize();
+    let colour = [0.9, 0.55, 0.2];
+    let t = 0.7;
+    let (strength, sheen_colour, sheen_roughness) = (0.8, [1.0, 0.9, 0.8], 1.0);
+    let mut scene =
+        sheet(wi, [0.2, 0.6, 0.3], Some(dt(t as f32, Vec3::from_array(colour.map(|c| c as f32)))));
+    let m = &mut scene.materials[0];
+    m.clearcoat = Some(scene::clearcoat::Clearcoat {
+        factor: strength as f32,
+        texture: None,
+        roughness: 0.3,
+        roughness_texture: None,
+        normal_texture: None,
+        normal_scale: 1.0,
+    });
+    m.sheen = Some(scene::sheen::Sheen {
+        color: Vec3::from_array(sheen_colour.map(|c| c as f32)),
+        color_texture: None,
+        roughness: sheen_roughness as f32,
+        roughness_texture: None,
+    });
+    // n = v = +z: the coat's Fresnel term at normal incidence is its F0.
+    let coat_keeps = 1.0 - strength * 0.04;
+    let max_c = sheen_colour.iter().copied().fold(0.0, f64::max);
+    let sheen_keeps = scene::sheen::albedo_scaling(
+        max_c,
+        scene::sheen::albedo(1.0, sheen_roughness),
+        scene::sheen::albedo(-wi.z as f64, sheen_roughness),
+    );
+    let expected = on_sheet(|_| Some(colour.map(|c| c * transmitted(wi, t) * coat_keeps * sheen_keeps)));
+    println!("coat keeps {coat_keeps:.4}, sheen keeps {sheen_keeps:.4}");
+    assert!(sheen_keeps < 0.9, "the sheen's scaling is {sheen_keeps}: the test would not see it");
+    let mut r = renderer();
+    for (mode, n, capture) in modes() {
+        let actual = render(&mut r, &scene, mode, n, capture, true);
+        assert_delta_e(&format!("dt-layers-{mode:?}-{n}-{capture}"), W, H, &actual, &expected, 0.15, 0.4);
+    }
+}
+
+/// A diffuse transmission on a see-through material has no room in the transmissive layer's
+/// G-buffer: the upload says it is not drawn, naming the material, and the frame is the one
+/// without it.
+#[test]
+fn a_see_through_diffuse_transmission_is_reported_and_left_out() {
+    let wi = Vec3::new(0.35, -0.2, -0.9).normalize();
+    let mut plain = sheet(wi, [0.5, 0.4, 0.3], None);
+    plain.materials[0].name = "frosted".into();
+    plain.materials[0].transmission =
+        Some(scene::transmission::Transmission { factor: 0.5, texture: None, volume: None, dispersion: 0.0 });
+    let mut with_dt = plain.clone();
+    with_dt.materials[0].diffuse_transmission = Some(dt(0.6, Vec3::ONE));
+    let mut r = renderer();
+    let s = RenderSettings { mode: Mode::Spectral, shadows: false, ..Default::default() };
+    let without = render_frame_wh(&mut r, &plain, (W, H), &s, false);
+    assert!(r.scene_warnings().is_empty(), "{:?}", r.scene_warnings());
+    let with = render_frame_wh(&mut r, &with_dt, (W, H), &s, false);
+    let w = r.scene_warnings();
+    assert!(
+        w.len() == 1 && w[0].contains("KHR_materials_diffuse_transmission") && w[0].contains("'frosted'"),
+        "{w:?}"
+    );
+    assert!(with == without);
+}
