@@ -507,3 +507,52 @@ fn a_see_through_diffuse_transmission_is_reported_and_left_out() {
     );
     assert!(with == without);
 }
+
+/// Beside an anisotropy's texture (at the transmission's slot) the factor's texture has a slot
+/// only when it is the colour's too (the extension's packing): then it is drawn (the sheet lit
+/// from behind shows no specular, so the anisotropy leaves it as it was); a factor texture of its
+/// own is reported by name and left out (the factor alone).
+#[test]
+fn beside_an_anisotropy_texture_the_factor_texture_needs_the_packing() {
+    let wi = Vec3::new(-0.3, 0.2, -0.9).normalize();
+    let tex = |i| Some(TextureRef { transform: None, index: i, tex_coord: 0 });
+    let mut scene = sheet(wi, [0.5, 0.5, 0.5], None);
+    scene.materials[0].name = "leaf".into();
+    scene.materials[0].anisotropy =
+        Some(scene::anisotropy::Anisotropy { strength: 0.8, rotation: 0.3, texture: tex(0) });
+    scene.textures = vec![
+        texel_texture("direction", [200, 128, 255, 255], false),
+        texel_texture("packed", [230, 140, 60, 150], true),
+        texel_texture("factor", [255, 255, 255, 60], false),
+    ];
+    let colour = [decode8(230), decode8(140), decode8(60)].map(|c| 0.8 * c);
+    let mut r = renderer();
+    let s = RenderSettings { mode: Mode::Spectral, shadows: false, ..Default::default() };
+    // Packed: drawn, no warning.
+    let mut packed = scene.clone();
+    packed.materials[0].diffuse_transmission = Some(DiffuseTransmission {
+        factor: 0.9,
+        texture: tex(1),
+        color: Vec3::splat(0.8),
+        color_texture: tex(1),
+    });
+    let actual: Vec<[f64; 3]> =
+        render_frame_wh(&mut r, &packed, (W, H), &s, false).iter().map(rgb_of).collect();
+    assert!(r.scene_warnings().is_empty(), "{:?}", r.scene_warnings());
+    let t = 0.9 * 150.0 / 255.0;
+    let expected = on_sheet(|_| Some(colour.map(|c| c * transmitted(wi, t))));
+    assert_delta_e("dt-aniso-packed", W, H, &actual, &expected, 0.15, 0.4);
+    // A factor texture of its own: reported, drawn with the factor alone.
+    let mut own = scene.clone();
+    own.materials[0].diffuse_transmission = Some(DiffuseTransmission {
+        factor: 0.9,
+        texture: tex(2),
+        color: Vec3::splat(0.8),
+        color_texture: tex(1),
+    });
+    let with_texture = render_frame_wh(&mut r, &own, (W, H), &s, false);
+    let w = r.scene_warnings();
+    assert!(w.len() == 1 && w[0].contains("diffuseTransmissionTexture") && w[0].contains("'leaf'"), "{w:?}");
+    own.materials[0].diffuse_transmission.as_mut().unwrap().texture = None;
+    assert!(render_frame_wh(&mut r, &own, (W, H), &s, false) == with_texture);
+}
