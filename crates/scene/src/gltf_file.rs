@@ -912,6 +912,19 @@ impl Loader<'_> {
             // as documented (a negative dispersion or thickness was accepted silently; found
             // by a sweep).
             self.transmission(&at, &Value::Object(Default::default()), volume, dispersion)?;
+            // A diffuse transmission would let light into this volume, which only a
+            // see-through material keeps (`Transmission::volume`): said, not silently thin.
+            let thick = volume
+                .and_then(|v| v.get("thicknessFactor"))
+                .and_then(Value::as_f64)
+                .is_some_and(|t| t > 0.0);
+            if thick && out.diffuse_transmission.is_some() && !out.unlit {
+                self.warnings.push(format!(
+                    "{at} ('{}'): its KHR_materials_volume is not kept without KHR_materials_transmission; \
+                     its diffuse transmission is drawn as a thin sheet, without the volume's absorption",
+                    out.name
+                ));
+            }
         }
         let values = [
             out.base_color.to_array().as_slice(),

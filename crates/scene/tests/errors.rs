@@ -275,6 +275,19 @@ fn bad_diffuse_transmission() {
             .diffuse_transmission
             .is_none()
     );
+    // With a thick volume but no KHR_materials_transmission: drawn thin, and said.
+    let mut vol = good.clone();
+    vol["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_materials_volume"));
+    vol["materials"][0]["extensions"]["KHR_materials_volume"] = json!({"thicknessFactor": 0.5});
+    let s2 = load(&vol);
+    assert!(s2.materials[0].transmission.is_none() && s2.materials[0].diffuse_transmission.is_some());
+    assert!(
+        s2.warnings.iter().any(|w| w.contains("materials[0]") && w.contains("drawn as a thin sheet")),
+        "{:?}",
+        s2.warnings
+    );
+    vol["materials"][0]["extensions"]["KHR_materials_volume"] = json!({"thicknessFactor": 0});
+    assert!(!load(&vol).warnings.iter().any(|w| w.contains("thin sheet")));
     // Exported and read back unchanged.
     let json = scene::export::to_gltf_json(&s).unwrap().to_string();
     let back = scene::load_slice("back.gltf", json.as_bytes(), None).unwrap();
