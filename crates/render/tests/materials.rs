@@ -78,3 +78,42 @@ fn textured_and_normal_mapped_patch_matches_cpu_brdf() {
     // The tilt towards the light must matter (≈ 1/cos 45°), or the test proves nothing.
     assert!(flat_ratio.iter().all(|&k| k > 1.3), "normal map barely changes shading: {:?}", &flat_ratio[..3]);
 }
+
+/// A normal map whose normal faces away from the viewer (a texel whose tangent-space z is
+/// negative, as a strong bump seen at a grazing angle gives) shades with the face's own normal,
+/// the path tracer's rule: the patch draws as it does without the map, whatever the texel's
+/// tilt. Its base colour is lit from the side the texel tilts to, where the mapped normal would
+/// catch more light than the face's.
+#[test]
+fn a_normal_facing_away_from_the_viewer_gives_way_to_the_faces() {
+    let chart = Chart { colours: vec![[1.0, 1.0, 1.0]], cols: 1, rows: 1, gap: 0.0 };
+    let wi = Vec3::new(1.0, 0.0, 0.4).normalize();
+    let mut scene = chart.scene(white_light(2.0, None), 0.5, 0.0);
+    scene.lights[0].kind = scene::LightKind::Directional { direction: -wi };
+    scene.materials[0].base_color = glam::Vec4::new(0.6, 0.5, 0.4, 1.0);
+    let mut r = renderer();
+    let s = RenderSettings { mode: Mode::Rgb, shadows: false, ..Default::default() };
+    let mut draw = |scene: &scene::Scene| -> Vec<[f64; 3]> {
+        r.set_scene(scene).unwrap();
+        r.resize(W, H).unwrap();
+        r.render(&scene.camera, &s).unwrap();
+        r.read_hdr().unwrap().iter().map(rgb_of).collect()
+    };
+    let plain = draw(&scene);
+    let expected: Vec<Option<[f64; 3]>> = (0..H)
+        .flat_map(|y| (0..W).map(move |x| (x, y)))
+        .zip(&plain)
+        .map(|((x, y), &p)| chart.patch_at(pixel_to_chart(x, y, W, H).0, 0.05).map(|_| p))
+        .collect();
+    assert!(plain.iter().any(|p| p[0] > 0.05), "the patch is not lit");
+    // (1, 0, −0.69): tilted past the surface towards +u, the light's side.
+    scene.textures = vec![texel_texture("away", [255, 128, 40, 255], false)];
+    scene.materials[0].normal_texture = Some(TextureRef { transform: None, index: 0, tex_coord: 0 });
+    let mapped = draw(&scene);
+    assert_delta_e("normal-facing-away", W, H, &mapped, &expected, 0.01, 0.05);
+    // A legitimate tilt towards the light still shows.
+    scene.textures = vec![texel_texture("tilt", [218, 128, 218, 255], false)];
+    let tilted = draw(&scene);
+    let c = (H / 2 * W + W / 2) as usize;
+    assert!(tilted[c][0] > 1.2 * plain[c][0], "{:?} vs {:?}", tilted[c], plain[c]);
+}

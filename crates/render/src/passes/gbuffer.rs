@@ -226,7 +226,7 @@ impl Targets {
         if self.coat {
             fields.push(format!("@location({}) coat: vec4<u32>", fields.len()));
             samples.push("let c = coat_sample(v);");
-            writes.push("r.coat = coat_target(o, c, v, front);");
+            writes.push("r.coat = coat_target(o, c, v, front, face);");
         }
         if self.diffuse_transmission {
             fields.push(format!("@location({}) specular: vec4<u32>", fields.len()));
@@ -253,8 +253,12 @@ impl Targets {
                 "@fragment\nfn {}(v: VertexOut, @builtin(front_facing) front: bool) -> GBufferOut_{name} {{\n",
                 self.entry(alpha)
             ));
-            for line in
-                samples.iter().copied().chain([format!("let o = gbuffer(v, front, {alpha});").as_str()])
+            // The face normal first: like the samples, before `gbuffer`'s discard.
+            let head = ["let face = face_normal(v);"];
+            for line in head
+                .into_iter()
+                .chain(samples.iter().copied())
+                .chain([format!("let o = gbuffer(v, front, face, {alpha});").as_str()])
             {
                 out.push_str(&format!("    {line}\n"));
             }

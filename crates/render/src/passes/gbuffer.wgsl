@@ -60,9 +60,34 @@ fn normal_mapped(n: vec3<f32>, tangent: vec4<f32>, side: f32, tn_sample: vec3<f3
     return normalize(t * tn.x + b * tn.y + n * tn.z);
 }
 
+// The face's own normal (unoriented, unnormalised) where a normal map, the base's or the coat's,
+// may need it (`facing_viewer`); zero for other materials, which pay nothing more. Taken before
+// any discard: derivatives need uniform control flow, and `material` is uniform.
+fn face_normal(v: VertexOut) -> vec3<f32> {
+    if (material.params.z > 0.5 || material.coat.w > 0.5) {
+        let p = world_from_depth(v.clip.xy, v.clip.z, frame);
+        return cross(dpdx(p), dpdy(p));
+    }
+    return vec3<f32>(0.0);
+}
+
+// A mapped normal that faces away from the viewer gives way to the face's own normal, turned to
+// the viewer: the path tracer's rule (its integrator's shading normal and `World::coat`), so
+// that both renderers shade such pixels alike (a strong bump at a grazing view, or a texel whose
+// tangent-space z is negative).
+fn facing_viewer(n: vec3<f32>, face: vec3<f32>, v: VertexOut) -> vec3<f32> {
+    let p = world_from_depth(v.clip.xy, v.clip.z, frame);
+    let view = view_origin(v.clip.xy, p, frame) - p;
+    if (dot(n, view) > 0.0 || dot(face, face) <= 0.0) {
+        return n;
+    }
+    let f = normalize(face);
+    return select(-f, f, dot(f, view) >= 0.0);
+}
+
 // `alpha_test`: the pipeline of MASK and BLEND materials (discards); opaque materials use one
 // without discard, which keeps early depth testing.
-fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
+fn gbuffer(v: VertexOut, front: bool, face: vec3<f32>, alpha_test: bool) -> GBufferOut {
     // Every texture is sampled before the discard (derivatives need uniform control flow).
     let base = textureSampleBias(base_color_tex, base_color_smp, material_uv(TEX_BASE, v.uv, v.uv1), frame.lod_bias)
         * material.base_color * v.color;
@@ -79,7 +104,7 @@ fn gbuffer(v: VertexOut, front: bool, alpha_test: bool) -> GBufferOut {
     let side = select(-1.0, 1.0, front);
     var n = normalize(v.normal) * side;
     if (material.params.z > 0.5 && dot(v.tangent.xyz, v.tangent.xyz) > 0.0) {
-        n = normal_mapped(n, v.tangent, side, tn_sample, material.emissive.w);
+        n = facing_viewer(normal_mapped(n, v.tangent, side, tn_sample, material.emissive.w), face, v);
     }
     // Emission is one-sided, towards the vertex normals, as the path tracer's and the polygon
     // lights' (docs/environment.md): the back of a double-sided lamp glowed here and was black
@@ -153,11 +178,11 @@ fn coat_sample(v: VertexOut) -> CoatSample {
     return CoatSample(clamp(c * material.coat.x, 0.0, 1.0), clamp(r * material.coat.y, 0.0, 1.0), tn);
 }
 
-fn coat_target(o: GBufferOut, c: CoatSample, v: VertexOut, front: bool) -> vec4<u32> {
+fn coat_target(o: GBufferOut, c: CoatSample, v: VertexOut, front: bool, face: vec3<f32>) -> vec4<u32> {
     let side = select(-1.0, 1.0, front);
     var n = normalize(v.normal) * side;
     if (material.coat.w > 0.5 && dot(v.tangent.xyz, v.tangent.xyz) > 0.0) {
-        n = normal_mapped(n, v.tangent, side, c.tn, material.coat.z);
+        n = facing_viewer(normal_mapped(n, v.tangent, side, c.tn, material.coat.z), face, v);
     }
     // An unlit surface (UNLIT_MARK) reflects nothing: no coat.
     let strength = select(c.strength, 0.0, o.base.a < 0.0);
