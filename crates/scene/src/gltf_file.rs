@@ -1212,21 +1212,38 @@ impl Loader<'_> {
         }))
     }
 
+    /// `field` of the extension object `ext` (at `at`): a number in [0, 1], `default` when absent.
+    fn unit_factor(&self, at: &str, ext: &Value, field: &str, default: f32) -> Result<f32, SceneError> {
+        match ext.get(field) {
+            None => Ok(default),
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => Ok(x as f32),
+                _ => Err(self.ctx.invalid(format!("{at}.{field}"), format!("{v} is not a number in [0, 1]"))),
+            },
+        }
+    }
+
+    /// `field` of the extension object `ext` (at `at`): three numbers in [0, 1] (linear RGB),
+    /// `default` when absent.
+    fn unit_rgb(&self, at: &str, ext: &Value, field: &str, default: Vec3) -> Result<Vec3, SceneError> {
+        let Some(v) = ext.get(field) else { return Ok(default) };
+        let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
+        match nums.as_deref() {
+            Some(&[r, g, b]) if [r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) => {
+                Ok(Vec3::new(r as f32, g as f32, b as f32))
+            }
+            _ => Err(self.ctx.invalid(
+                format!("{at}.{field}"),
+                format!("{v} is not three numbers in [0, 1] (linear RGB)"),
+            )),
+        }
+    }
+
     /// `KHR_materials_specular` (`sp` is its JSON), validated: `None` at its defaults (weight 1,
     /// white, no textures), which change nothing.
     fn specular(&mut self, at: &str, sp: &Value) -> Result<Option<crate::specular::Specular>, SceneError> {
         let at = format!("{at}.extensions.KHR_materials_specular");
-        let factor = match sp.get("specularFactor") {
-            None => 1.0,
-            Some(v) => match v.as_f64() {
-                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
-                _ => {
-                    return Err(self
-                        .ctx
-                        .invalid(format!("{at}.specularFactor"), format!("{v} is not a number in [0, 1]")));
-                }
-            },
-        };
+        let factor = self.unit_factor(&at, sp, "specularFactor", 1.0)?;
         let color = match sp.get("specularColorFactor") {
             None => Vec3::ONE,
             Some(v) => {
@@ -1263,35 +1280,8 @@ impl Loader<'_> {
     /// data.
     fn sheen(&mut self, at: &str, sh: &Value) -> Result<Option<crate::sheen::Sheen>, SceneError> {
         let at = format!("{at}.extensions.KHR_materials_sheen");
-        let color = match sh.get("sheenColorFactor") {
-            None => Vec3::ZERO,
-            Some(v) => {
-                let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
-                match nums.as_deref() {
-                    Some(&[r, g, b]) if [r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) => {
-                        Vec3::new(r as f32, g as f32, b as f32)
-                    }
-                    _ => {
-                        return Err(self.ctx.invalid(
-                            format!("{at}.sheenColorFactor"),
-                            format!("{v} is not three numbers in [0, 1] (linear RGB)"),
-                        ));
-                    }
-                }
-            }
-        };
-        let roughness = match sh.get("sheenRoughnessFactor") {
-            None => 0.0,
-            Some(v) => match v.as_f64() {
-                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
-                _ => {
-                    return Err(self.ctx.invalid(
-                        format!("{at}.sheenRoughnessFactor"),
-                        format!("{v} is not a number in [0, 1]"),
-                    ));
-                }
-            },
-        };
+        let color = self.unit_rgb(&at, sh, "sheenColorFactor", Vec3::ZERO)?;
+        let roughness = self.unit_factor(&at, sh, "sheenRoughnessFactor", 0.0)?;
         let color_texture = self.extension_texture(&at, sh, "sheenColorTexture", true)?;
         let roughness_texture = self.extension_texture(&at, sh, "sheenRoughnessTexture", false)?;
         let s = crate::sheen::Sheen { color, color_texture, roughness, roughness_texture };
@@ -1307,35 +1297,8 @@ impl Loader<'_> {
         dt: &Value,
     ) -> Result<Option<crate::diffuse_transmission::DiffuseTransmission>, SceneError> {
         let at = format!("{at}.extensions.KHR_materials_diffuse_transmission");
-        let factor = match dt.get("diffuseTransmissionFactor") {
-            None => 0.0,
-            Some(v) => match v.as_f64() {
-                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
-                _ => {
-                    return Err(self.ctx.invalid(
-                        format!("{at}.diffuseTransmissionFactor"),
-                        format!("{v} is not a number in [0, 1]"),
-                    ));
-                }
-            },
-        };
-        let color = match dt.get("diffuseTransmissionColorFactor") {
-            None => Vec3::ONE,
-            Some(v) => {
-                let nums: Option<Vec<f64>> = v.as_array().and_then(|a| a.iter().map(Value::as_f64).collect());
-                match nums.as_deref() {
-                    Some(&[r, g, b]) if [r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) => {
-                        Vec3::new(r as f32, g as f32, b as f32)
-                    }
-                    _ => {
-                        return Err(self.ctx.invalid(
-                            format!("{at}.diffuseTransmissionColorFactor"),
-                            format!("{v} is not three numbers in [0, 1] (linear RGB)"),
-                        ));
-                    }
-                }
-            }
-        };
+        let factor = self.unit_factor(&at, dt, "diffuseTransmissionFactor", 0.0)?;
+        let color = self.unit_rgb(&at, dt, "diffuseTransmissionColorFactor", Vec3::ONE)?;
         let texture = self.extension_texture(&at, dt, "diffuseTransmissionTexture", false)?;
         let color_texture = self.extension_texture(&at, dt, "diffuseTransmissionColorTexture", true)?;
         let d = crate::diffuse_transmission::DiffuseTransmission { factor, texture, color, color_texture };
@@ -1351,18 +1314,7 @@ impl Loader<'_> {
         an: &Value,
     ) -> Result<Option<crate::anisotropy::Anisotropy>, SceneError> {
         let at = format!("{at}.extensions.KHR_materials_anisotropy");
-        let strength = match an.get("anisotropyStrength") {
-            None => 0.0,
-            Some(v) => match v.as_f64() {
-                Some(x) if (0.0..=1.0).contains(&x) => x as f32,
-                _ => {
-                    return Err(self.ctx.invalid(
-                        format!("{at}.anisotropyStrength"),
-                        format!("{v} is not a number in [0, 1]"),
-                    ));
-                }
-            },
-        };
+        let strength = self.unit_factor(&at, an, "anisotropyStrength", 0.0)?;
         let max = crate::anisotropy::MAX_ROTATION;
         let rotation = match an.get("anisotropyRotation") {
             None => 0.0,
@@ -1427,29 +1379,9 @@ impl Loader<'_> {
                     f32::MAX,
                     "a distance > 0 in scene units",
                 )?;
-                let color = match v.get("attenuationColor") {
-                    None => [1.0; 3],
-                    Some(c) => {
-                        let nums: Option<Vec<f32>> = c
-                            .as_array()
-                            .map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect());
-                        match nums {
-                            Some(x)
-                                if x.len() == 3
-                                    && c.as_array().is_some_and(|a| a.len() == 3)
-                                    && x.iter().all(|c| (0.0..=1.0).contains(c)) =>
-                            {
-                                [x[0], x[1], x[2]]
-                            }
-                            _ => {
-                                return Err(self.ctx.invalid(
-                                    format!("{at}.extensions.{V}.attenuationColor"),
-                                    format!("{c} is not three numbers in [0, 1] (linear RGB)"),
-                                ));
-                            }
-                        }
-                    }
-                };
+                let color = self
+                    .unit_rgb(&format!("{at}.extensions.{V}"), v, "attenuationColor", Vec3::ONE)?
+                    .to_array();
                 let thickness_texture =
                     self.extension_texture(&format!("{at}.extensions.{V}"), v, "thicknessTexture", false)?;
                 // The extension: thickness 0 is a thin-walled surface.
