@@ -257,6 +257,19 @@ fn floor_render(tangent: Vec4, a: Anisotropy) -> crate::XyzImage {
         anisotropy: Some(a),
         ..Default::default()
     };
+    lit_floor(floor, m, vec![], 64, 16)
+}
+
+/// `floor` of material `m` (textures `textures`) seen from straight above by a camera whose
+/// image x is world +x and image y world +z, lit by a point light at the camera; direct light
+/// only, `size` × `size` at `spp` samples a pixel.
+fn lit_floor(
+    floor: scene::Mesh,
+    m: Material,
+    textures: Vec<scene::Texture>,
+    size: u32,
+    spp: u32,
+) -> crate::XyzImage {
     let light = scene::Light {
         name: "p".into(),
         kind: scene::LightKind::Point { position: Vec3::new(0.0, 3.0, 0.0), range: None },
@@ -264,11 +277,12 @@ fn floor_render(tangent: Vec4, a: Anisotropy) -> crate::XyzImage {
         stands_in_for: None,
     };
     let mut s = scene_with(vec![floor], vec![m], vec![light]);
+    s.textures = textures;
     s.camera = Camera::look_at(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, -Vec3::Z, 1.2);
     let st = crate::render::Settings {
         seed: 3,
         direct_only: true,
-        ..crate::render::Settings::new(64, 64, 16).unwrap()
+        ..crate::render::Settings::new(size, size, spp).unwrap()
     };
     crate::render::render(&s, &crate::upsample::GreyOnly, &st, &Default::default(), &|_| {}).unwrap()
 }
@@ -345,8 +359,7 @@ fn the_highlight_stretches_along_the_rotated_tangent() {
 }
 
 /// A white metal floor (y = 0, 4 × 4), normal-mapped by one texel tilted towards +t and +b and
-/// brushed along `dir` (rotation π/4, strength 0.8), rendered as [`floor_render`] renders its
-/// floor. `back`: the floor is built facing down (normals −y) and seen from above, its back
+/// brushed at rotation π/4 (strength 0.8), rendered by [`lit_floor`] at 48 × 48, 8 samples. `back`: the floor is built facing down (normals −y) and seen from above, its back
 /// face, with `tangent` as given; otherwise it faces up with tangent (1, 0, 0, 1).
 fn mapped_floor_render(back: Option<Vec4>) -> crate::XyzImage {
     let mut floor = quad(Vec3::ZERO, if back.is_some() { -Vec3::Y } else { Vec3::Y }, 2.0, 0);
@@ -360,29 +373,16 @@ fn mapped_floor_render(back: Option<Vec4>) -> crate::XyzImage {
         anisotropy: Some(aniso(0.8, std::f32::consts::FRAC_PI_4)),
         ..Default::default()
     };
-    let light = scene::Light {
-        name: "p".into(),
-        kind: scene::LightKind::Point { position: Vec3::new(0.0, 3.0, 0.0), range: None },
-        emission: scene::Emission { rgb: Vec3::ONE, intensity: 10.0, spectrum: None },
-        stands_in_for: None,
-    };
-    let mut s = scene_with(vec![floor], vec![m], vec![light]);
     // Tilted by about 35° towards t and b alike: (0.5, 0.5, 0.71) encoded in 8 bits.
-    s.textures = vec![scene::Texture {
+    let tilt = scene::Texture {
         sampler: Default::default(),
         name: "tilt".into(),
         width: 1,
         height: 1,
         rgba8: vec![191, 191, 218, 255],
         srgb: false,
-    }];
-    s.camera = Camera::look_at(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, -Vec3::Z, 1.2);
-    let st = crate::render::Settings {
-        seed: 3,
-        direct_only: true,
-        ..crate::render::Settings::new(48, 48, 8).unwrap()
     };
-    crate::render::render(&s, &crate::upsample::GreyOnly, &st, &Default::default(), &|_| {}).unwrap()
+    lit_floor(floor, m, vec![tilt], 48, 8)
 }
 
 /// A double-sided surface seen from behind turns its whole tangent frame with its normal
