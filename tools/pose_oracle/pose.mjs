@@ -16,7 +16,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 function usage(msg) {
 	if (msg) process.stderr.write(`pose.mjs: ${msg}\n`);
 	process.stderr.write(
-		'usage: node pose.mjs FILE.gltf|FILE.glb [--animation NAME|INDEX] [--time SECONDS] [--digits N] [--check-skin]\n'
+		'usage: node pose.mjs FILE.gltf|FILE.glb [--animation NAME|INDEX] [--time SECONDS] [--digits N] [--check-skin] [--normalize-rotations]\n'
 	);
 	process.exit(2);
 }
@@ -28,12 +28,14 @@ let animationArg = null;
 let timeArg = null;
 let digits = 7;
 let checkSkin = false;
+let normalizeRotations = false;
 for (let i = 0; i < args.length; i++) {
 	const a = args[i];
 	if (a === '--animation') animationArg = args[++i];
 	else if (a === '--time') timeArg = args[++i];
 	else if (a === '--digits') digits = parseInt(args[++i], 10);
 	else if (a === '--check-skin') checkSkin = true;
+	else if (a === '--normalize-rotations') normalizeRotations = true;
 	else if (a === '-h' || a === '--help') usage();
 	else if (a.startsWith('--')) usage(`unknown option ${a}`);
 	else if (file === null) file = a;
@@ -117,6 +119,27 @@ const parser = gltf.parser || parserRef;
 const root = gltf.scene;
 if (!root) throw new Error('the file has no scene');
 const sceneIndex = json.scene !== undefined ? json.scene : 0;
+
+// three uses rotations as given: a node rotation or a STEP / LINEAR rotation key that is not
+// of unit length scales and shears the node a little (the matrix formula assumes |q| = 1), and
+// LINEAR between two equal keys returns the key as is, between unequal ones slerps the
+// non-unit keys. glTF requires unit quaternions; with --normalize-rotations every node rotation
+// and every STEP / LINEAR rotation key is normalised first (CUBICSPLINE results are normalised
+// by three anyway).
+if (normalizeRotations) {
+	root.traverse((o) => o.quaternion.normalize());
+	for (const c of gltf.animations) {
+		for (const t of c.tracks) {
+			if (!(t instanceof THREE.QuaternionKeyframeTrack)) continue;
+			if (t.createInterpolant && t.createInterpolant.isInterpolantFactoryMethodGLTFCubicSpline) continue;
+			const v = t.values;
+			for (let i = 0; i + 3 < v.length; i += 4) {
+				const n = Math.hypot(v[i], v[i + 1], v[i + 2], v[i + 3]);
+				if (n > 0) for (let k = 0; k < 4; k++) v[i + k] /= n;
+			}
+		}
+	}
+}
 
 // ---- animation -------------------------------------------------------------------------------
 let clip = null;
@@ -279,8 +302,23 @@ for (const n of sceneDef.nodes || []) visitNode(n);
 if (clip) {
 	result.animation = { index: gltf.animations.indexOf(clip), name: clip.name, duration: clip.duration, time };
 }
+if (normalizeRotations) result.normalize_rotations = true;
 result.three = THREE.REVISION;
 if (checkSkin) process.stderr.write(`check-skin: max |three - direct| = ${skinCheckMax}\n`);
 
 console.log = origLog;
-process.stdout.write(JSON.stringify(result) + '\n');
+// One triangle a line: valid JSON, and fixtures diff readably.
+const parts = [];
+for (const [k, val] of Object.entries(result)) {
+	if (k !== 'meshes') {
+		parts.push(`${JSON.stringify(k)}:${JSON.stringify(val)}`);
+		continue;
+	}
+	const ms = val.map((m) => {
+		const { triangles, ...head } = m;
+		const h = JSON.stringify(head).slice(0, -1);
+		return `${h},"triangles":[\n${triangles.map((t) => JSON.stringify(t)).join(',\n')}\n]}`;
+	});
+	parts.push(`"meshes":[\n${ms.join(',\n')}\n]`);
+}
+process.stdout.write(`{${parts.join(',\n')}}\n`);
