@@ -218,8 +218,9 @@ const v4 = new THREE.Vector4();
 const v4b = new THREE.Vector4();
 let skinCheckMax = 0;
 
-function worldCorner(mesh, index) {
+function worldCorner(mesh, index, instanceMatrix) {
 	mesh.getVertexPosition(index, v); // morph targets, then (SkinnedMesh) skinning, in mesh-local space
+	if (instanceMatrix) v.applyMatrix4(instanceMatrix); // EXT_mesh_gpu_instancing: instance, then node
 	v.applyMatrix4(mesh.matrixWorld);
 	if (checkSkin && mesh.isSkinnedMesh) {
 		// Direct glTF formula: sum_j w_j * jointWorld_j * inverseBind_j * morphed(v)
@@ -241,7 +242,7 @@ function worldCorner(mesh, index) {
 	return [fmt(v.x), fmt(v.y), fmt(v.z)];
 }
 
-function triangles(mesh) {
+function triangles(mesh, instanceMatrix) {
 	const g = mesh.geometry;
 	const idx = g.index;
 	const count = idx ? idx.count : g.attributes.position.count;
@@ -250,7 +251,7 @@ function triangles(mesh) {
 	const out = [];
 	for (let i = start; i + 2 < end; i += 3) {
 		const tri = [];
-		for (let k = 0; k < 3; k++) tri.push(worldCorner(mesh, idx ? idx.getX(i + k) : i + k));
+		for (let k = 0; k < 3; k++) tri.push(worldCorner(mesh, idx ? idx.getX(i + k) : i + k, instanceMatrix));
 		out.push(tri);
 	}
 	return out;
@@ -268,15 +269,25 @@ const visitNode = (i) => {
 			drawables.forEach((d, order) => {
 				if (!d.isMesh) return; // points and lines draw no triangles
 				const a = parser.associations.get(d) || {};
-				const tris = triangles(d);
-				if (tris.length === 0) return;
-				result.meshes.push({
+				const head = {
 					node: i,
 					mesh: a.meshes !== undefined ? a.meshes : def.mesh,
 					primitive: a.primitives !== undefined ? a.primitives : order,
 					skinned: d.isSkinnedMesh === true,
-					triangles: tris,
-				});
+				};
+				if (d.isInstancedMesh) {
+					// One entry per instance, in instance order, each with "instance": k.
+					const im = new THREE.Matrix4();
+					for (let k = 0; k < d.count; k++) {
+						d.getMatrixAt(k, im);
+						const tris = triangles(d, im);
+						if (tris.length) result.meshes.push({ ...head, instance: k, triangles: tris });
+					}
+					return;
+				}
+				const tris = triangles(d);
+				if (tris.length === 0) return;
+				result.meshes.push({ ...head, triangles: tris });
 			});
 		}
 		if (def.camera !== undefined && result.camera === null) {
