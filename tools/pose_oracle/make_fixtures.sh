@@ -142,7 +142,7 @@ for line in open(sys.argv[1]):
         "gltf": f"{model}/{model}.gltf",
         "oracle": f"{model}/three-{name}.json",
         "animation": int(anim) if anim else None,
-        "animation_name": d.get("animation", {}).get("name"),
+        "animation_name": (d.get("animation") or {}).get("name"),
         "time": float(t) if t else None,
         "time_arg": t or None,
         "meshes": len(d["meshes"]),

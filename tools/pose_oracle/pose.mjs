@@ -311,7 +311,9 @@ const visitNode = (i) => {
 for (const n of sceneDef.nodes || []) visitNode(n);
 
 if (clip) {
-	result.animation = { index: gltf.animations.indexOf(clip), name: clip.name, duration: clip.duration, time };
+	const index = gltf.animations.indexOf(clip);
+	// name: the glTF animation's own name (null if none; three calls such a clip animation_<i>).
+	result.animation = { index, name: json.animations[index].name ?? null, duration: clip.duration, time };
 }
 if (normalizeRotations) result.normalize_rotations = true;
 result.three = THREE.REVISION;
