@@ -59,9 +59,20 @@ def _load_cached(
     env_sun=True,
     env_sun_share=None,
     variant=None,
+    animation=None,
+    time=None,
 ):
     """`load`, kept per process: what an unpickled `Scene` is (a Ray worker loads a scene
     once, however many tasks it runs with it)."""
     return load(
-        path_or_builtin, allow_outside_scene_dir, env, env_intensity, env_rotation, env_sun, env_sun_share, variant
+        path_or_builtin,
+        allow_outside_scene_dir,
+        env,
+        env_intensity,
+        env_rotation,
+        env_sun,
+        env_sun_share,
+        variant,
+        animation,
+        time,
     )

@@ -88,6 +88,8 @@ def load(
     env_sun: bool = True,
     env_sun_share: Optional[float] = None,
     variant: Optional[str] = None,
+    animation: Optional[Union[str, int]] = None,
+    time: Optional[float] = None,
 ) -> Scene:
     """Loads a built-in scene by name (cornell, colorchecker, metamerism, iridescence, glass,
     clearcoat, specular, sheen, anisotropy, translucent, underwater, fog, tinted-fog) or a .gltf/.glb file, as `spectra render SCENE` does; a scene
@@ -98,8 +100,11 @@ def load(
     the map's sun, where it has one, as a shadowed directional light in real time (False:
     `--no-env-sun`); `env_sun_share`: the share of the map's light a compact bright region must
     give to be that sun, in (0, 1] (`--env-sun-share`; default 0.15); `variant`: the file's
-    KHR_materials_variants variant to draw, by name (`--variant`). Raises
-    ValueError (bad scene, unknown variant), FileNotFoundError."""
+    KHR_materials_variants variant to draw, by name (`--variant`); `animation`, `time`: pose
+    the file by this animation (its name, or its index as a string or int) at this moment in
+    seconds (`--animation`, `--time`; a time alone poses the first animation; default: at rest,
+    skins and morph weights applied). Raises ValueError (bad scene, unknown variant or
+    animation, a time outside [0, 1e6]), FileNotFoundError."""
 
 class Renderer:
     """The real-time renderer (wgpu; lavapipe without a GPU) for one scene at one size. The GPU

@@ -211,6 +211,25 @@ fn opt_string(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
     opt(o, what, string)
 }
 
+/// An animation: its name (a str) or its index (an int ≥ 0), as `--animation` takes it.
+fn opt_name_or_index(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
+    opt(o, what, |o, what| {
+        if o.is_instance_of::<PyString>() {
+            return string(o, what);
+        }
+        let i = int(o, what).map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{what}: expected a str (a name) or an int (an index), got {}",
+                type_name(o)
+            ))
+        })?;
+        if i < 0 {
+            return Err(PyValueError::new_err(format!("{what} {i}: an index is 0 or more")));
+        }
+        Ok(i.to_string())
+    })
+}
+
 fn opt_path(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<std::path::PathBuf>> {
     opt(o, what, path)
 }
@@ -228,6 +247,8 @@ arg_fns! {
     path_arg("path") -> std::path::PathBuf = path;
     allow_outside_scene_dir("allow_outside_scene_dir") -> bool = boolean;
     variant("variant") -> Option<String> = opt_string;
+    animation("animation") -> Option<String> = opt_name_or_index;
+    time("time") -> Option<f64> = opt_float;
     env("env") -> Option<String> = opt_name_or_path;
     env_intensity("env_intensity") -> Option<f32> = opt_float32;
     env_rotation("env_rotation") -> Option<f32> = opt_float32;

@@ -129,6 +129,8 @@ struct LoadArgs {
     name: String,
     allow_outside_scene_dir: bool,
     variant: Option<String>,
+    animation: Option<String>,
+    time: Option<f64>,
     env: Option<String>,
     env_intensity: Option<f32>,
     env_rotation: Option<f32>,
@@ -198,6 +200,8 @@ impl Scene {
             h.env_sun,
             h.env_sun_share,
             h.variant.clone(),
+            h.animation.clone(),
+            h.time,
         )
             .into_pyobject(py)?;
         Ok((load, args))
@@ -231,6 +235,8 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 /// `allow_outside_scene_dir`: let the file's references (buffers, images, spectra,
 /// environment maps) leave its folder (off by default, as on the command line).
 /// `variant`: the file's KHR_materials_variants variant to draw, by name (`--variant`).
+/// `animation`, `time`: pose the file by this animation (name or index) at this moment in
+/// seconds (`--animation`, `--time`; a time alone poses the first animation); default: at rest.
 /// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
 /// environment when the scene has no lights (rendered with `water`, by `Renderer` or `truth`, the
@@ -241,7 +247,8 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 /// sun, in (0, 1] (`--env-sun-share`; default 0.15).
 #[pyfunction]
 #[pyo3(signature = (path_or_builtin, allow_outside_scene_dir = false, env = None, env_intensity = None,
-                    env_rotation = None, env_sun = true, env_sun_share = None, variant = None))]
+                    env_rotation = None, env_sun = true, env_sun_share = None, variant = None,
+                    animation = None, time = None))]
 #[allow(clippy::too_many_arguments)] // Python's keyword arguments, each its own option
 fn load(
     py: Python<'_>,
@@ -253,6 +260,8 @@ fn load(
     #[pyo3(from_py_with = args::env_sun)] env_sun: bool,
     #[pyo3(from_py_with = args::env_sun_share)] env_sun_share: Option<f32>,
     #[pyo3(from_py_with = args::variant)] variant: Option<String>,
+    #[pyo3(from_py_with = args::animation)] animation: Option<String>,
+    #[pyo3(from_py_with = args::time)] time: Option<f64>,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
         .to_str()
@@ -280,6 +289,8 @@ fn load(
         name: abs,
         allow_outside_scene_dir,
         variant: variant.clone(),
+        animation: animation.clone(),
+        time,
         env: env_abs,
         env_intensity,
         env_rotation,
@@ -296,7 +307,7 @@ fn load(
         });
         let args = setup::SceneArgs {
             scene: name.clone(),
-            files: setup::SceneFileArgs { allow_outside_scene_dir, variant },
+            files: setup::SceneFileArgs { allow_outside_scene_dir, variant, animation, time },
             env: setup::EnvArgs {
                 env: h.env,
                 env_intensity: h.env_intensity,

@@ -49,6 +49,7 @@ fn scene() -> Scene {
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     }
 }
 

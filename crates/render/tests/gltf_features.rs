@@ -85,6 +85,7 @@ fn scene(meshes: Vec<Mesh>, materials: Vec<Material>, textures: Vec<Texture>, li
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     }
 }
 

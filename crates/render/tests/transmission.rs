@@ -44,6 +44,7 @@ fn scene(pane: Option<Material>, stripe: bool) -> Scene {
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     };
     let bg = Material {
         name: "background".into(),

@@ -71,10 +71,34 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
             "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
             "this renderer has no scattering inside a volume",
         ),
-        "KHR_animation_pointer" => ("animations are ignored; the scene is drawn at rest", ""),
+        "KHR_animation_pointer" => (
+            "its animations of material, light and camera properties are ignored (nodes' animations are drawn)",
+            "",
+        ),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
         _ => ("it is ignored", ""),
     }
+}
+
+/// The document without its animation channels that target no node (`KHR_animation_pointer`'s),
+/// or `None` when it has none.
+pub(crate) fn without_pointer_channels(raw: &Value) -> Option<Value> {
+    let has = |c: &Value| c.pointer("/target/node").is_some();
+    let any = raw
+        .get("animations")?
+        .as_array()?
+        .iter()
+        .any(|a| a.get("channels").and_then(Value::as_array).is_some_and(|cs| !cs.iter().all(has)));
+    if !any {
+        return None;
+    }
+    let mut cleaned = raw.clone();
+    for a in cleaned.get_mut("animations")?.as_array_mut()? {
+        if let Some(cs) = a.get_mut("channels").and_then(Value::as_array_mut) {
+            cs.retain(has);
+        }
+    }
+    Some(cleaned)
 }
 
 fn strings(v: Option<&Value>) -> impl Iterator<Item = &str> {

@@ -10,6 +10,7 @@ use serde_json::Value;
 use crate::context::Ctx;
 use crate::error::SceneError;
 use crate::extras::{self, SceneExtras};
+use crate::pose;
 use crate::primitive::Needs;
 use crate::spec_gloss;
 use crate::{
@@ -50,6 +51,13 @@ pub struct LoadOptions {
     /// The `KHR_materials_variants` variant to draw, by name (`--variant`); `None`: the
     /// primitives' own materials. A name the file does not have is an error listing those it has.
     pub variant: Option<String>,
+    /// The animation to pose the scene by (`--animation`): its name, or its index when no
+    /// animation has that name. `None` with a [`time`](Self::time): the first animation.
+    pub animation: Option<String>,
+    /// The moment of the animation, in seconds (`--time`, default 0 when an animation is
+    /// named). Without either, the scene is drawn at rest: its nodes' own transforms and morph
+    /// weights, skins applied.
+    pub time: Option<f64>,
 }
 
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
@@ -67,7 +75,7 @@ pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Sc
     let mut ctx = Ctx::file(path);
     ctx.allow_outside = opts.allow_outside_scene_dir;
     let bytes = color::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| ctx.io(path, e))?;
-    from_slice(&ctx, &bytes, opts.variant.as_deref())
+    from_slice(&ctx, &bytes, opts)
 }
 
 /// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
@@ -80,7 +88,7 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
         inputs: Vec::new().into(),
         stamps: Vec::new().into(),
     };
-    from_slice(&ctx, bytes, None)
+    from_slice(&ctx, bytes, &LoadOptions::default())
 }
 
 /// The document's JSON as written (the `gltf` crate drops what it does not know, such as most
@@ -121,14 +129,30 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     serde_json::from_slice(&json).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))
 }
 
-pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Result<Scene, SceneError> {
+pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<Scene, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
     // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
     // problems (a wrong type in a sampler field) with a less helpful message.
     let raw = raw_json(ctx, bytes)?;
     gltf_ext::precheck(ctx, &raw)?;
-    let g = gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_err)?;
-    let mut root = g.document.into_json();
+    // KHR_animation_pointer's channels name no node, which the `gltf` crate's typed parse
+    // requires of every channel: without them the rest of the file loads (they stay ignored).
+    let (mut root, blob) = match gltf_ext::without_pointer_channels(&raw) {
+        Some(cleaned) => {
+            let blob = if bytes.starts_with(b"glTF") {
+                gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.bin.map(|b| b.into_owned())
+            } else {
+                None
+            };
+            let root: gltf::json::Root =
+                serde_json::from_value(cleaned).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
+            (root, blob)
+        }
+        None => {
+            let g = gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_err)?;
+            (g.document.into_json(), g.blob)
+        }
+    };
     // Checked by `gltf_ext::precheck` against what this loader implements; the crate's own check
     // only knows the extensions it parses itself.
     root.extensions_required.clear();
@@ -158,10 +182,17 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
     let document = gltf::Document::from_json(root).map_err(gltf_err)?;
     let doc = &document;
     let mut warnings = gltf_ext::warnings(&raw);
-    let variants = crate::variants::read(ctx, &raw, variant)?;
+    let variants = crate::variants::read(ctx, &raw, opts.variant.as_deref())?;
     warnings.extend(variants.unchosen_warning());
-    let mut buffers = load_buffers(ctx, doc, g.blob.as_deref(), &raw)?;
+    let mut buffers = load_buffers(ctx, doc, blob.as_deref(), &raw)?;
     meshopt_decode::decode(ctx, &raw, &mut buffers)?;
+    let chosen = pose::choose(ctx, doc, opts.animation.as_deref(), opts.time, &mut warnings)?;
+    let pose = pose::Pose::new(ctx, doc, &buffers, chosen, &mut warnings)?;
+    let mut choices: Vec<(String, String)> = Vec::new();
+    if let Some(v) = variants.chosen {
+        choices.push(("variant".into(), variants.names[v].clone()));
+    }
+    choices.extend(chosen.map(|c| c.describe(doc)).into_iter().flatten());
     let gscene = doc
         .default_scene()
         .or_else(|| doc.scenes().next())
@@ -206,16 +237,37 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
         if std::mem::replace(&mut seen[node.index()], true) {
             return Err(ctx.invalid(at, "node is reached twice: the node hierarchy must be a tree"));
         }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * pose.local(node.index());
         if !world.is_finite() {
             return Err(ctx.invalid(at, "transform is not finite"));
         }
         if let Some(mesh) = node.mesh() {
+            let weights = pose.morph_weights(ctx, &node, &mesh)?;
+            let joints = node.skin().map(|skin| pose.joint_matrices(ctx, &skin, &buffers)).transpose()?;
+            let deform = pose::Deform {
+                weights: &weights,
+                joints: joints.as_deref(),
+                fallback: world,
+                unweighted: 0.into(),
+            };
             // EXT_mesh_gpu_instancing: the mesh is drawn once per instance, each placed by its
-            // own transform within the node's frame; without it, once at the node.
-            let worlds: Vec<Mat4> = match instancing::transforms(ctx, &raw, doc, node.index(), &buffers)? {
-                Some(instances) => instances.into_iter().map(|m| world * m).collect(),
-                None => vec![world],
+            // own transform within the node's frame; without it, once at the node. A skinned
+            // mesh comes out of its joints in world space, where the node plays no part.
+            let instances = instancing::transforms(ctx, &raw, doc, node.index(), &buffers)?;
+            let worlds: Vec<Mat4> = match (instances, &joints) {
+                (_, Some(_)) => {
+                    if raw
+                        .pointer(&format!("/nodes/{}/extensions/EXT_mesh_gpu_instancing", node.index()))
+                        .is_some()
+                    {
+                        warnings.push(format!(
+                            "{at}: a skinned mesh is drawn once, where its joints place it; its EXT_mesh_gpu_instancing instances are ignored"
+                        ));
+                    }
+                    vec![Mat4::IDENTITY]
+                }
+                (Some(instances), None) => instances.into_iter().map(|m| world * m).collect(),
+                (None, None) => vec![world],
             };
             if let Some(bad) = worlds.iter().position(|w| !w.is_finite()) {
                 return Err(ctx.invalid(&at, format!("the transform of instance {bad} is not finite")));
@@ -241,7 +293,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
                     }
                 };
                 let need = needs.get(mi).cloned().unwrap_or_default();
-                let local = primitive::build(ctx, &pat, &prim, &buffers, mi, &need)?;
+                let local = primitive::build(ctx, &pat, &prim, &buffers, mi, &need, &deform)?;
                 if local.indices.is_empty() {
                     // Fewer indices than one triangle: nothing to draw (the renderers had a mesh
                     // of no triangles to upload).
@@ -269,7 +321,9 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
                 }
                 for w in &worlds {
                     let mut m = local.clone();
-                    primitive::to_world(&mut m, *w);
+                    if joints.is_none() {
+                        primitive::to_world(&mut m, *w);
+                    }
                     if let Some(k) =
                         m.positions.iter().position(|p| p.abs().max_element() > crate::MAX_COORDINATE)
                     {
@@ -288,6 +342,12 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
             }
             if meshes.len() > first {
                 first_mesh_of_node.insert(node.index(), first);
+            }
+            if deform.unweighted.get() > 0 {
+                warnings.push(format!(
+                    "{at}: {} skinned vertices have no joint weight (WEIGHTS_n all zero); they stay where the node places them",
+                    deform.unweighted.get()
+                ));
             }
         }
         if let (Some(cam), None) = (node.camera(), &camera) {
@@ -354,6 +414,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], variant: Option<&str>) -> Resu
         medium: sx.medium,
         inputs: ctx.inputs.take(),
         input_stamps: ctx.stamps.take(),
+        choices,
         origin: glam::DVec3::ZERO,
     };
     if scene.water.is_some() && scene.medium.is_some() {

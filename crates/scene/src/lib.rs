@@ -24,6 +24,7 @@ mod gltf_file;
 mod instancing;
 pub mod medium;
 mod meshopt_decode;
+mod pose;
 mod primitive;
 pub mod sheen;
 pub mod sky;
@@ -102,6 +103,11 @@ pub struct Scene {
     /// where it could not be stamped): a record hashing the files afterwards checks that they
     /// are still what was loaded.
     pub input_stamps: Vec<Option<color::input::FileStamp>>,
+    /// What the loader was asked to choose among a file's alternatives, resolved against it
+    /// (`variant`, `animation`, `time`): with the input files' contents, what identifies the
+    /// scene (a ground-truth record made at one moment of an animation must not merge with
+    /// another's). Empty when nothing was chosen.
+    pub choices: Vec<(String, String)>,
 }
 
 impl Scene {
@@ -124,6 +130,7 @@ impl Scene {
             inputs: Vec::new(),
             origin: glam::DVec3::ZERO,
             input_stamps: Vec::new(),
+            choices: Vec::new(),
         }
     }
 

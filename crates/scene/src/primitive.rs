@@ -10,6 +10,7 @@ use crate::Mesh;
 use crate::accessors::{self, Expect};
 use crate::context::Ctx;
 use crate::error::SceneError;
+use crate::pose::{self, Deform};
 
 /// Triangle list indices for `mode`, from the primitive's indices (or 0..n when unindexed).
 fn triangulate(ctx: &Ctx, at: &str, mode: Mode, idx: Vec<u32>) -> Result<Vec<u32>, SceneError> {
@@ -48,8 +49,9 @@ pub(crate) fn is_triangles(mode: Mode) -> bool {
     matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan)
 }
 
-/// Builds the mesh of `prim` in its node's local space (see [`to_world`]). `material` is the
-/// index the mesh will use.
+/// Builds the mesh of `prim` in its node's local space (see [`to_world`]), morphed by
+/// `deform`'s weights; skinned by its joints, the mesh comes out in world space instead.
+/// `material` is the index the mesh will use.
 pub(crate) fn build(
     ctx: &Ctx,
     at: &str,
@@ -57,6 +59,7 @@ pub(crate) fn build(
     buffers: &[Vec<u8>],
     material: usize,
     needs: &Needs,
+    deform: &Deform,
 ) -> Result<Mesh, SceneError> {
     use gltf::Semantic as S;
     let pos_at = format!("{at}.attributes.POSITION");
@@ -79,10 +82,10 @@ pub(crate) fn build(
     let vec3 = |v: Option<(Vec<f32>, usize)>| -> Option<Vec<Vec3>> {
         v.map(|(f, _)| f.chunks_exact(3).map(Vec3::from_slice).collect())
     };
-    let positions =
+    let mut positions =
         vec3(Some((accessors::read_f32(ctx, &pos_at, &pos_acc, buffers)?, 3))).unwrap_or_default();
-    let normals = vec3(attr(S::Normals, "NORMAL", &accessors::NORMAL)?);
-    let file_tangents: Vec<Vec4> = attr(S::Tangents, "TANGENT", &accessors::TANGENT)?
+    let mut normals = vec3(attr(S::Normals, "NORMAL", &accessors::NORMAL)?);
+    let mut file_tangents: Vec<Vec4> = attr(S::Tangents, "TANGENT", &accessors::TANGENT)?
         .map(|(f, _)| f.chunks_exact(4).map(Vec4::from_slice).collect())
         .unwrap_or_default();
     let uvs = vec2(attr(S::TexCoords(0), "TEXCOORD_0", &accessors::TEXCOORD)?);
@@ -122,7 +125,24 @@ pub(crate) fn build(
             format!("{field} reads TEXCOORD_1, but the primitive has no TEXCOORD_1 attribute"),
         ));
     }
-    let indices = triangulate(ctx, at, prim.mode(), raw_idx)?;
+    let mut indices = triangulate(ctx, at, prim.mode(), raw_idx)?;
+    if deform.morphs() {
+        let v = pose::Vertices {
+            positions: &mut positions,
+            normals: normals.as_deref_mut(),
+            tangents: &mut file_tangents,
+        };
+        pose::morph(ctx, at, prim, buffers, deform.weights, v)?;
+    }
+    if let Some(joints) = deform.joints {
+        let (m, unweighted) = pose::skin_matrices(ctx, at, prim, buffers, joints, deform.fallback)?;
+        deform.unweighted.set(deform.unweighted.get() + unweighted);
+        let normals = normals.as_deref_mut().unwrap_or(&mut []);
+        pose::apply_skin(&m, &mut positions, normals, &mut file_tangents, &mut indices);
+    }
+    if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(ctx.invalid(at, format!("vertex {k} is not finite once morphed and skinned")));
+    }
 
     let mesh = Mesh {
         colors,

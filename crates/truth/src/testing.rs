@@ -26,6 +26,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     }
 }
 

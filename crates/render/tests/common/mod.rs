@@ -177,6 +177,7 @@ impl Chart {
             inputs: vec![],
             origin: glam::DVec3::ZERO,
             input_stamps: vec![],
+            choices: vec![],
         }
     }
 }
@@ -537,6 +538,7 @@ pub fn sphere_scene(material: Material, env: scene::Environment, rings: u32) -> 
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     }
 }
 

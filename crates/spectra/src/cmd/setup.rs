@@ -772,20 +772,37 @@ pub struct SceneFileArgs {
     /// warning lists a file's variants). Default: the primitives' own materials.
     #[arg(long, value_name = "NAME")]
     pub variant: Option<String>,
+    /// Pose the scene by this glTF animation (its name, or its index in the file; the loader's
+    /// warning lists them) at `--time`. Default: drawn at rest, as the file's nodes stand
+    /// (skins and morph weights applied).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub animation: Option<String>,
+    /// The moment of the animation, in seconds (default 0; alone, it poses the file's first
+    /// animation). Animations hold their first and last keyframes outside their range.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub time: Option<f64>,
 }
 
 impl SceneFileArgs {
     /// Loads a built-in scene or a .gltf/.glb file, with these options.
     pub fn load(&self, name: &str) -> Result<scene::Scene> {
         let lower = name.to_ascii_lowercase();
-        if let Some(v) = &self.variant
-            && !(lower.ends_with(".gltf") || lower.ends_with(".glb"))
-        {
-            bail!("--variant {v}: material variants belong to glTF files; '{name}' is a built-in scene");
+        if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+            if let Some(v) = &self.variant {
+                bail!("--variant {v}: material variants belong to glTF files; '{name}' is a built-in scene");
+            }
+            if let Some(a) = &self.animation {
+                bail!("--animation {a}: animations belong to glTF files; '{name}' is a built-in scene");
+            }
+            if let Some(t) = self.time {
+                bail!("--time {t}: animations belong to glTF files; '{name}' is a built-in scene");
+            }
         }
         let opts = scene::LoadOptions {
             allow_outside_scene_dir: self.allow_outside_scene_dir,
             variant: self.variant.clone(),
+            animation: self.animation.clone(),
+            time: self.time,
         };
         scene::load_any_with(name, &opts).with_context(|| format!("loading scene '{name}'"))
     }

@@ -313,6 +313,8 @@ pub fn sum_fields(
             ),
         ),
     ];
+    // A file's variant and animation moment: the same files drawn otherwise.
+    fields.extend(scene.choices.iter().map(|(k, v)| (format!("scene.{k}"), v.clone())));
     if scene.inputs.is_empty() {
         // Built in code: its name, and what it holds (a built-in changes with the code).
         let s = scene;

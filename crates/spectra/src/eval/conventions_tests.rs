@@ -67,6 +67,7 @@ fn scene(mesh: Mesh, white: &str) -> Scene {
         inputs: vec![],
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
+        choices: vec![],
     }
 }
 
