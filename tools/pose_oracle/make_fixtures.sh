@@ -171,3 +171,14 @@ for entry in "${SCRATCH[@]}"; do
 	echo "scratch $model -> $scratch/$model" >&2
 done
 du -sh "$out" >&2
+
+# The hand check and the mixed-interpolation fuzz seed (crates/scene/tests/pose.rs,
+# hand_derived_poses_and_the_mixed_interpolations): the hand poses are copied from test/, the
+# seed's from the oracle with its keys made unit.
+hand="$out/hand"
+mkdir -p "$hand"
+cp "$repo/tools/pose_oracle/test/skin_morph_triangle.gltf" "$repo"/tools/pose_oracle/test/expected-*.json "$hand/"
+cp "$repo/crates/fuzz/corpus/gltf/skin-morph-animation.gltf" "$hand/mixed.gltf"
+for t in 0.3 0.5 1 2; do
+	node "$oracle" "$hand/mixed.gltf" --animation mixed --time "$t" --normalize-rotations > "$hand/three-mixed-$t.json"
+done

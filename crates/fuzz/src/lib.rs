@@ -22,7 +22,14 @@ pub const TARGETS: &[&str] =
 pub fn run_one(target: &str, data: &[u8]) {
     match target {
         // No base directory: file references are refused, as a scene without a folder's are.
-        "gltf" => drop(scene::load_slice("fuzz.gltf", data, None)),
+        "gltf" => {
+            drop(scene::load_slice("fuzz.gltf", data, None));
+            // Posed too, between keys, where a document has animations to sample.
+            if data.windows(10).any(|w| w == b"animations") {
+                let opts = scene::LoadOptions { time: Some(0.37), ..Default::default() };
+                drop(scene::load_slice_with("fuzz.gltf", data, None, &opts));
+            }
+        }
         "coeff" => drop(color::upsample::CoeffTable::from_bytes(data, "fuzz.coeff")),
         "csv" => drop(scene::spectrum_desc::csv_spectrum("fuzz.csv", data)),
         "medium" => {

@@ -64,6 +64,23 @@ fn main() -> ExitCode {
             format!("{{\"triangles\":[{}]}}", tris.join(","))
         })
         .collect();
-    println!("{{\"meshes\":[{}]}}", meshes.join(",\n"));
+    // The camera as the file places it (the loader frames a scene without one itself).
+    let has_camera = std::fs::read(&file)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v.get("nodes")?.as_array().map(|n| n.iter().any(|n| n.get("camera").is_some())))
+        .unwrap_or(false);
+    let camera = if !has_camera {
+        "null".to_string()
+    } else {
+        let t = s.camera.transform;
+        let p = t.w_axis.truncate().as_dvec3() + o;
+        let f = (-t.z_axis.truncate()).normalize();
+        format!(
+            "{{\"position\":[{:.7e},{:.7e},{:.7e}],\"forward\":[{:.7e},{:.7e},{:.7e}]}}",
+            p.x, p.y, p.z, f.x, f.y, f.z
+        )
+    };
+    println!("{{\"meshes\":[{}],\n\"camera\":{camera}}}", meshes.join(",\n"));
     ExitCode::SUCCESS
 }

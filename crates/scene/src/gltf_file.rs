@@ -81,6 +81,17 @@ pub fn load_with(path: impl AsRef<Path>, opts: &LoadOptions) -> Result<Scene, Sc
 /// Loads a glTF document held in memory; relative URIs resolve against `base_dir` when given
 /// (and must stay inside it). `name` is used in messages in place of a path.
 pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<Scene, SceneError> {
+    load_slice_with(name, bytes, base_dir, &LoadOptions::default())
+}
+
+/// [`load_slice`] with options (a variant, an animation's moment; `allow_outside_scene_dir`
+/// is not consulted: references stay inside `base_dir`).
+pub fn load_slice_with(
+    name: &str,
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    opts: &LoadOptions,
+) -> Result<Scene, SceneError> {
     let ctx = Ctx {
         path: name.into(),
         dir: base_dir.map(Path::to_path_buf),
@@ -88,7 +99,7 @@ pub fn load_slice(name: &str, bytes: &[u8], base_dir: Option<&Path>) -> Result<S
         inputs: Vec::new().into(),
         stamps: Vec::new().into(),
     };
-    from_slice(&ctx, bytes, &LoadOptions::default())
+    from_slice(&ctx, bytes, opts)
 }
 
 /// The document's JSON as written (the `gltf` crate drops what it does not know, such as most

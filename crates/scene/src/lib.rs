@@ -50,7 +50,7 @@ pub use error::{Result, SceneError};
 pub use export::write_gltf;
 pub use gltf_file::{
     LoadOptions, MAX_EMISSIVE, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION,
-    MAX_IMAGE_FILE_BYTES, MAX_LIGHT_INTENSITY, MAX_TRIANGLES, load, load_slice, load_with,
+    MAX_IMAGE_FILE_BYTES, MAX_LIGHT_INTENSITY, MAX_TRIANGLES, load, load_slice, load_slice_with, load_with,
 };
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the

@@ -330,7 +330,15 @@ impl Pose {
                 let at = format!("animations[{}].samplers[{}]", anim.index(), channel.sampler().index());
                 let property = target.property();
                 let targets = match (property, node.mesh()) {
-                    (Property::MorphTargetWeights, Some(m)) => target_count(ctx, &m)?,
+                    (Property::MorphTargetWeights, Some(m)) => match target_count(ctx, &m)? {
+                        0 => {
+                            return Err(ctx.invalid(
+                                format!("animations[{}].channels[{}].target", anim.index(), channel.index()),
+                                format!("animates the morph weights of nodes[{ni}], whose mesh has no morph targets"),
+                            ));
+                        }
+                        t => t,
+                    },
                     (Property::MorphTargetWeights, None) => {
                         return Err(ctx.invalid(
                             format!("animations[{}].channels[{}].target", anim.index(), channel.index()),
@@ -380,25 +388,32 @@ impl Pose {
                 parent[c.index()].get_or_insert(node.index());
             }
         }
-        let world = (0..n)
-            .map(|i| {
-                let mut m = local[i];
-                let mut at = parent[i];
-                let mut steps = 0;
-                while let Some(p) = at {
-                    steps += 1;
-                    if steps > n {
-                        return Err(ctx.invalid(
-                            format!("nodes[{i}]"),
-                            "its ancestors form a cycle: the node hierarchy must be a tree",
-                        ));
-                    }
-                    m = local[p] * m;
-                    at = parent[p];
+        // Each node's world transform once, from its root down (a deep chain costs its length,
+        // not its square).
+        let mut world: Vec<Option<Mat4>> = vec![None; n];
+        for i in 0..n {
+            let mut chain = vec![i];
+            let mut at = parent[i];
+            while let Some(p) = at {
+                if world[p].is_some() {
+                    break;
                 }
-                Ok(m)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+                if chain.len() > n {
+                    return Err(ctx.invalid(
+                        format!("nodes[{i}]"),
+                        "its ancestors form a cycle: the node hierarchy must be a tree",
+                    ));
+                }
+                chain.push(p);
+                at = parent[p];
+            }
+            let mut m = at.and_then(|p| world[p]).unwrap_or(Mat4::IDENTITY);
+            for &c in chain.iter().rev() {
+                m *= local[c];
+                world[c] = Some(m);
+            }
+        }
+        let world: Vec<Mat4> = world.into_iter().map(|m| m.expect("every node is reached")).collect();
         Ok(Pose { local, world, weights })
     }
 

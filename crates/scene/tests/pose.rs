@@ -306,3 +306,37 @@ fn data_uri(bytes: &[u8]) -> String {
     }
     s
 }
+
+/// `tests/data/pose/hand`: the oracle's own hand check (`tools/pose_oracle/test`, poses derived
+/// by hand in its README: a two-joint skin bent 90° by a LINEAR rotation, a morph weight and a
+/// camera), and `mixed.gltf` (the fuzz seed: that file plus STEP translations, CUBICSPLINE
+/// scales and weights, normalized-short rotation keys) against three.js.
+#[test]
+fn hand_derived_poses_and_the_mixed_interpolations() {
+    let dir = pose_dir().join("hand");
+    let tri = dir.join("skin_morph_triangle.gltf");
+    for (t, want) in [
+        (None, "rest"),
+        (Some(0.0), "bend-0"),
+        (Some(0.5), "bend-0.5"),
+        (Some(1.0), "bend-1"),
+        (Some(3.0), "bend-1"),
+    ] {
+        let s = load(&tri, t.map(|_| "bend"), t).unwrap();
+        let w = worst(&corners(&s), &oracle(&dir.join(format!("expected-{want}.json"))));
+        assert!(w < 2e-7, "{want} at {t:?}: {w:.2e}");
+        let v: Value =
+            serde_json::from_slice(&std::fs::read(dir.join(format!("expected-{want}.json"))).unwrap())
+                .unwrap();
+        let p = &v["camera"]["position"];
+        let cam = s.camera.transform.w_axis.truncate().as_dvec3() + s.origin;
+        let want_cam = DVec3::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap());
+        assert!(cam.distance(want_cam) < 1e-6, "camera {cam} against {want_cam}");
+    }
+    let mixed = dir.join("mixed.gltf");
+    for t in ["0.3", "0.5", "1", "2"] {
+        let s = load(&mixed, Some("mixed"), Some(t.parse().unwrap())).unwrap();
+        let w = worst(&corners(&s), &oracle(&dir.join(format!("three-mixed-{t}.json"))));
+        assert!(w < 2e-6, "mixed at {t}: {w:.2e}");
+    }
+}
