@@ -388,6 +388,38 @@ def test_material_variants_are_chosen_and_survive_pickling(tmp_path):
         spectra.load("cornell", variant="red")
 
 
+def test_animations_pose_the_scene_and_survive_pickling():
+    """`animation=`, `time=` are `--animation`, `--time`: the Fox (a skinned mesh with three
+    animations) posed by "Run" at 0.5 s, named or by its index, is drawn the same and otherwise
+    than at rest; a pickled posed scene keeps the pose; an unknown animation is a ValueError
+    listing the file's, a negative time a ValueError, a float index a TypeError; at rest the
+    warning says so."""
+    import pickle
+
+    fox = str(ROOT / "crates" / "scene" / "tests" / "data" / "pose" / "Fox" / "Fox.gltf")
+
+    def draw(scene):
+        return spectra.Renderer(scene, size=(48, 32)).render("rgb")
+
+    rest = spectra.load(fox)
+    assert any("drawn at rest" in w and "2 'Run'" in w for w in rest.warnings), rest.warnings
+    run = spectra.load(fox, animation="Run", time=0.5)
+    assert not any("drawn at rest" in w for w in run.warnings), run.warnings
+    a, b, r = draw(run), draw(spectra.load(fox, animation=2, time=0.5)), draw(rest)
+    assert np.isfinite(a).all() and np.isfinite(r).all()
+    assert np.array_equal(a, b), "the animation by its name and by its index"
+    # The fox is white over the default environment's grey ground: its pixels move.
+    moved = np.abs(a - r).max(axis=2) > 0.05
+    assert moved.sum() > 30, f"the posed fox differs from the one at rest in {moved.sum()} pixels"
+    assert np.array_equal(draw(pickle.loads(pickle.dumps(run))), a), "a pickled scene keeps its pose"
+    with pytest.raises(ValueError, match="0 'Survey', 1 'Walk' and 2 'Run'"):
+        spectra.load(fox, animation="Jump")
+    with pytest.raises(ValueError, match="time"):
+        spectra.load(fox, animation="Run", time=-1)
+    with pytest.raises(TypeError, match="animation"):
+        spectra.load(fox, animation=1.5)
+
+
 def test_env_sun_switch_is_the_clis_and_survives_pickling():
     """`env_sun=False` is `--no-env-sun`: rooitou_park's sun is then not a shadowed light, and
     the real-time image changes; a pickled scene keeps the choice."""
