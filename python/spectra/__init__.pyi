@@ -101,7 +101,8 @@ def load(
     `--no-env-sun`); `env_sun_share`: the share of the map's light a compact bright region must
     give to be that sun, in (0, 1] (`--env-sun-share`; default 0.15); `variant`: the file's
     KHR_materials_variants variant to draw, by name (`--variant`); `animation`, `time`: pose
-    the file by this animation (its name, or its index as a string or int) at this moment in
+    the file by this animation (a str: its name, else an index as `--animation` reads it; an
+    int: its index, whatever the names) at this moment in
     seconds (`--animation`, `--time`; a time alone poses the first animation; default: at rest,
     skins and morph weights applied). Raises ValueError (bad scene, unknown variant or
     animation, a time outside [0, 1e6]), FileNotFoundError."""

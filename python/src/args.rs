@@ -211,11 +211,12 @@ fn opt_string(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
     opt(o, what, string)
 }
 
-/// An animation: its name (a str) or its index (an int ≥ 0), as `--animation` takes it.
-fn opt_name_or_index(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String>> {
+/// An animation: its name (a str, which `--animation` reads as a name, else an index) or its
+/// index (an int ≥ 0, an index whatever the names).
+fn opt_animation(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<scene::AnimationRef>> {
     opt(o, what, |o, what| {
         if o.is_instance_of::<PyString>() {
-            return string(o, what);
+            return string(o, what).map(scene::AnimationRef::NameOrIndex);
         }
         let i = int(o, what).map_err(|_| {
             PyTypeError::new_err(format!(
@@ -223,10 +224,9 @@ fn opt_name_or_index(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<String
                 type_name(o)
             ))
         })?;
-        if i < 0 {
-            return Err(PyValueError::new_err(format!("{what} {i}: an index is 0 or more")));
-        }
-        Ok(i.to_string())
+        usize::try_from(i)
+            .map(scene::AnimationRef::Index)
+            .map_err(|_| PyValueError::new_err(format!("{what} {i}: an index is 0 or more")))
     })
 }
 
@@ -247,7 +247,7 @@ arg_fns! {
     path_arg("path") -> std::path::PathBuf = path;
     allow_outside_scene_dir("allow_outside_scene_dir") -> bool = boolean;
     variant("variant") -> Option<String> = opt_string;
-    animation("animation") -> Option<String> = opt_name_or_index;
+    animation("animation") -> Option<scene::AnimationRef> = opt_animation;
     time("time") -> Option<f64> = opt_float;
     env("env") -> Option<String> = opt_name_or_path;
     env_intensity("env_intensity") -> Option<f32> = opt_float32;

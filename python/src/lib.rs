@@ -129,7 +129,7 @@ struct LoadArgs {
     name: String,
     allow_outside_scene_dir: bool,
     variant: Option<String>,
-    animation: Option<String>,
+    animation: Option<scene::AnimationRef>,
     time: Option<f64>,
     env: Option<String>,
     env_intensity: Option<f32>,
@@ -191,6 +191,12 @@ impl Scene {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
         let load = py.import("spectra")?.getattr("_load_cached")?;
         let h = &self.how;
+        // An index stays an int, a name a str: what `load` was given.
+        let animation: Option<Bound<'py, PyAny>> = match &h.animation {
+            None => None,
+            Some(scene::AnimationRef::Index(i)) => Some(i.into_pyobject(py)?.into_any()),
+            Some(scene::AnimationRef::NameOrIndex(a)) => Some(a.into_pyobject(py)?.into_any()),
+        };
         let args = (
             h.name.clone(),
             h.allow_outside_scene_dir,
@@ -200,7 +206,7 @@ impl Scene {
             h.env_sun,
             h.env_sun_share,
             h.variant.clone(),
-            h.animation.clone(),
+            animation,
             h.time,
         )
             .into_pyobject(py)?;
@@ -235,7 +241,8 @@ fn scene_of(obj: &Bound<'_, PyAny>, what: &str, under_water: bool) -> PyResult<A
 /// `allow_outside_scene_dir`: let the file's references (buffers, images, spectra,
 /// environment maps) leave its folder (off by default, as on the command line).
 /// `variant`: the file's KHR_materials_variants variant to draw, by name (`--variant`).
-/// `animation`, `time`: pose the file by this animation (name or index) at this moment in
+/// `animation`, `time`: pose the file by this animation (a str: its name, else an index; an int:
+/// its index) at this moment in
 /// seconds (`--animation`, `--time`; a time alone poses the first animation); default: at rest.
 /// `env`: the environment light, as `--env`: an equirectangular .hdr/.exr file, "default" (a
 /// uniform D65 sky over a grey ground) or "none"; default: the scene's own, else the default
@@ -260,7 +267,7 @@ fn load(
     #[pyo3(from_py_with = args::env_sun)] env_sun: bool,
     #[pyo3(from_py_with = args::env_sun_share)] env_sun_share: Option<f32>,
     #[pyo3(from_py_with = args::variant)] variant: Option<String>,
-    #[pyo3(from_py_with = args::animation)] animation: Option<String>,
+    #[pyo3(from_py_with = args::animation)] animation: Option<scene::AnimationRef>,
     #[pyo3(from_py_with = args::time)] time: Option<f64>,
 ) -> PyResult<Scene> {
     let name = path_or_builtin
@@ -307,7 +314,19 @@ fn load(
         });
         let args = setup::SceneArgs {
             scene: name.clone(),
-            files: setup::SceneFileArgs { allow_outside_scene_dir, variant, animation, time },
+            files: setup::SceneFileArgs {
+                allow_outside_scene_dir,
+                variant,
+                animation: match &animation {
+                    Some(scene::AnimationRef::NameOrIndex(a)) => Some(a.clone()),
+                    _ => None,
+                },
+                animation_index: match animation {
+                    Some(scene::AnimationRef::Index(i)) => Some(i),
+                    _ => None,
+                },
+                time,
+            },
             env: setup::EnvArgs {
                 env: h.env,
                 env_intensity: h.env_intensity,
@@ -321,7 +340,8 @@ fn load(
             if (is_file && std::fs::symlink_metadata(&name).is_err()) || env_missing {
                 PyFileNotFoundError::new_err(format!("{e:#}"))
             } else {
-                value(e).into()
+                // `--time -1: …` is `time -1: …` here, as the argument was given.
+                value(anyhow::anyhow!(python_flags(&format!("{e:#}")))).into()
             }
         };
         // `SceneArgs::load` in two steps, to know whether the environment is `load`'s choice.
@@ -378,10 +398,13 @@ const PYTHON_FLAGS: &[(&str, &str)] = &[
     ("--split-beams", "split_beams=True"),
     ("--isotropic", "isotropic=True"),
     ("--phase-g", "phase_g"),
+    ("--variant", "variant"),
+    ("--animation", "animation"),
+    ("--time", "time"),
 ];
 
-/// A message of the CLI's about `Renderer`'s picture flags with each flag spelt as the Python
-/// argument that gives it (`--scatter-steps 33: …` → `scatter_steps 33: …`), clap's value names
+/// A message of the CLI's about `Renderer`'s picture flags or `load`'s file choices
+/// (`--variant`, `--animation`, `--time`) with each flag spelt as the Python argument that gives it (`--scatter-steps 33: …` → `scatter_steps 33: …`), clap's value names
 /// (` <STEPS>`) dropped. Other flags (`--water`, `--rgb-medium`) are left as they are.
 fn python_flags(message: &str) -> String {
     let mut out = String::with_capacity(message.len());

@@ -418,6 +418,37 @@ def test_animations_pose_the_scene_and_survive_pickling():
         spectra.load(fox, animation="Run", time=-1)
     with pytest.raises(TypeError, match="animation"):
         spectra.load(fox, animation=1.5)
+    # Python's spelling in the messages, not the CLI's.
+    with pytest.raises(ValueError, match=r"^[^-]*\btime -1: must be seconds"):
+        spectra.load(fox, time=-1)
+
+
+def test_an_int_animation_is_an_index_whatever_the_names(tmp_path):
+    """`animation=2` is the file's third animation even where another is named "2"; the str
+    "2" is that name (as `--animation 2` reads it), and a pickled scene keeps which."""
+    import json
+    import pickle
+    import shutil
+
+    src = ROOT / "crates" / "scene" / "tests" / "data" / "pose" / "Fox"
+    doc = json.loads((src / "Fox.gltf").read_text())
+    doc["animations"][0]["name"] = "2"
+    (tmp_path / "Fox.gltf").write_text(json.dumps(doc))
+    shutil.copy(src / "Fox.bin", tmp_path / "Fox.bin")
+    fox = str(tmp_path / "Fox.gltf")
+
+    def draw(scene):
+        return spectra.Renderer(scene, size=(48, 32)).render("rgb")
+
+    by_int = spectra.load(fox, animation=2, time=0.5)
+    by_name = spectra.load(fox, animation="2", time=0.5)
+    assert np.array_equal(draw(by_int), draw(spectra.load(fox, animation="Run", time=0.5)))
+    assert np.array_equal(draw(by_name), draw(spectra.load(fox, animation=0, time=0.5)))
+    assert not np.array_equal(draw(by_int), draw(by_name))
+    assert np.array_equal(draw(pickle.loads(pickle.dumps(by_int))), draw(by_int))
+    assert np.array_equal(draw(pickle.loads(pickle.dumps(by_name))), draw(by_name))
+    with pytest.raises(ValueError, match="animation 3: the file has no such animation"):
+        spectra.load(fox, animation=3)
 
 
 def test_env_sun_switch_is_the_clis_and_survives_pickling():

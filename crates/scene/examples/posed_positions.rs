@@ -12,7 +12,7 @@ fn main() -> ExitCode {
     let mut opts = scene::LoadOptions::default();
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--animation" => opts.animation = args.next(),
+            "--animation" => opts.animation = args.next().map(scene::AnimationRef::NameOrIndex),
             "--time" => match args.next().and_then(|t| t.parse().ok()) {
                 Some(t) => opts.time = Some(t),
                 None => {

@@ -51,13 +51,22 @@ pub struct LoadOptions {
     /// The `KHR_materials_variants` variant to draw, by name (`--variant`); `None`: the
     /// primitives' own materials. A name the file does not have is an error listing those it has.
     pub variant: Option<String>,
-    /// The animation to pose the scene by (`--animation`): its name, or its index when no
-    /// animation has that name. `None` with a [`time`](Self::time): the first animation.
-    pub animation: Option<String>,
+    /// The animation to pose the scene by (`--animation`). `None` with a
+    /// [`time`](Self::time): the first animation.
+    pub animation: Option<AnimationRef>,
     /// The moment of the animation, in seconds (`--time`, default 0 when an animation is
     /// named). Without either, the scene is drawn at rest: its nodes' own transforms and morph
     /// weights, skins applied.
     pub time: Option<f64>,
+}
+
+/// An animation of a file, as a user names it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum AnimationRef {
+    /// As `--animation` reads it: a name (exactly, then in any case), else an index.
+    NameOrIndex(String),
+    /// Its index in the file's `animations` (Python's `animation=2`), whatever the names.
+    Index(usize),
 }
 
 /// Loads a glTF 2.0 file (`.gltf` with external or embedded buffers, or binary `.glb`).
@@ -197,7 +206,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
     warnings.extend(variants.unchosen_warning());
     let mut buffers = load_buffers(ctx, doc, blob.as_deref(), &raw)?;
     meshopt_decode::decode(ctx, &raw, &mut buffers)?;
-    let chosen = pose::choose(ctx, doc, opts.animation.as_deref(), opts.time, &mut warnings)?;
+    let chosen = pose::choose(ctx, doc, opts.animation.as_ref(), opts.time, &mut warnings)?;
     let pose = pose::Pose::new(ctx, doc, &buffers, chosen, &mut warnings)?;
     let mut choices: Vec<(String, String)> = Vec::new();
     if let Some(v) = variants.chosen {

@@ -49,7 +49,7 @@ pub use environment::{Environment, EnvironmentError};
 pub use error::{Result, SceneError};
 pub use export::write_gltf;
 pub use gltf_file::{
-    LoadOptions, MAX_EMISSIVE, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION,
+    AnimationRef, LoadOptions, MAX_EMISSIVE, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION,
     MAX_IMAGE_FILE_BYTES, MAX_LIGHT_INTENSITY, MAX_TRIANGLES, load, load_slice, load_slice_with, load_with,
 };
 

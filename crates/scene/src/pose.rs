@@ -14,6 +14,7 @@ use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::{Interpolation, Property};
 
+use crate::AnimationRef;
 use crate::accessors::{self, Expect};
 use crate::context::Ctx;
 use crate::error::SceneError;
@@ -78,7 +79,7 @@ fn names(doc: &gltf::Document) -> String {
 pub(crate) fn choose(
     ctx: &Ctx,
     doc: &gltf::Document,
-    animation: Option<&str>,
+    animation: Option<&AnimationRef>,
     time: Option<f64>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Chosen>, SceneError> {
@@ -100,16 +101,21 @@ pub(crate) fn choose(
         return Ok(None);
     }
     let flag = match (animation, time) {
-        (Some(a), _) => format!("--animation {a}"),
+        (Some(AnimationRef::NameOrIndex(a)), _) => format!("--animation {a}"),
+        (Some(AnimationRef::Index(i)), _) => format!("--animation {i}"),
         (None, Some(t)) => format!("--time {t}"),
         (None, None) => unreachable!(),
     };
     if count == 0 {
         return Err(ctx.invalid("animations", format!("{flag}: the file has no animations")));
     }
+    let no_such = || {
+        ctx.invalid("animations", format!("{flag}: the file has no such animation; it has {}", names(doc)))
+    };
     let index = match animation {
         None => 0,
-        Some(a) => {
+        Some(AnimationRef::Index(i)) => Some(*i).filter(|&i| i < count).ok_or_else(no_such)?,
+        Some(AnimationRef::NameOrIndex(a)) => {
             let all: Vec<gltf::Animation> = doc.animations().collect();
             all.iter()
                 .position(|x| x.name() == Some(a))

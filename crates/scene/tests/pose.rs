@@ -14,7 +14,11 @@ fn pose_dir() -> PathBuf {
 }
 
 fn load(path: &Path, animation: Option<&str>, time: Option<f64>) -> Result<scene::Scene, scene::SceneError> {
-    let opts = scene::LoadOptions { animation: animation.map(String::from), time, ..Default::default() };
+    let opts = scene::LoadOptions {
+        animation: animation.map(|a| scene::AnimationRef::NameOrIndex(a.into())),
+        time,
+        ..Default::default()
+    };
     scene::load_with(path, &opts)
 }
 

@@ -777,6 +777,10 @@ pub struct SceneFileArgs {
     /// (skins and morph weights applied).
     #[arg(long, value_name = "NAME|INDEX")]
     pub animation: Option<String>,
+    /// An animation by its index alone (the Python API's `animation=2`), which `animation`
+    /// would first look for among the names.
+    #[arg(skip)]
+    pub animation_index: Option<usize>,
     /// The moment of the animation, in seconds (default 0; alone, it poses the file's first
     /// animation). Animations hold their first and last keyframes outside their range.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
@@ -791,7 +795,7 @@ impl SceneFileArgs {
             if let Some(v) = &self.variant {
                 bail!("--variant {v}: material variants belong to glTF files; '{name}' is a built-in scene");
             }
-            if let Some(a) = &self.animation {
+            if let Some(a) = self.animation.clone().or(self.animation_index.map(|i| i.to_string())) {
                 bail!("--animation {a}: animations belong to glTF files; '{name}' is a built-in scene");
             }
             if let Some(t) = self.time {
@@ -801,7 +805,11 @@ impl SceneFileArgs {
         let opts = scene::LoadOptions {
             allow_outside_scene_dir: self.allow_outside_scene_dir,
             variant: self.variant.clone(),
-            animation: self.animation.clone(),
+            animation: match (&self.animation, self.animation_index) {
+                (_, Some(i)) => Some(scene::AnimationRef::Index(i)),
+                (Some(a), None) => Some(scene::AnimationRef::NameOrIndex(a.clone())),
+                (None, None) => None,
+            },
             time: self.time,
         };
         scene::load_any_with(name, &opts).with_context(|| format!("loading scene '{name}'"))
