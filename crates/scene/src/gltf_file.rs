@@ -157,6 +157,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
     gltf_ext::precheck(ctx, &raw)?;
     // KHR_animation_pointer's channels name no node, which the `gltf` crate's typed parse
     // requires of every channel: without them the rest of the file loads (they stay ignored).
+    pose::check_targets(ctx, &raw)?;
     let (mut root, blob) = match gltf_ext::without_pointer_channels(&raw) {
         Some(cleaned) => {
             let blob = if bytes.starts_with(b"glTF") {

@@ -133,6 +133,42 @@ pub(crate) fn choose(
     Ok(Some(Chosen { animation: index, time }))
 }
 
+/// Checks what the `gltf` crate's validation leaves to its accessors, which would panic: each
+/// animation channel's target node (an index of one of the file's nodes) and path (of the
+/// four glTF defines; `KHR_animation_pointer`'s "pointer" channels are removed before this).
+pub(crate) fn check_targets(ctx: &Ctx, raw: &serde_json::Value) -> Result<(), SceneError> {
+    let nodes = raw.get("nodes").and_then(serde_json::Value::as_array).map_or(0, Vec::len);
+    let Some(anims) = raw.get("animations").and_then(serde_json::Value::as_array) else { return Ok(()) };
+    for (a, anim) in anims.iter().enumerate() {
+        let Some(channels) = anim.get("channels").and_then(serde_json::Value::as_array) else { continue };
+        for (c, ch) in channels.iter().enumerate() {
+            let at = format!("animations[{a}].channels[{c}].target");
+            let node = ch.pointer("/target/node");
+            if let Some(n) = node
+                && n.as_u64().is_none_or(|n| n as usize >= nodes)
+            {
+                return Err(ctx.invalid(
+                    format!("{at}.node"),
+                    format!("{n} is not the index of one of the file's {nodes} nodes"),
+                ));
+            }
+            let path = ch.pointer("/target/path");
+            if node.is_some()
+                && !path
+                    .and_then(serde_json::Value::as_str)
+                    .is_some_and(|p| ["translation", "rotation", "scale", "weights"].contains(&p))
+            {
+                let shown = path.map_or("missing".to_string(), |p| p.to_string());
+                return Err(ctx.invalid(
+                    format!("{at}.path"),
+                    format!("{shown}: expected \"translation\", \"rotation\", \"scale\" or \"weights\""),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The posed scene graph: each node's local transform and morph weights.
 pub(crate) struct Pose {
     local: Vec<Mat4>,

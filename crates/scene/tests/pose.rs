@@ -200,6 +200,16 @@ fn bad_animation_and_skin_data_is_an_error_naming_the_field() {
             }),
             &["animations[0].samplers[0].input", "key times must increase, and key 4 does not"],
         ),
+        // Found by the fuzzer: the `gltf` crate validates neither a channel's node nor its path,
+        // and panicked on reading them.
+        (
+            Box::new(|d: &mut Value| d["animations"][0]["channels"][0]["target"]["node"] = json!(7)),
+            &["animations[0].channels[0].target.node", "7 is not the index of one of the file's 3 nodes"],
+        ),
+        (
+            Box::new(|d: &mut Value| d["animations"][0]["channels"][0]["target"]["path"] = json!("colour")),
+            &["animations[0].channels[0].target.path", "\"colour\": expected \"translation\""],
+        ),
         (
             Box::new(|d: &mut Value| d["skins"][0]["joints"] = json!([1])),
             &["JOINTS_0", "names joint 1, but the skin has 1 joints"],
