@@ -52,6 +52,7 @@ pub use gltf_file::{
     AnimationRef, LoadOptions, MAX_EMISSIVE, MAX_FILE_BYTES, MAX_IMAGE_DECODED_BYTES, MAX_IMAGE_DIMENSION,
     MAX_IMAGE_FILE_BYTES, MAX_LIGHT_INTENSITY, MAX_TRIANGLES, load, load_slice, load_slice_with, load_with,
 };
+pub use pose::MAX_TIME as MAX_ANIMATION_TIME;
 
 /// Loads a scene by built-in name (`cornell`, `colorchecker`, `metamerism`) or, when the
 /// argument ends in `.gltf` or `.glb` (any case), from that file.

@@ -94,6 +94,7 @@ fn the_table_states_the_bounds_the_code_enforces() {
     has("--env-intensity", format!("0–{:e}", scene::environment::MAX_INTENSITY));
     has("--env-rotation", format!("±{:e}", scene::environment::MAX_ROTATION_DEGREES));
     has("--env-sun-share", "(0, 1]".into());
+    has("--time", format!("0–{:e} s", scene::MAX_ANIMATION_TIME));
     has("--frames", format!("1–{}", crate::cmd::bench::MAX_FRAMES));
     has("--samples", format!("render: 1–{} frames", crate::cmd::render::MAX_SAMPLES));
     has("--warmup", format!("0–{}", crate::cmd::bench::MAX_FRAMES));
