@@ -33,6 +33,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_materials_diffuse_transmission",
     "EXT_texture_webp",
     "KHR_materials_variants",
+    "KHR_animation_pointer",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -71,10 +72,7 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
             "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
             "this renderer has no scattering inside a volume",
         ),
-        "KHR_animation_pointer" => (
-            "its animations of material, light and camera properties are ignored (nodes' animations are drawn)",
-            "",
-        ),
+        "KHR_node_visibility" => ("every node is drawn, hidden ones too", ""),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
         _ => ("it is ignored", ""),
     }

@@ -149,30 +149,22 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
     serde_json::from_slice(&json).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))
 }
 
-pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<Scene, SceneError> {
+/// The typed document of `raw` (the file's JSON, or it with animated values written in):
+/// without `KHR_animation_pointer`'s channels, which name no node (the `gltf` crate's typed parse
+/// requires one of every channel), with the WebP sources filled in, checked and validated.
+/// `file`: the file's bytes when `raw` is their JSON as written (the crate parses them itself).
+fn document_of(ctx: &Ctx, raw: &Value, file: Option<&[u8]>) -> Result<gltf::Document, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
-    // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
-    // problems (a wrong type in a sampler field) with a less helpful message.
-    let raw = raw_json(ctx, bytes)?;
-    gltf_ext::precheck(ctx, &raw)?;
-    // KHR_animation_pointer's channels name no node, which the `gltf` crate's typed parse
-    // requires of every channel: without them the rest of the file loads (they stay ignored).
-    pose::check_targets(ctx, &raw)?;
-    let (mut root, blob) = match gltf_ext::without_pointer_channels(&raw) {
+    let mut root: gltf::json::Root = match gltf_ext::without_pointer_channels(raw) {
         Some(cleaned) => {
-            let blob = if bytes.starts_with(b"glTF") {
-                gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.bin.map(|b| b.into_owned())
-            } else {
-                None
-            };
-            let root: gltf::json::Root =
-                serde_json::from_value(cleaned).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?;
-            (root, blob)
+            serde_json::from_value(cleaned).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?
         }
-        None => {
-            let g = gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_err)?;
-            (g.document.into_json(), g.blob)
-        }
+        None => match file {
+            Some(bytes) => {
+                gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_err)?.document.into_json()
+            }
+            None => serde_json::from_value(raw.clone()).map_err(|e| gltf_err(gltf::Error::Deserialize(e)))?,
+        },
     };
     // Checked by `gltf_ext::precheck` against what this loader implements; the crate's own check
     // only knows the extensions it parses itself.
@@ -200,7 +192,23 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
         }
     }
     precheck(ctx, &root)?;
-    let document = gltf::Document::from_json(root).map_err(gltf_err)?;
+    gltf::Document::from_json(root).map_err(gltf_err)
+}
+
+pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<Scene, SceneError> {
+    let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
+    // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
+    // problems (a wrong type in a sampler field) with a less helpful message.
+    let raw = raw_json(ctx, bytes)?;
+    gltf_ext::precheck(ctx, &raw)?;
+    // Animation targets the `gltf` crate reads unchecked (it would panic).
+    pose::check_targets(ctx, &raw)?;
+    let blob = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(bytes).map_err(gltf_err)?.bin.map(|b| b.into_owned())
+    } else {
+        None
+    };
+    let document = document_of(ctx, &raw, Some(bytes))?;
     let doc = &document;
     let mut warnings = gltf_ext::warnings(&raw);
     let variants = crate::variants::read(ctx, &raw, opts.variant.as_deref())?;
@@ -208,6 +216,20 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
     let mut buffers = load_buffers(ctx, doc, blob.as_deref(), &raw)?;
     meshopt_decode::decode(ctx, &raw, &mut buffers)?;
     let chosen = pose::choose(ctx, doc, opts.animation.as_ref(), opts.time, &mut warnings)?;
+    // KHR_animation_pointer: the chosen moment's values written into the document itself, which
+    // is then read as if the file held them (materials, lights, cameras, nodes, weights).
+    let patched = match chosen {
+        Some(c) => pose::pointer_values(ctx, doc, &raw, &buffers, c, &mut warnings)?,
+        None => None,
+    };
+    let (raw, document) = match patched {
+        Some(p) => {
+            let d = document_of(ctx, &p, None)?;
+            (p, d)
+        }
+        None => (raw, document),
+    };
+    let doc = &document;
     let pose = pose::Pose::new(ctx, doc, &buffers, chosen, &mut warnings)?;
     let mut choices: Vec<(String, String)> = Vec::new();
     if let Some(v) = variants.chosen {

@@ -169,6 +169,199 @@ pub(crate) fn check_targets(ctx: &Ctx, raw: &serde_json::Value) -> Result<(), Sc
     Ok(())
 }
 
+/// What a `KHR_animation_pointer` pointer animates, where the loader reads it: `Some(rotation)`
+/// (a unit quaternion, slerped) for the properties both renderers draw, `None` for the rest.
+fn drawn_pointer(tokens: &[String]) -> Option<bool> {
+    let t: Vec<&str> = tokens.iter().map(String::as_str).collect();
+    match t.as_slice() {
+        ["nodes", _, "rotation"] => Some(true),
+        ["nodes", _, "translation" | "scale" | "weights"] | ["meshes", _, "weights"] => Some(false),
+        ["materials", _, ..] | ["cameras", _, ..] => Some(false),
+        ["extensions", "KHR_lights_punctual", "lights", _, ..] => Some(false),
+        _ => None,
+    }
+}
+
+/// A JSON pointer's reference tokens (RFC 6901: `~1` is `/`, `~0` is `~`).
+fn pointer_tokens(p: &str) -> Option<Vec<String>> {
+    let rest = p.strip_prefix('/')?;
+    Some(rest.split('/').map(|t| t.replace("~1", "/").replace("~0", "~")).collect())
+}
+
+/// Sets the property `tokens` names in `doc` to `value`: the objects and arrays on the way must
+/// exist (a pointer names a property of the file, or one with a default in an object it has).
+fn set_pointer(
+    doc: &mut serde_json::Value,
+    tokens: &[String],
+    value: serde_json::Value,
+) -> Result<(), String> {
+    let (last, path) = tokens.split_last().ok_or("is empty")?;
+    let mut at = doc;
+    for (k, t) in path.iter().enumerate() {
+        let next = match at {
+            serde_json::Value::Object(o) => o.get_mut(t),
+            serde_json::Value::Array(a) => t.parse::<usize>().ok().and_then(|i| a.get_mut(i)),
+            _ => None,
+        };
+        at = next.ok_or_else(|| format!("names nothing in the file: no '/{}'", tokens[..=k].join("/")))?;
+    }
+    match at {
+        serde_json::Value::Object(o) => {
+            o.insert(last.clone(), value);
+            Ok(())
+        }
+        serde_json::Value::Array(a) => {
+            let slot = last
+                .parse::<usize>()
+                .ok()
+                .and_then(|i| a.get_mut(i))
+                .ok_or("names no element of its array")?;
+            *slot = value;
+            Ok(())
+        }
+        _ => Err("names a property inside a value that is not an object".into()),
+    }
+}
+
+/// `KHR_animation_pointer`: the chosen animation's pointer channels sampled at its time and
+/// written into a copy of the document, or `None` when it has none. Pointers the renderers do
+/// not read (other extensions, `extras`) are skipped with a warning.
+pub(crate) fn pointer_values(
+    ctx: &Ctx,
+    doc: &gltf::Document,
+    raw: &serde_json::Value,
+    buffers: &[Vec<u8>],
+    chosen: Chosen,
+    warnings: &mut Vec<String>,
+) -> Result<Option<serde_json::Value>, SceneError> {
+    let a = chosen.animation;
+    let Some(channels) =
+        raw.pointer(&format!("/animations/{a}/channels")).and_then(serde_json::Value::as_array)
+    else {
+        return Ok(None);
+    };
+    let anim = doc.animations().nth(a).expect("chosen is checked");
+    let samplers: Vec<gltf::animation::Sampler> = anim.samplers().collect();
+    let mut out: Option<serde_json::Value> = None;
+    let mut skipped = Vec::new();
+    for (c, ch) in channels.iter().enumerate() {
+        if ch.pointer("/target/node").is_some() {
+            continue;
+        }
+        let at = format!("animations[{a}].channels[{c}]");
+        let pat = format!("{at}.target.extensions.KHR_animation_pointer.pointer");
+        let Some(ext) = ch.pointer("/target/extensions/KHR_animation_pointer") else {
+            // Neither a node nor a pointer: an extension this loader does not know animates it.
+            skipped.push(format!("{at} (no node, no pointer)"));
+            continue;
+        };
+        let pointer = ext
+            .get("pointer")
+            .and_then(serde_json::Value::as_str)
+            .ok_or_else(|| ctx.invalid(&pat, "is missing or not a string"))?;
+        let tokens = pointer_tokens(pointer).ok_or_else(|| {
+            ctx.invalid(&pat, format!("'{pointer}' is not a JSON pointer (it starts with '/')"))
+        })?;
+        let Some(rotation) = drawn_pointer(&tokens) else {
+            skipped.push(format!("'{pointer}'"));
+            continue;
+        };
+        let sampler = ch
+            .get("sampler")
+            .and_then(serde_json::Value::as_u64)
+            .and_then(|s| samplers.get(s as usize))
+            .ok_or_else(|| {
+                ctx.invalid(
+                    format!("{at}.sampler"),
+                    format!("is not the index of one of the animation's {} samplers", samplers.len()),
+                )
+            })?;
+        let sat = format!("animations[{a}].samplers[{}]", sampler.index());
+        let k = pointer_keys(ctx, &sat, sampler, buffers)?;
+        let v = k.at(chosen.time, rotation && k.width == 4);
+        let output = sampler.output();
+        let integers = !output.normalized() && output.data_type() != F32;
+        let number = |x: f32| -> serde_json::Value {
+            if integers {
+                serde_json::Value::from(x.round() as i64)
+            } else {
+                serde_json::Value::from(f64::from(x))
+            }
+        };
+        let value = if k.width == 1 && !matches!(tokens.last().map(String::as_str), Some("weights")) {
+            number(v[0])
+        } else {
+            serde_json::Value::Array(v.iter().map(|&x| number(x)).collect())
+        };
+        if let [n, i, "translation" | "rotation" | "scale"] =
+            tokens.iter().map(String::as_str).collect::<Vec<_>>().as_slice()
+            && *n == "nodes"
+            && raw.pointer(&format!("/nodes/{i}/matrix")).is_some()
+        {
+            return Err(ctx.invalid(&pat, format!("'{pointer}' animates a node given by its matrix (glTF 2.0 §3.7.2.1: an animated node has TRS)")));
+        }
+        let doc_out = out.get_or_insert_with(|| raw.clone());
+        set_pointer(doc_out, &tokens, value).map_err(|m| ctx.invalid(&pat, format!("'{pointer}' {m}")))?;
+    }
+    if !skipped.is_empty() {
+        warnings.push(format!(
+            "KHR_animation_pointer: {} not drawn (neither renderer reads what {} point{} at); the rest of the animation is",
+            skipped.join(", "),
+            if skipped.len() == 1 { "it" } else { "they" },
+            if skipped.len() == 1 { "s" } else { "" }
+        ));
+    }
+    Ok(out)
+}
+
+/// A pointer channel's keys: any scalar or vector output (floats or integers, normalized or
+/// not), its width the output's components per key (a SCALAR output of n per key is an array
+/// of n, as morph weights are).
+fn pointer_keys(
+    ctx: &Ctx,
+    at: &str,
+    sampler: &gltf::animation::Sampler,
+    buffers: &[Vec<u8>],
+) -> Result<Keys, SceneError> {
+    const OUT: Expect = Expect {
+        dims: &[Dimensions::Scalar, Dimensions::Vec2, Dimensions::Vec3, Dimensions::Vec4],
+        types: &[F32, I8, U8, I16, U16, DataType::U32],
+        normalized: &[],
+    };
+    let input = sampler.input();
+    let in_at = format!("{at}.input");
+    accessors::check(ctx, &in_at, &input, &TIMES, buffers)?;
+    let times = accessors::read_f32(ctx, &in_at, &input, buffers)?;
+    if let Some(k) = times.iter().position(|t| !t.is_finite() || *t < 0.0) {
+        return Err(ctx.invalid(&in_at, format!("key time {k} is negative or not finite")));
+    }
+    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(ctx.invalid(&in_at, format!("key times must increase, and key {} does not", k + 1)));
+    }
+    let output = sampler.output();
+    let out_at = format!("{at}.output");
+    accessors::check(ctx, &out_at, &output, &OUT, buffers)?;
+    let interpolation = sampler.interpolation();
+    let per_key = times.len() * if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+    let m = output.dimensions().multiplicity();
+    let width = if m == 1 { output.count() / per_key } else { m };
+    if width == 0 || output.count() * m != per_key * width {
+        return Err(ctx.invalid(
+            &out_at,
+            format!(
+                "has {} elements for {} keys; expected a whole number of values per key",
+                output.count(),
+                times.len()
+            ),
+        ));
+    }
+    let values = accessors::read_f32(ctx, &out_at, &output, buffers)?;
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(ctx.invalid(&out_at, format!("value {} is not finite", k / width)));
+    }
+    Ok(Keys { times, values, width, interpolation })
+}
+
 /// The posed scene graph: each node's local transform and morph weights.
 pub(crate) struct Pose {
     local: Vec<Mat4>,
@@ -364,7 +557,15 @@ impl Pose {
             let anim = doc.animations().nth(ch.animation).expect("chosen is checked");
             // Each node's TRS, from its own (decomposed) transform, overridden by the channels.
             let mut trs: Vec<Option<(Vec3, Quat, Vec3)>> = vec![None; n];
+            // The animation's end: its last key over every sampler, the pointer channels' too.
             let mut end = 0.0f32;
+            for (k, sampler) in anim.samplers().enumerate() {
+                let input = sampler.input();
+                let at = format!("animations[{}].samplers[{k}].input", anim.index());
+                accessors::check(ctx, &at, &input, &TIMES, buffers)?;
+                let times = accessors::read_f32(ctx, &at, &input, buffers)?;
+                end = end.max(times.last().copied().filter(|t| t.is_finite()).unwrap_or(0.0));
+            }
             for channel in anim.channels() {
                 let target = channel.target();
                 let node = target.node();
@@ -390,7 +591,6 @@ impl Pose {
                     _ => 0,
                 };
                 let k = keys(ctx, &at, &channel.sampler(), property, targets, buffers)?;
-                end = end.max(*k.times.last().expect("an accessor has elements"));
                 let v = k.at(ch.time, property == Property::Rotation);
                 if property == Property::MorphTargetWeights {
                     weights[ni] = Some(v);

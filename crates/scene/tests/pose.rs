@@ -246,20 +246,176 @@ fn bad_animation_and_skin_data_is_an_error_naming_the_field() {
     }
 }
 
+/// A little scene for `KHR_animation_pointer`: a quad (mesh 0, one morph target lifting it by 1
+/// in z) at node 0, a camera at node 1, a point light at node 2, material 0 with a base colour
+/// and a `pbrMetallicRoughness` object; one animation over [0, 2] s whose channels are `pointers`
+/// (pointer, interpolation, VEC type, key values as floats), each sampler on the times 0, 2.
+fn pointer_scene(pointers: &[(&str, &str, &str, Vec<f32>)]) -> Value {
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut push = |data: &[f32], count: usize, ty: &str| {
+        let off = bytes.len();
+        bytes.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+        views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": data.len() * 4}));
+        accessors
+            .push(json!({"bufferView": views.len() - 1, "componentType": 5126, "count": count, "type": ty}));
+        accessors.len() - 1
+    };
+    let quad =
+        [-1.0f32, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0];
+    let pos = push(&quad, 6, "VEC3");
+    let lift: Vec<f32> = (0..6).flat_map(|_| [0.0, 0.0, 1.0]).collect();
+    let target = push(&lift, 6, "VEC3");
+    let times = push(&[0.0, 2.0], 2, "SCALAR");
+    let mut channels = Vec::new();
+    let mut samplers = Vec::new();
+    for (k, (pointer, interp, ty, values)) in pointers.iter().enumerate() {
+        let per: usize = match *ty {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            _ => 4,
+        };
+        let out = push(values, values.len() / per, ty);
+        samplers.push(json!({"input": times, "output": out, "interpolation": interp}));
+        channels.push(json!({"sampler": k, "target": {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": pointer}}}}));
+    }
+    let len = bytes.len();
+    accessors[pos]["min"] = json!([-1.0, -1.0, 0.0]);
+    accessors[pos]["max"] = json!([1.0, 1.0, 0.0]);
+    json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_animation_pointer", "KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [
+            {"mesh": 0},
+            {"camera": 0, "translation": [0.0, 0.0, 5.0]},
+            {"translation": [0.0, 2.0, 2.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.0, 0.0, 1.0]}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pos}, "material": 0, "targets": [{"POSITION": target}]}], "weights": [0.0]}],
+        "animations": [{"name": "pointers", "channels": channels, "samplers": samplers}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len, "uri": data_uri(&bytes)}]
+    })
+}
+
+fn load_doc(doc: &Value, time: Option<f64>) -> Result<scene::Scene, scene::SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("pointers.gltf");
+    std::fs::write(&file, doc.to_string()).unwrap();
+    load(&file, None, time)
+}
+
 #[test]
-fn pointer_animations_are_skipped_and_node_animations_drawn() {
-    // KHR_animation_pointer's channels name no node: the file loads (before, the whole file
-    // was refused: "missing field `node`"), its node channels pose it, the pointer ones are
-    // ignored with a warning.
+fn pointer_animations_set_materials_lights_cameras_and_weights() {
+    let doc = pointer_scene(&[
+        (
+            "/materials/0/pbrMetallicRoughness/baseColorFactor",
+            "LINEAR",
+            "VEC4",
+            vec![1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0],
+        ),
+        // Absent from the file but with a default (and its object present): created.
+        ("/materials/0/emissiveFactor", "LINEAR", "VEC3", vec![0.0, 0.0, 0.0, 0.0, 2.0, 0.0]),
+        ("/materials/0/pbrMetallicRoughness/roughnessFactor", "STEP", "SCALAR", vec![0.25, 0.75]),
+        ("/extensions/KHR_lights_punctual/lights/0/intensity", "LINEAR", "SCALAR", vec![10.0, 30.0]),
+        ("/cameras/0/perspective/yfov", "LINEAR", "SCALAR", vec![0.8, 0.4]),
+        ("/meshes/0/weights", "LINEAR", "SCALAR", vec![0.0, 1.0]),
+        ("/nodes/0/rotation", "LINEAR", "VEC4", vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0]),
+    ]);
+    let rest = load_doc(&doc, None).unwrap();
+    assert_eq!(rest.materials[0].base_color.to_array(), [1.0, 0.0, 0.0, 1.0]);
+    assert_eq!(rest.camera.yfov, 0.8);
+    let s = load_doc(&doc, Some(1.0)).unwrap();
+    let m = &s.materials[0];
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-6;
+    assert!(
+        m.base_color.to_array().iter().zip([0.5, 0.0, 0.5, 1.0]).all(|(a, b)| close(*a, b)),
+        "{:?}",
+        m.base_color
+    );
+    assert!(close(m.emissive.y, 1.0) && close(m.emissive.x, 0.0), "{:?}", m.emissive);
+    assert_eq!(m.roughness, 0.25, "STEP holds the earlier key");
+    assert!(close(s.lights[0].emission.intensity, 20.0), "{:?}", s.lights[0].emission);
+    assert!(close(s.camera.yfov, 0.6), "{}", s.camera.yfov);
+    // Half the lift (weight 0.5) and a quarter turn about z (slerp halfway to 180°): the corner
+    // (1, −1, 0) goes to (1, −1, 0.5) turned by 90°, i.e. (1, 1, 0.5).
+    let c = corners(&s);
+    let tri = &c[0][0];
+    assert!(tri[1].distance(DVec3::new(1.0, 1.0, 0.5)) < 1e-5, "{:?}", tri);
+    assert!(s.warnings.iter().all(|w| !w.contains("KHR_animation_pointer")), "{:?}", s.warnings);
+    // Past the end, the last keys.
+    let late = load_doc(&doc, Some(5.0)).unwrap();
+    assert_eq!(late.materials[0].roughness, 0.75);
+    assert!(
+        late.warnings.iter().any(|w| w.contains("past the end of animation 0 'pointers' (2 s)")),
+        "{:?}",
+        late.warnings
+    );
+}
+
+#[test]
+fn pointers_nothing_reads_are_skipped_and_bad_ones_named() {
+    let doc = pointer_scene(&[
+        (
+            "/materials/0/pbrMetallicRoughness/baseColorFactor",
+            "LINEAR",
+            "VEC4",
+            vec![1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0],
+        ),
+        ("/extras/dial", "LINEAR", "SCALAR", vec![0.0, 1.0]),
+    ]);
+    let s = load_doc(&doc, Some(1.0)).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("KHR_animation_pointer: '/extras/dial' not drawn")),
+        "{:?}",
+        s.warnings
+    );
+    assert!((s.materials[0].base_color.x - 0.5).abs() < 1e-6);
+    let bad = |pointer: &str, parts: &[&str]| {
+        let doc = pointer_scene(&[(pointer, "LINEAR", "SCALAR", vec![0.0, 1.0])]);
+        let e = load_doc(&doc, Some(1.0)).unwrap_err().to_string();
+        assert!(
+            e.contains("animations[0].channels[0].target.extensions.KHR_animation_pointer.pointer"),
+            "{e}"
+        );
+        for p in parts {
+            assert!(e.contains(p), "{pointer}: error lacks '{p}': {e}");
+        }
+    };
+    bad("/materials/3/alphaCutoff", &["names nothing in the file: no '/materials/3'"]);
+    bad("materials/0/alphaCutoff", &["is not a JSON pointer"]);
+    // A value the material cannot have is the loader's own error, naming the field.
+    let doc = pointer_scene(&[(
+        "/materials/0/pbrMetallicRoughness/roughnessFactor",
+        "LINEAR",
+        "SCALAR",
+        vec![0.0, 4.0],
+    )]);
+    let e = load_doc(&doc, Some(1.0)).unwrap_err().to_string();
+    assert!(e.contains("roughnessFactor"), "{e}");
+}
+
+#[test]
+fn pointer_channels_beside_node_channels_leave_the_nodes_to_them() {
+    // KHR_animation_pointer's channels name no node (a file using them was refused before this
+    // loader read them: "missing field `node`"); with one beside SimpleSkin's node channel, the
+    // skin is posed as without it.
     let (_dir, file) = edited_skin(|d| {
         d["animations"][0]["channels"].as_array_mut().unwrap().push(json!({
             "sampler": 0,
-            "target": {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": "/materials/0/alphaCutoff"}}}
+            "target": {"path": "pointer", "extensions": {"KHR_animation_pointer": {"pointer": "/extras/spin"}}}
         }));
         d["extensionsUsed"] = json!(["KHR_animation_pointer"]);
     });
     let s = load(&file, None, Some(1.25)).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("KHR_animation_pointer")), "{:?}", s.warnings);
+    assert!(s.warnings.iter().any(|w| w.contains("'/extras/spin' not drawn")), "{:?}", s.warnings);
     let plain = load(&pose_dir().join("SimpleSkin/SimpleSkin.gltf"), None, Some(1.25)).unwrap();
     assert_eq!(corners(&s), corners(&plain));
 }
