@@ -314,6 +314,26 @@ pub(crate) fn pointer_values(
     Ok(out)
 }
 
+/// A sampler's key times, checked: finite, not negative, increasing.
+fn key_times(
+    ctx: &Ctx,
+    at: &str,
+    sampler: &gltf::animation::Sampler,
+    buffers: &[Vec<u8>],
+) -> Result<Vec<f32>, SceneError> {
+    let input = sampler.input();
+    let in_at = format!("{at}.input");
+    accessors::check(ctx, &in_at, &input, &TIMES, buffers)?;
+    let times = accessors::read_f32(ctx, &in_at, &input, buffers)?;
+    if let Some(k) = times.iter().position(|t| !t.is_finite() || *t < 0.0) {
+        return Err(ctx.invalid(&in_at, format!("key time {k} is negative or not finite")));
+    }
+    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(ctx.invalid(&in_at, format!("key times must increase, and key {} does not", k + 1)));
+    }
+    Ok(times)
+}
+
 /// A pointer channel's keys: any scalar or vector output (floats or integers, normalized or
 /// not), its width the output's components per key (a SCALAR output of n per key is an array
 /// of n, as morph weights are).
@@ -328,16 +348,7 @@ fn pointer_keys(
         types: &[F32, I8, U8, I16, U16, DataType::U32],
         normalized: &[],
     };
-    let input = sampler.input();
-    let in_at = format!("{at}.input");
-    accessors::check(ctx, &in_at, &input, &TIMES, buffers)?;
-    let times = accessors::read_f32(ctx, &in_at, &input, buffers)?;
-    if let Some(k) = times.iter().position(|t| !t.is_finite() || *t < 0.0) {
-        return Err(ctx.invalid(&in_at, format!("key time {k} is negative or not finite")));
-    }
-    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(ctx.invalid(&in_at, format!("key times must increase, and key {} does not", k + 1)));
-    }
+    let times = key_times(ctx, at, sampler, buffers)?;
     let output = sampler.output();
     let out_at = format!("{at}.output");
     accessors::check(ctx, &out_at, &output, &OUT, buffers)?;
@@ -473,16 +484,7 @@ fn keys(
     targets: usize,
     buffers: &[Vec<u8>],
 ) -> Result<Keys, SceneError> {
-    let input = sampler.input();
-    let in_at = format!("{at}.input");
-    accessors::check(ctx, &in_at, &input, &TIMES, buffers)?;
-    let times = accessors::read_f32(ctx, &in_at, &input, buffers)?;
-    if let Some(k) = times.iter().position(|t| !t.is_finite() || *t < 0.0) {
-        return Err(ctx.invalid(&in_at, format!("key time {k} is negative or not finite")));
-    }
-    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(ctx.invalid(&in_at, format!("key times must increase, and key {} does not", k + 1)));
-    }
+    let times = key_times(ctx, at, sampler, buffers)?;
     let (want, width) = match property {
         Property::Translation | Property::Scale => (&VEC3_OUT, 3),
         Property::Rotation => (&ROTATION_OUT, 4),
