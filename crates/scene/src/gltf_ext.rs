@@ -34,6 +34,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "EXT_texture_webp",
     "KHR_materials_variants",
     "KHR_animation_pointer",
+    "KHR_node_visibility",
 ];
 
 /// Extensions one renderer draws and the other ignores: a file may use them optionally (with a
@@ -72,9 +73,21 @@ fn unsupported(ext: &str) -> (&'static str, &'static str) {
             "the volume's scattering is ignored; it only absorbs (KHR_materials_volume)",
             "this renderer has no scattering inside a volume",
         ),
-        "KHR_node_visibility" => ("every node is drawn, hidden ones too", ""),
         "KHR_xmp_json_ld" | "KHR_xmp" => ("", ""),
         _ => ("it is ignored", ""),
+    }
+}
+
+/// `KHR_node_visibility`'s `visible` of node `ni` (default true; a value that is not a boolean
+/// is an error naming it).
+pub(crate) fn node_visible(ctx: &Ctx, raw: &Value, ni: usize) -> Result<bool, SceneError> {
+    match raw.pointer(&format!("/nodes/{ni}/extensions/KHR_node_visibility/visible")) {
+        None => Ok(true),
+        Some(Value::Bool(b)) => Ok(*b),
+        Some(v) => Err(ctx.invalid(
+            format!("nodes[{ni}].extensions.KHR_node_visibility.visible"),
+            format!("{v} is not true or false"),
+        )),
     }
 }
 

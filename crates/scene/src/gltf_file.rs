@@ -269,13 +269,15 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
     let mut lights = Vec::new();
     let mut camera = None;
     // Depth-first over the scene graph in file order; "first camera" means first in this order.
-    let mut stack: Vec<(gltf::Node, Mat4)> = gscene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    // (node, parent's world transform, whether the parents are visible: KHR_node_visibility)
+    let mut stack: Vec<(gltf::Node, Mat4, bool)> =
+        gscene.nodes().map(|n| (n, Mat4::IDENTITY, true)).collect();
     stack.reverse();
     let mut seen = vec![false; doc.nodes().len()];
     let mut first_mesh_of_node: HashMap<usize, usize> = HashMap::new();
     // (index in `lights`, glTF light index, node it stands in for)
     let mut stand_ins: Vec<(usize, usize, usize)> = Vec::new();
-    while let Some((node, parent)) = stack.pop() {
+    while let Some((node, parent, shown)) = stack.pop() {
         let at = format!("nodes[{}]", node.index());
         if std::mem::replace(&mut seen[node.index()], true) {
             return Err(ctx.invalid(at, "node is reached twice: the node hierarchy must be a tree"));
@@ -284,7 +286,10 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
         if !world.is_finite() {
             return Err(ctx.invalid(at, "transform is not finite"));
         }
-        if let Some(mesh) = node.mesh() {
+        // KHR_node_visibility: a hidden node hides its meshes and lights and its children's;
+        // cameras stay.
+        let visible = gltf_ext::node_visible(ctx, &raw, node.index())? && shown;
+        if let Some(mesh) = node.mesh().filter(|_| visible) {
             let weights = pose.morph_weights(ctx, &node, &mesh)?;
             let joints = node.skin().map(|skin| pose.joint_matrices(ctx, &skin, &buffers)).transpose()?;
             let deform = pose::Deform {
@@ -398,7 +403,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
             warnings.extend(warning);
             camera = Some((c, cam.index()));
         }
-        if let Some(light) = node.light() {
+        if let Some(light) = node.light().filter(|_| visible) {
             let (l, stand_in) = light_of(ctx, &light, &node, world)?;
             if let Some(n) = stand_in {
                 stand_ins.push((lights.len(), light.index(), n));
@@ -406,7 +411,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
             lights.push(l);
         }
         for child in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((child, world));
+            stack.push((child, world, visible));
         }
     }
     for (li, gl, node) in stand_ins {

@@ -176,6 +176,7 @@ fn drawn_pointer(tokens: &[String]) -> Option<bool> {
     match t.as_slice() {
         ["nodes", _, "rotation"] => Some(true),
         ["nodes", _, "translation" | "scale" | "weights"] | ["meshes", _, "weights"] => Some(false),
+        ["nodes", _, "extensions", "KHR_node_visibility", "visible"] => Some(false),
         ["materials", _, ..] | ["cameras", _, ..] => Some(false),
         ["extensions", "KHR_lights_punctual", "lights", _, ..] => Some(false),
         _ => None,
@@ -288,7 +289,11 @@ pub(crate) fn pointer_values(
                 serde_json::Value::from(f64::from(x))
             }
         };
-        let value = if k.width == 1 && !matches!(tokens.last().map(String::as_str), Some("weights")) {
+        let boolean = tokens.iter().any(|t| t == "KHR_node_visibility");
+        let value = if boolean {
+            // A bool property: unsigned bytes, 0 false and anything else true (STEP).
+            serde_json::Value::Bool(v[0] != 0.0)
+        } else if k.width == 1 && !matches!(tokens.last().map(String::as_str), Some("weights")) {
             number(v[0])
         } else {
             serde_json::Value::Array(v.iter().map(|&x| number(x)).collect())

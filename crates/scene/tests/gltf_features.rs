@@ -571,7 +571,7 @@ fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     // Draco used with an uncompressed fallback: drawn, with a warning.
     let mut d = base.clone();
     d["extensionsUsed"] =
-        json!(["KHR_draco_mesh_compression", "KHR_materials_volume_scatter", "KHR_node_visibility"]);
+        json!(["KHR_draco_mesh_compression", "KHR_materials_volume_scatter", "KHR_interactivity"]);
     d["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let s = load(&d).unwrap();

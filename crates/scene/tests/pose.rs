@@ -403,6 +403,45 @@ fn pointers_nothing_reads_are_skipped_and_bad_ones_named() {
 }
 
 #[test]
+fn hidden_nodes_hide_their_meshes_lights_and_children_but_not_cameras() {
+    // KHR_node_visibility: node 3 (hidden) holds the mesh's node 0 (visible itself); the light's
+    // node 2 is hidden; the camera's node 1 is under hidden node 3 too but still looks.
+    let mut doc = pointer_scene(&[(
+        "/nodes/3/extensions/KHR_node_visibility/visible",
+        "STEP",
+        "SCALAR",
+        vec![0.0, 1.0],
+    )]);
+    doc["nodes"][0]["extensions"] = json!({"KHR_node_visibility": {"visible": true}});
+    doc["nodes"][2]["extensions"]["KHR_node_visibility"] = json!({"visible": false});
+    doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"children": [0, 1], "extensions": {"KHR_node_visibility": {"visible": false}}}));
+    doc["scenes"][0]["nodes"] = json!([3, 2]);
+    doc["extensionsUsed"].as_array_mut().unwrap().push(json!("KHR_node_visibility"));
+    let at_rest = load_doc(&doc, None).unwrap();
+    assert!(at_rest.meshes.is_empty(), "the hidden parent hides its visible child's mesh");
+    assert!(at_rest.lights.is_empty(), "a hidden light gives no light");
+    assert!(
+        (at_rest.camera.transform.w_axis.truncate() + at_rest.origin.as_vec3())
+            .distance(glam::Vec3::new(0.0, 0.0, 5.0))
+            < 1e-5
+    );
+    assert!(at_rest.warnings.iter().any(|w| w.contains("no triangles to draw")), "{:?}", at_rest.warnings);
+    // Animated by KHR_animation_pointer (STEP): hidden until 2 s, shown from then on.
+    assert!(load_doc(&doc, Some(1.0)).unwrap().meshes.is_empty());
+    assert_eq!(load_doc(&doc, Some(2.0)).unwrap().meshes.len(), 1);
+    // Not a boolean: named.
+    doc["nodes"][0]["extensions"]["KHR_node_visibility"]["visible"] = json!(1);
+    let e = load_doc(&doc, None).unwrap_err().to_string();
+    assert!(
+        e.contains("nodes[0].extensions.KHR_node_visibility.visible") && e.contains("is not true or false"),
+        "{e}"
+    );
+}
+
+#[test]
 fn pointer_channels_beside_node_channels_leave_the_nodes_to_them() {
     // KHR_animation_pointer's channels name no node (a file using them was refused before this
     // loader read them: "missing field `node`"); with one beside SimpleSkin's node channel, the
