@@ -19,6 +19,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
+    "KHR_draco_mesh_compression",
     "KHR_materials_unlit",
     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_iridescence",
@@ -41,8 +42,6 @@ pub(crate) const SUPPORTED: &[&str] = &[
 /// warning saying which renderer ignores what) but not require them. None at present.
 const PARTLY_SUPPORTED: &[&str] = &[];
 
-pub(crate) const DECOMPRESS: &str =
-    "decompress the file first, e.g. `npx @gltf-transform/cli copy in.glb out.glb`";
 pub(crate) const KTX2: &str = "convert its KTX2 textures to PNG first, e.g. `npx @gltf-transform/cli ktxdecompress in.glb out.glb` (needs KTX-Software's `ktx` on the PATH)";
 pub(crate) const DDS: &str = "re-export the file with PNG or JPEG textures";
 
@@ -61,10 +60,6 @@ pub(crate) fn undecodable_image(bytes: &[u8]) -> Option<(&'static str, &'static 
 /// when the file requires it.
 fn unsupported(ext: &str) -> (&'static str, &'static str) {
     match ext {
-        "KHR_draco_mesh_compression" => (
-            "its Draco-compressed geometry is not decoded; the uncompressed copies in the file are drawn",
-            DECOMPRESS,
-        ),
         "KHR_texture_basisu" => {
             ("its KTX2/Basis textures are not decoded; the PNG/JPEG fallbacks are used", KTX2)
         }
@@ -178,27 +173,6 @@ pub(crate) fn warnings(raw: &Value) -> Vec<String> {
 pub(crate) fn precheck(ctx: &Ctx, raw: &Value) -> Result<(), SceneError> {
     check_required(ctx, raw)?;
     let arr = |k: &str| raw.get(k).and_then(Value::as_array).map(Vec::as_slice).unwrap_or_default();
-    let accessors = arr("accessors");
-    for (mi, m) in arr("meshes").iter().enumerate() {
-        for (pi, p) in m.get("primitives").and_then(Value::as_array).into_iter().flatten().enumerate() {
-            if p.pointer("/extensions/KHR_draco_mesh_compression").is_none() {
-                continue;
-            }
-            let mut used =
-                p.get("attributes").and_then(Value::as_object).into_iter().flat_map(|a| a.values());
-            let no_data = |v: &Value| {
-                v.as_u64()
-                    .and_then(|i| accessors.get(i as usize))
-                    .is_some_and(|a| a.get("bufferView").is_none() && a.get("sparse").is_none())
-            };
-            if used.any(no_data) || p.get("indices").is_some_and(no_data) {
-                return Err(ctx.invalid(
-                    format!("meshes[{mi}].primitives[{pi}]"),
-                    format!("its geometry is only Draco-compressed (KHR_draco_mesh_compression), which is not supported; {DECOMPRESS}"),
-                ));
-            }
-        }
-    }
     for (ti, t) in arr("textures").iter().enumerate() {
         if t.get("source").is_some() {
             continue;
@@ -306,15 +280,15 @@ mod tests {
     #[test]
     fn optional_extensions_warn_required_ones_refuse_with_advice() {
         let raw = json!({
-            "extensionsUsed": ["KHR_materials_volume_scatter", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld", "KHR_draco_mesh_compression"],
-            "extensionsRequired": ["KHR_draco_mesh_compression"],
+            "extensionsUsed": ["KHR_materials_volume_scatter", "KHR_materials_sheen", "KHR_texture_transform", "KHR_xmp_json_ld"],
+            "extensionsRequired": ["MSFT_texture_dds"],
         });
         let w = warnings(&raw);
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("KHR_materials_volume_scatter") && w[0].contains("ignored"), "{w:?}");
         let e = check_required(&Ctx::builtin("t"), &raw).unwrap_err().to_string();
-        assert!(e.contains("extensionsRequired[0]") && e.contains("KHR_draco_mesh_compression"), "{e}");
-        assert!(e.contains("@gltf-transform/cli copy"), "{e}");
+        assert!(e.contains("extensionsRequired[0]") && e.contains("MSFT_texture_dds"), "{e}");
+        assert!(e.contains("re-export the file with PNG or JPEG textures"), "{e}");
         // Sheen, anisotropy and diffuse transmission are read (the loader stores them for the
         // renderers): a file may require them.
         for ext in ["KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_diffuse_transmission"] {

@@ -15,7 +15,8 @@ use crate::primitive::Needs;
 use crate::spec_gloss;
 use crate::{
     AlphaMode, Camera, Emission, Filter, Light, LightKind, Material, Mesh, Sampler, Scene,
-    SpectralReflectance, Texture, TextureRef, Wrap, gltf_ext, instancing, meshopt_decode, primitive, uri,
+    SpectralReflectance, Texture, TextureRef, Wrap, draco, gltf_ext, instancing, meshopt_decode, primitive,
+    uri,
 };
 
 /// The most triangles a scene may have after instancing and node flattening: a small hostile
@@ -195,6 +196,14 @@ fn document_of(ctx: &Ctx, raw: &Value, file: Option<&[u8]>) -> Result<gltf::Docu
     gltf::Document::from_json(root).map_err(gltf_err)
 }
 
+/// The typed document of `raw` without the crate's validation, for reading its buffers only.
+fn unvalidated(ctx: &Ctx, raw: &Value) -> Result<gltf::Document, SceneError> {
+    let cleaned = gltf_ext::without_pointer_channels(raw);
+    let root: gltf::json::Root = serde_json::from_value(cleaned.unwrap_or_else(|| raw.clone()))
+        .map_err(|e| SceneError::Gltf { path: ctx.path.clone(), cause: gltf::Error::Deserialize(e) })?;
+    Ok(gltf::Document::from_json_without_validation(root))
+}
+
 pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<Scene, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
     // Our checks of the JSON first: the `gltf` crate's typed parse would reject some of the same
@@ -208,13 +217,31 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
     } else {
         None
     };
-    let document = document_of(ctx, &raw, Some(bytes))?;
+    // Draco-compressed accessors have no data until decoded, which the crate's validation
+    // refuses: such a file's buffers are read from the unchecked document, and the decoded one
+    // is validated.
+    let compressed = draco::used(&raw);
+    let document = if compressed { unvalidated(ctx, &raw)? } else { document_of(ctx, &raw, Some(bytes))? };
     let doc = &document;
     let mut warnings = gltf_ext::warnings(&raw);
     let variants = crate::variants::read(ctx, &raw, opts.variant.as_deref())?;
     warnings.extend(variants.unchosen_warning());
     let mut buffers = load_buffers(ctx, doc, blob.as_deref(), &raw)?;
     meshopt_decode::decode(ctx, &raw, &mut buffers)?;
+    // KHR_draco_mesh_compression: the decoded geometry in a buffer of its own, the document's
+    // accessors pointed at it.
+    let (raw, document) = match draco::decode(ctx, &raw, &mut buffers)? {
+        Some(decoded) => {
+            let d = document_of(ctx, &decoded, None)?;
+            (decoded, d)
+        }
+        None if compressed => {
+            let d = document_of(ctx, &raw, Some(bytes))?;
+            (raw, d)
+        }
+        None => (raw, document),
+    };
+    let doc = &document;
     let chosen = pose::choose(ctx, doc, opts.animation.as_ref(), opts.time, &mut warnings)?;
     // KHR_animation_pointer: the chosen moment's values written into the document itself, which
     // is then read as if the file held them (materials, lights, cameras, nodes, weights).

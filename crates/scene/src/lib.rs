@@ -11,6 +11,7 @@ pub mod builtin;
 pub mod clearcoat;
 mod context;
 pub mod diffuse_transmission;
+mod draco;
 pub mod emission;
 pub mod emitters;
 pub mod environment;
