@@ -384,3 +384,18 @@ fn corrupted_ktx2_images_never_panic() {
     eprintln!("{loaded} loaded, {refused} refused");
     assert!(refused > 0);
 }
+
+/// The fuzz corpus's KTX2 seed (`make_fixtures.py`) loads, so that the fuzzer's mutations start
+/// from a file that reaches the transcoder: both textures 8×8 from the one KTX2 image, the base
+/// colour use warned about (the image is linear data).
+#[test]
+fn the_fuzz_seed_loads() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/gltf/ktx2-basisu.glb");
+    let s = scene::load_slice("ktx2-basisu.glb", &std::fs::read(path).unwrap(), None).unwrap();
+    assert_eq!(
+        s.textures.iter().map(|t| (t.width, t.height, t.srgb)).collect::<Vec<_>>(),
+        [(8, 8, true), (8, 8, false)]
+    );
+    assert_eq!(s.textures[0].rgba8, s.textures[1].rgba8);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+}

@@ -54,3 +54,49 @@ def one_level(data: bytes, level: int) -> bytes:
 steel = (here / "steel_orm.ktx2").read_bytes()
 (here / "steel_orm_raw.ktx2").write_bytes(one_level(steel, 0))
 (here / "steel_orm_8x8.ktx2").write_bytes(one_level(steel, 5))
+
+
+def seed_glb(ktx2: bytes) -> bytes:
+    """The fuzz corpus's KTX2 seed: a textured triangle whose image, in the GLB's binary chunk, is
+    the 8×8 UASTC fixture, so that the fuzzer's byte mutations reach the KTX2 header and blocks."""
+    import json
+
+    geometry = struct.pack("<15f", 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1)
+    blob = geometry + ktx2
+    blob += b"\0" * (-len(blob) % 4)
+    doc = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_texture_basisu"],
+        "extensionsRequired": ["KHR_texture_basisu"],
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 1}}}
+        ],
+        "textures": [
+            {"extensions": {"KHR_texture_basisu": {"source": 0}}},
+            {"source": 1, "extensions": {"KHR_texture_basisu": {"source": 0}}},
+        ],
+        "images": [{"bufferView": 2, "mimeType": "image/ktx2"}, {"bufferView": 2, "mimeType": "image/ktx2"}],
+        "buffers": [{"byteLength": len(blob)}],
+        "bufferViews": [
+            {"buffer": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+            {"buffer": 0, "byteOffset": 60, "byteLength": len(ktx2)},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+        ],
+    }
+    j = json.dumps(doc, separators=(",", ":")).encode()
+    j += b" " * (-len(j) % 4)
+    total = 12 + 8 + len(j) + 8 + len(blob)
+    return (
+        b"glTF" + struct.pack("<II", 2, total) + struct.pack("<I", len(j)) + b"JSON" + j
+        + struct.pack("<I", len(blob)) + b"BIN\0" + blob
+    )
+
+
+(here / "../../../../fuzz/corpus/gltf/ktx2-basisu.glb").write_bytes(seed_glb((here / "steel_orm_8x8.ktx2").read_bytes()))
