@@ -140,15 +140,31 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         let stored = if scheme == 2 { unpacked } else { length };
         if stored != expected {
             return Err(format!(
-                "the KTX2 image's level 0 holds {stored} bytes of UASTC data; a {width}×{height} image \
-                 has {expected}"
+                "the KTX2 image's level 0 holds {stored} bytes of UASTC data; {width}×{height} texels \
+                 take {expected}"
             ));
         }
     }
-    if codec == "ETC1S" && scheme != 1 {
-        return Err(format!(
-            "the KTX2 image is ETC1S with supercompression scheme {scheme}; ETC1S is stored BasisLZ (1)"
-        ));
+    // The extension's rules: ETC1S is BasisLZ (1); UASTC is stored plain (0) or Zstandard (2).
+    match (codec, scheme) {
+        ("ETC1S", 1) | ("UASTC", 0 | 2) => {}
+        _ => {
+            return Err(format!(
+                "the KTX2 image is {codec} with supercompression scheme {scheme}; KHR_texture_basisu \
+                 allows BasisLZ (1) for ETC1S, none (0) or Zstandard (2) for UASTC"
+            ));
+        }
+    }
+    // The texels are used as stored: the extension allows no swizzle and only the glTF
+    // orientation, and a file that says otherwise would be drawn wrong without a word.
+    for (key, allowed) in [("KTXswizzle", "rgba"), ("KTXorientation", "rd")] {
+        if let Some(value) = key_value(bytes, key)
+            && value != allowed
+        {
+            return Err(format!(
+                "the KTX2 image's {key} is {value:?}; KHR_texture_basisu allows only {allowed:?} (or none)"
+            ));
+        }
     }
     if levels > 16 {
         return Err(format!("the KTX2 file claims {levels} mip levels; a 16384-texel side has at most 15"));
@@ -178,6 +194,26 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         _ => None,
     };
     Ok(Decoded { width, height, rgba8, declared_srgb })
+}
+
+/// The value of `key` in the KTX2 file's key/value data (without its terminating NUL), if the
+/// file has it; a malformed block reads as having none (the transcoder does not need it).
+fn key_value(bytes: &[u8], key: &str) -> Option<String> {
+    let (offset, length) = (u32_at(bytes, 56) as usize, u32_at(bytes, 60) as usize);
+    let mut kvd = bytes.get(offset..offset.checked_add(length)?)?;
+    while kvd.len() >= 4 {
+        let n = u32_at(kvd, 0) as usize;
+        let entry = kvd.get(4..4usize.checked_add(n)?)?;
+        if let Some(rest) = entry.strip_prefix(key.as_bytes())
+            && let Some(value) = rest.strip_prefix(b"\0")
+        {
+            let value = value.strip_suffix(b"\0").unwrap_or(value);
+            return Some(String::from_utf8_lossy(value).into_owned());
+        }
+        // Entries are padded to 4 bytes.
+        kvd = kvd.get((4 + n).next_multiple_of(4)..)?;
+    }
+    None
 }
 
 fn basisu_error(e: &basisu::Error) -> String {

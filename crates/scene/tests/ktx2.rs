@@ -285,6 +285,22 @@ fn patched(f: impl Fn(&mut Vec<u8>)) -> Vec<u8> {
     b
 }
 
+/// The 8×8 fixture with a key/value block holding `key` = `value`.
+fn with_key_value(key: &str, value: &str) -> Vec<u8> {
+    patched(|b| {
+        let mut entry = [key.as_bytes(), b"\0", value.as_bytes(), b"\0"].concat();
+        let at = b.len() as u32;
+        b.extend((entry.len() as u32).to_le_bytes());
+        while entry.len() % 4 != 0 {
+            entry.push(0);
+        }
+        b.extend(&entry);
+        let length = b.len() as u32 - at;
+        set_u32(b, 56, at);
+        set_u32(b, 60, length);
+    })
+}
+
 fn set_u32(b: &mut [u8], at: usize, v: u32) {
     b[at..at + 4].copy_from_slice(&v.to_le_bytes());
 }
@@ -327,7 +343,7 @@ fn hostile_ktx2_images_are_named_in_one_line() {
                 set_u32(b, 44, 2);
                 set_u64(b, 96, 1 << 40);
             }),
-            &["images[0]", "1099511627776 bytes of UASTC data", "has 64"],
+            &["images[0]", "1099511627776 bytes of UASTC data", "8×8 texels take 64"],
         ),
         (
             "a level beyond the file",
@@ -335,11 +351,27 @@ fn hostile_ktx2_images_are_named_in_one_line() {
             &["images[0]", "level 0", "lies outside"],
         ),
         ("an ASTC colour model", patched(|b| b[104 + 12] = 162), &["images[0]", "colour model is 162"]),
+        (
+            "UASTC under BasisLZ",
+            patched(|b| set_u32(b, 44, 1)),
+            &["images[0]", "UASTC with supercompression scheme 1", "allows"],
+        ),
+        (
+            "a swizzle",
+            with_key_value("KTXswizzle", "bgra"),
+            &["images[0]", "KTXswizzle is \"bgra\"", "\"rgba\""],
+        ),
+        ("flipped", with_key_value("KTXorientation", "ru"), &["images[0]", "KTXorientation is \"ru\""]),
     ];
     for (what, bytes, parts) in cases {
         let e = error(&with(&bytes));
         eprintln!("{what}: {e}");
         assert_has(&e, parts);
+    }
+
+    // The values the extension allows are accepted.
+    for (k, v) in [("KTXswizzle", "rgba"), ("KTXorientation", "rd")] {
+        load(&with(&with_key_value(k, v))).unwrap();
     }
 
     // The extension's image index.
