@@ -152,7 +152,7 @@ fn raw_json(ctx: &Ctx, bytes: &[u8]) -> Result<Value, SceneError> {
 
 /// The typed document of `raw` (the file's JSON, or it with animated values written in):
 /// without `KHR_animation_pointer`'s channels, which name no node (the `gltf` crate's typed parse
-/// requires one of every channel), with the WebP sources filled in, checked and validated.
+/// requires one of every channel), with the WebP and KTX2 sources filled in, checked and validated.
 /// `file`: the file's bytes when `raw` is their JSON as written (the crate parses them itself).
 fn document_of(ctx: &Ctx, raw: &Value, file: Option<&[u8]>) -> Result<gltf::Document, SceneError> {
     let gltf_err = |e| SceneError::Gltf { path: ctx.path.clone(), cause: e };
@@ -170,25 +170,36 @@ fn document_of(ctx: &Ctx, raw: &Value, file: Option<&[u8]>) -> Result<gltf::Docu
     // Checked by `gltf_ext::precheck` against what this loader implements; the crate's own check
     // only knows the extensions it parses itself.
     root.extensions_required.clear();
-    // EXT_texture_webp's image index is checked here, and a texture whose only image is its
-    // WebP one (no `source`, which the crate's validation requires) gets it as its source; the
-    // loader prefers the WebP image anyway (`Loader::texture_image`).
+    // The image extensions' indices are checked here, and a texture whose only images are in
+    // them (no `source`, which the crate's validation requires) gets the preferred one as its
+    // source; the loader prefers it anyway (`Loader::texture_image`).
     let images = root.images.len();
     for (i, t) in root.textures.iter_mut().enumerate() {
-        let Some(webp) = raw.pointer(&format!("/textures/{i}/extensions/EXT_texture_webp")) else { continue };
-        let at = format!("textures[{i}].extensions.EXT_texture_webp.source");
-        let w = match webp.get("source") {
-            Some(v) => match v.as_u64().filter(|&w| (w as usize) < images) {
-                Some(w) => w as u32,
+        let mut preferred = None;
+        for (ext, what) in gltf_ext::IMAGE_EXTENSIONS {
+            let Some(obj) = raw.pointer(&format!("/textures/{i}/extensions/{ext}")) else { continue };
+            let at = format!("textures[{i}].extensions.{ext}.source");
+            let w = match obj.get("source") {
+                Some(v) => match v.as_u64().filter(|&w| (w as usize) < images) {
+                    Some(w) => w as u32,
+                    None => {
+                        return Err(ctx.invalid(
+                            at,
+                            format!("{v} is not the index of one of the file's {images} images"),
+                        ));
+                    }
+                },
                 None => {
                     return Err(
-                        ctx.invalid(at, format!("{v} is not the index of one of the file's {images} images"))
+                        ctx.invalid(at, format!("is missing (the extension names its {what} image there)"))
                     );
                 }
-            },
-            None => return Err(ctx.invalid(at, "is missing (the extension names its WebP image there)")),
-        };
-        if raw.pointer(&format!("/textures/{i}/source")).is_none() {
+            };
+            preferred = preferred.or(Some(w));
+        }
+        if let Some(w) = preferred
+            && raw.pointer(&format!("/textures/{i}/source")).is_none()
+        {
             t.source = gltf::json::Index::new(w);
         }
     }
@@ -278,6 +289,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
         textures: Vec::new(),
         tex_map: HashMap::new(),
         images: HashMap::new(),
+        ktx2_srgb: HashMap::new(),
     };
     let mut materials = Vec::new();
     let mut needs = Vec::new();
@@ -873,6 +885,9 @@ struct Loader<'a> {
     tex_map: HashMap<(usize, bool), usize>,
     /// glTF image index → decoded RGBA8.
     images: HashMap<usize, (u32, u32, Vec<u8>)>,
+    /// glTF image index → whether a KTX2 image's data format descriptor says sRGB (true) or
+    /// linear (false); PNG and JPEG say nothing the loader reads.
+    ktx2_srgb: HashMap<usize, bool>,
 }
 
 fn wrap(w: gltf::texture::WrappingMode) -> Wrap {
@@ -1614,14 +1629,16 @@ impl Loader<'_> {
         Ok(())
     }
 
-    /// The image a texture shows: its `EXT_texture_webp` source where it has one (the extension
-    /// asks a client that decodes WebP to prefer it; `source`, if any, is the PNG/JPEG fallback
-    /// for others), else its `source`.
+    /// The image a texture shows: the first of [`gltf_ext::IMAGE_EXTENSIONS`] it has (each
+    /// extension asks a client that decodes its format to prefer it; `source`, if any, is the
+    /// PNG/JPEG fallback for others), else its `source`.
     fn texture_image(&self, t: &gltf::Texture) -> usize {
-        self.raw
-            .pointer(&format!("/textures/{}/extensions/EXT_texture_webp/source", t.index()))
-            .and_then(Value::as_u64)
-            // Checked against the images in `from_slice`.
+        gltf_ext::IMAGE_EXTENSIONS
+            .iter()
+            .find_map(|(ext, _)| {
+                self.raw.pointer(&format!("/textures/{}/extensions/{ext}/source", t.index()))?.as_u64()
+            })
+            // Checked against the images in `document_of`.
             .map_or_else(|| t.source().index(), |i| i as usize)
     }
 
@@ -1672,26 +1689,35 @@ impl Loader<'_> {
                     .ctx
                     .invalid(&iat, format!("is a {format} image, which is not supported; {advice}")));
             }
-            if image::guess_format(&bytes).ok() == Some(image::ImageFormat::Jpeg) && jpeg_truncated(&bytes) {
-                return Err(self.ctx.invalid(
-                    &iat,
-                    "the JPEG ends before its end-of-image marker (a truncated file; the decoder would \
+            if bytes.starts_with(crate::ktx2::MAGIC) {
+                let k = crate::ktx2::decode(&bytes).map_err(|e| self.ctx.invalid(&iat, e))?;
+                if let Some(declared) = k.declared_srgb {
+                    self.ktx2_srgb.insert(img.index(), declared);
+                }
+                self.images.insert(img.index(), (k.width, k.height, k.rgba8));
+            } else {
+                if image::guess_format(&bytes).ok() == Some(image::ImageFormat::Jpeg)
+                    && jpeg_truncated(&bytes)
+                {
+                    return Err(self.ctx.invalid(
+                        &iat,
+                        "the JPEG ends before its end-of-image marker (a truncated file; the decoder would \
                      fill the rest in grey)",
-                ));
-            }
-            let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
-                .with_guessed_format()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
-            // Checked against the header before any pixel buffer is allocated: a few bytes of
-            // PNG can claim 2³¹ × 2³¹ pixels.
-            let (w, h) = reader
-                .into_dimensions()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
-            if w > MAX_IMAGE_DIMENSION
-                || h > MAX_IMAGE_DIMENSION
-                || 4 * w as u64 * h as u64 > MAX_IMAGE_DECODED_BYTES
-            {
-                return Err(self.ctx.invalid(
+                    ));
+                }
+                let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+                    .with_guessed_format()
+                    .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+                // Checked against the header before any pixel buffer is allocated: a few bytes of
+                // PNG can claim 2³¹ × 2³¹ pixels.
+                let (w, h) = reader
+                    .into_dimensions()
+                    .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+                if w > MAX_IMAGE_DIMENSION
+                    || h > MAX_IMAGE_DIMENSION
+                    || 4 * w as u64 * h as u64 > MAX_IMAGE_DECODED_BYTES
+                {
+                    return Err(self.ctx.invalid(
                     &iat,
                     format!(
                         "the image is {w}×{h}; at most {MAX_IMAGE_DIMENSION} on a side and {} MiB decoded \
@@ -1699,21 +1725,34 @@ impl Loader<'_> {
                         MAX_IMAGE_DECODED_BYTES >> 20
                     ),
                 ));
+                }
+                let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
+                    .with_guessed_format()
+                    .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
+                let mut limits = image::Limits::default();
+                limits.max_image_width = Some(MAX_IMAGE_DIMENSION);
+                limits.max_image_height = Some(MAX_IMAGE_DIMENSION);
+                // Decoding may hold the image at 16 bits per channel before conversion.
+                limits.max_alloc = Some(2 * MAX_IMAGE_DECODED_BYTES);
+                reader.limits(limits);
+                let decoded = reader
+                    .decode()
+                    .map_err(|e| self.ctx.invalid(&iat, format!("cannot decode image: {e}")))?
+                    .into_rgba8();
+                self.images.insert(img.index(), (decoded.width(), decoded.height(), decoded.into_raw()));
             }
-            let mut reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
-                .with_guessed_format()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot read image: {e}")))?;
-            let mut limits = image::Limits::default();
-            limits.max_image_width = Some(MAX_IMAGE_DIMENSION);
-            limits.max_image_height = Some(MAX_IMAGE_DIMENSION);
-            // Decoding may hold the image at 16 bits per channel before conversion.
-            limits.max_alloc = Some(2 * MAX_IMAGE_DECODED_BYTES);
-            reader.limits(limits);
-            let decoded = reader
-                .decode()
-                .map_err(|e| self.ctx.invalid(&iat, format!("cannot decode image: {e}")))?
-                .into_rgba8();
-            self.images.insert(img.index(), (decoded.width(), decoded.height(), decoded.into_raw()));
+        }
+        // As for PNG, the use decides how the texels are read (the glTF rule: colour textures
+        // are sRGB, data textures linear); a KTX2 that declares the other transfer function is
+        // read the same way, with a word, since one of the two is wrong.
+        if let Some(&declared) = self.ktx2_srgb.get(&img.index())
+            && declared != srgb
+        {
+            let (says, read) = if declared { ("sRGB", "linear data") } else { ("linear", "sRGB colour") };
+            self.warnings.push(format!(
+                "{iat}: the KTX2 image declares a {says} transfer function but {at} uses it as {read}; \
+                 it is read as {read}"
+            ));
         }
         let (width, height, rgba8) = self.images[&img.index()].clone();
         let name = t.name().or(img.name()).map_or_else(|| format!("texture {}", t.index()), str::to_string);

@@ -23,6 +23,7 @@ pub mod framing;
 mod gltf_ext;
 mod gltf_file;
 mod instancing;
+mod ktx2;
 pub mod medium;
 mod meshopt_decode;
 mod pose;
