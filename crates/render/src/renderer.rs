@@ -705,11 +705,11 @@ impl Renderer {
         // in X, Y and Z), so its RGB image is no colour: a see-through layer, which reads the
         // opaque layer's image as its background (transmission.wgsl), reads the one a frame
         // with the display's weights drew just before.
-        if self.scene.as_ref().is_some_and(|s| s.has_transmission) {
-            if let Err(e) = self.render_frame(camera, &untimed, true) {
-                self.accumulating = accumulating;
-                return Err(e);
-            }
+        if self.scene.as_ref().is_some_and(|s| s.has_transmission)
+            && let Err(e) = self.render_frame(camera, &untimed, true)
+        {
+            self.accumulating = accumulating;
+            return Err(e);
         }
         self.capture_frame = true;
         let radiance = self.render_frame(camera, &untimed, true).and_then(|()| self.read_capture_buffer());

@@ -281,14 +281,14 @@ fn run_into(cfg: Config) -> Result<Results> {
     // The run writes many files into --out (the report, its charts, every case's images): an
     // input kept there could be one of them (a --table named mae.svg was replaced by the chart;
     // every other command refuses an output that is an input).
-    if let (Some(t), Ok(out)) = (cfg.table.as_deref(), cfg.out.canonicalize()) {
-        if t.canonicalize().is_ok_and(|t| t.starts_with(&out)) {
-            anyhow::bail!(
-                "--table {} lies in --out {}, whose files an evaluation writes; move the table or choose another --out",
-                t.display(),
-                cfg.out.display()
-            );
-        }
+    if let (Some(t), Ok(out)) = (cfg.table.as_deref(), cfg.out.canonicalize())
+        && t.canonicalize().is_ok_and(|t| t.starts_with(&out))
+    {
+        anyhow::bail!(
+            "--table {} lies in --out {}, whose files an evaluation writes; move the table or choose another --out",
+            t.display(),
+            cfg.out.display()
+        );
     }
     std::fs::create_dir_all(&cfg.out).with_context(|| format!("creating {}", cfg.out.display()))?;
     // An earlier run's results are replaced, but only once this run's inputs are all read, and
