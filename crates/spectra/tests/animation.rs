@@ -215,3 +215,63 @@ fn animation_options_are_checked() {
     assert!(!out.exists(), "nothing written");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `render --times`: a numbered sequence, each frame the image a single `--time` render of its
+/// moment makes (byte for byte), the running fox moving between frames; `--resume` draws only
+/// the frames that are missing.
+#[test]
+fn times_render_a_sequence_of_the_single_moments() {
+    let d = tmp("sequence");
+    let base = ["render", FOX, "--animation", "Run", "--size", "32x24"];
+    let pattern = d.join("run_%03d.png");
+    ok(&with(&base, &["--times", "0:0.5:0.25", "--out", s(&pattern)]));
+    let frame = |i: usize| std::fs::read(d.join(format!("run_{i:03}.png"))).unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["run_000.png", "run_001.png", "run_002.png"]);
+    for (i, t) in ["0", "0.25", "0.5"].iter().enumerate() {
+        let single = d.join(format!("single_{i}.png"));
+        ok(&with(&base, &["--time", t, "--out", s(&single)]));
+        assert!(std::fs::read(&single).unwrap() == frame(i), "frame {i} is not the render at {t} s");
+    }
+    assert!(frame(0) != frame(2), "the fox does not move between 0 and 0.5 s");
+    // An interrupted sequence's rerun: the frames there are kept, the missing one drawn.
+    std::fs::remove_file(d.join("run_001.png")).unwrap();
+    let before = std::fs::metadata(d.join("run_000.png")).unwrap().modified().unwrap();
+    let out = spectra(&with(&base, &["--times", "0:0.5:0.25", "--resume", "--out", s(&pattern)]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("2 already there kept, 1 drawn"), "{err}");
+    assert_eq!(std::fs::metadata(d.join("run_000.png")).unwrap().modified().unwrap(), before);
+    assert!(std::fs::read(d.join("single_1.png")).unwrap() == frame(1));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn times_are_checked() {
+    let d = tmp("times");
+    let out = d.join("f_%02d.png");
+    refused(&["render", FOX, "--times", "0:1", "--out", s(&out)], &["--times 0:1", "START:END:STEP"]);
+    refused(&["render", FOX, "--times", "0:1:0", "--out", s(&out)], &["the step 0 is not a positive"]);
+    refused(
+        &["render", FOX, "--times", "0:1:0.5", "--out", s(&d.join("f.png"))],
+        &["--out", "frame-number pattern"],
+    );
+    refused(&["render", "cornell", "--times", "0:1:0.5", "--out", s(&out)], &["built-in scene"]);
+    // The command line's own errors (clap's, status 2).
+    for (args, want) in [
+        (vec!["render", FOX, "--times", "0:1:0.5", "--time", "1", "--out", s(&out)], "cannot be used with"),
+        (vec!["render", FOX, "--resume", "--out", s(&out)], "--times"),
+    ] {
+        let o = spectra(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            o.status.code() == Some(2) && err.starts_with("error:") && err.contains(want),
+            "{args:?}: {err}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0, "nothing written");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -232,3 +232,33 @@ fn demo_leaves_its_folder_as_it_was() {
         assert_eq!(visible, expected, "left after Ctrl-C at {stage}: {left:?}; {stderr}");
     }
 }
+
+/// A sequence interrupted after some frames keeps them, each complete, says how many and how
+/// to draw the rest, and leaves no temporary file.
+#[test]
+fn render_sequence_keeps_its_finished_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../scene/tests/data/pose/Fox/Fox.gltf");
+    let pattern = dir.path().join("f_%04d.png");
+    let cmd = spectra(&[
+        "render",
+        fox,
+        "--animation",
+        "Run",
+        "--times",
+        "0:1000:0.05",
+        "--size",
+        "64x48",
+        "--out",
+        pattern.to_str().unwrap(),
+    ]);
+    let stderr = interrupt(cmd, Duration::from_secs(8), None, true);
+    let names = entries(dir.path());
+    assert!(!names.is_empty(), "no frame in 8 s: {stderr}");
+    assert!(names.iter().all(|n| n.starts_with("f_") && n.ends_with(".png") && n.len() == 10), "{names:?}");
+    assert!(stderr.contains(&format!("{} of 20001 frames written", names.len())), "{stderr}");
+    assert!(stderr.contains("--resume"), "{stderr}");
+    for n in names {
+        image::open(dir.path().join(&n)).unwrap_or_else(|e| panic!("{n}: {e}"));
+    }
+}

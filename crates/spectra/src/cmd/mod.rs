@@ -9,6 +9,7 @@ pub mod lut;
 pub mod merge;
 pub mod observers;
 pub mod render;
+pub mod sequence;
 pub mod setup;
 pub mod truth;
 pub mod truth_cache;

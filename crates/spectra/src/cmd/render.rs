@@ -1,6 +1,7 @@
 //! `spectra render`: one frame of the real-time renderer, headless, to PNG (tone-mapped) or
 //! EXR (linear HDR × 2^EV).
 
+use super::sequence;
 use super::setup::{LookArgs, SceneArgs, parse_size};
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
@@ -36,6 +37,17 @@ pub struct RenderArgs {
     /// samples the pixel centres once; at most 256.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
     pub samples: u32,
+    /// Render the glTF file's animation (`--animation`, default its first) as a sequence of
+    /// frames: START:END:STEP in seconds (END included when a step lands on it), or a list of
+    /// moments T1,T2,…. `--out` (and `--spectral-out`) then hold a frame number, %d or %0Nd,
+    /// e.g. `--out fox_%04d.png` (frames numbered from 0, as ffmpeg reads them). Each frame is
+    /// written when drawn; Ctrl-C keeps those finished. At most 100000 frames.
+    #[arg(long, value_name = "START:END:STEP|T1,T2,…", conflicts_with = "time")]
+    pub times: Option<String>,
+    /// With `--times`: skip the frames whose files already exist (an interrupted sequence's
+    /// rerun draws only the rest).
+    #[arg(long, requires = "times")]
+    pub resume: bool,
 }
 
 /// The most frames `--samples` averages.
@@ -131,31 +143,43 @@ pub fn warn_if_too_dim(scene: &scene::Scene, hdr: &[[f32; 4]]) {
     }
 }
 
-/// Renders the frame and writes `args.out`.
+/// Where one frame goes: `--out` and `--spectral-out`, or a sequence's frame of them.
+struct Outputs {
+    out: PathBuf,
+    spectral_out: Option<PathBuf>,
+}
+
+/// Renders the frame and writes its outputs; `first`: the renderer's warnings about the scene
+/// are printed (a sequence's later frames would repeat them).
+#[allow(clippy::too_many_arguments)]
 fn render_frame(
     r: &mut Renderer,
     args: &RenderArgs,
+    outputs: &Outputs,
     scene: &scene::Scene,
     settings: &RenderSettings,
     custom: Option<render::CustomShader>,
     format: OutFormat,
     (width, height): (u32, u32),
+    first: bool,
 ) -> Result<()> {
     // Before anything is allocated for the frame.
-    if let Some(sp) = &args.spectral_out {
+    if let Some(sp) = &outputs.spectral_out {
         r.check_spectral_capture(width, height, settings.wavelengths)
             .map_err(|e| anyhow!("--spectral-out {}: {e}", sp.display()))?;
     }
     r.set_scene(scene)?;
-    for w in r.scene_warnings() {
-        eprintln!("warning: {}: {w}", scene.source);
+    if first {
+        for w in r.scene_warnings() {
+            eprintln!("warning: {}: {w}", scene.source);
+        }
     }
     // The water's or the RGB medium's hooks.
     if let Some(c) = custom {
         r.set_custom_shader(c)?;
     }
     r.resize(width, height).map_err(|e| anyhow!("--size {width}x{height}: {e}"))?;
-    if args.spectral_out.is_some() {
+    if outputs.spectral_out.is_some() {
         r.set_spectral_capture(true);
     }
     // Encoding a large image takes seconds; Ctrl-C meanwhile must not be followed by a write.
@@ -168,7 +192,7 @@ fn render_frame(
     let k = settings.exposure_ev.exp2();
     // Linear outputs hold the HDR values themselves, so their clipping is worth a warning (a PNG
     // is tone mapped: a clipped pixel is white either way).
-    let linear_out = args.spectral_out.is_some() || matches!(format, OutFormat::Exr);
+    let linear_out = outputs.spectral_out.is_some() || matches!(format, OutFormat::Exr);
     let hdr = read_linear(r, samples)?;
     warn_if_too_dim(scene, &hdr);
     let clipped = if linear_out { render::passes::hdr_clipped(&hdr) } else { 0 };
@@ -187,7 +211,7 @@ fn render_frame(
     interrupted()?;
     let _hold = color::cancel::hold();
     let mut staged = Vec::new();
-    if let Some(sp) = &args.spectral_out {
+    if let Some(sp) = &outputs.spectral_out {
         let cap = r.read_spectral_capture()?;
         let rgb = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let rgb = compare::image::Image::new(width, height, rgb)?;
@@ -216,18 +240,45 @@ fn render_frame(
         OutFormat::Exr => {
             let data = hdr.iter().map(|p| [p[0], p[1], p[2]]).collect();
             let img = compare::image::Image::new(width, height, data)?;
-            compare::io::encode_image(&args.out, &img, Default::default())
-                .with_context(|| format!("writing {}", args.out.display()))?
+            compare::io::encode_image(&outputs.out, &img, Default::default())
+                .with_context(|| format!("writing {}", outputs.out.display()))?
         }
     };
-    staged.push(super::stage_output(&args.out, &bytes)?);
+    staged.push(super::stage_output(&outputs.out, &bytes)?);
     super::commit_outputs(staged)
+}
+
+/// The outputs of frame `index` of a sequence, or the single frame's (`times` is `None`).
+fn outputs(args: &RenderArgs, times: Option<&[f64]>, index: usize) -> Result<Outputs> {
+    if times.is_none() {
+        return Ok(Outputs { out: args.out.clone(), spectral_out: args.spectral_out.clone() });
+    }
+    Ok(Outputs {
+        out: sequence::frame_path("--out", &args.out, index)?,
+        spectral_out: args
+            .spectral_out
+            .as_deref()
+            .map(|sp| sequence::frame_path("--spectral-out", sp, index))
+            .transpose()?,
+    })
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let format = out_format(&args.out)?;
     let (width, height) = parse_size(&args.size)?;
-    super::check_output("--out", &args.out)?;
+    let times = args.times.as_deref().map(sequence::parse_times).transpose()?;
+    if times.is_some() {
+        let lower = args.scene.scene.to_ascii_lowercase();
+        if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+            bail!(
+                "--times {}: animations belong to glTF files; '{}' is a built-in scene",
+                args.times.as_deref().unwrap_or_default(),
+                args.scene.scene
+            );
+        }
+    }
+    let first = outputs(&args, times.as_deref(), 0)?;
+    super::check_output("--out", &first.out)?;
     if let Some(sp) = &args.spectral_out {
         if !sp.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
             bail!(
@@ -246,32 +297,46 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 "--spectral-out needs --mode spectral (or naive): --mode rgb shades in RGB and has no wavelengths to write"
             );
         }
-        super::check_output("--spectral-out", sp)?;
+        super::check_output("--spectral-out", first.spectral_out.as_deref().unwrap_or(sp))?;
     }
-    let scene = args.scene.load(args.look.water.water.as_deref())?;
+    let water_arg = args.look.water.water.as_deref();
+    let scene = match &times {
+        Some(t) => args.scene.load_at(water_arg, t[0], true)?,
+        None => args.scene.load(water_arg)?,
+    };
     let mut inputs = args.scene.input_files(&scene);
     inputs.extend(args.look.table.input_files());
     inputs.extend(args.look.rgb_medium.input_files());
     inputs.extend(super::setup::observer_input(args.look.spectrum.observer.as_deref()));
-    super::check_outputs(
-        &[("--out", Some(&args.out)), ("--spectral-out", args.spectral_out.as_deref())],
-        &inputs,
-    )?;
+    for i in 0..times.as_ref().map_or(1, Vec::len) {
+        let o = outputs(&args, times.as_deref(), i)?;
+        super::check_outputs(
+            &[("--out", Some(&o.out)), ("--spectral-out", o.spectral_out.as_deref())],
+            &inputs,
+        )?;
+    }
     let settings = args.look.settings(&scene, !args.no_shadows, false)?;
     let table = args.look.table.load()?;
     let media = args.look.media(&scene, &table)?;
-    let custom = media.shader()?;
-    let water = media.water;
     let mut r = Renderer::with_table(table)?;
-    let frame = render_frame(&mut r, &args, &scene, &settings, custom, format, (width, height));
-    if let Err(e) = frame {
-        if color::cancel::is_cancelled() {
-            // Dropping the device waits for the frame in flight (28 s at 4096² on lavapipe):
-            // the process is about to exit, so let the OS reclaim it instead.
-            std::mem::forget(r);
+    let size = (width, height);
+    let frames = match &times {
+        None => render_frame(&mut r, &args, &first, &scene, &settings, media.shader()?, format, size, true)
+            .map(|()| String::new()),
+        Some(times) => render_sequence(&mut r, &args, times, &scene, &settings, &media, format, size),
+    };
+    let frames = match frames {
+        Ok(f) => f,
+        Err(e) => {
+            if color::cancel::is_cancelled() {
+                // Dropping the device waits for the frame in flight (28 s at 4096² on lavapipe):
+                // the process is about to exit, so let the OS reclaim it instead.
+                std::mem::forget(r);
+            }
+            return Err(e);
         }
-        return Err(e);
-    }
+    };
+    let water = media.water;
     let under = water.as_ref().map_or(String::new(), |m| {
         let ty = m.water_type.map_or("custom".to_string(), |t| t.to_string());
         format!(", under water {ty} at {} m", m.depth)
@@ -331,7 +396,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         _ => format!(" N={} {:.0}–{:.0} nm", settings.wavelengths, settings.range.min, settings.range.max),
     };
     eprintln!(
-        "{}: {} {}×{}, {}{spectrum}{under}, on {}",
+        "{}{frames}: {} {}×{}, {}{spectrum}{under}, on {}",
         args.out.display(),
         scene.source,
         width,
@@ -340,6 +405,75 @@ pub fn run(args: RenderArgs) -> Result<()> {
         r.gpu().describe()
     );
     Ok(())
+}
+
+/// Draws and writes each frame of `--times` in turn, the first from `first_scene`, the others
+/// from the file loaded again at their moment (the pose is made when a file is loaded); what
+/// the summary line adds (" (N frames …)").
+#[allow(clippy::too_many_arguments)]
+fn render_sequence(
+    r: &mut Renderer,
+    args: &RenderArgs,
+    times: &[f64],
+    first_scene: &scene::Scene,
+    settings: &RenderSettings,
+    media: &super::setup::RealtimeMedia,
+    format: OutFormat,
+    size: (u32, u32),
+) -> Result<String> {
+    let n = times.len();
+    let (mut written, mut kept) = (Vec::new(), 0usize);
+    let water_arg = args.look.water.water.as_deref();
+    for (i, &t) in times.iter().enumerate() {
+        let o = outputs(args, Some(times), i)?;
+        if args.resume && o.out.is_file() && o.spectral_out.as_deref().is_none_or(Path::is_file) {
+            kept += 1;
+            continue;
+        }
+        let first = written.is_empty();
+        let mut frame = || -> Result<()> {
+            let later;
+            let scene = if i == 0 {
+                first_scene
+            } else {
+                later = args.scene.load_at(water_arg, t, false)?;
+                &later
+            };
+            render_frame(r, args, &o, scene, settings, media.shader()?, format, size, first)
+        };
+        match frame() {
+            Ok(()) => {
+                eprintln!("{}: frame {}/{n} at {t} s", o.out.display(), i + 1);
+                written.push(o.out);
+            }
+            // Ctrl-C: what the frame in flight surfaced as matters less than what was kept.
+            Err(_) if color::cancel::is_cancelled() && !written.is_empty() => {
+                return Err(super::KeptOnInterrupt(format!(
+                    "{} of {n} frames written ({} … {}); rerun with --resume to draw the rest",
+                    written.len() + kept,
+                    written[0].display(),
+                    written[written.len() - 1].display()
+                ))
+                .into());
+            }
+            Err(e) => {
+                return Err(e.context(format!(
+                    "frame {i} at {t} s ({} of {n} frames written before it)",
+                    written.len() + kept
+                )));
+            }
+        }
+    }
+    Ok(format!(
+        " ({n} frames, {}–{} s{})",
+        times[0],
+        times[n - 1],
+        if kept > 0 {
+            format!("; {kept} already there kept, {} drawn", written.len())
+        } else {
+            String::new()
+        }
+    ))
 }
 
 #[cfg(test)]

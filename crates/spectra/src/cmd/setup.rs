@@ -63,6 +63,21 @@ impl SceneArgs {
         self.env.apply(&mut scene, water.is_some())?;
         Ok(scene)
     }
+
+    /// As [`Self::load`], posed at `time` (a sequence's frame); `say`: print the loader's
+    /// warnings and the environment's note (the first frame says what every frame would).
+    pub fn load_at(&self, water: Option<&str>, time: f64, say: bool) -> Result<scene::Scene> {
+        let mut files = self.files.clone();
+        files.time = Some(time);
+        let mut scene = files.load(&self.scene)?;
+        if say {
+            print_warnings(&scene);
+            self.env.apply(&mut scene, water.is_some())?;
+        } else {
+            self.env.choice(water.is_some()).apply(&mut scene)?;
+        }
+        Ok(scene)
+    }
 }
 
 /// What the picture looks like: shared by `spectra render` and `spectra view`.
@@ -845,16 +860,19 @@ pub struct EnvArgs {
 impl EnvArgs {
     /// Sets the scene's environment as asked; prints the note (default environment chosen) or
     /// warning (nothing lights the scene) on stderr.
-    pub fn apply(&self, scene: &mut scene::Scene, under_water: bool) -> Result<()> {
-        let choice = scene::environment::EnvironmentChoice {
+    pub fn choice(&self, under_water: bool) -> scene::environment::EnvironmentChoice {
+        scene::environment::EnvironmentChoice {
             env: self.env.clone(),
             intensity: self.env_intensity,
             rotation: self.env_rotation,
             no_sun: self.no_env_sun,
             sun_share: self.env_sun_share,
             under_water,
-        };
-        if let Some(note) = choice.apply(scene)? {
+        }
+    }
+
+    pub fn apply(&self, scene: &mut scene::Scene, under_water: bool) -> Result<()> {
+        if let Some(note) = self.choice(under_water).apply(scene)? {
             eprintln!("{note}");
         }
         Ok(())
