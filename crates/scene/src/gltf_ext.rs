@@ -19,6 +19,7 @@ pub(crate) const SUPPORTED: &[&str] = &[
     "KHR_mesh_quantization",
     "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
     "KHR_draco_mesh_compression",
     "KHR_materials_unlit",
     "KHR_materials_pbrSpecularGlossiness",

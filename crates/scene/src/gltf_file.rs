@@ -571,7 +571,7 @@ fn load_buffers(
         .map(|b| {
             let at = format!("buffers[{}]", b.index());
             if let Some(len) = meshopt_decode::fallback_len(raw, b.index()) {
-                // Filled by decoding the EXT_meshopt_compression views that point into it.
+                // Filled by decoding the meshopt-compressed views that point into it.
                 if len > meshopt_decode::MAX_FALLBACK_BYTES {
                     return Err(ctx.invalid(
                         format!("{at}.byteLength"),

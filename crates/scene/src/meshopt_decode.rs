@@ -1,5 +1,7 @@
-//! `EXT_meshopt_compression`: buffer views whose bytes are stored compressed in another buffer
-//! are decoded (with the `meshopt` crate, the reference decoder) into the place the view names,
+//! `EXT_meshopt_compression` and its Khronos successor `KHR_meshopt_compression` (the same
+//! bitstreams, plus the COLOR filter and version 1 of the attribute codec): buffer views whose
+//! bytes are stored compressed in another buffer are decoded (with the `meshopt` crate, the
+//! reference decoder, which reads both attribute codec versions) into the place the view names,
 //! before any accessor is read. The view's own buffer is usually a "fallback" buffer without
 //! data, which [`fallback_len`] makes the loader allocate instead of reading.
 //!
@@ -19,9 +21,13 @@ pub(crate) const MAX_FALLBACK_BYTES: u64 = 1 << 30;
 /// data of its own (its contents come from decoding).
 pub(crate) fn fallback_len(raw: &Value, i: usize) -> Option<u64> {
     let b = raw.get("buffers")?.get(i)?;
-    let fallback = b.pointer("/extensions/EXT_meshopt_compression/fallback").and_then(Value::as_bool);
+    let fallback =
+        NAMES.iter().find_map(|n| b.pointer(&format!("/extensions/{n}/fallback"))).and_then(Value::as_bool);
     (fallback == Some(true) && b.get("uri").is_none()).then(|| b.get("byteLength").and_then(Value::as_u64))?
 }
+
+/// The two extensions, the Khronos one first.
+const NAMES: [&str; 2] = ["KHR_meshopt_compression", "EXT_meshopt_compression"];
 
 #[derive(Clone)]
 struct Elem<const N: usize>([u8; N]);
@@ -110,6 +116,19 @@ fn filter(name: &str, data: &mut [u8], stride: usize) -> Option<()> {
             }
             put(data, &v, |x: i16| x.to_le_bytes().to_vec());
         }
+        ("COLOR", 4) => {
+            let mut v: Vec<[u8; 4]> = data.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+            meshopt::decode_filter_color(&mut v);
+            put(data, &v, |x: u8| vec![x]);
+        }
+        ("COLOR", 8) => {
+            let mut v: Vec<[u16; 4]> = data
+                .chunks_exact(8)
+                .map(|c| std::array::from_fn(|k| u16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
+                .collect();
+            meshopt::decode_filter_color(&mut v);
+            put(data, &v, |x: u16| x.to_le_bytes().to_vec());
+        }
         ("EXPONENTIAL", s) if s % 4 == 0 => {
             // Each 32-bit component is decoded on its own, so any stride is a run of [u32; 1].
             let mut v: Vec<[u32; 1]> =
@@ -126,8 +145,19 @@ fn filter(name: &str, data: &mut [u8], stride: usize) -> Option<()> {
 pub(crate) fn decode(ctx: &Ctx, raw: &Value, buffers: &mut [Vec<u8>]) -> Result<(), SceneError> {
     let Some(views) = raw.get("bufferViews").and_then(Value::as_array) else { return Ok(()) };
     for (vi, view) in views.iter().enumerate() {
-        let Some(ext) = view.pointer("/extensions/EXT_meshopt_compression") else { continue };
-        let at = format!("bufferViews[{vi}].extensions.EXT_meshopt_compression");
+        let found: Vec<(&str, &Value)> =
+            NAMES.iter().filter_map(|n| Some((*n, view.pointer(&format!("/extensions/{n}"))?))).collect();
+        let (name, ext) = match found[..] {
+            [] => continue,
+            [one] => one,
+            _ => {
+                return Err(ctx.invalid(
+                    format!("bufferViews[{vi}].extensions"),
+                    "has both KHR_meshopt_compression and EXT_meshopt_compression, which the extension forbids",
+                ));
+            }
+        };
+        let at = format!("bufferViews[{vi}].extensions.{name}");
         let uint = |obj: &Value, k: &str, default: Option<u64>, at: &str| -> Result<usize, SceneError> {
             match obj.get(k) {
                 None => {
@@ -203,11 +233,17 @@ pub(crate) fn decode(ctx: &Ctx, raw: &Value, buffers: &mut [Vec<u8>]) -> Result<
             }
         };
         if mode == "ATTRIBUTES" {
+            if filter_name == "COLOR" && name == "EXT_meshopt_compression" {
+                return Err(ctx.invalid(
+                    format!("{at}.filter"),
+                    "COLOR is a filter of KHR_meshopt_compression, not of EXT_meshopt_compression",
+                ));
+            }
             filter(filter_name, &mut data, stride).ok_or_else(|| {
                 ctx.invalid(
                     format!("{at}.filter"),
                     format!(
-                        "'{filter_name}' with byteStride {stride} is not supported (NONE; OCTAHEDRAL with 4 or 8; QUATERNION with 8; EXPONENTIAL with a multiple of 4)"
+                        "'{filter_name}' with byteStride {stride} is not supported (NONE; OCTAHEDRAL with 4 or 8; QUATERNION with 8; EXPONENTIAL with a multiple of 4; COLOR with 4 or 8)"
                     ),
                 )
             })?;
@@ -258,5 +294,9 @@ pub(crate) mod tests {
         let z = bytes[2] as i8 as f32 / 127.0;
         assert!((z - 1.0).abs() < 0.02, "{bytes:?}");
         assert!(filter("QUATERNION", &mut bytes, 4).is_none());
+        // COLOR decodes 4 components of 1 or 2 bytes, nothing else.
+        assert!(filter("COLOR", &mut [0u8; 12], 12).is_none());
+        assert!(filter("COLOR", &mut [0u8; 16], 16).is_none());
+        assert!(filter("COLOR", &mut [0u8; 8], 8).is_some());
     }
 }

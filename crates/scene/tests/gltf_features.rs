@@ -540,6 +540,74 @@ fn meshopt_compressed_views_are_decoded() {
     assert_has(&error(&bad), &["buffers[1].byteLength"]);
 }
 
+/// `KHR_meshopt_compression`: the Khronos extension reads as EXT_meshopt_compression does, and
+/// adds version 1 of the attribute codec and the COLOR filter (YCoCg), here on a COLOR_0 of
+/// normalized bytes; COLOR under the EXT name, or both names on one view, are errors.
+#[test]
+fn khr_meshopt_compression_adds_the_color_filter_and_codec_version_1() {
+    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let colors: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 1.0], [0.2, 0.6, 0.9, 0.5], [0.05, 0.95, 0.3, 0.0]];
+    let vbytes: Vec<[u8; 12]> = positions
+        .iter()
+        .map(|p| p.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>().try_into().unwrap())
+        .collect();
+    let venc = meshopt::encode_vertex_buffer_level(&vbytes, 2, Some(1)).unwrap();
+    assert_eq!(meshopt::decode_vertex_version(&venc), Some(1));
+    let cfilt: Vec<[u8; 4]> = meshopt::encode_filter_color(&colors, 8);
+    let cenc = meshopt::encode_vertex_buffer_level(&cfilt, 2, Some(1)).unwrap();
+    let mut compressed = venc.clone();
+    compressed.resize(compressed.len().div_ceil(4) * 4, 0);
+    let coff = compressed.len();
+    compressed.extend(&cenc);
+    let ext = "KHR_meshopt_compression";
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": [ext],
+        "extensionsRequired": [ext],
+        "buffers": [
+            {"byteLength": compressed.len(), "uri": data_uri("application/octet-stream", &compressed)},
+            {"byteLength": 36 + 12, "extensions": {ext: {"fallback": true}}},
+        ],
+        "bufferViews": [
+            {"buffer": 1, "byteOffset": 0, "byteLength": 36, "byteStride": 12,
+             "extensions": {ext: {"buffer": 0, "byteLength": venc.len(), "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}}},
+            {"buffer": 1, "byteOffset": 36, "byteLength": 12, "byteStride": 4,
+             "extensions": {ext: {"buffer": 0, "byteOffset": coff, "byteLength": cenc.len(), "byteStride": 4, "count": 3, "mode": "ATTRIBUTES", "filter": "COLOR"}}},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": F32, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": U8, "normalized": true, "count": 3, "type": "VEC4"},
+        ],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}}]}],
+        "scenes": [{"nodes": [0]}],
+    });
+    let s = load(&doc).unwrap();
+    let m = &s.meshes[0];
+    assert_eq!(m.positions, positions.map(Vec3::from));
+    for (got, want) in m.colors.iter().zip(colors) {
+        // 8-bit YCoCg: within two steps of a byte per channel.
+        assert!((*got - Vec4::from(want)).abs().max_element() <= 2.0 / 255.0, "{got} vs {want:?}");
+    }
+    // Without the filter the bytes are YCoCg, not the colours: the check above can fail.
+    let mut raw = doc.clone();
+    raw["bufferViews"][1]["extensions"][ext].as_object_mut().unwrap().remove("filter");
+    let unfiltered = load(&raw).unwrap();
+    assert!((unfiltered.meshes[0].colors[1] - Vec4::from(colors[1])).abs().max_element() > 0.05);
+
+    let mut bad = doc.clone();
+    let text = bad.to_string().replace(ext, "EXT_meshopt_compression");
+    bad = serde_json::from_str(&text).unwrap();
+    assert_has(
+        &error(&bad),
+        &["bufferViews[1].extensions.EXT_meshopt_compression.filter", "COLOR", "KHR_meshopt_compression"],
+    );
+    let mut bad = doc.clone();
+    let both = bad["bufferViews"][0]["extensions"][ext].clone();
+    bad["bufferViews"][0]["extensions"]["EXT_meshopt_compression"] = both;
+    assert_has(&error(&bad), &["bufferViews[0].extensions", "both"]);
+}
+
 #[test]
 fn unsupported_extensions_refuse_or_warn_with_what_to_do() {
     let mut b = Bin::default();
