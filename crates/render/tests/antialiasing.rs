@@ -50,6 +50,7 @@ fn scene() -> Scene {
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     }
 }
 

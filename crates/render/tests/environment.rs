@@ -253,6 +253,7 @@ fn an_emissive_quad_lights_the_floor_below_as_lamberts_formula_says() {
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     };
     let want = radiance as f64 * square_irradiance(0.5, 1.0) / std::f64::consts::PI;
     for (mode, shadows) in [(Mode::Rgb, false), (Mode::Spectral, false), (Mode::Spectral, true)] {

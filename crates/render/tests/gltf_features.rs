@@ -86,6 +86,7 @@ fn scene(meshes: Vec<Mesh>, materials: Vec<Material>, textures: Vec<Texture>, li
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     }
 }
 

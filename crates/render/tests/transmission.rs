@@ -45,6 +45,7 @@ fn scene(pane: Option<Material>, stripe: bool) -> Scene {
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     };
     let bg = Material {
         name: "background".into(),

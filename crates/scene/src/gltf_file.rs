@@ -253,7 +253,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
         None => (raw, document),
     };
     let doc = &document;
-    let chosen = pose::choose(ctx, doc, opts.animation.as_ref(), opts.time, &mut warnings)?;
+    let chosen = pose::choose(ctx, doc, opts.animation.as_ref(), opts.time, &buffers, &mut warnings)?;
     // KHR_animation_pointer: the chosen moment's values written into the document itself, which
     // is then read as if the file held them (materials, lights, cameras, nodes, weights).
     let patched = match chosen {
@@ -502,6 +502,7 @@ pub(crate) fn from_slice(ctx: &Ctx, bytes: &[u8], opts: &LoadOptions) -> Result<
         inputs: ctx.inputs.take(),
         input_stamps: ctx.stamps.take(),
         choices,
+        animation_end: pose.animation_end.map(f64::from),
         origin: glam::DVec3::ZERO,
     };
     if scene.water.is_some() && scene.medium.is_some() {

@@ -111,6 +111,9 @@ pub struct Scene {
     /// scene (a ground-truth record made at one moment of an animation must not merge with
     /// another's). Empty when nothing was chosen.
     pub choices: Vec<(String, String)>,
+    /// The end of the animation the scene was posed by (its last key, in seconds), `None` at
+    /// rest: what `render --times START:end:STEP` reads.
+    pub animation_end: Option<f64>,
 }
 
 impl Scene {
@@ -134,6 +137,7 @@ impl Scene {
             origin: glam::DVec3::ZERO,
             input_stamps: Vec::new(),
             choices: Vec::new(),
+            animation_end: None,
         }
     }
 

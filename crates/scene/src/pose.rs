@@ -65,8 +65,35 @@ fn animation_name(a: &gltf::Animation) -> String {
     }
 }
 
-fn names(doc: &gltf::Document) -> String {
-    let all: Vec<String> = doc.animations().map(|a| animation_name(&a)).collect();
+/// Seconds to the millisecond, without trailing zeros.
+fn seconds(t: f32) -> String {
+    let s = format!("{t:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// The end of `anim`: its last key over every sampler (the pointer channels' too).
+fn end_of(ctx: &Ctx, anim: &gltf::Animation, buffers: &[Vec<u8>]) -> Result<f32, SceneError> {
+    let mut end = 0.0f32;
+    for (k, sampler) in anim.samplers().enumerate() {
+        let input = sampler.input();
+        let at = format!("animations[{}].samplers[{k}].input", anim.index());
+        accessors::check(ctx, &at, &input, &TIMES, buffers)?;
+        let times = accessors::read_f32(ctx, &at, &input, buffers)?;
+        end = end.max(times.last().copied().filter(|t| t.is_finite()).unwrap_or(0.0));
+    }
+    Ok(end)
+}
+
+/// The file's animations as `--animation` names them, each with its length where its key times
+/// can be read (an animation not chosen is not otherwise checked): `0 'Survey' of 3.417 s`.
+fn names(ctx: &Ctx, doc: &gltf::Document, buffers: &[Vec<u8>]) -> String {
+    let all: Vec<String> = doc
+        .animations()
+        .map(|a| match end_of(ctx, &a, buffers) {
+            Ok(end) => format!("{} of {} s", animation_name(&a), seconds(end)),
+            Err(_) => animation_name(&a),
+        })
+        .collect();
     match all.split_last() {
         Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
         _ => all.join(""),
@@ -81,6 +108,7 @@ pub(crate) fn choose(
     doc: &gltf::Document,
     animation: Option<&AnimationRef>,
     time: Option<f64>,
+    buffers: &[Vec<u8>],
     warnings: &mut Vec<String>,
 ) -> Result<Option<Chosen>, SceneError> {
     let count = doc.animations().len();
@@ -95,7 +123,7 @@ pub(crate) fn choose(
             warnings.push(format!(
                 "the file has {count} animation{s} ({}); drawn at rest, as its nodes stand (choose one \
                  with --animation NAME and a moment with --time SECONDS)",
-                names(doc)
+                names(ctx, doc, buffers)
             ));
         }
         return Ok(None);
@@ -110,7 +138,10 @@ pub(crate) fn choose(
         return Err(ctx.invalid("animations", format!("{flag}: the file has no animations")));
     }
     let no_such = || {
-        ctx.invalid("animations", format!("{flag}: the file has no such animation; it has {}", names(doc)))
+        ctx.invalid(
+            "animations",
+            format!("{flag}: the file has no such animation; it has {}", names(ctx, doc, buffers)),
+        )
     };
     let index = match animation {
         None => 0,
@@ -124,7 +155,10 @@ pub(crate) fn choose(
                 .ok_or_else(|| {
                     ctx.invalid(
                         "animations",
-                        format!("{flag}: the file has no such animation; it has {}", names(doc)),
+                        format!(
+                            "{flag}: the file has no such animation; it has {}",
+                            names(ctx, doc, buffers)
+                        ),
                     )
                 })?
         }
@@ -380,6 +414,8 @@ fn pointer_keys(
 
 /// The posed scene graph: each node's local transform and morph weights.
 pub(crate) struct Pose {
+    /// The chosen animation's end ([`crate::Scene::animation_end`]).
+    pub(crate) animation_end: Option<f32>,
     local: Vec<Mat4>,
     world: Vec<Mat4>,
     /// Morph weights set by an animation or by `node.weights`; `None`: the mesh's own.
@@ -560,19 +596,13 @@ impl Pose {
                 weights[node.index()] = Some(w.to_vec());
             }
         }
+        let mut animation_end = None;
         if let Some(ch) = chosen {
             let anim = doc.animations().nth(ch.animation).expect("chosen is checked");
             // Each node's TRS, from its own (decomposed) transform, overridden by the channels.
             let mut trs: Vec<Option<(Vec3, Quat, Vec3)>> = vec![None; n];
-            // The animation's end: its last key over every sampler, the pointer channels' too.
-            let mut end = 0.0f32;
-            for (k, sampler) in anim.samplers().enumerate() {
-                let input = sampler.input();
-                let at = format!("animations[{}].samplers[{k}].input", anim.index());
-                accessors::check(ctx, &at, &input, &TIMES, buffers)?;
-                let times = accessors::read_f32(ctx, &at, &input, buffers)?;
-                end = end.max(times.last().copied().filter(|t| t.is_finite()).unwrap_or(0.0));
-            }
+            let end = end_of(ctx, &anim, buffers)?;
+            animation_end = Some(end);
             for channel in anim.channels() {
                 let target = channel.target();
                 let node = target.node();
@@ -663,7 +693,7 @@ impl Pose {
             }
         }
         let world: Vec<Mat4> = world.into_iter().map(|m| m.expect("every node is reached")).collect();
-        Ok(Pose { local, world, weights })
+        Ok(Pose { animation_end, local, world, weights })
     }
 
     /// Node `i`'s local transform in this pose.

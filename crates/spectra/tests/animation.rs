@@ -201,11 +201,15 @@ fn animation_options_are_checked() {
     );
     refused(
         &["render", FOX, "--animation", "Jump", "--out", o],
-        &["--animation Jump", "no such animation", "0 'Survey', 1 'Walk' and 2 'Run'"],
+        &[
+            "--animation Jump",
+            "no such animation",
+            "0 'Survey' of 3.417 s, 1 'Walk' of 0.708 s and 2 'Run' of 1.158 s",
+        ],
     );
     refused(
         &["render", FOX, "--animation", "3", "--out", o],
-        &["--animation 3", "0 'Survey', 1 'Walk' and 2 'Run'"],
+        &["--animation 3", "0 'Survey' of 3.417 s, 1 'Walk' of 0.708 s and 2 'Run' of 1.158 s"],
     );
     refused(
         &["truth", FOX, "--animation", "Run", "--time", "-1", "--out", o],
@@ -246,6 +250,23 @@ fn times_render_a_sequence_of_the_single_moments() {
     assert!(out.status.success() && err.contains("2 already there kept, 1 drawn"), "{err}");
     assert_eq!(std::fs::metadata(d.join("run_000.png")).unwrap().modified().unwrap(), before);
     assert!(std::fs::read(d.join("single_1.png")).unwrap() == frame(1));
+    // To the animation's end: Walk's last key is at 0.708 s, so 0.5, 0.6 and 0.7.
+    let walk = d.join("walk_%d.png");
+    let out = spectra(&[
+        "render",
+        FOX,
+        "--animation",
+        "Walk",
+        "--size",
+        "16x12",
+        "--times",
+        "0.5:end:0.1",
+        "--out",
+        s(&walk),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("(3 frames, 0.5–0.7 s)"), "{err}");
+    assert!(d.join("walk_2.png").is_file() && !d.join("walk_3.png").exists());
     let _ = std::fs::remove_dir_all(&d);
 }
 

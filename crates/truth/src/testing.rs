@@ -27,6 +27,7 @@ pub fn scene_with(meshes: Vec<Mesh>, materials: Vec<Material>, lights: Vec<Light
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     }
 }
 

@@ -178,6 +178,7 @@ impl Chart {
             origin: glam::DVec3::ZERO,
             input_stamps: vec![],
             choices: vec![],
+            animation_end: None,
         }
     }
 }
@@ -539,6 +540,7 @@ pub fn sphere_scene(material: Material, env: scene::Environment, rings: u32) -> 
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     }
 }
 

@@ -38,8 +38,8 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=MAX_SAMPLES as i64))]
     pub samples: u32,
     /// Render the glTF file's animation (`--animation`, default its first) as a sequence of
-    /// frames: START:END:STEP in seconds (END included when a step lands on it), or a list of
-    /// moments T1,T2,…. `--out` (and `--spectral-out`) then hold a frame number, %d or %0Nd,
+    /// frames: START:END:STEP in seconds (END included when a step lands on it; `end`: the
+    /// animation's last key, e.g. 0:end:0.04), or a list of moments T1,T2,…. `--out` (and `--spectral-out`) then hold a frame number, %d or %0Nd,
     /// e.g. `--out fox_%04d.png` (frames numbered from 0, as ffmpeg reads them). Each frame is
     /// written when drawn; Ctrl-C keeps those finished. At most 100000 frames.
     #[arg(long, value_name = "START:END:STEP|T1,T2,…", conflicts_with = "time")]
@@ -266,17 +266,30 @@ fn outputs(args: &RenderArgs, times: Option<&[f64]>, index: usize) -> Result<Out
 pub fn run(args: RenderArgs) -> Result<()> {
     let format = out_format(&args.out)?;
     let (width, height) = parse_size(&args.size)?;
-    let times = args.times.as_deref().map(sequence::parse_times).transpose()?;
-    if times.is_some() {
-        let lower = args.scene.scene.to_ascii_lowercase();
-        if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
-            bail!(
-                "--times {}: animations belong to glTF files; '{}' is a built-in scene",
-                args.times.as_deref().unwrap_or_default(),
-                args.scene.scene
-            );
+    let water_arg = args.look.water.water.as_deref();
+    // A range to the animation's end needs the file: it is loaded at the start first.
+    let mut loaded = None;
+    let times = match args.times.as_deref() {
+        None => None,
+        Some(arg) => {
+            let lower = args.scene.scene.to_ascii_lowercase();
+            if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+                bail!(
+                    "--times {arg}: animations belong to glTF files; '{}' is a built-in scene",
+                    args.scene.scene
+                );
+            }
+            let end = if sequence::needs_end(arg) {
+                let scene = args.scene.load_at(water_arg, sequence::start(arg)?, true)?;
+                let end = scene.animation_end;
+                loaded = Some(scene);
+                end
+            } else {
+                None
+            };
+            Some(sequence::parse_times(arg, end)?)
         }
-    }
+    };
     let first = outputs(&args, times.as_deref(), 0)?;
     super::check_output("--out", &first.out)?;
     if let Some(sp) = &args.spectral_out {
@@ -299,10 +312,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         super::check_output("--spectral-out", first.spectral_out.as_deref().unwrap_or(sp))?;
     }
-    let water_arg = args.look.water.water.as_deref();
-    let scene = match &times {
-        Some(t) => args.scene.load_at(water_arg, t[0], true)?,
-        None => args.scene.load(water_arg)?,
+    let scene = match (loaded, &times) {
+        (Some(scene), _) => scene,
+        (None, Some(t)) => args.scene.load_at(water_arg, t[0], true)?,
+        (None, None) => args.scene.load(water_arg)?,
     };
     let mut inputs = args.scene.input_files(&scene);
     inputs.extend(args.look.table.input_files());

@@ -8,10 +8,22 @@ use std::path::{Path, PathBuf};
 /// The most frames one `--times` asks for (an hour at 24 frames per second is 86 400).
 pub const MAX_FRAMES: usize = 100_000;
 
+/// Whether `--times` ends its range at the animation's end (`START:end:STEP`), which only the
+/// loaded file knows.
+pub fn needs_end(arg: &str) -> bool {
+    arg.split(':').nth(1).is_some_and(|e| e.trim().eq_ignore_ascii_case("end"))
+}
+
+/// The first moment `--times` names (what a range's `end` is looked up at).
+pub fn start(arg: &str) -> Result<f64> {
+    let first = arg.split([':', ',']).next().unwrap_or_default().trim();
+    first.parse().map_err(|_| anyhow::anyhow!("--times {arg}: '{first}' is not a number of seconds"))
+}
+
 /// The moments `--times` names: `START:END:STEP` (seconds; END included when a step lands on
-/// it, to a billionth of the step) or a comma list. Each within [0, the loader's largest
-/// animation time]; at most [`MAX_FRAMES`].
-pub fn parse_times(arg: &str) -> Result<Vec<f64>> {
+/// it, to a billionth of the step; `end`: `animation_end`, the chosen animation's last key) or
+/// a comma list. Each within [0, the loader's largest animation time]; at most [`MAX_FRAMES`].
+pub fn parse_times(arg: &str, animation_end: Option<f64>) -> Result<Vec<f64>> {
     let bad = |why: String| anyhow::anyhow!("--times {arg}: {why}");
     let number = |s: &str| -> Result<f64> {
         let v: f64 =
@@ -26,7 +38,13 @@ pub fn parse_times(arg: &str) -> Result<Vec<f64>> {
         let [a, b, s] = parts[..] else {
             return Err(bad("a range is START:END:STEP (seconds), e.g. 0:2:0.04".into()));
         };
-        let (a, b) = (number(a)?, number(b)?);
+        let a = number(a)?;
+        let b = if b.trim().eq_ignore_ascii_case("end") {
+            animation_end
+                .ok_or_else(|| bad("'end' is the end of the file's animation, and none is chosen".into()))?
+        } else {
+            number(b)?
+        };
         let step: f64 =
             s.trim().parse().map_err(|_| bad(format!("the step '{}' is not a number", s.trim())))?;
         if !(step.is_finite() && step > 0.0) {
@@ -39,8 +57,9 @@ pub fn parse_times(arg: &str) -> Result<Vec<f64>> {
         if steps + 1.0 > MAX_FRAMES as f64 {
             return Err(bad(format!("{} frames; at most {MAX_FRAMES}", steps + 1.0)));
         }
-        // Each moment from the start, not by adding steps: no drift over long sequences.
-        (0..=steps as usize).map(|i| (a + i as f64 * step).min(b)).collect()
+        // Each moment from the start, not by adding steps: no drift over long sequences; to the
+        // nanosecond, so that 0.1 × 3 reads 0.3 in names and messages.
+        (0..=steps as usize).map(|i| ((a + i as f64 * step) * 1e9).round() / 1e9).map(|t| t.min(b)).collect()
     } else {
         let list: Vec<&str> = arg.split(',').collect();
         if list.len() > MAX_FRAMES {
@@ -93,17 +112,26 @@ pub fn frame_path(flag: &str, pattern: &Path, index: usize) -> Result<PathBuf> {
 mod tests {
     use super::*;
 
+    fn parse_times_(arg: &str) -> Result<Vec<f64>> {
+        parse_times(arg, None)
+    }
+
     #[test]
     fn ranges_and_lists() {
-        assert_eq!(parse_times("0:1:0.25").unwrap(), [0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert_eq!(parse_times_("0:1:0.25").unwrap(), [0.0, 0.25, 0.5, 0.75, 1.0]);
         // The end is kept when a step lands on it despite rounding (0.1 × 30 is 3.0000000000000004).
-        let t = parse_times("0:3:0.1").unwrap();
+        let t = parse_times_("0:3:0.1").unwrap();
         assert_eq!(t.len(), 31);
         assert_eq!(*t.last().unwrap(), 3.0);
-        assert_eq!(parse_times("0.5:1.2:0.5").unwrap(), [0.5, 1.0]);
-        assert_eq!(parse_times("2:2:1").unwrap(), [2.0]);
-        assert_eq!(parse_times("0, 0.5,1.25").unwrap(), [0.0, 0.5, 1.25]);
-        assert_eq!(parse_times("3").unwrap(), [3.0]);
+        assert_eq!(parse_times_("0.5:1.2:0.5").unwrap(), [0.5, 1.0]);
+        assert_eq!(parse_times_("0:0.3:0.1").unwrap(), [0.0, 0.1, 0.2, 0.3]);
+        assert_eq!(parse_times_("2:2:1").unwrap(), [2.0]);
+        assert_eq!(parse_times_("0, 0.5,1.25").unwrap(), [0.0, 0.5, 1.25]);
+        assert_eq!(parse_times_("3").unwrap(), [3.0]);
+        assert!(needs_end("0.5:END:0.25") && !needs_end("0:1:0.5") && !needs_end("0,1"));
+        assert_eq!(start("0.5:end:0.25").unwrap(), 0.5);
+        assert_eq!(parse_times("0.5:end:0.25", Some(1.1)).unwrap(), [0.5, 0.75, 1.0]);
+        assert!(parse_times("2:end:0.25", Some(1.0)).unwrap_err().to_string().contains("comes before"));
         for (arg, want) in [
             ("1:0:0.1", "comes before"),
             ("0:1:0", "not a positive"),
@@ -116,8 +144,9 @@ mod tests {
             ("0:100000:0.5", "200001 frames; at most 100000"),
             ("0,x", "'x' is not a number"),
             ("inf", "inf s is outside 0"),
+            ("0:end:0.5", "none is chosen"),
         ] {
-            let e = parse_times(arg).unwrap_err().to_string();
+            let e = parse_times_(arg).unwrap_err().to_string();
             assert!(e.starts_with(&format!("--times {arg}: ")) && e.contains(want), "{arg}: {e}");
         }
     }

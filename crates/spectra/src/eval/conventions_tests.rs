@@ -68,6 +68,7 @@ fn scene(mesh: Mesh, white: &str) -> Scene {
         origin: glam::DVec3::ZERO,
         input_stamps: vec![],
         choices: vec![],
+        animation_end: None,
     }
 }
 
