@@ -296,3 +296,36 @@ fn times_are_checked() {
     assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0, "nothing written");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `truth --times`: each frame is the path tracer's render of its moment (the same pixels as a
+/// single `--time` render), the fox moving between them; `--resume` renders only the frames
+/// that are missing.
+#[test]
+fn truth_times_render_each_moment() {
+    let d = tmp("truth-sequence");
+    let base = ["truth", FOX, "--animation", "Run", "--size", "24x16", "--spp", "2"];
+    let pattern = d.join("t_%02d.exr");
+    ok(&with(&base, &["--times", "0:0.5:0.25", "--out", s(&pattern)]));
+    let frame = |i: usize| d.join(format!("t_{i:02}.exr"));
+    let max_delta_e = |a: &Path, b: &Path| {
+        let out = spectra(&["diff", s(a), s(b), "--json"]);
+        assert!(out.status.success(), "diff: {}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["delta_e2000"]["max"].as_f64().unwrap()
+    };
+    let single = d.join("single.exr");
+    ok(&with(&base, &["--time", "0.25", "--out", s(&single)]));
+    assert_eq!(max_delta_e(&frame(1), &single), 0.0, "frame 1 is not the render at 0.25 s");
+    assert!(mean_delta_e(&frame(0), &frame(2)) > 0.1, "the fox does not move between 0 and 0.5 s");
+    std::fs::remove_file(frame(1)).unwrap();
+    let out = spectra(&with(&base, &["--times", "0:0.5:0.25", "--resume", "--out", s(&pattern)]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("2 already there kept, 1 rendered"), "{err}");
+    assert_eq!(max_delta_e(&frame(1), &single), 0.0);
+    refused(&with(&base, &["--times", "0:1:0.5", "--out", s(&d.join("t.exr"))]), &["frame-number pattern"]);
+    refused(
+        &with(&base, &["--times", "0:1:0.5", "--export-mitsuba", s(&d.join("m"))]),
+        &["--export-mitsuba exports one moment"],
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -262,3 +262,30 @@ fn render_sequence_keeps_its_finished_frames() {
         image::open(dir.path().join(&n)).unwrap_or_else(|e| panic!("{n}: {e}"));
     }
 }
+
+/// A truth sequence interrupted inside its first frame keeps that frame's samples in its
+/// checkpoint and says so, with how many frames were written.
+#[test]
+fn truth_sequence_keeps_the_current_frames_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../scene/tests/data/pose/Fox/Fox.gltf");
+    let pattern = dir.path().join("t_%02d.exr");
+    let cmd = spectra(&[
+        "truth",
+        fox,
+        "--animation",
+        "Run",
+        "--times",
+        "0,0.5",
+        "--size",
+        "8x6",
+        "--spp",
+        "100000000",
+        "--out",
+        pattern.to_str().unwrap(),
+    ]);
+    let stderr = interrupt(cmd, Duration::from_secs(4), None, true);
+    assert!(stderr.contains("0 of 2 frames written; frame 0: "), "{stderr}");
+    assert!(stderr.contains("t_00.exr.checkpoint") && stderr.contains("--resume"), "{stderr}");
+    assert_eq!(entries(dir.path()), vec!["t_00.exr.checkpoint".to_string()]);
+}
