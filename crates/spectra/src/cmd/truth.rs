@@ -806,6 +806,85 @@ pub fn run(a: Args) -> Result<()> {
     Ok(())
 }
 
+/// `truth --times`: each frame a render of its own (`run` with its moment and output names),
+/// in order; `--resume` skips the frames whose output exists without a checkpoint beside it
+/// and continues the one with a checkpoint.
+fn run_sequence(a: Args, arg: &str) -> Result<()> {
+    use super::sequence;
+    let lower = a.scene.scene.to_ascii_lowercase();
+    if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+        bail!("--times {arg}: animations belong to glTF files; '{}' is a built-in scene", a.scene.scene);
+    }
+    if a.export_mitsuba.is_some() {
+        bail!("--export-mitsuba exports one moment: give --time instead of --times");
+    }
+    let Some(out) = a.out.clone() else {
+        bail!("--times needs --out with a frame number, e.g. --out run_%04d.exr");
+    };
+    let end = if sequence::needs_end(arg) {
+        a.scene.load_at(a.water.water.as_deref(), sequence::start(arg)?, false)?.animation_end
+    } else {
+        None
+    };
+    let times = sequence::parse_times(arg, end)?;
+    let n = times.len();
+    let frame = |i: usize| -> Result<(std::path::PathBuf, Option<std::path::PathBuf>)> {
+        Ok((
+            sequence::frame_path("--out", &out, i)?,
+            a.spectral_out.as_deref().map(|sp| sequence::frame_path("--spectral-out", sp, i)).transpose()?,
+        ))
+    };
+    // Every name is checked before the first frame is rendered.
+    for i in 0..n {
+        frame(i)?;
+    }
+    let (mut done, mut kept) = (0usize, 0usize);
+    for (i, &t) in times.iter().enumerate() {
+        let (o, sp) = frame(i)?;
+        let checkpoint = super::checkpoint::path_for(&o);
+        let resume = a.resume && checkpoint.exists();
+        if a.resume && !resume && o.is_file() && sp.as_deref().is_none_or(std::path::Path::is_file) {
+            kept += 1;
+            continue;
+        }
+        eprintln!("frame {}/{n} at {t} s: {}", i + 1, o.display());
+        let mut f = a.clone();
+        f.times = None;
+        f.out = Some(o.clone());
+        f.spectral_out = sp;
+        f.scene.files.time = Some(t);
+        f.resume = resume;
+        match run(f) {
+            Ok(()) => done += 1,
+            Err(e) if color::cancel::is_cancelled() => {
+                let this = match e.downcast_ref::<super::KeptOnInterrupt>() {
+                    Some(k) => format!("; frame {i}: {k}"),
+                    None => String::new(),
+                };
+                return Err(super::KeptOnInterrupt(format!(
+                    "{} of {n} frames written{this}; the same command with --resume goes on",
+                    done + kept
+                ))
+                .into());
+            }
+            Err(e) => {
+                return Err(e.context(format!(
+                    "frame {i} at {t} s ({} of {n} frames written before it)",
+                    done + kept
+                )));
+            }
+        }
+    }
+    eprintln!(
+        "{}: {n} frames, {}–{} s{}",
+        out.display(),
+        times[0],
+        times[n - 1],
+        if kept > 0 { format!(" ({kept} already there kept, {done} rendered)") } else { String::new() }
+    );
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -979,83 +1058,4 @@ mod tests {
             assert!(sky.eval(550.0) > 0.0);
         }
     }
-}
-
-/// `truth --times`: each frame a render of its own (`run` with its moment and output names),
-/// in order; `--resume` skips the frames whose output exists without a checkpoint beside it
-/// and continues the one with a checkpoint.
-fn run_sequence(a: Args, arg: &str) -> Result<()> {
-    use super::sequence;
-    let lower = a.scene.scene.to_ascii_lowercase();
-    if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
-        bail!("--times {arg}: animations belong to glTF files; '{}' is a built-in scene", a.scene.scene);
-    }
-    if a.export_mitsuba.is_some() {
-        bail!("--export-mitsuba exports one moment: give --time instead of --times");
-    }
-    let Some(out) = a.out.clone() else {
-        bail!("--times needs --out with a frame number, e.g. --out run_%04d.exr");
-    };
-    let end = if sequence::needs_end(arg) {
-        a.scene.load_at(a.water.water.as_deref(), sequence::start(arg)?, false)?.animation_end
-    } else {
-        None
-    };
-    let times = sequence::parse_times(arg, end)?;
-    let n = times.len();
-    let frame = |i: usize| -> Result<(std::path::PathBuf, Option<std::path::PathBuf>)> {
-        Ok((
-            sequence::frame_path("--out", &out, i)?,
-            a.spectral_out.as_deref().map(|sp| sequence::frame_path("--spectral-out", sp, i)).transpose()?,
-        ))
-    };
-    // Every name is checked before the first frame is rendered.
-    for i in 0..n {
-        frame(i)?;
-    }
-    let (mut done, mut kept) = (0usize, 0usize);
-    for (i, &t) in times.iter().enumerate() {
-        let (o, sp) = frame(i)?;
-        let checkpoint = super::checkpoint::path_for(&o);
-        let resume = a.resume && checkpoint.exists();
-        if a.resume && !resume && o.is_file() && sp.as_deref().is_none_or(std::path::Path::is_file) {
-            kept += 1;
-            continue;
-        }
-        eprintln!("frame {}/{n} at {t} s: {}", i + 1, o.display());
-        let mut f = a.clone();
-        f.times = None;
-        f.out = Some(o.clone());
-        f.spectral_out = sp;
-        f.scene.files.time = Some(t);
-        f.resume = resume;
-        match run(f) {
-            Ok(()) => done += 1,
-            Err(e) if color::cancel::is_cancelled() => {
-                let this = match e.downcast_ref::<super::KeptOnInterrupt>() {
-                    Some(k) => format!("; frame {i}: {k}"),
-                    None => String::new(),
-                };
-                return Err(super::KeptOnInterrupt(format!(
-                    "{} of {n} frames written{this}; the same command with --resume goes on",
-                    done + kept
-                ))
-                .into());
-            }
-            Err(e) => {
-                return Err(e.context(format!(
-                    "frame {i} at {t} s ({} of {n} frames written before it)",
-                    done + kept
-                )));
-            }
-        }
-    }
-    eprintln!(
-        "{}: {n} frames, {}–{} s{}",
-        out.display(),
-        times[0],
-        times[n - 1],
-        if kept > 0 { format!(" ({kept} already there kept, {done} rendered)") } else { String::new() }
-    );
-    Ok(())
 }
