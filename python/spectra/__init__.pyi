@@ -78,6 +78,9 @@ class Scene:
     @property
     def lights(self) -> int:
         """The number of lights (stand-ins included)."""
+    @property
+    def animation_end(self) -> Optional[float]:
+        """The end of the animation the scene is posed by (its last key, s); None at rest."""
 
 def load(
     path_or_builtin: _Path,

@@ -183,6 +183,13 @@ impl Scene {
         self.inner.lights.len()
     }
 
+    /// The end of the animation the scene is posed by (its last key, in seconds); `None` at
+    /// rest. A sequence is `[spectra.load(f, animation=a, time=t) for t in ...]` up to it.
+    #[getter]
+    fn animation_end(&self) -> Option<f64> {
+        self.inner.animation_end
+    }
+
     /// Pickled as `spectra.load` with the same arguments: unpickling loads the scene again (a
     /// file must be reachable at the same path there, e.g. on every node of a Ray cluster).
     fn __reduce__<'py>(

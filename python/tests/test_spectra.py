@@ -412,6 +412,7 @@ def test_animations_pose_the_scene_and_survive_pickling():
     moved = np.abs(a - r).max(axis=2) > 0.05
     assert moved.sum() > 30, f"the posed fox differs from the one at rest in {moved.sum()} pixels"
     assert np.array_equal(draw(pickle.loads(pickle.dumps(run))), a), "a pickled scene keeps its pose"
+    assert rest.animation_end is None and abs(run.animation_end - 1.1583333) < 1e-6, run.animation_end
     with pytest.raises(ValueError, match="0 'Survey' of 3.417 s, 1 'Walk' of 0.708 s and 2 'Run' of 1.158 s"):
         spectra.load(fox, animation="Jump")
     with pytest.raises(ValueError, match="time"):
