@@ -272,13 +272,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let times = match args.times.as_deref() {
         None => None,
         Some(arg) => {
-            let lower = args.scene.scene.to_ascii_lowercase();
-            if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
-                bail!(
-                    "--times {arg}: animations belong to glTF files; '{}' is a built-in scene",
-                    args.scene.scene
-                );
-            }
+            sequence::require_gltf(arg, &args.scene.scene)?;
             let end = if sequence::needs_end(arg) {
                 let scene = args.scene.load_at(water_arg, sequence::start(arg)?, true)?;
                 let end = scene.animation_end;

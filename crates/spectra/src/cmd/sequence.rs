@@ -8,6 +8,16 @@ use std::path::{Path, PathBuf};
 /// The most frames one `--times` asks for (an hour at 24 frames per second is 86 400).
 pub const MAX_FRAMES: usize = 100_000;
 
+/// Refuses `--times ARG` for a built-in scene (`scene`: the scene argument): only glTF files
+/// have animations. `render` and `truth` share it.
+pub fn require_gltf(arg: &str, scene: &str) -> Result<()> {
+    let lower = scene.to_ascii_lowercase();
+    if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+        bail!("--times {arg}: animations belong to glTF files; '{scene}' is a built-in scene");
+    }
+    Ok(())
+}
+
 /// Whether `--times` ends its range at the animation's end (`START:end:STEP`), which only the
 /// loaded file knows.
 pub fn needs_end(arg: &str) -> bool {

@@ -811,10 +811,7 @@ pub fn run(a: Args) -> Result<()> {
 /// and continues the one with a checkpoint.
 fn run_sequence(a: Args, arg: &str) -> Result<()> {
     use super::sequence;
-    let lower = a.scene.scene.to_ascii_lowercase();
-    if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
-        bail!("--times {arg}: animations belong to glTF files; '{}' is a built-in scene", a.scene.scene);
-    }
+    sequence::require_gltf(arg, &a.scene.scene)?;
     if a.export_mitsuba.is_some() {
         bail!("--export-mitsuba exports one moment: give --time instead of --times");
     }
